@@ -1,0 +1,41 @@
+"""The project's exception and warning types.
+
+Every error that grainview or the solver raises on purpose is a :class:`GrainviewError`, so a
+caller can catch them all at once; each also derives from the matching built-in type
+(``ValueError``, ``OSError``) so that generic handlers keep working.
+"""
+
+from __future__ import annotations
+
+
+class GrainviewError(Exception):
+    """Base class of every error raised on purpose by grainview and the solver."""
+
+
+class SchemaError(GrainviewError, ValueError):
+    """A dataset or file does not follow the grainview data contract (docs/schema.md).
+
+    ``problems`` holds one line per problem found; the message lists them all, so a user
+    sees everything wrong with a file at once rather than one problem per attempt.
+    """
+
+    def __init__(self, problems, source: str | None = None):
+        if isinstance(problems, str):
+            problems = [problems]
+        self.problems = list(problems)
+        self.source = source
+        where = f" in {source}" if source else ""
+        head = f"{len(self.problems)} problem(s) with the grainview data contract{where}:"
+        super().__init__("\n  - ".join([head, *self.problems]))
+
+
+class FileFormatError(GrainviewError, OSError):
+    """A path cannot be read as a grainview netCDF file (missing, not netCDF, truncated)."""
+
+
+class ParameterError(GrainviewError, ValueError):
+    """A parameter passed by the user is out of range or of the wrong form."""
+
+
+class ConvergenceWarning(UserWarning):
+    """The contact solver stopped at its iteration limit before reaching its tolerance."""

@@ -1,0 +1,75 @@
+"""Stress of the packing: the tensor, p, q, q/p, principal direction, and the partial
+stresses of simple and double contacts (paper Eqs. M and sigmasd; ERRATA item 1).
+
+By default the stress includes the particle–wall contacts: with them the sum over contacts
+equals the sum of the particles' tensorial moments exactly (see
+:func:`grainview.arrays.stress.stress_tensor`), i.e. the stress the walls apply.
+"""
+
+from __future__ import annotations
+
+import xarray as xr
+
+from . import sample
+from ._lift import TENSOR_DIMS, apply, with_attrs
+from .arrays import stress as _stress
+from .arrays.tensors import principal
+from .contacts import kind_code, selection
+
+CONTACT_XY = ("contact", "xy")
+
+
+def stress_tensor(ds: xr.Dataset, kind="all", walls: bool = True) -> xr.DataArray:
+    """sigma (time, xy_a, xy_b) in Pa: (1/V) sum_c f^c (x) l^c (paper Eq. M, ERRATA 1).
+
+    ``kind="simple"`` or ``"double"`` restricts the sum to one contact kind, so that
+    ``stress_tensor(ds, "simple") + stress_tensor(ds, "double") == stress_tensor(ds)``
+    (paper Eq. sigmasd). ``walls=False`` leaves out the particle–wall contacts.
+    """
+    mask = selection(ds, walls=walls, kind=kind)
+    label = {None: "", 1: " of simple contacts", 2: " of double contacts"}[kind_code(kind)]
+    return apply(_stress.stress_tensor, ds["fn"], ds["ft"], ds["normal"], ds["branch"], mask,
+                 sample.volume(ds),
+                 core_dims=[("contact",), ("contact",), CONTACT_XY, CONTACT_XY, ("contact",), ()],
+                 output_core_dims=[TENSOR_DIMS], output_sizes={d: 2 for d in TENSOR_DIMS},
+                 names=["stress"],
+                 attrs={"units": "Pa", "long_name": f"stress tensor{label}",
+                        "comment": "sigma = (1/V) sum_c f (x) l, compression positive"})
+
+
+def _principal_parts(sigma: xr.DataArray):
+    return apply(principal, sigma, core_dims=[TENSOR_DIMS], output_core_dims=[(), (), ()])
+
+
+def stress_invariants(ds: xr.Dataset, kind="all", walls: bool = True,
+                      sigma: xr.DataArray | None = None) -> xr.Dataset:
+    """p, q, q/p and theta_sigma of the stress tensor (paper Sec. III).
+
+    ``p = (s1 + s2)/2`` and ``q = (s1 - s2)/2`` with ``s1 >= s2`` the principal values of the
+    symmetric part of sigma (Pa); ``theta_sigma`` the major principal direction in [0, pi)
+    (rad). For a partial stress (``kind`` simple or double), ``q_over_p`` divides its deviator
+    by the p of the whole sample, as the paper's Fig. 18 does.
+    """
+    sigma = stress_tensor(ds, kind, walls) if sigma is None else sigma
+    s1, s2, theta = _principal_parts(sigma)
+    p = (s1 + s2) / 2
+    q = (s1 - s2) / 2
+    if kind_code(kind) is None:
+        p_ref = p
+    else:
+        t1, t2, _ = _principal_parts(stress_tensor(ds, "all", walls))
+        p_ref = (t1 + t2) / 2
+    return xr.Dataset({
+        "p": with_attrs(p, "p", "Pa", "mean stress p = (s1 + s2)/2"),
+        "q": with_attrs(q, "q", "Pa", "stress deviator q = (s1 - s2)/2"),
+        "q_over_p": with_attrs(q / p_ref, "q_over_p", "1", "normalised shear stress q/p"),
+        "theta_sigma": with_attrs(theta, "theta_sigma", "rad", "major principal stress direction"),
+        "sigma_1": with_attrs(s1, "sigma_1", "Pa", "major principal stress"),
+        "sigma_2": with_attrs(s2, "sigma_2", "Pa", "minor principal stress"),
+    })
+
+
+def stress_direction(ds: xr.Dataset, walls: bool = True) -> xr.DataArray:
+    """Major principal stress direction theta_sigma (time,), rad: the reference direction of
+    the signed anisotropies a', a_n, a_t (ERRATA, "Signs")."""
+    return stress_invariants(ds, walls=walls)["theta_sigma"]

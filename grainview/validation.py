@@ -1,0 +1,108 @@
+"""Checking a dataset against the data contract.
+
+:func:`validate` collects every problem it finds and raises them together as one
+:class:`~grainview.errors.SchemaError`. On a dask-backed dataset the value checks are lazy
+reductions computed in a single pass over the chunks, so a file larger than memory is checked
+without being loaded, and nothing is ever written back.
+"""
+
+from __future__ import annotations
+
+import dask
+import numpy as np
+import xarray as xr
+
+from .contacts import occupied
+from .errors import SchemaError
+from .schema import KIND_DOUBLE, KIND_SIMPLE, VARIABLES
+
+UNIT_NORMAL_TOLERANCE = 1e-6
+"""Largest accepted | |n| - 1 | for an occupied contact normal."""
+
+
+def _structure_problems(ds: xr.Dataset) -> list[str]:
+    problems = []
+    for name, var in VARIABLES.items():
+        if name not in ds.variables:
+            if var.required:
+                problems.append(f"variable {name!r} is missing (expected dims {var.dims})")
+            continue
+        dims = ds[name].dims
+        if set(dims) != set(var.dims) or len(dims) != len(var.dims):
+            problems.append(f"variable {name!r} has dims {dims}, expected {var.dims}")
+        elif dims != var.dims:
+            problems.append(f"variable {name!r} has dims in order {dims}, expected {var.dims}")
+        kind = ds[name].dtype.kind
+        if var.is_integer and kind not in "iu":
+            problems.append(f"variable {name!r} has dtype {ds[name].dtype}, expected an integer type "
+                            f"({var.dtype}) with sentinels instead of a _FillValue")
+        if not var.is_integer and kind != "f":
+            problems.append(f"variable {name!r} has dtype {ds[name].dtype}, expected floating point ({var.dtype})")
+    if "xy" in ds.dims and ds.sizes["xy"] != 2:
+        problems.append(f"dimension 'xy' has size {ds.sizes['xy']}, expected 2 (x, y)")
+    return problems
+
+
+def _value_checks(ds: xr.Dataset) -> dict[str, xr.DataArray]:
+    """Lazy counts of bad entries, keyed by the message to show when the count is > 0."""
+    n = ds.sizes["particle"]
+    n_walls = ds.sizes.get("wall", 0)
+    checks = {}
+    radius = ds["radius"]
+    checks["radius: {} particle(s) with negative or non-finite radius"] = (~(radius > 0)).sum()
+    nv = ds["n_vertices"]
+    checks["n_vertices: {} particle(s) with a value that is neither 0 (disk) nor >= 3"] = ((nv != 0) & (nv < 3)).sum()
+    for name in ("mass", "inertia"):
+        checks[f"{name}: {{}} particle(s) with negative or non-finite {name}"] = (~(ds[name] > 0)).sum()
+    for name in ("position", "angle"):
+        checks[f"{name}: {{}} non-finite value(s)"] = (~np.isfinite(ds[name])).sum()
+    count = ds["contact_count"]
+    checks[f"contact_count: {{}} snapshot(s) with a count outside [0, {ds.sizes['contact']}]"] = (
+        (count < 0) | (count > ds.sizes["contact"])).sum()
+    occ = occupied(ds)
+    i, j = ds["i"], ds["j"]
+    bad_i = occ & ((i < 0) | (i >= n))
+    bad_j = occ & ((j < 0) | (j >= n + n_walls))
+    checks[f"i: {{}} occupied slot(s) with a particle id outside [0, {n})"] = bad_i.sum()
+    checks[f"j: {{}} occupied slot(s) with a body id outside [0, {n + n_walls}) "
+           f"(particles 0..{n - 1}, walls {n}..{n + n_walls - 1})"] = bad_j.sum()
+    checks["i, j: {} particle pair(s) with i >= j (expected i < j)"] = (occ & (j < n) & (i >= j)).sum()
+    checks[f"kind: {{}} occupied slot(s) with a kind other than {KIND_SIMPLE} (simple) or {KIND_DOUBLE} (double)"] = (
+        occ & (ds["kind"] != KIND_SIMPLE) & (ds["kind"] != KIND_DOUBLE)).sum()
+    for name in ("fn", "ft"):
+        checks[f"{name}: {{}} NaN or infinite force(s) in occupied slots"] = (occ & ~np.isfinite(ds[name])).sum()
+    for name in ("point", "branch"):
+        checks[f"{name}: {{}} non-finite vector(s) in occupied slots"] = (
+            occ & ~np.isfinite(ds[name]).all("xy")).sum()
+    norm = np.sqrt((ds["normal"] ** 2).sum("xy"))
+    checks[f"normal: {{}} occupied slot(s) whose normal is not a unit vector (| |n| - 1 | > {UNIT_NORMAL_TOLERANCE:g}, or NaN)"] = (
+        occ & ~(abs(norm - 1) <= UNIT_NORMAL_TOLERANCE)).sum()
+    checks["box_min, box_max: {} snapshot(s) where box_max is not above box_min in x and y"] = (
+        ~(ds["box_max"] > ds["box_min"]).all("xy")).sum()
+    return checks
+
+
+def validate(ds: xr.Dataset, source: str | None = None) -> xr.Dataset:
+    """Check ``ds`` against the contract; raise one :class:`SchemaError` listing every problem.
+
+    Checked: every required variable present with its dims and an integer/float dtype as the
+    contract says; no negative radius, mass or inertia; ``n_vertices`` 0 or >= 3; finite
+    positions; ``contact_count`` within the slots; in occupied slots: ids in range and
+    ``i < j`` for particle pairs, kind 1 or 2, finite forces, points and branches, unit normals;
+    a box of positive size. Returns ``ds`` unchanged so calls can be chained.
+    """
+    if not isinstance(ds, xr.Dataset):
+        raise SchemaError(f"expected an xarray.Dataset, got {type(ds).__name__}", source)
+    source = source or ds.encoding.get("source")
+    problems = _structure_problems(ds)
+    if problems:  # values cannot be checked reliably on a malformed structure
+        raise SchemaError(problems, source)
+    checks = _value_checks(ds)
+    (counts,) = dask.compute(list(checks.values()))
+    for message, value in zip(checks, counts):
+        value = int(np.asarray(value))
+        if value:
+            problems.append(message.format(value))
+    if problems:
+        raise SchemaError(problems, source)
+    return ds
