@@ -1,28 +1,50 @@
 """The ``ds.grain`` accessor: holds the dataset and delegates to the topic modules.
 
-Every method is a one-line call of a function of the same name in a topic module
-(:mod:`grainview.stress`, :mod:`grainview.fabric`, ...), where the docstring with the formula
-lives. Nothing is computed here.
+Every method calls the function of the same name in a topic module (:mod:`grainview.stress`,
+:mod:`grainview.fabric`, ...), where the docstring with the formula and the paper reference
+lives; the accessor shows that docstring too. Nothing is computed here.
 """
 
 from __future__ import annotations
 
+import functools
+
 import xarray as xr
 
-from . import stress, validation
+from . import connectivity, fabric, forces, strain, stress, validation
+
+
+def _delegate(func):
+    @functools.wraps(func)
+    def method(self, *args, **kwargs):
+        return func(self._ds, *args, **kwargs)
+    return method
 
 
 @xr.register_dataset_accessor("grain")
 class GrainAccessor:
+    """Analyses of a packing dataset of the grainview contract: ``ds.grain.<name>(...)``."""
+
     def __init__(self, ds: xr.Dataset):
         self._ds = ds
 
-    def validate(self):
-        """Check the dataset against the contract (:func:`grainview.validation.validate`)."""
-        return validation.validate(self._ds)
-
-    def stress_tensor(self, kind="all", walls=True):
-        return stress.stress_tensor(self._ds, kind, walls)
-
-    def stress_invariants(self, kind="all", walls=True):
-        return stress.stress_invariants(self._ds, kind, walls)
+    validate = _delegate(validation.validate)
+    # stress and strain
+    stress_tensor = _delegate(stress.stress_tensor)
+    stress_invariants = _delegate(stress.stress_invariants)
+    strains = _delegate(strain.strains)
+    friction_and_dilatancy = _delegate(strain.friction_and_dilatancy)
+    inertia_number = _delegate(strain.inertia_number)
+    # texture
+    fabric_tensor = _delegate(fabric.fabric_tensor)
+    fabric_anisotropy = _delegate(fabric.fabric_anisotropy)
+    orientation_pdf = _delegate(fabric.orientation_pdf)
+    contact_numbers = _delegate(connectivity.contact_numbers)
+    coordination = _delegate(connectivity.coordination)
+    connectivity_pdf = _delegate(connectivity.connectivity_pdf)
+    joint_connectivity_pdf = _delegate(connectivity.joint_connectivity_pdf)
+    # forces
+    angular_force_averages = _delegate(forces.angular_force_averages)
+    force_tensors = _delegate(forces.force_tensors)
+    force_anisotropies = _delegate(forces.force_anisotropies)
+    harmonic_prediction = _delegate(forces.harmonic_prediction)

@@ -345,7 +345,7 @@ class SnapshotWriter:
                 nc.createDimension("wall", n_walls)
                 nc.createDimension("wall_strlen", width)
                 wv = nc.createVariable("wall", "S1", ("wall", "wall_strlen"))
-                wv[:] = np.array([list(s.ljust(width).encode()) for s in names], dtype="S1").reshape(n_walls, width)
+                wv[:] = netCDF4.stringtochar(np.array(names, dtype=f"S{width}"))
                 wv.long_name = "wall name"
                 wv._Encoding = "utf-8"
             names = [*REQUIRED, *optional]

@@ -1,0 +1,85 @@
+"""Fabric of the contact network (paper Sec. IV.B, Eqs. F and a'; ERRATA item 2).
+
+Contacts default to particle–particle ones (``walls=False``): wall contacts have normals
+fixed by the walls and would bias the orientation statistics.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import xarray as xr
+
+from ._lift import TENSOR_DIMS, apply, with_attrs
+from .arrays import fabric as _fabric
+from .arrays.tensors import principal, signed_anisotropy
+from .contacts import kind_code, selection
+from .errors import ParameterError
+from .stress import stress_direction
+
+
+def fabric_tensor(ds: xr.Dataset, kind="all", walls: bool = False) -> xr.DataArray:
+    """F (time, xy_a, xy_b) = (1/N_c) sum_c n (x) n, dimensionless, tr F = 1 (paper Eq. F).
+
+    With ``kind="simple"`` or ``"double"`` the sum runs over that kind while N_c stays the
+    count of all contacts, so F = F_s + F_d exactly (paper Eq. fabricsd).
+    """
+    mask_all = selection(ds, walls=walls)
+    mask = selection(ds, walls=walls, kind=kind)
+    label = {None: "", 1: " of simple contacts", 2: " of double contacts"}[kind_code(kind)]
+    return apply(_fabric.fabric_tensor, ds["normal"], mask, mask_all,
+                 core_dims=[("contact", "xy"), ("contact",), ("contact",)],
+                 output_core_dims=[TENSOR_DIMS], output_sizes={d: 2 for d in TENSOR_DIMS},
+                 names=["fabric"], attrs={"units": "1", "long_name": f"fabric tensor{label}"})
+
+
+def _reference_direction(ds, reference):
+    if reference is None or (isinstance(reference, str) and reference == "stress"):
+        return stress_direction(ds)
+    if isinstance(reference, (int, float, np.floating)):
+        return float(reference)
+    if isinstance(reference, xr.DataArray):
+        return reference
+    raise ParameterError(f"reference={reference!r}: expected 'stress', an angle in rad or a DataArray")
+
+
+def fabric_anisotropy(ds: xr.Dataset, kind="all", walls: bool = False, reference="stress") -> xr.Dataset:
+    """a = 2 (F_1 - F_2), theta_F and the signed a' = a cos 2(theta_F - theta') (paper Eq. a').
+
+    ``reference`` is theta': ``"stress"`` (default, the major principal stress direction of
+    the whole sample, ERRATA "Signs"), a fixed angle in rad, or a DataArray over time. For a
+    partial tensor (kind simple/double) the anisotropies a_s, a'_s are those of F_s, whose
+    trace is k_s (paper Fig. 22).
+    """
+    f1, f2, theta = apply(principal, fabric_tensor(ds, kind, walls), core_dims=[TENSOR_DIMS],
+                          output_core_dims=[(), (), ()])
+    ref = _reference_direction(ds, reference)
+    a_prime = signed_anisotropy(f1, f2, theta, ref, normalisation=1.0)
+    return xr.Dataset({
+        "a": with_attrs(2 * (f1 - f2), "a", "1", "fabric anisotropy a = 2 (F1 - F2)"),
+        "a_prime": with_attrs(a_prime, "a_prime", "1", "signed fabric anisotropy a'"),
+        "theta_F": with_attrs(theta, "theta_F", "rad", "major principal direction of the fabric"),
+    })
+
+
+def orientation_pdf(ds: xr.Dataset, bins: int = 36, kind="all", walls: bool = False) -> xr.DataArray:
+    """P(theta) (time, theta): density of contact-normal orientations on [0, pi), rad-1,
+    normalised so that sum P dtheta = 1 (paper Fig. 8)."""
+    bins = _check_bins(bins)
+    mask = selection(ds, walls=walls, kind=kind)
+    da = apply(_fabric.orientation_pdf, ds["normal"], mask, core_dims=[("contact", "xy"), ("contact",)],
+               output_core_dims=[("theta",)], output_sizes={"theta": bins}, kwargs={"n_bins": bins},
+               names=["orientation_pdf"],
+               attrs={"units": "rad-1", "long_name": "probability density of contact orientations P(theta)"})
+    return da.assign_coords(theta=theta_coord(bins))
+
+
+def theta_coord(bins: int) -> xr.DataArray:
+    """Centres theta_k = k pi/bins of the ``bins`` angular sectors, rad."""
+    centres = np.arange(bins) * np.pi / bins
+    return xr.DataArray(centres, dims="theta", attrs={"units": "rad", "long_name": "contact orientation theta"})
+
+
+def _check_bins(bins) -> int:
+    if not isinstance(bins, (int, np.integer)) or bins < 1:
+        raise ParameterError(f"bins={bins!r}: expected a positive integer number of angular sectors")
+    return int(bins)

@@ -1,0 +1,86 @@
+"""Force anisotropies (paper Sec. V.A, Eqs. fnft, HnHt, anat, qa; ERRATA item 3 and "Signs").
+
+``a_n`` and ``a_t`` are signed like a': multiplied by cos 2(theta - theta_sigma), theta being
+the major direction of H^(n) (resp. H^(t)) and theta_sigma the major principal stress
+direction, so that (a' + a_n + a_t)/2 predicts q/p whatever the directions.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import xarray as xr
+
+from ._lift import TENSOR_DIMS, apply, with_attrs
+from .arrays import forces as _forces
+from .arrays.tensors import principal
+from .contacts import selection
+from .fabric import _check_bins, _reference_direction, fabric_anisotropy, theta_coord
+from .stress import stress_invariants
+
+CONTACT_ARGS = [("contact",), ("contact",), ("contact", "xy"), ("contact",)]
+
+
+def angular_force_averages(ds: xr.Dataset, bins: int = 36, kind="all", walls: bool = False) -> xr.Dataset:
+    """<f_n>(theta), <f_t>(theta) (N) and N_c(theta) on ``bins`` sectors of [0, pi)
+    (paper Eq. fnft, Fig. 10); NaN in empty sectors."""
+    bins = _check_bins(bins)
+    mask = selection(ds, walls=walls, kind=kind)
+    fn, ft, count = apply(_forces.angular_averages, ds["fn"], ds["ft"], ds["normal"], mask,
+                          core_dims=CONTACT_ARGS, output_core_dims=[("theta",)] * 3,
+                          output_sizes={"theta": bins}, kwargs={"n_bins": bins})
+    return xr.Dataset({
+        "fn_mean": with_attrs(fn, "fn_mean", "N", "mean normal force <f_n>(theta)"),
+        "ft_mean": with_attrs(ft, "ft_mean", "N", "mean tangential force <f_t>(theta)"),
+        "count": with_attrs(count, "count", "1", "number of contacts N_c(theta)"),
+    }).assign_coords(theta=theta_coord(bins))
+
+
+def force_tensors(ds: xr.Dataset, bins: int = 36, kind="all", walls: bool = False) -> xr.Dataset:
+    """H^(n) and H^(t) (time, xy_a, xy_b) in N (ERRATA item 3)."""
+    bins = _check_bins(bins)
+    mask = selection(ds, walls=walls, kind=kind)
+    h_n, h_t = apply(_forces.force_tensors, ds["fn"], ds["ft"], ds["normal"], mask,
+                     core_dims=CONTACT_ARGS, output_core_dims=[TENSOR_DIMS, TENSOR_DIMS],
+                     output_sizes={d: 2 for d in TENSOR_DIMS}, kwargs={"n_bins": bins})
+    return xr.Dataset({
+        "H_n": with_attrs(h_n, "H_n", "N", "normal force tensor H^(n)"),
+        "H_t": with_attrs(h_t, "H_t", "N", "tangential force tensor H^(t) (symmetric part)"),
+    })
+
+
+def force_anisotropies(ds: xr.Dataset, bins: int = 36, kind="all", walls: bool = False,
+                       reference="stress") -> xr.Dataset:
+    """a_n = 2 (H^n_1 - H^n_2)/tr H^n and a_t = 2 (H^t_1 - H^t_2)/tr H^n (ERRATA item 3),
+    signed by cos 2(theta - theta') with theta' the ``reference`` direction (default: major
+    principal stress direction); also theta_n, theta_t and the unsigned magnitudes."""
+    h = force_tensors(ds, bins, kind, walls)
+    n1, n2, theta_n = apply(principal, h["H_n"], core_dims=[TENSOR_DIMS], output_core_dims=[(), (), ()])
+    t1, t2, theta_t = apply(principal, h["H_t"], core_dims=[TENSOR_DIMS], output_core_dims=[(), (), ()])
+    trace = n1 + n2
+    ref = _reference_direction(ds, reference)
+    a_n = 2 * (n1 - n2) / trace
+    a_t = 2 * (t1 - t2) / trace
+    return xr.Dataset({
+        "a_n": with_attrs(a_n * np.cos(2 * (theta_n - ref)), "a_n", "1", "signed normal force anisotropy a_n"),
+        "a_t": with_attrs(a_t * np.cos(2 * (theta_t - ref)), "a_t", "1", "signed tangential force anisotropy a_t"),
+        "a_n_magnitude": with_attrs(a_n, "a_n_magnitude", "1", "normal force anisotropy |a_n|"),
+        "a_t_magnitude": with_attrs(a_t, "a_t_magnitude", "1", "tangential force anisotropy |a_t|"),
+        "theta_n": with_attrs(theta_n, "theta_n", "rad", "major direction of H^(n)"),
+        "theta_t": with_attrs(theta_t, "theta_t", "rad", "major direction of H^(t)"),
+    })
+
+
+def harmonic_prediction(ds: xr.Dataset, bins: int = 36, walls: bool = False) -> xr.Dataset:
+    """q/p and its harmonic prediction (a' + a_n + a_t)/2 (paper Eq. qa, Fig. 12).
+
+    The anisotropies use the contacts selected by ``walls`` (default particle–particle);
+    q/p is the stress of the whole sample (wall contacts included).
+    """
+    fab = fabric_anisotropy(ds, walls=walls)
+    frc = force_anisotropies(ds, bins, walls=walls)
+    prediction = (fab["a_prime"] + frc["a_n"] + frc["a_t"]) / 2
+    return xr.Dataset({
+        "q_over_p": stress_invariants(ds)["q_over_p"],
+        "prediction": with_attrs(prediction, "prediction", "1", "harmonic prediction (a' + a_n + a_t)/2"),
+        "a_prime": fab["a_prime"], "a_n": frc["a_n"], "a_t": frc["a_t"],
+    })

@@ -1,0 +1,95 @@
+"""Strains of a biaxial test and the angles and numbers derived from them
+(paper Sec. III, Eqs. for eps_1, eps_p, phi, psi and I; ERRATA item 6).
+
+Compression is positive for eps_1 and eps_2, dilation positive for eps_p, as the ERRATA
+states. The reference state is the snapshot ``reference`` (default the first).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import xarray as xr
+
+from . import sample
+from ._lift import with_attrs
+from .stress import stress_invariants
+
+
+def time_derivative(da: xr.DataArray) -> xr.DataArray:
+    """d(da)/dt by centred differences (one-sided at both ends), lazily on any chunking.
+
+    Built from ``shift`` so dask handles the chunk overlaps (``differentiate`` cannot work on
+    one-snapshot chunks). NaN when there is a single snapshot.
+    """
+    t = da["time"].astype(float)
+    ahead, behind = da.shift(time=-1), da.shift(time=1)
+    t_ahead, t_behind = t.shift(time=-1), t.shift(time=1)
+    ahead = ahead.fillna(da) if da.sizes["time"] > 1 else ahead
+    behind = behind.fillna(da) if da.sizes["time"] > 1 else behind
+    dt = t_ahead.fillna(t) - t_behind.fillna(t)
+    return (ahead - behind) / dt.where(dt != 0)
+
+
+def _ratio(num, den):
+    """num/den, NaN where den == 0 (no division warnings, lazily)."""
+    return num / den.where(den != 0)
+
+
+def _log_strain(size, reference):
+    size0 = size.isel(time=reference)
+    return np.log(1 + (size0 - size) / size0)
+
+
+def strains(ds: xr.Dataset, reference: int = 0) -> xr.Dataset:
+    """eps_1, eps_2, eps_p, eps_q (dimensionless) of every snapshot.
+
+    eps_1 = ln(1 + dh/h0) with dh = h0 - h (vertical, compression positive);
+    eps_2 = ln(1 + dl/l0) with dl = l0 - l (horizontal);
+    eps_p = ln(1 + dV/V0) with dV = V - V0 (volumetric, dilation positive);
+    eps_q = eps_1 - eps_2 (shear strain). ERRATA item 6.
+    """
+    h, l, v = sample.height(ds), sample.width(ds), sample.area(ds)
+    eps_1 = _log_strain(h, reference)
+    eps_2 = _log_strain(l, reference)
+    v0 = v.isel(time=reference)
+    eps_p = np.log(1 + (v - v0) / v0)
+    out = xr.Dataset({
+        "eps_1": with_attrs(eps_1, "eps_1", "1", "vertical strain eps_1 (compression positive)"),
+        "eps_2": with_attrs(eps_2, "eps_2", "1", "horizontal strain eps_2 (compression positive)"),
+        "eps_p": with_attrs(eps_p, "eps_p", "1", "volumetric strain eps_p (dilation positive)"),
+        "eps_q": with_attrs(eps_1 - eps_2, "eps_q", "1", "shear strain eps_q = eps_1 - eps_2"),
+    })
+    return out.drop_vars([c for c in out.coords if c != "time"])
+
+
+def friction_and_dilatancy(ds: xr.Dataset, reference: int = 0) -> xr.Dataset:
+    """Friction angle phi, cumulative and incremental dilatancy angles psi (rad).
+
+    sin phi = q/p; sin psi = eps_p/eps_q (cumulative; NaN where eps_q = 0);
+    sin psi_incremental = d eps_p / d eps_q (centred differences in time). Values of the
+    sines outside [-1, 1] give NaN rather than a clipped angle.
+    """
+    eps = strains(ds, reference)
+    q_over_p = stress_invariants(ds)["q_over_p"]
+    ratio = _ratio(eps["eps_p"], eps["eps_q"])
+    rate = _ratio(time_derivative(eps["eps_p"]), time_derivative(eps["eps_q"]))
+    with np.errstate(invalid="ignore"):
+        return xr.Dataset({
+            "phi": with_attrs(np.arcsin(q_over_p), "phi", "rad", "friction angle, sin phi = q/p"),
+            "psi": with_attrs(np.arcsin(ratio), "psi", "rad", "dilatancy angle, sin psi = eps_p/eps_q"),
+            "psi_incremental": with_attrs(np.arcsin(rate), "psi_incremental", "rad",
+                                          "incremental dilatancy angle, sin psi = d eps_p/d eps_q"),
+        })
+
+
+def inertia_number(ds: xr.Dataset) -> xr.DataArray:
+    """Inertia parameter I = eps_dot sqrt(m/p) (paper Eq. 3), dimensionless.
+
+    eps_dot = |dh/dt|/h is the vertical strain rate (s-1), m the total mass of the particles
+    (kg) and p the mean stress times the slab thickness (N m-1), as in the paper's 2D setting.
+    """
+    h = sample.height(ds)
+    rate = abs(time_derivative(h)) / h
+    p_line = stress_invariants(ds)["p"] * sample.thickness(ds)
+    total_mass = ds["mass"].sum()
+    return with_attrs(rate * np.sqrt(total_mass / p_line), "inertia_number", "1", "inertia parameter I")

@@ -1,0 +1,120 @@
+"""The data contract on disk: writing, reading back, laziness of open_dataset, bad files."""
+
+import hashlib
+
+import numpy as np
+import pytest
+import xarray as xr
+
+import grainview
+from grainview.errors import FileFormatError, SchemaError
+from grainview.schema import SnapshotWriter, contact_slots
+
+from . import builders
+
+
+def _write(ds, path, **kw):
+    n = ds.sizes["particle"]
+    with SnapshotWriter.create(path, radius=ds.radius.values, n_vertices=ds.n_vertices.values,
+                               mass=ds.mass.values, inertia=ds.inertia.values,
+                               n_walls=ds.sizes.get("wall", 0), n_contact_slots=ds.sizes["contact"],
+                               attrs={"mu": 0.4, "scene": "test"}, **kw) as w:
+        for k in range(ds.sizes["time"]):
+            snap = ds.isel(time=k)
+            m = int(snap.contact_count)
+            contacts = {name: snap[name].values[:m] for name in ("i", "j", "kind", "normal", "fn", "ft", "point", "branch")}
+            w.append(time=float(snap.time), position=snap.position.values, angle=snap.angle.values,
+                     contacts=contacts, box_min=snap.box_min.values, box_max=snap.box_max.values)
+    return path
+
+
+def _sha(path):
+    return hashlib.sha256(open(path, "rb").read()).hexdigest()
+
+
+def test_contact_slots_is_planar_graph_bound():
+    assert contact_slots(100, 4) == 3 * 104 - 6
+    assert contact_slots(2, 0) == 2
+
+
+def test_round_trip_keeps_values_and_integer_types(tmp_path):
+    ds = builders.mixed_contacts()
+    path = _write(ds, tmp_path / "run.nc")
+    back = grainview.open_dataset(path, chunks=None)
+    for name in ("i", "j", "kind", "contact_count"):
+        assert back[name].dtype.kind == "i", name
+        np.testing.assert_array_equal(back[name].values, ds[name].values)
+    for name in ("fn", "ft", "normal", "branch", "point", "position", "radius"):
+        np.testing.assert_array_equal(back[name].values, ds[name].values)
+    assert list(back.xy.values) == ["x", "y"]
+    assert list(back.wall.values) == ["bottom", "right", "top", "left"]
+    assert back.attrs["grainview_schema_version"] == grainview.SCHEMA_VERSION
+    assert back.attrs["mu"] == 0.4
+    assert back.fn.attrs["units"] == "N" and back.kind.attrs["flag_meanings"] == "empty simple double"
+    grainview.validate(back)
+
+
+def test_open_dataset_is_lazy_and_chunked_along_time_only(tmp_path):
+    path = _write(builders.mixed_contacts(t=3), tmp_path / "run.nc")
+    ds = grainview.open_dataset(path, chunks=2)
+    assert ds.fn.chunks == ((2, 1), (ds.sizes["contact"],))
+    assert ds.position.chunks[1:] == ((ds.sizes["particle"],), (2,))
+    with pytest.raises(ValueError, match="only 'time'"):
+        grainview.open_dataset(path, chunks={"contact": 5})
+
+
+def test_trailing_incomplete_snapshot_is_dropped(tmp_path):
+    path = _write(builders.mixed_contacts(t=2), tmp_path / "run.nc")
+    import netCDF4
+    with netCDF4.Dataset(path, "a") as nc:  # a writer killed after the forces, before time
+        nc.variables["fn"][2] = np.ones(nc.dimensions["contact"].size)
+    assert netCDF4.Dataset(path).dimensions["time"].size == 3
+    ds = grainview.open_dataset(path, chunks=None)
+    assert ds.sizes["time"] == 2
+    w = SnapshotWriter.open_append(path)
+    assert w.n_snapshots == 2
+    w.close()
+
+
+def test_reading_never_modifies_the_file(tmp_path):
+    path = _write(builders.mixed_contacts(), tmp_path / "run.nc")
+    before = _sha(path)
+    ds = grainview.open_dataset(path, validate=True)
+    ds.grain.stress_invariants().compute()
+    ds.close()
+    assert _sha(path) == before
+
+
+def test_writer_refuses_to_overwrite(tmp_path):
+    path = tmp_path / "run.nc"
+    path.write_bytes(b"precious")
+    ds = builders.two_disks()
+    with pytest.raises(FileExistsError, match="overwrite"):
+        _write(ds, path)
+    assert path.read_bytes() == b"precious"
+
+
+def test_not_netcdf_and_missing_files_give_clear_errors(tmp_path):
+    bad = tmp_path / "notes.nc"
+    bad.write_text("this is not netCDF")
+    with pytest.raises(FileFormatError, match="not a readable netCDF"):
+        grainview.open_dataset(bad)
+    with pytest.raises(FileFormatError, match="no such file"):
+        grainview.open_dataset(tmp_path / "missing.nc")
+
+
+def test_newer_schema_version_is_refused(tmp_path):
+    ds = builders.two_disks()
+    ds.attrs["grainview_schema_version"] = "99.0"
+    path = tmp_path / "future.nc"
+    ds.to_netcdf(path, encoding=grainview.schema.netcdf_encoding(ds))
+    with pytest.raises(SchemaError, match="newer than this grainview"):
+        grainview.open_dataset(path)
+
+
+def test_to_netcdf_with_contract_encoding_round_trips(tmp_path):
+    ds = builders.mixed_contacts()
+    path = tmp_path / "x.nc"
+    ds.to_netcdf(path, encoding=grainview.schema.netcdf_encoding(ds))
+    back = grainview.open_dataset(path, chunks=None)
+    xr.testing.assert_equal(back[["i", "j", "kind", "fn"]], ds[["i", "j", "kind", "fn"]])

@@ -1,0 +1,84 @@
+"""validate(): every problem of the contract named, all at once, lazily in one pass."""
+
+import numpy as np
+import pytest
+
+import grainview
+from grainview.errors import SchemaError
+
+from . import builders
+from .conftest import raise_if_dask_computes
+
+
+def _problems(ds):
+    with pytest.raises(SchemaError) as info:
+        grainview.validate(ds)
+    return info.value.problems
+
+
+def test_valid_dataset_passes_eager_and_chunked(prepare):
+    ds = prepare(builders.mixed_contacts())
+    assert grainview.validate(ds) is ds
+
+
+def test_chunked_validation_is_a_single_compute():
+    ds = builders.mixed_contacts(t=4).chunk(time=1)
+    with raise_if_dask_computes(max_computes=1):
+        ds.grain.validate()
+
+
+def test_missing_variable_and_wrong_dims():
+    ds = builders.two_disks().drop_vars("fn")
+    ds["radius"] = ds.radius.expand_dims(time=ds.time)
+    problems = _problems(ds)
+    assert any("'fn' is missing" in p for p in problems)
+    assert any("'radius' has dims ('time', 'particle')" in p for p in problems)
+
+
+def test_shuffled_dims_and_float_integers():
+    ds = builders.two_disks()
+    ds["normal"] = ds.normal.transpose("time", "xy", "contact")
+    ds["i"] = ds.i.astype(float)
+    problems = _problems(ds)
+    assert any("'normal' has dims in order" in p for p in problems)
+    assert any("'i' has dtype float64, expected an integer" in p for p in problems)
+
+
+@pytest.mark.parametrize("backend_name", ["eager", "chunked"])
+def test_all_value_problems_are_collected(backend_name):
+    ds = builders.square_lattice()
+    ds["fn"][0, 0] = np.nan
+    ds["normal"][0, 1] = [2.0, 0.0]
+    ds["j"][0, 2] = 999
+    ds["radius"][3] = -1.0
+    ds["kind"][0, 4] = 7
+    if backend_name == "chunked":
+        ds = ds.chunk(time=1)
+    problems = _problems(ds)
+    text = "\n".join(problems)
+    assert len(problems) == 5, text
+    assert "fn: 1 NaN" in text
+    assert "normal: 1 occupied slot(s) whose normal is not a unit vector" in text
+    assert "j: 1 occupied slot(s) with a body id outside [0, 12)" in text
+    assert "radius: 1 particle(s) with negative" in text
+    assert "kind: 1 occupied slot(s)" in text
+
+
+def test_empty_slots_are_not_checked():
+    ds = builders.two_disks()
+    assert ds.sizes["contact"] > 1 and np.isnan(ds.fn[0, 1])  # padding holds fill values
+    grainview.validate(ds)
+
+
+def test_pair_order_and_particle_range():
+    ds = builders.two_disks()
+    ds["i"][0, 0], ds["j"][0, 0] = 1, 0
+    assert any("i >= j" in p for p in _problems(ds))
+    ds = builders.two_disks()
+    ds["i"][0, 0] = -3
+    assert any("i: 1 occupied slot(s) with a particle id outside [0, 2)" in p for p in _problems(ds))
+
+
+def test_not_a_dataset():
+    with pytest.raises(SchemaError, match="expected an xarray.Dataset"):
+        grainview.validate({"fn": 1})
