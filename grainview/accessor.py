@@ -17,6 +17,7 @@ from . import connectivity, fabric, forces, strain, stress, validation
 def _delegate(func):
     @functools.wraps(func)
     def method(self, *args, **kwargs):
+        self._check_structure()
         return func(self._ds, *args, **kwargs)
     return method
 
@@ -27,8 +28,19 @@ class GrainAccessor:
 
     def __init__(self, ds: xr.Dataset):
         self._ds = ds
+        self._structure_ok = False
 
-    validate = _delegate(validation.validate)
+    def _check_structure(self):
+        """Structural check (no data read) before any analysis, so that a malformed dataset
+        gives a :class:`~grainview.errors.SchemaError` naming the problem, not a KeyError."""
+        if not self._structure_ok:
+            validation.check_structure(self._ds)
+            self._structure_ok = True
+
+    def validate(self):
+        """Check the dataset against the contract (:func:`grainview.validation.validate`)."""
+        return validation.validate(self._ds)
+
     # stress and strain
     stress_tensor = _delegate(stress.stress_tensor)
     stress_invariants = _delegate(stress.stress_invariants)

@@ -14,7 +14,30 @@ import numpy as np
 import xarray as xr
 
 from .errors import FileFormatError, SchemaError
-from .schema import SCHEMA_VERSION
+from .schema import SCHEMA_VERSION, complete_snapshots
+
+
+def _check_netcdf3_length(path: str) -> None:
+    """Raise FileFormatError when a netCDF-3 file is shorter than its header says.
+
+    netCDF-3 readers return zeros for the missing bytes of a truncated file instead of
+    failing, so the length is checked: header + fixed-size variables + records.
+    """
+    with open(path, "rb") as fh:
+        magic = fh.read(4)
+    if magic[:3] != b"CDF" or magic[3:] not in (b"\x01", b"\x02"):
+        return
+    from scipy.io import netcdf_file
+
+    with netcdf_file(path, "r", mmap=True) as nc:
+        header = nc.fp.tell()
+        fixed = sum((v.data.nbytes + 3) // 4 * 4 for v in nc.variables.values() if not v.isrec)
+        expected = header + fixed + nc._recs * nc._recsize
+        for v in nc.variables.values():  # drop the mmap references before closing
+            v.data = None
+    size = os.path.getsize(path)
+    if size < expected:
+        raise FileFormatError(f"{path}: truncated file ({size} bytes, its header needs at least {expected})")
 
 
 def _check_version(ds, source):
@@ -43,21 +66,27 @@ def open_dataset(path, chunks: int | dict | None = "auto", validate: bool = Fals
     validate : run :func:`grainview.validation.validate` before returning.
 
     The file is opened read-only and never modified. Trailing snapshots whose ``time`` is
-    missing (a writer killed mid-snapshot) are dropped.
+    missing or whose ``complete`` flag is not set (a writer killed mid-snapshot) are dropped;
+    a netCDF-3 file shorter than its header says raises :class:`FileFormatError`.
     """
     source = os.fspath(path)
     if not os.path.exists(source):
         raise FileFormatError(f"{source}: no such file")
     try:
+        _check_netcdf3_length(source)
         ds = xr.open_dataset(source, engine="netcdf4", chunks=None, cache=False,
                              decode_times=False, mask_and_scale=True)
-    except (OSError, ValueError, RuntimeError, KeyError, TypeError) as exc:
+        complete = complete_snapshots(ds.variables) if "time" in ds.variables and "time" in ds.dims else None
+    except FileFormatError:
+        raise
+    except (OSError, ValueError, RuntimeError, KeyError, TypeError, IndexError) as exc:
         raise FileFormatError(f"{source}: not a readable netCDF file ({exc})") from exc
     _check_version(ds, source)
-    if "time" in ds.dims and "time" in ds.variables:
-        t = np.asarray(ds["time"].values)
-        finite = np.flatnonzero(np.isfinite(t))
-        n_complete = int(finite[-1] + 1) if finite.size else 0
+    if complete is not None:
+        n_complete = int(np.argmin(complete)) if not complete.all() else complete.size
+        if complete[n_complete:].any():
+            raise FileFormatError(f"{source}: snapshot {n_complete} is incomplete but later ones are "
+                                  "complete; the file is damaged")
         if n_complete < ds.sizes["time"]:
             ds = ds.isel(time=slice(0, n_complete))
     for name in ("xy", "wall"):

@@ -98,11 +98,24 @@ VARIABLES: dict[str, Var] = {
     "nlgs_residual": Var(("time",), "f8", "1", "final NLGS residual of the last step", False),
     "max_interpenetration": Var(("time",), "f8", "m", "largest interpenetration between bodies", False),
     "kinetic_energy": Var(("time",), "f8", "J", "total kinetic energy", False),
+    # written last in each snapshot by SnapshotWriter (the last bytes of a netCDF-3 record)
+    "complete": Var(("time",), "i1", "1", "1 once the snapshot is completely written", False),
 }
 
 REQUIRED = tuple(name for name, var in VARIABLES.items() if var.required)
 CONTACT_VARIABLES = ("i", "j", "kind", "normal", "fn", "ft", "point", "branch")
 DIAGNOSTICS = ("step", "nlgs_iterations", "nlgs_residual", "max_interpenetration", "kinetic_energy")
+
+
+def complete_snapshots(variables) -> np.ndarray:
+    """Boolean per snapshot: ``time`` finite and, where the file has it, ``complete == 1``.
+
+    ``variables`` maps names to array-likes (a netCDF4 or xarray dataset's variables).
+    """
+    ok = np.isfinite(np.asarray(variables["time"][:], dtype=float))
+    if "complete" in variables:
+        ok &= np.asarray(variables["complete"][:]) == 1
+    return ok
 
 
 def variable_attrs(name: str) -> dict:
@@ -277,7 +290,8 @@ def netcdf_encoding(ds: xr.Dataset) -> dict:
     enc = {}
     for name in ds.variables:
         if name in VARIABLES:
-            enc[name] = {"_FillValue": None} if VARIABLES[name].is_integer else {"_FillValue": np.nan}
+            floating = ds[name].dtype.kind == "f"
+            enc[name] = {"_FillValue": np.nan} if floating else {"_FillValue": None}
     if "time" in ds.variables:
         enc["time"] = {"_FillValue": np.nan}
     return enc
@@ -286,9 +300,10 @@ def netcdf_encoding(ds: xr.Dataset) -> dict:
 class SnapshotWriter:
     """Create a netCDF file of the contract and append snapshots while a run goes on.
 
-    The file is synced to disk after every snapshot and ``time`` is written last, so a
-    reader (:func:`grainview.open_dataset`) sees every completed snapshot and drops a
-    trailing one whose ``time`` is still the fill value. The format is netCDF-3 (64-bit
+    The file is synced to disk after every snapshot; ``time`` and then the flag ``complete``
+    are written last (``complete`` is the last variable of each netCDF-3 record, so a record
+    cut short reads 0 there), so a reader (:func:`grainview.open_dataset`) sees every
+    completed snapshot and drops a trailing incomplete one. The format is netCDF-3 (64-bit
     offset) by default: its fixed layout survives a killed writer better than HDF5's.
 
     Use as a context manager::
@@ -307,11 +322,11 @@ class SnapshotWriter:
 
     @classmethod
     def create(cls, path, *, radius, n_vertices, mass, inertia, n_walls=0, wall_names=None,
-               wall_normal=None, optional=("velocity", "angular_velocity", "wall_position",
-                                           "wall_force", *DIAGNOSTICS),
+               wall_normal=None, optional=(),
                attrs=None, n_contact_slots=None, overwrite=False, format="NETCDF3_64BIT_OFFSET"):
         """Create ``path`` with the static particle data; ``optional`` names the optional
-        per-snapshot variables this file will hold (others are not written at all)."""
+        per-snapshot variables this file will hold (e.g. ``("velocity", *DIAGNOSTICS)``);
+        the others are not written at all."""
         import netCDF4
 
         path = os.fspath(path)
@@ -351,6 +366,7 @@ class SnapshotWriter:
             names = [*REQUIRED, *optional]
             if n_walls and wall_normal is not None:
                 names.append("wall_normal")
+            names.append("complete")  # defined last: the last bytes of each record
             for name in dict.fromkeys(names):
                 var = VARIABLES[name]
                 fill = None if var.is_integer else np.nan
@@ -385,8 +401,7 @@ class SnapshotWriter:
     @property
     def n_snapshots(self) -> int:
         """Number of complete snapshots (trailing ones with no time are not counted)."""
-        t = self._nc.variables["time"][:]
-        complete = np.flatnonzero(np.isfinite(t))
+        complete = np.flatnonzero(complete_snapshots(self._nc.variables))
         return int(complete[-1] + 1) if complete.size else 0
 
     def append(self, *, time, position, angle, contacts, box_min, box_max, **optional):
@@ -413,7 +428,8 @@ class SnapshotWriter:
                 nc.variables[name][k] = value
             elif name not in VARIABLES:
                 raise ParameterError(f"unknown variable {name!r}")
-        nc.variables["time"][k] = time  # last: marks the snapshot complete
+        nc.variables["time"][k] = time
+        nc.variables["complete"][k] = 1  # last: marks the snapshot complete
         nc.sync()
 
     def close(self):

@@ -43,17 +43,27 @@ def _structure_problems(ds: xr.Dataset) -> list[str]:
     return problems
 
 
+def check_structure(ds: xr.Dataset, source: str | None = None) -> None:
+    """Raise :class:`SchemaError` for structural problems only (missing variables, dims,
+    dtypes): cheap, reads no data. The analyses call it before computing anything."""
+    if not isinstance(ds, xr.Dataset):
+        raise SchemaError(f"expected an xarray.Dataset, got {type(ds).__name__}", source)
+    problems = _structure_problems(ds)
+    if problems:
+        raise SchemaError(problems, source or ds.encoding.get("source"))
+
+
 def _value_checks(ds: xr.Dataset) -> dict[str, xr.DataArray]:
     """Lazy counts of bad entries, keyed by the message to show when the count is > 0."""
     n = ds.sizes["particle"]
     n_walls = ds.sizes.get("wall", 0)
     checks = {}
     radius = ds["radius"]
-    checks["radius: {} particle(s) with negative or non-finite radius"] = (~(radius > 0)).sum()
+    checks["radius: {} particle(s) with negative or non-finite radius"] = (~(np.isfinite(radius) & (radius > 0))).sum()
     nv = ds["n_vertices"]
     checks["n_vertices: {} particle(s) with a value that is neither 0 (disk) nor >= 3"] = ((nv != 0) & (nv < 3)).sum()
     for name in ("mass", "inertia"):
-        checks[f"{name}: {{}} particle(s) with negative or non-finite {name}"] = (~(ds[name] > 0)).sum()
+        checks[f"{name}: {{}} particle(s) with negative or non-finite {name}"] = (~(np.isfinite(ds[name]) & (ds[name] > 0))).sum()
     for name in ("position", "angle"):
         checks[f"{name}: {{}} non-finite value(s)"] = (~np.isfinite(ds[name])).sum()
     count = ds["contact_count"]
@@ -77,8 +87,12 @@ def _value_checks(ds: xr.Dataset) -> dict[str, xr.DataArray]:
     norm = np.sqrt((ds["normal"] ** 2).sum("xy"))
     checks[f"normal: {{}} occupied slot(s) whose normal is not a unit vector (| |n| - 1 | > {UNIT_NORMAL_TOLERANCE:g}, or NaN)"] = (
         occ & ~(abs(norm - 1) <= UNIT_NORMAL_TOLERANCE)).sum()
-    checks["box_min, box_max: {} snapshot(s) where box_max is not above box_min in x and y"] = (
-        ~(ds["box_max"] > ds["box_min"]).all("xy")).sum()
+    for name, var in VARIABLES.items():
+        if not var.required and not var.is_integer and name in ds.variables:
+            checks[f"{name}: {{}} non-finite value(s)"] = (~np.isfinite(ds[name])).sum()
+    box_ok = (np.isfinite(ds["box_min"]) & np.isfinite(ds["box_max"]) & (ds["box_max"] > ds["box_min"])).all("xy")
+    checks["box_min, box_max: {} snapshot(s) where the box is not finite with box_max above box_min "
+           "in x and y"] = (~box_ok).sum()
     return checks
 
 
@@ -91,12 +105,9 @@ def validate(ds: xr.Dataset, source: str | None = None) -> xr.Dataset:
     ``i < j`` for particle pairs, kind 1 or 2, finite forces, points and branches, unit normals;
     a box of positive size. Returns ``ds`` unchanged so calls can be chained.
     """
-    if not isinstance(ds, xr.Dataset):
-        raise SchemaError(f"expected an xarray.Dataset, got {type(ds).__name__}", source)
-    source = source or ds.encoding.get("source")
-    problems = _structure_problems(ds)
-    if problems:  # values cannot be checked reliably on a malformed structure
-        raise SchemaError(problems, source)
+    source = source or (ds.encoding.get("source") if isinstance(ds, xr.Dataset) else None)
+    check_structure(ds, source)  # values cannot be checked reliably on a malformed structure
+    problems = []
     checks = _value_checks(ds)
     (counts,) = dask.compute(list(checks.values()))
     for message, value in zip(checks, counts):

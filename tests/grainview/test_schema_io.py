@@ -118,3 +118,25 @@ def test_to_netcdf_with_contract_encoding_round_trips(tmp_path):
     ds.to_netcdf(path, encoding=grainview.schema.netcdf_encoding(ds))
     back = grainview.open_dataset(path, chunks=None)
     xr.testing.assert_equal(back[["i", "j", "kind", "fn"]], ds[["i", "j", "kind", "fn"]])
+
+
+@pytest.mark.parametrize("fraction", [0.1, 0.5, 0.9, 0.999])
+def test_truncated_files_are_refused(tmp_path, fraction):
+    path = _write(builders.mixed_contacts(t=3), tmp_path / "run.nc")
+    data = path.read_bytes()
+    cut = tmp_path / "cut.nc"
+    cut.write_bytes(data[: int(len(data) * fraction)])
+    with pytest.raises(FileFormatError, match="truncated|not a readable"):
+        grainview.open_dataset(cut)
+
+
+def test_record_cut_short_is_dropped_by_its_flag(tmp_path):
+    path = _write(builders.mixed_contacts(t=3), tmp_path / "run.nc")
+    import netCDF4
+    with netCDF4.Dataset(path, "a") as nc:  # the last record lost its final bytes
+        nc.variables["complete"][2] = 0
+    assert grainview.open_dataset(path, chunks=None).sizes["time"] == 2
+    with netCDF4.Dataset(path, "a") as nc:
+        nc.variables["complete"][0] = 0
+    with pytest.raises(FileFormatError, match="snapshot 0 is incomplete"):
+        grainview.open_dataset(path)
