@@ -11,7 +11,7 @@ import functools
 
 import xarray as xr
 
-from . import connectivity, fabric, forces, strain, stress, validation
+from . import connectivity, fabric, forces, sample, strain, stress, validation
 
 
 def _delegate(func):
@@ -47,6 +47,7 @@ class GrainAccessor:
     strains = _delegate(strain.strains)
     friction_and_dilatancy = _delegate(strain.friction_and_dilatancy)
     inertia_number = _delegate(strain.inertia_number)
+    solid_fraction = _delegate(sample.solid_fraction)
     # texture
     fabric_tensor = _delegate(fabric.fabric_tensor)
     fabric_anisotropy = _delegate(fabric.fabric_anisotropy)

@@ -107,6 +107,16 @@ CONTACT_VARIABLES = ("i", "j", "kind", "normal", "fn", "ft", "point", "branch")
 DIAGNOSTICS = ("step", "nlgs_iterations", "nlgs_residual", "max_interpenetration", "kinetic_energy")
 
 
+def particle_area(radius, n_vertices):
+    """Area of each particle in m2: pi R^2 for a disk (n = 0), (n/2) R^2 sin(2 pi/n) for a
+    regular n-gon of circumscribed radius R. Part of the contract's shape definition."""
+    radius = np.asarray(radius, dtype=float)
+    n = np.asarray(n_vertices)
+    safe_n = np.where(n >= 3, n, 3)
+    polygon = 0.5 * safe_n * radius**2 * np.sin(2 * np.pi / safe_n)
+    return np.where(n >= 3, polygon, np.pi * radius**2)
+
+
 def complete_snapshots(variables) -> np.ndarray:
     """Boolean per snapshot: ``time`` finite and, where the file has it, ``complete == 1``.
 

@@ -117,3 +117,13 @@ def test_lazy_equals_eager():
              ds.grain.strains(), ds.grain.friction_and_dilatancy()]
     for l, e in zip(lazy, eager):
         xr.testing.assert_allclose(l.compute(), e, rtol=1e-13)
+
+
+def test_solid_fraction_of_disks_and_pentagons():
+    from grainview.schema import particle_area
+    assert particle_area(1.0, 0) == pytest.approx(np.pi, rel=RTOL)
+    assert particle_area(1.0, 4) == pytest.approx(2.0, rel=RTOL)  # square of diagonal 2
+    assert particle_area(2.0, 6) == pytest.approx(6 * np.sqrt(3) / 4 * 4, rel=RTOL)  # 6 triangles of side 2
+    ds, h, l, t = box_history()
+    phi = ds.grain.solid_fraction().values
+    np.testing.assert_allclose(phi, 2 * np.pi * builders.R**2 / (h * l), rtol=RTOL)
