@@ -1,0 +1,81 @@
+"""Shared helpers of the benchmarks: machine description, medians of repeated timings, peak
+memory of a measurement run in a fresh process, Markdown tables."""
+
+from __future__ import annotations
+
+import datetime
+import multiprocessing as mp
+import os
+import platform
+import resource
+import statistics
+import subprocess
+import time
+
+
+def machine_description() -> str:
+    """One Markdown paragraph: date, CPU, cores, memory, Python and library versions."""
+    import dask
+    import numba
+    import numpy
+    import xarray
+
+    cpu = platform.processor() or "unknown CPU"
+    try:
+        with open("/proc/cpuinfo") as fh:
+            for line in fh:
+                if line.startswith("model name"):
+                    cpu = line.split(":", 1)[1].strip()
+                    break
+    except OSError:
+        pass
+    mem_gib = os.sysconf("SC_PAGE_SIZE") * os.sysconf("SC_PHYS_PAGES") / 2**30
+    try:
+        commit = subprocess.run(["git", "rev-parse", "--short", "HEAD"], capture_output=True, text=True,
+                                cwd=os.path.dirname(__file__)).stdout.strip()
+    except OSError:
+        commit = "?"
+    return (f"Run on {datetime.datetime.now(datetime.timezone.utc):%Y-%m-%d %H:%M UTC}, commit {commit}; "
+            f"{cpu}, {os.cpu_count()} cores, {mem_gib:.0f} GiB; Python {platform.python_version()}, "
+            f"numpy {numpy.__version__}, numba {numba.__version__}, xarray {xarray.__version__}, "
+            f"dask {dask.__version__}.")
+
+
+def median_time(func, repeats=5, warmup=1):
+    """Median wall time of ``func()`` over ``repeats`` calls after ``warmup`` calls (s)."""
+    for _ in range(warmup):
+        func()
+    times = []
+    for _ in range(repeats):
+        start = time.perf_counter()
+        func()
+        times.append(time.perf_counter() - start)
+    return statistics.median(times), times
+
+
+def _child(queue, func, args):
+    try:
+        result = func(*args)
+        peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024  # MiB on Linux
+        queue.put((result, peak, None))
+    except BaseException as exc:  # report, do not hang the parent
+        queue.put((None, None, repr(exc)))
+
+
+def in_fresh_process(func, *args):
+    """Run ``func(*args)`` in a fresh process; return (result, peak resident memory in MiB)."""
+    ctx = mp.get_context("spawn")
+    queue = ctx.Queue()
+    proc = ctx.Process(target=_child, args=(queue, func, args))
+    proc.start()
+    result, peak, error = queue.get()
+    proc.join()
+    if error:
+        raise RuntimeError(f"benchmark child failed: {error}")
+    return result, peak
+
+
+def markdown_table(header, rows) -> str:
+    lines = ["| " + " | ".join(header) + " |", "|" + "---|" * len(header)]
+    lines += ["| " + " | ".join(str(c) for c in row) + " |" for row in rows]
+    return "\n".join(lines)
