@@ -1,0 +1,123 @@
+"""The pentagons-versus-disks report: the paper's headline numbers next to a run's own, and
+every figure the data supports.
+
+:func:`headline_table` reduces each run to the numbers the paper quotes (ERRATA.md,
+"Reference figures"), averaged over its *residual state* (the snapshots with eps_q in the last
+``residual`` fraction of the run); :func:`write_report` writes that table as CSV and
+Markdown and draws the figures.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+import xarray as xr
+
+from .errors import ParameterError
+
+# The paper's values (ERRATA.md, "Reference figures"); strings where the paper gives no number.
+PAPER = {
+    "pentagons": {
+        "q/p (residual)": 0.35, "solid fraction (initial)": 0.80, "z (initial)": 3.20, "z (residual)": 3.75,
+        "a (residual)": "small (nearly isotropic)", "a_n (residual)": "larger than disks",
+        "a_t (residual)": "close to a_n", "alpha (strong-force pdf)": 0.74, "weak fraction": 0.58,
+        "very weak fraction": 0.32, "very weak simple": 0.25, "very weak double": 0.07,
+        "k_s": "> k_d", "k_d": "< k_s", "f_d / f_s": 1.5, "k_s^S / k_d^S": 0.5, "k_s^W / k_d^W": 2.0,
+    },
+    "disks": {
+        "q/p (residual)": 0.28, "solid fraction (initial)": 0.82, "z (initial)": 3.95, "z (residual)": 3.85,
+        "a (residual)": "up to ~0.3", "a_n (residual)": "smaller than pentagons",
+        "a_t (residual)": "about a_n/2", "alpha (strong-force pdf)": 1.4, "weak fraction": 0.62,
+        "very weak fraction": "-", "very weak simple": "-", "very weak double": "-",
+        "k_s": 1.0, "k_d": 0.0, "f_d / f_s": "-", "k_s^S / k_d^S": "-", "k_s^W / k_d^W": "-",
+    },
+}
+
+
+def residual_times(ds: xr.Dataset, residual: float = 0.3) -> xr.DataArray:
+    """Boolean (time,): the snapshots of the residual state, eps_q >= (1 - residual) max eps_q."""
+    if not 0 < residual <= 1:
+        raise ParameterError(f"residual={residual!r}: expected a fraction in (0, 1]")
+    eps_q = ds.grain.strains()["eps_q"].compute()
+    return eps_q >= (1 - residual) * float(eps_q.max())
+
+
+def _ratio(a, b):
+    return float(a) / float(b) if float(b) != 0 else float("nan")
+
+
+def run_summary(ds: xr.Dataset, residual: float = 0.3) -> dict:
+    """The headline numbers of one run (keys as in :data:`PAPER`)."""
+    from .force_networks import contact_proportions
+    from .force_pdf import pooled_force_pdf, strong_force_exponent
+
+    late = residual_times(ds, residual)
+    res = ds.isel(time=np.flatnonzero(late.values))
+
+    def mean(da):
+        return float(da.mean("time").compute())
+
+    prop = contact_proportions(res).mean("time").compute()
+    alpha = strong_force_exponent(pooled_force_pdf(res, scale="linear", bins=40, range=(0.0, 6.0)))
+    anis = res.grain.harmonic_prediction()
+    return {
+        "q/p (residual)": mean(res.grain.stress_invariants()["q_over_p"]),
+        "solid fraction (initial)": float(ds.grain.solid_fraction().isel(time=0)),
+        "z (initial)": float(ds.grain.coordination()["z"].isel(time=0)),
+        "z (residual)": mean(res.grain.coordination()["z"]),
+        "a (residual)": mean(res.grain.fabric_anisotropy()["a"]),
+        "a_n (residual)": mean(anis["a_n"]),
+        "a_t (residual)": mean(anis["a_t"]),
+        "alpha (strong-force pdf)": float(alpha),
+        "weak fraction": float(prop["weak_fraction"]),
+        "very weak fraction": float(prop["very_weak_fraction"]),
+        "very weak simple": float(prop["very_weak_simple"]),
+        "very weak double": float(prop["very_weak_double"]),
+        "k_s": float(prop["k_s"]),
+        "k_d": float(prop["k_d"]),
+        "f_d / f_s": _ratio(prop["f_d"], prop["f_s"]),
+        "k_s^S / k_d^S": _ratio(prop["k_s_strong"], prop["k_d_strong"]),
+        "k_s^W / k_d^W": _ratio(prop["k_s_weak"], prop["k_d_weak"]),
+    }
+
+
+def headline_table(runs: dict, residual: float = 0.3) -> pd.DataFrame:
+    """One row per headline quantity; for each run a column of its value and, where the run's
+    label names a shape of the paper ("pentagons", "disks"), a column of the paper's value."""
+    if not runs:
+        raise ParameterError("runs is empty: expected {label: dataset}")
+    columns = {}
+    for label, ds in runs.items():
+        columns[f"{label} (this run)"] = run_summary(ds, residual)
+        paper = PAPER.get(paper_key(label))
+        if paper is not None:
+            columns[f"{label} (paper)"] = paper
+    return pd.DataFrame(columns)
+
+
+def paper_key(label: str) -> str | None:
+    """The paper's sample a run label refers to: "pentagons" (S1), "disks" (S2) or None."""
+    low = label.lower()
+    if "pent" in low or "s1" in low:
+        return "pentagons"
+    if "disk" in low or "disc" in low or "s2" in low:
+        return "disks"
+    return None
+
+
+def write_table(table: pd.DataFrame, out: Path) -> list[Path]:
+    """Write ``table`` as ``headline.csv`` and ``headline.md`` in ``out``."""
+    out = Path(out)
+    out.mkdir(parents=True, exist_ok=True)
+    csv, md = out / "headline.csv", out / "headline.md"
+    table.to_csv(csv)
+
+    def fmt(v):
+        return f"{v:.3f}" if isinstance(v, (float, np.floating)) and np.isfinite(v) else str(v)
+
+    lines = ["| quantity | " + " | ".join(table.columns) + " |", "|---" * (len(table.columns) + 1) + "|"]
+    lines += ["| " + " | ".join([str(idx), *(fmt(v) for v in row)]) + " |" for idx, row in table.iterrows()]
+    md.write_text("\n".join(lines) + "\n")
+    return [csv, md]
