@@ -61,3 +61,11 @@ class GrainAccessor:
     force_tensors = _delegate(forces.force_tensors)
     force_anisotropies = _delegate(forces.force_anisotropies)
     harmonic_prediction = _delegate(forces.harmonic_prediction)
+
+    @property
+    def plot(self):
+        """The paper's figures drawn from this dataset: ``ds.grain.plot.<name>(...)``
+        (:mod:`grainview.plot`; matplotlib is imported on first use)."""
+        from .plot import PlotAccessor
+
+        return PlotAccessor(self._ds)

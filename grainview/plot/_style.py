@@ -1,0 +1,242 @@
+"""Shared helpers of the figure modules: which datasets to draw, which snapshots, axis labels
+with units taken from the ``units`` attributes, legends, and saving a figure as PNG and PDF.
+
+Every figure function of :mod:`grainview.plot` takes either one dataset of the contract, or
+several to compare on the same axes as a dict ``{label: ds}`` or a list of ``(label, ds)``
+pairs; :func:`datasets` turns any of these into a list of ``(label, ds)``.
+"""
+
+from __future__ import annotations
+
+import re
+from pathlib import Path
+
+import numpy as np
+import xarray as xr
+
+from ..errors import ParameterError
+
+EPS_Q_LABEL = r"$\varepsilon_q$"
+"""Label of the x axis of every evolution (shear strain, dimensionless)."""
+
+DIMENSIONLESS = ("", "1", None)
+
+
+# -- which data --------------------------------------------------------------------------------
+
+def datasets(data, label: str | None = None) -> list[tuple[str | None, xr.Dataset]]:
+    """``[(label, ds), ...]`` from one dataset, a dict ``{label: ds}`` or a list of pairs.
+
+    A single dataset gets ``label`` (None: no legend entry)."""
+    if isinstance(data, xr.Dataset):
+        return [(label, data)]
+    if isinstance(data, dict):
+        pairs = list(data.items())
+    elif isinstance(data, (list, tuple)):
+        pairs = list(data)
+    else:
+        raise ParameterError(f"data={type(data).__name__}: expected a dataset, a dict {{label: dataset}} "
+                             "or a list of (label, dataset) pairs")
+    if not pairs:
+        raise ParameterError("data is empty: expected at least one dataset")
+    for pair in pairs:
+        if not (isinstance(pair, (list, tuple)) and len(pair) == 2 and isinstance(pair[1], xr.Dataset)):
+            raise ParameterError(f"data item {pair!r}: expected a (label, dataset) pair")
+    return [(str(lab), ds) for lab, ds in pairs]
+
+
+def single_dataset(data, label: str | None = None) -> tuple[str | None, xr.Dataset]:
+    """The one ``(label, ds)`` of ``data``; a map or a grey-level diagram draws one sample."""
+    pairs = datasets(data, label)
+    if len(pairs) != 1:
+        raise ParameterError(f"data holds {len(pairs)} datasets: this figure draws one sample at a time "
+                             "(call it once per sample, on separate axes)")
+    return pairs[0]
+
+
+def select_snapshots(ds: xr.Dataset, time="residual", residual: float = 0.3) -> xr.Dataset:
+    """The snapshots a distribution is averaged over.
+
+    ``time``: an integer snapshot index (``-1`` the last); ``"residual"`` the residual state,
+    i.e. the snapshots with eps_q >= (1 - ``residual``) max eps_q
+    (:func:`grainview.report.residual_times`); ``"all"`` or None every snapshot; a slice or a
+    sequence of indices.
+    """
+    n = ds.sizes["time"]
+    if time is None or (isinstance(time, str) and time == "all"):
+        return ds
+    if isinstance(time, str) and time == "residual":
+        from ..report import residual_times  # local: report draws figures with this package
+        keep = np.flatnonzero(np.asarray(residual_times(ds, residual)))
+        return ds.isel(time=keep)
+    if isinstance(time, (int, np.integer)) and not isinstance(time, bool):
+        if not -n <= time < n:
+            raise ParameterError(f"time={time}: expected a snapshot index in [{-n}, {n})")
+        return ds.isel(time=[int(time)])
+    if isinstance(time, slice):
+        return ds.isel(time=time)
+    try:
+        idx = np.asarray(time, dtype=int)
+    except (TypeError, ValueError):
+        idx = None
+    if idx is None or idx.ndim != 1 or idx.size == 0 or (idx < -n).any() or (idx >= n).any():
+        raise ParameterError(f"time={time!r}: expected 'residual', 'all', a snapshot index, a slice "
+                             f"or a sequence of indices in [{-n}, {n})")
+    return ds.isel(time=idx)
+
+
+def snapshot_index(ds: xr.Dataset, time=-1) -> int:
+    """A single snapshot index (maps draw one snapshot); negative counts from the end."""
+    n = ds.sizes["time"]
+    if not isinstance(time, (int, np.integer)) or isinstance(time, bool) or not -n <= time < n:
+        raise ParameterError(f"time={time!r}: expected one snapshot index in [{-n}, {n})")
+    return int(time) % n
+
+
+def time_mean(da: xr.DataArray) -> xr.DataArray:
+    """Average over the snapshots (NaN-aware), computed; attributes kept."""
+    out = da.mean("time", skipna=True, keep_attrs=True) if "time" in da.dims else da
+    return out.compute()
+
+
+def eps_q(ds: xr.Dataset) -> np.ndarray:
+    """Shear strain eps_q of every snapshot (:func:`grainview.strain.strains`), as numbers."""
+    from ..strain import strains
+    return np.asarray(strains(ds)["eps_q"].values, dtype=float)
+
+
+def values(da: xr.DataArray) -> np.ndarray:
+    """The numbers of ``da`` (computing a lazy one) as a float array."""
+    return np.asarray(da.values, dtype=float)
+
+
+# -- axes and labels ---------------------------------------------------------------------------
+
+def get_axes(ax=None, polar: bool = False):
+    """``ax`` itself, or new axes on a new figure (polar ones when asked)."""
+    if ax is not None:
+        if polar and getattr(ax, "name", "") != "polar":
+            raise ParameterError("ax: this figure needs polar axes (subplot_kw={'projection': 'polar'})")
+        return ax
+    import matplotlib.pyplot as plt
+    _, ax = plt.subplots(subplot_kw={"projection": "polar"} if polar else None)
+    return ax
+
+
+def new_figure(n_panels: int, polar: bool = False, width: float = 4.5, height: float = 3.6):
+    """A figure with ``n_panels`` axes side by side; returns (figure, list of axes)."""
+    import matplotlib.pyplot as plt
+    fig, axes = plt.subplots(1, n_panels, figsize=(width * n_panels, height), squeeze=False,
+                             subplot_kw={"projection": "polar"} if polar else None, layout="constrained")
+    return fig, list(axes[0])
+
+
+def format_units(units) -> str:
+    """CF-style units ("rad-1", "kg m2", "m s-1") as mathtext ("rad$^{-1}$", "kg m$^{2}$")."""
+    if units in DIMENSIONLESS:
+        return ""
+    return re.sub(r"([A-Za-z]+)(-?\d+)", r"\1$^{\2}$", str(units))
+
+
+def axis_label(symbol: str, units=None) -> str:
+    """``"symbol (units)"``, or ``symbol`` alone when the quantity is dimensionless."""
+    text = format_units(units)
+    return f"{symbol} ({text})" if text else symbol
+
+
+def units_of(da: xr.DataArray) -> str | None:
+    """The ``units`` attribute of ``da`` (None when absent)."""
+    return da.attrs.get("units")
+
+
+def set_labels(ax, xlabel: str | None = None, ylabel: str | None = None):
+    """Set the axis labels that are given."""
+    if xlabel is not None:
+        ax.set_xlabel(xlabel)
+    if ylabel is not None:
+        ax.set_ylabel(ylabel)
+
+
+def finish(ax, pairs, title: str | None = None):
+    """Legend when any curve is labelled, and the title."""
+    polar = getattr(ax, "name", "") == "polar"
+    handles, labels = ax.get_legend_handles_labels()
+    if labels:
+        if polar:
+            ax.legend(fontsize="small", loc="upper left", bbox_to_anchor=(1.0, 1.1))
+        else:
+            ax.legend(fontsize="small")
+    if polar:
+        radian_ticks(ax)
+    if title:
+        ax.set_title(title, pad=14 if polar else None)
+    return ax
+
+
+PI_TICK_LABELS = ["0", r"$\pi/4$", r"$\pi/2$", r"$3\pi/4$", r"$\pi$", r"$5\pi/4$", r"$3\pi/2$", r"$7\pi/4$"]
+
+
+def radian_ticks(ax):
+    """Angular ticks of polar axes at multiples of pi/4, labelled in rad."""
+    ax.set_xticks(np.arange(8) * np.pi / 4, PI_TICK_LABELS)
+
+
+def series_label(dataset_label: str | None, curve: str | None) -> str | None:
+    """Legend entry of one curve: "dataset, curve", either part alone, or None."""
+    parts = [p for p in (dataset_label, curve) if p]
+    return ", ".join(parts) if parts else None
+
+
+# -- saving ------------------------------------------------------------------------------------
+
+def save_figure(fig, path, dpi: int = 150) -> list[Path]:
+    """Write ``fig`` (a Figure, or Axes whose figure is meant) as ``path.png`` and
+    ``path.pdf``; ``path`` has no suffix. Parent folders are created. Returns both paths."""
+    figure = getattr(fig, "figure", fig) if not hasattr(fig, "savefig") else fig
+    if not hasattr(figure, "savefig"):
+        raise ParameterError(f"fig={type(fig).__name__}: expected a matplotlib Figure or Axes")
+    base = Path(path)
+    if base.suffix.lower() in (".png", ".pdf"):
+        base = base.with_suffix("")
+    base.parent.mkdir(parents=True, exist_ok=True)
+    out = [base.with_name(base.name + ".png"), base.with_name(base.name + ".pdf")]
+    figure.savefig(out[0], dpi=dpi)
+    figure.savefig(out[1])
+    return out
+
+
+# -- evolutions --------------------------------------------------------------------------------
+
+LINESTYLES = ("-", "--", ":", "-.")
+
+
+def next_colour(ax) -> str:
+    """The first colour of the default cycle not yet used by a line of ``ax``, so that
+    samples drawn by successive calls on the same axes get different colours."""
+    used = {line.get_color() for line in ax.lines}
+    for k in range(10):
+        if f"C{k}" not in used:
+            return f"C{k}"
+    return f"C{len(used) % 10}"
+
+
+def draw_evolutions(ax, pairs, compute, curves, marker: str = "", **line_kw):
+    """One line per (dataset, curve) against eps_q.
+
+    ``compute(ds)`` returns a Dataset (or a DataArray) over time; ``curves`` lists
+    ``(curve_label, variable_name)`` of it (a name None takes the DataArray itself). The curves
+    of one sample share its colour and differ by line style; samples differ by colour.
+    Returns the drawn DataArrays (computed), in drawing order.
+    """
+    drawn = []
+    given = line_kw.pop("color", None)
+    for label, ds in pairs:
+        x = eps_q(ds)
+        result = compute(ds).compute()
+        colour = given if given is not None and len(pairs) == 1 else next_colour(ax)
+        for k, (curve_label, name) in enumerate(curves):
+            y = result if name is None else result[name]
+            ax.plot(x, values(y), LINESTYLES[k % len(LINESTYLES)], marker=marker, color=colour,
+                    label=series_label(label, curve_label), **line_kw)
+            drawn.append(y)
+    return drawn

@@ -1,0 +1,296 @@
+"""Figures of force transmission (paper Sec. V and VI): polar <f_n>(theta), <f_t>(theta)
+(Fig. 10), force anisotropies a_n, a_t (Fig. 11), normal-force pdfs with the exponential fit of
+the strong forces (Fig. 14), the xi-network's q(xi)/p and a'(xi) (Figs. 15, 16), the proportions
+k_s, k_d, f_s, f_d (Fig. 19), the s->d and d->s transitions (Fig. 20), pdfs per contact kind
+(Fig. 23) and the strong/weak proportions k_s^S, k_s^W, k_d^S, k_d^W (Fig. 25).
+
+Distributions are averaged over the snapshots chosen by ``time`` (default ``"residual"``, see
+:func:`grainview.plot._style.select_snapshots`); evolutions are drawn against eps_q.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import xarray as xr
+
+from ..errors import ParameterError
+from ..forces import angular_force_averages, force_anisotropies
+from ._style import (EPS_Q_LABEL, axis_label, datasets, draw_evolutions, finish, get_axes, new_figure,
+                     next_colour, select_snapshots, series_label, set_labels, time_mean, units_of, values)
+from .texture import full_turn
+
+FORCE_RATIO_LABEL = r"$f_n/\langle f_n\rangle$"
+XI_LABEL = r"$\xi$"
+
+
+# -- Fig. 10: angular averages -----------------------------------------------------------------
+
+def angular_profile(ds: xr.Dataset, component: str = "fn", time="residual", bins: int = 36, kind="all",
+                    walls: bool = False, normalise: bool = True) -> xr.DataArray:
+    """<f_n>(theta) (``component="fn"``) or <f_t>(theta) (``"ft"``) on ``bins`` sectors of
+    [0, pi), averaged over the snapshots ``time`` (:func:`grainview.forces.angular_force_averages`,
+    paper Eq. fnft). With ``normalise`` each snapshot's profile is divided by that snapshot's
+    mean normal force <f_n> over the same contacts (dimensionless); otherwise in N."""
+    if component not in ("fn", "ft"):
+        raise ParameterError(f"component={component!r}: expected 'fn' or 'ft'")
+    avg = angular_force_averages(select_snapshots(ds, time), bins=bins, kind=kind, walls=walls)
+    profile = avg[f"{component}_mean"]
+    if normalise:
+        count = avg["count"]
+        mean_fn = (avg["fn_mean"].fillna(0) * count).sum("theta") / count.sum("theta")
+        profile = (profile / mean_fn).assign_attrs(units="1", long_name=profile.attrs["long_name"] + " / <f_n>")
+    return time_mean(profile)
+
+
+def plot_normal_force_polar(data, ax=None, label=None, time="residual", bins: int = 36, kind="all",
+                            walls: bool = False, normalise: bool = True, **line_kw):
+    """Polar plot of the angle-averaged normal force <f_n>(theta) (paper Fig. 10a), divided by
+    <f_n> unless ``normalise=False`` (then N). Drawn over the full turn (pi-periodic)."""
+    return _polar(data, ax, label, "fn", r"\langle f_n\rangle(\theta)", time, bins, kind, walls, normalise,
+                  line_kw)
+
+
+def plot_tangential_force_polar(data, ax=None, label=None, time="residual", bins: int = 36, kind="all",
+                                walls: bool = False, normalise: bool = True, **line_kw):
+    """Polar plot of the magnitude |<f_t>(theta)| of the angle-averaged tangential force
+    (paper Fig. 10b), divided by <f_n> unless ``normalise=False`` (then N). A polar radius
+    cannot be negative: the sign of <f_t>(theta), that of -sin 2(theta - theta_t), is dropped."""
+    return _polar(data, ax, label, "ft", r"|\langle f_t\rangle(\theta)|", time, bins, kind, walls, normalise,
+                  line_kw)
+
+
+def _polar(data, ax, label, component, symbol, time, bins, kind, walls, normalise, line_kw):
+    ax = get_axes(ax, polar=True)
+    for lab, ds in datasets(data, label):
+        profile = angular_profile(ds, component, time, bins, kind, walls, normalise)
+        r = values(profile)
+        r = np.abs(r) if component == "ft" else r
+        theta, r = full_turn(profile["theta"].values, r)
+        ax.plot(theta, r, color=next_colour(ax), label=lab, **line_kw)
+    ax.set_xlabel(axis_label(r"$\theta$", "rad"))
+    title = "$" + symbol + (r"/\langle f_n\rangle" if normalise else "") + "$"
+    return finish(ax, None, title=axis_label(title, units_of(profile)))
+
+
+def plot_angular_forces(data, label=None, **kw):
+    """Figure of paper Fig. 10: (a) <f_n>(theta) and (b) |<f_t>(theta)| in polar axes."""
+    fig, (ax_n, ax_t) = new_figure(2, polar=True)
+    plot_normal_force_polar(data, ax_n, label, **kw)
+    plot_tangential_force_polar(data, ax_t, label, **kw)
+    return fig
+
+
+# -- Fig. 11: force anisotropies ---------------------------------------------------------------
+
+def plot_force_anisotropy(data, ax=None, label=None, component: str = "a_n", bins: int = 36,
+                          walls: bool = False, **line_kw):
+    """Signed force anisotropy a_n (``component="a_n"``) or a_t (``"a_t"``) against eps_q
+    (paper Fig. 11, ERRATA 3 and "Signs"; :func:`grainview.forces.force_anisotropies`)."""
+    if component not in ("a_n", "a_t"):
+        raise ParameterError(f"component={component!r}: expected 'a_n' or 'a_t'")
+    ax = get_axes(ax)
+    draw_evolutions(ax, datasets(data, label), lambda ds: force_anisotropies(ds, bins, walls=walls),
+                    [(None, component)], **line_kw)
+    set_labels(ax, EPS_Q_LABEL, f"${component}$")
+    return finish(ax, None)
+
+
+def plot_force_anisotropies(data, label=None, **kw):
+    """Figure of paper Fig. 11: (a) a_n and (b) a_t against eps_q."""
+    fig, (ax_n, ax_t) = new_figure(2)
+    plot_force_anisotropy(data, ax_n, label, "a_n", **kw)
+    plot_force_anisotropy(data, ax_t, label, "a_t", **kw)
+    return fig
+
+
+# -- Figs. 14 and 23: force pdfs ---------------------------------------------------------------
+
+SCALES = {"log-linear": "linear", "log-log": "log"}
+
+
+def force_pdf_of(ds: xr.Dataset, scale: str = "log-linear", time="residual", bins: int = 40,
+                 range=None, kind="all", walls: bool = False) -> xr.Dataset:
+    """The pdf of f_n/<f_n> over the snapshots ``time`` (contacts pooled over them), with linear
+    bins for ``scale="log-linear"`` and logarithmic bins for ``"log-log"``
+    (:func:`grainview.force_pdf.pooled_force_pdf`). Variables ``pdf`` (bin) and coordinate
+    ``f_over_mean`` (bin centres)."""
+    from ..force_pdf import pooled_force_pdf
+    if scale not in SCALES:
+        raise ParameterError(f"scale={scale!r}: expected 'log-linear' or 'log-log'")
+    if range is None and scale == "log-linear":
+        range = (0.0, 6.0)
+    pdf = pooled_force_pdf(select_snapshots(ds, time), bins=bins, scale=SCALES[scale], range=range, kind=kind,
+                           walls=walls)
+    if "time" in pdf.dims:
+        pdf = pdf.mean("time", keep_attrs=True)
+    return pdf.compute()
+
+
+def exponential_fit(pdf: xr.Dataset, alpha: float, threshold: float = 1.0) -> float:
+    """Prefactor A of P = A exp(-alpha f/<f_n>) given alpha
+    (:func:`grainview.force_pdf.strong_force_exponent`): the intercept of that weighted least
+    squares fit of ln P = ln A - alpha x, i.e. the count-weighted mean of ln P + alpha x over
+    the bins above ``threshold`` that hold contacts."""
+    x = np.asarray(pdf["f_over_mean"].values, float)
+    p = values(pdf["pdf"])
+    weight = values(pdf["count"]) if "count" in pdf else np.ones_like(p)
+    keep = (x > threshold) & (p > 0) & np.isfinite(p) & (weight > 0)
+    if not keep.any() or not np.isfinite(alpha):
+        return float("nan")
+    return float(np.exp(np.average(np.log(p[keep]) + alpha * x[keep], weights=weight[keep])))
+
+
+def plot_force_pdf(data, ax=None, label=None, scale: str = "log-linear", time="residual", bins: int = 40,
+                   range=None, kind="all", walls: bool = False, fit: bool = True, **line_kw):
+    """Pdf P of the normal forces f_n/<f_n> (paper Fig. 14) in log-linear (``scale=
+    "log-linear"``, linear bins on [0, 6] by default) or log-log scales (logarithmic bins).
+
+    With ``fit`` (log-linear only) a dashed line P = A exp(-alpha f_n/<f_n>) over the strong
+    forces (f_n > <f_n>) is drawn after each sample's pdf, alpha from
+    :func:`grainview.force_pdf.strong_force_exponent` given in the legend. Empty bins are not
+    drawn. Lines per sample: the pdf, then the fit when drawn."""
+    from ..force_pdf import strong_force_exponent
+    ax = get_axes(ax)
+    for lab, ds in datasets(data, label):
+        pdf = force_pdf_of(ds, scale, time, bins, range, kind, walls)
+        _draw_pdf(ax, pdf, lab, next_colour(ax), line_kw)
+        if fit and scale == "log-linear":
+            alpha = float(strong_force_exponent(pdf))
+            _draw_fit(ax, pdf, alpha, lab, ax.lines[-1].get_color())
+    _pdf_axes(ax, scale)
+    return finish(ax, None)
+
+
+def _draw_pdf(ax, pdf, label, colour, line_kw, style="o-"):
+    x = np.asarray(pdf["f_over_mean"].values, float)
+    p = values(pdf["pdf"])
+    keep = p > 0
+    ax.plot(x[keep], p[keep], style, markersize=3, color=colour, label=label, **line_kw)
+
+
+def _draw_fit(ax, pdf, alpha, label, colour):
+    prefactor = exponential_fit(pdf, alpha)
+    x = np.asarray(pdf["f_over_mean"].values, float)
+    x = x[x > 1.0]
+    ax.plot(x, prefactor * np.exp(-alpha * x), "--", color=colour, linewidth=1,
+            label=series_label(label, rf"$\exp(-{alpha:.2f}\, f_n/\langle f_n\rangle)$"))
+
+
+def _pdf_axes(ax, scale):
+    ax.set_yscale("log")
+    if scale == "log-log":
+        ax.set_xscale("log")
+    set_labels(ax, FORCE_RATIO_LABEL, "$P$")
+
+
+def plot_force_pdfs(data, label=None, **kw):
+    """Figure of paper Fig. 14: (a) log-linear and (b) log-log pdfs of f_n/<f_n>."""
+    fig, (ax_lin, ax_log) = new_figure(2)
+    plot_force_pdf(data, ax_lin, label, scale="log-linear", **kw)
+    plot_force_pdf(data, ax_log, label, scale="log-log", **kw)
+    return fig
+
+
+def plot_force_pdf_by_kind(data, ax=None, label=None, scale: str = "log-linear", time="residual",
+                           bins: int = 40, range=None, walls: bool = False, **line_kw):
+    """Pdfs of f_n/<f_n> for simple (s, solid) and double (d, dashed) contacts (paper Fig. 23),
+    each normalised over its own contacts (:func:`grainview.force_pdf.pooled_force_pdf` with
+    ``kind``). Two lines per sample: s then d."""
+    ax = get_axes(ax)
+    for lab, ds in datasets(data, label):
+        colour = next_colour(ax)
+        for kind, name, style in (("simple", "s", "o-"), ("double", "d", "s--")):
+            pdf = force_pdf_of(ds, scale, time, bins, range, kind, walls)
+            _draw_pdf(ax, pdf, series_label(lab, name), colour, line_kw, style)
+    _pdf_axes(ax, scale)
+    return finish(ax, None)
+
+
+def plot_force_pdfs_by_kind(data, label=None, **kw):
+    """Figure of paper Fig. 23: pdfs per contact kind, (a) log-linear and (b) log-log."""
+    fig, (ax_lin, ax_log) = new_figure(2)
+    plot_force_pdf_by_kind(data, ax_lin, label, scale="log-linear", **kw)
+    plot_force_pdf_by_kind(data, ax_log, label, scale="log-log", **kw)
+    return fig
+
+
+# -- Figs. 15, 16: the xi-network --------------------------------------------------------------
+
+def xi_profile(ds: xr.Dataset, xi=None, time="residual") -> xr.Dataset:
+    """q(xi)/p, a'(xi) and the contact fraction of the xi-network (contacts f_n < xi <f_n>;
+    ERRATA 5; :func:`grainview.xi_network.xi_network`, whose cutoffs are the default),
+    averaged over the snapshots ``time``."""
+    from ..xi_network import xi_network
+    subset = select_snapshots(ds, time)
+    result = xi_network(subset) if xi is None else xi_network(subset, xi=np.asarray(xi, float))
+    return result.mean("time", keep_attrs=True).compute()
+
+
+def plot_xi_stress(data, ax=None, label=None, xi=None, time="residual", **line_kw):
+    """Partial shear stress q(xi)/p of the contacts f_n < xi <f_n> against the cutoff xi
+    (paper Fig. 15; divided by the p of the whole sample, ERRATA 5)."""
+    return _xi(data, ax, label, xi, time, "q_over_p", r"$q(\xi)/p$", line_kw)
+
+
+def plot_xi_anisotropy(data, ax=None, label=None, xi=None, time="residual", **line_kw):
+    """Partial fabric anisotropy a'(xi) of the contacts f_n < xi <f_n> against the cutoff xi
+    (paper Fig. 16; signed against the whole sample's major stress direction, ERRATA 5)."""
+    return _xi(data, ax, label, xi, time, "a_prime", r"$a'(\xi)$", line_kw)
+
+
+def _xi(data, ax, label, xi, time, name, ylabel, line_kw):
+    ax = get_axes(ax)
+    for lab, ds in datasets(data, label):
+        prof = xi_profile(ds, xi, time)
+        ax.plot(np.asarray(prof["xi"].values, float), values(prof[name]), "o-", markersize=3,
+                color=next_colour(ax), label=lab, **line_kw)
+    set_labels(ax, XI_LABEL, ylabel)
+    return finish(ax, None)
+
+
+# -- Figs. 19, 20, 25: proportions and transitions ---------------------------------------------
+
+def plot_contact_proportions(data, ax=None, label=None, **line_kw):
+    """Proportions k_s, k_d of simple and double contacts and the relative force averages
+    f_s = k_s <f_n>_s/<f_n>, f_d = k_d <f_n>_d/<f_n> (ERRATA 4) against eps_q (paper Fig. 19;
+    :func:`grainview.force_networks.contact_proportions`). Four lines per sample: k_s, k_d,
+    f_s, f_d."""
+    from ..force_networks import contact_proportions
+    ax = get_axes(ax)
+    curves = [("$k_s$", "k_s"), ("$k_d$", "k_d"), ("$f_s$", "f_s"), ("$f_d$", "f_d")]
+    draw_evolutions(ax, datasets(data, label), contact_proportions, curves, **line_kw)
+    set_labels(ax, EPS_Q_LABEL, "proportion")
+    return finish(ax, None)
+
+
+def plot_type_transitions(data, ax=None, label=None, **line_kw):
+    """Cumulative proportions Delta gamma of simple contacts turned double (s->d) and double
+    turned simple (d->s) against eps_q (paper Fig. 20, ERRATA 8;
+    :func:`grainview.persistence.type_transitions`). Two lines per sample."""
+    from ..persistence import type_transitions
+    ax = get_axes(ax)
+    curves = [(r"$s\rightarrow d$", "delta_gamma_s_to_d"), (r"$d\rightarrow s$", "delta_gamma_d_to_s")]
+    draw_evolutions(ax, datasets(data, label), type_transitions, curves, **line_kw)
+    set_labels(ax, EPS_Q_LABEL, r"$\Delta\gamma$")
+    return finish(ax, None)
+
+
+def plot_strong_weak_proportions(data, ax=None, label=None, **line_kw):
+    """Fractions of all contacts that are simple and strong (k_s^S), simple and weak (k_s^W),
+    double and strong (k_d^S), double and weak (k_d^W), strong meaning f_n > <f_n> (ERRATA 4),
+    against eps_q (paper Fig. 25; :func:`grainview.force_networks.contact_proportions`). Four
+    lines per sample in that order."""
+    from ..force_networks import contact_proportions
+    ax = get_axes(ax)
+    curves = [("$k_s^S$", "k_s_strong"), ("$k_s^W$", "k_s_weak"), ("$k_d^S$", "k_d_strong"),
+              ("$k_d^W$", "k_d_weak")]
+    draw_evolutions(ax, datasets(data, label), contact_proportions, curves, **line_kw)
+    set_labels(ax, EPS_Q_LABEL, "proportion")
+    return finish(ax, None)
+
+
+__all__ = ["plot_normal_force_polar", "plot_tangential_force_polar", "plot_angular_forces",
+           "plot_force_anisotropy", "plot_force_anisotropies", "plot_force_pdf", "plot_force_pdfs",
+           "plot_force_pdf_by_kind", "plot_force_pdfs_by_kind", "plot_xi_stress", "plot_xi_anisotropy",
+           "plot_contact_proportions", "plot_type_transitions", "plot_strong_weak_proportions",
+           "angular_profile", "force_pdf_of", "exponential_fit", "xi_profile"]

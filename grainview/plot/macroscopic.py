@@ -1,0 +1,83 @@
+"""Figures of the macroscopic behaviour (paper Sec. III and V): q/p (Fig. 3), eps_p (Fig. 4),
+the stress–dilatancy diagram (Fig. 5), q/p against its harmonic prediction (Fig. 12) and the
+partial q/p of simple and double contacts (Fig. 18), all against the shear strain eps_q.
+
+Each function takes one dataset, a dict ``{label: ds}`` or a list of ``(label, ds)`` and draws
+every sample on the same axes (one colour per sample), returning the axes.
+"""
+
+from __future__ import annotations
+
+import xarray as xr
+
+from ..strain import friction_and_dilatancy, strains
+from ..stress import stress_invariants
+from ..forces import harmonic_prediction
+from ._style import (EPS_Q_LABEL, axis_label, datasets, draw_evolutions, finish, get_axes,
+                     next_colour, set_labels, values)
+
+
+def plot_q_over_p(data, ax=None, label=None, **line_kw):
+    """Normalised shear stress q/p against eps_q (paper Fig. 3).
+
+    q/p from :func:`grainview.stress.stress_invariants` (wall contacts included, ERRATA 1),
+    eps_q from :func:`grainview.strain.strains` (ERRATA 6). Both dimensionless."""
+    ax = get_axes(ax)
+    draw_evolutions(ax, datasets(data, label), stress_invariants, [(None, "q_over_p")], **line_kw)
+    set_labels(ax, EPS_Q_LABEL, "$q/p$")
+    return finish(ax, None)
+
+
+def plot_volumetric_strain(data, ax=None, label=None, **line_kw):
+    """Cumulative volumetric strain eps_p (dilation positive) against eps_q (paper Fig. 4)."""
+    ax = get_axes(ax)
+    draw_evolutions(ax, datasets(data, label), strains, [(None, "eps_p")], **line_kw)
+    set_labels(ax, EPS_Q_LABEL, r"$\varepsilon_p$")
+    return finish(ax, None)
+
+
+def plot_stress_dilatancy(data, ax=None, label=None, incremental: bool = False, **line_kw):
+    """Stress–dilatancy diagram: dilatancy angle psi against friction angle phi, in rad
+    (paper Fig. 5): sin phi = q/p, sin psi = eps_p/eps_q (cumulative) or, with
+    ``incremental=True``, d eps_p/d eps_q (:func:`grainview.strain.friction_and_dilatancy`).
+    Snapshots where psi is undefined (eps_q = 0) leave a gap."""
+    ax = get_axes(ax)
+    name = "psi_incremental" if incremental else "psi"
+    for lab, ds in datasets(data, label):
+        angles = friction_and_dilatancy(ds).compute()
+        ax.plot(values(angles["phi"]), values(angles[name]), "o-", markersize=3, color=next_colour(ax),
+                label=lab, **line_kw)
+    set_labels(ax, axis_label(r"$\varphi$", angles["phi"].attrs["units"]),
+               axis_label(r"$\psi$", angles[name].attrs["units"]))
+    return finish(ax, None)
+
+
+def plot_harmonic_prediction(data, ax=None, label=None, bins: int = 36, **line_kw):
+    """q/p (solid) and its harmonic prediction (a' + a_n + a_t)/2 (dashed) against eps_q
+    (paper Eq. qa, Fig. 12; :func:`grainview.forces.harmonic_prediction`, ``bins`` angular
+    sectors). Two lines per sample, in that order."""
+    ax = get_axes(ax)
+    curves = [("$q/p$", "q_over_p"), ("$(a' + a_n + a_t)/2$", "prediction")]
+    draw_evolutions(ax, datasets(data, label), lambda ds: harmonic_prediction(ds, bins), curves, **line_kw)
+    set_labels(ax, EPS_Q_LABEL, "$q/p$")
+    return finish(ax, None)
+
+
+def plot_partial_q_over_p(data, ax=None, label=None, **line_kw):
+    """q/p of simple contacts (s), double contacts (d) and all contacts (s+d) against eps_q
+    (paper Fig. 18); each partial deviator is divided by the p of the whole sample
+    (:func:`grainview.stress.stress_invariants` with ``kind``). Three lines per sample: s, d,
+    s+d."""
+    ax = get_axes(ax)
+    curves = [("s", "simple"), ("d", "double"), ("s+d", "all")]
+    draw_evolutions(ax, datasets(data, label), _partial_q_over_p, curves, **line_kw)
+    set_labels(ax, EPS_Q_LABEL, "$q/p$")
+    return finish(ax, None)
+
+
+def _partial_q_over_p(ds):
+    return xr.Dataset({kind: stress_invariants(ds, kind)["q_over_p"] for kind in ("simple", "double", "all")})
+
+
+__all__ = ["plot_q_over_p", "plot_volumetric_strain", "plot_stress_dilatancy",
+           "plot_harmonic_prediction", "plot_partial_q_over_p"]

@@ -1,0 +1,170 @@
+"""Maps of one snapshot: the particles (disks and regular polygons) and the normal-force
+network drawn along the branch vectors (paper Figs. 13, 17, 24).
+
+Particles: a disk is a circle of its radius; polygon p with n vertices has vertex k at
+``position[p] + radius[p] (cos(angle[p] + 2 pi k/n), sin(angle[p] + 2 pi k/n))`` (docs/schema.md).
+Contacts: the segment from the centre of body i to ``position[i] + branch``, i.e. to the centre
+of j for a particle pair, or to the contact point for a wall contact. All contacts of a map are
+one :class:`~matplotlib.collections.LineCollection` and all particles one collection per shape
+(no Python loop per contact or particle).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import xarray as xr
+from matplotlib.collections import EllipseCollection, LineCollection, PolyCollection
+
+from ..contacts import selection
+from ._style import axis_label, get_axes, single_dataset, snapshot_index
+
+PARTICLE_FACE = "0.92"
+PARTICLE_EDGE = "0.55"
+CLASS_COLOURS = {1: "tab:blue", 2: "tab:green", 3: "tab:red"}
+"""Colours of the tricolor map: very weak (blue), weak (green), strong (red) (paper Fig. 17)."""
+KIND_COLOURS = {1: "tab:blue", 2: "tab:red"}
+"""Colours of the kind map: simple (blue), double (red) (paper Fig. 24)."""
+
+
+def polygon_vertices(position, radius, angle, n_vertices: int) -> np.ndarray:
+    """(P, n, 2) vertices of P regular n-gons: vertex k at
+    position + radius (cos(angle + 2 pi k/n), sin(angle + 2 pi k/n)), m."""
+    phase = angle[:, None] + 2 * np.pi * np.arange(n_vertices) / n_vertices
+    return position[:, None, :] + radius[:, None, None] * np.stack([np.cos(phase), np.sin(phase)], -1)
+
+
+def plot_particles(data, ax=None, time: int = -1, facecolor=PARTICLE_FACE, edgecolor=PARTICLE_EDGE,
+                   linewidth: float = 0.5):
+    """Draw the particles of snapshot ``time``: disks as one EllipseCollection, the polygons of
+    each vertex count as one PolyCollection. Sets equal aspect, the box as limits, x and y
+    labels in m. Returns the axes."""
+    _, ds = single_dataset(data)
+    ax = get_axes(ax)
+    k = snapshot_index(ds, time)
+    position = np.asarray(ds["position"].isel(time=k).values, float)
+    angle = np.asarray(ds["angle"].isel(time=k).values, float)
+    radius = np.asarray(ds["radius"].values, float)
+    n_vertices = np.asarray(ds["n_vertices"].values, int)
+    style = dict(facecolors=facecolor, edgecolors=edgecolor, linewidths=linewidth, zorder=1)
+    disks = n_vertices == 0
+    if disks.any():
+        ax.add_collection(EllipseCollection(2 * radius[disks], 2 * radius[disks], np.zeros(disks.sum()),
+                                            units="xy", offsets=position[disks], offset_transform=ax.transData,
+                                            **style))
+    for n in np.unique(n_vertices[~disks]):
+        sel = n_vertices == n
+        ax.add_collection(PolyCollection(polygon_vertices(position[sel], radius[sel], angle[sel], int(n)),
+                                         **style))
+    _frame(ax, ds, k)
+    return ax
+
+
+def _frame(ax, ds, k):
+    lo = np.asarray(ds["box_min"].isel(time=k).values, float)
+    hi = np.asarray(ds["box_max"].isel(time=k).values, float)
+    ax.set_xlim(lo[0], hi[0])
+    ax.set_ylim(lo[1], hi[1])
+    ax.set_aspect("equal")
+    ax.set_xlabel(axis_label("$x$", ds["position"].attrs.get("units", "m")))
+    ax.set_ylabel(axis_label("$y$", ds["position"].attrs.get("units", "m")))
+
+
+def contact_segments(ds: xr.Dataset, k: int, mask) -> tuple[np.ndarray, np.ndarray]:
+    """(C, 2, 2) segments from the centre of i along the branch vector, and the slot indices
+    of the C contacts of snapshot ``k`` selected by the boolean ``mask`` (contact,), m."""
+    slots = np.flatnonzero(np.asarray(mask, bool))
+    snap = ds.isel(time=k, contact=slots)
+    i = np.asarray(snap["i"].values, int)
+    start = np.asarray(ds["position"].isel(time=k).values, float)[i]
+    end = start + np.asarray(snap["branch"].values, float)
+    return np.stack([start, end], axis=1), slots
+
+
+def force_linewidths(fn, max_linewidth: float) -> np.ndarray:
+    """Line widths proportional to the normal force: max_linewidth * f_n / max f_n (points)."""
+    fn = np.asarray(fn, float)
+    top = fn.max() if fn.size else 0.0
+    return max_linewidth * fn / top if top > 0 else np.zeros_like(fn)
+
+
+def _network(ds, k, mask, colours, ax, max_linewidth, width_by_force, linewidth, particles, zorder=2):
+    if particles:
+        plot_particles(ds, ax, time=k)
+    else:
+        _frame(ax, ds, k)
+    segments, slots = contact_segments(ds, k, mask)
+    fn = np.asarray(ds["fn"].isel(time=k).values, float)[slots]
+    widths = force_linewidths(fn, max_linewidth) if width_by_force else np.full(slots.size, linewidth)
+    colours = colours(slots) if callable(colours) else colours
+    lines = LineCollection(segments, linewidths=widths, colors=colours, capstyle="round", zorder=zorder)
+    lines.set_gid("contacts")
+    ax.add_collection(lines)
+    return lines
+
+
+def contact_collection(ax) -> LineCollection:
+    """The LineCollection of contacts drawn by a map on ``ax``."""
+    for coll in ax.collections:
+        if isinstance(coll, LineCollection) and coll.get_gid() == "contacts":
+            return coll
+    raise LookupError("no contact map on these axes")
+
+
+def plot_force_chains(data, ax=None, time: int = -1, walls: bool = False, max_linewidth: float = 3.0,
+                      colour="k", particles: bool = True):
+    """Map of the normal forces of snapshot ``time`` (paper Fig. 13): each force-bearing
+    contact (f_n > 0) a segment along its branch vector, of width proportional to f_n
+    (``max_linewidth`` points for the largest force), over the particles. Wall contacts only
+    with ``walls=True``. Returns the axes."""
+    _, ds = single_dataset(data)
+    ax = get_axes(ax)
+    k = snapshot_index(ds, time)
+    mask = selection(ds.isel(time=k), walls=walls, force_bearing=True).values
+    _network(ds, k, mask, colour, ax, max_linewidth, True, None, particles)
+    return ax
+
+
+def plot_force_classes(data, ax=None, time: int = -1, walls: bool = False, very_weak: float = 0.1,
+                       strong: float = 1.0, width_by_force: bool = False, linewidth: float = 1.0,
+                       max_linewidth: float = 3.0, particles: bool = True):
+    """Tricolor map of snapshot ``time`` (paper Fig. 17): very weak contacts
+    (f_n < ``very_weak`` <f_n>) in blue, weak ones in green, strong ones (f_n > ``strong``
+    <f_n>) in red, as classified by :func:`grainview.force_networks.force_class`. Uniform
+    ``linewidth`` unless ``width_by_force``. Returns the axes, with a legend of the classes."""
+    from ..force_networks import force_class
+    _, ds = single_dataset(data)
+    ax = get_axes(ax)
+    k = snapshot_index(ds, time)
+    snap = ds.isel(time=[k])
+    classes = np.asarray(force_class(snap, very_weak=very_weak, strong=strong, walls=walls).isel(time=0).values, int)
+    mask = selection(snap.isel(time=0), walls=walls).values & (classes > 0)
+    palette = np.array([CLASS_COLOURS.get(c, "k") for c in range(4)], dtype=object)
+    _network(ds, k, mask, lambda slots: list(palette[classes[slots]]), ax, max_linewidth, width_by_force,
+             linewidth, particles)
+    _legend(ax, {"very weak": CLASS_COLOURS[1], "weak": CLASS_COLOURS[2], "strong": CLASS_COLOURS[3]})
+    return ax
+
+
+def plot_contact_kinds(data, ax=None, time: int = -1, walls: bool = False, max_linewidth: float = 3.0,
+                       particles: bool = True):
+    """Map of the normal-force network of snapshot ``time`` with simple contacts in blue and
+    double contacts in red, width proportional to f_n (paper Fig. 24). Returns the axes."""
+    _, ds = single_dataset(data)
+    ax = get_axes(ax)
+    k = snapshot_index(ds, time)
+    mask = selection(ds.isel(time=k), walls=walls, force_bearing=True).values
+    kind = np.asarray(ds["kind"].isel(time=k).values, int)
+    _network(ds, k, mask, lambda slots: [KIND_COLOURS.get(c, "k") for c in kind[slots]], ax, max_linewidth,
+             True, None, particles)
+    _legend(ax, {"simple (s)": KIND_COLOURS[1], "double (d)": KIND_COLOURS[2]})
+    return ax
+
+
+def _legend(ax, entries):
+    from matplotlib.lines import Line2D
+    handles = [Line2D([], [], color=c, label=name) for name, c in entries.items()]
+    ax.legend(handles=handles, fontsize="small", loc="upper right")
+
+
+__all__ = ["plot_particles", "plot_force_chains", "plot_force_classes", "plot_contact_kinds",
+           "polygon_vertices", "contact_segments", "force_linewidths", "contact_collection"]

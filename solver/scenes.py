@@ -1,0 +1,172 @@
+"""The paper's protocol as scenes (Sec. II.B): a geometric deposit, isotropic compaction under
+sigma_0 on the right and top walls with zero gravity, then biaxial compression with the top
+wall moving down at constant velocity and sigma_0 held on the right wall. Every number is a
+parameter whose default is the paper's.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import signal
+import sys
+
+import numpy as np
+from tqdm.auto import tqdm
+
+from grainview.errors import ParameterError
+
+from .output import Recorder
+from .packing import PAPER_DIAMETERS, PAPER_FRACTIONS, box_width_for, deposit
+from .stepper import Parameters, Simulation
+from .walls import Walls
+
+SHAPES = {"disk": 0, "disks": 0, "pentagon": 5, "pentagons": 5}
+
+
+def n_vertices_of(shape) -> int:
+    """0 for disks, n for regular n-gons; accepts "disk", "pentagon" or an integer."""
+    if isinstance(shape, str):
+        if shape not in SHAPES:
+            raise ParameterError(f"shape={shape!r}: expected 'disk', 'pentagon' or a number of vertices >= 3")
+        return SHAPES[shape]
+    n = int(shape)
+    if n != 0 and n < 3:
+        raise ParameterError(f"shape={shape!r}: a polygon needs at least 3 vertices (0 for disks)")
+    return n
+
+
+@contextlib.contextmanager
+def interruptible():
+    """Turn Ctrl-C into a flag checked between steps, so a run stops after a whole step."""
+    state = {"stop": False}
+    if sys.platform == "win32" or signal.getsignal(signal.SIGINT) is None:
+        yield state
+        return
+    try:
+        previous = signal.signal(signal.SIGINT, lambda *_: state.__setitem__("stop", True))
+    except ValueError:  # not the main thread
+        yield state
+        return
+    try:
+        yield state
+    finally:
+        signal.signal(signal.SIGINT, previous)
+
+
+def _progress(total, desc, progress):
+    enabled = sys.stderr.isatty() if progress is None else bool(progress)
+    return tqdm(total=total, desc=desc, unit="step", disable=not enabled, leave=False)
+
+
+def compaction_sample(n=400, shape="pentagon", *, sigma0=1e4, friction=0.4, wall_friction=0.0,
+                      time_step=5e-4, seed=0, diameters=PAPER_DIAMETERS, fractions=PAPER_FRACTIONS,
+                      aspect=2.0, wall_mass=None, max_wall_speed=0.05, **parameters) -> Simulation:
+    """A deposited sample in its box, ready for isotropic compaction: bottom and left walls
+    fixed, right and top walls pushed by ``sigma0`` (Pa), zero gravity. ``wall_mass``
+    defaults to the total particle mass (kg); the pushed walls move inwards at most at
+    ``max_wall_speed`` (m s-1) while they close the loose deposit."""
+    if not (np.isfinite(sigma0) and sigma0 > 0):
+        raise ParameterError(f"sigma0={sigma0!r}: expected a positive stress in Pa")
+    nv = n_vertices_of(shape)
+    width = box_width_for(n, diameters, fractions, aspect_ratio=aspect)
+    position, angle, radius, n_vertices, height = deposit(n, diameters, fractions, nvert=nv, width=width, seed=seed)
+    walls = Walls.box(width, height + 0.5 * float(radius.min()))
+    params = Parameters(time_step=time_step, friction=friction, wall_friction=wall_friction, seed=seed, **parameters)
+    sim = Simulation(position, angle, radius, n_vertices, walls, params)
+    mass = float(sim.mass.sum()) if wall_mass is None else float(wall_mass)
+    walls.drive_stress("right", sigma0, mass, max_wall_speed)
+    walls.drive_stress("top", sigma0, mass, max_wall_speed)
+    sim.sigma0 = sigma0
+    return sim
+
+
+def wall_state(sim):
+    """Stress (Pa) on and strain rate (s-1) of every wall: the normal force of the particles
+    over the wall's length, and the wall's normal speed over the box size across it."""
+    lo, hi = sim.walls.box_bounds()
+    size = np.where(sim.walls.length_axis == 0, hi[1] - lo[1], hi[0] - lo[0])
+    rate = np.sum(sim.walls.velocity * sim.walls.normal, axis=1) / size
+    return sim.wall_stresses(), rate
+
+
+def is_equilibrium(stresses, rates, sigma0, stress_tolerance=0.01, strain_rate_tolerance=1e-3):
+    """Equilibrium over a window of steps: on every stress-driven wall, the mean stress is
+    within ``stress_tolerance`` (relative) of sigma0 and the mean strain rate below
+    ``strain_rate_tolerance`` s-1. ``stresses`` and ``rates`` are (steps, driven walls).
+
+    Means over a window, because a rigid wall on a rigid packing chatters from step to step
+    while its momentum balance holds on average. The particles' kinetic energy is not used:
+    in zero gravity a rattler keeps its velocity inside its cage forever.
+    """
+    stresses, rates = np.asarray(stresses), np.asarray(rates)
+    ok_stress = np.all(np.abs(stresses.mean(0) / sigma0 - 1) <= stress_tolerance)
+    return bool(ok_stress and np.all(np.abs(rates.mean(0)) <= strain_rate_tolerance))
+
+
+def isotropic_compaction(sim: Simulation, *, max_steps=40000, window=200, stress_tolerance=0.01,
+                         strain_rate_tolerance=1e-3, progress=None):
+    """Step ``sim`` until the last ``window`` steps are at equilibrium (:func:`is_equilibrium`)
+    or for ``max_steps``. Returns the number of steps taken and sets ``sim.settled`` (False
+    when ``max_steps`` ran out first) and ``sim.compaction_stress`` (the window's mean wall
+    stresses, Pa). The wall speed cap is lifted once settled, so that a following test drives
+    the walls by their stress alone."""
+    from collections import deque
+
+    sigma0 = sim.sigma0
+    driven = np.flatnonzero(sim.walls.mode == 2)
+    stresses, rates = deque(maxlen=window), deque(maxlen=window)
+    sim.settled = False
+    with interruptible() as flag, _progress(max_steps, "isotropic compaction", progress) as bar:
+        for k in range(max_steps):
+            sim.step()
+            bar.update(1)
+            stress, rate = wall_state(sim)
+            stresses.append(stress[driven])
+            rates.append(rate[driven])
+            if len(stresses) == window and k % 10 == 0 and is_equilibrium(
+                    stresses, rates, sigma0, stress_tolerance, strain_rate_tolerance):
+                sim.settled = True
+                break
+            if flag["stop"]:
+                raise KeyboardInterrupt
+    sim.compaction_stress = np.mean(stresses, axis=0) if stresses else np.zeros(len(driven))
+    sim.walls.max_speed[:] = np.inf
+    return k + 1
+
+
+def biaxial_test(sim: Simulation, path, *, strain=0.1, velocity=0.01, every=20, overwrite=False,
+                 attrs=None, progress=None):
+    """Biaxial compression of a compacted sample, written to ``path`` every ``every`` steps.
+
+    The top wall moves down at ``velocity`` (m s-1) until eps_1 = ln(1 + dh/h0) reaches
+    ``strain``; the right wall keeps the confining stress sigma0; bottom and left are fixed.
+    The snapshot at the start of the test is written first. Ctrl-C stops after the current
+    step, with every written snapshot kept.
+    """
+    if not (0 < strain < 1):
+        raise ParameterError(f"strain={strain!r}: expected a vertical strain in (0, 1)")
+    if not (velocity > 0):
+        raise ParameterError(f"velocity={velocity!r}: expected a positive wall speed in m s-1")
+    if int(every) < 1:
+        raise ParameterError(f"every={every!r}: expected a positive number of steps between snapshots")
+    lo, hi = sim.walls.box_bounds()
+    h0 = float(hi[1] - lo[1])
+    travel = h0 * (np.exp(strain) - 1)
+    n_steps = int(np.ceil(travel / velocity / sim.parameters.time_step))
+    sim.walls.drive_velocity("top", (0.0, -velocity))
+    run_attrs = {"scene": "biaxial", "strain_target": strain, "wall_velocity_m_s": velocity,
+                 "sigma0_Pa": getattr(sim, "sigma0", np.nan), "snapshot_every": int(every)}
+    run_attrs.update(attrs or {})
+    with Recorder(path, sim, attrs=run_attrs, overwrite=overwrite) as rec, interruptible() as flag, \
+            _progress(n_steps, "biaxial test", progress) as bar:
+        rec.write()
+        for k in range(1, n_steps + 1):
+            sim.step()
+            bar.update(1)
+            if k % every == 0 or k == n_steps:
+                rec.write()
+            if flag["stop"]:
+                print(f"interrupted after step {sim.step_index}: {path} holds every snapshot written so far",
+                      file=sys.stderr)
+                raise KeyboardInterrupt
+    return n_steps

@@ -1,0 +1,328 @@
+"""Moreau–Jean time stepping of rigid disks and polygons between walls.
+
+One step of length h (the theta-scheme, theta = 1/2 by default):
+
+1. contact detection: the cell-list broad phase is reused while no particle has moved more
+   than half the ``skin`` since it ran; the narrow phase runs every step;
+2. free velocities: v_free = v- + h M^-1 F_ext (gravity, wall stresses);
+3. NLGS (``solver.nlgs``) for the impulses p and the end-of-step velocities v+, warm-started
+   with the previous step's impulses of the same contact points (matched by body pair and
+   point rank);
+4. positions: x+ = x- + h [(1 - theta) v- + theta v+], likewise angles and wall positions.
+
+Forces are impulses divided by h. Nothing here loops over particles or contacts in Python:
+each stage is one numba kernel or one vectorised numpy expression.
+"""
+
+from __future__ import annotations
+
+import warnings
+from dataclasses import asdict, dataclass
+
+import numpy as np
+
+from grainview.errors import ConvergenceWarning, ParameterError
+
+from . import broadphase, narrowphase, nlgs
+from .shapes import mass_and_inertia
+from .walls import STRESS, VELOCITY, Walls
+
+
+def _cross2(r, normal):
+    """(omega x r) . n per unit omega: r_x n_y - r_y n_x, row by row."""
+    return r[:, 0] * normal[:, 1] - r[:, 1] * normal[:, 0]
+
+
+@dataclass
+class Parameters:
+    """Numerical and physical parameters; defaults are the paper's (Sec. II.B)."""
+
+    time_step: float = 5e-4  # s
+    theta: float = 0.5
+    friction: float = 0.4  # between particles
+    wall_friction: float = 0.0
+    gravity: tuple = (0.0, 0.0)  # m s-2
+    density: float = 2600.0  # kg m-3
+    thickness: float = 1.0  # m, slab thickness of the 2D sample
+    tolerance: float = 1.7e-4  # NLGS quadratic norm
+    max_tolerance: float = 1e-2  # NLGS max norm
+    max_iterations: int = 2000
+    alert: float | None = None  # m; default: 2% of the smallest diameter
+    skin: float | None = None  # m; default: 10% of the smallest diameter
+    shuffle: bool = False  # random NLGS ordering
+    seed: int = 0
+    overlap_recovery_speed: float = 1e-3  # m s-1, cap of the split-impulse separation of overlaps
+    overlap_recovery_rate: float = 0.2  # fraction of an overlap removed per step, below the cap
+
+    def validate(self):
+        checks = [
+            ("time_step", self.time_step > 0 and np.isfinite(self.time_step), "a positive number of seconds"),
+            ("theta", 0.5 <= self.theta <= 1, "in [0.5, 1]"),
+            ("friction", 0 <= self.friction and np.isfinite(self.friction), ">= 0"),
+            ("wall_friction", 0 <= self.wall_friction and np.isfinite(self.wall_friction), ">= 0"),
+            ("density", self.density > 0 and np.isfinite(self.density), "> 0 kg m-3"),
+            ("thickness", self.thickness > 0, "> 0 m"),
+            ("tolerance", self.tolerance > 0, "> 0"),
+            ("max_tolerance", self.max_tolerance > 0, "> 0"),
+            ("max_iterations", int(self.max_iterations) >= 1, ">= 1"),
+            ("gravity", len(self.gravity) == 2 and np.all(np.isfinite(self.gravity)), "a finite 2-vector in m s-2"),
+            ("overlap_recovery_speed", self.overlap_recovery_speed >= 0, ">= 0 m s-1"),
+            ("overlap_recovery_rate", 0 <= self.overlap_recovery_rate <= 1, "in [0, 1]"),
+        ]
+        bad = [f"{name}={getattr(self, name)!r}: expected {expected}" for name, ok, expected in checks if not ok]
+        for name in ("alert", "skin"):
+            value = getattr(self, name)
+            if value is not None and not (value > 0 and np.isfinite(value)):
+                bad.append(f"{name}={value!r}: expected a positive length in m")
+        if bad:
+            raise ParameterError("invalid solver parameters: " + "; ".join(bad))
+        return self
+
+
+@dataclass
+class StepInfo:
+    iterations: int
+    residual: float
+    max_residual: float
+    converged: bool
+    n_points: int
+    max_interpenetration: float
+
+
+class Simulation:
+    """State of a packing (particles and walls) and its time stepping.
+
+    Parameters
+    ----------
+    position : (N, 2) m; angle : (N,) rad; radius : (N,) circumscribed radius, m;
+    n_vertices : (N,) 0 for disks, >= 3 for regular polygons; walls : :class:`Walls`.
+    """
+
+    def __init__(self, position, angle, radius, n_vertices, walls: Walls, parameters: Parameters | None = None,
+                 velocity=None, angular_velocity=None):
+        p = (parameters or Parameters()).validate()
+        self.parameters = p
+        self.position = np.array(position, dtype=float).reshape(-1, 2)
+        n = len(self.position)
+        if n == 0:
+            raise ParameterError("the sample is empty: expected at least one particle")
+        self.radius = np.array(radius, dtype=float).reshape(n)
+        self.n_vertices = np.array(n_vertices, dtype=np.int64).reshape(n)
+        self.angle = np.zeros(n) if angle is None else np.array(angle, dtype=float).reshape(n)
+        if np.any(~np.isfinite(self.position)) or np.any(~np.isfinite(self.angle)):
+            raise ParameterError("positions and angles must be finite")
+        if np.any(~(self.radius > 0)):
+            raise ParameterError("radius must be > 0 m for every particle")
+        if np.any((self.n_vertices != 0) & (self.n_vertices < 3)):
+            raise ParameterError("n_vertices must be 0 (disk) or >= 3 (regular polygon)")
+        self.walls = walls
+        self.mass, self.inertia = mass_and_inertia(self.radius, self.n_vertices, p.density, p.thickness)
+        w = len(walls)
+        self.n_particles, self.n_walls = n, w
+        self.velocity = np.zeros((n + w, 2))
+        self.angular_velocity = np.zeros(n + w)
+        if velocity is not None:
+            self.velocity[:n] = velocity
+        if angular_velocity is not None:
+            self.angular_velocity[:n] = angular_velocity
+        self.velocity[n:] = walls.velocity
+        diameter = 2 * float(self.radius.min())
+        self.alert = p.alert if p.alert is not None else 0.02 * diameter
+        self.skin = p.skin if p.skin is not None else 0.1 * diameter
+        self.time = 0.0
+        self.step_index = 0
+        self.has_polygons = bool(np.any(self.n_vertices > 0))
+        self._anchor = None  # positions at the last broad phase
+        self._candidates = None
+        self._keys = np.empty(0, np.int64)
+        self._impulse = np.empty((0, 2))
+        self.points = None
+        self.impulse = np.empty((0, 2))
+        self.last = None
+
+    # -- mobility ---------------------------------------------------------------------------
+    def _mobility(self):
+        n, w = self.n_particles, self.n_walls
+        minv = np.zeros((n + w, 3))
+        minv[:n, 0] = minv[:n, 2] = 1.0 / self.mass
+        iinv = np.zeros(n + w)
+        iinv[:n] = 1.0 / self.inertia
+        stress = self.walls.mode == STRESS
+        nrm = self.walls.normal[stress]
+        m = self.walls.mass[stress][:, None]
+        minv[n:][stress] = np.stack([nrm[:, 0] ** 2, nrm[:, 0] * nrm[:, 1], nrm[:, 1] ** 2], -1) / m
+        return minv, iinv
+
+    def wall_lengths(self):
+        """Length of each wall in m (the box's extent along it)."""
+        lo, hi = self.walls.box_bounds()
+        return np.where(self.walls.length_axis == 0, hi[0] - lo[0], hi[1] - lo[1])
+
+    # -- detection --------------------------------------------------------------------------
+    def detect(self):
+        moved = np.inf if self._anchor is None else float(np.max(np.abs(self.position - self._anchor)))
+        if moved > 0.5 * self.skin:
+            margin = self.alert + self.skin
+            pi, pj = broadphase.candidate_pairs(self.position, self.radius, margin)
+            wp, ww = broadphase.wall_candidates(self.position, self.radius, self.walls.point, self.walls.normal, margin)
+            self._candidates = (pi, pj, wp, ww)
+            self._anchor = self.position.copy()
+        pi, pj, wp, ww = self._candidates
+        # walls move independently of the particles: keep every wall candidate within reach
+        return narrowphase.detect(self.position, self.angle, self.radius, self.n_vertices, self.walls.point,
+                                  self.walls.normal, self.alert, pi, pj, wp, ww)
+
+    def _point_keys(self, pts):
+        bodies = self.n_particles + self.n_walls
+        rank = np.zeros(len(pts.pair), np.int64)
+        if len(pts.pair) > 1:
+            rank[1:] = (pts.pair[1:] == pts.pair[:-1]).astype(np.int64)
+        return (pts.body_i.astype(np.int64) * bodies + pts.body_j) * 2 + rank
+
+    # -- one step ---------------------------------------------------------------------------
+    def step(self) -> StepInfo:
+        p = self.parameters
+        h, theta = p.time_step, p.theta
+        n, w = self.n_particles, self.n_walls
+        pts = self.detect()
+        keys = self._point_keys(pts)
+        impulse = np.zeros((len(keys), 2))
+        if len(self._keys) and len(keys):
+            order = np.argsort(self._keys)
+            sorted_keys = self._keys[order]
+            where = np.searchsorted(sorted_keys, keys)
+            where = np.minimum(where, len(sorted_keys) - 1)
+            hit = sorted_keys[where] == keys
+            impulse[hit] = self._impulse[order[where[hit]]]
+        # free velocities
+        v_start = self.velocity.copy()
+        omega_start = self.angular_velocity.copy()
+        v = v_start.copy()
+        omega = omega_start.copy()
+        velocity_walls = np.flatnonzero(self.walls.mode == VELOCITY)
+        v[n + velocity_walls] = self.walls.velocity[velocity_walls]
+        v_start[n + velocity_walls] = self.walls.velocity[velocity_walls]
+        if p.gravity[0] != 0.0 or p.gravity[1] != 0.0:
+            v[:n] += h * np.asarray(p.gravity)
+        stress_walls = np.flatnonzero(self.walls.mode == STRESS)
+        if stress_walls.size:
+            force = (self.walls.stress * self.wall_lengths() * p.thickness)[stress_walls, None] * self.walls.normal[stress_walls]
+            v[n + stress_walls] += h * force / self.walls.mass[stress_walls, None]
+        # contact geometry
+        centre = np.concatenate([self.position, self.walls.point])
+        a, b = pts.body_i.astype(np.int64), pts.body_j.astype(np.int64)
+        ra = pts.point - centre[a]
+        rb = pts.point - centre[b]
+        rb[b >= n] = 0.0
+        nx, ny = pts.normal[:, 0].copy(), pts.normal[:, 1].copy()
+        # gap predicted to mid-step with the start velocities (IQS bias)
+        u0 = (v_start[b] + omega_start[b, None] * np.stack([-rb[:, 1], rb[:, 0]], -1)
+              - v_start[a] - omega_start[a, None] * np.stack([-ra[:, 1], ra[:, 0]], -1))
+        un0 = u0[:, 0] * nx + u0[:, 1] * ny
+        g_star = pts.gap + h * (1 - theta) * un0
+        bias = self.contact_bias(g_star)
+        mu = np.where(b >= n, p.wall_friction, p.friction)
+        minv, iinv = self._mobility()
+        vx, vy, om = v[:, 0].copy(), v[:, 1].copy(), omega.copy()
+        pn, pt = impulse[:, 0].copy(), impulse[:, 1].copy()
+        iterations, residual, worst = nlgs.solve(
+            a, b, nx, ny, ra[:, 0].copy(), ra[:, 1].copy(), rb[:, 0].copy(), rb[:, 1].copy(), bias, mu, pn, pt,
+            vx, vy, om, minv[:, 0].copy(), minv[:, 1].copy(), minv[:, 2].copy(), iinv, p.tolerance,
+            p.max_tolerance, int(p.max_iterations), p.shuffle, p.seed + self.step_index)
+        converged = iterations < p.max_iterations or (residual <= p.tolerance and worst <= p.max_tolerance)
+        if not converged:
+            warnings.warn(f"NLGS did not converge at step {self.step_index} (t = {self.time:.6g} s): "
+                          f"{iterations} iterations, quadratic residual {residual:.3g} (tolerance "
+                          f"{p.tolerance:g}), max residual {worst:.3g} (tolerance {p.max_tolerance:g})",
+                          ConvergenceWarning, stacklevel=2)
+        v_end = np.stack([vx, vy], -1)
+        v_end[n + velocity_walls] = self.walls.velocity[velocity_walls]
+        fixed = np.flatnonzero(self.walls.mode == 0)
+        v_end[n + fixed] = 0.0
+        if stress_walls.size:  # cap the inward speed of pushed walls (closing a loose sample)
+            inward = np.sum(v_end[n + stress_walls] * self.walls.normal[stress_walls], axis=1)
+            excess = np.maximum(inward - self.walls.max_speed[stress_walls], 0.0)
+            v_end[n + stress_walls] -= excess[:, None] * self.walls.normal[stress_walls]
+        om[n:] = 0.0
+        # theta-scheme update of positions
+        step_v = (1 - theta) * v_start + theta * v_end
+        step_om = (1 - theta) * omega_start + theta * om
+        g_end = pts.gap + h * ((step_v[b] - step_v[a]) * pts.normal).sum(1) if len(keys) else pts.gap
+        if p.overlap_recovery_speed > 0 and len(keys):
+            # the end-of-step gaps (first order) tell which overlaps remain
+            g_end = g_end + h * (step_om[b] * _cross2(rb, pts.normal) - step_om[a] * _cross2(ra, pts.normal))
+            if g_end.min() < 0.0:
+                pseudo_v, pseudo_om = self._recover_overlaps(a, b, nx, ny, ra, rb, g_end, minv, iinv)
+                pseudo_v[n + np.flatnonzero(self.walls.mode != STRESS)] = 0.0
+                step_v = step_v + pseudo_v
+                step_om = step_om + pseudo_om
+        self.position += h * step_v[:n]
+        self.angle += h * step_om[:n]
+        self.walls.point += h * step_v[n:]
+        self.walls.velocity[stress_walls] = v_end[n + stress_walls]
+        self.velocity = v_end
+        self.angular_velocity = om
+        self.points = pts
+        self.impulse = np.stack([pn, pt], -1)
+        self._keys, self._impulse = keys, self.impulse
+        self.time += h
+        self.step_index += 1
+        overlap = float(max(0.0, -pts.gap.min())) if len(pts.gap) else 0.0
+        self.last = StepInfo(int(iterations), float(residual), float(worst), bool(converged), len(keys), overlap)
+        return self.last
+
+    def contact_bias(self, g_star):
+        """The shift b of Signorini's condition u_n + b >= 0 for gaps g* predicted to mid-step:
+        b = max(0, g*)/(theta h). An open gap may close within the step; an existing overlap
+        is not pushed out by the velocities (LMGC90's IQS law)."""
+        p = self.parameters
+        return np.maximum(g_star, 0.0) / (p.theta * p.time_step)
+
+    def _recover_overlaps(self, a, b, nx, ny, ra, rb, g_end, minv, iinv):
+        """Split-impulse removal of overlaps: pseudo-velocities that move the bodies apart at
+        most at ``overlap_recovery_speed``, removing ``overlap_recovery_rate`` of each overlap
+        per step, frictionless, added to the positions only. The real velocities (momentum,
+        kinetic energy) are untouched, so existing overlaps are removed gently and never
+        pushed out explosively. Returns the pseudo-velocities (bodies, 2) and (bodies,)."""
+        p = self.parameters
+        h = p.time_step
+        recover = np.minimum(p.overlap_recovery_rate * np.maximum(-g_end, 0.0) / h, p.overlap_recovery_speed)
+        bias = np.where(g_end >= 0.0, g_end / h, -recover)
+        m = len(a)
+        bodies = self.n_particles + self.n_walls
+        vx, vy, om = np.zeros(bodies), np.zeros(bodies), np.zeros(bodies)
+        pn, pt = np.zeros(m), np.zeros(m)
+        nlgs.solve(a, b, nx, ny, ra[:, 0].copy(), ra[:, 1].copy(), rb[:, 0].copy(), rb[:, 1].copy(), bias,
+                   np.zeros(m), pn, pt, vx, vy, om, minv[:, 0].copy(), minv[:, 1].copy(), minv[:, 2].copy(), iinv,
+                   p.tolerance, p.max_tolerance, 200, False, 0)
+        return np.stack([vx, vy], -1), om
+
+    # -- derived quantities ------------------------------------------------------------------
+    def kinetic_energy(self):
+        """Kinetic energy of the particles in J."""
+        n = self.n_particles
+        return float(0.5 * np.sum(self.mass * np.sum(self.velocity[:n] ** 2, axis=1))
+                     + 0.5 * np.sum(self.inertia * self.angular_velocity[:n] ** 2))
+
+    def wall_forces(self):
+        """(W, 2) total force exerted by the particles on each wall in N, from the last step."""
+        out = np.zeros((self.n_walls, 2))
+        if self.points is None or not len(self.points.gap):
+            return out
+        pts = self.points
+        f = (self.impulse[:, 0:1] * pts.normal + self.impulse[:, 1:2] * np.stack([-pts.normal[:, 1], pts.normal[:, 0]], -1))
+        f /= self.parameters.time_step
+        on_wall = pts.body_j >= self.n_particles
+        np.add.at(out, pts.body_j[on_wall] - self.n_particles, f[on_wall])
+        return out
+
+    def wall_stresses(self):
+        """Normal stress exerted by the particles on each wall, Pa (force / length / thickness)."""
+        f = self.wall_forces()
+        normal_force = -np.sum(f * self.walls.normal, axis=1)
+        return normal_force / (self.wall_lengths() * self.parameters.thickness)
+
+    def parameters_dict(self):
+        d = asdict(self.parameters)
+        d.update(alert=self.alert, skin=self.skin)
+        return d

@@ -1,0 +1,447 @@
+"""Figures of grainview.plot: each test draws on a small dataset and checks what was drawn
+against the analysis functions (the plotted numbers), against hand-computed values on lattices
+whose answers are known, and checks the labels (units) and the saved files."""
+
+from __future__ import annotations
+
+import matplotlib
+
+matplotlib.use("Agg")
+
+import matplotlib.pyplot as plt  # noqa: E402
+import numpy as np  # noqa: E402
+import pytest  # noqa: E402
+from matplotlib.collections import EllipseCollection, PolyCollection  # noqa: E402
+from matplotlib.colors import to_rgba  # noqa: E402
+
+import grainview  # noqa: E402
+from grainview import plot as gp  # noqa: E402
+from grainview.connectivity import connectivity_pdf, coordination, joint_connectivity_pdf  # noqa: E402
+from grainview.errors import ParameterError  # noqa: E402
+from grainview.fabric import fabric_anisotropy, orientation_pdf  # noqa: E402
+from grainview.forces import force_anisotropies, harmonic_prediction  # noqa: E402
+from grainview.plot import PlotAccessor, save_figure  # noqa: E402
+from grainview.plot._style import select_snapshots  # noqa: E402
+from grainview.plot.maps import contact_collection  # noqa: E402
+from grainview.strain import friction_and_dilatancy, strains  # noqa: E402
+from grainview.stress import stress_invariants  # noqa: E402
+from grainview.synthetic import harmonic_series  # noqa: E402
+
+from . import builders  # noqa: E402
+
+R = builders.R
+
+
+@pytest.fixture(autouse=True)
+def close_figures():
+    yield
+    plt.close("all")
+
+
+@pytest.fixture(scope="module")
+def series():
+    return harmonic_series(n_snapshots=4, n_contacts=300, seed=3)
+
+
+@pytest.fixture(scope="module")
+def other_series():
+    return harmonic_series(n_snapshots=5, n_contacts=200, anisotropy=(0.1, 0.2, 0.1), seed=4)
+
+
+def pentagon_grid(nx=5, ny=4, seed=0):
+    """Pentagons (n_vertices=5) on an nx-by-ny grid, each horizontal and vertical neighbour
+    pair in contact with a random kind and exponential normal force; one contact carries
+    f_n = 0 (not force bearing) and particle 0 touches the bottom wall (f_n = 0.7 N)."""
+    rng = np.random.default_rng(seed)
+    a = 1.9 * R
+    ix, iy = np.meshgrid(np.arange(nx), np.arange(ny), indexing="ij")
+    ids = ix * ny + iy
+    pos = np.stack([ix.ravel() * a, iy.ravel() * a], -1).astype(float)
+    i = np.concatenate([ids[:-1, :].ravel(), ids[:, :-1].ravel()])
+    j = np.concatenate([ids[1:, :].ravel(), ids[:, 1:].ravel()])
+    normal = (pos[j] - pos[i]) / a
+    c = i.size
+    fn = rng.exponential(1.0, c)
+    fn[3] = 0.0
+    kind = rng.integers(1, 3, c)
+    n = nx * ny
+    contacts = dict(i=np.append(i, 0), j=np.append(j, n), kind=np.append(kind, 1),
+                    normal=np.vstack([normal, [[0.0, -1.0]]]), fn=np.append(fn, 0.7), ft=np.zeros(c + 1),
+                    branch=np.vstack([pos[j] - pos[i], [[0.0, -R]]]),
+                    point=np.vstack([pos[i] + normal * R, [[0.0, -R]]]))
+    angle = rng.uniform(0, 2 * np.pi, (1, n))
+    return grainview.make_dataset(radius=np.full(n, R), position=pos, n_vertices=5, angle=angle,
+                                  contacts=[contacts], box_min=[-R, -R], box_max=[(nx - 1) * a + R, (ny - 1) * a + R],
+                                  n_walls=1, wall_names=["bottom"])
+
+
+def legend_texts(ax):
+    return [t.get_text() for t in ax.get_legend().get_texts()]
+
+
+# -- evolutions against eps_q -----------------------------------------------------------------
+
+EVOLUTIONS = {
+    "q_over_p": (gp.plot_q_over_p, {}, "$q/p$", lambda ds: [stress_invariants(ds)["q_over_p"]]),
+    "eps_p": (gp.plot_volumetric_strain, {}, r"$\varepsilon_p$", lambda ds: [strains(ds)["eps_p"]]),
+    "harmonic": (gp.plot_harmonic_prediction, {}, "$q/p$",
+                 lambda ds: [harmonic_prediction(ds)[v] for v in ("q_over_p", "prediction")]),
+    "partial_q": (gp.plot_partial_q_over_p, {}, "$q/p$",
+                  lambda ds: [stress_invariants(ds, k)["q_over_p"] for k in ("simple", "double", "all")]),
+    "z": (gp.plot_coordination, {}, "$z$", lambda ds: [coordination(ds)["z"]]),
+    "a_prime": (gp.plot_fabric_anisotropy, {}, "$a'$", lambda ds: [fabric_anisotropy(ds)["a_prime"]]),
+    "partial_a": (gp.plot_partial_fabric_anisotropy, {}, "$a'$",
+                  lambda ds: [fabric_anisotropy(ds, k)["a_prime"] for k in ("simple", "double")]),
+    "a_n": (gp.plot_force_anisotropy, {"component": "a_n"}, "$a_n$", lambda ds: [force_anisotropies(ds)["a_n"]]),
+    "a_t": (gp.plot_force_anisotropy, {"component": "a_t"}, "$a_t$", lambda ds: [force_anisotropies(ds)["a_t"]]),
+}
+
+
+@pytest.mark.parametrize("name", list(EVOLUTIONS))
+def test_evolution_lines_hold_the_analysis_values(name, series, other_series):
+    func, kw, ylabel, expected = EVOLUTIONS[name]
+    ax = func({"pentagons": series, "disks": other_series}, **kw)
+    per_sample = [expected(ds) for ds in (series, other_series)]
+    n_curves = len(per_sample[0])
+    assert len(ax.lines) == 2 * n_curves
+    for s, ds in enumerate((series, other_series)):
+        for k, want in enumerate(per_sample[s]):
+            line = ax.lines[s * n_curves + k]
+            np.testing.assert_allclose(line.get_xdata(), strains(ds)["eps_q"].values)
+            np.testing.assert_allclose(line.get_ydata(), want.values, equal_nan=True)
+        colours = {ax.lines[s * n_curves + k].get_color() for k in range(n_curves)}
+        assert len(colours) == 1  # one colour per sample
+    assert ax.lines[0].get_color() != ax.lines[n_curves].get_color()
+    assert ax.get_xlabel() == r"$\varepsilon_q$" and ax.get_ylabel() == ylabel
+    assert all(text.startswith(("pentagons", "disks")) for text in legend_texts(ax))
+    assert len(legend_texts(ax)) == 2 * n_curves
+
+
+def test_q_over_p_of_a_square_lattice_is_the_hand_value():
+    # 4 x 3 grid: 9 horizontal contacts of 2 N and 8 vertical of 5 N, all with branch 2R:
+    # sigma_xx V = 9 * 2 * 2R, sigma_yy V = 8 * 5 * 2R, so q/p = (40 - 18)/(40 + 18).
+    ax = gp.plot_q_over_p(builders.square_lattice(4, 3, fx=2.0, fy=5.0))
+    np.testing.assert_allclose(ax.lines[0].get_ydata(), [22 / 58])
+    np.testing.assert_allclose(ax.lines[0].get_xdata(), [0.0])
+    assert ax.get_legend() is None  # one unlabelled sample: no legend
+
+
+def test_successive_calls_on_one_axes_compare_samples(series, other_series):
+    ax = gp.plot_q_over_p(series, label="pentagons")
+    PlotAccessor(other_series).q_over_p(ax=ax, label="disks")
+    assert len(ax.lines) == 2
+    assert ax.lines[0].get_color() != ax.lines[1].get_color()
+    assert legend_texts(ax) == ["pentagons", "disks"]
+    np.testing.assert_allclose(ax.lines[1].get_ydata(), stress_invariants(other_series)["q_over_p"].values)
+
+
+def test_stress_dilatancy_draws_psi_against_phi_in_rad(series):
+    ax = gp.plot_stress_dilatancy([("a", series)])
+    angles = friction_and_dilatancy(series)
+    np.testing.assert_allclose(ax.lines[0].get_xdata(), angles["phi"].values)
+    np.testing.assert_allclose(ax.lines[0].get_ydata(), angles["psi"].values, equal_nan=True)
+    assert ax.get_xlabel() == r"$\varphi$ (rad)" and ax.get_ylabel() == r"$\psi$ (rad)"
+    ax = gp.plot_stress_dilatancy(series, incremental=True)
+    np.testing.assert_allclose(ax.lines[0].get_ydata(), angles["psi_incremental"].values, equal_nan=True)
+
+
+def test_force_anisotropies_figure_has_a_n_and_a_t_panels(series):
+    fig = gp.plot_force_anisotropies(series)
+    assert len(fig.axes) == 2
+    got = force_anisotropies(series)
+    np.testing.assert_allclose(fig.axes[0].lines[0].get_ydata(), got["a_n"].values)
+    np.testing.assert_allclose(fig.axes[1].lines[0].get_ydata(), got["a_t"].values)
+
+
+# -- distributions ----------------------------------------------------------------------------
+
+def test_residual_state_is_the_last_snapshots(series):
+    eps = strains(series)["eps_q"].values
+    kept = select_snapshots(series, "residual")["time"].values
+    np.testing.assert_array_equal(kept, series["time"].values[eps >= 0.7 * eps.max()])
+    assert 0 < kept.size < series.sizes["time"]
+    np.testing.assert_array_equal(select_snapshots(series, -1)["time"].values, series["time"].values[-1:])
+    with pytest.raises(ParameterError, match="time"):
+        select_snapshots(series, 7)
+
+
+def test_connectivity_pdf_of_a_square_lattice():
+    # 4 x 3 grid: 4 corners with 2 contacts, 6 border particles with 3, 2 interior with 4.
+    ax = gp.plot_connectivity_pdf(builders.square_lattice(4, 3), max_c=6)
+    np.testing.assert_allclose(ax.lines[0].get_xdata(), np.arange(7))
+    np.testing.assert_allclose(ax.lines[0].get_ydata(), [0, 0, 4 / 12, 6 / 12, 2 / 12, 0, 0], atol=1e-15)
+    assert ax.get_xlabel() == "$c$" and ax.get_ylabel() == "$P(c)$"
+
+
+def test_connectivity_pdf_averages_the_residual_snapshots(series, other_series):
+    ax = gp.plot_connectivity_pdf({"a": series, "b": other_series})
+    assert len(ax.lines) == 2
+    for line, ds in zip(ax.lines, (series, other_series)):
+        want = connectivity_pdf(select_snapshots(ds, "residual")).mean("time")
+        np.testing.assert_allclose(line.get_ydata(), want.values)
+
+
+def test_orientation_pdf_polar_of_a_square_lattice():
+    # 9 contacts at theta = 0 and 8 at pi/2; 4 sectors of width pi/4 centred on k pi/4.
+    ax = gp.plot_orientation_pdf(builders.square_lattice(4, 3), bins=4, time=0)
+    assert ax.name == "polar"
+    line = ax.lines[0]
+    p0, p2 = 9 / 17 / (np.pi / 4), 8 / 17 / (np.pi / 4)
+    np.testing.assert_allclose(line.get_xdata(), np.arange(9) * np.pi / 4)
+    np.testing.assert_allclose(line.get_ydata(), [p0, 0, p2, 0, p0, 0, p2, 0, p0], atol=1e-12)
+    assert ax.get_xlabel() == r"$\theta$ (rad)"
+    assert ax.get_title() == r"$P(\theta)$ (rad$^{-1}$)"
+
+
+def test_orientation_pdf_of_series_matches_the_analysis(series):
+    ax = gp.plot_orientation_pdf(series, bins=12)
+    want = orientation_pdf(select_snapshots(series, "residual"), bins=12).mean("time").values
+    np.testing.assert_allclose(ax.lines[0].get_ydata(), np.concatenate([want, want, want[:1]]))
+
+
+def test_joint_connectivity_map_is_p_ms_md():
+    # horizontal contacts double, vertical simple on the 4 x 3 grid: m_d is the number of
+    # horizontal neighbours (1 or 2), m_s the vertical ones (1 or 2)
+    kinds = [2] * 9 + [1] * 8
+    ds = builders.square_lattice(4, 3, kinds=kinds)
+    ax = gp.plot_joint_connectivity(ds, max_m=3, time=0)
+    image = np.asarray(ax.images[0].get_array())
+    want = joint_connectivity_pdf(ds, max_m=3).isel(time=0).values.T
+    np.testing.assert_allclose(image, want)
+    # corners: m_s = 1, m_d = 1 (4); top/bottom borders: m_s = 1, m_d = 2 (4);
+    # left/right: m_s = 2, m_d = 1 (2); interior: m_s = 2, m_d = 2 (2)
+    assert image[1, 1] == pytest.approx(4 / 12) and image[2, 1] == pytest.approx(4 / 12)
+    assert image[1, 2] == pytest.approx(2 / 12) and image[2, 2] == pytest.approx(2 / 12)
+    assert ax.get_xlabel() == "$m_s$" and ax.get_ylabel() == "$m_d$"
+    with pytest.raises(ParameterError, match="one sample"):
+        gp.plot_joint_connectivity({"a": ds, "b": ds})
+
+
+def test_polar_forces_of_a_square_lattice():
+    ds = builders.square_lattice(4, 3, fx=2.0, fy=5.0)
+    mean = (9 * 2.0 + 8 * 5.0) / 17
+    ax = gp.plot_normal_force_polar(ds, bins=4, time=0)
+    np.testing.assert_allclose(ax.lines[0].get_ydata(),
+                               [2 / mean, np.nan, 5 / mean, np.nan, 2 / mean, np.nan, 5 / mean, np.nan, 2 / mean])
+    assert ax.get_title() == r"$\langle f_n\rangle(\theta)/\langle f_n\rangle$"
+    ax = gp.plot_normal_force_polar(ds, bins=4, time=0, normalise=False)
+    np.testing.assert_allclose(ax.lines[0].get_ydata()[[0, 2]], [2.0, 5.0])
+    assert ax.get_title() == r"$\langle f_n\rangle(\theta)$ (N)"
+
+
+def test_polar_tangential_force_is_its_magnitude():
+    ds = builders.two_disks(force=3.0, tangential=-1.5)
+    ax = gp.plot_tangential_force_polar(ds, bins=4, time=0)
+    np.testing.assert_allclose(ax.lines[0].get_ydata()[[0, 4, 8]], [0.5, 0.5, 0.5])
+    fig = gp.plot_angular_forces({"a": ds, "b": ds}, bins=4, time=0)
+    assert len(fig.axes) == 2 and all(a.name == "polar" and len(a.lines) == 2 for a in fig.axes)
+    with pytest.raises(ParameterError, match="polar"):
+        gp.plot_tangential_force_polar(ds, ax=plt.subplots()[1])
+
+
+# -- maps -------------------------------------------------------------------------------------
+
+def test_particles_are_drawn_as_regular_pentagons():
+    ds = pentagon_grid()
+    ax = gp.plot_particles(ds)
+    polys = [c for c in ax.collections if isinstance(c, PolyCollection)]
+    assert len(polys) == 1 and len(polys[0].get_paths()) == 20
+    p = 7
+    x, a = ds["position"].values[0, p], ds["angle"].values[0, p]
+    phase = a + 2 * np.pi * np.arange(5) / 5
+    want = x + R * np.stack([np.cos(phase), np.sin(phase)], -1)
+    np.testing.assert_allclose(polys[0].get_paths()[p].vertices[:5], want)
+    assert ax.get_xlabel() == "$x$ (m)" and ax.get_ylabel() == "$y$ (m)"
+
+
+def test_disks_are_one_ellipse_collection_of_their_diameters():
+    ax = gp.plot_particles(builders.square_lattice(4, 3))
+    (disks,) = [c for c in ax.collections if isinstance(c, EllipseCollection)]
+    np.testing.assert_allclose(disks.get_offsets(), builders.square_lattice(4, 3)["position"].values[0])
+    np.testing.assert_allclose(disks._widths, np.full(12, R))  # matplotlib stores half widths
+
+
+def test_force_chain_widths_are_proportional_to_fn():
+    ds = pentagon_grid()
+    ax = gp.plot_force_chains(ds, max_linewidth=4.0)
+    lines = contact_collection(ax)
+    c = int(ds["contact_count"][0])
+    fn = ds["fn"].values[0, :c]
+    n = ds.sizes["particle"]
+    kept = (fn > 0) & (ds["j"].values[0, :c] < n)  # force-bearing particle pairs
+    segments = np.asarray(lines.get_segments())
+    assert len(segments) == kept.sum() == c - 2
+    widths = np.asarray(lines.get_linewidths())
+    np.testing.assert_allclose(widths, 4.0 * fn[kept] / fn[kept].max())
+    pos = ds["position"].values[0]
+    i, j = ds["i"].values[0, :c][kept], ds["j"].values[0, :c][kept]
+    np.testing.assert_allclose(segments[:, 0], pos[i])
+    np.testing.assert_allclose(segments[:, 1], pos[j])
+    # with walls, the wall contact runs from particle 0 to its contact point
+    ax = gp.plot_force_chains(ds, walls=True)
+    segments = np.asarray(contact_collection(ax).get_segments())
+    assert len(segments) == c - 1
+    np.testing.assert_allclose(segments[-1], [pos[0], pos[0] + [0.0, -R]])
+
+
+def test_kind_map_colours_simple_blue_and_double_red():
+    ds = pentagon_grid()
+    ax = gp.plot_contact_kinds(ds)
+    lines = contact_collection(ax)
+    c = int(ds["contact_count"][0])
+    fn, kind = ds["fn"].values[0, :c], ds["kind"].values[0, :c]
+    kept = (fn > 0) & (ds["j"].values[0, :c] < ds.sizes["particle"])
+    colours = np.asarray(lines.get_colors())
+    want = np.array([to_rgba("tab:blue") if k == 1 else to_rgba("tab:red") for k in kind[kept]])
+    np.testing.assert_allclose(colours, want)
+    np.testing.assert_allclose(lines.get_linewidths(), 3.0 * fn[kept] / fn[kept].max())
+    assert legend_texts(ax) == ["simple (s)", "double (d)"]
+
+
+def test_map_takes_one_sample_and_one_snapshot(series):
+    with pytest.raises(ParameterError, match="one sample"):
+        gp.plot_force_chains([("a", series), ("b", series)])
+    with pytest.raises(ParameterError, match="time"):
+        gp.plot_force_chains(series, time=10)
+    ax = gp.plot_force_chains(series, time=1, particles=False)
+    assert len(contact_collection(ax).get_segments()) == int(series["contact_count"][1])
+    assert not any(isinstance(c, (PolyCollection, EllipseCollection)) for c in ax.collections)
+
+
+# -- figures of the force-network modules -----------------------------------------------------
+
+def test_tricolor_map_colours_match_force_classes():
+    force_networks = pytest.importorskip("grainview.force_networks")
+    ds = pentagon_grid(seed=2)
+    ax = gp.plot_force_classes(ds)
+    classes = force_networks.force_class(ds).values[0]
+    c = int(ds["contact_count"][0])
+    particle_pairs = ds["j"].values[0, :c] < ds.sizes["particle"]
+    labels = classes[:c][particle_pairs]
+    colours = [tuple(col) for col in np.asarray(contact_collection(ax).get_colors())]
+    for code, name in ((1, "tab:blue"), (2, "tab:green"), (3, "tab:red")):
+        assert colours.count(to_rgba(name)) == np.count_nonzero(labels == code)
+    assert len(colours) == np.count_nonzero(labels > 0)
+    assert legend_texts(ax) == ["very weak", "weak", "strong"]
+
+
+def test_force_pdf_log_linear_with_exponential_fit(series, other_series):
+    force_pdf = pytest.importorskip("grainview.force_pdf")
+    ax = gp.plot_force_pdf({"a": series, "b": other_series}, bins=30)
+    assert len(ax.lines) == 4  # pdf and fit per sample
+    want = force_pdf.pooled_force_pdf(select_snapshots(series, "residual"), bins=30, scale="linear",
+                                      range=(0.0, 6.0))
+    p = want["pdf"].values if "time" not in want["pdf"].dims else want["pdf"].mean("time").values
+    keep = p > 0
+    np.testing.assert_allclose(ax.lines[0].get_ydata(), p[keep])
+    np.testing.assert_allclose(ax.lines[0].get_xdata(), want["f_over_mean"].values[keep])
+    alpha = float(force_pdf.strong_force_exponent(want))
+    x, y = ax.lines[1].get_xdata(), ax.lines[1].get_ydata()
+    assert (x > 1).all()
+    np.testing.assert_allclose(np.diff(np.log(y)) / np.diff(x), -alpha)  # exp(-alpha x)
+    assert f"{alpha:.2f}" in legend_texts(ax)[1]
+    assert ax.get_yscale() == "log" and ax.get_xscale() == "linear"
+    assert ax.get_xlabel() == r"$f_n/\langle f_n\rangle$" and ax.get_ylabel() == "$P$"
+
+
+def test_force_pdf_figures_log_log_and_per_kind(series):
+    pytest.importorskip("grainview.force_pdf")
+    fig = gp.plot_force_pdfs(series, bins=20)
+    assert [a.get_xscale() for a in fig.axes] == ["linear", "log"]
+    assert len(fig.axes[1].lines) == 1  # no fit in log-log
+    fig = gp.plot_force_pdfs_by_kind({"a": series}, bins=20)
+    ax = fig.axes[0]
+    assert len(ax.lines) == 2 and legend_texts(ax) == ["a, s", "a, d"]
+    from grainview.force_pdf import pooled_force_pdf
+    want = pooled_force_pdf(select_snapshots(series, "residual"), bins=20, scale="linear", range=(0.0, 6.0),
+                            kind="double")
+    p = want["pdf"].values if "time" not in want["pdf"].dims else want["pdf"].mean("time").values
+    np.testing.assert_allclose(ax.lines[1].get_ydata(), p[p > 0])
+
+
+@pytest.mark.parametrize("func, name, ylabel", [(gp.plot_xi_stress, "q_over_p", r"$q(\xi)/p$"),
+                                                 (gp.plot_xi_anisotropy, "a_prime", r"$a'(\xi)$")])
+def test_xi_network_curves(series, func, name, ylabel):
+    xi_network = pytest.importorskip("grainview.xi_network")
+    xi = np.array([0.5, 1.0, 2.0, 4.0])
+    ax = func(series, xi=xi)
+    want = xi_network.xi_network(select_snapshots(series, "residual"), xi=xi)[name].mean("time")
+    np.testing.assert_allclose(ax.lines[0].get_xdata(), xi)
+    np.testing.assert_allclose(ax.lines[0].get_ydata(), want.values, equal_nan=True)
+    assert ax.get_xlabel() == r"$\xi$" and ax.get_ylabel() == ylabel
+
+
+@pytest.mark.parametrize("func, names", [
+    (gp.plot_contact_proportions, ["k_s", "k_d", "f_s", "f_d"]),
+    (gp.plot_strong_weak_proportions, ["k_s_strong", "k_s_weak", "k_d_strong", "k_d_weak"])])
+def test_proportion_curves(series, func, names):
+    force_networks = pytest.importorskip("grainview.force_networks")
+    ax = func(series)
+    want = force_networks.contact_proportions(series)
+    assert len(ax.lines) == 4
+    for line, name in zip(ax.lines, names):
+        np.testing.assert_allclose(line.get_ydata(), want[name].values)
+        np.testing.assert_allclose(line.get_xdata(), strains(series)["eps_q"].values)
+
+
+def test_persistence_and_transitions():
+    persistence = pytest.importorskip("grainview.persistence")
+    ds = builders.mixed_contacts(seed=1, t=3)  # random pairs and kinds: gamma falls below 1
+    ax = gp.plot_persistence({"mixed": ds})
+    gamma = persistence.persistence(ds).values
+    np.testing.assert_allclose(ax.lines[0].get_ydata(), gamma)
+    assert gamma[0] == 1.0 and gamma[-1] < 1.0
+    assert ax.get_ylabel() == r"$\gamma$"
+    ax = gp.plot_type_transitions(ds)
+    want = persistence.type_transitions(ds)
+    np.testing.assert_allclose(ax.lines[0].get_ydata(), want["delta_gamma_s_to_d"].values)
+    np.testing.assert_allclose(ax.lines[1].get_ydata(), want["delta_gamma_d_to_s"].values)
+    np.testing.assert_allclose(ax.lines[1].get_xdata(), strains(ds)["eps_q"].values)
+    assert ax.get_ylabel() == r"$\Delta\gamma$"
+
+
+# -- accessor and saving ----------------------------------------------------------------------
+
+def test_accessor_has_a_method_for_every_figure(series):
+    acc = PlotAccessor(series)
+    for func in gp.FIGURES.values():
+        name = func.__name__.removeprefix("plot_")
+        assert getattr(type(acc), name).__wrapped__ is func
+    ax = acc.fabric_anisotropy()
+    np.testing.assert_allclose(ax.lines[0].get_ydata(), fabric_anisotropy(series)["a_prime"].values)
+
+    class Holder:
+        def __init__(self, ds):
+            self._ds = ds
+
+    gp.attach(Holder)
+    ax = Holder(series).plot.q_over_p()
+    np.testing.assert_allclose(ax.lines[0].get_ydata(), stress_invariants(series)["q_over_p"].values)
+
+
+def test_save_figure_writes_png_and_pdf(tmp_path, series):
+    ax = gp.plot_q_over_p(series)
+    paths = save_figure(ax.figure, tmp_path / "figs" / "fig03")
+    assert [p.name for p in paths] == ["fig03.png", "fig03.pdf"]
+    assert paths[0].read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    assert paths[1].read_bytes()[:5] == b"%PDF-"
+    paths = save_figure(ax, tmp_path / "fig03b.png")  # axes accepted, suffix replaced
+    assert all(p.exists() and p.stat().st_size > 0 for p in paths)
+
+
+def test_bad_data_argument_is_a_parameter_error(series):
+    with pytest.raises(ParameterError, match="data"):
+        gp.plot_q_over_p([series])
+    with pytest.raises(ParameterError, match="component"):
+        gp.plot_force_anisotropy(series, component="a_x")
+
+
+def test_dask_backed_dataset_draws_the_same_numbers(series):
+    lazy = series.chunk({"time": 1})
+    eager_ax = gp.plot_orientation_pdf(series, bins=12)
+    lazy_ax = gp.plot_orientation_pdf(lazy, bins=12)
+    np.testing.assert_allclose(lazy_ax.lines[0].get_ydata(), eager_ax.lines[0].get_ydata())
+    ax = gp.plot_harmonic_prediction(lazy)
+    np.testing.assert_allclose(ax.lines[1].get_ydata(), harmonic_prediction(series)["prediction"].values)
+    ax = gp.plot_force_chains(lazy, particles=False)
+    assert len(contact_collection(ax).get_segments()) == int(series["contact_count"][-1])
