@@ -11,7 +11,10 @@ import functools
 
 import xarray as xr
 
-from . import connectivity, fabric, forces, sample, strain, stress, validation
+from . import connectivity, fabric, force_networks, forces, sample, strain, stress, validation
+from . import force_pdf as _force_pdf
+from . import persistence as _persistence
+from . import xi_network as _xi_network
 
 
 def _delegate(func):
@@ -61,6 +64,14 @@ class GrainAccessor:
     force_tensors = _delegate(forces.force_tensors)
     force_anisotropies = _delegate(forces.force_anisotropies)
     harmonic_prediction = _delegate(forces.harmonic_prediction)
+    force_pdf = _delegate(_force_pdf.force_pdf)
+    pooled_force_pdf = _delegate(_force_pdf.pooled_force_pdf)
+    force_class = _delegate(force_networks.force_class)
+    contact_proportions = _delegate(force_networks.contact_proportions)
+    xi_network = _delegate(_xi_network.xi_network)
+    # contact history (these compute, one time-chunk at a time)
+    persistence = _delegate(_persistence.persistence)
+    type_transitions = _delegate(_persistence.type_transitions)
 
     @property
     def plot(self):

@@ -1,0 +1,199 @@
+"""Contact persistence gamma(t) and the transitions between simple and double contacts
+(paper Sec. IV.A Fig. 6b, Sec. VI Fig. 20; ERRATA item 8).
+
+A contact is identified by its pair of bodies {i, j}, encoded as the int64 key
+``min(i, j) (N + W) + max(i, j)`` (N particles, W walls), so the result does not depend on
+the order of the slots or of i and j. Pairs are matched with sorted keys and
+``np.searchsorted``, with no loop over contacts.
+
+These quantities couple snapshots, so they are computed rather than left lazy: on a dask-backed
+dataset the snapshots are read one time-chunk at a time, carrying the state needed from one
+chunk to the next (the reference contacts, the previous snapshot), so a file larger than
+memory streams through.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import xarray as xr
+
+from ._lift import with_attrs
+from .contacts import n_particles, selection
+from .errors import ParameterError
+from .schema import KIND_DOUBLE, KIND_SIMPLE
+
+_MAX_KEY = np.iinfo(np.int64).max // 2
+
+
+def body_count(ds: xr.Dataset) -> int:
+    """N + W: particles plus walls, the stride of the pair keys."""
+    n_walls = max(ds.sizes.get("wall", 0), int(ds.attrs.get("n_walls", 0) or 0))
+    return n_particles(ds) + n_walls
+
+
+def pair_keys(i, j, n_bodies):
+    """int64 key ``min(i, j) n_bodies + max(i, j)`` of each pair (unique for bodies < n_bodies)."""
+    i = np.asarray(i, np.int64)
+    j = np.asarray(j, np.int64)
+    return np.minimum(i, j) * n_bodies + np.maximum(i, j)
+
+
+def time_blocks(ds: xr.Dataset):
+    """Slices of ``time`` following the dataset's dask chunks (one slice when eager)."""
+    chunks = ds["fn"].chunksizes.get("time") if ds["fn"].chunks is not None else None
+    sizes = chunks or (ds.sizes["time"],)
+    start = 0
+    for size in sizes:
+        yield slice(start, start + size)
+        start += size
+
+
+def _blocks(ds, walls, force_bearing, start=0):
+    """Yield ``(block slice, keys (T, C) int64, present (T, C) bool, kind (T, C))`` per time
+    block from the block holding snapshot ``start`` on; each block is computed on its own."""
+    stride = body_count(ds)
+    present = selection(ds, walls=walls, force_bearing=force_bearing)
+    small = xr.Dataset({"i": ds["i"], "j": ds["j"], "kind": ds["kind"], "present": present})
+    small = small.transpose("time", "contact")
+    for block in time_blocks(ds):
+        if block.stop <= start:
+            continue
+        values = small.isel(time=block).compute()
+        present = values["present"].values
+        keys = np.where(present, pair_keys(values["i"].values, values["j"].values, stride), -1)
+        yield block, keys, present, values["kind"].values
+
+
+def _check_flag(name, value):
+    if not isinstance(value, (bool, np.bool_)):
+        raise ParameterError(f"{name}={value!r}: expected True or False")
+
+
+def persistence(ds: xr.Dataset, reference: int = 0, uninterrupted: bool = False, walls: bool = False,
+                force_bearing: bool = False) -> xr.DataArray:
+    """gamma(t): fraction of the contacts of the reference snapshot still present at t
+    (paper Sec. IV.A, Fig. 6b; ERRATA item 8).
+
+    gamma(t) = |C(ref) & C(t)| / |C(ref)|, C(t) the set of pairs {i, j} in contact at t
+    (occupied slots, particle–particle unless ``walls``, with f_n > 0 if ``force_bearing``).
+    With ``uninterrupted=True`` a contact counts only if present at every snapshot from the
+    reference to t. ``reference`` is a snapshot index (negative counts from the end); gamma is
+    1 there and NaN before it (and NaN if the reference holds no contact). Dimensionless.
+    Computed (not lazy), streaming one time-chunk at a time.
+    """
+    _check_flag("uninterrupted", uninterrupted)
+    _check_flag("walls", walls)
+    _check_flag("force_bearing", force_bearing)
+    n_time = ds.sizes["time"]
+    if isinstance(reference, bool) or not isinstance(reference, (int, np.integer)) or not -n_time <= reference < n_time:
+        raise ParameterError(f"reference={reference!r}: expected a snapshot index in [{-n_time}, {n_time})")
+    reference = int(reference) % n_time
+    gamma = np.full(n_time, np.nan)
+    ref_keys = alive = None
+    for block, keys, present, _ in _blocks(ds, walls, force_bearing, start=reference):
+        first = max(reference - block.start, 0)
+        if ref_keys is None:
+            ref_row = first
+            ref_keys = np.unique(keys[ref_row][present[ref_row]])
+            alive = np.ones(ref_keys.size, bool)
+        if ref_keys.size == 0:
+            break
+        keys, present = keys[first:], present[first:]
+        position = np.minimum(np.searchsorted(ref_keys, keys), ref_keys.size - 1)
+        hit = present & (ref_keys[position] == keys)
+        found = np.zeros((keys.shape[0], ref_keys.size), bool)  # found[t, r]: reference contact r at t
+        rows, cols = np.nonzero(hit)
+        found[rows, position[rows, cols]] = True
+        if uninterrupted:
+            found = np.logical_and.accumulate(found & alive, axis=0)
+            alive = found[-1].copy()
+        gamma[block.start + first:block.stop] = found.sum(axis=1) / ref_keys.size
+    da = xr.DataArray(gamma, dims="time", coords={"time": ds["time"].values})
+    return with_attrs(da, "gamma", "1", "fraction of persistent contacts gamma",
+                      reference=reference, uninterrupted=int(uninterrupted), walls=int(walls),
+                      force_bearing=int(force_bearing))
+
+
+def _pair_transitions(prev_keys, prev_kind, prev_present, keys, kind, present, stride):
+    """Numbers of contacts present at t-1 and t that went simple -> double and double -> simple,
+    and the number of contacts at t-1, for consecutive rows (prev row r matches row r).
+
+    Rows are separated by adding ``r * stride**2`` to the keys (exact integer offsets), so a
+    single sort and ``np.searchsorted`` match all pairs of a block.
+    """
+    n_rows = keys.shape[0]
+    span = stride * stride
+    rows_per_pass = max(1, _MAX_KEY // span - 1)
+    s_to_d = np.zeros(n_rows, np.int64)
+    d_to_s = np.zeros(n_rows, np.int64)
+    for lo in range(0, n_rows, rows_per_pass):  # one pass unless keys would overflow int64
+        hi = min(lo + rows_per_pass, n_rows)
+        offset = np.arange(hi - lo, dtype=np.int64)[:, None] * span
+        before = (prev_keys[lo:hi] + offset)[prev_present[lo:hi]]
+        before_kind = prev_kind[lo:hi][prev_present[lo:hi]]
+        order = np.argsort(before, kind="stable")
+        before, before_kind = before[order], before_kind[order]
+        row, col = np.nonzero(present[lo:hi])
+        now = keys[lo:hi][row, col] + offset[row, 0]
+        if before.size == 0 or now.size == 0:
+            continue
+        position = np.minimum(np.searchsorted(before, now), before.size - 1)
+        matched = before[position] == now
+        was, becomes = before_kind[position], kind[lo:hi][row, col]
+        s_to_d[lo:hi] = np.bincount(row[matched & (was == KIND_SIMPLE) & (becomes == KIND_DOUBLE)],
+                                    minlength=hi - lo)
+        d_to_s[lo:hi] = np.bincount(row[matched & (was == KIND_DOUBLE) & (becomes == KIND_SIMPLE)],
+                                    minlength=hi - lo)
+    return s_to_d, d_to_s, prev_present.sum(axis=1)
+
+
+def type_transitions(ds: xr.Dataset, walls: bool = False, force_bearing: bool = False) -> xr.Dataset:
+    """Cumulative fractions Delta gamma_{s->d}(t) and Delta gamma_{d->s}(t) of contacts that
+    changed type (paper Sec. VI, Fig. 20; ERRATA item 8).
+
+    Definition used here (the paper gives none in formula): for each pair of consecutive
+    snapshots (t-1, t),
+
+        g_{s->d}(t) = #{pairs {i, j} in contact at t-1 and at t, simple at t-1, double at t}
+                      / N_c(t-1),
+
+    N_c(t-1) the number of contacts at t-1 (occupied slots, particle–particle unless ``walls``,
+    f_n > 0 if ``force_bearing``); likewise g_{d->s}. Delta gamma(t) = sum_{t' <= t} g(t'),
+    with Delta gamma(0) = 0 (a step from a snapshot without contacts adds 0). Dimensionless.
+    Computed (not lazy), streaming one time-chunk at a time with the last snapshot of each
+    chunk carried over to the next.
+    """
+    _check_flag("walls", walls)
+    _check_flag("force_bearing", force_bearing)
+    stride = body_count(ds)
+    n_time = ds.sizes["time"]
+    s_to_d = np.zeros(n_time)
+    d_to_s = np.zeros(n_time)
+    carry = None
+    for block, keys, present, kind in _blocks(ds, walls, force_bearing):
+        if carry is None:  # the first snapshot has no predecessor
+            carry = (keys[:1], kind[:1], present[:1])
+            keys, kind, present, start = keys[1:], kind[1:], present[1:], block.start + 1
+        else:
+            start = block.start
+        prev_keys = np.concatenate([carry[0], keys[:-1]])
+        prev_kind = np.concatenate([carry[1], kind[:-1]])
+        prev_present = np.concatenate([carry[2], present[:-1]])
+        if keys.shape[0]:
+            n_sd, n_ds, n_prev = _pair_transitions(prev_keys, prev_kind, prev_present, keys, kind, present, stride)
+            with np.errstate(invalid="ignore", divide="ignore"):
+                s_to_d[start:block.stop] = np.where(n_prev > 0, n_sd / np.maximum(n_prev, 1), 0.0)
+                d_to_s[start:block.stop] = np.where(n_prev > 0, n_ds / np.maximum(n_prev, 1), 0.0)
+            carry = (keys[-1:], kind[-1:], present[-1:])
+    coords = {"time": ds["time"].values}
+    out = xr.Dataset({
+        "delta_gamma_s_to_d": with_attrs(xr.DataArray(np.cumsum(s_to_d), dims="time", coords=coords),
+                                         "delta_gamma_s_to_d", "1",
+                                         "cumulative fraction of contacts turning simple to double"),
+        "delta_gamma_d_to_s": with_attrs(xr.DataArray(np.cumsum(d_to_s), dims="time", coords=coords),
+                                         "delta_gamma_d_to_s", "1",
+                                         "cumulative fraction of contacts turning double to simple"),
+    })
+    out.attrs.update(walls=int(walls), force_bearing=int(force_bearing),
+                     comment="increment at t: contacts present at t-1 and t that changed kind, over N_c(t-1)")
+    return out

@@ -1,0 +1,176 @@
+"""Force pdfs: hand-counted histograms, np.histogram as oracle, pooling, and the exponent of
+the strong-force tail recovered from forces drawn with a known alpha."""
+
+import numpy as np
+import pytest
+import xarray as xr
+
+from grainview import make_dataset
+from grainview.errors import ParameterError
+from grainview.force_pdf import force_pdf, pooled_force_pdf, strong_force_exponent
+
+from . import builders
+from .conftest import raise_if_dask_computes
+
+RTOL = 1e-12
+
+
+def contacts_dataset(snapshots, n_particles=6, n_walls=0):
+    """Particles at rest; each snapshot a dict of i, j, fn and optionally kind (default simple).
+    Normals along x, branch 0.02 m along the normal: only the forces matter here."""
+    contacts = []
+    for snap in snapshots:
+        m = len(snap["i"])
+        normal = np.tile([1.0, 0.0], (m, 1))
+        contacts.append(dict(i=snap["i"], j=snap["j"], fn=snap["fn"], kind=snap.get("kind", np.ones(m)),
+                             normal=normal, ft=np.zeros(m), branch=0.02 * normal, point=np.zeros((m, 2))))
+    t = len(snapshots)
+    return make_dataset(radius=np.full(n_particles, 0.01), position=np.zeros((t, n_particles, 2)),
+                        contacts=contacts, box_min=[0.0, 0.0], box_max=[1.0, 1.0], n_walls=n_walls)
+
+
+def particle_contacts(ds):
+    """Boolean (time, contact): occupied particle–particle slots, by plain numpy."""
+    occupied = np.arange(ds.sizes["contact"]) < ds.contact_count.values[:, None]
+    return occupied & (ds.j.values < ds.sizes["particle"])
+
+
+def hand_dataset():
+    """Snapshot 0: f = 1, 2, 3, 6 (mean 3) and a wall contact of 100 N; snapshot 1: f = 0, 2, 2, 4
+    (mean 2). Kinds in snapshot 0: s, d, s, d."""
+    return contacts_dataset([
+        dict(i=[0, 1, 2, 3, 4], j=[1, 2, 3, 4, 6], fn=[1.0, 2.0, 3.0, 6.0, 100.0], kind=[1, 2, 1, 2, 1]),
+        dict(i=[0, 1, 2, 3], j=[1, 2, 3, 4], fn=[0.0, 2.0, 2.0, 4.0]),
+    ], n_walls=4)
+
+
+def test_linear_pdf_by_hand(prepare):
+    ds = prepare(hand_dataset())
+    with raise_if_dask_computes():
+        out = force_pdf(ds, bins=4, scale="linear", range=(0.0, 2.0))
+    out = out.compute()
+    # ratios f/<f>: 1/3, 2/3, 1, 2 (2 sits on the last edge, which np.histogram includes)
+    # and 0, 1, 1, 2; edges 0, 0.5, 1, 1.5, 2
+    np.testing.assert_array_equal(out["count"].values, [[1, 1, 1, 1], [1, 0, 2, 1]])
+    np.testing.assert_allclose(out["pdf"].values, [[0.5, 0.5, 0.5, 0.5], [0.5, 0.0, 1.0, 0.5]], rtol=RTOL)
+    np.testing.assert_allclose((out["pdf"] * out["bin_width"]).sum("bin").values, 1.0, rtol=RTOL)
+    np.testing.assert_allclose(out["f_over_mean"].values, [0.25, 0.75, 1.25, 1.75], rtol=RTOL)
+    np.testing.assert_allclose(out["bin_edges"].values, [0, 0.5, 1, 1.5, 2], rtol=RTOL)
+    np.testing.assert_array_equal(out["n_contacts"].values, [4, 4])
+    np.testing.assert_allclose(out["zero_fraction"].values, [0.0, 0.25], rtol=RTOL)
+    np.testing.assert_allclose(out["outside_fraction"].values, [0.0, 0.0], atol=0)
+
+
+def test_log_pdf_skips_zero_forces(prepare):
+    ds = prepare(hand_dataset())
+    with raise_if_dask_computes():
+        out = force_pdf(ds, bins=2, scale="log", range=(0.5, 2.0))
+    out = out.compute()
+    # edges 0.5, 1, 2: snapshot 0 -> 1/3 outside, 2/3 | 1, 2; snapshot 1 -> 0 skipped | 1, 1, 2
+    np.testing.assert_array_equal(out["count"].values, [[1, 2], [0, 3]])
+    np.testing.assert_allclose(out["pdf"].values, [[1 / (3 * 0.5), 2 / (3 * 1.0)], [0.0, 1.0]], rtol=RTOL)
+    np.testing.assert_allclose(out["f_over_mean"].values, [np.sqrt(0.5), np.sqrt(2.0)], rtol=RTOL)
+    np.testing.assert_allclose(out["zero_fraction"].values, [0.0, 0.25], rtol=RTOL)
+    np.testing.assert_allclose(out["outside_fraction"].values, [0.25, 0.25], rtol=RTOL)
+
+
+def test_walls_and_kind_selection(prepare):
+    ds = prepare(hand_dataset())
+    with_walls = force_pdf(ds, bins=2, scale="linear", range=(0.0, 5.0), walls=True).compute()
+    # snapshot 0 with the wall contact: mean 112/5, ratios 5/112, 10/112, 15/112, 30/112, 500/112
+    np.testing.assert_array_equal(with_walls["count"].values[0], [4, 1])
+    # simple contacts of snapshot 0 (f = 1 and 3), still normalised by the mean of all kinds (3)
+    simple = force_pdf(ds, bins=4, scale="linear", range=(0.0, 2.0), kind="simple").compute()
+    np.testing.assert_array_equal(simple["count"].values[0], [1, 0, 1, 0])
+    np.testing.assert_array_equal(simple["n_contacts"].values, [2, 4])
+    double = force_pdf(ds, bins=4, scale="linear", range=(0.0, 2.0), kind="double").compute()
+    np.testing.assert_array_equal(double["count"].values[0], [0, 1, 0, 1])
+
+
+@pytest.mark.parametrize("scale,value_range", [("linear", (0.0, 3.0)), ("log", (0.05, 4.0))])
+def test_matches_numpy_histogram(scale, value_range):
+    ds = builders.mixed_contacts(seed=3, t=4)
+    out = force_pdf(ds, bins=7, scale=scale, range=value_range)
+    mask = particle_contacts(ds)
+    for k in range(ds.sizes["time"]):
+        f = ds.fn.values[k][mask[k]]
+        ratio = f / f.mean()
+        edges = np.linspace(*value_range, 8) if scale == "linear" else np.geomspace(*value_range, 8)
+        pdf, _ = np.histogram(ratio, bins=edges, density=True)
+        count, _ = np.histogram(ratio, bins=edges)
+        np.testing.assert_array_equal(out["count"].values[k], count)
+        np.testing.assert_allclose(out["pdf"].values[k], pdf, rtol=RTOL)
+
+
+def test_pooled_pdf_is_histogram_of_all_snapshots(prepare):
+    eager = builders.mixed_contacts(seed=5, t=4)
+    ds = prepare(eager)
+    with raise_if_dask_computes():
+        pooled = pooled_force_pdf(ds, bins=6, scale="linear", range=(0.0, 3.0))
+    pooled = pooled.compute()
+    mask = particle_contacts(eager)
+    ratios = np.concatenate([eager.fn.values[k][mask[k]] / eager.fn.values[k][mask[k]].mean() for k in range(4)])
+    pdf, _ = np.histogram(ratios, bins=np.linspace(0, 3, 7), density=True)
+    np.testing.assert_allclose(pooled["pdf"].values, pdf, rtol=RTOL)
+    assert pooled["pdf"].dims == ("bin",)
+    assert int(pooled["n_contacts"]) == ratios.size
+    assert float(pooled["outside_fraction"]) == pytest.approx(np.mean(ratios > 3.0), rel=RTOL)
+
+
+def test_strong_force_exponent_exact_on_exponential_pdf():
+    x = np.linspace(0.05, 5.95, 60)
+    pdf = xr.Dataset({"pdf": ("bin", 0.3 * np.exp(-0.74 * x)), "count": ("bin", np.arange(1, 61))},
+                     coords={"f_over_mean": ("bin", x)})
+    assert float(strong_force_exponent(pdf)) == pytest.approx(0.74, rel=RTOL)
+    # empty bins are left out, and bins at or below the mean never enter the fit
+    pdf["count"][30:40] = 0
+    pdf["pdf"][:10] = 1e6
+    assert float(strong_force_exponent(pdf)) == pytest.approx(0.74, rel=RTOL)
+    too_few = pdf.assign(count=pdf["count"].where(pdf.f_over_mean < 1.1, 0))
+    assert np.isnan(float(strong_force_exponent(too_few)))
+
+
+def uniform_plus_exponential(alpha, n, rng):
+    """f/<f> uniform on [0, 1) with probability w, 1 + Exp(alpha) otherwise, w chosen so that
+    the mean is 1: the pdf above the mean is (1 - w) alpha exp(-alpha (x - 1))."""
+    w = (1 / alpha) / (0.5 + 1 / alpha)
+    weak = rng.uniform(size=n) < w
+    return np.where(weak, rng.uniform(0, 1, n), 1 + rng.exponential(1 / alpha, n))
+
+
+@pytest.mark.parametrize("alpha", [0.74, 1.4])
+def test_strong_force_exponent_recovers_known_alpha(alpha):
+    rng = np.random.default_rng(42)
+    n_snap, n_c = 4, 25_000  # 10^5 contacts in all
+    n_part = 2 * n_c
+    i = np.arange(0, n_part, 2)
+    snaps = [dict(i=i, j=i + 1, fn=2.5 * uniform_plus_exponential(alpha, n_c, rng), kind=np.ones(n_c),
+                  normal=np.tile([1.0, 0.0], (n_c, 1)), branch=np.tile([0.02, 0.0], (n_c, 1)),
+                  point=np.zeros((n_c, 2))) for _ in range(n_snap)]
+    ds = make_dataset(radius=np.full(n_part, 0.01), position=np.zeros((n_snap, n_part, 2)), contacts=snaps,
+                      box_min=[0.0, 0.0], box_max=[1.0, 1.0], n_contact_slots=n_c)
+    pooled = pooled_force_pdf(ds.chunk({"time": 2}), scale="linear", bins=40, range=(0.0, 6.0))
+    assert float(strong_force_exponent(pooled)) == pytest.approx(alpha, abs=0.02)
+    per_snapshot = strong_force_exponent(force_pdf(ds, scale="linear", bins=40, range=(0.0, 6.0)))
+    assert per_snapshot.dims == ("time",)
+    np.testing.assert_allclose(per_snapshot.values, alpha, atol=0.06)
+
+
+@pytest.mark.parametrize("kwargs,word", [
+    (dict(bins=0), "bins"), (dict(bins=2.5), "bins"), (dict(bins=True), "bins"),
+    (dict(scale="cubic"), "scale"), (dict(range=(1.0, 0.0)), "range"), (dict(range=(0.0, 1.0)), "log"),
+    (dict(scale="linear", range="wide"), "range"), (dict(kind="triple"), "kind"),
+])
+def test_bad_parameters(kwargs, word):
+    ds = hand_dataset()
+    with pytest.raises(ParameterError, match=word):
+        force_pdf(ds, **kwargs)
+    with pytest.raises(ParameterError, match=word):
+        pooled_force_pdf(ds, **kwargs)
+
+
+def test_bad_exponent_input():
+    with pytest.raises(ParameterError, match="force_pdf"):
+        strong_force_exponent(xr.Dataset({"x": ("bin", [1.0])}))
+    with pytest.raises(ParameterError, match="low"):
+        strong_force_exponent(force_pdf(hand_dataset()), low=2.0, high=1.0)
