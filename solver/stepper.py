@@ -16,6 +16,7 @@ each stage is one numba kernel or one vectorised numpy expression.
 
 from __future__ import annotations
 
+import time
 import warnings
 from dataclasses import asdict, dataclass
 
@@ -133,12 +134,16 @@ class Simulation:
         self.step_index = 0
         self.has_polygons = bool(np.any(self.n_vertices > 0))
         self._anchor = None  # positions at the last broad phase
+        self._wall_anchor = None  # wall positions at the last broad phase
+        self.reuse_detection = True  # reuse broad-phase candidates while nothing moved skin/2
         self._candidates = None
         self._keys = np.empty(0, np.int64)
         self._impulse = np.empty((0, 2))
         self.points = None
         self.impulse = np.empty((0, 2))
         self.last = None
+        self.timings = {"broad_phase": 0.0, "narrow_phase": 0.0, "solve": 0.0, "update": 0.0}
+        self.counters = {"steps": 0, "broad_phase_runs": 0, "sweeps": 0, "point_sweeps": 0}
 
     # -- mobility ---------------------------------------------------------------------------
     def _mobility(self):
@@ -160,17 +165,24 @@ class Simulation:
 
     # -- detection --------------------------------------------------------------------------
     def detect(self):
+        start = time.perf_counter()
         moved = np.inf if self._anchor is None else float(np.max(np.abs(self.position - self._anchor)))
-        if moved > 0.5 * self.skin:
+        walls_moved = 0.0 if self._wall_anchor is None else float(np.max(np.abs(self.walls.point - self._wall_anchor), initial=0.0))
+        if moved > 0.5 * self.skin or walls_moved > 0.5 * self.skin or not self.reuse_detection:
             margin = self.alert + self.skin
             pi, pj = broadphase.candidate_pairs(self.position, self.radius, margin)
             wp, ww = broadphase.wall_candidates(self.position, self.radius, self.walls.point, self.walls.normal, margin)
             self._candidates = (pi, pj, wp, ww)
             self._anchor = self.position.copy()
+            self._wall_anchor = self.walls.point.copy()
+            self.counters["broad_phase_runs"] += 1
+        middle = time.perf_counter()
         pi, pj, wp, ww = self._candidates
-        # walls move independently of the particles: keep every wall candidate within reach
-        return narrowphase.detect(self.position, self.angle, self.radius, self.n_vertices, self.walls.point,
-                                  self.walls.normal, self.alert, pi, pj, wp, ww)
+        points = narrowphase.detect(self.position, self.angle, self.radius, self.n_vertices, self.walls.point,
+                                    self.walls.normal, self.alert, pi, pj, wp, ww)
+        self.timings["broad_phase"] += middle - start
+        self.timings["narrow_phase"] += time.perf_counter() - middle
+        return points
 
     def _point_keys(self, pts):
         bodies = self.n_particles + self.n_walls
@@ -223,12 +235,17 @@ class Simulation:
         bias = self.contact_bias(g_star)
         mu = np.where(b >= n, p.wall_friction, p.friction)
         minv, iinv = self._mobility()
+        solve_start = time.perf_counter()
         vx, vy, om = v[:, 0].copy(), v[:, 1].copy(), omega.copy()
         pn, pt = impulse[:, 0].copy(), impulse[:, 1].copy()
         iterations, residual, worst = nlgs.solve(
             a, b, nx, ny, ra[:, 0].copy(), ra[:, 1].copy(), rb[:, 0].copy(), rb[:, 1].copy(), bias, mu, pn, pt,
             vx, vy, om, minv[:, 0].copy(), minv[:, 1].copy(), minv[:, 2].copy(), iinv, p.tolerance,
             p.max_tolerance, int(p.max_iterations), p.shuffle, p.seed + self.step_index)
+        self.timings["solve"] += time.perf_counter() - solve_start
+        update_start = time.perf_counter()
+        self.counters["sweeps"] += int(iterations)
+        self.counters["point_sweeps"] += int(iterations) * len(keys)
         converged = iterations < p.max_iterations or (residual <= p.tolerance and worst <= p.max_tolerance)
         if not converged:
             warnings.warn(f"NLGS did not converge at step {self.step_index} (t = {self.time:.6g} s): "
@@ -267,6 +284,8 @@ class Simulation:
         self._keys, self._impulse = keys, self.impulse
         self.time += h
         self.step_index += 1
+        self.counters["steps"] += 1
+        self.timings["update"] += time.perf_counter() - update_start
         overlap = float(max(0.0, -pts.gap.min())) if len(pts.gap) else 0.0
         self.last = StepInfo(int(iterations), float(residual), float(worst), bool(converged), len(keys), overlap)
         return self.last
