@@ -1,4 +1,4 @@
-"""The ``grainview`` command line: ``info FILE`` and ``demo``.
+"""The ``grainview`` command line: ``study``, ``run``, ``report``, ``info`` and ``demo``.
 
 Errors a user can cause are printed as one line (``grainview: error: ...``) with exit code 2,
 never as a traceback.
@@ -58,11 +58,114 @@ def _demo(args) -> int:
     return 0
 
 
+def _simulate(shape, particles, strain, every, path, seed, overwrite, progress, scene="biaxial"):
+    """Deposit, compact isotropically and (for ``scene="biaxial"``) shear one sample into
+    ``path``; returns the path. An isotropic run writes its final compacted state."""
+    import warnings
+
+    from solver import biaxial_test, compaction_sample, isotropic_compaction
+    from solver.output import Recorder
+
+    path = Path(path)
+    if path.exists() and not overwrite:
+        raise GrainviewError(f"{path} exists; pass --overwrite to replace it")
+    print(f"{shape}: depositing {particles} particles and compacting under 10 kPa ...", flush=True)
+    sim = compaction_sample(particles, shape, seed=seed)
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        steps = isotropic_compaction(sim, progress=progress)
+        settled = "settled" if sim.settled else "NOT settled (step limit reached)"
+        print(f"{shape}: compaction {settled} after {steps} steps; wall stresses "
+              f"{', '.join(f'{s:.0f}' for s in sim.compaction_stress)} Pa", flush=True)
+        if scene == "isotropic":
+            with Recorder(path, sim, attrs={"scene": "isotropic"}, overwrite=overwrite) as rec:
+                rec.write()
+        else:
+            print(f"{shape}: biaxial compression to eps_1 = {strain} ...", flush=True)
+            biaxial_test(sim, path, strain=strain, every=every, overwrite=overwrite, progress=progress)
+    unconverged = sum("did not converge" in str(w.message) for w in caught)
+    if unconverged:
+        print(f"{shape}: warning: NLGS reached its iteration limit in {unconverged} step(s)", file=sys.stderr)
+    print(f"{shape}: wrote {path}", flush=True)
+    return path
+
+
+def _progress_flag(args):
+    return None if args.progress == "auto" else args.progress == "on"
+
+
+def _run(args) -> int:
+    _simulate(args.shape, args.particles, args.strain, args.every, args.out, args.seed, args.overwrite,
+              _progress_flag(args), scene=args.scene)
+    return 0
+
+
+def _report(args) -> int:
+    from .io import open_dataset
+    from .report import write_report
+
+    labels = args.labels.split(",") if args.labels else [Path(f).stem for f in args.files]
+    if len(labels) != len(args.files):
+        raise GrainviewError(f"--labels has {len(labels)} names for {len(args.files)} files")
+    runs = {label: open_dataset(f, validate=True) for label, f in zip(labels, args.files)}
+    result = write_report(runs, args.out)
+    print(result["table"].to_string())
+    print(f"wrote {len(result['files'])} files in {args.out}")
+    return 0
+
+
+def _study(args) -> int:
+    out = Path(args.out)
+    out.mkdir(parents=True, exist_ok=True)
+    paths = {}
+    for label, shape in (("pentagons", "pentagon"), ("disks", "disk")):
+        paths[label] = _simulate(shape, args.particles, args.strain, args.every, out / f"{label}.nc", args.seed,
+                                 args.overwrite, _progress_flag(args))
+    args.files = [str(p) for p in paths.values()]
+    args.labels = ",".join(paths)
+    args.out = str(out / "report")
+    return _report(args)
+
+
 def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(prog="grainview", description=(
         "Contact dynamics of disks and polygons, and the force-transmission analyses of "
         "Azema et al., Phys. Rev. E 76, 011301 (2007)."))
     sub = parser.add_subparsers(dest="command", required=True)
+
+    def simulation_options(p, particles=400, strain=0.05, every=100):
+        p.add_argument("--particles", type=int, default=particles, help=f"particles per sample (default {particles})")
+        p.add_argument("--strain", type=float, default=strain,
+                       help=f"vertical strain eps_1 of the biaxial test (default {strain})")
+        p.add_argument("--every", type=int, default=every, help=f"steps between snapshots (default {every})")
+        p.add_argument("--seed", type=int, default=0, help="random seed of the deposit (default 0)")
+        p.add_argument("--overwrite", action="store_true", help="replace existing output files")
+        p.add_argument("--progress", choices=["auto", "on", "off"], default="auto",
+                       help="progress bars (default: on in a terminal)")
+
+    study = sub.add_parser("study", help="the paper's study: pentagons vs disks, simulated, analysed, plotted",
+                           description="Deposit, compact (10 kPa) and shear an S1-like pentagon sample and an "
+                           "S2-like disk sample, then write the report (table vs the paper, figures).")
+    study.add_argument("--out", default="study", help="output folder (default: study)")
+    simulation_options(study)
+    study.set_defaults(func=_study)
+
+    run = sub.add_parser("run", help="simulate one sample into a netCDF file",
+                         description="Geometric deposit, isotropic compaction under sigma_0 = 10 kPa, then "
+                         "(scene biaxial) compression at 1 cm/s with sigma_0 held laterally.")
+    run.add_argument("scene", nargs="?", choices=["biaxial", "isotropic"], default="biaxial",
+                     help="biaxial (default) or isotropic (writes the compacted state)")
+    run.add_argument("--shape", default="pentagon", help="pentagon (default), disk, or a number of vertices")
+    run.add_argument("--out", default="run.nc", help="output netCDF file (default: run.nc)")
+    simulation_options(run)
+    run.set_defaults(func=_run)
+
+    report = sub.add_parser("report", help="analyse runs: headline table vs the paper and all figures")
+    report.add_argument("files", nargs="+", help="netCDF files of the grainview contract")
+    report.add_argument("--labels", default=None, help="comma-separated labels (default: file names); "
+                        "labels containing 'pent' or 'disk' are compared with the paper's S1/S2 values")
+    report.add_argument("--out", default="report", help="output folder (default: report)")
+    report.set_defaults(func=_report)
     info = sub.add_parser("info", help="validate a grainview netCDF file and print its summary")
     info.add_argument("file", help="path of a netCDF file of the grainview data contract")
     info.set_defaults(func=_info)
@@ -81,7 +184,7 @@ def main(argv=None) -> int:
     args = parser.parse_args(argv)
     try:
         return args.func(args)
-    except (GrainviewError, FileExistsError) as exc:
+    except (GrainviewError, FileExistsError, FileNotFoundError) as exc:
         message = str(exc).replace("\n", "\n  ")
         print(f"grainview: error: {message}", file=sys.stderr)
         return 2

@@ -121,3 +121,71 @@ def write_table(table: pd.DataFrame, out: Path) -> list[Path]:
     lines += ["| " + " | ".join([str(idx), *(fmt(v) for v in row)]) + " |" for idx, row in table.iterrows()]
     md.write_text("\n".join(lines) + "\n")
     return [csv, md]
+
+
+POLYGON_FIGURES = ("18", "19", "20", "21", "22", "23", "24", "25")
+"""Figures about simple versus double contacts (paper Sec. VI): drawn for polygon runs only."""
+MAP_FIGURES = ("13", "17", "21", "24")
+"""Figures that draw one sample per call: one file per run."""
+
+FIGURE_NAMES = {
+    "03": "q_over_p", "04": "volumetric_strain", "05": "stress_dilatancy", "06a": "coordination",
+    "06b": "persistence", "07": "connectivity", "08": "orientation_pdf", "09": "fabric_anisotropy",
+    "10": "angular_forces", "11": "force_anisotropies", "12": "harmonic_prediction", "13": "force_chains",
+    "14": "force_pdfs", "15": "xi_stress", "16": "xi_anisotropy", "17": "force_classes",
+    "18": "partial_q_over_p", "19": "contact_proportions", "20": "type_transitions",
+    "21": "joint_connectivity", "22": "partial_fabric_anisotropy", "23": "force_pdfs_by_kind",
+    "24": "contact_kinds", "25": "strong_weak_proportions",
+}
+
+
+def _slug(label: str) -> str:
+    return "".join(c if c.isalnum() else "_" for c in label).strip("_").lower() or "run"
+
+
+def write_figures(runs: dict, out: Path, time=-1) -> list[Path]:
+    """Draw every figure of the paper the runs support into ``out`` (PNG and PDF).
+
+    Comparative figures get all runs on one axes; the maps and P(m_s, m_d) one file per run
+    (snapshot ``time``, default the last); the simple-versus-double figures only the runs
+    that contain polygons. Returns the paths written.
+    """
+    import matplotlib
+
+    matplotlib.use("Agg", force=False)
+    import matplotlib.pyplot as plt
+
+    from .plot import FIGURES, save_figure
+
+    out = Path(out)
+    out.mkdir(parents=True, exist_ok=True)
+    polygon_runs = {k: v for k, v in runs.items() if int(v["n_vertices"].max()) > 0}
+    written = []
+    for number, func in FIGURES.items():
+        chosen = polygon_runs if number in POLYGON_FIGURES else runs
+        if not chosen:
+            continue
+        name = f"fig{number}_{FIGURE_NAMES[number]}"
+        targets = ([(f"{name}_{_slug(label)}", {label: ds}) for label, ds in chosen.items()]
+                   if number in MAP_FIGURES else [(name, chosen)])
+        for stem, data in targets:
+            kwargs = {}
+            if number in MAP_FIGURES:
+                data = next(iter(data.values()))
+                kwargs["time"] = time
+            result = func(data, **kwargs)
+            fig = result if hasattr(result, "savefig") else result.figure
+            save_figure(fig, out / stem)
+            plt.close(fig)
+            written += [out / f"{stem}.png", out / f"{stem}.pdf"]
+    return written
+
+
+def write_report(runs: dict, out, residual: float = 0.3) -> dict:
+    """The whole report of ``runs`` ({label: dataset}) in folder ``out``: the headline table
+    (CSV, Markdown) and every figure. Returns {"table": DataFrame, "files": [paths]}."""
+    out = Path(out)
+    table = headline_table(runs, residual)
+    files = write_table(table, out)
+    files += write_figures(runs, out / "figures")
+    return {"table": table, "files": files}
