@@ -6,6 +6,7 @@ import xarray as xr
 from hypothesis import given, settings, strategies as st
 
 from grainview import make_dataset
+from grainview.synthetic import harmonic_contacts
 from grainview.errors import ParameterError
 
 from . import builders
@@ -65,23 +66,15 @@ def test_angular_averages_and_orientation_pdf():
     assert avg.theta.attrs["units"] == "rad"
 
 
-def harmonic_sample(n=100_000, a=0.3, a_n=0.4, a_t=0.25, theta_0=0.3, mean_force=2.0, seed=0):
-    """Contacts drawn from the harmonic model of ERRATA item 3, all directions theta_0, with
-    tangential forces that resist the shear (f_t = -<f> a_t sin 2(theta - theta_0))."""
-    rng = np.random.default_rng(seed)
-    theta = rng.uniform(0, np.pi, 4 * n)  # rejection sampling of P(theta)
-    keep = rng.uniform(0, 1 + a, theta.size) < 1 + a * np.cos(2 * (theta - theta_0))
-    theta = theta[keep][:n]
-    normal = np.stack([np.cos(theta), np.sin(theta)], -1)
-    fn = mean_force * (1 + a_n * np.cos(2 * (theta - theta_0))) * rng.uniform(0.5, 1.5, n)
-    ft = -mean_force * a_t * np.sin(2 * (theta - theta_0)) * np.ones(n)
-    n_part = 2 * n
-    i = np.arange(0, n_part, 2)
-    j = i + 1
-    pos = np.zeros((n_part, 2))
-    pos[j] = normal * 0.02
-    return make_dataset(radius=np.full(n_part, 0.01), position=pos,
-                        contacts=[dict(i=i, j=j, kind=np.ones(n, "i1"), normal=normal, fn=fn, ft=ft)],
+def harmonic_sample(n=100_000, a=0.3, a_n=0.4, a_t=0.25, theta_0=0.3, seed=0):
+    """Contacts drawn from the harmonic model of ERRATA item 3 (grainview.synthetic), all
+    directions theta_0, tangential forces resisting the shear; each contact its own pair."""
+    normal, fn, ft, kind = harmonic_contacts(n, a, a_n, a_t, theta_0, mean_force=2.0, rng=seed)
+    i = np.arange(0, 2 * n, 2)
+    pos = np.zeros((2 * n, 2))
+    pos[i + 1] = normal * 0.02
+    return make_dataset(radius=np.full(2 * n, 0.01), position=pos,
+                        contacts=[dict(i=i, j=i + 1, kind=kind, normal=normal, fn=fn, ft=ft)],
                         box_min=[-1, -1], box_max=[1, 1], n_contact_slots=n)
 
 
