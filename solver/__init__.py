@@ -13,9 +13,10 @@ biaxial compression, written as netCDF files of the grainview data contract.
 
 __version__ = "0.1.0"
 
-from .scenes import biaxial_test, compaction_sample, is_equilibrium, isotropic_compaction, wall_state  # noqa: E402
+from .scenes import (biaxial_test, compaction_sample, gravity_scene, is_equilibrium, isotropic_compaction,  # noqa: E402
+                     wall_state)
 from .stepper import Parameters, Simulation, StepInfo  # noqa: E402
 from .walls import Walls  # noqa: E402
 
 __all__ = ["Simulation", "Parameters", "StepInfo", "Walls", "compaction_sample", "isotropic_compaction",
-           "biaxial_test", "is_equilibrium", "wall_state", "__version__"]
+           "biaxial_test", "gravity_scene", "is_equilibrium", "wall_state", "__version__"]

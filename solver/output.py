@@ -4,7 +4,12 @@ snapshot (through :class:`grainview.schema.SnapshotWriter`).
 Contacts are written per body pair: a double contact's two points become one slot with the
 resultant force and its application point (the fn-weighted mean of the two points, their
 midpoint when both forces vanish). Only force-bearing contacts (f_n > 0) are written: pairs
-within the alert distance that carry nothing are not contacts of the packing.
+within the alert distance that carry nothing are not contacts of the packing. The kind is the
+detection's (geometric: two edges facing each other within the alert distance give a double
+contact), also when only one of its two points carries a force. ``branch`` is x_j - x_i for
+particle pairs (positions of the snapshot) and the contact point minus x_i for wall contacts;
+``wall_force`` is the total force exerted by the particles on each wall, sum of f over its
+contacts (f = f_n n + f_t t, force of i on j = the wall).
 """
 
 from __future__ import annotations
@@ -52,6 +57,24 @@ def pair_contacts(sim):
                 point=point[keep], branch=branch[keep])
 
 
+def sample_box(sim):
+    """(box_min, box_max) in m written with each snapshot: the four box walls' positions
+    (left, bottom, right, top) when the walls form a box; otherwise (an open scene such as
+    particles on a floor) the bounding box of the particles' circumscribed disks and of the
+    walls' reference points."""
+    from .walls import BOX_NAMES
+
+    if set(BOX_NAMES) <= set(sim.walls.names):
+        return sim.walls.box_bounds()
+    r = sim.radius[:, None]
+    lo = (sim.position - r).min(0)
+    hi = (sim.position + r).max(0)
+    if len(sim.walls):
+        lo = np.minimum(lo, sim.walls.point.min(0))
+        hi = np.maximum(hi, sim.walls.point.max(0))
+    return lo, hi
+
+
 class Recorder:
     """Stream snapshots of ``sim`` into ``path`` (context manager)."""
 
@@ -68,7 +91,7 @@ class Recorder:
     def write(self):
         sim = self.sim
         n = sim.n_particles
-        lo, hi = sim.walls.box_bounds()
+        lo, hi = sample_box(sim)
         info = sim.last
         self.writer.append(
             time=sim.time, position=sim.position, angle=sim.angle, contacts=pair_contacts(sim), box_min=lo, box_max=hi,

@@ -58,6 +58,21 @@ def _progress(total, desc, progress):
     return tqdm(total=total, desc=desc, unit="step", disable=not enabled, leave=False)
 
 
+def gravity_scene(position, angle, radius, n_vertices, *, gravity=9.81, tilt=0.0, sides=None,
+                  **parameters) -> Simulation:
+    """Particles on a fixed floor (the line y = 0, optional side walls at x = sides[0], sides[1])
+    under gravity of magnitude ``gravity`` (m s-2) tilted by ``tilt`` (rad): the vector
+    g (sin tilt, -cos tilt), which is the same as a floor inclined by ``tilt`` in a vertical
+    gravity field, seen in the floor's frame. ``parameters`` go to :class:`Parameters`
+    (friction with the floor is ``wall_friction``). For tests and demonstrations with analytic
+    answers (resting bodies, a column, a block on an inclined plane)."""
+    if not (np.isfinite(gravity) and np.isfinite(tilt)):
+        raise ParameterError(f"gravity={gravity!r}, tilt={tilt!r}: expected finite numbers (m s-2, rad)")
+    g = (float(gravity) * np.sin(tilt), -float(gravity) * np.cos(tilt))
+    params = Parameters(gravity=g, **parameters)
+    return Simulation(position, angle, radius, n_vertices, Walls.floor(sides=sides), params)
+
+
 def compaction_sample(n=400, shape="pentagon", *, sigma0=1e4, friction=0.4, wall_friction=0.0,
                       time_step=5e-4, seed=0, diameters=PAPER_DIAMETERS, fractions=PAPER_FRACTIONS,
                       aspect=2.0, wall_mass=None, max_wall_speed=0.05, **parameters) -> Simulation:

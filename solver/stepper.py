@@ -43,10 +43,10 @@ class Parameters:
     friction: float = 0.4  # between particles
     wall_friction: float = 0.0
     gravity: tuple = (0.0, 0.0)  # m s-2
-    density: float = 2600.0  # kg m-3
+    density: float = 2600.0  # kg m-3 (not given in the paper; glass-like grains assumed)
     thickness: float = 1.0  # m, slab thickness of the 2D sample
-    tolerance: float = 1.7e-4  # NLGS quadratic norm
-    max_tolerance: float = 1e-2  # NLGS max norm
+    tolerance: float = 1.7e-4  # NLGS quadratic norm of the velocity changes over a sweep (solver.nlgs)
+    max_tolerance: float = 1e-2  # NLGS max norm: largest single change over the RMS (solver.nlgs)
     max_iterations: int = 2000
     alert: float | None = None  # m; default: 2% of the smallest diameter
     skin: float | None = None  # m; default: 10% of the smallest diameter
