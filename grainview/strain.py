@@ -73,13 +73,15 @@ def friction_and_dilatancy(ds: xr.Dataset, reference: int = 0) -> xr.Dataset:
     q_over_p = stress_invariants(ds)["q_over_p"]
     ratio = _ratio(eps["eps_p"], eps["eps_q"])
     rate = _ratio(time_derivative(eps["eps_p"]), time_derivative(eps["eps_q"]))
-    with np.errstate(invalid="ignore"):
-        return xr.Dataset({
-            "phi": with_attrs(np.arcsin(q_over_p), "phi", "rad", "friction angle, sin phi = q/p"),
-            "psi": with_attrs(np.arcsin(ratio), "psi", "rad", "dilatancy angle, sin psi = eps_p/eps_q"),
-            "psi_incremental": with_attrs(np.arcsin(rate), "psi_incremental", "rad",
-                                          "incremental dilatancy angle, sin psi = d eps_p/d eps_q"),
-        })
+    def asin(sine):  # NaN outside [-1, 1], without warnings when dask computes later
+        return np.arcsin(sine.where(abs(sine) <= 1))
+
+    return xr.Dataset({
+        "phi": with_attrs(asin(q_over_p), "phi", "rad", "friction angle, sin phi = q/p"),
+        "psi": with_attrs(asin(ratio), "psi", "rad", "dilatancy angle, sin psi = eps_p/eps_q"),
+        "psi_incremental": with_attrs(asin(rate), "psi_incremental", "rad",
+                                      "incremental dilatancy angle, sin psi = d eps_p/d eps_q"),
+    })
 
 
 def inertia_number(ds: xr.Dataset) -> xr.DataArray:
