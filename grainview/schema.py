@@ -92,6 +92,14 @@ VARIABLES: dict[str, Var] = {
     "wall_normal": Var(("wall", "xy"), "f8", "1", "unit wall normal pointing into the sample", False),
     "wall_position": Var(("time", "wall", "xy"), "f8", "m", "a point of the wall line", False),
     "wall_force": Var(("time", "wall", "xy"), "f8", "N", "total force exerted by the particles on the wall", False),
+    # restart state (issue 6): what a resumed run needs beyond the snapshot itself
+    "wall_velocity": Var(("time", "wall", "xy"), "f8", "m s-1", "velocity of the wall (imposed, or reached under its stress)", False),
+    "normal_impulse": Var(("time", "contact", "contact_point"), "f8", "N s",
+                          "normal impulse of the last time step at each point of the contact, in detection "
+                          "order (0 for the second point of a simple contact and in empty slots)", False),
+    "tangential_impulse": Var(("time", "contact", "contact_point"), "f8", "N s",
+                              "tangential impulse of the last time step at each point of the contact, along t "
+                              "(0 for the second point of a simple contact and in empty slots)", False),
     # solver diagnostics
     "step": Var(("time",), "i4", "1", "time-step index of the snapshot", False),
     "nlgs_iterations": Var(("time",), "i4", "1", "NLGS iterations of the last step", False),
@@ -307,6 +315,24 @@ def netcdf_encoding(ds: xr.Dataset) -> dict:
     return enc
 
 
+def _move_into_place(temporary: str, path: str, overwrite: bool) -> None:
+    """Rename ``temporary`` to ``path`` atomically; without ``overwrite`` an existing ``path``
+    (even one created meanwhile by another process) is kept and FileExistsError raised."""
+    if overwrite:
+        os.replace(temporary, path)
+        return
+    try:
+        os.link(temporary, path)  # fails if path exists: no check-then-rename race
+    except FileExistsError:
+        raise FileExistsError(f"{path} exists; pass overwrite=True to replace it") from None
+    except OSError:  # file systems without hard links
+        if os.path.exists(path):
+            raise FileExistsError(f"{path} exists; pass overwrite=True to replace it") from None
+        os.replace(temporary, path)
+        return
+    os.remove(temporary)
+
+
 class SnapshotWriter:
     """Create a netCDF file of the contract and append snapshots while a run goes on.
 
@@ -350,12 +376,19 @@ class SnapshotWriter:
             raise ParameterError(f"unknown optional variables {unknown}")
         if not n_walls:
             optional = [o for o in optional if "wall" not in VARIABLES[o].dims]
-        nc = netCDF4.Dataset(path, "w", format=format)
+        # The header and the static data are written under a temporary name and the file is
+        # moved into place once they are on disk: a run killed while the file is being created
+        # leaves either no file or a valid empty one, never a partial header (issue 6).
+        directory, base = os.path.split(os.path.abspath(path))
+        temporary = os.path.join(directory, f".{base}.{os.getpid()}.part")
+        nc = netCDF4.Dataset(temporary, "w", format=format)
         try:
             nc.set_auto_mask(False)
             nc.createDimension("time", None)
             nc.createDimension("particle", n)
             nc.createDimension("contact", slots)
+            if any("contact_point" in VARIABLES[o].dims for o in optional):
+                nc.createDimension("contact_point", 2)  # the two points of a double contact
             nc.createDimension("xy", 2)
             nc.createDimension("xy_strlen", 1)
             xy = nc.createVariable("xy", "S1", ("xy", "xy_strlen"))
@@ -389,11 +422,16 @@ class SnapshotWriter:
                 nc.variables[name][:] = np.broadcast_to(np.asarray(value, VARIABLES[name].dtype),
                                                         nc.variables[name].shape)
             nc.setncatts(global_attrs(n, n_walls, attrs))
-            nc.sync()
-        except BaseException:
             nc.close()
-            os.remove(path)
+            _move_into_place(temporary, path, overwrite)
+        except BaseException:
+            if nc.isopen():
+                nc.close()
+            if os.path.exists(temporary):
+                os.remove(temporary)
             raise
+        nc = netCDF4.Dataset(path, "a")
+        nc.set_auto_mask(False)
         return cls(nc, path)
 
     @classmethod

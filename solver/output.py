@@ -20,7 +20,8 @@ from grainview.schema import DIAGNOSTICS, SnapshotWriter
 
 from . import __version__
 
-OPTIONAL = ("velocity", "angular_velocity", "wall_position", "wall_force", *DIAGNOSTICS)
+OPTIONAL = ("velocity", "angular_velocity", "wall_position", "wall_velocity", "wall_force",
+            "normal_impulse", "tangential_impulse", *DIAGNOSTICS)
 
 
 def pair_contacts(sim):
@@ -57,6 +58,41 @@ def pair_contacts(sim):
                 point=point[keep], branch=branch[keep])
 
 
+# --- restart state (issue 6; read back by solver.restart) ------------------------------------
+def point_impulses(sim, n_slots):
+    """Normal and tangential impulses (N s) of the last step at the points of the contacts that
+    :func:`pair_contacts` writes, in its slot order: two (n_slots, 2) arrays whose column 0 is
+    the pair's first contact point and column 1 its second (0 for a simple contact), 0 in empty
+    slots. They are the exact warm start of the next step: the resultant forces fn, ft of the
+    file cannot give back the two points' impulses of a double contact, nor p = f h bit for bit.
+    Pairs that are not written carry no impulse (f_n = 0 at every point, so f_t = 0 by Coulomb)."""
+    normal = np.zeros((n_slots, 2))
+    tangential = np.zeros((n_slots, 2))
+    pts = sim.points
+    if pts is None or len(pts.pair) == 0:
+        return normal, tangential
+    pair = pts.pair
+    fn = np.bincount(pair, weights=sim.impulse[:, 0] / sim.parameters.time_step, minlength=pts.n_pairs)
+    keep = fn > 0  # the same selection as pair_contacts
+    slot = np.cumsum(keep) - 1
+    rank = np.zeros(len(pair), np.int64)
+    rank[1:] = pair[1:] == pair[:-1]
+    written = keep[pair]
+    normal[slot[pair[written]], rank[written]] = sim.impulse[written, 0]
+    tangential[slot[pair[written]], rank[written]] = sim.impulse[written, 1]
+    return normal, tangential
+
+
+def wall_settings(walls):
+    """Global attributes describing how each wall is driven during the recording: mode (0 fixed,
+    1 imposed velocity, 2 imposed stress), stress (Pa), mass (kg), cap on the inward speed
+    (m s-1) and the axis along which its length is measured (0: x, 1: y)."""
+    return {"wall_mode": walls.mode.astype("i4"), "wall_mode_meanings": "fixed velocity stress",
+            "wall_stress_Pa": walls.stress.astype("f8"), "wall_mass_kg": walls.mass.astype("f8"),
+            "wall_max_speed_m_s": walls.max_speed.astype("f8"), "wall_length_axis": walls.length_axis.astype("i4")}
+# --- end restart state ------------------------------------------------------------------------
+
+
 def sample_box(sim):
     """(box_min, box_max) in m written with each snapshot: the four box walls' positions
     (left, bottom, right, top) when the walls form a box; otherwise (an open scene such as
@@ -80,6 +116,8 @@ class Recorder:
 
     def __init__(self, path, sim, attrs=None, overwrite=False, optional=OPTIONAL):
         params = {f"solver_{k}": (v if v is not None else "none") for k, v in sim.parameters_dict().items()}
+        if sim.n_walls:
+            params.update(wall_settings(sim.walls))
         params.update(attrs or {})
         params["solver_version"] = __version__
         self.sim = sim
@@ -88,14 +126,25 @@ class Recorder:
             n_walls=sim.n_walls, wall_names=sim.walls.names, wall_normal=sim.walls.normal,
             optional=optional, attrs=params, overwrite=overwrite)
 
+    @classmethod
+    def append_to(cls, path, sim):
+        """Go on recording ``sim`` at the end of the existing file ``path`` (a resumed run,
+        :mod:`solver.restart`); the file's attributes are left as they are."""
+        recorder = cls.__new__(cls)
+        recorder.sim = sim
+        recorder.writer = SnapshotWriter.open_append(path)
+        return recorder
+
     def write(self):
         sim = self.sim
         n = sim.n_particles
         lo, hi = sample_box(sim)
         info = sim.last
+        normal_impulse, tangential_impulse = point_impulses(sim, self.writer.n_slots)
         self.writer.append(
             time=sim.time, position=sim.position, angle=sim.angle, contacts=pair_contacts(sim), box_min=lo, box_max=hi,
             velocity=sim.velocity[:n], angular_velocity=sim.angular_velocity[:n], wall_position=sim.walls.point,
+            wall_velocity=sim.walls.velocity, normal_impulse=normal_impulse, tangential_impulse=tangential_impulse,
             wall_force=sim.wall_forces(), step=sim.step_index,
             nlgs_iterations=info.iterations if info else 0, nlgs_residual=info.residual if info else 0.0,
             max_interpenetration=info.max_interpenetration if info else 0.0, kinetic_energy=sim.kinetic_energy())

@@ -170,18 +170,30 @@ def biaxial_test(sim: Simulation, path, *, strain=0.1, velocity=0.01, every=20, 
     n_steps = int(np.ceil(travel / velocity / sim.parameters.time_step))
     sim.walls.drive_velocity("top", (0.0, -velocity))
     run_attrs = {"scene": "biaxial", "strain_target": strain, "wall_velocity_m_s": velocity,
-                 "sigma0_Pa": getattr(sim, "sigma0", np.nan), "snapshot_every": int(every)}
+                 "sigma0_Pa": getattr(sim, "sigma0", np.nan), "snapshot_every": int(every),
+                 "biaxial_steps": n_steps}
     run_attrs.update(attrs or {})
-    with Recorder(path, sim, attrs=run_attrs, overwrite=overwrite) as rec, interruptible() as flag, \
-            _progress(n_steps, "biaxial test", progress) as bar:
+    with Recorder(path, sim, attrs=run_attrs, overwrite=overwrite) as rec:
         rec.write()
-        for k in range(1, n_steps + 1):
+        biaxial_steps(sim, rec, first=1, n_steps=n_steps, every=int(every), progress=progress)
+    return n_steps
+
+
+def biaxial_steps(sim: Simulation, recorder, *, first, n_steps, every, progress=None):
+    """Steps ``first`` .. ``n_steps`` (counted from the start of the test) of a biaxial test,
+    with a snapshot every ``every`` steps and at the last one; shared by :func:`biaxial_test`
+    and :func:`solver.restart.resume`. Ctrl-C stops after the current step (its snapshot
+    written if one is due) and prints how to resume; then raises KeyboardInterrupt."""
+    from .restart import resume_instructions
+
+    with interruptible() as flag, _progress(n_steps, "biaxial test", progress) as bar:
+        bar.update(first - 1)
+        for k in range(first, n_steps + 1):
             sim.step()
             bar.update(1)
             if k % every == 0 or k == n_steps:
-                rec.write()
-            if flag["stop"]:
-                print(f"interrupted after step {sim.step_index}: {path} holds every snapshot written so far",
-                      file=sys.stderr)
+                recorder.write()
+            if flag["stop"] and k < n_steps:
+                print(f"interrupted after step {sim.step_index}: {recorder.writer.path} holds every snapshot "
+                      f"written so far\n{resume_instructions(recorder.writer.path)}", file=sys.stderr)
                 raise KeyboardInterrupt
-    return n_steps

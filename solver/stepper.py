@@ -166,8 +166,9 @@ class Simulation:
     # -- detection --------------------------------------------------------------------------
     def detect(self):
         start = time.perf_counter()
-        moved = np.inf if self._anchor is None else float(np.max(np.abs(self.position - self._anchor)))
-        walls_moved = 0.0 if self._wall_anchor is None else float(np.max(np.abs(self.walls.point - self._wall_anchor), initial=0.0))
+        moved = np.inf if self._anchor is None else float(np.sqrt(np.max(np.sum((self.position - self._anchor) ** 2, axis=1))))
+        walls_moved = 0.0 if self._wall_anchor is None else float(
+            np.sqrt(np.max(np.sum((self.walls.point - self._wall_anchor) ** 2, axis=1), initial=0.0)))
         if moved > 0.5 * self.skin or walls_moved > 0.5 * self.skin or not self.reuse_detection:
             margin = self.alert + self.skin
             pi, pj = broadphase.candidate_pairs(self.position, self.radius, margin)

@@ -1,0 +1,213 @@
+"""Resuming a biaxial test from its own output file (issue 6).
+
+A run killed at any moment (SIGKILL, a cluster's wall-time limit, Ctrl-C) leaves a file whose
+complete snapshots all open (:class:`grainview.schema.SnapshotWriter` syncs the file after each
+one and marks it ``complete`` last). The last complete snapshot holds the whole state of the
+run, so :func:`resume` rebuilds the :class:`~solver.stepper.Simulation` from it and goes on
+appending to the same file:
+
+* particles: ``position``, ``angle``, ``velocity``, ``angular_velocity`` (f8, exact);
+* walls: ``wall_position``, ``wall_velocity`` per snapshot; ``wall_normal`` and the wall names;
+  how each wall is driven (global attributes ``wall_mode``, ``wall_stress_Pa``,
+  ``wall_mass_kg``, ``wall_max_speed_m_s``, ``wall_length_axis``, see
+  :func:`solver.output.wall_settings`);
+* the warm start of the next step: ``normal_impulse`` and ``tangential_impulse``, the impulses
+  of the last step at each contact point, keyed by body pair and point rank as the stepper
+  keys them (the resultant forces ``fn``, ``ft`` could not give the two points of a double
+  contact back);
+* ``time`` and ``step`` (the step index); the solver parameters (attributes ``solver_*``); the
+  test itself (``strain_target``, ``wall_velocity_m_s``, ``snapshot_every``, ``biaxial_steps``,
+  ``sigma0_Pa``).
+
+There is no random state to restore: the only random draw of a step, the NLGS ordering when
+``shuffle`` is on, is seeded with ``seed + step index``. The broad phase is redone at the first
+resumed step; it only selects candidate pairs, and the narrow phase keeps the contacts in the
+candidates' sorted order, so the contacts found are the same. A resumed run therefore writes
+the same snapshots, bit for bit, as an uninterrupted one.
+
+From a shell::
+
+    python -m solver.restart run.nc
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import shlex
+import sys
+import warnings
+from dataclasses import fields
+from types import SimpleNamespace
+
+import numpy as np
+
+from grainview.errors import FileFormatError, GrainviewError
+
+from .stepper import Parameters, Simulation
+from .walls import Walls
+
+STATE_VARIABLES = ("velocity", "angular_velocity", "wall_normal", "wall_position", "wall_velocity",
+                   "normal_impulse", "tangential_impulse", "step")
+"""Variables a file needs, besides the required ones, to be resumed."""
+WALL_ATTRIBUTES = ("wall_mode", "wall_stress_Pa", "wall_mass_kg", "wall_max_speed_m_s", "wall_length_axis")
+BIAXIAL_ATTRIBUTES = ("strain_target", "wall_velocity_m_s", "snapshot_every", "biaxial_steps")
+
+
+def resume_instructions(path) -> str:
+    """How to resume the run written to ``path``: the shell command and the Python call."""
+    path = os.path.abspath(os.fspath(path))
+    return (f"resume it with:  {shlex.quote(sys.executable)} -m solver.restart {shlex.quote(path)}\n"
+            f"or in Python:    from solver.restart import resume; resume({path!r})")
+
+
+def _parameters(attrs, source) -> Parameters:
+    """The solver parameters written as global attributes ``solver_<name>``."""
+    values = {}
+    for field in fields(Parameters):
+        key = f"solver_{field.name}"
+        if key not in attrs:
+            raise FileFormatError(f"{source}: cannot resume, global attribute {key!r} is missing")
+        value = attrs[key]
+        if isinstance(value, str):
+            value = None if value == "none" else value
+        elif field.name == "gravity":
+            value = tuple(float(g) for g in np.atleast_1d(value))
+        elif field.name == "shuffle":
+            value = bool(value)
+        elif field.name in ("seed", "max_iterations"):
+            value = int(value)
+        else:
+            value = float(value)
+        values[field.name] = value
+    return Parameters(**values)
+
+
+def _check_resumable(ds, source):
+    missing = [name for name in STATE_VARIABLES if name not in ds.variables]
+    missing += [name for name in (*WALL_ATTRIBUTES, *BIAXIAL_ATTRIBUTES) if name not in ds.attrs]
+    if missing:
+        raise FileFormatError(f"{source}: cannot resume, the file lacks {missing} (written by a solver "
+                              "without restart support, or not by this solver)")
+    if ds.attrs.get("scene") != "biaxial":
+        raise FileFormatError(f"{source}: cannot resume, scene={ds.attrs.get('scene')!r}: only a biaxial test "
+                              "('biaxial') can be resumed")
+    if ds.sizes["time"] == 0:
+        raise FileFormatError(f"{source}: cannot resume, the file holds no complete snapshot (the run was "
+                              "stopped before its first one): start the run again")
+
+
+def load_state(path):
+    """The simulation at the last complete snapshot of ``path`` and the test's settings.
+
+    Returns ``(sim, test)``: ``sim`` a :class:`Simulation` whose next step is the one after the
+    snapshot, with its warm start; ``test`` a dict with ``first_step`` (step index of the
+    test's first snapshot), ``n_steps``, ``every``, ``snapshots`` (complete snapshots in the
+    file). Raises :class:`FileFormatError` naming what is missing when the file cannot be
+    resumed. The file is only read.
+    """
+    import grainview
+
+    source = os.fspath(path)
+    with grainview.open_dataset(source, chunks=None) as ds:
+        _check_resumable(ds, source)
+        last = ds.isel(time=-1)
+        attrs = dict(ds.attrs)
+        names = tuple(str(name) for name in ds["wall"].values)
+        count = int(last["contact_count"])
+        state = {name: last[name].values.copy() for name in (
+            "position", "angle", "velocity", "angular_velocity", "wall_position", "wall_velocity")}
+        static = {name: ds[name].values.copy() for name in ("radius", "n_vertices", "mass", "inertia", "wall_normal")}
+        contacts = {name: last[name].values[:count].copy()
+                    for name in ("i", "j", "normal_impulse", "tangential_impulse")}
+        time, step, first_step = float(last["time"]), int(last["step"]), int(ds["step"].values[0])
+        snapshots = ds.sizes["time"]
+    for name, value in state.items():
+        if not np.all(np.isfinite(value)):
+            raise FileFormatError(f"{source}: cannot resume, {name} of the last snapshot is not finite")
+
+    walls = Walls(state["wall_position"], static["wall_normal"], names,
+                  mode=np.asarray(attrs["wall_mode"], np.int64), velocity=state["wall_velocity"],
+                  stress=np.asarray(attrs["wall_stress_Pa"], float), mass=np.asarray(attrs["wall_mass_kg"], float),
+                  length_axis=np.asarray(attrs["wall_length_axis"], np.int64),
+                  max_speed=np.asarray(attrs["wall_max_speed_m_s"], float))
+    sim = Simulation(state["position"], state["angle"], static["radius"], static["n_vertices"], walls,
+                     _parameters(attrs, source), velocity=state["velocity"],
+                     angular_velocity=state["angular_velocity"])
+    if not (np.array_equal(sim.mass, static["mass"]) and np.array_equal(sim.inertia, static["inertia"])):
+        raise FileFormatError(f"{source}: cannot resume, the masses and inertias of the file differ from those "
+                              "of its solver parameters (density, thickness)")
+    sim.time, sim.step_index = time, step
+    sim.sigma0 = float(attrs.get("sigma0_Pa", np.nan))
+    set_warm_start(sim, contacts["i"], contacts["j"], contacts["normal_impulse"], contacts["tangential_impulse"])
+    test = {"first_step": first_step, "n_steps": int(attrs["biaxial_steps"]), "every": int(attrs["snapshot_every"]),
+            "snapshots": snapshots}
+    return sim, test
+
+
+def set_warm_start(sim, i, j, normal_impulse, tangential_impulse):
+    """Give ``sim`` the impulses of its last step as the warm start of the next one.
+
+    ``i``, ``j`` (m,) are the body pairs of the contacts, ``normal_impulse`` and
+    ``tangential_impulse`` (m, 2) their points' impulses in N s (column = point rank in the
+    pair, as the stepper ranks them). The keys are the stepper's own
+    (:meth:`Simulation._point_keys`), so each impulse goes to the same contact point as in an
+    uninterrupted run; a zero impulse is the same as none.
+    """
+    m = len(i)
+    points = SimpleNamespace(pair=np.repeat(np.arange(m), 2), body_i=np.repeat(np.asarray(i, np.int64), 2),
+                             body_j=np.repeat(np.asarray(j, np.int64), 2))
+    sim._keys = sim._point_keys(points)
+    sim._impulse = np.stack([np.asarray(normal_impulse, float).reshape(2 * m),
+                             np.asarray(tangential_impulse, float).reshape(2 * m)], -1)
+
+
+def resume(path, progress=None) -> int:
+    """Continue the biaxial test written to ``path`` from its last complete snapshot until its
+    strain target, appending the snapshots to the same file. Returns the number of steps
+    taken (0 when the test had already finished).
+
+    The snapshots written are those an uninterrupted run writes, bit for bit (see the module
+    docstring). Ctrl-C stops again after the current step, with instructions to resume.
+    ``progress``: a tqdm bar (None: when stderr is a terminal).
+    """
+    from .output import Recorder
+    from .scenes import biaxial_steps
+
+    sim, test = load_state(path)
+    first = sim.step_index - test["first_step"] + 1
+    if first > test["n_steps"]:
+        return 0
+    with Recorder.append_to(path, sim) as recorder:
+        biaxial_steps(sim, recorder, first=first, n_steps=test["n_steps"], every=test["every"], progress=progress)
+    return test["n_steps"] - first + 1
+
+
+def main(argv=None) -> int:
+    """``python -m solver.restart PATH``: resume the biaxial test written to PATH."""
+    parser = argparse.ArgumentParser(prog="python -m solver.restart", description=main.__doc__)
+    parser.add_argument("path", help="the netCDF file of an interrupted biaxial test")
+    parser.add_argument("--progress", choices=("auto", "on", "off"), default="auto", help="progress bar")
+    args = parser.parse_args(argv)
+    progress = None if args.progress == "auto" else args.progress == "on"
+    try:
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            steps = resume(args.path, progress=progress)
+    except (GrainviewError, FileNotFoundError) as exc:
+        print(f"solver.restart: error: {exc}", file=sys.stderr)
+        return 2
+    except KeyboardInterrupt:
+        return 130
+    for w in caught:
+        if "did not converge" not in str(w.message):
+            warnings.showwarning(w.message, w.category, w.filename, w.lineno)
+    unconverged = sum("did not converge" in str(w.message) for w in caught)
+    if unconverged:
+        print(f"warning: NLGS reached its iteration limit in {unconverged} step(s)", file=sys.stderr)
+    print(f"{args.path}: {'already complete' if steps == 0 else f'resumed for {steps} steps, complete'}")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,302 @@
+"""Nothing lost (issue 6): a biaxial run killed with SIGKILL at random moments leaves a file
+that opens, validates and holds only complete snapshots, each equal to the uninterrupted
+run's; resuming such a file gives the uninterrupted run's file byte for byte; Ctrl-C stops
+cleanly and prints the command that resumes the run.
+
+The run: 40 pentagons, 300 steps of isotropic compaction, a biaxial test of 128 steps with a
+snapshot every 2 steps (65 snapshots). The interrupted runs are subprocesses running
+``CHILD``, which prints a line after each snapshot is written, so that the kill moments are
+drawn (seeded) in snapshot counts plus a few milliseconds, whatever the machine's speed.
+"""
+
+import os
+import shlex
+import signal
+import subprocess
+import sys
+import time
+import warnings
+from pathlib import Path
+
+import netCDF4
+import numpy as np
+import pytest
+
+import grainview
+from grainview.errors import FileFormatError
+from grainview.schema import VARIABLES
+from solver import biaxial_test, compaction_sample, isotropic_compaction
+from solver.output import Recorder, point_impulses
+from solver.restart import load_state, resume
+
+REPO = Path(__file__).resolve().parents[2]
+SNAPSHOTS = 65  # 1 + 128 steps / every 2
+TIME_VARIABLES = {name for name, var in VARIABLES.items() if "time" in var.dims} | {"time"}
+RUN = dict(n=40, seed=2, compaction_steps=300, strain=0.002, every=2)
+
+CHILD = """
+import sys, warnings
+warnings.simplefilter("ignore")
+from solver import biaxial_test, compaction_sample, isotropic_compaction
+from solver.output import Recorder
+
+path, n, seed, compaction_steps, strain, every = sys.argv[1], *map(float, sys.argv[2:])
+sim = compaction_sample(int(n), "pentagon", seed=int(seed))
+isotropic_compaction(sim, max_steps=int(compaction_steps), progress=False)
+write = Recorder.write
+
+def write_and_report(recorder):
+    write(recorder)
+    print("snapshot", flush=True)
+
+Recorder.write = write_and_report
+biaxial_test(sim, path, strain=strain, every=int(every), progress=False)
+print("done", flush=True)
+"""
+
+
+def _run_in_process(path):
+    sim = compaction_sample(RUN["n"], "pentagon", seed=RUN["seed"])
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        isotropic_compaction(sim, max_steps=RUN["compaction_steps"], progress=False)
+        return biaxial_test(sim, path, strain=RUN["strain"], every=RUN["every"], progress=False)
+
+
+def _start_child(path):
+    env = dict(os.environ, PYTHONPATH=os.pathsep.join([str(REPO), os.environ.get("PYTHONPATH", "")]))
+    args = [sys.executable, "-c", CHILD, str(path), *(str(RUN[k]) for k in ("n", "seed", "compaction_steps",
+                                                                             "strain", "every"))]
+    return subprocess.Popen(args, cwd=REPO, env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+
+
+def _wait_for_snapshots(child, count):
+    """Read the child's report lines until ``count`` snapshots are written (or it ended)."""
+    seen = 0
+    while seen < count:
+        line = child.stdout.readline()
+        if not line:
+            break
+        seen += line.strip() == "snapshot"
+    return seen
+
+
+def _variables(path):
+    """Every variable of the file as numpy arrays (complete snapshots only), and the attributes."""
+    with grainview.open_dataset(path, chunks=None) as ds:
+        return {name: ds[name].values.copy() for name in ds.variables}, dict(ds.attrs)
+
+
+def _assert_prefix_of(data, reference_data):
+    """Each per-snapshot variable of ``data`` equals the first snapshots of the reference's,
+    bit for bit; the static ones are equal."""
+    n = data["time"].size
+    assert data.keys() == reference_data.keys()
+    for name, value in data.items():
+        expected = reference_data[name]
+        np.testing.assert_array_equal(value, expected[:n] if name in TIME_VARIABLES else expected, err_msg=name)
+
+
+@pytest.fixture(scope="module")
+def reference(tmp_path_factory):
+    """The uninterrupted run, in this process (it also fills the numba cache for the children)."""
+    path = tmp_path_factory.mktemp("reference") / "a.nc"
+    steps = _run_in_process(path)
+    assert steps == 128
+    return path
+
+
+def test_reference_run_holds_the_restart_state(reference):
+    data, attrs = _variables(reference)
+    assert data["time"].size == SNAPSHOTS
+    np.testing.assert_array_equal(data["step"], data["step"][0] + 2 * np.arange(SNAPSHOTS))
+    assert attrs["biaxial_steps"] == 128 and attrs["snapshot_every"] == 2
+    np.testing.assert_array_equal(attrs["wall_mode"], [0, 2, 1, 0])  # bottom, right (sigma0), top (velocity), left
+    np.testing.assert_array_equal(attrs["wall_max_speed_m_s"], np.inf)  # lifted after compaction
+    np.testing.assert_array_equal(data["wall_velocity"][:, 2], np.tile([0.0, -0.01], (SNAPSHOTS, 1)))
+    np.testing.assert_array_equal(data["wall_velocity"][:, [0, 3]], 0.0)
+    # the points' impulses add up to the resultant forces: f = (p_1 + p_2) / h
+    h = attrs["solver_time_step"]
+    occupied = data["i"] >= 0
+    np.testing.assert_allclose(data["normal_impulse"].sum(-1)[occupied] / h, data["fn"][occupied], rtol=1e-12)
+    np.testing.assert_allclose(data["tangential_impulse"].sum(-1)[occupied] / h, data["ft"][occupied],
+                               rtol=1e-12, atol=1e-12 * np.nanmax(data["fn"]))
+    # a simple contact has one point; empty slots carry no impulse
+    simple = data["kind"] == 1
+    assert np.all(data["normal_impulse"][simple, 1] == 0) and np.all(data["normal_impulse"][~occupied] == 0)
+    double_loaded = (data["kind"] == 2) & (data["normal_impulse"] > 0).all(-1)
+    assert double_loaded.sum() > 10  # double contacts with both points loaded: the resultant alone would not do
+
+
+def test_restored_simulation_is_the_state_of_the_last_snapshot(reference, tmp_path):
+    """load_state gives back the state the uninterrupted run had at that snapshot, exactly,
+    including the warm start (same keys, same impulses)."""
+    sim = compaction_sample(RUN["n"], "pentagon", seed=RUN["seed"])
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        isotropic_compaction(sim, max_steps=RUN["compaction_steps"], progress=False)
+        biaxial_test(sim, tmp_path / "b.nc", strain=RUN["strain"], every=RUN["every"], progress=False)
+    restored, test = load_state(tmp_path / "b.nc")
+    assert test == {"first_step": sim.step_index - 128, "n_steps": 128, "every": 2, "snapshots": SNAPSHOTS}
+    assert (restored.time, restored.step_index) == (sim.time, sim.step_index)
+    for name in ("position", "angle", "velocity", "angular_velocity", "mass", "inertia", "alert", "skin"):
+        np.testing.assert_array_equal(getattr(restored, name), getattr(sim, name), err_msg=name)
+    for name in ("point", "velocity", "mode", "stress", "mass", "max_speed", "length_axis", "normal"):
+        np.testing.assert_array_equal(getattr(restored.walls, name), getattr(sim.walls, name), err_msg=name)
+    assert restored.parameters_dict() == sim.parameters_dict()
+    # warm start: every nonzero impulse of the last step under the same key
+    nonzero = np.any(sim._impulse != 0, axis=1)
+    order = np.argsort(restored._keys)
+    where = np.searchsorted(restored._keys[order], sim._keys[nonzero])
+    np.testing.assert_array_equal(restored._keys[order][where], sim._keys[nonzero])
+    np.testing.assert_array_equal(restored._impulse[order][where], sim._impulse[nonzero])
+    assert np.count_nonzero(np.any(restored._impulse != 0, axis=1)) == np.count_nonzero(nonzero)
+
+
+def test_point_impulses_follow_the_slots_of_pair_contacts():
+    """A hand-made last step: three pairs, the second not loaded (not written)."""
+    sim = compaction_sample(6, "disk", seed=0)
+    sim.points = type("Points", (), dict(pair=np.array([0, 0, 1, 2, 2]), n_pairs=3))()
+    sim.impulse = np.array([[1.0, 0.1], [2.0, -0.2], [0.0, 0.0], [3.0, 0.3], [0.0, 0.0]])
+    normal, tangential = point_impulses(sim, n_slots=4)
+    np.testing.assert_array_equal(normal, [[1.0, 2.0], [3.0, 0.0], [0, 0], [0, 0]])
+    np.testing.assert_array_equal(tangential, [[0.1, -0.2], [0.3, 0.0], [0, 0], [0, 0]])
+
+
+def _check_complete_snapshots(path, reference_data):
+    """The file opens, validates, and each snapshot is complete and equal to the reference's."""
+    ds = grainview.open_dataset(path, validate=True, chunks=None)
+    n_particles, n_walls = ds.sizes["particle"], ds.sizes["wall"]
+    count = ds["contact_count"].values
+    i, j, kind, fn = ds["i"].values, ds["j"].values, ds["kind"].values, ds["fn"].values
+    ds.close()
+    slots = np.arange(i.shape[1])[None, :]
+    occupied = slots < count[:, None]
+    assert np.all((i[occupied] >= 0) & (i[occupied] < n_particles))
+    assert np.all((j[occupied] > i[occupied]) & (j[occupied] < n_particles + n_walls))
+    assert np.all(np.isin(kind[occupied], [1, 2])) and np.all(fn[occupied] > 0)
+    assert np.all(i[~occupied] == -1) and np.all(kind[~occupied] == 0) and np.all(np.isnan(fn[~occupied]))
+    data, _ = _variables(path)
+    assert np.all(np.diff(data["time"]) > 0)
+    assert np.all(data["complete"] == 1)
+    _assert_prefix_of(data, reference_data)
+    return data["time"].size
+
+
+def test_sigkill_at_random_moments_leaves_complete_snapshots_and_resumes_bitwise(reference, tmp_path):
+    reference_data, _ = _variables(reference)
+    reference_bytes = reference.read_bytes()
+    rng = np.random.default_rng(6)
+    kills = sorted(rng.choice(np.arange(1, SNAPSHOTS - 4), size=4, replace=False))
+    for k, reported in enumerate(kills):
+        path = tmp_path / f"killed{k}.nc"
+        child = _start_child(path)
+        try:
+            written = _wait_for_snapshots(child, reported)
+            time.sleep(rng.uniform(0.0, 0.006))  # a moment within the next snapshot's steps or its writing
+            child.send_signal(signal.SIGKILL)
+            child.wait(timeout=60)
+        finally:
+            if child.poll() is None:
+                child.kill()
+            child.stdout.close()
+            stderr = child.stderr.read()
+            child.stderr.close()
+        assert written == reported, stderr
+        assert child.returncode == -signal.SIGKILL
+        n = _check_complete_snapshots(path, reference_data)
+        assert n >= written, f"a snapshot reported as written is missing ({n} < {written})"
+        # resume: the file becomes the uninterrupted run's file, byte for byte
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            steps = resume(path, progress=False)
+        assert steps == 128 - 2 * (n - 1)
+        assert path.read_bytes() == reference_bytes, f"kill after {reported} snapshots: resumed file differs"
+
+
+def test_sigint_stops_cleanly_and_prints_the_resume_command(reference, tmp_path):
+    reference_data, _ = _variables(reference)
+    path = tmp_path / "interrupted.nc"
+    child = _start_child(path)
+    try:
+        _wait_for_snapshots(child, 20)
+        child.send_signal(signal.SIGINT)
+        _, stderr = child.communicate(timeout=60)
+    finally:
+        if child.poll() is None:
+            child.kill()
+    # the uncaught KeyboardInterrupt ends Python the conventional way: killed by SIGINT
+    assert child.returncode == -signal.SIGINT, stderr
+    assert "interrupted after step" in stderr
+    stopped_at = int(stderr.split("interrupted after step ")[1].split(":")[0])
+    command = next(line for line in stderr.splitlines() if line.startswith("resume it with:"))
+    command = shlex.split(command.split(":", 1)[1])
+    assert command == [sys.executable, "-m", "solver.restart", str(path.resolve())]
+    assert f"from solver.restart import resume; resume({str(path.resolve())!r})" in stderr
+    # closed cleanly: no record beyond the complete snapshots; those are the reference's
+    n = _check_complete_snapshots(path, reference_data)
+    with netCDF4.Dataset(path) as nc:
+        assert nc.dimensions["time"].size == n
+    last_step = int(reference_data["step"][n - 1])
+    assert 0 <= stopped_at - last_step < RUN["every"]  # stopped after a whole step, no due snapshot skipped
+    assert n < SNAPSHOTS
+    # the printed command finishes the run: the uninterrupted run's file, byte for byte
+    env = dict(os.environ, PYTHONPATH=os.pathsep.join([str(REPO), os.environ.get("PYTHONPATH", "")]))
+    done = subprocess.run(command, cwd=tmp_path, env=env, capture_output=True, text=True, timeout=120)
+    assert done.returncode == 0, done.stderr
+    assert "complete" in done.stdout
+    assert path.read_bytes() == reference.read_bytes()
+
+
+def test_resuming_a_finished_run_changes_nothing(reference, tmp_path):
+    path = tmp_path / "finished.nc"
+    path.write_bytes(reference.read_bytes())
+    assert resume(path, progress=False) == 0
+    assert path.read_bytes() == reference.read_bytes()
+
+
+def test_files_that_cannot_be_resumed_say_why(reference, tmp_path):
+    # a file without the restart state (here: another scene, written by the Recorder directly)
+    sim = compaction_sample(6, "disk", seed=0)
+    other = tmp_path / "rest.nc"
+    with Recorder(other, sim, attrs={"scene": "rest"}) as rec:
+        rec.write()
+    with pytest.raises(FileFormatError, match="lacks .*biaxial_steps"):
+        resume(other)
+    # a biaxial file stopped before its first snapshot was complete
+    empty = tmp_path / "empty.nc"
+    empty.write_bytes(reference.read_bytes())
+    with netCDF4.Dataset(empty, "a") as nc:
+        nc.variables["complete"][:] = 0
+    with pytest.raises(FileFormatError, match="no complete snapshot"):
+        resume(empty)
+    with pytest.raises(FileFormatError, match="no such file"):
+        resume(tmp_path / "missing.nc")
+
+
+CREATE_AND_DIE = """
+import os, signal, sys
+import grainview.schema as schema
+from solver import compaction_sample
+from solver.output import Recorder
+
+def die(*args, **kwargs):  # SIGKILL in the middle of creating the file, its header half written
+    os.kill(os.getpid(), signal.SIGKILL)
+
+schema.global_attrs = die
+Recorder(sys.argv[1], compaction_sample(6, "disk", seed=0))
+"""
+
+
+def test_a_run_killed_while_creating_its_file_leaves_no_partial_file(tmp_path):
+    """The file is created under a temporary name and moved into place once its header is
+    written: a kill while it is created leaves nothing at ``path`` (no file that a reader or
+    a resume would trip over)."""
+    path = tmp_path / "new.nc"
+    env = dict(os.environ, PYTHONPATH=os.pathsep.join([str(REPO), os.environ.get("PYTHONPATH", "")]))
+    child = subprocess.run([sys.executable, "-c", CREATE_AND_DIE, str(path)], cwd=REPO, env=env,
+                           capture_output=True, text=True, timeout=120)
+    assert child.returncode == -signal.SIGKILL, child.stderr
+    assert not path.exists()
+    leftovers = [p.name for p in tmp_path.iterdir()]  # only the hidden temporary file
+    assert len(leftovers) == 1 and leftovers[0].startswith(".new.nc.") and leftovers[0].endswith(".part")
