@@ -108,7 +108,7 @@ def _report(args) -> int:
     if len(labels) != len(args.files):
         raise GrainviewError(f"--labels has {len(labels)} names for {len(args.files)} files")
     runs = {label: open_dataset(f, validate=True) for label, f in zip(labels, args.files)}
-    result = write_report(runs, args.out)
+    result = write_report(runs, args.out, overwrite=args.overwrite)
     print(result["table"].to_string())
     print(f"wrote {len(result['files'])} files in {args.out}")
     return 0
@@ -165,6 +165,7 @@ def build_parser() -> argparse.ArgumentParser:
     report.add_argument("--labels", default=None, help="comma-separated labels (default: file names); "
                         "labels containing 'pent' or 'disk' are compared with the paper's S1/S2 values")
     report.add_argument("--out", default="report", help="output folder (default: report)")
+    report.add_argument("--overwrite", action="store_true", help="replace an existing report in --out")
     report.set_defaults(func=_report)
     info = sub.add_parser("info", help="validate a grainview netCDF file and print its summary")
     info.add_argument("file", help="path of a netCDF file of the grainview data contract")

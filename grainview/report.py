@@ -181,10 +181,15 @@ def write_figures(runs: dict, out: Path, time=-1) -> list[Path]:
     return written
 
 
-def write_report(runs: dict, out, residual: float = 0.3) -> dict:
+def write_report(runs: dict, out, residual: float = 0.3, overwrite: bool = False) -> dict:
     """The whole report of ``runs`` ({label: dataset}) in folder ``out``: the headline table
-    (CSV, Markdown) and every figure. Returns {"table": DataFrame, "files": [paths]}."""
+    (CSV, Markdown) and every figure. Returns {"table": DataFrame, "files": [paths]}.
+
+    A folder that already holds a report is refused unless ``overwrite`` is True, so that
+    nothing a user owns is replaced by accident."""
     out = Path(out)
+    if not overwrite and (out / "headline.csv").exists():
+        raise FileExistsError(f"{out} already holds a report; pass --overwrite (overwrite=True) to replace it")
     table = headline_table(runs, residual)
     files = write_table(table, out)
     files += write_figures(runs, out / "figures")

@@ -55,3 +55,11 @@ def test_run_refuses_to_overwrite(tmp_path, capsys):
     path.write_bytes(b"keep")
     assert main(["run", "--particles", "10", "--out", str(path)]) == 2
     assert "--overwrite" in capsys.readouterr().err and path.read_bytes() == b"keep"
+
+
+def test_report_refuses_to_overwrite_an_existing_report(study, capsys):
+    files = [str(study / "pentagons.nc"), str(study / "disks.nc")]
+    before = (study / "report" / "headline.csv").read_bytes()
+    assert main(["report", *files, "--out", str(study / "report")]) == 2
+    assert "--overwrite" in capsys.readouterr().err
+    assert (study / "report" / "headline.csv").read_bytes() == before
