@@ -54,6 +54,9 @@ class Parameters:
     seed: int = 0
     overlap_recovery_speed: float = 1e-3  # m s-1, cap of the split-impulse separation of overlaps
     overlap_recovery_rate: float = 0.2  # fraction of an overlap removed per step, below the cap
+    overlap_recovery_threshold: float = 1e-4  # fraction of the smallest diameter: smaller overlaps are left
+    overlap_recovery_tolerance: float = 1e-2  # NLGS tolerance of the recovery pass (a correction, not physics)
+    overlap_recovery_iterations: int = 50  # sweep cap of the recovery pass
 
     def validate(self):
         checks = [
@@ -143,7 +146,7 @@ class Simulation:
         self.impulse = np.empty((0, 2))
         self.last = None
         self.timings = {"broad_phase": 0.0, "narrow_phase": 0.0, "solve": 0.0, "update": 0.0}
-        self.counters = {"steps": 0, "broad_phase_runs": 0, "sweeps": 0, "point_sweeps": 0}
+        self.counters = {"steps": 0, "broad_phase_runs": 0, "sweeps": 0, "point_sweeps": 0, "recovery_sweeps": 0}
 
     # -- mobility ---------------------------------------------------------------------------
     def _mobility(self):
@@ -197,6 +200,11 @@ class Simulation:
         p = self.parameters
         h, theta = p.time_step, p.theta
         n, w = self.n_particles, self.n_walls
+        reach = h * float(np.sqrt(np.max(np.sum(self.velocity[:n] ** 2, axis=1), initial=0.0)))
+        if reach > self.alert:
+            warnings.warn(f"step {self.step_index}: particles move {reach:.3g} m per step, more than the alert "
+                          f"distance {self.alert:.3g} m, so contacts may be found already deep; reduce "
+                          "time_step or raise alert", RuntimeWarning, stacklevel=2)
         pts = self.detect()
         keys = self._point_keys(pts)
         impulse = np.zeros((len(keys), 2))
@@ -269,7 +277,7 @@ class Simulation:
         if p.overlap_recovery_speed > 0 and len(keys):
             # the end-of-step gaps (first order) tell which overlaps remain
             g_end = g_end + h * (step_om[b] * _cross2(rb, pts.normal) - step_om[a] * _cross2(ra, pts.normal))
-            if g_end.min() < 0.0:
+            if g_end.min() < -p.overlap_recovery_threshold * 2 * float(self.radius.min()):
                 pseudo_v, pseudo_om = self._recover_overlaps(a, b, nx, ny, ra, rb, g_end, minv, iinv)
                 pseudo_v[n + np.flatnonzero(self.walls.mode != STRESS)] = 0.0
                 step_v = step_v + pseudo_v
@@ -312,9 +320,11 @@ class Simulation:
         bodies = self.n_particles + self.n_walls
         vx, vy, om = np.zeros(bodies), np.zeros(bodies), np.zeros(bodies)
         pn, pt = np.zeros(m), np.zeros(m)
-        nlgs.solve(a, b, nx, ny, ra[:, 0].copy(), ra[:, 1].copy(), rb[:, 0].copy(), rb[:, 1].copy(), bias,
-                   np.zeros(m), pn, pt, vx, vy, om, minv[:, 0].copy(), minv[:, 1].copy(), minv[:, 2].copy(), iinv,
-                   p.tolerance, p.max_tolerance, 200, False, 0)
+        iterations, _, _ = nlgs.solve(
+            a, b, nx, ny, ra[:, 0].copy(), ra[:, 1].copy(), rb[:, 0].copy(), rb[:, 1].copy(), bias, np.zeros(m), pn, pt,
+            vx, vy, om, minv[:, 0].copy(), minv[:, 1].copy(), minv[:, 2].copy(), iinv, p.overlap_recovery_tolerance,
+            1.0, int(p.overlap_recovery_iterations), False, 0)
+        self.counters["recovery_sweeps"] += int(iterations)
         return np.stack([vx, vy], -1), om
 
     # -- derived quantities ------------------------------------------------------------------

@@ -95,7 +95,8 @@ def test_head_on_collision_conserves_momentum_and_is_inelastic(recovery_speed, s
     assert abs(relative[1]) < 1e-15
     assert sim.velocity[0, 0] == pytest.approx(0.0, abs=1e-12)  # equal masses: both at rest
     if recovery_speed:
-        assert sim.last.max_interpenetration < 1e-12
+        # overlaps below the recovery threshold (1e-4 of the diameter) are left alone
+        assert sim.last.max_interpenetration <= 1e-4 * 2 * R
 
 
 def test_masses_and_inertia_of_regular_polygons():
