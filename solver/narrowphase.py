@@ -13,7 +13,7 @@ Contact geometry per kind of pair (paper Sec. II, "Contact dynamics for polygons
   two surfaces on the centre line.
 * disk-wall: gap = (x - p_w).n_w - r, point midway between the disk's extreme point and the wall.
 * polygon-wall: the vertex nearest to the wall gives a simple contact. When the other end of
-  the edge most parallel to the wall is also within the alert distance, the edge gives a
+  the edge most parallel to the wall passes the double-contact criterion below, the edge gives a
   DOUBLE contact with one point per vertex. Each point is the middle of the vertex and its
   orthogonal projection onto the wall, with the vertex's own gap.
 * polygon-polygon (Moreau's "shadow overlap", written as separating axes on the edge
@@ -24,7 +24,8 @@ Contact geometry per kind of pair (paper Sec. II, "Contact dynamics for polygons
   and its orthogonal projection onto the reference edge (paper: "the nominal contact point is
   chosen at the center of this distance").
   When the other end of the partner's edge most anti-parallel to the reference edge (the
-  INCIDENT edge) is also within the alert distance of the reference line, the two edges
+  INCIDENT edge) passes the double-contact criterion below (its distance to the reference
+  line), the two edges
   overlap: a DOUBLE contact. Its normal is the mean of the reference normal and minus the
   incident normal (the common tangent is the mean direction of the two edges). The incident
   edge is clipped to the reference edge's extent (the clipping of Box2D: E. Catto, "Contact
@@ -41,10 +42,13 @@ Contact geometry per kind of pair (paper Sec. II, "Contact dynamics for polygons
   boundary (on an edge or at a vertex), n along q -> centre, gap = |centre - q| - r. Centre
   inside: the edge with the largest signed distance s, n its outward normal, gap = s - r.
 
-Double-contact criterion: a gap criterion, not an angular one. The second vertex is taken
-when its gap is <= alert (+ :data:`DOUBLE_GAP_TOLERANCE` for round-off), so two edges at an
-angle delta form a double contact when L sin(delta) <~ alert - gap (L the edge length): the
-angular tolerance is about asin(alert / L). Each point is a unilateral constraint of its own
+Double-contact criterion: the second vertex (s1, the other end of the incident edge or of
+the edge facing the wall) is taken when s1 <= max(s0, 0) + double_alert (+
+:data:`DOUBLE_GAP_TOLERANCE` for round-off), s0 the gap of the nearest vertex and
+``double_alert`` the alert distance unless the caller sets it. Two edges at an angle delta
+therefore form a double contact when L sin(delta) <~ double_alert (L the edge length), an
+angular tolerance of about asin(double_alert / L), whether they touch or are still apart;
+overlapping edges (s0 < 0) need s1 <= double_alert. Each point is a unilateral constraint of its own
 in the solver, so a point that is within the alert distance but not touching carries no force;
 an analysis that wants "double" to mean "two force-bearing points" should check the forces.
 
@@ -90,7 +94,7 @@ length; shorter ones (edges meeting at a single corner) give a simple contact.""
 
 DOUBLE_GAP_TOLERANCE = 1e-10
 """Round-off allowance of the double-contact test: the second vertex is taken when its gap is
-<= alert + DOUBLE_GAP_TOLERANCE * (sum of the circumscribed radii), so that exactly parallel
+<= max(s0, 0) + double_alert + DOUBLE_GAP_TOLERANCE * (sum of the circumscribed radii), so that exactly parallel
 edges touching with alert = 0 give a double contact whatever the last bits of the vertices."""
 
 
@@ -204,7 +208,7 @@ def _best_edge(p, q, verts, norms, nvert):
 
 
 @njit(cache=True)
-def _polygon_polygon(a, b, verts, norms, nvert, radius, alert, c, normal, point, gap):
+def _polygon_polygon(a, b, verts, norms, nvert, radius, double_alert, c, normal, point, gap):
     """Shadow-overlap contact of polygons a and b; normal from a to b. See the module doc."""
     sa, ea, ka = _best_edge(a, b, verts, norms, nvert)
     sb, eb, kb = _best_edge(b, a, verts, norms, nvert)
@@ -238,7 +242,7 @@ def _polygon_polygon(a, b, verts, norms, nvert, radius, alert, c, normal, point,
     v1y = verts[inc, k1, 1]
     s1 = (v1x - r0x) * nrx + (v1y - r0y) * nry
     n_points = 1
-    if s1 <= alert + DOUBLE_GAP_TOLERANCE * (radius[a] + radius[b]):
+    if s1 <= max(s0, 0.0) + double_alert + DOUBLE_GAP_TOLERANCE * (radius[a] + radius[b]):
         # clip the incident edge v0 -> v1 to the extent [0, L] of the reference edge
         length = math.sqrt((r1x - r0x) ** 2 + (r1y - r0y) ** 2)
         ux = (r1x - r0x) / length
@@ -354,7 +358,7 @@ def _polygon_disk(p, d, pos, verts, norms, nvert, radius, sign, c, normal, point
 
 
 @njit(cache=True)
-def _polygon_wall(p, verts, nvert, radius, px, py, wnx, wny, alert, c, normal, point, gap):
+def _polygon_wall(p, verts, nvert, radius, px, py, wnx, wny, double_alert, c, normal, point, gap):
     """Contact of polygon p with the wall through (px, py) of inward unit normal (wnx, wny)."""
     n = nvert[p]
     # signed distance of every vertex to the wall line; lowest vertex k0
@@ -380,7 +384,7 @@ def _polygon_wall(p, verts, nvert, radius, px, py, wnx, wny, alert, c, normal, p
     normal[c, 1] = -wny
     v0x = verts[p, k0, 0]
     v0y = verts[p, k0, 1]
-    if s1 > alert + DOUBLE_GAP_TOLERANCE * radius[p]:
+    if s1 > max(s0, 0.0) + double_alert + DOUBLE_GAP_TOLERANCE * radius[p]:
         gap[c, 0] = s0
         point[c, 0, 0] = v0x - 0.5 * s0 * wnx
         point[c, 0, 1] = v0y - 0.5 * s0 * wny
@@ -403,7 +407,7 @@ def _polygon_wall(p, verts, nvert, radius, px, py, wnx, wny, alert, c, normal, p
 
 
 @njit(cache=True)
-def _pair_points(a, b, pos, radius, nvert, verts, norms, alert, c, normal, point, gap):
+def _pair_points(a, b, pos, radius, nvert, verts, norms, double_alert, c, normal, point, gap):
     """Contact points between particles a < b, normal from a to b. Returns the count (1 or 2)."""
     na = nvert[a]
     nb = nvert[b]
@@ -414,11 +418,11 @@ def _pair_points(a, b, pos, radius, nvert, verts, norms, alert, c, normal, point
         return _polygon_disk(b, a, pos, verts, norms, nvert, radius, -1.0, c, normal, point, gap)
     if nb == 0:
         return _polygon_disk(a, b, pos, verts, norms, nvert, radius, 1.0, c, normal, point, gap)
-    return _polygon_polygon(a, b, verts, norms, nvert, radius, alert, c, normal, point, gap)
+    return _polygon_polygon(a, b, verts, norms, nvert, radius, double_alert, c, normal, point, gap)
 
 
 @njit(cache=True)
-def _detect_kernel(pos, angle, radius, nvert, wall_point, wall_normal, alert, pi, pj, wp, ww):
+def _detect_kernel(pos, angle, radius, nvert, wall_point, wall_normal, alert, double_alert, pi, pj, wp, ww):
     """Pass 1: up to two points per candidate into fixed slots (each candidate writes only its
     own slot); pass 2: compaction of the kept ones at prefix-sum offsets."""
     n_particles = pos.shape[0]
@@ -437,7 +441,7 @@ def _detect_kernel(pos, angle, radius, nvert, wall_point, wall_normal, alert, pi
             j = pj[c]
             a = min(i, j)
             b = max(i, j)
-            cnt = _pair_points(a, b, pos, radius, nvert, verts, norms, alert, c, normal, point, gap)
+            cnt = _pair_points(a, b, pos, radius, nvert, verts, norms, double_alert, c, normal, point, gap)
             if i > j:
                 normal[c, 0] = -normal[c, 0]
                 normal[c, 1] = -normal[c, 1]
@@ -449,7 +453,7 @@ def _detect_kernel(pos, angle, radius, nvert, wall_point, wall_normal, alert, pi
                                  wall_normal[w, 0], wall_normal[w, 1], c, normal, point, gap)
             else:
                 cnt = _polygon_wall(p, verts, nvert, radius, wall_point[w, 0], wall_point[w, 1],
-                                    wall_normal[w, 0], wall_normal[w, 1], alert, c, normal, point, gap)
+                                    wall_normal[w, 0], wall_normal[w, 1], double_alert, c, normal, point, gap)
         kind[c] = KIND_DOUBLE if cnt == 2 else KIND_SIMPLE
         # keep the contact if its nearest point is within the alert distance
         gmin = gap[c, 0]
@@ -501,7 +505,7 @@ def _index_array(name, value, upper):
     return arr
 
 
-def detect(pos, angle, radius, nvert, wall_point, wall_normal, alert, pi, pj, wp, ww):
+def detect(pos, angle, radius, nvert, wall_point, wall_normal, alert, pi, pj, wp, ww, double_alert=None):
     """Contact points of the candidate particle pairs (pi, pj) and particle-wall candidates
     (wp, ww) (from :mod:`solver.broadphase`), keeping the contacts with gap <= alert.
 
@@ -511,7 +515,10 @@ def detect(pos, angle, radius, nvert, wall_point, wall_normal, alert, pi, pj, wp
     nvert : (N,) int, 0 = disk, >= 3 = regular polygon;
     wall_point : (W, 2) m, a point of each wall line; wall_normal : (W, 2) unit, into the sample;
     alert : m, >= 0; pi, pj : particle pairs (any order, pi != pj);
-    wp, ww : particle and wall index of each wall candidate.
+    wp, ww : particle and wall index of each wall candidate;
+    double_alert : m, >= 0, the tolerance of the double-contact criterion (module doc);
+    default ``alert``. The stepper widens ``alert`` for fast steps but keeps this one fixed,
+    so that a fast approach does not turn edges far from parallel into double contacts.
 
     Returns
     -------
@@ -530,6 +537,9 @@ def detect(pos, angle, radius, nvert, wall_point, wall_normal, alert, pi, pj, wp
     alert = float(alert)
     if not np.isfinite(alert) or alert < 0:
         raise ParameterError(f"alert={alert!r}: expected a finite alert distance >= 0 (m)")
+    double_alert = alert if double_alert is None else float(double_alert)
+    if not np.isfinite(double_alert) or double_alert < 0:
+        raise ParameterError(f"double_alert={double_alert!r}: expected a finite distance >= 0 (m)")
     pi = _index_array("pi", pi, n)
     pj = _index_array("pj", pj, n)
     if pi.shape != pj.shape:
@@ -540,5 +550,5 @@ def detect(pos, angle, radius, nvert, wall_point, wall_normal, alert, pi, pj, wp
     ww = _index_array("ww", ww, wall_point.shape[0])
     if wp.shape != ww.shape:
         raise ParameterError(f"wp and ww must have the same length, got {wp.size} and {ww.size}")
-    out = _detect_kernel(pos, angle, radius, nvert, wall_point, wall_normal, alert, pi, pj, wp, ww)
+    out = _detect_kernel(pos, angle, radius, nvert, wall_point, wall_normal, alert, double_alert, pi, pj, wp, ww)
     return ContactPoints(*out[:7], int(out[7]))

@@ -140,6 +140,8 @@ class Simulation:
         self._wall_anchor = None  # wall positions at the last broad phase
         self.reuse_detection = True  # reuse broad-phase candidates while nothing moved skin/2
         self._candidates = None
+        self._margin = 0.0  # alert + skin of the last broad phase
+        self.step_alert = None  # alert distance of the current step (see alert_for_step)
         self._keys = np.empty(0, np.int64)
         self._impulse = np.empty((0, 2))
         self.points = None
@@ -172,21 +174,52 @@ class Simulation:
         moved = np.inf if self._anchor is None else float(np.sqrt(np.max(np.sum((self.position - self._anchor) ** 2, axis=1))))
         walls_moved = 0.0 if self._wall_anchor is None else float(
             np.sqrt(np.max(np.sum((self.walls.point - self._wall_anchor) ** 2, axis=1), initial=0.0)))
-        if moved > 0.5 * self.skin or walls_moved > 0.5 * self.skin or not self.reuse_detection:
-            margin = self.alert + self.skin
+        alert = self.step_alert if self.step_alert is not None else self.alert
+        margin = alert + self.skin
+        if (moved > 0.5 * self.skin or walls_moved > 0.5 * self.skin or not self.reuse_detection
+                or margin > self._margin):
             pi, pj = broadphase.candidate_pairs(self.position, self.radius, margin)
             wp, ww = broadphase.wall_candidates(self.position, self.radius, self.walls.point, self.walls.normal, margin)
             self._candidates = (pi, pj, wp, ww)
             self._anchor = self.position.copy()
             self._wall_anchor = self.walls.point.copy()
+            self._margin = margin
             self.counters["broad_phase_runs"] += 1
         middle = time.perf_counter()
         pi, pj, wp, ww = self._candidates
         points = narrowphase.detect(self.position, self.angle, self.radius, self.n_vertices, self.walls.point,
-                                    self.walls.normal, self.alert, pi, pj, wp, ww)
+                                    self.walls.normal, alert, pi, pj, wp, ww, double_alert=self.alert)
         self.timings["broad_phase"] += middle - start
         self.timings["narrow_phase"] += time.perf_counter() - middle
         return points
+
+    def alert_for_step(self):
+        """Alert distance (m) of the coming step: ``alert``, widened to what bodies can close in one step.
+
+        A contact is seen by the solver only when its gap is <= the alert distance at the start
+        of the step; a pair that closes a larger gap within the step is found already deep at
+        the next one (the overlap grows with h u_n). The closing distance over a step is bounded
+        by h U, with U the larger of s_1 + s_2 (the two fastest particles head on) and
+        s_1 + max_walls |v_w| + h |g| (the fastest particle against a wall, with the step's
+        gravity), s_i = |v_i| + |omega_i| R_i the fastest speed of a point of particle i. The step uses
+        max(alert, h U), capped at half the smallest diameter; beyond the cap (bodies moving
+        more than a radius per step) a RuntimeWarning asks for a smaller time step. In
+        quasi-static runs h U << alert and nothing changes.
+        """
+        p = self.parameters
+        h, n = p.time_step, self.n_particles
+        speed = np.sqrt(np.sum(self.velocity[:n] ** 2, axis=1)) + np.abs(self.angular_velocity[:n]) * self.radius
+        fastest = np.partition(speed, n - 2)[-2:] if n > 1 else np.r_[0.0, speed]
+        wall_speed = float(np.sqrt(np.sum(self.velocity[n:] ** 2, axis=1)).max(initial=0.0))
+        # the two fastest particles head on, or the fastest against the fastest wall (gravity
+        # moves every particle alike: it changes only the particle-wall closing speed)
+        closing = h * max(float(fastest.sum()), float(fastest[-1]) + wall_speed + h * float(np.hypot(*p.gravity)))
+        cap = float(self.radius.min())
+        if closing > cap:
+            warnings.warn(f"step {self.step_index}: bodies may close {closing:.3g} m in one step, more than the "
+                          f"smallest radius {cap:.3g} m, so contacts may be missed or found deep; reduce time_step",
+                          RuntimeWarning, stacklevel=3)
+        return max(self.alert, min(closing, cap))
 
     def _point_keys(self, pts):
         bodies = self.n_particles + self.n_walls
@@ -200,11 +233,7 @@ class Simulation:
         p = self.parameters
         h, theta = p.time_step, p.theta
         n, w = self.n_particles, self.n_walls
-        reach = h * float(np.sqrt(np.max(np.sum(self.velocity[:n] ** 2, axis=1), initial=0.0)))
-        if reach > self.alert:
-            warnings.warn(f"step {self.step_index}: particles move {reach:.3g} m per step, more than the alert "
-                          f"distance {self.alert:.3g} m, so contacts may be found already deep; reduce "
-                          "time_step or raise alert", RuntimeWarning, stacklevel=2)
+        self.step_alert = self.alert_for_step()
         pts = self.detect()
         keys = self._point_keys(pts)
         impulse = np.zeros((len(keys), 2))

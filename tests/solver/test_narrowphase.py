@@ -485,7 +485,8 @@ def test_polygon_wall_against_numpy_oracle():
         assert (sel.size > 0) == (s[k] <= alert)
         if not sel.size:
             continue
-        expected = [k] if s[other] > alert else [k, other]
+        # double-contact criterion (solver.narrowphase): s1 <= max(s0, 0) + alert
+        expected = [k] if s[other] > max(s[k], 0.0) + alert else [k, other]
         assert sel.size == len(expected)
         n_double += sel.size == 2
         got = sorted(zip(c.gap[sel].tolist(), map(tuple, c.point[sel])))
@@ -567,4 +568,9 @@ def test_extreme_configurations_stay_finite():
     wp, ww = wall_candidates(pos, radius, wall_point, wall_normal, alert)
     c = detect(pos, angle, radius, nvert, wall_point, wall_normal, alert, pi, pj, wp, ww)
     check_layout(c)
-    assert c.n_pairs > 100 and np.all(c.gap <= alert + 1e-9)
+    # the nearest point of each contact is within the alert distance; the second point of a
+    # double within max(s0, 0) + alert <= 2 alert
+    assert c.n_pairs > 100 and np.all(c.gap <= 2 * alert + 1e-9)
+    first = np.r_[True, c.pair[1:] != c.pair[:-1]]
+    nearest = np.minimum.reduceat(c.gap, np.flatnonzero(first))
+    assert np.all(nearest <= alert + 1e-9)

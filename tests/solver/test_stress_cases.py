@@ -82,6 +82,57 @@ def test_time_step_ten_times_the_default():
     assert overlap < 5e-2 * 2 * sim.radius.mean()
 
 
+@pytest.mark.parametrize("n_vertices", [0, 5])
+def test_fast_impact_at_ten_times_the_time_step(n_vertices):
+    """A particle thrown at 1.5 m/s onto a resting one with h = 5e-3 s: it closes 7.5 mm (30%
+    of a diameter) per step, 15 times the default alert distance. The stepper widens the alert
+    distance to what bodies can close in one step, so the contact is caught before the
+    impact; what remains is the theta-scheme's own overlap, about h (1 - theta) u at impact.
+    Stated bound: 1.3 h (1 - theta) u (3.75 mm) over 8 random impacts."""
+    h, theta, speed = 5e-3, 0.5, 1.5
+    rng = np.random.default_rng(0)
+    floor_height = R * np.cos(np.pi / 5) if n_vertices else R
+    worst = 0.0
+    for _ in range(8):
+        position = [[0.0, floor_height], [rng.uniform(-1.5, 1.5) * R, floor_height + 2 * R + rng.uniform(0.05, 0.2) * R]]
+        angle = [ON_EDGE if n_vertices else 0.0, rng.uniform(0, 2 * np.pi)]
+        sim = gravity_scene(position, angle, [R, R], [n_vertices] * 2, time_step=h, theta=theta)
+        sim.velocity[1, 1] = -speed
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", ConvergenceWarning)
+            for _ in range(60):
+                sim.step()
+                if sim.step_index == 1:
+                    assert sim.step_alert >= h * speed > 10 * sim.alert  # widened for the throw
+                between = (sim.points.body_i == 0) & (sim.points.body_j == 1)
+                if between.any():
+                    worst = max(worst, -sim.points.gap[between].min())
+                assert np.all(np.isfinite(sim.position)) and np.all(np.isfinite(sim.velocity))
+    assert 0.0 < worst < 1.3 * h * (1 - theta) * speed
+
+
+def test_widened_alert_never_makes_far_from_parallel_edges_double():
+    """The alert distance of a fast step is widened, the double-contact tolerance is not: two
+    pentagon edges 20 degrees apart, 3 mm apart, give a simple contact whatever the alert."""
+    from solver import narrowphase
+
+    inradius = R * np.cos(np.pi / 5)
+    tilt = np.radians(20.0)
+    # bottom pentagon with a horizontal edge on top (vertices at 54 + 72 k deg), the top one
+    # with its bottom edge tilted by 20 deg: nearest vertex 1.1 mm above, the other end 5 mm
+    position = np.array([[0.0, 0.0], [0.0, 2 * inradius + 3e-3]])
+    angle = np.array([np.radians(54.0), ON_EDGE + tilt])
+    no_walls = (np.empty((0, 2)), np.empty((0, 2)))
+    wide = narrowphase.detect(position, angle, [R, R], [5, 5], *no_walls, 1e-2, [0], [1], [], [], double_alert=0.5e-3)
+    assert wide.kind.tolist() == [1]  # seen (gap 1.1 mm <= 10 mm), simple
+    assert wide.gap[0] == pytest.approx(1.097e-3, rel=1e-3)
+    narrow = narrowphase.detect(position, angle, [R, R], [5, 5], *no_walls, 0.5e-3, [0], [1], [], [])
+    assert narrow.n_pairs == 0  # the default alert alone does not see it
+    # were the double tolerance widened with the alert, the same edges would be double
+    loose = narrowphase.detect(position, angle, [R, R], [5, 5], *no_walls, 1e-2, [0], [1], [], [])
+    assert loose.kind.tolist() == [2, 2]
+
+
 def test_exactly_parallel_and_aligned_edges_touching_with_zero_gap():
     # two pentagons face to face, created touching (gap exactly 0), on a floor
     inradius = R * np.cos(np.pi / 5)
