@@ -42,6 +42,7 @@ TARGET_DETECTION_SHARE = 0.20
 @dataclass
 class Config:
     quick: bool = False
+    plot_dir: str = HERE  # where plots go: next to the RESULTS file that links them
     # scaling
     sizes: tuple = (500, 1000, 4000, 14400, 57600)
     compaction_seconds: dict = None  # per N, wall-clock budget of the compaction
@@ -371,7 +372,7 @@ def section_work_precision(cfg: Config, log=print):
         text, points = _wp_shape(cfg, shape, log)
         parts.append(text)
         all_points[shape] = points
-    _wp_plot(all_points, os.path.join(HERE, "work_precision.png"))
+    _wp_plot(all_points, os.path.join(cfg.plot_dir, "work_precision.png"))
     verdict = []
     for shape, points in all_points.items():
         d = [p for p in points if p["default"]]
