@@ -6,7 +6,7 @@ Each ``section_*`` function runs one section and returns Markdown (text and tabl
 
 Samples. A "dense sample" is :func:`solver.compaction_sample` (paper size mix, box h/l ~ 2,
 sigma_0 = 10 kPa on the right and top walls, zero gravity, friction 0.4) compacted for a fixed
-wall-clock budget with the pushed walls allowed to close at up to ``max_wall_speed`` (faster
+number of steps (the same in every run) with the pushed walls allowed to close at up to ``max_wall_speed`` (faster
 than the library default, to fit the run in minutes); it is not always at full equilibrium,
 so every table reports the contact points per particle actually reached. A "biaxial step" is
 then a step with the top wall moved down at 1 cm/s and sigma_0 kept on the right wall.
@@ -45,15 +45,15 @@ class Config:
     plot_dir: str = HERE  # where plots go: next to the RESULTS file that links them
     # scaling
     sizes: tuple = (500, 1000, 4000, 14400, 57600)
-    compaction_seconds: dict = None  # per N, wall-clock budget of the compaction
+    compaction_steps: dict = None  # per (shape, N): a fixed count, so that every run measures the same state
     timed_steps: dict = None
-    pentagon_compaction_factor: dict = None  # pentagon deposits are looser: longer compaction
     # work-precision
     wp_particles: int = 250
     wp_compaction_steps: int = 8000  # a fixed count, so that every run starts from the same state
     wp_duration: float = 0.04  # s of biaxial test
     wp_tolerances: tuple = (1e-2, 1e-3, 1.7e-4, 3e-5, 1e-5)
     wp_time_steps: tuple = (2.5e-4, 5e-4, 1e-3)
+    wp_budgets: tuple = (20, 100, 500)  # fixed sweep counts (no tolerance) at dt = 5e-4
     # peers
     peer_particles: int = 1000
     peer_settle_steps: int = 3000
@@ -68,13 +68,14 @@ class Config:
     def __post_init__(self):
         if self.quick:
             self.sizes = (300, 1000)
-            self.compaction_seconds = {300: 3.0, 1000: 3.0}
+            self.compaction_steps = {(shape, n): 200 for shape in ("disk", "pentagon") for n in self.sizes}
             self.timed_steps = {300: 10, 1000: 5}
             self.wp_particles = 80
             self.wp_compaction_steps = 500
             self.wp_duration = 0.004
             self.wp_tolerances = (1e-2, 1.7e-4)
             self.wp_time_steps = (5e-4, 1e-3)
+            self.wp_budgets = (20,)
             self.peer_particles = 60
             self.peer_settle_steps = 100
             self.peer_steps = 20
@@ -82,11 +83,14 @@ class Config:
             self.skip_particles = 200
             self.skip_steps = 10
             self.stress_scale = 0
-            self.pentagon_compaction_factor = {}
         else:
-            self.compaction_seconds = self.compaction_seconds or {500: 25.0, 1000: 35.0, 4000: 50.0, 14400: 70.0, 57600: 150.0}
+            # ~25-150 s of compaction each on the 2-core VM of RESULTS.md; the samples of 4000 and
+            # more stay loose (contact points / particle in the table)
+            self.compaction_steps = self.compaction_steps or {
+                ("disk", 500): 30_000, ("disk", 1000): 19_000, ("disk", 4000): 350, ("disk", 14400): 135,
+                ("disk", 57600): 60, ("pentagon", 500): 12_000, ("pentagon", 1000): 3400,
+                ("pentagon", 4000): 1200, ("pentagon", 14400): 1200, ("pentagon", 57600): 1000}
             self.timed_steps = self.timed_steps or {500: 40, 1000: 30, 4000: 20, 14400: 6, 57600: 3}
-            self.pentagon_compaction_factor = self.pentagon_compaction_factor or {4000: 1.6, 14400: 2.0}
 
 
 # --------------------------------------------------------------------------------------------
@@ -157,8 +161,8 @@ def fmt(x, digits=3):
 # --------------------------------------------------------------------------------------------
 # a. scaling
 # --------------------------------------------------------------------------------------------
-def _scaling_case(n, shape, seconds, steps):
-    sim, compaction_steps = dense_sample(n, shape, seconds)
+def _scaling_case(n, shape, compaction, steps):
+    sim, compaction_steps = dense_sample(n, shape, np.inf, max_steps=compaction)
     start_biaxial(sim)
     run_steps(sim, 2)  # warm-up (numba caches loaded)
     reset_meters(sim)
@@ -175,8 +179,7 @@ def section_scaling(cfg: Config, log=print):
     for shape in ("disk", "pentagon"):
         for n in cfg.sizes:
             try:
-                seconds = cfg.compaction_seconds[n] * (cfg.pentagon_compaction_factor.get(n, 1.0) if shape == "pentagon" else 1.0)
-                r, peak = in_fresh_process(_scaling_case, n, shape, seconds, cfg.timed_steps[n])
+                r, peak = in_fresh_process(_scaling_case, n, shape, cfg.compaction_steps[shape, n], cfg.timed_steps[n])
             except RuntimeError as exc:
                 rows.append([shape, n] + ["failed: " + str(exc)[:80]] + [""] * 10)
                 continue
@@ -197,10 +200,8 @@ def section_scaling(cfg: Config, log=print):
               "us / step / particle", "NLGS sweeps / step", "recovery sweeps / step", "ns / point / sweep", "detection share",
               "NLGS share", "update share (overlap recovery)",
               "broad-phase runs", "non-converged steps", "peak RSS (MiB)"]
-    budgets = ", ".join(f"{cfg.compaction_seconds[n]:.0f} s" + (f" ({cfg.compaction_seconds[n] * cfg.pentagon_compaction_factor[n]:.0f} s for pentagons)"
-                                                             if n in cfg.pentagon_compaction_factor else "") for n in cfg.sizes)
-    text = (f"Dense samples (compaction_sample + {budgets} "
-            f"of wall-clock compaction for N = {', '.join(str(n) for n in cfg.sizes)}, walls closing at <= 0.5 m/s), "
+    text = (f"Samples from compaction_sample compacted for a fixed number of steps (the 'compaction steps' "
+            f"column; the same in every run), walls closing at <= 0.5 m/s, "
             "then biaxial steps (top wall 1 cm/s down, sigma_0 = 10 kPa on the right wall) at the default "
             "tolerance (1.7e-4 quadratic, 1e-2 max norm, <= 2000 sweeps) and dt = 5e-4 s. Each case in a "
             "fresh process; 'ns / point / sweep' = NLGS solve time / (sweeps x contact points), Delassus "
@@ -320,16 +321,32 @@ def _wp_shape(cfg, shape, log):
             e_f = _force_error(forces, ref_forces)
             e_1 = float(np.linalg.norm(first - first_ref[dt]) / np.linalg.norm(first_ref[dt]))
             default = dt == 5e-4 and tol == 1.7e-4
-            points.append(dict(dt=dt, tol=tol, time=elapsed, e_f=e_f, e_q=e_q, e_v=e_v, e_1=e_1, default=default))
+            points.append(dict(dt=dt, tol=tol, budget=None, time=elapsed, e_f=e_f, e_q=e_q, e_v=e_v, e_1=e_1, default=default))
             rows.append([f"{dt:g}", f"{tol:g}" + (" (default)" if default else ""), f"{elapsed:.2f}", f"{sweeps:.0f}",
                          bad, fmt(e_1), fmt(e_f), fmt(e_q), fmt(e_v)])
             log(rows[-1])
+    # fixed budgets: no tolerance (1e-30), every step spends exactly `budget` sweeps
+    dt = 5e-4
+    for budget in cfg.wp_budgets if dt in cfg.wp_time_steps else ():
+        elapsed, series, forces, _, sweeps, first = _wp_run(base, dt, 1e-30, cfg.wp_duration, record,
+                                                            max_iterations=budget)
+        m = min(len(series), len(ref_series))
+        e_q = float(np.max(np.abs(series[:m, 0] - ref_series[:m, 0])))
+        e_v = float(np.max(np.abs(series[:m, 1] - ref_series[:m, 1])))
+        e_f = _force_error(forces, ref_forces)
+        e_1 = float(np.linalg.norm(first - first_ref[dt]) / np.linalg.norm(first_ref[dt]))
+        points.append(dict(dt=dt, tol=None, budget=budget, time=elapsed, e_f=e_f, e_q=e_q, e_v=e_v, e_1=e_1,
+                           default=False))
+        rows.append([f"{dt:g}", f"none: {budget} sweeps", f"{elapsed:.2f}", f"{sweeps:.0f}", "-", fmt(e_1), fmt(e_f),
+                     fmt(e_q), fmt(e_v)])
+        log(rows[-1])
     header = ["dt (s)", "tolerance", "run time (s)", "sweeps / step", "non-converged steps",
               "force error, same state (rel. L2)", "force error, end of run (rel. L2)", "max |q/p - ref|",
               "max |eps_p - ref|"]
     n = base.n_particles
     text = (f"**{shape}s**, N = {n}, {compaction_steps} compaction steps, {base.last.n_points / n:.2f} contact "
-            f"points/particle at the start; biaxial run of {cfg.wp_duration:g} s (top wall 1 cm/s), at most 5000 sweeps per step; reference: "
+            f"points/particle at the start; biaxial run of {cfg.wp_duration:g} s (top wall 1 cm/s), at most 5000 sweeps per step ('none: k sweeps' rows: "
+            f"no tolerance, exactly k sweeps every step); reference: "
             f"dt = {ref_dt:g} s, tolerance {ref_tol:g} (100x tighter than the default; max norm {ref_tol * 1e-2 / 1.7e-4:.2g}), "
             f"{t_ref:.1f} s, {ref_sweeps:.0f} sweeps/step, {ref_bad} steps at the 20,000-sweep cap. "
             f"'Same state': the forces of the first step from the common starting state against the same step "
@@ -347,20 +364,26 @@ def _wp_plot(all_points, path):
     fig, axes = plt.subplots(1, 4, figsize=(17, 4))
     for (shape, points), colour in zip(all_points.items(), ("C0", "C1")):
         for dt, marker in zip(sorted({p["dt"] for p in points}), ("o", "s", "^", "v")):
-            sel = [p for p in points if p["dt"] == dt]
+            sel = [p for p in points if p["dt"] == dt and p["budget"] is None]
             for ax, key in zip(axes, ("e_1", "e_f", "e_q", "e_v")):
                 ax.loglog([max(p[key], 1e-12) for p in sel], [p["time"] for p in sel], marker=marker, color=colour,
                           label=f"{shape}, dt={dt:g}")
                 for p in sel:
                     if p["default"]:
                         ax.plot(max(p[key], 1e-12), p["time"], "*", ms=18, color="red", mfc="none")
+        fixed = [p for p in points if p["budget"] is not None]
+        if fixed:
+            for ax, key in zip(axes, ("e_1", "e_f", "e_q", "e_v")):
+                ax.loglog([max(p[key], 1e-12) for p in fixed], [p["time"] for p in fixed], "x--", color=colour,
+                          label=f"{shape}, dt=5e-4, fixed sweeps {fixed[0]['budget']}..{fixed[-1]['budget']}")
     for ax, title in zip(axes, ("forces, same state (rel. L2)", "forces, end of run (rel. L2)", "max |q/p - ref|",
                                 "max |eps_p - ref|")):
         ax.set_xlabel(f"error: {title}")
         ax.set_ylabel("run time (s)")
         ax.grid(True, which="both", alpha=0.3)
     axes[0].legend(fontsize=7)
-    fig.suptitle("Work-precision (tolerance varied along each line; red star: defaults dt = 5e-4, tol = 1.7e-4)")
+    fig.suptitle("Work-precision (tolerance varied along each solid line, fixed sweep count along each dashed one; "
+                 "red star: defaults dt = 5e-4, tol = 1.7e-4)")
     fig.tight_layout()
     fig.savefig(path, dpi=80)
     plt.close(fig)
@@ -379,12 +402,15 @@ def section_work_precision(cfg: Config, log=print):
         if not d:
             continue
         d = d[0]
-        same_dt = sorted([p for p in points if p["dt"] == 5e-4], key=lambda p: p["tol"])
+        same_dt = sorted([p for p in points if p["dt"] == 5e-4 and p["budget"] is None], key=lambda p: p["tol"])
         verdict.append(f"- {shape}s: defaults cost {d['time']:.2f} s for a same-state force error {fmt(d['e_1'])}, "
                        f"end-of-run force error {fmt(d['e_f'])}, q/p error {fmt(d['e_q'])}, eps_p error {fmt(d['e_v'])}; "
                        f"at dt = 5e-4 the tolerances from {same_dt[-1]['tol']:g} to {same_dt[0]['tol']:g} cost "
                        f"{same_dt[-1]['time']:.2f} .. {same_dt[0]['time']:.2f} s for same-state force errors "
-                       f"{fmt(same_dt[-1]['e_1'])} .. {fmt(same_dt[0]['e_1'])}.")
+                       f"{fmt(same_dt[-1]['e_1'])} .. {fmt(same_dt[0]['e_1'])}"
+                       + "".join(f"; {p['budget']} fixed sweeps: {p['time']:.2f} s, same-state force error "
+                                 f"{fmt(p['e_1'])}, q/p error {fmt(p['e_q'])}" for p in points if p["budget"])
+                       + ".")
     return ("\n\n".join(parts) + "\n\n![work-precision](work_precision.png)\n\n" + "\n".join(verdict)), all_points
 
 
