@@ -48,7 +48,12 @@ the edge facing the wall) is taken when s1 <= max(s0, 0) + double_alert (+
 ``double_alert`` the alert distance unless the caller sets it. Two edges at an angle delta
 therefore form a double contact when L sin(delta) <~ double_alert (L the edge length), an
 angular tolerance of about asin(double_alert / L), whether they touch or are still apart;
-overlapping edges (s0 < 0) need s1 <= double_alert. Each point is a unilateral constraint of its own
+overlapping edges (s0 < 0) need s1 <= double_alert. For edges within 10 degrees of
+anti-parallel (:data:`DOUBLE_CLIP_COS`) the test is also made at the end of the common segment
+instead of at s1: when the incident edge overhangs the reference edge (corner on corner), its
+far vertex may be far from the reference line while the common segment lies within
+double_alert of it, and a single point would leave the second corner free to turn into the
+partner (the fast friction-0 compaction of benchmarks/RESULTS.md §f). Each point is a unilateral constraint of its own
 in the solver, so a point that is within the alert distance but not touching carries no force;
 an analysis that wants "double" to mean "two force-bearing points" should check the forces.
 
@@ -91,6 +96,10 @@ __all__ = ["ContactPoints", "detect", "KIND_SIMPLE", "KIND_DOUBLE", "DOUBLE_MIN_
 DOUBLE_MIN_OVERLAP = 1e-9
 """A double contact needs a common segment longer than this fraction of the reference edge
 length; shorter ones (edges meeting at a single corner) give a simple contact."""
+
+DOUBLE_CLIP_COS = math.cos(math.radians(10.0))
+"""Edges within 10 degrees of anti-parallel are also tested at the clipped end of the incident
+edge (corner on corner: the incident edge overhangs the reference edge), see the module doc."""
 
 DOUBLE_GAP_TOLERANCE = 1e-10
 """Round-off allowance of the double-contact test: the second vertex is taken when its gap is
@@ -242,7 +251,12 @@ def _polygon_polygon(a, b, verts, norms, nvert, radius, double_alert, c, normal,
     v1y = verts[inc, k1, 1]
     s1 = (v1x - r0x) * nrx + (v1y - r0y) * nry
     n_points = 1
-    if s1 <= max(s0, 0.0) + double_alert + DOUBLE_GAP_TOLERANCE * (radius[a] + radius[b]):
+    threshold = max(s0, 0.0) + double_alert + DOUBLE_GAP_TOLERANCE * (radius[a] + radius[b])
+    far_ok = s1 <= threshold
+    # near-parallel edges: the criterion is also tested at the clipped end of the incident edge
+    # (a long incident edge against a short reference edge, corner on corner)
+    near_parallel = min(d_next, d_prev) <= -DOUBLE_CLIP_COS
+    if far_ok or near_parallel:
         # clip the incident edge v0 -> v1 to the extent [0, L] of the reference edge
         length = math.sqrt((r1x - r0x) ** 2 + (r1y - r0y) ** 2)
         ux = (r1x - r0x) / length
@@ -254,9 +268,10 @@ def _polygon_polygon(a, b, verts, norms, nvert, radius, double_alert, c, normal,
         lam_b = (length - t0) / dt
         lo = max(0.0, min(lam_a, lam_b))
         hi = min(1.0, max(lam_a, lam_b))
-        if (hi - lo) * abs(dt) > DOUBLE_MIN_OVERLAP * length:
+        clip_ok = far_ok or (s0 + hi * (s1 - s0) <= threshold)
+        if clip_ok and (hi - lo) * abs(dt) > DOUBLE_MIN_OVERLAP * length:
             n_points = 2
-        elif t0 < 0.0 or t0 > length:
+        elif far_ok and (t0 < 0.0 or t0 > length):
             # near-parallel edges meeting at (or missing by) one corner, the deepest vertex
             # beyond the reference edge: take the point of the incident edge facing the
             # nearest end of the reference edge (e.g. vertex on vertex)

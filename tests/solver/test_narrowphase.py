@@ -249,6 +249,48 @@ def test_near_parallel_edges_double_with_mean_normal():
     assert c.kind.tolist() == [1]
 
 
+def test_corner_on_corner_near_parallel_is_double_when_the_common_segment_is_within_alert():
+    # B's facing edge tilted by delta and slid along A's right edge so that the two edges
+    # overlap corner on corner: A's upper corner pokes into B's edge (the reference edge), and
+    # the other end of A's edge (the incident edge), far below B's edge, is farther than the
+    # alert distance from B's edge line; but the end of the common segment (A's edge clipped to
+    # B's edge: at B's lower vertex) is within it -> double, both points on the common segment
+    # (Box2D's clipping criterion)
+    delta, pen, slide, alert = 0.06, 0.01, 0.6, 0.04
+    length = 2 * np.sin(np.pi / 5)
+    pos = [[0.0, 0.0], [2 * C36 - pen, slide * length]]
+    angle = [-np.pi / 5, 4 * np.pi / 5 + delta]
+    va = naive.polygon(*pos[0], 1.0, angle[0], 5)  # right edge vertical: x = C36, |y| <= sin 36
+    vb = naive.polygon(*pos[1], 1.0, angle[1], 5)
+    corner_y = np.sin(np.pi / 5)
+    facing = vb[np.argsort(vb[:, 0])[:2]]  # B's two leftmost vertices: its facing edge
+    lower, upper = facing[np.argsort(facing[:, 1])]
+    b_normal = (upper - lower)[::-1] * [1, -1] / length  # B's facing edge, outward normal (to -x)
+    b_normal *= np.sign(-b_normal[0])
+    far_gap = (np.array([C36, -corner_y]) - lower) @ b_normal  # A's lower corner from B's edge line
+    assert far_gap > alert  # the far vertex fails the vertex-based test
+    c = pair_contact(pos, angle, [1.0, 1.0], [5, 5], alert=alert)
+    check_layout(c)
+    assert c.kind.tolist() == [2, 2]
+    deep, shallow = np.argmin(c.gap), np.argmax(c.gap)
+    # the deep point: A's upper corner, gap = its distance into B's edge = the SAT separation
+    assert c.gap[deep] == pytest.approx(naive.sat_separation(va, vb), abs=1e-14)
+    assert c.gap[deep] == pytest.approx((np.array([C36, corner_y]) - lower) @ b_normal, abs=1e-14)
+    assert c.point[deep, 1] == pytest.approx(corner_y, abs=abs(c.gap[deep]))
+    # the shallow point: A's edge facing B's lower vertex, gap = that vertex's distance to A's
+    # edge line over cos(delta) (measured along B's normal)
+    assert 0 < c.gap[shallow] <= alert
+    assert c.gap[shallow] == pytest.approx((lower[0] - C36) / np.cos(delta), rel=1e-12)
+    assert c.point[shallow, 1] == pytest.approx(lower[1], abs=c.gap[shallow])
+    # a smaller alert than that gap: simple again
+    c = pair_contact(pos, angle, [1.0, 1.0], [5, 5], alert=0.5 * c.gap.max())
+    assert c.kind.tolist() == [1]
+    # and edges 20 degrees apart overhanging the same way stay simple at any alert below the
+    # far vertex's gap (the clipped test is for near-parallel edges only, within 10 degrees)
+    c = pair_contact(pos, [angle[0], 4 * np.pi / 5 + 0.35], [1.0, 1.0], [5, 5], alert=alert)
+    assert c.kind.tolist() == [1]
+
+
 def test_vertex_on_vertex_and_corner_touching_are_finite_simple():
     # vertices pointing at each other, touching at (1, 0)
     c = pair_contact([[0.0, 0.0], [2.0, 0.0]], [0.0, np.pi], [1.0, 1.0], [5, 5], alert=1e-9)
