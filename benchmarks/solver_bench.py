@@ -311,15 +311,20 @@ def _wp_shape(cfg, shape, log):
     log(f"work-precision {shape}: reference {t_ref:.1f} s, {ref_sweeps:.0f} sweeps/step, {ref_bad} non-converged")
     # same-state reference per time step: the first step from the base state solved to 1e-10
     first_ref = {dt: _wp_run(base, dt, 1e-10, dt, record, max_iterations=200_000)[5] for dt in cfg.wp_time_steps}
+
+    def errors(series, forces, first, dt):
+        """Same-state force, end-of-run force, q/p and eps_p errors against the references."""
+        m = min(len(series), len(ref_series))
+        e_q = float(np.max(np.abs(series[:m, 0] - ref_series[:m, 0])))
+        e_v = float(np.max(np.abs(series[:m, 1] - ref_series[:m, 1])))
+        e_1 = float(np.linalg.norm(first - first_ref[dt]) / np.linalg.norm(first_ref[dt]))
+        return e_1, _force_error(forces, ref_forces), e_q, e_v
+
     rows, points = [], []
     for dt in cfg.wp_time_steps:
         for tol in cfg.wp_tolerances:
             elapsed, series, forces, bad, sweeps, first = _wp_run(base, dt, tol, cfg.wp_duration, record)
-            m = min(len(series), len(ref_series))
-            e_q = float(np.max(np.abs(series[:m, 0] - ref_series[:m, 0])))
-            e_v = float(np.max(np.abs(series[:m, 1] - ref_series[:m, 1])))
-            e_f = _force_error(forces, ref_forces)
-            e_1 = float(np.linalg.norm(first - first_ref[dt]) / np.linalg.norm(first_ref[dt]))
+            e_1, e_f, e_q, e_v = errors(series, forces, first, dt)
             default = dt == 5e-4 and tol == 1.7e-4
             points.append(dict(dt=dt, tol=tol, budget=None, time=elapsed, e_f=e_f, e_q=e_q, e_v=e_v, e_1=e_1, default=default))
             rows.append([f"{dt:g}", f"{tol:g}" + (" (default)" if default else ""), f"{elapsed:.2f}", f"{sweeps:.0f}",
@@ -330,11 +335,7 @@ def _wp_shape(cfg, shape, log):
     for budget in cfg.wp_budgets if dt in cfg.wp_time_steps else ():
         elapsed, series, forces, _, sweeps, first = _wp_run(base, dt, 1e-30, cfg.wp_duration, record,
                                                             max_iterations=budget)
-        m = min(len(series), len(ref_series))
-        e_q = float(np.max(np.abs(series[:m, 0] - ref_series[:m, 0])))
-        e_v = float(np.max(np.abs(series[:m, 1] - ref_series[:m, 1])))
-        e_f = _force_error(forces, ref_forces)
-        e_1 = float(np.linalg.norm(first - first_ref[dt]) / np.linalg.norm(first_ref[dt]))
+        e_1, e_f, e_q, e_v = errors(series, forces, first, dt)
         points.append(dict(dt=dt, tol=None, budget=budget, time=elapsed, e_f=e_f, e_q=e_q, e_v=e_v, e_1=e_1,
                            default=False))
         rows.append([f"{dt:g}", f"none: {budget} sweeps", f"{elapsed:.2f}", f"{sweeps:.0f}", "-", fmt(e_1), fmt(e_f),
@@ -360,6 +361,7 @@ def _wp_plot(all_points, path):
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
+    import matplotlib.ticker
 
     fig, axes = plt.subplots(1, 4, figsize=(17, 4))
     for (shape, points), colour in zip(all_points.items(), ("C0", "C1")):
@@ -378,6 +380,7 @@ def _wp_plot(all_points, path):
                           label=f"{shape}, dt=5e-4, fixed sweeps {fixed[0]['budget']}..{fixed[-1]['budget']}")
     for ax, title in zip(axes, ("forces, same state (rel. L2)", "forces, end of run (rel. L2)", "max |q/p - ref|",
                                 "max |eps_p - ref|")):
+        ax.xaxis.set_minor_formatter(matplotlib.ticker.NullFormatter())  # decades only: minor labels collide
         ax.set_xlabel(f"error: {title}")
         ax.set_ylabel("run time (s)")
         ax.grid(True, which="both", alpha=0.3)
