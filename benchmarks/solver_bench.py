@@ -263,7 +263,7 @@ def _wp_run(base, time_step, tolerance, duration, record_every, max_iterations=5
     p.time_step, p.tolerance = time_step, tolerance
     p.max_tolerance = tolerance * (1e-2 / 1.7e-4)  # keep the defaults' ratio of the two norms
     p.max_iterations = max_iterations
-    sim._impulse = sim._impulse * ratio  # warm start: same forces, impulses over the new step
+    sim.scale_warm_start(ratio)  # warm start: same forces, impulses over the new step
     reset_meters(sim)
     steps = int(round(duration / time_step))
     per_record = int(round(record_every / time_step))

@@ -38,7 +38,6 @@ import shlex
 import sys
 import warnings
 from dataclasses import fields
-from types import SimpleNamespace
 
 import numpy as np
 
@@ -139,27 +138,10 @@ def load_state(path):
                               "of its solver parameters (density, thickness)")
     sim.time, sim.step_index = time, step
     sim.sigma0 = float(attrs.get("sigma0_Pa", np.nan))
-    set_warm_start(sim, contacts["i"], contacts["j"], contacts["normal_impulse"], contacts["tangential_impulse"])
+    sim.set_warm_start(contacts["i"], contacts["j"], contacts["normal_impulse"], contacts["tangential_impulse"])
     test = {"first_step": first_step, "n_steps": int(attrs["biaxial_steps"]), "every": int(attrs["snapshot_every"]),
             "snapshots": snapshots}
     return sim, test
-
-
-def set_warm_start(sim, i, j, normal_impulse, tangential_impulse):
-    """Give ``sim`` the impulses of its last step as the warm start of the next one.
-
-    ``i``, ``j`` (m,) are the body pairs of the contacts, ``normal_impulse`` and
-    ``tangential_impulse`` (m, 2) their points' impulses in N s (column = point rank in the
-    pair, as the stepper ranks them). The keys are the stepper's own
-    (:meth:`Simulation._point_keys`), so each impulse goes to the same contact point as in an
-    uninterrupted run; a zero impulse is the same as none.
-    """
-    m = len(i)
-    points = SimpleNamespace(pair=np.repeat(np.arange(m), 2), body_i=np.repeat(np.asarray(i, np.int64), 2),
-                             body_j=np.repeat(np.asarray(j, np.int64), 2))
-    sim._keys = sim._point_keys(points)
-    sim._impulse = np.stack([np.asarray(normal_impulse, float).reshape(2 * m),
-                             np.asarray(tangential_impulse, float).reshape(2 * m)], -1)
 
 
 def resume(path, progress=None) -> int:

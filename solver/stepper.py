@@ -19,6 +19,7 @@ from __future__ import annotations
 import time
 import warnings
 from dataclasses import asdict, dataclass
+from typing import NamedTuple
 
 import numpy as np
 
@@ -81,6 +82,14 @@ class Parameters:
         if bad:
             raise ParameterError("invalid solver parameters: " + "; ".join(bad))
         return self
+
+
+class _Points(NamedTuple):
+    """The fields of a contact-point set that :meth:`Simulation._point_keys` reads."""
+
+    pair: np.ndarray
+    body_i: np.ndarray
+    body_j: np.ndarray
 
 
 @dataclass
@@ -220,6 +229,27 @@ class Simulation:
                           f"smallest radius {cap:.3g} m, so contacts may be missed or found deep; reduce time_step",
                           RuntimeWarning, stacklevel=3)
         return max(self.alert, min(closing, cap))
+
+    def set_warm_start(self, i, j, normal_impulse, tangential_impulse):
+        """Set the impulses that warm-start the next step (e.g. those of a file's last snapshot).
+
+        ``i``, ``j`` (m,) are the body pairs of the contacts, ``normal_impulse`` and
+        ``tangential_impulse`` (m, 2) their points' impulses in N s (column = point rank in the
+        pair, as the stepper ranks them: the keys are :meth:`_point_keys`), so each impulse goes
+        to the same contact point as in an uninterrupted run; a zero impulse is the same as none.
+        """
+        m = len(i)
+        pair = np.repeat(np.arange(m), 2)
+        points = _Points(pair=pair, body_i=np.repeat(np.asarray(i, np.int64), 2),
+                         body_j=np.repeat(np.asarray(j, np.int64), 2))
+        self._keys = self._point_keys(points)
+        self._impulse = np.stack([np.asarray(normal_impulse, float).reshape(2 * m),
+                                  np.asarray(tangential_impulse, float).reshape(2 * m)], -1)
+
+    def scale_warm_start(self, factor):
+        """Multiply the warm-start impulses by ``factor`` (e.g. h_new / h_old when the time step
+        changes: the same forces over a different step)."""
+        self._impulse = self._impulse * float(factor)
 
     def _point_keys(self, pts):
         bodies = self.n_particles + self.n_walls

@@ -76,6 +76,32 @@ def test_warm_start_makes_a_settled_step_converge_in_one_sweep():
     assert sim.last.iterations == 1 and sim.last.converged
 
 
+def test_warm_start_set_from_pairs_and_scaled():
+    # a settled column: its impulses, given back pair by pair, warm-start the next step to one
+    # sweep; the same impulses halved (a time step halved) too, since h is halved with them
+    n = 6
+    kwargs = dict(tolerance=1e-8, max_tolerance=1e-8)
+    sim = gravity_scene(np.stack([np.zeros(n), R + 2 * R * np.arange(n)], -1), np.zeros(n), np.full(n, R),
+                        np.zeros(n), **kwargs)
+    for _ in range(6):
+        sim.step()
+    pts = sim.points
+    pairs = np.flatnonzero(np.r_[True, pts.pair[1:] != pts.pair[:-1]])
+    assert np.all(pts.kind == 1)  # disks: one point per pair, rank 0
+    normal = np.zeros((len(pairs), 2))
+    tangential = np.zeros((len(pairs), 2))
+    normal[:, 0], tangential[:, 0] = sim.impulse[pairs, 0], sim.impulse[pairs, 1]
+    fresh = gravity_scene(sim.position, sim.angle, sim.radius, np.zeros(n), **kwargs)
+    fresh.velocity[:] = sim.velocity
+    fresh.set_warm_start(pts.body_i[pairs], pts.body_j[pairs], normal, tangential)
+    assert fresh.step().iterations == 1
+    np.testing.assert_allclose(fresh.impulse, sim.impulse, rtol=1e-6)
+    fresh.scale_warm_start(0.5)
+    fresh.parameters.time_step *= 0.5
+    assert fresh.step().iterations == 1
+    np.testing.assert_allclose(fresh.impulse, 0.5 * sim.impulse, rtol=1e-6)
+
+
 def test_random_ordering_gives_the_same_column_forces():
     n = 8
     forces = []
