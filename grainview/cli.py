@@ -78,7 +78,7 @@ def _simulate(shape, particles, strain, every, path, seed, overwrite, progress, 
         print(f"{shape}: compaction {settled} after {steps} steps; wall stresses "
               f"{', '.join(f'{s:.0f}' for s in sim.compaction_stress)} Pa", flush=True)
         if scene == "isotropic":
-            with Recorder(path, sim, attrs={"scene": "isotropic"}, overwrite=overwrite) as rec:
+            with Recorder(path, sim, attrs={"scene": "isotropic", "sigma0_Pa": sim.sigma0}, overwrite=overwrite) as rec:
                 rec.write()
         else:
             print(f"{shape}: biaxial compression to eps_1 = {strain} ...", flush=True)

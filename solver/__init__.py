@@ -15,9 +15,9 @@ __version__ = "0.1.0"
 
 from .scenes import (biaxial_test, compaction_sample, gravity_scene, is_equilibrium, isotropic_compaction,  # noqa: E402
                      wall_state)
-from .restart import resume  # noqa: E402
+from .restart import load_sample, resume  # noqa: E402
 from .stepper import Parameters, Simulation, StepInfo  # noqa: E402
 from .walls import Walls  # noqa: E402
 
 __all__ = ["Simulation", "Parameters", "StepInfo", "Walls", "compaction_sample", "isotropic_compaction",
-           "biaxial_test", "resume", "gravity_scene", "is_equilibrium", "wall_state", "__version__"]
+           "biaxial_test", "resume", "load_sample", "gravity_scene", "is_equilibrium", "wall_state", "__version__"]

@@ -96,6 +96,71 @@ def _check_resumable(ds, source):
                               "stopped before its first one): start the run again")
 
 
+def _snapshot_state(ds, index, source):
+    """The whole solver state at snapshot ``index`` of an open dataset (plain numpy arrays)."""
+    snap = ds.isel(time=index)
+    count = int(snap["contact_count"])
+    state = {name: snap[name].values.copy() for name in (
+        "position", "angle", "velocity", "angular_velocity", "wall_position", "wall_velocity")}
+    for name, value in state.items():
+        if not np.all(np.isfinite(value)):
+            raise FileFormatError(f"{source}: cannot restart, {name} of snapshot {index} is not finite")
+    state.update({name: ds[name].values.copy() for name in ("radius", "n_vertices", "mass", "inertia", "wall_normal")})
+    state.update({name: snap[name].values[:count].copy()
+                  for name in ("i", "j", "normal_impulse", "tangential_impulse")})
+    state.update(time=float(snap["time"]), step=int(snap["step"]), first_step=int(ds["step"].values[0]),
+                 names=tuple(str(name) for name in ds["wall"].values), attrs=dict(ds.attrs))
+    return state
+
+
+def _simulation(state, source) -> Simulation:
+    """Rebuild a :class:`Simulation` (walls, parameters, warm start) from :func:`_snapshot_state`."""
+    attrs = state["attrs"]
+    walls = Walls(state["wall_position"], state["wall_normal"], state["names"],
+                  mode=np.asarray(attrs["wall_mode"], np.int64), velocity=state["wall_velocity"],
+                  stress=np.asarray(attrs["wall_stress_Pa"], float), mass=np.asarray(attrs["wall_mass_kg"], float),
+                  length_axis=np.asarray(attrs["wall_length_axis"], np.int64),
+                  max_speed=np.asarray(attrs["wall_max_speed_m_s"], float))
+    sim = Simulation(state["position"], state["angle"], state["radius"], state["n_vertices"], walls,
+                     _parameters(attrs, source), velocity=state["velocity"],
+                     angular_velocity=state["angular_velocity"])
+    if not (np.array_equal(sim.mass, state["mass"]) and np.array_equal(sim.inertia, state["inertia"])):
+        raise FileFormatError(f"{source}: cannot restart, the masses and inertias of the file differ from those "
+                              "of its solver parameters (density, thickness)")
+    sim.time, sim.step_index = state["time"], state["step"]
+    sim.sigma0 = float(attrs.get("sigma0_Pa", np.nan))
+    sim.set_warm_start(state["i"], state["j"], state["normal_impulse"], state["tangential_impulse"])
+    return sim
+
+
+def load_sample(path, index=-1) -> Simulation:
+    """The simulation at snapshot ``index`` (default: the last complete one) of a file this
+    solver wrote, whatever its scene: positions, velocities, walls driven as recorded, solver
+    parameters, the confining stress ``sim.sigma0`` (Pa, NaN if the file does not say) and the
+    warm start of the next step. Use it to start a test from a saved compacted sample::
+
+        sim = load_sample("pentagons_compacted.nc")
+        biaxial_test(sim, "biaxial.nc", strain=0.25)
+
+    Raises :class:`FileFormatError` naming what is missing. The file is only read.
+    """
+    import grainview
+
+    source = os.fspath(path)
+    with grainview.open_dataset(source, chunks=None) as ds:
+        missing = [name for name in STATE_VARIABLES if name not in ds.variables]
+        missing += [name for name in WALL_ATTRIBUTES if name not in ds.attrs]
+        if missing:
+            raise FileFormatError(f"{source}: cannot restart from it, the file lacks {missing} (written by a "
+                                  "solver without restart support, or not by this solver)")
+        if ds.sizes["time"] == 0:
+            raise FileFormatError(f"{source}: the file holds no complete snapshot")
+        if not -ds.sizes["time"] <= int(index) < ds.sizes["time"]:
+            raise FileFormatError(f"{source}: index={index!r} is outside its {ds.sizes['time']} snapshots")
+        state = _snapshot_state(ds, int(index), source)
+    return _simulation(state, source)
+
+
 def load_state(path):
     """The simulation at the last complete snapshot of ``path`` and the test's settings.
 
@@ -110,37 +175,12 @@ def load_state(path):
     source = os.fspath(path)
     with grainview.open_dataset(source, chunks=None) as ds:
         _check_resumable(ds, source)
-        last = ds.isel(time=-1)
-        attrs = dict(ds.attrs)
-        names = tuple(str(name) for name in ds["wall"].values)
-        count = int(last["contact_count"])
-        state = {name: last[name].values.copy() for name in (
-            "position", "angle", "velocity", "angular_velocity", "wall_position", "wall_velocity")}
-        static = {name: ds[name].values.copy() for name in ("radius", "n_vertices", "mass", "inertia", "wall_normal")}
-        contacts = {name: last[name].values[:count].copy()
-                    for name in ("i", "j", "normal_impulse", "tangential_impulse")}
-        time, step, first_step = float(last["time"]), int(last["step"]), int(ds["step"].values[0])
+        state = _snapshot_state(ds, -1, source)
         snapshots = ds.sizes["time"]
-    for name, value in state.items():
-        if not np.all(np.isfinite(value)):
-            raise FileFormatError(f"{source}: cannot resume, {name} of the last snapshot is not finite")
-
-    walls = Walls(state["wall_position"], static["wall_normal"], names,
-                  mode=np.asarray(attrs["wall_mode"], np.int64), velocity=state["wall_velocity"],
-                  stress=np.asarray(attrs["wall_stress_Pa"], float), mass=np.asarray(attrs["wall_mass_kg"], float),
-                  length_axis=np.asarray(attrs["wall_length_axis"], np.int64),
-                  max_speed=np.asarray(attrs["wall_max_speed_m_s"], float))
-    sim = Simulation(state["position"], state["angle"], static["radius"], static["n_vertices"], walls,
-                     _parameters(attrs, source), velocity=state["velocity"],
-                     angular_velocity=state["angular_velocity"])
-    if not (np.array_equal(sim.mass, static["mass"]) and np.array_equal(sim.inertia, static["inertia"])):
-        raise FileFormatError(f"{source}: cannot resume, the masses and inertias of the file differ from those "
-                              "of its solver parameters (density, thickness)")
-    sim.time, sim.step_index = time, step
-    sim.sigma0 = float(attrs.get("sigma0_Pa", np.nan))
-    sim.set_warm_start(contacts["i"], contacts["j"], contacts["normal_impulse"], contacts["tangential_impulse"])
-    test = {"first_step": first_step, "n_steps": int(attrs["biaxial_steps"]), "every": int(attrs["snapshot_every"]),
-            "snapshots": snapshots}
+    sim = _simulation(state, source)
+    attrs = state["attrs"]
+    test = {"first_step": state["first_step"], "n_steps": int(attrs["biaxial_steps"]),
+            "every": int(attrs["snapshot_every"]), "snapshots": snapshots}
     return sim, test
 
 
