@@ -17,14 +17,15 @@ from .errors import ParameterError
 from .stress import stress_direction
 
 
-def fabric_tensor(ds: xr.Dataset, kind="all", walls: bool = False) -> xr.DataArray:
+def fabric_tensor(ds: xr.Dataset, kind="all", walls: bool = False, near=None) -> xr.DataArray:
     """F (time, xy_a, xy_b) = (1/N_c) sum_c n (x) n, dimensionless, tr F = 1 (paper Eq. F).
 
     With ``kind="simple"`` or ``"double"`` the sum runs over that kind while N_c stays the
-    count of all contacts, so F = F_s + F_d exactly (paper Eq. fabricsd).
+    count of all contacts, so F = F_s + F_d exactly (paper Eq. fabricsd). ``near``: which
+    pairs are contacts (:func:`grainview.contacts.in_network`; default force-bearing only).
     """
-    mask_all = selection(ds, walls=walls)
-    mask = selection(ds, walls=walls, kind=kind)
+    mask_all = selection(ds, walls=walls, near=near)
+    mask = selection(ds, walls=walls, kind=kind, near=near)
     label = {None: "", 1: " of simple contacts", 2: " of double contacts"}[kind_code(kind)]
     return apply(_fabric.fabric_tensor, ds["normal"], mask, mask_all,
                  core_dims=[("contact", "xy"), ("contact",), ("contact",)],
@@ -42,7 +43,7 @@ def _reference_direction(ds, reference):
     raise ParameterError(f"reference={reference!r}: expected 'stress', an angle in rad or a DataArray")
 
 
-def fabric_anisotropy(ds: xr.Dataset, kind="all", walls: bool = False, reference="stress") -> xr.Dataset:
+def fabric_anisotropy(ds: xr.Dataset, kind="all", walls: bool = False, reference="stress", near=None) -> xr.Dataset:
     """a = 2 (F_1 - F_2), theta_F and the signed a' = a cos 2(theta_F - theta') (paper Eq. a').
 
     ``reference`` is theta': ``"stress"`` (default, the major principal stress direction of
@@ -50,7 +51,7 @@ def fabric_anisotropy(ds: xr.Dataset, kind="all", walls: bool = False, reference
     partial tensor (kind simple/double) the anisotropies a_s, a'_s are those of F_s, whose
     trace is k_s (paper Fig. 22).
     """
-    f1, f2, theta = apply(principal, fabric_tensor(ds, kind, walls), core_dims=[TENSOR_DIMS],
+    f1, f2, theta = apply(principal, fabric_tensor(ds, kind, walls, near), core_dims=[TENSOR_DIMS],
                           output_core_dims=[(), (), ()])
     ref = _reference_direction(ds, reference)
     a_prime = signed_anisotropy(f1, f2, theta, ref, normalisation=1.0)
@@ -61,11 +62,11 @@ def fabric_anisotropy(ds: xr.Dataset, kind="all", walls: bool = False, reference
     })
 
 
-def orientation_pdf(ds: xr.Dataset, bins: int = 36, kind="all", walls: bool = False) -> xr.DataArray:
+def orientation_pdf(ds: xr.Dataset, bins: int = 36, kind="all", walls: bool = False, near=None) -> xr.DataArray:
     """P(theta) (time, theta): density of contact-normal orientations on [0, pi), rad-1,
     normalised so that sum P dtheta = 1 (paper Fig. 8)."""
     bins = _check_bins(bins)
-    mask = selection(ds, walls=walls, kind=kind)
+    mask = selection(ds, walls=walls, kind=kind, near=near)
     da = apply(_fabric.orientation_pdf, ds["normal"], mask, core_dims=[("contact", "xy"), ("contact",)],
                output_core_dims=[("theta",)], output_sizes={"theta": bins}, kwargs={"n_bins": bins},
                names=["orientation_pdf"],

@@ -12,7 +12,7 @@ import xarray as xr
 
 from ._lift import apply, with_attrs
 from .arrays import force_networks as _net
-from .contacts import selection
+from .contacts import near_attr, selection
 from .errors import ParameterError
 
 
@@ -26,15 +26,18 @@ def _check_thresholds(very_weak, strong):
     return float(very_weak), float(strong)
 
 
-def force_class(ds: xr.Dataset, very_weak: float = 0.1, strong: float = 1.0, walls: bool = False) -> xr.DataArray:
+def force_class(ds: xr.Dataset, very_weak: float = 0.1, strong: float = 1.0, walls: bool = False,
+                near=None) -> xr.DataArray:
     """Force class of each contact slot (time, contact), int8 (paper Fig. 17's tricolor map):
 
     0 not selected (empty slot, or a wall contact with ``walls=False``); 1 very weak,
     f_n < very_weak <f_n>; 2 weak (intermediate), very_weak <f_n> <= f_n <= strong <f_n>;
     3 strong, f_n > strong <f_n>. Defaults 0.1 and 1 as in the paper (Secs. V.B and V.C).
+    ``near``: which pairs are contacts (:func:`grainview.contacts.in_network`; default the
+    force-bearing ones; with a gap threshold the near pairs, f_n = 0, are very weak).
     """
     very_weak, strong = _check_thresholds(very_weak, strong)
-    da = apply(_net.force_classes, ds["fn"], selection(ds, walls=walls), core_dims=[("contact",)] * 2,
+    da = apply(_net.force_classes, ds["fn"], selection(ds, walls=walls, near=near), core_dims=[("contact",)] * 2,
                output_core_dims=[("contact",)], kwargs={"very_weak": very_weak, "strong": strong},
                output_dtypes=[np.int8])
     return with_attrs(da, "force_class", "1", "force class of the contact",
@@ -65,7 +68,7 @@ _ATTRS = {
 
 
 def contact_proportions(ds: xr.Dataset, walls: bool = False, very_weak: float = 0.1,
-                        strong: float = 1.0) -> xr.Dataset:
+                        strong: float = 1.0, near=None) -> xr.Dataset:
     """Proportions of simple/double and weak/strong contacts per snapshot (time,) (ERRATA 4).
 
     * k_s = N_s/N_c, k_d = N_d/N_c (paper Fig. 19), over the N_c selected contacts;
@@ -80,15 +83,16 @@ def contact_proportions(ds: xr.Dataset, walls: bool = False, very_weak: float = 
       all contacts (paper: ~32 % = 25 % simple + 7 % double for pentagons);
     * n_contacts, and the means mean_fn, mean_fn_simple, mean_fn_double in N.
 
-    All contacts of the selection count, including those with f_n = 0 (they are very weak).
-    Lazy on dask input.
+    ``near``: which pairs are contacts (:func:`grainview.contacts.in_network`): None (default)
+    the force-bearing ones; with a gap threshold in m the near pairs count too, with f_n = 0
+    (they are very weak). Lazy on dask input.
     """
     very_weak, strong = _check_thresholds(very_weak, strong)
     names = _net.PROPORTIONS
-    outputs = apply(_net.proportions, ds["fn"], ds["kind"], selection(ds, walls=walls),
+    outputs = apply(_net.proportions, ds["fn"], ds["kind"], selection(ds, walls=walls, near=near),
                     core_dims=[("contact",)] * 3, output_core_dims=[()] * len(names),
                     kwargs={"very_weak": very_weak, "strong": strong},
                     output_dtypes=[np.int64] + [float] * (len(names) - 1))
     out = xr.Dataset({name: with_attrs(da, name, *_ATTRS[name]) for name, da in zip(names, outputs)})
-    out.attrs.update(walls=int(walls), very_weak=very_weak, strong=strong)
+    out.attrs.update(walls=int(walls), very_weak=very_weak, strong=strong, near=near_attr(near))
     return out

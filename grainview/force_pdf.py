@@ -41,13 +41,13 @@ def _check(bins, scale, value_range):
     return int(bins), scale, (low, high)
 
 
-def _histogram(ds, bins, scale, value_range, kind, walls):
+def _histogram(ds, bins, scale, value_range, kind, walls, near=None):
     """Lazy per-snapshot counts, selected-contact counts and zero-force counts, and the edges."""
     bins, scale, value_range = _check(bins, scale, value_range)
     kind_code(kind)  # validates
     edges = _pdf.bin_edges(bins, scale, value_range)
     counts, n_selected, n_zero = apply(
-        _pdf.force_histogram, ds["fn"], selection(ds, walls=walls, kind=kind), selection(ds, walls=walls),
+        _pdf.force_histogram, ds["fn"], selection(ds, walls=walls, kind=kind, near=near), selection(ds, walls=walls, near=near),
         core_dims=[("contact",)] * 3, output_core_dims=[("bin",), (), ()], output_sizes={"bin": bins},
         kwargs={"edges": edges}, output_dtypes=[np.int64, np.int64, np.int64])
     return counts, n_selected, n_zero, edges, scale
@@ -83,7 +83,7 @@ def _pdf_dataset(counts, n_selected, n_zero, edges, scale, attrs):
 
 
 def force_pdf(ds: xr.Dataset, bins: int = 50, scale: str = "log", range=None, kind="all",
-              walls: bool = False) -> xr.Dataset:
+              walls: bool = False, near=None) -> xr.Dataset:
     """P(f_n/<f_n>) per snapshot (time, bin), dimensionless (paper Fig. 14; Fig. 23 by kind).
 
     Each snapshot's forces are divided by its mean normal force <f_n> over the contacts of
@@ -97,17 +97,19 @@ def force_pdf(ds: xr.Dataset, bins: int = 50, scale: str = "log", range=None, ki
     scale : "log" (log-spaced bins, geometric centres; contacts with f_n <= 0 are skipped and
         reported by ``zero_fraction``) or "linear".
     range : (low, high) of f_n/<f_n>; default (1e-4, 10) for log and (0, 10) for linear bins.
+    near : which pairs are contacts (:func:`grainview.contacts.in_network`): None (default)
+        the force-bearing ones; a gap threshold in m adds the near pairs (f_n = 0).
 
     Returns a Dataset with ``pdf`` and ``count`` (time, bin), ``n_contacts``,
     ``zero_fraction`` and ``outside_fraction`` (time), and the coordinates ``f_over_mean``
     (bin centres), ``bin_width`` and ``bin_edges`` (dim ``edge``). Lazy on dask input.
     """
-    counts, n_selected, n_zero, edges, scale = _histogram(ds, bins, scale, range, kind, walls)
+    counts, n_selected, n_zero, edges, scale = _histogram(ds, bins, scale, range, kind, walls, near)
     return _pdf_dataset(counts, n_selected, n_zero, edges, scale, {"kind": str(kind), "walls": int(walls)})
 
 
 def pooled_force_pdf(ds: xr.Dataset, bins: int = 50, scale: str = "log", range=None, kind="all",
-                     walls: bool = False) -> xr.Dataset:
+                     walls: bool = False, near=None) -> xr.Dataset:
     """P(f_n/<f_n>) of the contacts of every snapshot of ``ds`` pooled (dims: bin).
 
     Each contact is normalised by the mean normal force of its own snapshot (as in
@@ -116,7 +118,7 @@ def pooled_force_pdf(ds: xr.Dataset, bins: int = 50, scale: str = "log", range=N
     a time (a dask reduction), so the file is never loaded whole. Select the snapshots to pool
     first, e.g. ``pooled_force_pdf(ds.isel(time=slice(-20, None)))`` for the residual state.
     """
-    counts, n_selected, n_zero, edges, scale = _histogram(ds, bins, scale, range, kind, walls)
+    counts, n_selected, n_zero, edges, scale = _histogram(ds, bins, scale, range, kind, walls, near)
     return _pdf_dataset(counts.sum("time"), n_selected.sum("time"), n_zero.sum("time"), edges, scale,
                         {"kind": str(kind), "walls": int(walls), "pooled_snapshots": int(ds.sizes["time"])})
 

@@ -20,11 +20,12 @@ from .stress import stress_invariants
 CONTACT_ARGS = [("contact",), ("contact",), ("contact", "xy"), ("contact",)]
 
 
-def angular_force_averages(ds: xr.Dataset, bins: int = 36, kind="all", walls: bool = False) -> xr.Dataset:
+def angular_force_averages(ds: xr.Dataset, bins: int = 36, kind="all", walls: bool = False, near=None) -> xr.Dataset:
     """<f_n>(theta), <f_t>(theta) (N) and N_c(theta) on ``bins`` sectors of [0, pi)
-    (paper Eq. fnft, Fig. 10); NaN in empty sectors."""
+    (paper Eq. fnft, Fig. 10); NaN in empty sectors. ``near``: which pairs are contacts
+    (:func:`grainview.contacts.in_network`; default force-bearing only)."""
     bins = _check_bins(bins)
-    mask = selection(ds, walls=walls, kind=kind)
+    mask = selection(ds, walls=walls, kind=kind, near=near)
     fn, ft, count = apply(_forces.angular_averages, ds["fn"], ds["ft"], ds["normal"], mask,
                           core_dims=CONTACT_ARGS, output_core_dims=[("theta",)] * 3,
                           output_sizes={"theta": bins}, kwargs={"n_bins": bins})
@@ -35,10 +36,10 @@ def angular_force_averages(ds: xr.Dataset, bins: int = 36, kind="all", walls: bo
     }).assign_coords(theta=theta_coord(bins))
 
 
-def force_tensors(ds: xr.Dataset, bins: int = 36, kind="all", walls: bool = False) -> xr.Dataset:
+def force_tensors(ds: xr.Dataset, bins: int = 36, kind="all", walls: bool = False, near=None) -> xr.Dataset:
     """H^(n) and H^(t) (time, xy_a, xy_b) in N (ERRATA item 3)."""
     bins = _check_bins(bins)
-    mask = selection(ds, walls=walls, kind=kind)
+    mask = selection(ds, walls=walls, kind=kind, near=near)
     h_n, h_t = apply(_forces.force_tensors, ds["fn"], ds["ft"], ds["normal"], mask,
                      core_dims=CONTACT_ARGS, output_core_dims=[TENSOR_DIMS, TENSOR_DIMS],
                      output_sizes={d: 2 for d in TENSOR_DIMS}, kwargs={"n_bins": bins})
@@ -49,11 +50,11 @@ def force_tensors(ds: xr.Dataset, bins: int = 36, kind="all", walls: bool = Fals
 
 
 def force_anisotropies(ds: xr.Dataset, bins: int = 36, kind="all", walls: bool = False,
-                       reference="stress") -> xr.Dataset:
+                       reference="stress", near=None) -> xr.Dataset:
     """a_n = 2 (H^n_1 - H^n_2)/tr H^n and a_t = 2 (H^t_1 - H^t_2)/tr H^n (ERRATA item 3),
     signed by cos 2(theta - theta') with theta' the ``reference`` direction (default: major
     principal stress direction); also theta_n, theta_t and the unsigned magnitudes."""
-    h = force_tensors(ds, bins, kind, walls)
+    h = force_tensors(ds, bins, kind, walls, near)
     n1, n2, theta_n = apply(principal, h["H_n"], core_dims=[TENSOR_DIMS], output_core_dims=[(), (), ()])
     t1, t2, theta_t = apply(principal, h["H_t"], core_dims=[TENSOR_DIMS], output_core_dims=[(), (), ()])
     trace = n1 + n2
@@ -70,14 +71,15 @@ def force_anisotropies(ds: xr.Dataset, bins: int = 36, kind="all", walls: bool =
     })
 
 
-def harmonic_prediction(ds: xr.Dataset, bins: int = 36, walls: bool = False) -> xr.Dataset:
+def harmonic_prediction(ds: xr.Dataset, bins: int = 36, walls: bool = False, near=None) -> xr.Dataset:
     """q/p and its harmonic prediction (a' + a_n + a_t)/2 (paper Eq. qa, Fig. 12).
 
     The anisotropies use the contacts selected by ``walls`` (default particle–particle);
-    q/p is the stress of the whole sample (wall contacts included).
+    q/p is the stress of the whole sample (wall contacts included). ``near``: which pairs are
+    contacts of the anisotropies (:func:`grainview.contacts.in_network`).
     """
-    fab = fabric_anisotropy(ds, walls=walls)
-    frc = force_anisotropies(ds, bins, walls=walls)
+    fab = fabric_anisotropy(ds, walls=walls, near=near)
+    frc = force_anisotropies(ds, bins, walls=walls, near=near)
     prediction = (fab["a_prime"] + frc["a_n"] + frc["a_t"]) / 2
     return xr.Dataset({
         "q_over_p": stress_invariants(ds)["q_over_p"],

@@ -18,7 +18,7 @@ import numpy as np
 import xarray as xr
 
 from ._lift import with_attrs
-from .contacts import n_particles, selection
+from .contacts import check_near, n_particles, near_attr, selection
 from .errors import ParameterError
 from .schema import KIND_DOUBLE, KIND_SIMPLE
 
@@ -48,11 +48,11 @@ def time_blocks(ds: xr.Dataset):
         start += size
 
 
-def _blocks(ds, walls, force_bearing, start=0):
+def _blocks(ds, walls, near, start=0):
     """Yield ``(block slice, keys (T, C) int64, present (T, C) bool, kind (T, C))`` per time
     block from the block holding snapshot ``start`` on; each block is computed on its own."""
     stride = body_count(ds)
-    present = selection(ds, walls=walls, force_bearing=force_bearing)
+    present = selection(ds, walls=walls, near=near)
     small = xr.Dataset({"i": ds["i"], "j": ds["j"], "kind": ds["kind"], "present": present})
     small = small.transpose("time", "contact")
     for block in time_blocks(ds):
@@ -70,12 +70,13 @@ def _check_flag(name, value):
 
 
 def persistence(ds: xr.Dataset, reference: int = 0, uninterrupted: bool = False, walls: bool = False,
-                force_bearing: bool = False) -> xr.DataArray:
+                near=None) -> xr.DataArray:
     """gamma(t): fraction of the contacts of the reference snapshot still present at t
     (paper Sec. IV.A, Fig. 6b; ERRATA item 8).
 
     gamma(t) = |C(ref) & C(t)| / |C(ref)|, C(t) the set of pairs {i, j} in contact at t
-    (occupied slots, particle–particle unless ``walls``, with f_n > 0 if ``force_bearing``).
+    (particle–particle unless ``walls``; force-bearing, f_n > 0, unless ``near`` adds the
+    pairs within that gap, :func:`grainview.contacts.in_network`).
     With ``uninterrupted=True`` a contact counts only if present at every snapshot from the
     reference to t. ``reference`` is a snapshot index (negative counts from the end); gamma is
     1 there and NaN before it (and NaN if the reference holds no contact). Dimensionless.
@@ -83,14 +84,14 @@ def persistence(ds: xr.Dataset, reference: int = 0, uninterrupted: bool = False,
     """
     _check_flag("uninterrupted", uninterrupted)
     _check_flag("walls", walls)
-    _check_flag("force_bearing", force_bearing)
+    check_near(ds, near)
     n_time = ds.sizes["time"]
     if isinstance(reference, bool) or not isinstance(reference, (int, np.integer)) or not -n_time <= reference < n_time:
         raise ParameterError(f"reference={reference!r}: expected a snapshot index in [{-n_time}, {n_time})")
     reference = int(reference) % n_time
     gamma = np.full(n_time, np.nan)
     ref_keys = alive = None
-    for block, keys, present, _ in _blocks(ds, walls, force_bearing, start=reference):
+    for block, keys, present, _ in _blocks(ds, walls, near, start=reference):
         first = max(reference - block.start, 0)
         if ref_keys is None:
             ref_row = first
@@ -111,7 +112,7 @@ def persistence(ds: xr.Dataset, reference: int = 0, uninterrupted: bool = False,
     da = xr.DataArray(gamma, dims="time", coords={"time": ds["time"].values})
     return with_attrs(da, "gamma", "1", "fraction of persistent contacts gamma",
                       reference=reference, uninterrupted=int(uninterrupted), walls=int(walls),
-                      force_bearing=int(force_bearing))
+                      near=near_attr(near))
 
 
 def _pair_transitions(prev_keys, prev_kind, prev_present, keys, kind, present, stride):
@@ -147,7 +148,7 @@ def _pair_transitions(prev_keys, prev_kind, prev_present, keys, kind, present, s
     return s_to_d, d_to_s, prev_present.sum(axis=1)
 
 
-def type_transitions(ds: xr.Dataset, walls: bool = False, force_bearing: bool = False) -> xr.Dataset:
+def type_transitions(ds: xr.Dataset, walls: bool = False, near=None) -> xr.Dataset:
     """Cumulative fractions Delta gamma_{s->d}(t) and Delta gamma_{d->s}(t) of contacts that
     changed type (paper Sec. VI, Fig. 20; ERRATA item 8).
 
@@ -157,20 +158,20 @@ def type_transitions(ds: xr.Dataset, walls: bool = False, force_bearing: bool = 
         g_{s->d}(t) = #{pairs {i, j} in contact at t-1 and at t, simple at t-1, double at t}
                       / N_c(t-1),
 
-    N_c(t-1) the number of contacts at t-1 (occupied slots, particle–particle unless ``walls``,
-    f_n > 0 if ``force_bearing``); likewise g_{d->s}. Delta gamma(t) = sum_{t' <= t} g(t'),
+    N_c(t-1) the number of contacts at t-1 (particle–particle unless ``walls``; force-bearing
+    unless ``near`` adds near pairs, :func:`grainview.contacts.in_network`); likewise g_{d->s}. Delta gamma(t) = sum_{t' <= t} g(t'),
     with Delta gamma(0) = 0 (a step from a snapshot without contacts adds 0). Dimensionless.
     Computed (not lazy), streaming one time-chunk at a time with the last snapshot of each
     chunk carried over to the next.
     """
     _check_flag("walls", walls)
-    _check_flag("force_bearing", force_bearing)
+    check_near(ds, near)
     stride = body_count(ds)
     n_time = ds.sizes["time"]
     s_to_d = np.zeros(n_time)
     d_to_s = np.zeros(n_time)
     carry = None
-    for block, keys, present, kind in _blocks(ds, walls, force_bearing):
+    for block, keys, present, kind in _blocks(ds, walls, near):
         if carry is None:  # the first snapshot has no predecessor
             carry = (keys[:1], kind[:1], present[:1])
             keys, kind, present, start = keys[1:], kind[1:], present[1:], block.start + 1
@@ -194,6 +195,6 @@ def type_transitions(ds: xr.Dataset, walls: bool = False, force_bearing: bool = 
                                          "delta_gamma_d_to_s", "1",
                                          "cumulative fraction of contacts turning double to simple"),
     })
-    out.attrs.update(walls=int(walls), force_bearing=int(force_bearing),
+    out.attrs.update(walls=int(walls), near=near_attr(near),
                      comment="increment at t: contacts present at t-1 and t that changed kind, over N_c(t-1)")
     return out

@@ -85,6 +85,8 @@ VARIABLES: dict[str, Var] = {
     "ft": Var(("time", "contact"), "f8", "N", "tangential force exerted by i on j along t = (-n_y, n_x)"),
     "point": Var(("time", "contact", "xy"), "f8", "m", "application point of the contact force"),
     "branch": Var(("time", "contact", "xy"), "f8", "m", "branch vector: centre of i to centre of j (to the contact point for walls)"),
+    "gap": Var(("time", "contact"), "f8", "m", "smallest separation of the contact's points along the normal "
+               "(negative: overlap)", False),
     # sample box
     "box_min": Var(("time", "xy"), "f8", "m", "lower-left corner of the sample box"),
     "box_max": Var(("time", "xy"), "f8", "m", "upper-right corner of the sample box"),
@@ -112,6 +114,8 @@ VARIABLES: dict[str, Var] = {
 
 REQUIRED = tuple(name for name, var in VARIABLES.items() if var.required)
 CONTACT_VARIABLES = ("i", "j", "kind", "normal", "fn", "ft", "point", "branch")
+OPTIONAL_CONTACT_VARIABLES = ("gap",)
+"""Optional variables given per contact, like the required ones, in a snapshot's ``contacts``."""
 DIAGNOSTICS = ("step", "nlgs_iterations", "nlgs_residual", "max_interpenetration", "kinetic_energy")
 
 
@@ -223,7 +227,8 @@ def make_dataset(
     radius : (N,) array, m
     position : (T, N, 2) array, m (a (N, 2) array is taken as a single snapshot)
     contacts : list of T dicts with keys ``i, j, kind, normal, fn, ft`` and optionally
-        ``point`` and ``branch`` (one entry per contact; a double contact is one entry).
+        ``point``, ``branch`` and ``gap`` (one entry per contact; a double contact is one
+        entry; ``gap`` in m, given for every snapshot or none).
         ``branch`` defaults to ``x_j - x_i`` for particle pairs; ``point`` defaults to the
         point on the segment i-j at distance ``r_i`` from i (exact for disks). For wall
         contacts (``j >= N``) both ``point`` and ``branch`` must be given.
@@ -247,8 +252,9 @@ def make_dataset(
     angle = np.zeros((t, n)) if angle is None else np.broadcast_to(np.asarray(angle, "f8"), (t, n))
     slots = n_contact_slots or contact_slots(n, n_walls)
 
+    names = CONTACT_VARIABLES + tuple(v for v in OPTIONAL_CONTACT_VARIABLES if contacts and v in contacts[0])
     data = {name: _empty((t, slots) + ((2,) if VARIABLES[name].dims[-1] == "xy" else ()), name)
-            for name in CONTACT_VARIABLES}
+            for name in names}
     count = np.zeros(t, "i4")
     for k, snap in enumerate(contacts):
         i = np.asarray(snap["i"], "i4")
@@ -264,6 +270,10 @@ def make_dataset(
         data["normal"][k, :m] = normal
         data["fn"][k, :m] = snap["fn"]
         data["ft"][k, :m] = snap.get("ft", np.zeros(m))
+        for name in names[len(CONTACT_VARIABLES):]:
+            if name not in snap:
+                raise ParameterError(f"snapshot {k} lacks {name!r}: give it for every snapshot or none")
+            data[name][k, :m] = snap[name]
         wall = j >= n
         if "branch" in snap:
             data["branch"][k, :m] = np.asarray(snap["branch"], "f8").reshape(m, 2)
@@ -446,6 +456,10 @@ class SnapshotWriter:
         nc.set_auto_mask(False)
         return cls(nc, path)
 
+    def attribute(self, name, default=None):
+        """The file's global attribute ``name`` (``default`` when it has none)."""
+        return self._nc.getncattr(name) if name in self._nc.ncattrs() else default
+
     @property
     def n_snapshots(self) -> int:
         """Number of complete snapshots (trailing ones with no time are not counted)."""
@@ -464,7 +478,8 @@ class SnapshotWriter:
         nc.variables["angle"][k] = angle
         nc.variables["box_min"][k] = box_min
         nc.variables["box_max"][k] = box_max
-        for name in CONTACT_VARIABLES:
+        for name in CONTACT_VARIABLES + tuple(v for v in OPTIONAL_CONTACT_VARIABLES
+                                              if v in contacts and v in nc.variables):
             var = VARIABLES[name]
             shape = (self.n_slots, 2) if var.dims[-1] == "xy" else (self.n_slots,)
             buf = _empty(shape, name)

@@ -8,6 +8,7 @@ equals the sum of the particles' tensorial moments exactly (see
 
 from __future__ import annotations
 
+import numpy as np
 import xarray as xr
 
 from . import sample
@@ -24,9 +25,10 @@ def stress_tensor(ds: xr.Dataset, kind="all", walls: bool = True) -> xr.DataArra
 
     ``kind="simple"`` or ``"double"`` restricts the sum to one contact kind, so that
     ``stress_tensor(ds, "simple") + stress_tensor(ds, "double") == stress_tensor(ds)``
-    (paper Eq. sigmasd). ``walls=False`` leaves out the particle–wall contacts.
+    (paper Eq. sigmasd). ``walls=False`` leaves out the particle–wall contacts. Every pair
+    the file holds is summed (a pair without force adds nothing).
     """
-    mask = selection(ds, walls=walls, kind=kind)
+    mask = selection(ds, walls=walls, kind=kind, near=np.inf)
     label = {None: "", 1: " of simple contacts", 2: " of double contacts"}[kind_code(kind)]
     return apply(_stress.stress_tensor, ds["fn"], ds["ft"], ds["normal"], ds["branch"], mask,
                  sample.volume(ds),

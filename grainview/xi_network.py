@@ -36,7 +36,7 @@ def _check_xi(xi):
     return values
 
 
-def xi_network(ds: xr.Dataset, xi=DEFAULT_XI, walls: bool = False) -> xr.Dataset:
+def xi_network(ds: xr.Dataset, xi=DEFAULT_XI, walls: bool = False, near=None) -> xr.Dataset:
     """q(xi)/p, a'(xi) and the contact fraction of the xi-networks (time, xi) (ERRATA item 5).
 
     The xi-network of a snapshot is the set of selected contacts (particle–particle by
@@ -54,11 +54,13 @@ def xi_network(ds: xr.Dataset, xi=DEFAULT_XI, walls: bool = False) -> xr.Dataset
 
     ``xi``: any 1-D sequence of cutoffs >= 0 (default 0, 0.05, ..., 5). Dimensionless results;
     lazy on dask input. One sort per snapshot serves every xi (see
-    :mod:`grainview.arrays.xi_network`).
+    :mod:`grainview.arrays.xi_network`). ``near``: which pairs are contacts
+    (:func:`grainview.contacts.in_network`; default force-bearing only; near pairs carry
+    f_n = 0 and so belong to every xi-network with xi > 0).
     """
     xi = _check_xi(xi)
     whole = stress_invariants(ds)
-    outputs = apply(_xi.xi_network, ds["fn"], ds["ft"], ds["normal"], ds["branch"], selection(ds, walls=walls),
+    outputs = apply(_xi.xi_network, ds["fn"], ds["ft"], ds["normal"], ds["branch"], selection(ds, walls=walls, near=near),
                     volume(ds), whole["p"], whole["theta_sigma"],
                     core_dims=[("contact",), ("contact",), ("contact", "xy"), ("contact", "xy"), ("contact",),
                                (), (), ()],

@@ -3,16 +3,25 @@ snapshot (through :class:`grainview.schema.SnapshotWriter`).
 
 Contacts are written per body pair: a double contact's two points become one slot with the
 resultant force and its application point (the fn-weighted mean of the two points, their
-midpoint when both forces vanish). Only force-bearing contacts (f_n > 0) are written: pairs
-within the alert distance that carry nothing are not contacts of the packing. The kind is the
-detection's (geometric: two edges facing each other within the alert distance give a double
-contact), also when only one of its two points carries a force. ``branch`` is x_j - x_i for
-particle pairs (positions of the snapshot) and the contact point minus x_i for wall contacts;
-``wall_force`` is the total force exerted by the particles on each wall, sum of f over its
-contacts (f = f_n n + f_t t, force of i on j = the wall).
+midpoint when both forces vanish). By default only force-bearing contacts (f_n > 0) are
+written: pairs within the alert distance that carry nothing are not contacts of the packing.
+With ``near`` (m; the recorder uses the alert distance) the open or unloaded pairs whose gap is
+<= near are written too, with f_n = f_t = 0, so that an analysis can count them as a code that
+keeps every pair within its alert distance does (``grainview.contacts.in_network``); the file
+then says so in its attribute ``near_contacts_m``. ``gap`` is the pair's smallest separation
+along the normal at the start of the step (negative: overlap). :func:`written_pairs` alone
+decides what is written, for the contacts and for the restart impulses alike.
+
+The kind is the detection's (geometric: two edges facing each other within the alert distance
+give a double contact), also when only one of its two points carries a force. ``branch`` is
+x_j - x_i for particle pairs (positions of the snapshot) and the contact point minus x_i for
+wall contacts; ``wall_force`` is the total force exerted by the particles on each wall, sum of
+f over its contacts (f = f_n n + f_t t, force of i on j = the wall).
 """
 
 from __future__ import annotations
+
+import warnings
 
 import numpy as np
 
@@ -21,45 +30,81 @@ from grainview.schema import DIAGNOSTICS, SnapshotWriter
 from . import __version__
 
 OPTIONAL = ("velocity", "angular_velocity", "wall_position", "wall_velocity", "wall_force",
-            "normal_impulse", "tangential_impulse", *DIAGNOSTICS)
+            "normal_impulse", "tangential_impulse", "gap", *DIAGNOSTICS)
 
 
-def pair_contacts(sim):
-    """The contacts of the last step, one entry per body pair (dict of contract arrays)."""
+def _pair_sums(pts, values):
+    """Sum of ``values`` (one per contact point) over the points of each pair."""
+    return np.bincount(pts.pair, weights=values, minlength=pts.n_pairs)
+
+
+def _pair_gaps(pts):
+    """Smallest gap (m) of each pair's points."""
+    gap = np.full(pts.n_pairs, np.inf)
+    np.minimum.at(gap, pts.pair, pts.gap)
+    return gap
+
+
+def written_pairs(sim, near=None, n_slots=None):
+    """Which body pairs of the last step are written, as a boolean mask over its pairs.
+
+    The force-bearing pairs (resultant f_n > 0) and, with ``near`` (m), every other pair
+    whose smallest gap is <= near. When ``n_slots`` is given and the pairs do not fit, the
+    near pairs with the largest gaps are left out (with a warning); force-bearing pairs are
+    always kept.
+    """
+    pts = sim.points
+    if pts is None or len(pts.pair) == 0:
+        return np.zeros(0, bool)
+    keep = _pair_sums(pts, sim.impulse[:, 0]) > 0
+    if near is None:
+        return keep
+    gap = _pair_gaps(pts)
+    near_pairs = ~keep & (gap <= near)
+    if n_slots is not None and keep.sum() + near_pairs.sum() > n_slots:
+        room = max(int(n_slots - keep.sum()), 0)
+        candidates = np.flatnonzero(near_pairs)
+        chosen = candidates[np.argsort(gap[candidates], kind="stable")[:room]]
+        warnings.warn(f"step {sim.step_index}: {near_pairs.sum()} near pairs do not all fit in the file's "
+                      f"{n_slots} contact slots; the {near_pairs.sum() - room} farthest are not written",
+                      RuntimeWarning, stacklevel=2)
+        near_pairs = np.zeros_like(near_pairs)
+        near_pairs[chosen] = True
+    return keep | near_pairs
+
+
+def pair_contacts(sim, near=None, n_slots=None):
+    """The contacts of the last step, one entry per written body pair (dict of contract
+    arrays, ``gap`` included); :func:`written_pairs` says which."""
     pts = sim.points
     h = sim.parameters.time_step
     n = sim.n_particles
     if pts is None or len(pts.pair) == 0:
         empty = np.empty(0)
         return dict(i=np.empty(0, "i4"), j=np.empty(0, "i4"), kind=np.empty(0, "i1"), normal=np.empty((0, 2)),
-                    fn=empty, ft=empty, point=np.empty((0, 2)), branch=np.empty((0, 2)))
+                    fn=empty, ft=empty, point=np.empty((0, 2)), branch=np.empty((0, 2)), gap=empty)
     fn_pt = sim.impulse[:, 0] / h
-    ft_pt = sim.impulse[:, 1] / h
-    pair = pts.pair
-    n_pairs = pts.n_pairs
-    first = np.r_[0, np.flatnonzero(np.diff(pair)) + 1]
-    fn = np.bincount(pair, weights=fn_pt, minlength=n_pairs)
-    ft = np.bincount(pair, weights=ft_pt, minlength=n_pairs)
-    weight = np.bincount(pair, weights=np.ones_like(fn_pt), minlength=n_pairs)
-    wx = np.bincount(pair, weights=fn_pt * pts.point[:, 0], minlength=n_pairs)
-    wy = np.bincount(pair, weights=fn_pt * pts.point[:, 1], minlength=n_pairs)
-    mx = np.bincount(pair, weights=pts.point[:, 0], minlength=n_pairs) / weight
-    my = np.bincount(pair, weights=pts.point[:, 1], minlength=n_pairs) / weight
+    fn = _pair_sums(pts, fn_pt)
+    ft = _pair_sums(pts, sim.impulse[:, 1] / h)
+    weight = _pair_sums(pts, np.ones_like(fn_pt))
+    loaded = np.stack([_pair_sums(pts, fn_pt * pts.point[:, 0]), _pair_sums(pts, fn_pt * pts.point[:, 1])], -1)
+    middle = np.stack([_pair_sums(pts, pts.point[:, 0]), _pair_sums(pts, pts.point[:, 1])], -1)
     with np.errstate(invalid="ignore", divide="ignore"):
-        point = np.where((fn > 0)[:, None], np.stack([wx, wy], -1) / fn[:, None], np.stack([mx, my], -1))
+        point = np.where((fn > 0)[:, None], loaded / fn[:, None], middle / weight[:, None])
+    first = np.r_[0, np.flatnonzero(np.diff(pts.pair)) + 1]
     i = pts.body_i[first]
     j = pts.body_j[first]
-    normal = pts.normal[first]
-    kind = pts.kind[first]
     centre_i = sim.position[i]
     branch = np.where((j >= n)[:, None], point - centre_i, sim.position[np.minimum(j, n - 1)] - centre_i)
-    keep = fn > 0
-    return dict(i=i[keep], j=j[keep], kind=kind[keep], normal=normal[keep], fn=fn[keep], ft=ft[keep],
-                point=point[keep], branch=branch[keep])
+    keep = written_pairs(sim, near, n_slots)
+    loaded_pair = fn > 0
+    return dict(i=i[keep], j=j[keep], kind=pts.kind[first][keep], normal=pts.normal[first][keep],
+                fn=np.where(loaded_pair, fn, 0.0)[keep], ft=np.where(loaded_pair, ft, 0.0)[keep],
+                point=point[keep], branch=branch[keep], gap=_pair_gaps(pts)[keep])
 
 
-# --- restart state (issue 6; read back by solver.restart) ------------------------------------
-def point_impulses(sim, n_slots):
+# --- restart state (read back by solver.restart) -------------------------------------------
+def point_impulses(sim, n_slots, near=None):
     """Normal and tangential impulses (N s) of the last step at the points of the contacts that
     :func:`pair_contacts` writes, in its slot order: two (n_slots, 2) arrays whose column 0 is
     the pair's first contact point and column 1 its second (0 for a simple contact), 0 in empty
@@ -72,8 +117,7 @@ def point_impulses(sim, n_slots):
     if pts is None or len(pts.pair) == 0:
         return normal, tangential
     pair = pts.pair
-    fn = np.bincount(pair, weights=sim.impulse[:, 0] / sim.parameters.time_step, minlength=pts.n_pairs)
-    keep = fn > 0  # the same selection as pair_contacts
+    keep = written_pairs(sim, near, n_slots)
     slot = np.cumsum(keep) - 1
     rank = np.zeros(len(pair), np.int64)
     rank[1:] = pair[1:] == pair[:-1]
@@ -90,7 +134,6 @@ def wall_settings(walls):
     return {"wall_mode": walls.mode.astype("i4"), "wall_mode_meanings": "fixed velocity stress",
             "wall_stress_Pa": walls.stress.astype("f8"), "wall_mass_kg": walls.mass.astype("f8"),
             "wall_max_speed_m_s": walls.max_speed.astype("f8"), "wall_length_axis": walls.length_axis.astype("i4")}
-# --- end restart state ------------------------------------------------------------------------
 
 
 def sample_box(sim):
@@ -112,14 +155,20 @@ def sample_box(sim):
 
 
 class Recorder:
-    """Stream snapshots of ``sim`` into ``path`` (context manager)."""
+    """Stream snapshots of ``sim`` into ``path`` (context manager).
 
-    def __init__(self, path, sim, attrs=None, overwrite=False, optional=OPTIONAL):
+    ``near_contacts=True`` also writes the pairs within the alert distance that carry no force
+    (:func:`written_pairs` with ``near = sim.alert``; attribute ``near_contacts_m``).
+    """
+
+    def __init__(self, path, sim, attrs=None, overwrite=False, optional=OPTIONAL, near_contacts=False):
         params = {f"solver_{k}": (v if v is not None else "none") for k, v in sim.parameters_dict().items()}
         if sim.n_walls:
             params.update(wall_settings(sim.walls))
         params.update(attrs or {})
         params["solver_version"] = __version__
+        self.near = float(sim.alert) if near_contacts else None
+        params["near_contacts_m"] = "none" if self.near is None else self.near
         self.sim = sim
         self.writer = SnapshotWriter.create(
             path, radius=sim.radius, n_vertices=sim.n_vertices, mass=sim.mass, inertia=sim.inertia,
@@ -133,6 +182,8 @@ class Recorder:
         recorder = cls.__new__(cls)
         recorder.sim = sim
         recorder.writer = SnapshotWriter.open_append(path)
+        near = recorder.writer.attribute("near_contacts_m", "none")
+        recorder.near = None if isinstance(near, str) else float(near)
         return recorder
 
     def write(self):
@@ -140,9 +191,11 @@ class Recorder:
         n = sim.n_particles
         lo, hi = sample_box(sim)
         info = sim.last
-        normal_impulse, tangential_impulse = point_impulses(sim, self.writer.n_slots)
+        slots = self.writer.n_slots
+        normal_impulse, tangential_impulse = point_impulses(sim, slots, self.near)
         self.writer.append(
-            time=sim.time, position=sim.position, angle=sim.angle, contacts=pair_contacts(sim), box_min=lo, box_max=hi,
+            time=sim.time, position=sim.position, angle=sim.angle, contacts=pair_contacts(sim, self.near, slots),
+            box_min=lo, box_max=hi,
             velocity=sim.velocity[:n], angular_velocity=sim.angular_velocity[:n], wall_position=sim.walls.point,
             wall_velocity=sim.walls.velocity, normal_impulse=normal_impulse, tangential_impulse=tangential_impulse,
             wall_force=sim.wall_forces(), step=sim.step_index,

@@ -150,13 +150,14 @@ def isotropic_compaction(sim: Simulation, *, max_steps=40000, window=200, stress
 
 
 def biaxial_test(sim: Simulation, path, *, strain=0.1, velocity=0.01, every=20, overwrite=False,
-                 attrs=None, progress=None):
+                 attrs=None, progress=None, near_contacts=False):
     """Biaxial compression of a compacted sample, written to ``path`` every ``every`` steps.
 
     The top wall moves down at ``velocity`` (m s-1) until eps_1 = ln(1 + dh/h0) reaches
     ``strain``; the right wall keeps the confining stress sigma0; bottom and left are fixed.
     The snapshot at the start of the test is written first. Ctrl-C stops after the current
-    step, with every written snapshot kept.
+    step, with every written snapshot kept. ``near_contacts``: also write the pairs within the
+    alert distance that carry no force (:class:`solver.output.Recorder`).
     """
     if not (0 < strain < 1):
         raise ParameterError(f"strain={strain!r}: expected a vertical strain in (0, 1)")
@@ -173,7 +174,7 @@ def biaxial_test(sim: Simulation, path, *, strain=0.1, velocity=0.01, every=20, 
                  "sigma0_Pa": getattr(sim, "sigma0", np.nan), "snapshot_every": int(every),
                  "biaxial_steps": n_steps}
     run_attrs.update(attrs or {})
-    with Recorder(path, sim, attrs=run_attrs, overwrite=overwrite) as rec:
+    with Recorder(path, sim, attrs=run_attrs, overwrite=overwrite, near_contacts=near_contacts) as rec:
         rec.write()
         biaxial_steps(sim, rec, first=1, n_steps=n_steps, every=int(every), progress=progress)
     return n_steps

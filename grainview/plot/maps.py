@@ -119,7 +119,7 @@ def plot_force_chains(data, ax=None, time: int = -1, walls: bool = False, max_li
     _, ds = single_dataset(data)
     ax = get_axes(ax)
     k = snapshot_index(ds, time)
-    mask = selection(ds.isel(time=k), walls=walls, force_bearing=True).values
+    mask = selection(ds.isel(time=k), walls=walls).values
     _network(ds, k, mask, colour, ax, max_linewidth, True, None, particles)
     return ax
 
@@ -152,7 +152,7 @@ def plot_contact_kinds(data, ax=None, time: int = -1, walls: bool = False, max_l
     _, ds = single_dataset(data)
     ax = get_axes(ax)
     k = snapshot_index(ds, time)
-    mask = selection(ds.isel(time=k), walls=walls, force_bearing=True).values
+    mask = selection(ds.isel(time=k), walls=walls).values
     kind = np.asarray(ds["kind"].isel(time=k).values, int)
     _network(ds, k, mask, lambda slots: [KIND_COLOURS.get(c, "k") for c in kind[slots]], ax, max_linewidth,
              True, None, particles)

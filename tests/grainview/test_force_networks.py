@@ -39,8 +39,11 @@ def hand_dataset():
 def test_force_class_by_hand(prepare):
     ds = prepare(hand_dataset())
     with raise_if_dask_computes():
-        labels = force_class(ds)
+        labels = force_class(ds, near=np.inf)  # every pair the file holds, the f_n = 0 one too
+        loaded = force_class(ds)
     labels = labels.compute()
+    # force-bearing only (the default): mean (1 + 2 + 10 + 37)/4 = 12.5, thresholds 1.25 and 12.5
+    np.testing.assert_array_equal(loaded.values[0, :6], [0, 1, 2, 2, 3, 0])
     assert labels.dtype == np.int8
     assert labels.dims == ("time", "contact")
     # thresholds 0.1 * 10 = 1 and 10: 0 very weak, 1 (not < 1) weak, 2 weak, 10 (<= 10) weak,
@@ -55,16 +58,22 @@ def test_force_class_by_hand(prepare):
 def test_force_class_thresholds_and_walls():
     ds = hand_dataset()
     # with the wall contact the mean is 150/6 = 25: 0, 1, 2 < 2.5 very weak, 10 weak, 37 and 100 strong
-    np.testing.assert_array_equal(force_class(ds, walls=True).values[0, :6], [1, 1, 1, 2, 3, 3])
+    np.testing.assert_array_equal(force_class(ds, walls=True, near=np.inf).values[0, :6], [1, 1, 1, 2, 3, 3])
     # thresholds 0.15 * 10 = 1.5 and 0.5 * 10 = 5
-    np.testing.assert_array_equal(force_class(ds, very_weak=0.15, strong=0.5).values[0, :5], [1, 1, 2, 3, 3])
+    np.testing.assert_array_equal(force_class(ds, very_weak=0.15, strong=0.5, near=np.inf).values[0, :5],
+                                  [1, 1, 2, 3, 3])
 
 
 def test_contact_proportions_by_hand(prepare):
     ds = prepare(hand_dataset())
     with raise_if_dask_computes():
-        prop = contact_proportions(ds)
+        prop = contact_proportions(ds, near=np.inf)  # every pair the file holds, the f_n = 0 one too
+        loaded = contact_proportions(ds)
     prop = prop.compute().isel(time=0)
+    # force-bearing only (the default): 4 contacts, mean 12.5, 1 very weak (f = 1 < 1.25)
+    loaded = loaded.compute().isel(time=0)
+    assert int(loaded["n_contacts"]) == 4 and float(loaded["mean_fn"]) == pytest.approx(12.5, rel=RTOL)
+    assert float(loaded["very_weak_fraction"]) == pytest.approx(1 / 4, rel=RTOL)
     k_s, k_d = 3 / 5, 2 / 5
     mean, mean_s, mean_d = 10.0, 38 / 3, 6.0
     expected = {
@@ -88,7 +97,7 @@ def test_contact_proportions_second_snapshot_and_walls():
     assert float(prop["f_s"]) == 0.0 and float(prop["f_d"]) == 1.0
     assert float(prop["k_d_weak"]) == 1.0 and float(prop["k_d_strong"]) == 0.0
     assert np.isnan(float(prop["mean_fn_simple"]))
-    walls = contact_proportions(hand_dataset(), walls=True).isel(time=0)
+    walls = contact_proportions(hand_dataset(), walls=True, near=np.inf).isel(time=0)
     # mean 25: strong 37 (s), 100 (s); very weak 0, 1 (s), 2 (d)
     assert float(walls["k_s"]) == pytest.approx(4 / 6, rel=RTOL)
     assert float(walls["k_s_strong"]) == pytest.approx(2 / 6, rel=RTOL)

@@ -47,7 +47,11 @@ def hand_dataset():
 def test_linear_pdf_by_hand(prepare):
     ds = prepare(hand_dataset())
     with raise_if_dask_computes():
-        out = force_pdf(ds, bins=4, scale="linear", range=(0.0, 2.0))
+        out = force_pdf(ds, bins=4, scale="linear", range=(0.0, 2.0), near=np.inf)
+        loaded = force_pdf(ds, bins=4, scale="linear", range=(0.0, 2.0))
+    # force-bearing only (the default): snapshot 1 has 3 contacts, none with f_n = 0
+    np.testing.assert_array_equal(loaded["n_contacts"].values, [4, 3])
+    np.testing.assert_allclose(loaded["zero_fraction"].values, [0.0, 0.0], atol=0)
     out = out.compute()
     # ratios f/<f>: 1/3, 2/3, 1, 2 (2 sits on the last edge, which np.histogram includes)
     # and 0, 1, 1, 2; edges 0, 0.5, 1, 1.5, 2
@@ -64,7 +68,7 @@ def test_linear_pdf_by_hand(prepare):
 def test_log_pdf_skips_zero_forces(prepare):
     ds = prepare(hand_dataset())
     with raise_if_dask_computes():
-        out = force_pdf(ds, bins=2, scale="log", range=(0.5, 2.0))
+        out = force_pdf(ds, bins=2, scale="log", range=(0.5, 2.0), near=np.inf)
     out = out.compute()
     # edges 0.5, 1, 2: snapshot 0 -> 1/3 outside, 2/3 | 1, 2; snapshot 1 -> 0 skipped | 1, 1, 2
     np.testing.assert_array_equal(out["count"].values, [[1, 2], [0, 3]])
@@ -76,14 +80,14 @@ def test_log_pdf_skips_zero_forces(prepare):
 
 def test_walls_and_kind_selection(prepare):
     ds = prepare(hand_dataset())
-    with_walls = force_pdf(ds, bins=2, scale="linear", range=(0.0, 5.0), walls=True).compute()
+    with_walls = force_pdf(ds, bins=2, scale="linear", range=(0.0, 5.0), walls=True, near=np.inf).compute()
     # snapshot 0 with the wall contact: mean 112/5, ratios 5/112, 10/112, 15/112, 30/112, 500/112
     np.testing.assert_array_equal(with_walls["count"].values[0], [4, 1])
     # simple contacts of snapshot 0 (f = 1 and 3), still normalised by the mean of all kinds (3)
-    simple = force_pdf(ds, bins=4, scale="linear", range=(0.0, 2.0), kind="simple").compute()
+    simple = force_pdf(ds, bins=4, scale="linear", range=(0.0, 2.0), kind="simple", near=np.inf).compute()
     np.testing.assert_array_equal(simple["count"].values[0], [1, 0, 1, 0])
     np.testing.assert_array_equal(simple["n_contacts"].values, [2, 4])
-    double = force_pdf(ds, bins=4, scale="linear", range=(0.0, 2.0), kind="double").compute()
+    double = force_pdf(ds, bins=4, scale="linear", range=(0.0, 2.0), kind="double", near=np.inf).compute()
     np.testing.assert_array_equal(double["count"].values[0], [0, 1, 0, 1])
 
 

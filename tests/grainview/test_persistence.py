@@ -49,34 +49,36 @@ SEQUENCE = [
 
 def test_gamma_by_hand(prepare):
     ds = prepare(sequence_dataset(SEQUENCE))
-    np.testing.assert_allclose(persistence(ds).values, [1, 3 / 4, 3 / 4, 0, 1], rtol=1e-12)
-    np.testing.assert_allclose(persistence(ds, uninterrupted=True).values, [1, 3 / 4, 2 / 4, 0, 0], rtol=1e-12)
+    # every pair the file holds (near=inf): (3,4) carries no force at t = 1 but is present
+    np.testing.assert_allclose(persistence(ds, near=np.inf).values, [1, 3 / 4, 3 / 4, 0, 1], rtol=1e-12)
+    np.testing.assert_allclose(persistence(ds, near=np.inf, uninterrupted=True).values, [1, 3 / 4, 2 / 4, 0, 0],
+                               rtol=1e-12)
     # the wall contact counts too with walls=True (5 reference contacts)
-    np.testing.assert_allclose(persistence(ds, walls=True).values, [1, 4 / 5, 4 / 5, 1 / 5, 1], rtol=1e-12)
-    # force-bearing only: (3,4) is absent at t = 1
-    np.testing.assert_allclose(persistence(ds, force_bearing=True).values, [1, 2 / 4, 3 / 4, 0, 1], rtol=1e-12)
-    np.testing.assert_allclose(persistence(ds, force_bearing=True, uninterrupted=True).values,
-                               [1, 2 / 4, 1 / 4, 0, 0], rtol=1e-12)
+    np.testing.assert_allclose(persistence(ds, walls=True, near=np.inf).values, [1, 4 / 5, 4 / 5, 1 / 5, 1],
+                               rtol=1e-12)
+    # force-bearing only (the default): (3,4) is absent at t = 1
+    np.testing.assert_allclose(persistence(ds).values, [1, 2 / 4, 3 / 4, 0, 1], rtol=1e-12)
+    np.testing.assert_allclose(persistence(ds, uninterrupted=True).values, [1, 2 / 4, 1 / 4, 0, 0], rtol=1e-12)
 
 
 def test_gamma_from_a_later_reference(prepare):
     ds = prepare(sequence_dataset(SEQUENCE))
     # reference t = 1: {(0,1), (2,3), (3,4), (0,4)}
-    gamma = persistence(ds, reference=1)
+    gamma = persistence(ds, reference=1, near=np.inf)
     assert np.isnan(gamma.values[0])
     np.testing.assert_allclose(gamma.values[1:], [1, 2 / 4, 1 / 4, 3 / 4], rtol=1e-12)
-    np.testing.assert_allclose(persistence(ds, reference=-4, uninterrupted=True).values[1:], [1, 2 / 4, 0, 0],
+    np.testing.assert_allclose(persistence(ds, reference=-4, uninterrupted=True, near=np.inf).values[1:], [1, 2 / 4, 0, 0],
                                rtol=1e-12)
     assert gamma.attrs["reference"] == 1
 
 
 def test_transitions_by_hand(prepare):
     ds = prepare(sequence_dataset(SEQUENCE))
-    out = type_transitions(ds)
+    out = type_transitions(ds, near=np.inf)  # every pair the file holds, (3,4) at t1 too
     # t0 -> t1: (3,4) s -> d, (2,3) d -> s, over 4 contacts at t0; t1 -> t2: (0,1) s -> d over 4
     np.testing.assert_allclose(out.delta_gamma_s_to_d.values, [0, 1 / 4, 2 / 4, 2 / 4, 2 / 4], rtol=1e-12)
     np.testing.assert_allclose(out.delta_gamma_d_to_s.values, [0, 1 / 4, 1 / 4, 1 / 4, 1 / 4], rtol=1e-12)
-    with_walls = type_transitions(ds, walls=True)  # the wall contact adds one contact to each N_c(t-1)
+    with_walls = type_transitions(ds, walls=True, near=np.inf)  # the wall contact adds one contact to each N_c(t-1)
     np.testing.assert_allclose(with_walls.delta_gamma_s_to_d.values, [0, 1 / 5, 2 / 5, 2 / 5, 2 / 5], rtol=1e-12)
 
 
