@@ -12,6 +12,12 @@ from pathlib import Path
 
 from .errors import GrainviewError
 
+RESIDUAL_STRAIN = 0.3
+"""Default start of the residual window (eps_q); the same as grainview.strain.RESIDUAL_STRAIN,
+repeated here so that ``--help`` does not import xarray."""
+DEFAULT_STRAIN = 0.25
+"""Default vertical strain of a biaxial test: eps_q ~0.45, into the residual state."""
+
 
 def _info(args) -> int:
     from .io import open_dataset
@@ -58,45 +64,87 @@ def _demo(args) -> int:
     return 0
 
 
-def _simulate(shape, particles, strain, every, path, seed, overwrite, progress, scene="biaxial"):
-    """Deposit, compact isotropically and (for ``scene="biaxial"``) shear one sample into
-    ``path``; returns the path. An isotropic run writes its final compacted state."""
+def _preparation(args, shape):
+    """The :class:`solver.preparation.Preparation` the command line asks for."""
+    from solver.preparation import preparation
+
+    return preparation(args.preparation, particles=args.particles, shape=shape, seed=args.seed,
+                       compaction_friction=args.compaction_friction, max_inertia_number=args.max_inertia_number,
+                       aspect=args.aspect, pressure_ramp=args.pressure_ramp)
+
+
+def _check_test(args):
+    """Check the settings of the biaxial test before anything is simulated."""
+    if not (0 < args.strain < 1):
+        raise GrainviewError(f"--strain {args.strain}: expected a vertical strain eps_1 in (0, 1)")
+    if args.every < 1:
+        raise GrainviewError(f"--every {args.every}: expected a positive number of steps between snapshots")
+    if not (args.velocity > 0):
+        raise GrainviewError(f"--velocity {args.velocity}: expected a positive wall speed in m s-1")
+
+
+def _simulate(prep, path, *, strain, every, velocity, near_contacts, overwrite, progress, scene="biaxial"):
+    """Deposit, compact isotropically (as ``prep`` says) and, for ``scene="biaxial"``, shear
+    one sample into ``path``; returns the path. An isotropic run writes its compacted state."""
     import warnings
 
-    from solver import biaxial_test, compaction_sample, isotropic_compaction
+    from solver import biaxial_test
     from solver.output import Recorder
+    from solver.preparation import prepare_sample
 
     path = Path(path)
     if path.exists() and not overwrite:
         raise GrainviewError(f"{path} exists; pass --overwrite to replace it")
-    print(f"{shape}: depositing {particles} particles and compacting under 10 kPa ...", flush=True)
-    sim = compaction_sample(particles, shape, seed=seed)
+    name = prep.shape
+    print(f"{name}: depositing {prep.particles} particles and compacting under {prep.sigma0:g} Pa ...", flush=True)
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
-        steps = isotropic_compaction(sim, progress=progress)
+        sim = prepare_sample(prep, progress=progress)
         settled = "settled" if sim.settled else "NOT settled (step limit reached)"
-        print(f"{shape}: compaction {settled} after {steps} steps; wall stresses "
+        print(f"{name}: compaction {settled} after {sim.compaction_steps} steps; wall stresses "
               f"{', '.join(f'{s:.0f}' for s in sim.compaction_stress)} Pa", flush=True)
+        attrs = {**prep.attrs(), "preparation_name": prep_name(prep), "sigma0_Pa": prep.sigma0,
+                 "compaction_steps": sim.compaction_steps, "compaction_settled": int(sim.settled),
+                 "compaction_inertia_number": sim.compaction_inertia_number}
         if scene == "isotropic":
-            with Recorder(path, sim, attrs={"scene": "isotropic", "sigma0_Pa": sim.sigma0}, overwrite=overwrite) as rec:
+            with Recorder(path, sim, attrs={"scene": "isotropic", **attrs}, overwrite=overwrite,
+                          near_contacts=near_contacts) as rec:
                 rec.write()
         else:
-            print(f"{shape}: biaxial compression to eps_1 = {strain} ...", flush=True)
-            biaxial_test(sim, path, strain=strain, every=every, overwrite=overwrite, progress=progress)
+            print(f"{name}: biaxial compression to eps_1 = {strain} at {velocity:g} m/s ...", flush=True)
+            biaxial_test(sim, path, strain=strain, every=every, velocity=velocity, overwrite=overwrite,
+                         progress=progress, attrs=attrs, near_contacts=near_contacts)
     unconverged = sum("did not converge" in str(w.message) for w in caught)
     if unconverged:
-        print(f"{shape}: warning: NLGS reached its iteration limit in {unconverged} step(s)", file=sys.stderr)
-    print(f"{shape}: wrote {path}", flush=True)
+        print(f"{name}: warning: NLGS reached its iteration limit in {unconverged} step(s)", file=sys.stderr)
+    print(f"{name}: wrote {path}", flush=True)
     return path
+
+
+def prep_name(prep) -> str:
+    """The preset a preparation is, or "custom"."""
+    from solver.preparation import PRESETS
+
+    core = {k: v for k, v in prep.__dict__.items() if k not in ("particles", "shape", "seed")}
+    for name, preset in PRESETS.items():
+        if core == {k: v for k, v in preset.__dict__.items() if k not in ("particles", "shape", "seed")}:
+            return name
+    return "custom"
 
 
 def _progress_flag(args):
     return None if args.progress == "auto" else args.progress == "on"
 
 
+def _simulation_kwargs(args):
+    return dict(strain=args.strain, every=args.every, velocity=args.velocity, near_contacts=args.near_contacts,
+                overwrite=args.overwrite, progress=_progress_flag(args))
+
+
 def _run(args) -> int:
-    _simulate(args.shape, args.particles, args.strain, args.every, args.out, args.seed, args.overwrite,
-              _progress_flag(args), scene=args.scene)
+    _check_test(args)
+    prep = _preparation(args, args.shape)
+    _simulate(prep, args.out, scene=args.scene, **_simulation_kwargs(args))
     return 0
 
 
@@ -108,19 +156,37 @@ def _report(args) -> int:
     if len(labels) != len(args.files):
         raise GrainviewError(f"--labels has {len(labels)} names for {len(args.files)} files")
     runs = {label: open_dataset(f, validate=True) for label, f in zip(labels, args.files)}
-    result = write_report(runs, args.out, overwrite=args.overwrite)
+    result = write_report(runs, args.out, residual_strain=args.residual_strain, overwrite=args.overwrite)
     print(result["table"].to_string())
     print(f"wrote {len(result['files'])} files in {args.out}")
     return 0
 
 
 def _study(args) -> int:
+    from concurrent.futures import ProcessPoolExecutor
+
+    _check_test(args)
+    if args.jobs < 1:
+        raise GrainviewError(f"--jobs {args.jobs}: expected at least 1 process")
     out = Path(args.out)
+    samples = {"pentagons": "pentagon", "disks": "disk"}
+    preps = {label: _preparation(args, shape) for label, shape in samples.items()}
+    paths = {label: out / f"{label}.nc" for label in samples}
+    if not args.overwrite:
+        for path in paths.values():
+            if path.exists():
+                raise GrainviewError(f"{path} exists; pass --overwrite to replace it")
     out.mkdir(parents=True, exist_ok=True)
-    paths = {}
-    for label, shape in (("pentagons", "pentagon"), ("disks", "disk")):
-        paths[label] = _simulate(shape, args.particles, args.strain, args.every, out / f"{label}.nc", args.seed,
-                                 args.overwrite, _progress_flag(args))
+    kwargs = _simulation_kwargs(args)
+    if args.jobs == 1:
+        for label in samples:
+            _simulate(preps[label], paths[label], **kwargs)
+    else:  # one process per sample: the two samples run side by side on two cores
+        kwargs["progress"] = False
+        with ProcessPoolExecutor(max_workers=min(args.jobs, len(samples))) as pool:
+            futures = [pool.submit(_simulate, preps[label], paths[label], **kwargs) for label in samples]
+            for future in futures:
+                future.result()
     args.files = [str(p) for p in paths.values()]
     args.labels = ",".join(paths)
     args.out = str(out / "report")
@@ -133,12 +199,36 @@ def build_parser() -> argparse.ArgumentParser:
         "Azema et al., Phys. Rev. E 76, 011301 (2007)."))
     sub = parser.add_subparsers(dest="command", required=True)
 
-    def simulation_options(p, particles=400, strain=0.05, every=100):
+    def residual_option(p):
+        p.add_argument("--residual-strain", type=float, default=RESIDUAL_STRAIN,
+                       help=f"the residual state starts at this shear strain eps_q (default {RESIDUAL_STRAIN}); "
+                       "a run short of it reports 'not reached'")
+
+    def simulation_options(p, particles=400, strain=DEFAULT_STRAIN, every=200):
+        from solver.preparation import PRESETS
+
         p.add_argument("--particles", type=int, default=particles, help=f"particles per sample (default {particles})")
         p.add_argument("--strain", type=float, default=strain,
-                       help=f"vertical strain eps_1 of the biaxial test (default {strain})")
+                       help=f"vertical strain eps_1 of the biaxial test (default {strain}: eps_q ~0.45, "
+                       "into the residual state)")
+        p.add_argument("--velocity", type=float, default=0.01,
+                       help="speed of the top wall in m/s (default 0.01, the paper's)")
         p.add_argument("--every", type=int, default=every, help=f"steps between snapshots (default {every})")
         p.add_argument("--seed", type=int, default=0, help="random seed of the deposit (default 0)")
+        prep = p.add_argument_group("sample preparation (docs/fidelity.md)")
+        prep.add_argument("--preparation", choices=sorted(PRESETS), default="paper",
+                          help="named preparation (default paper: compaction with friction 0.4, walls closing "
+                          "at up to 5 cm/s); the options below change it")
+        prep.add_argument("--compaction-friction", type=float, default=None,
+                          help="grain friction during compaction (default: the test's 0.4)")
+        prep.add_argument("--max-inertia-number", type=float, default=None,
+                          help="cap of the inertia number I = (v/L) d sqrt(rho/sigma0) of the closing walls")
+        prep.add_argument("--aspect", type=float, default=None, help="h/l of the sample box (default 2)")
+        prep.add_argument("--pressure-ramp", type=float, default=None,
+                          help="time in s over which sigma0 rises from 0 (default 0: applied at once)")
+        p.add_argument("--near-contacts", action="store_true",
+                       help="also write the pairs within the alert distance that carry no force (with their "
+                       "gap), for the analyses' near= counting")
         p.add_argument("--overwrite", action="store_true", help="replace existing output files")
         p.add_argument("--progress", choices=["auto", "on", "off"], default="auto",
                        help="progress bars (default: on in a terminal)")
@@ -147,6 +237,8 @@ def build_parser() -> argparse.ArgumentParser:
                            description="Deposit, compact (10 kPa) and shear an S1-like pentagon sample and an "
                            "S2-like disk sample, then write the report (table vs the paper, figures).")
     study.add_argument("--out", default="study", help="output folder (default: study)")
+    study.add_argument("--jobs", type=int, default=2, help="processes: the two samples side by side (default 2)")
+    residual_option(study)
     simulation_options(study)
     study.set_defaults(func=_study)
 
@@ -166,6 +258,7 @@ def build_parser() -> argparse.ArgumentParser:
                         "labels containing 'pent' or 'disk' are compared with the paper's S1/S2 values")
     report.add_argument("--out", default="report", help="output folder (default: report)")
     report.add_argument("--overwrite", action="store_true", help="replace an existing report in --out")
+    residual_option(report)
     report.set_defaults(func=_report)
     info = sub.add_parser("info", help="validate a grainview netCDF file and print its summary")
     info.add_argument("file", help="path of a netCDF file of the grainview data contract")

@@ -1,10 +1,13 @@
 """The pentagons-versus-disks report: the paper's headline numbers next to a run's own, and
 every figure the data supports.
 
-:func:`headline_table` reduces each run to the numbers the paper quotes (ERRATA.md,
-"Reference figures"), averaged over its *residual state* (the snapshots with eps_q in the last
-``residual`` fraction of the run); :func:`write_report` writes that table as CSV and
-Markdown and draws the figures.
+:func:`headline_table` reduces each run to the numbers the paper quotes (docs/fidelity.md
+lists them with the paper's sections), averaged over its *residual state*: the snapshots with
+eps_q >= ``residual_strain`` (default 0.3, :func:`grainview.strain.residual_window`). A run
+that stops short of it reports "not reached" for every residual value instead of another
+state's average. The table also says what it describes: particles, seed, preparation, the
+strain window and its snapshots, and the double-contact criterion of the run.
+:func:`write_report` writes that table as CSV and Markdown and draws the figures.
 """
 
 from __future__ import annotations
@@ -16,45 +19,91 @@ import pandas as pd
 import xarray as xr
 
 from .errors import ParameterError
+from .strain import RESIDUAL_STRAIN, residual_window
 
-# The paper's values (ERRATA.md, "Reference figures"); strings where the paper gives no number.
+NOT_REACHED = "not reached"
+"""Value of a residual-state row of a run that stops short of the residual window."""
+
+# The paper's values (Azema et al. 2007, Secs. III-VI; docs/fidelity.md); strings where the
+# paper gives no number. k_d, q_s/p and q_d/p are implied rather than quoted: see
+# docs/fidelity.md.
 PAPER = {
     "pentagons": {
-        "q/p (residual)": 0.35, "solid fraction (initial)": 0.80, "z (initial)": 3.20, "z (residual)": 3.75,
-        "a (residual)": "small (nearly isotropic)", "a_n (residual)": "larger than disks",
-        "a_t (residual)": "close to a_n", "alpha (strong-force pdf)": 0.74, "weak fraction": 0.58,
+        "particles": 14400, "q/p (residual)": 0.35, "solid fraction (initial)": 0.80, "z (initial)": 3.20,
+        "z (residual)": 3.75, "z with walls (residual)": "-", "a (residual)": "small (nearly isotropic)",
+        "a_n (residual)": "larger than disks", "a_t (residual)": "close to a_n",
+        "(a' + a_n + a_t)/2 (residual)": "~q/p", "alpha (strong-force pdf)": 0.74, "weak fraction": 0.58,
         "very weak fraction": 0.32, "very weak simple": 0.25, "very weak double": 0.07,
-        "k_s": "> k_d", "k_d": "< k_s", "f_d / f_s": 1.5, "k_s^S / k_d^S": 0.5, "k_s^W / k_d^W": 2.0,
+        "k_s": "> k_d", "k_d": "~0.47 (implied)", "q_s/p": "q_d/p / 2-3", "q_d/p": "2-3 q_s/p", "f_d / f_s": 1.5,
+        "k_s^S / k_d^S": 0.5, "k_s^W / k_d^W": 2.0,
     },
     "disks": {
-        "q/p (residual)": 0.28, "solid fraction (initial)": 0.82, "z (initial)": 3.95, "z (residual)": 3.85,
-        "a (residual)": "up to ~0.3", "a_n (residual)": "smaller than pentagons",
-        "a_t (residual)": "about a_n/2", "alpha (strong-force pdf)": 1.4, "weak fraction": 0.62,
+        "particles": 10000, "q/p (residual)": 0.28, "solid fraction (initial)": 0.82, "z (initial)": 3.95,
+        "z (residual)": 3.85, "z with walls (residual)": "-", "a (residual)": "up to ~0.3",
+        "a_n (residual)": "smaller than pentagons", "a_t (residual)": "about a_n/2",
+        "(a' + a_n + a_t)/2 (residual)": "~q/p", "alpha (strong-force pdf)": 1.4, "weak fraction": 0.62,
         "very weak fraction": "-", "very weak simple": "-", "very weak double": "-",
-        "k_s": 1.0, "k_d": 0.0, "f_d / f_s": "-", "k_s^S / k_d^S": "-", "k_s^W / k_d^W": "-",
+        "k_s": 1.0, "k_d": 0.0, "q_s/p": "= q/p", "q_d/p": 0.0, "f_d / f_s": "-", "k_s^S / k_d^S": "-",
+        "k_s^W / k_d^W": "-",
     },
 }
 
+for _paper in PAPER.values():
+    _paper.update({"seed": "-", "preparation": "geometric construction, isotropic compaction at 10 kPa",
+                   "residual window": "eps_q >= ~0.3 (Figs. 7, 8, 10)",
+                   "double-contact criterion": "LMGC90 shadow overlap (docs/fidelity.md)"})
 
-def residual_times(ds: xr.Dataset, residual: float = 0.3) -> xr.DataArray:
-    """Boolean (time,): the snapshots of the residual state, eps_q >= (1 - residual) max eps_q."""
-    if not 0 < residual <= 1:
-        raise ParameterError(f"residual={residual!r}: expected a fraction in (0, 1]")
-    eps_q = ds.grain.strains()["eps_q"].compute()
-    return eps_q >= (1 - residual) * float(eps_q.max())
+INITIAL_ROWS = ("solid fraction (initial)", "z (initial)")
+"""Rows read on the first snapshot; every other number row is a residual-state mean."""
 
 
 def _ratio(a, b):
     return float(a) / float(b) if float(b) != 0 else float("nan")
 
 
-def run_summary(ds: xr.Dataset, residual: float = 0.3) -> dict:
-    """The headline numbers of one run (keys as in :data:`PAPER`)."""
+def describe_run(ds: xr.Dataset, window: xr.DataArray, residual_strain: float) -> dict:
+    """The rows that say what a run is: particles, seed, preparation, window, criterion."""
+    attrs = ds.attrs
+    n_vertices = ds["n_vertices"].values
+    shape = "disks" if not n_vertices.any() else f"{int(n_vertices.max())}-gons"
+    eps_q = window["eps_q"] if "eps_q" in window.coords else None
+    if bool(window.any()):
+        lo = float(eps_q.where(window).min()) if eps_q is not None else residual_strain
+        hi = float(eps_q.where(window).max()) if eps_q is not None else np.nan
+        text = f"eps_q {lo:.2f}-{hi:.2f} ({int(window.sum())} snapshots)"
+    else:
+        top = float(eps_q.max()) if eps_q is not None else np.nan
+        text = f"{NOT_REACHED}: eps_q >= {residual_strain:g} wanted, run ends at {top:.3f}"
+    preparation = attrs.get("preparation_name", "unknown")
+    alert = attrs.get("solver_alert")
+    criterion = ("-" if not n_vertices.any() else
+                 "two edges facing within the alert distance" + ("" if alert is None else f" ({float(alert) * 1e3:.2g} mm)"))
+    return {
+        "particles": f"{ds.sizes['particle']} {shape}",
+        "seed": str(attrs.get("preparation_seed", attrs.get("solver_seed", "?"))),
+        "preparation": str(preparation),
+        "residual window": text,
+        "double-contact criterion": criterion,
+    }
+
+
+def run_summary(ds: xr.Dataset, residual_strain: float = RESIDUAL_STRAIN) -> dict:
+    """The headline numbers of one run (keys as in :data:`PAPER`), residual values averaged
+    over the snapshots with eps_q >= ``residual_strain`` ("not reached" when there are none)."""
     from .force_networks import contact_proportions
     from .force_pdf import pooled_force_pdf, strong_force_exponent
+    from .strain import strains
 
-    late = residual_times(ds, residual)
-    res = ds.isel(time=np.flatnonzero(late.values))
+    window = residual_window(ds, residual_strain)
+    window = window.assign_coords(eps_q=strains(ds)["eps_q"].compute())
+    out = describe_run(ds, window, residual_strain)
+    out["solid fraction (initial)"] = float(ds.grain.solid_fraction().isel(time=0))
+    out["z (initial)"] = float(ds.grain.coordination()["z"].isel(time=0))
+    residual_rows = [key for key in PAPER["pentagons"] if key not in out and key not in INITIAL_ROWS]
+    if not bool(window.any()):
+        out.update({key: NOT_REACHED for key in residual_rows})
+        return out
+    res = ds.isel(time=np.flatnonzero(window.values))
 
     def mean(da):
         return float(da.mean("time").compute())
@@ -62,14 +111,15 @@ def run_summary(ds: xr.Dataset, residual: float = 0.3) -> dict:
     prop = contact_proportions(res).mean("time").compute()
     alpha = strong_force_exponent(pooled_force_pdf(res, scale="linear", bins=40, range=(0.0, 6.0)))
     anis = res.grain.harmonic_prediction()
-    return {
-        "q/p (residual)": mean(res.grain.stress_invariants()["q_over_p"]),
-        "solid fraction (initial)": float(ds.grain.solid_fraction().isel(time=0)),
-        "z (initial)": float(ds.grain.coordination()["z"].isel(time=0)),
+    inv = res.grain.stress_invariants()
+    out.update({
+        "q/p (residual)": mean(inv["q_over_p"]),
         "z (residual)": mean(res.grain.coordination()["z"]),
+        "z with walls (residual)": mean(res.grain.coordination(walls=True)["z"]),
         "a (residual)": mean(res.grain.fabric_anisotropy()["a"]),
         "a_n (residual)": mean(anis["a_n"]),
         "a_t (residual)": mean(anis["a_t"]),
+        "(a' + a_n + a_t)/2 (residual)": mean(anis["prediction"]),
         "alpha (strong-force pdf)": float(alpha),
         "weak fraction": float(prop["weak_fraction"]),
         "very weak fraction": float(prop["very_weak_fraction"]),
@@ -77,20 +127,23 @@ def run_summary(ds: xr.Dataset, residual: float = 0.3) -> dict:
         "very weak double": float(prop["very_weak_double"]),
         "k_s": float(prop["k_s"]),
         "k_d": float(prop["k_d"]),
+        "q_s/p": mean(res.grain.stress_invariants(kind="simple")["q_over_p"]),
+        "q_d/p": mean(res.grain.stress_invariants(kind="double")["q_over_p"]),
         "f_d / f_s": _ratio(prop["f_d"], prop["f_s"]),
         "k_s^S / k_d^S": _ratio(prop["k_s_strong"], prop["k_d_strong"]),
         "k_s^W / k_d^W": _ratio(prop["k_s_weak"], prop["k_d_weak"]),
-    }
+    })
+    return out
 
 
-def headline_table(runs: dict, residual: float = 0.3) -> pd.DataFrame:
+def headline_table(runs: dict, residual_strain: float = RESIDUAL_STRAIN) -> pd.DataFrame:
     """One row per headline quantity; for each run a column of its value and, where the run's
     label names a shape of the paper ("pentagons", "disks"), a column of the paper's value."""
     if not runs:
         raise ParameterError("runs is empty: expected {label: dataset}")
     columns = {}
     for label, ds in runs.items():
-        columns[f"{label} (this run)"] = run_summary(ds, residual)
+        columns[f"{label} (this run)"] = run_summary(ds, residual_strain)
         paper = PAPER.get(paper_key(label))
         if paper is not None:
             columns[f"{label} (paper)"] = paper
@@ -127,6 +180,8 @@ POLYGON_FIGURES = ("18", "19", "20", "21", "22", "23", "24", "25")
 """Figures about simple versus double contacts (paper Sec. VI): drawn for polygon runs only."""
 MAP_FIGURES = ("13", "17", "21", "24")
 """Figures that draw one sample per call: one file per run."""
+DISTRIBUTION_FIGURES = ("07", "08", "10", "14", "15", "16", "23")
+"""Figures that average distributions over the residual state (their ``time`` argument)."""
 
 FIGURE_NAMES = {
     "03": "q_over_p", "04": "volumetric_strain", "05": "stress_dilatancy", "06a": "coordination",
@@ -143,7 +198,27 @@ def _slug(label: str) -> str:
     return "".join(c if c.isalnum() else "_" for c in label).strip("_").lower() or "run"
 
 
-def write_figures(runs: dict, out: Path, time=-1) -> list[Path]:
+def caption(label: str, ds: xr.Dataset, snapshot: bool, residual_strain: float = RESIDUAL_STRAIN,
+            time=-1) -> str:
+    """One line saying what a figure shows of run ``label``: N and shape, seed, preparation,
+    and the snapshot (maps) or the residual window the distributions average over."""
+    from .plot._style import residual_snapshots
+
+    n_vertices = ds["n_vertices"].values
+    shape = "disks" if not n_vertices.any() else f"{int(n_vertices.max())}-gons"
+    seed = ds.attrs.get("preparation_seed", ds.attrs.get("solver_seed", "?"))
+    preparation = ds.attrs.get("preparation_name", "unknown")
+    if snapshot:
+        from .strain import strains
+
+        eps_q = float(strains(ds)["eps_q"].isel(time=time))
+        what = f"snapshot {time} (eps_q = {eps_q:.3f})"
+    else:
+        what = f"distributions: {residual_snapshots(ds, residual_strain).attrs['window']}"
+    return f"{label}: N = {ds.sizes['particle']} {shape}, seed {seed}, preparation '{preparation}'; {what}"
+
+
+def write_figures(runs: dict, out: Path, time=-1, residual_strain: float = RESIDUAL_STRAIN) -> list[Path]:
     """Draw every figure of the paper the runs support into ``out`` (PNG and PDF).
 
     Comparative figures get all runs on one axes; the maps and P(m_s, m_d) one file per run
@@ -156,6 +231,7 @@ def write_figures(runs: dict, out: Path, time=-1) -> list[Path]:
     import matplotlib.pyplot as plt
 
     from .plot import FIGURES, save_figure
+    from .plot._style import Residual, add_caption
 
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
@@ -171,17 +247,20 @@ def write_figures(runs: dict, out: Path, time=-1) -> list[Path]:
         for stem, data in targets:
             kwargs = {}
             if number in MAP_FIGURES:
-                data = next(iter(data.values()))
                 kwargs["time"] = time
-            result = func(data, **kwargs)
+            elif number in DISTRIBUTION_FIGURES:
+                kwargs["time"] = Residual(residual_strain)
+            result = func(data if number not in MAP_FIGURES else next(iter(data.values())), **kwargs)
             fig = result if hasattr(result, "savefig") else result.figure
+            add_caption(fig, [caption(label, ds, number in MAP_FIGURES, residual_strain, time)
+                              for label, ds in data.items()])
             save_figure(fig, out / stem)
             plt.close(fig)
             written += [out / f"{stem}.png", out / f"{stem}.pdf"]
     return written
 
 
-def write_report(runs: dict, out, residual: float = 0.3, overwrite: bool = False) -> dict:
+def write_report(runs: dict, out, residual_strain: float = RESIDUAL_STRAIN, overwrite: bool = False) -> dict:
     """The whole report of ``runs`` ({label: dataset}) in folder ``out``: the headline table
     (CSV, Markdown) and every figure. Returns {"table": DataFrame, "files": [paths]}.
 
@@ -190,7 +269,7 @@ def write_report(runs: dict, out, residual: float = 0.3, overwrite: bool = False
     out = Path(out)
     if not overwrite and (out / "headline.csv").exists():
         raise FileExistsError(f"{out} already holds a report; pass --overwrite (overwrite=True) to replace it")
-    table = headline_table(runs, residual)
+    table = headline_table(runs, residual_strain)
     files = write_table(table, out)
-    files += write_figures(runs, out / "figures")
+    files += write_figures(runs, out / "figures", residual_strain=residual_strain)
     return {"table": table, "files": files}

@@ -12,7 +12,12 @@ import xarray as xr
 
 from . import sample
 from ._lift import with_attrs
+from .errors import ParameterError
 from .stress import stress_invariants
+
+RESIDUAL_STRAIN = 0.3
+"""Start of the residual state in shear strain eps_q (the paper reads its residual values at
+eps_q >= 0.3: Figs. 7, 8, 10 and the residual plateaus of Figs. 3, 6, 9, 11)."""
 
 
 def time_derivative(da: xr.DataArray) -> xr.DataArray:
@@ -60,6 +65,20 @@ def strains(ds: xr.Dataset, reference: int = 0) -> xr.Dataset:
         "eps_q": with_attrs(eps_1 - eps_2, "eps_q", "1", "shear strain eps_q = eps_1 - eps_2"),
     })
     return out.drop_vars([c for c in out.coords if c != "time"])
+
+
+def residual_window(ds: xr.Dataset, start: float = RESIDUAL_STRAIN) -> xr.DataArray:
+    """Boolean (time,): the snapshots of the residual state, eps_q >= ``start`` (computed).
+
+    A run that stops short of ``start`` has no residual snapshot (all False): its residual
+    values are "not reached" rather than those of another state.
+    """
+    if isinstance(start, bool) or not isinstance(start, (int, float, np.integer, np.floating)) \
+            or not np.isfinite(start) or start < 0:
+        raise ParameterError(f"residual strain start={start!r}: expected a shear strain eps_q >= 0")
+    eps_q = strains(ds)["eps_q"].compute()
+    window = eps_q >= start
+    return window.rename("residual").assign_attrs(long_name=f"residual state, eps_q >= {start:g}", units="1")
 
 
 def friction_and_dilatancy(ds: xr.Dataset, reference: int = 0) -> xr.Dataset:

@@ -18,7 +18,7 @@ from grainview.errors import ParameterError
 from .output import Recorder
 from .packing import PAPER_DIAMETERS, PAPER_FRACTIONS, box_width_for, deposit
 from .stepper import Parameters, Simulation
-from .walls import Walls
+from .walls import STRESS, Walls
 
 SHAPES = {"disk": 0, "disks": 0, "pentagon": 5, "pentagons": 5}
 
@@ -98,9 +98,7 @@ def compaction_sample(n=400, shape="pentagon", *, sigma0=1e4, friction=0.4, wall
 def wall_state(sim):
     """Stress (Pa) on and strain rate (s-1) of every wall: the normal force of the particles
     over the wall's length, and the wall's normal speed over the box size across it."""
-    lo, hi = sim.walls.box_bounds()
-    size = np.where(sim.walls.length_axis == 0, hi[1] - lo[1], hi[0] - lo[0])
-    rate = np.sum(sim.walls.velocity * sim.walls.normal, axis=1) / size
+    rate = np.sum(sim.walls.velocity * sim.walls.normal, axis=1) / _box_size_across(sim)
     return sim.wall_stresses(), rate
 
 
@@ -118,35 +116,80 @@ def is_equilibrium(stresses, rates, sigma0, stress_tolerance=0.01, strain_rate_t
     return bool(ok_stress and np.all(np.abs(rates.mean(0)) <= strain_rate_tolerance))
 
 
+def inertia_number_speed(inertia_number, size, mean_diameter, density, sigma0):
+    """Wall speed (m s-1) at which a wall closing a box of extent ``size`` (m) strains the
+    sample at the inertia number ``inertia_number``: I = eps_dot d sqrt(rho/sigma0) (GDR MiDi
+    2004) with eps_dot = v/size, d the mean particle diameter (m), rho the grains' density
+    (kg m-3) and sigma0 the confining stress (Pa); so v = I size / (d sqrt(rho/sigma0))."""
+    return inertia_number * size / (mean_diameter * np.sqrt(density / sigma0))
+
+
 def isotropic_compaction(sim: Simulation, *, max_steps=40000, window=200, stress_tolerance=0.01,
-                         strain_rate_tolerance=1e-3, progress=None):
+                         strain_rate_tolerance=1e-3, max_inertia_number=None, pressure_ramp=0.0,
+                         progress=None):
     """Step ``sim`` until the last ``window`` steps are at equilibrium (:func:`is_equilibrium`)
     or for ``max_steps``. Returns the number of steps taken and sets ``sim.settled`` (False
-    when ``max_steps`` ran out first) and ``sim.compaction_stress`` (the window's mean wall
-    stresses, Pa). The wall speed cap is lifted once settled, so that a following test drives
-    the walls by their stress alone."""
+    when ``max_steps`` ran out first), ``sim.compaction_stress`` (the window's mean wall
+    stresses, Pa) and ``sim.compaction_inertia_number`` (the largest inertia number of a
+    pushed wall over the compaction). The wall speed cap is lifted once settled, so that a
+    following test drives the walls by their stress alone.
+
+    Quasi-static compaction: with ``max_inertia_number`` the inward speed of each pushed wall
+    is capped, step by step, at the speed that strains the sample at that inertia number,
+    I = (v / L) d sqrt(rho / sigma0) (:func:`inertia_number_speed`; L the box extent across
+    the wall, d the mean diameter), on top of the walls' own ``max_speed``. With
+    ``pressure_ramp`` (s) the stress on the pushed walls rises linearly from 0 to its target
+    over that time; equilibrium is only looked for once the ramp is over.
+    """
     from collections import deque
 
+    if max_inertia_number is not None and not (np.isfinite(max_inertia_number) and max_inertia_number > 0):
+        raise ParameterError(f"max_inertia_number={max_inertia_number!r}: expected a positive number (or None)")
+    if not (np.isfinite(pressure_ramp) and pressure_ramp >= 0):
+        raise ParameterError(f"pressure_ramp={pressure_ramp!r}: expected a duration >= 0 in s")
     sigma0 = sim.sigma0
-    driven = np.flatnonzero(sim.walls.mode == 2)
+    h = sim.parameters.time_step
+    driven = np.flatnonzero(sim.walls.mode == STRESS)
+    target = sim.walls.stress[driven].copy()
+    own_cap = sim.walls.max_speed[driven].copy()
+    mean_diameter = 2.0 * float(sim.radius.mean())
+    scale = mean_diameter * np.sqrt(sim.parameters.density / sigma0)
+    ramp_steps = int(np.ceil(pressure_ramp / h))
     stresses, rates = deque(maxlen=window), deque(maxlen=window)
+    largest_inertia = 0.0
     sim.settled = False
     with interruptible() as flag, _progress(max_steps, "isotropic compaction", progress) as bar:
         for k in range(max_steps):
+            if k < ramp_steps:
+                sim.walls.stress[driven] = target * (k + 1) / ramp_steps
+            if max_inertia_number is not None:
+                size = _box_size_across(sim)[driven]
+                sim.walls.max_speed[driven] = np.minimum(
+                    own_cap, inertia_number_speed(max_inertia_number, size, mean_diameter,
+                                                  sim.parameters.density, sigma0))
             sim.step()
             bar.update(1)
             stress, rate = wall_state(sim)
+            largest_inertia = max(largest_inertia, float(np.max(np.abs(rate[driven]), initial=0.0)) * scale)
             stresses.append(stress[driven])
             rates.append(rate[driven])
-            if len(stresses) == window and k % 10 == 0 and is_equilibrium(
+            if k >= ramp_steps and len(stresses) == window and k % 10 == 0 and is_equilibrium(
                     stresses, rates, sigma0, stress_tolerance, strain_rate_tolerance):
                 sim.settled = True
                 break
             if flag["stop"]:
                 raise KeyboardInterrupt
+    sim.walls.stress[driven] = target
     sim.compaction_stress = np.mean(stresses, axis=0) if stresses else np.zeros(len(driven))
+    sim.compaction_inertia_number = largest_inertia
     sim.walls.max_speed[:] = np.inf
     return k + 1
+
+
+def _box_size_across(sim):
+    """Extent (m) of the box across each wall: the height for bottom/top, the width for sides."""
+    lo, hi = sim.walls.box_bounds()
+    return np.where(sim.walls.length_axis == 0, hi[1] - lo[1], hi[0] - lo[0])
 
 
 def biaxial_test(sim: Simulation, path, *, strain=0.1, velocity=0.01, every=20, overwrite=False,

@@ -8,14 +8,18 @@ import pytest
 import grainview
 from grainview.cli import main
 from grainview.plot import FIGURES
-from grainview.report import FIGURE_NAMES, MAP_FIGURES, POLYGON_FIGURES, residual_times
+from grainview.report import FIGURE_NAMES, MAP_FIGURES, NOT_REACHED, POLYGON_FIGURES
+from grainview.strain import residual_window
+
+WINDOW = 0.003
+"""A residual window the tiny runs reach (they stop near eps_q ~0.008)."""
 
 
 @pytest.fixture(scope="module")
 def study(tmp_path_factory):
     out = tmp_path_factory.mktemp("study")
     assert main(["study", "--out", str(out), "--particles", "30", "--strain", "0.004", "--every", "10",
-                 "--progress", "off"]) == 0
+                 "--residual-strain", str(WINDOW), "--progress", "off"]) == 0
     return out
 
 
@@ -35,9 +39,10 @@ def test_table_equals_the_accessors(study):
     table = pd.read_csv(study / "report" / "headline.csv", index_col=0)
     for label in ("pentagons", "disks"):
         ds = grainview.open_dataset(study / f"{label}.nc", validate=True)
-        late = np.flatnonzero(residual_times(ds).values)
+        late = np.flatnonzero(residual_window(ds, WINDOW).values)
+        assert 0 < late.size < ds.sizes["time"]
         res = ds.isel(time=late)
-        column = table[f"{label} (this run)"].astype(float)
+        column = pd.to_numeric(table[f"{label} (this run)"], errors="coerce")
         assert column["q/p (residual)"] == pytest.approx(float(res.grain.stress_invariants()["q_over_p"].mean()), rel=1e-12)
         assert column["z (residual)"] == pytest.approx(float(res.grain.coordination()["z"].mean()), rel=1e-12)
         assert column["a (residual)"] == pytest.approx(float(res.grain.fabric_anisotropy()["a"].mean()), rel=1e-12)
@@ -45,7 +50,26 @@ def test_table_equals_the_accessors(study):
         prop = res.grain.contact_proportions().mean("time")
         assert column["weak fraction"] == pytest.approx(float(prop["weak_fraction"]), rel=1e-12)
         assert column["k_s"] == pytest.approx(float(prop["k_s"]), rel=1e-12)
+        assert column["k_d"] == pytest.approx(float(prop["k_d"]), rel=1e-12)
+        q_d = res.grain.stress_invariants(kind="double")["q_over_p"].mean()
+        assert column["q_d/p"] == pytest.approx(float(q_d), rel=1e-12)
     assert table.loc["q/p (residual)", "pentagons (paper)"] == "0.35"
+    assert table.loc["particles", "pentagons (this run)"] == "30 5-gons"
+    assert table.loc["particles", "disks (this run)"] == "30 disks"
+    assert table.loc["preparation", "pentagons (this run)"] == "paper"
+    assert table.loc["residual window", "disks (this run)"].startswith(f"eps_q {WINDOW:.2f}"[:8])
+
+
+def test_a_run_short_of_the_residual_window_reports_not_reached(study, tmp_path):
+    paths = [str(study / f"{label}.nc") for label in ("pentagons", "disks")]
+    out = tmp_path / "report"
+    assert main(["report", *paths, "--labels", "pentagons,disks", "--out", str(out)]) == 0  # window 0.3
+    table = pd.read_csv(out / "headline.csv", index_col=0)
+    for label in ("pentagons", "disks"):
+        column = table[f"{label} (this run)"]
+        assert column["q/p (residual)"] == NOT_REACHED and column["z (residual)"] == NOT_REACHED
+        assert column["residual window"].startswith(NOT_REACHED)
+        float(column["z (initial)"])  # initial values are still reported
     md = (study / "report" / "headline.md").read_text()
     assert md.startswith("| quantity | pentagons (this run) |")
 

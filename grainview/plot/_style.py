@@ -9,12 +9,14 @@ pairs; :func:`datasets` turns any of these into a list of ``(label, ds)``.
 from __future__ import annotations
 
 import re
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 import xarray as xr
 
 from ..errors import ParameterError
+from ..strain import RESIDUAL_STRAIN, residual_window, strains
 
 EPS_Q_LABEL = r"$\varepsilon_q$"
 """Label of the x axis of every evolution (shear strain, dimensionless)."""
@@ -54,21 +56,35 @@ def single_dataset(data, label: str | None = None) -> tuple[str | None, xr.Datas
     return pairs[0]
 
 
-def select_snapshots(ds: xr.Dataset, time="residual", residual: float = 0.3) -> xr.Dataset:
+@dataclass(frozen=True)
+class Residual:
+    """A ``time`` selector for the figures: the residual state from eps_q >= ``start`` on
+    (``time="residual"`` is ``Residual(RESIDUAL_STRAIN)``)."""
+
+    start: float = RESIDUAL_STRAIN
+
+
+SHORT_RUN_FRACTION = 0.3
+"""A run short of the residual window averages the last 30% of its shear strain instead."""
+
+
+def select_snapshots(ds: xr.Dataset, time="residual", residual_strain: float = RESIDUAL_STRAIN) -> xr.Dataset:
     """The snapshots a distribution is averaged over.
 
-    ``time``: an integer snapshot index (``-1`` the last); ``"residual"`` the residual state,
-    i.e. the snapshots with eps_q >= (1 - ``residual``) max eps_q
-    (:func:`grainview.report.residual_times`); ``"all"`` or None every snapshot; a slice or a
-    sequence of indices.
+    ``time``: an integer snapshot index (``-1`` the last); ``"residual"`` (or
+    :class:`Residual`, to choose where it starts) the residual state,
+    the snapshots with eps_q >= ``residual_strain`` (:func:`grainview.strain.residual_window`)
+    or, for a run that stops short of it, those with eps_q >= 0.7 max eps_q; the window used
+    is described in the result's attribute ``window``; ``"all"`` or None every snapshot; a
+    slice or a sequence of indices.
     """
     n = ds.sizes["time"]
     if time is None or (isinstance(time, str) and time == "all"):
         return ds
     if isinstance(time, str) and time == "residual":
-        from ..report import residual_times  # local: report draws figures with this package
-        keep = np.flatnonzero(np.asarray(residual_times(ds, residual)))
-        return ds.isel(time=keep)
+        return residual_snapshots(ds, residual_strain)
+    if isinstance(time, Residual):
+        return residual_snapshots(ds, time.start)
     if isinstance(time, (int, np.integer)) and not isinstance(time, bool):
         if not -n <= time < n:
             raise ParameterError(f"time={time}: expected a snapshot index in [{-n}, {n})")
@@ -83,6 +99,23 @@ def select_snapshots(ds: xr.Dataset, time="residual", residual: float = 0.3) -> 
         raise ParameterError(f"time={time!r}: expected 'residual', 'all', a snapshot index, a slice "
                              f"or a sequence of indices in [{-n}, {n})")
     return ds.isel(time=idx)
+
+
+def residual_snapshots(ds: xr.Dataset, residual_strain: float = RESIDUAL_STRAIN) -> xr.Dataset:
+    """The residual snapshots of ``ds`` (see :func:`select_snapshots`), with ``attrs["window"]``
+    saying which window was used and whether the residual state was reached."""
+    window = residual_window(ds, residual_strain)
+    eps_q = strains(ds)["eps_q"].compute()
+    if bool(window.any()):
+        note = f"residual: eps_q >= {residual_strain:g} ({int(window.sum())} snapshots)"
+    else:
+        top = float(eps_q.max())
+        window = eps_q >= (1 - SHORT_RUN_FRACTION) * top
+        note = (f"residual eps_q >= {residual_strain:g} NOT reached: last {SHORT_RUN_FRACTION:.0%} of the run, "
+                f"eps_q {(1 - SHORT_RUN_FRACTION) * top:.3f}-{top:.3f} ({int(window.sum())} snapshots)")
+    out = ds.isel(time=np.flatnonzero(window.values))
+    out.attrs = {**ds.attrs, "window": note}
+    return out
 
 
 def snapshot_index(ds: xr.Dataset, time=-1) -> int:
@@ -200,9 +233,17 @@ def save_figure(fig, path, dpi: int = 150) -> list[Path]:
         base = base.with_suffix("")
     base.parent.mkdir(parents=True, exist_ok=True)
     out = [base.with_name(base.name + ".png"), base.with_name(base.name + ".pdf")]
-    figure.savefig(out[0], dpi=dpi)
-    figure.savefig(out[1])
+    figure.savefig(out[0], dpi=dpi, bbox_inches="tight")
+    figure.savefig(out[1], bbox_inches="tight")
     return out
+
+
+def add_caption(fig, lines) -> None:
+    """Write ``lines`` (what the figure shows: samples, N, strain window, preparation, seed)
+    in small type under the figure; :func:`save_figure` keeps it in the saved file."""
+    figure = getattr(fig, "figure", fig) if not hasattr(fig, "savefig") else fig
+    figure.text(0.0, -0.01, "\n".join(lines), ha="left", va="top", fontsize=6, color="0.3",
+                transform=figure.transFigure)
 
 
 # -- evolutions --------------------------------------------------------------------------------

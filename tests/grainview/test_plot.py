@@ -157,9 +157,18 @@ def test_force_anisotropies_figure_has_a_n_and_a_t_panels(series):
 
 def test_residual_state_is_the_last_snapshots(series):
     eps = strains(series)["eps_q"].values
-    kept = select_snapshots(series, "residual")["time"].values
+    # the synthetic series stops at eps_q ~0.14, short of the residual window eps_q >= 0.3:
+    # the last 30% of its shear strain are used instead, and the figure is told so
+    assert eps.max() < 0.3
+    chosen = select_snapshots(series, "residual")
+    kept = chosen["time"].values
     np.testing.assert_array_equal(kept, series["time"].values[eps >= 0.7 * eps.max()])
     assert 0 < kept.size < series.sizes["time"]
+    assert "NOT reached" in chosen.attrs["window"]
+    # a window the run reaches: eps_q >= 0.05
+    reached = select_snapshots(series, "residual", residual_strain=0.05)
+    np.testing.assert_array_equal(reached["time"].values, series["time"].values[eps >= 0.05])
+    assert reached.attrs["window"].startswith("residual: eps_q >= 0.05")
     np.testing.assert_array_equal(select_snapshots(series, -1)["time"].values, series["time"].values[-1:])
     with pytest.raises(ParameterError, match="time"):
         select_snapshots(series, 7)

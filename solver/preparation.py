@@ -1,0 +1,118 @@
+"""Sample preparation as documented options: how a packing is made before it is tested.
+
+The paper (Sec. II.B) builds "a dense packing ... following simple geometrical rules" and
+compacts it isotropically under sigma0 = 10 kPa on the right and top walls, zero gravity,
+friction 0.4 between grains and 0 with the walls, to solid fractions 0.80 (pentagons, S1) and
+0.82 (disks, S2) with z = 3.20 and 3.95. It does not say how fast the walls closed, nor with
+which friction the grains were compacted. Those choices set the initial state (not the
+residual one), so they are options here, each recorded in the output file's attributes
+(``preparation_*``):
+
+* ``particles``, ``shape``, ``seed``: the sample (the paper's size mix, see
+  :mod:`solver.packing`);
+* ``aspect``: h/l of the deposit's box (paper: about 2);
+* ``sigma0``: the confining stress (Pa);
+* ``friction``: grain-grain friction of the TEST; ``compaction_friction``: during compaction
+  (None: the same). Compacting frictionless and switching friction on for the test is the
+  usual way to a dense sample (``compaction_friction=0``);
+* ``max_wall_speed`` (m s-1) and ``max_inertia_number``: caps on the closing speed of the
+  pushed walls. The second makes compaction quasi-static in the sense of GDR MiDi (2004):
+  I = eps_dot d sqrt(rho / sigma0) stays below the cap
+  (:func:`solver.scenes.inertia_number_speed`);
+* ``pressure_ramp`` (s): sigma0 raised linearly from 0 over that time.
+
+:data:`PRESETS` names the preparations documented in docs/fidelity.md.
+"""
+
+from __future__ import annotations
+
+from dataclasses import asdict, dataclass, replace
+
+import numpy as np
+
+from grainview.errors import ParameterError
+
+from .scenes import compaction_sample, isotropic_compaction, n_vertices_of
+
+
+@dataclass(frozen=True)
+class Preparation:
+    """How a sample is prepared (see the module docstring); every default is the paper's or,
+    where the paper is silent, this project's historical default."""
+
+    particles: int = 400
+    shape: str = "pentagon"
+    seed: int = 0
+    aspect: float = 2.0
+    sigma0: float = 1e4  # Pa
+    friction: float = 0.4  # grain-grain friction of the test
+    compaction_friction: float | None = None  # None: the test's friction
+    max_wall_speed: float = 0.05  # m s-1
+    max_inertia_number: float | None = None
+    pressure_ramp: float = 0.0  # s
+    max_steps: int = 40000  # compaction step limit
+
+    def validate(self):
+        checks = [
+            ("particles", isinstance(self.particles, (int, np.integer)) and self.particles >= 2, "an integer >= 2"),
+            ("seed", isinstance(self.seed, (int, np.integer)) and self.seed >= 0, "an integer >= 0"),
+            ("aspect", np.isfinite(self.aspect) and 0.2 <= self.aspect <= 20, "h/l in [0.2, 20]"),
+            ("sigma0", np.isfinite(self.sigma0) and self.sigma0 > 0, "a positive stress in Pa"),
+            ("friction", np.isfinite(self.friction) and 0 <= self.friction <= 10, "in [0, 10]"),
+            ("compaction_friction", self.compaction_friction is None
+             or (np.isfinite(self.compaction_friction) and 0 <= self.compaction_friction <= 10), "in [0, 10] or None"),
+            ("max_wall_speed", self.max_wall_speed > 0, "a positive speed in m s-1 (inf: no cap)"),
+            ("max_inertia_number", self.max_inertia_number is None
+             or (np.isfinite(self.max_inertia_number) and self.max_inertia_number > 0), "a positive number or None"),
+            ("pressure_ramp", np.isfinite(self.pressure_ramp) and self.pressure_ramp >= 0, "a duration >= 0 in s"),
+            ("max_steps", isinstance(self.max_steps, (int, np.integer)) and self.max_steps >= 1, "an integer >= 1"),
+        ]
+        bad = [f"{name}={getattr(self, name)!r}: expected {expected}" for name, ok, expected in checks if not ok]
+        try:
+            n_vertices_of(self.shape)
+        except ParameterError as exc:
+            bad.append(str(exc))
+        if bad:
+            raise ParameterError("invalid preparation: " + "; ".join(bad))
+        return self
+
+    def attrs(self) -> dict:
+        """The preparation as file attributes ``preparation_<name>`` ("none" for None)."""
+        return {f"preparation_{k}": ("none" if v is None else v) for k, v in asdict(self).items()}
+
+
+PRESETS = {
+    "paper": Preparation(),
+    "frictionless": Preparation(compaction_friction=0.0),
+    "quasistatic": Preparation(max_inertia_number=1e-4),
+}
+"""Named preparations (docs/fidelity.md): ``paper`` compacts with the test's friction 0.4
+and walls closing at up to 5 cm/s (this project's default); ``frictionless`` compacts with
+friction 0 (then 0.4 for the test); ``quasistatic`` caps the closing walls at I = 1e-4."""
+
+
+def preparation(name_or_prep="paper", **changes) -> Preparation:
+    """A :class:`Preparation` from a preset name (or an instance) with ``changes`` applied."""
+    if isinstance(name_or_prep, Preparation):
+        prep = name_or_prep
+    elif name_or_prep in PRESETS:
+        prep = PRESETS[name_or_prep]
+    else:
+        raise ParameterError(f"preparation={name_or_prep!r}: expected one of {sorted(PRESETS)} or a Preparation")
+    return replace(prep, **{k: v for k, v in changes.items() if v is not None}).validate()
+
+
+def prepare_sample(prep: Preparation, progress=None, **parameters):
+    """Deposit and compact a sample as ``prep`` says; returns the compacted :class:`Simulation`
+    with the test's friction set, and the compaction's outcome in ``sim.settled``,
+    ``sim.compaction_stress``, ``sim.compaction_inertia_number`` and ``sim.compaction_steps``.
+    ``parameters`` go to :class:`solver.Parameters` (time step, tolerances...)."""
+    prep = prep.validate()
+    compaction_friction = prep.friction if prep.compaction_friction is None else prep.compaction_friction
+    sim = compaction_sample(prep.particles, prep.shape, sigma0=prep.sigma0, friction=compaction_friction,
+                            seed=prep.seed, aspect=prep.aspect, max_wall_speed=prep.max_wall_speed, **parameters)
+    sim.compaction_steps = isotropic_compaction(sim, max_steps=prep.max_steps, max_inertia_number=prep.max_inertia_number,
+                                                pressure_ramp=prep.pressure_ramp, progress=progress)
+    sim.parameters.friction = prep.friction
+    sim.preparation = prep
+    return sim
