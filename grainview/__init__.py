@@ -8,7 +8,7 @@ Open a file of the data contract (docs/schema.md) and use the ``ds.grain`` acces
     ds.grain.stress_invariants()["q_over_p"].plot()
 
 The formulas follow Azema, Radjai, Peyroux & Saussine, Phys. Rev. E 76, 011301 (2007), with
-the corrections of ERRATA.md, as each function's docstring says.
+the corrected forms of docs/conventions.md, as each function's docstring says.
 """
 
 from . import accessor as _accessor  # noqa: F401  (registers ds.grain)

@@ -1,5 +1,5 @@
 """Connectivity of the force-bearing network: z, P(c), P(m_s, m_d) (paper Sec. IV.A, Figs.
-6a, 7, 21; ERRATA item 7).
+6a, 7, 21; docs/conventions.md §7).
 
 Rattler rule: only force-bearing contacts (f_n > 0) count; a double contact counts once; a
 particle with fewer than ``min_contacts`` such contacts (default 1: none at all) is a rattler

@@ -1,4 +1,4 @@
-"""Fabric of the contact network (paper Sec. IV.B, Eqs. F and a'; ERRATA item 2).
+"""Fabric of the contact network (paper Sec. IV.B, Eqs. F and a'; docs/conventions.md §2).
 
 Contacts default to particle–particle ones (``walls=False``): wall contacts have normals
 fixed by the walls and would bias the orientation statistics.
@@ -47,7 +47,7 @@ def fabric_anisotropy(ds: xr.Dataset, kind="all", walls: bool = False, reference
     """a = 2 (F_1 - F_2), theta_F and the signed a' = a cos 2(theta_F - theta') (paper Eq. a').
 
     ``reference`` is theta': ``"stress"`` (default, the major principal stress direction of
-    the whole sample, ERRATA "Signs"), a fixed angle in rad, or a DataArray over time. For a
+    the whole sample, docs/conventions.md §3, "Signs"), a fixed angle in rad, or a DataArray over time. For a
     partial tensor (kind simple/double) the anisotropies a_s, a'_s are those of F_s, whose
     trace is k_s (paper Fig. 22).
     """

@@ -1,5 +1,5 @@
 """Very weak, weak and strong force networks, and the proportions of simple and double
-contacts in them (paper Sec. V.C Fig. 17, Sec. VI Figs. 19 and 25; ERRATA item 4).
+contacts in them (paper Sec. V.C Fig. 17, Sec. VI Figs. 19 and 25; docs/conventions.md §4).
 
 <f_n> is each snapshot's mean normal force over the selected contacts; contacts default to
 particle–particle ones (``walls=False``).
@@ -69,12 +69,12 @@ _ATTRS = {
 
 def contact_proportions(ds: xr.Dataset, walls: bool = False, very_weak: float = 0.1,
                         strong: float = 1.0, near=None) -> xr.Dataset:
-    """Proportions of simple/double and weak/strong contacts per snapshot (time,) (ERRATA 4).
+    """Proportions of simple/double and weak/strong contacts per snapshot (time,) (docs/conventions.md §4).
 
     * k_s = N_s/N_c, k_d = N_d/N_c (paper Fig. 19), over the N_c selected contacts;
     * f_s = k_s <f_n>_s/<f_n>, f_d = k_d <f_n>_d/<f_n> (Fig. 19). The paper prints
       f_s = k_s <f_n>_d/<f_n> and f_d = k_d <f_n>_s/<f_n>, with s and d swapped in the means;
-      that is a misprint (ERRATA item 4): only the corrected form gives f_s + f_d = 1 and
+      that is a misprint (docs/conventions.md §4): only the corrected form gives f_s + f_d = 1 and
       f_d = f_s = 0.5 in an isotropic state with equal means;
     * k_s_strong, k_s_weak, k_d_strong, k_d_weak (k_s^S, k_s^W, k_d^S, k_d^W, Fig. 25): fractions
       of all contacts that are simple/double and strong (f_n > strong <f_n>) or weak

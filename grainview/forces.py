@@ -1,4 +1,4 @@
-"""Force anisotropies (paper Sec. V.A, Eqs. fnft, HnHt, anat, qa; ERRATA item 3 and "Signs").
+"""Force anisotropies (paper Sec. V.A, Eqs. fnft, HnHt, anat, qa; docs/conventions.md §3 and "Signs").
 
 ``a_n`` and ``a_t`` are signed like a': multiplied by cos 2(theta - theta_sigma), theta being
 the major direction of H^(n) (resp. H^(t)) and theta_sigma the major principal stress
@@ -37,7 +37,7 @@ def angular_force_averages(ds: xr.Dataset, bins: int = 36, kind="all", walls: bo
 
 
 def force_tensors(ds: xr.Dataset, bins: int = 36, kind="all", walls: bool = False, near=None) -> xr.Dataset:
-    """H^(n) and H^(t) (time, xy_a, xy_b) in N (ERRATA item 3)."""
+    """H^(n) and H^(t) (time, xy_a, xy_b) in N (docs/conventions.md §3)."""
     bins = _check_bins(bins)
     mask = selection(ds, walls=walls, kind=kind, near=near)
     h_n, h_t = apply(_forces.force_tensors, ds["fn"], ds["ft"], ds["normal"], mask,
@@ -51,7 +51,7 @@ def force_tensors(ds: xr.Dataset, bins: int = 36, kind="all", walls: bool = Fals
 
 def force_anisotropies(ds: xr.Dataset, bins: int = 36, kind="all", walls: bool = False,
                        reference="stress", near=None) -> xr.Dataset:
-    """a_n = 2 (H^n_1 - H^n_2)/tr H^n and a_t = 2 (H^t_1 - H^t_2)/tr H^n (ERRATA item 3),
+    """a_n = 2 (H^n_1 - H^n_2)/tr H^n and a_t = 2 (H^t_1 - H^t_2)/tr H^n (docs/conventions.md §3),
     signed by cos 2(theta - theta') with theta' the ``reference`` direction (default: major
     principal stress direction); also theta_n, theta_t and the unsigned magnitudes."""
     h = force_tensors(ds, bins, kind, walls, near)

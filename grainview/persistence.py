@@ -1,5 +1,5 @@
 """Contact persistence gamma(t) and the transitions between simple and double contacts
-(paper Sec. IV.A Fig. 6b, Sec. VI Fig. 20; ERRATA item 8).
+(paper Sec. IV.A Fig. 6b, Sec. VI Fig. 20; docs/conventions.md §8).
 
 A contact is identified by its pair of bodies {i, j}, encoded as the int64 key
 ``min(i, j) (N + W) + max(i, j)`` (N particles, W walls), so the result does not depend on
@@ -72,7 +72,7 @@ def _check_flag(name, value):
 def persistence(ds: xr.Dataset, reference: int = 0, uninterrupted: bool = False, walls: bool = False,
                 near=None) -> xr.DataArray:
     """gamma(t): fraction of the contacts of the reference snapshot still present at t
-    (paper Sec. IV.A, Fig. 6b; ERRATA item 8).
+    (paper Sec. IV.A, Fig. 6b; docs/conventions.md §8).
 
     gamma(t) = |C(ref) & C(t)| / |C(ref)|, C(t) the set of pairs {i, j} in contact at t
     (particle–particle unless ``walls``; force-bearing, f_n > 0, unless ``near`` adds the
@@ -150,7 +150,7 @@ def _pair_transitions(prev_keys, prev_kind, prev_present, keys, kind, present, s
 
 def type_transitions(ds: xr.Dataset, walls: bool = False, near=None) -> xr.Dataset:
     """Cumulative fractions Delta gamma_{s->d}(t) and Delta gamma_{d->s}(t) of contacts that
-    changed type (paper Sec. VI, Fig. 20; ERRATA item 8).
+    changed type (paper Sec. VI, Fig. 20; docs/conventions.md §8).
 
     Definition used here (the paper gives none in formula): for each pair of consecutive
     snapshots (t-1, t),

@@ -26,7 +26,7 @@ def height(ds: xr.Dataset) -> xr.DataArray:
 
 
 def volume(ds: xr.Dataset) -> xr.DataArray:
-    """Sample volume V = l h times the slab thickness (m3); the V of the stress (ERRATA 1)."""
+    """Sample volume V = l h times the slab thickness (m3); the V of the stress (docs/conventions.md §1)."""
     return with_attrs(width(ds) * height(ds) * thickness(ds), "volume", "m3", "sample volume V")
 
 

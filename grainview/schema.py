@@ -9,7 +9,7 @@ describes in prose. Three things are built from the table :data:`VARIABLES` belo
   simulation runs (used by the solver);
 * :func:`grainview.validation.validate` checks a dataset against the same table.
 
-Conventions (``../shared/paper/ERRATA.md``): 2D, SI units, a slab of thickness
+Conventions (docs/conventions.md §0): 2D, SI units, a slab of thickness
 ``thickness_m`` (global attribute, 1 m by default) so that forces are in N and stresses in Pa.
 For a contact between bodies ``i`` and ``j`` (``i < j``; walls are bodies ``N + w``), ``normal``
 is the unit vector from i to j, ``t = (-n_y, n_x)``, and ``fn``/``ft`` are the components of the
@@ -94,7 +94,7 @@ VARIABLES: dict[str, Var] = {
     "wall_normal": Var(("wall", "xy"), "f8", "1", "unit wall normal pointing into the sample", False),
     "wall_position": Var(("time", "wall", "xy"), "f8", "m", "a point of the wall line", False),
     "wall_force": Var(("time", "wall", "xy"), "f8", "N", "total force exerted by the particles on the wall", False),
-    # restart state (issue 6): what a resumed run needs beyond the snapshot itself
+    # restart state: what a resumed run needs beyond the snapshot itself
     "wall_velocity": Var(("time", "wall", "xy"), "f8", "m s-1", "velocity of the wall (imposed, or reached under its stress)", False),
     "normal_impulse": Var(("time", "contact", "contact_point"), "f8", "N s",
                           "normal impulse of the last time step at each point of the contact, in detection "
@@ -388,7 +388,7 @@ class SnapshotWriter:
             optional = [o for o in optional if "wall" not in VARIABLES[o].dims]
         # The header and the static data are written under a temporary name and the file is
         # moved into place once they are on disk: a run killed while the file is being created
-        # leaves either no file or a valid empty one, never a partial header (issue 6).
+        # leaves either no file or a valid empty one, never a partial header.
         directory, base = os.path.split(os.path.abspath(path))
         temporary = os.path.join(directory, f".{base}.{os.getpid()}.part")
         nc = netCDF4.Dataset(temporary, "w", format=format)

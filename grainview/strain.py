@@ -1,8 +1,8 @@
 """Strains of a biaxial test and the angles and numbers derived from them
-(paper Sec. III, Eqs. for eps_1, eps_p, phi, psi and I; ERRATA item 6).
+(paper Sec. III, Eqs. for eps_1, eps_p, phi, psi and I; docs/conventions.md §6).
 
-Compression is positive for eps_1 and eps_2, dilation positive for eps_p, as the ERRATA
-states. The reference state is the snapshot ``reference`` (default the first).
+Compression is positive for eps_1 and eps_2, dilation positive for eps_p, as docs/conventions.md
+§6 states. The reference state is the snapshot ``reference`` (default the first).
 """
 
 from __future__ import annotations
@@ -51,7 +51,7 @@ def strains(ds: xr.Dataset, reference: int = 0) -> xr.Dataset:
     eps_1 = ln(1 + dh/h0) with dh = h0 - h (vertical, compression positive);
     eps_2 = ln(1 + dl/l0) with dl = l0 - l (horizontal);
     eps_p = ln(1 + dV/V0) with dV = V - V0 (volumetric, dilation positive);
-    eps_q = eps_1 - eps_2 (shear strain). ERRATA item 6.
+    eps_q = eps_1 - eps_2 (shear strain). docs/conventions.md §6.
     """
     h, l, v = sample.height(ds), sample.width(ds), sample.area(ds)
     eps_1 = _log_strain(h, reference)

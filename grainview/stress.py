@@ -1,5 +1,5 @@
 """Stress of the packing: the tensor, p, q, q/p, principal direction, and the partial
-stresses of simple and double contacts (paper Eqs. M and sigmasd; ERRATA item 1).
+stresses of simple and double contacts (paper Eqs. M and sigmasd; docs/conventions.md §1).
 
 By default the stress includes the particle–wall contacts: with them the sum over contacts
 equals the sum of the particles' tensorial moments exactly (see
@@ -21,7 +21,7 @@ CONTACT_XY = ("contact", "xy")
 
 
 def stress_tensor(ds: xr.Dataset, kind="all", walls: bool = True) -> xr.DataArray:
-    """sigma (time, xy_a, xy_b) in Pa: (1/V) sum_c f^c (x) l^c (paper Eq. M, ERRATA 1).
+    """sigma (time, xy_a, xy_b) in Pa: (1/V) sum_c f^c (x) l^c (paper Eq. M, docs/conventions.md §1).
 
     ``kind="simple"`` or ``"double"`` restricts the sum to one contact kind, so that
     ``stress_tensor(ds, "simple") + stress_tensor(ds, "double") == stress_tensor(ds)``
@@ -73,5 +73,5 @@ def stress_invariants(ds: xr.Dataset, kind="all", walls: bool = True,
 
 def stress_direction(ds: xr.Dataset, walls: bool = True) -> xr.DataArray:
     """Major principal stress direction theta_sigma (time,), rad: the reference direction of
-    the signed anisotropies a', a_n, a_t (ERRATA, "Signs")."""
+    the signed anisotropies a', a_n, a_t (docs/conventions.md §3, "Signs")."""
     return stress_invariants(ds, walls=walls)["theta_sigma"]

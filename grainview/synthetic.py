@@ -1,4 +1,4 @@
-"""Synthetic datasets of the contract drawn from the harmonic model (ERRATA item 3).
+"""Synthetic datasets of the contract drawn from the harmonic model (docs/conventions.md §3).
 
 Used by the demo, the tests and the analysis benchmarks: contacts whose orientation density
 is P(theta) = (1/pi)[1 + a cos 2(theta - theta_0)], normal forces

@@ -1,5 +1,5 @@
 """The xi-network: stress and fabric carried by the contacts with f_n < xi <f_n> (paper
-Sec. V.C, Figs. 15 and 16; ERRATA item 5).
+Sec. V.C, Figs. 15 and 16; docs/conventions.md §5).
 
 Sweeping xi from 0 to the largest force shows how the shear stress and the fabric anisotropy
 are shared between weak and strong contacts: the paper finds q(xi)/p ~ 0 for xi < 1 (the weak
@@ -37,7 +37,7 @@ def _check_xi(xi):
 
 
 def xi_network(ds: xr.Dataset, xi=DEFAULT_XI, walls: bool = False, near=None) -> xr.Dataset:
-    """q(xi)/p, a'(xi) and the contact fraction of the xi-networks (time, xi) (ERRATA item 5).
+    """q(xi)/p, a'(xi) and the contact fraction of the xi-networks (time, xi) (docs/conventions.md §5).
 
     The xi-network of a snapshot is the set of selected contacts (particle–particle by
     default) with f_n < xi <f_n> (strict), <f_n> their mean normal force.

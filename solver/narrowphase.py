@@ -1,6 +1,6 @@
 """Narrow phase of contact detection: contact points, normals and gaps of candidate pairs.
 
-Conventions (``grainview.schema``, ``../shared/paper/ERRATA.md``): the unit normal ``n`` of a
+Conventions (``grainview.schema``, docs/conventions.md §0): the unit normal ``n`` of a
 contact points from body i to body j; for a wall contact i is the particle and j = N + w, so
 n = -n_w (n_w: the wall's unit normal, pointing into the sample). ``gap`` is the signed
 distance between the two bodies along n at the contact point (m; negative = interpenetration).

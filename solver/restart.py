@@ -1,4 +1,4 @@
-"""Resuming a biaxial test from its own output file (issue 6).
+"""Resuming a biaxial test from its own output file, and starting a test from any saved snapshot.
 
 A run killed at any moment (SIGKILL, a cluster's wall-time limit, Ctrl-C) leaves a file whose
 complete snapshots all open (:class:`grainview.schema.SnapshotWriter` syncs the file after each

@@ -1,5 +1,5 @@
 """Coordination of the particles: contact numbers, z, P(c) and P(m_s, m_d)
-(paper Sec. IV.A and Fig. 21; ERRATA item 7)."""
+(paper Sec. IV.A and Fig. 21; docs/conventions.md §7)."""
 
 from __future__ import annotations
 
@@ -20,7 +20,7 @@ def contact_numbers(i, j, mask, n_particles):
 
 def coordination(counts, min_contacts=1):
     """z = sum_i c_i / N' over the N' particles with c_i >= ``min_contacts`` (the others are
-    rattlers and left out; ERRATA item 7 uses min_contacts = 1). Returns (z, N')."""
+    rattlers and left out; docs/conventions.md §7 uses min_contacts = 1). Returns (z, N')."""
     keep = counts >= min_contacts
     n_kept = keep.sum(axis=-1)
     with np.errstate(invalid="ignore", divide="ignore"):

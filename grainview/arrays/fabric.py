@@ -1,5 +1,5 @@
 """Fabric of the contact network: tensor, anisotropy and the distribution of contact
-orientations (paper Eqs. F and a'; ERRATA item 2)."""
+orientations (paper Eqs. F and a'; docs/conventions.md §2)."""
 
 from __future__ import annotations
 

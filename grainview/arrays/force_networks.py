@@ -1,5 +1,5 @@
 """Weak and strong force networks and the proportions of simple and double contacts
-(paper Secs. V.C and VI, Figs. 17, 19 and 25; ERRATA item 4)."""
+(paper Secs. V.C and VI, Figs. 17, 19 and 25; docs/conventions.md §4)."""
 
 from __future__ import annotations
 
@@ -34,14 +34,14 @@ PROPORTIONS = (
 
 
 def proportions(fn, kind, mask, very_weak=0.1, strong=1.0):
-    """Proportions of simple (s) and double (d), weak and strong contacts (ERRATA item 4).
+    """Proportions of simple (s) and double (d), weak and strong contacts (docs/conventions.md §4).
 
     With N_c the contacts of ``mask`` (..., C), N_s and N_d those of kind simple and double,
     <f_n> the mean normal force over all of them and <f_n>_s, <f_n>_d over each kind:
 
     * k_s = N_s/N_c, k_d = N_d/N_c;
     * f_s = k_s <f_n>_s/<f_n> and f_d = k_d <f_n>_d/<f_n> (the paper's printed formulas swap s
-      and d; ERRATA item 4), computed as sum_s f_n / sum f_n (the same by algebra, and 0 rather
+      and d; docs/conventions.md §4), computed as sum_s f_n / sum f_n (the same by algebra, and 0 rather
       than NaN when a kind is absent), so f_s + f_d = 1;
     * k_s_strong, k_s_weak, k_d_strong, k_d_weak: fractions of all N_c contacts that are simple
       or double and strong (f_n > strong <f_n>) or weak (f_n <= strong <f_n>);

@@ -1,5 +1,5 @@
 """Angular averages of the contact forces and the force tensors H^(n), H^(t)
-(paper Eqs. fnft, HnHt, anat; ERRATA item 3)."""
+(paper Eqs. fnft, HnHt, anat; docs/conventions.md §3)."""
 
 from __future__ import annotations
 
@@ -45,7 +45,7 @@ def sector_integrals(n_bins):
 
 
 def force_tensors(fn, ft, normal, mask, n_bins):
-    """H^(n) and H^(t) (..., 2, 2) in N (ERRATA item 3, which corrects the printed H^(t)).
+    """H^(n) and H^(t) (..., 2, 2) in N (docs/conventions.md §3, which corrects the printed H^(t)).
 
     H^(n)_ab = (1/pi) int_0^pi <f_n>(theta) n_a n_b dtheta and
     H^(t)_ab = sym[(1/pi) int_0^pi <f_t>(theta) n_a t_b dtheta], with the bin averages taken

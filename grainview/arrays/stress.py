@@ -1,4 +1,4 @@
-"""Stress tensor of a packing from its contact forces (paper Eq. M; ERRATA item 1)."""
+"""Stress tensor of a packing from its contact forces (paper Eq. M; docs/conventions.md §1)."""
 
 from __future__ import annotations
 
@@ -13,7 +13,7 @@ def stress_tensor(fn, ft, normal, branch, mask, volume):
     ``f = fn n + ft t`` (t = (-n_y, n_x)) is the force exerted by i on j, ``l`` the branch
     vector (centre of i to centre of j; particle centre to contact point for walls), so that
     compression is positive. Equivalent to ``(1/V) sum_i M^i`` with the tensorial moments
-    ``M^i = sum_{c in i} f^c (x) (r^c - x^i)`` of the paper (Eq. M), which the ERRATA states.
+    ``M^i = sum_{c in i} f^c (x) (r^c - x^i)`` of the paper (Eq. M), docs/conventions.md §1.
 
     Shapes: fn, ft, mask (..., C); normal, branch (..., C, 2); volume (...) in m^3 (box area
     times slab thickness). Forces in N, result (..., 2, 2) in Pa. Summing over disjoint masks

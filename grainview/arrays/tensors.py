@@ -24,7 +24,7 @@ def principal(tensor):
 def signed_anisotropy(t1, t2, theta, theta_ref, normalisation=None):
     """Signed anisotropy ``2 (T_1 - T_2)/norm * cos 2(theta - theta_ref)``.
 
-    With ``normalisation=None`` the norm is ``T_1 + T_2`` (the trace); ERRATA item 2 and 3.
+    With ``normalisation=None`` the norm is ``T_1 + T_2`` (the trace); docs/conventions.md §2 and §3.
     """
     norm = (t1 + t2) if normalisation is None else normalisation
     with np.errstate(invalid="ignore", divide="ignore"):

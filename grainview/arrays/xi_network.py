@@ -1,5 +1,5 @@
 """The xi-network: the contacts with f_n < xi <f_n> (paper Sec. V.C, Figs. 15 and 16;
-ERRATA item 5).
+docs/conventions.md §5).
 
 For K values of xi the subsets are nested, so one sort of each snapshot's forces and cumulative
 sums of the contacts' stress terms f_a l_b and fabric terms n_a n_b give every subset's sums
@@ -61,7 +61,7 @@ def subset_sums(fn, ft, normal, branch, mask, xi):
 
 
 def xi_network(fn, ft, normal, branch, mask, volume, p, theta_sigma, xi):
-    """q(xi)/p, a'(xi), N(xi)/N_c and N(xi) of the xi-networks (ERRATA item 5).
+    """q(xi)/p, a'(xi), N(xi)/N_c and N(xi) of the xi-networks (docs/conventions.md §5).
 
     For each xi, the subset holds the contacts of ``mask`` with f_n < xi <f_n> (strict):
 

@@ -85,7 +85,7 @@ def plot_angular_forces(data, label=None, **kw):
 def plot_force_anisotropy(data, ax=None, label=None, component: str = "a_n", bins: int = 36,
                           walls: bool = False, **line_kw):
     """Signed force anisotropy a_n (``component="a_n"``) or a_t (``"a_t"``) against eps_q
-    (paper Fig. 11, ERRATA 3 and "Signs"; :func:`grainview.forces.force_anisotropies`)."""
+    (paper Fig. 11, docs/conventions.md §3 and "Signs"; :func:`grainview.forces.force_anisotropies`)."""
     if component not in ("a_n", "a_t"):
         raise ParameterError(f"component={component!r}: expected 'a_n' or 'a_t'")
     ax = get_axes(ax)
@@ -218,7 +218,7 @@ def plot_force_pdfs_by_kind(data, label=None, **kw):
 
 def xi_profile(ds: xr.Dataset, xi=None, time="residual") -> xr.Dataset:
     """q(xi)/p, a'(xi) and the contact fraction of the xi-network (contacts f_n < xi <f_n>;
-    ERRATA 5; :func:`grainview.xi_network.xi_network`, whose cutoffs are the default),
+    docs/conventions.md §5; :func:`grainview.xi_network.xi_network`, whose cutoffs are the default),
     averaged over the snapshots ``time``."""
     from ..xi_network import xi_network
     subset = select_snapshots(ds, time)
@@ -228,13 +228,13 @@ def xi_profile(ds: xr.Dataset, xi=None, time="residual") -> xr.Dataset:
 
 def plot_xi_stress(data, ax=None, label=None, xi=None, time="residual", **line_kw):
     """Partial shear stress q(xi)/p of the contacts f_n < xi <f_n> against the cutoff xi
-    (paper Fig. 15; divided by the p of the whole sample, ERRATA 5)."""
+    (paper Fig. 15; divided by the p of the whole sample, docs/conventions.md §5)."""
     return _xi(data, ax, label, xi, time, "q_over_p", r"$q(\xi)/p$", line_kw)
 
 
 def plot_xi_anisotropy(data, ax=None, label=None, xi=None, time="residual", **line_kw):
     """Partial fabric anisotropy a'(xi) of the contacts f_n < xi <f_n> against the cutoff xi
-    (paper Fig. 16; signed against the whole sample's major stress direction, ERRATA 5)."""
+    (paper Fig. 16; signed against the whole sample's major stress direction, docs/conventions.md §5)."""
     return _xi(data, ax, label, xi, time, "a_prime", r"$a'(\xi)$", line_kw)
 
 
@@ -252,7 +252,7 @@ def _xi(data, ax, label, xi, time, name, ylabel, line_kw):
 
 def plot_contact_proportions(data, ax=None, label=None, **line_kw):
     """Proportions k_s, k_d of simple and double contacts and the relative force averages
-    f_s = k_s <f_n>_s/<f_n>, f_d = k_d <f_n>_d/<f_n> (ERRATA 4) against eps_q (paper Fig. 19;
+    f_s = k_s <f_n>_s/<f_n>, f_d = k_d <f_n>_d/<f_n> (docs/conventions.md §4) against eps_q (paper Fig. 19;
     :func:`grainview.force_networks.contact_proportions`). Four lines per sample: k_s, k_d,
     f_s, f_d."""
     from ..force_networks import contact_proportions
@@ -265,7 +265,7 @@ def plot_contact_proportions(data, ax=None, label=None, **line_kw):
 
 def plot_type_transitions(data, ax=None, label=None, **line_kw):
     """Cumulative proportions Delta gamma of simple contacts turned double (s->d) and double
-    turned simple (d->s) against eps_q (paper Fig. 20, ERRATA 8;
+    turned simple (d->s) against eps_q (paper Fig. 20, docs/conventions.md §8;
     :func:`grainview.persistence.type_transitions`). Two lines per sample."""
     from ..persistence import type_transitions
     ax = get_axes(ax)
@@ -277,7 +277,7 @@ def plot_type_transitions(data, ax=None, label=None, **line_kw):
 
 def plot_strong_weak_proportions(data, ax=None, label=None, **line_kw):
     """Fractions of all contacts that are simple and strong (k_s^S), simple and weak (k_s^W),
-    double and strong (k_d^S), double and weak (k_d^W), strong meaning f_n > <f_n> (ERRATA 4),
+    double and strong (k_d^S), double and weak (k_d^W), strong meaning f_n > <f_n> (docs/conventions.md §4),
     against eps_q (paper Fig. 25; :func:`grainview.force_networks.contact_proportions`). Four
     lines per sample in that order."""
     from ..force_networks import contact_proportions

@@ -20,8 +20,8 @@ from ._style import (EPS_Q_LABEL, axis_label, datasets, draw_evolutions, finish,
 def plot_q_over_p(data, ax=None, label=None, **line_kw):
     """Normalised shear stress q/p against eps_q (paper Fig. 3).
 
-    q/p from :func:`grainview.stress.stress_invariants` (wall contacts included, ERRATA 1),
-    eps_q from :func:`grainview.strain.strains` (ERRATA 6). Both dimensionless."""
+    q/p from :func:`grainview.stress.stress_invariants` (wall contacts included, docs/conventions.md §1),
+    eps_q from :func:`grainview.strain.strains` (docs/conventions.md §6). Both dimensionless."""
     ax = get_axes(ax)
     draw_evolutions(ax, datasets(data, label), stress_invariants, [(None, "q_over_p")], **line_kw)
     set_labels(ax, EPS_Q_LABEL, "$q/p$")

@@ -20,7 +20,7 @@ from ._style import (EPS_Q_LABEL, axis_label, datasets, draw_evolutions, finish,
 
 def plot_coordination(data, ax=None, label=None, walls: bool = False, **line_kw):
     """Coordination number z of the force-bearing network (rattlers left out, a double contact
-    counted once; ERRATA 7) against eps_q (paper Fig. 6a;
+    counted once; docs/conventions.md §7) against eps_q (paper Fig. 6a;
     :func:`grainview.connectivity.coordination`)."""
     ax = get_axes(ax)
     draw_evolutions(ax, datasets(data, label), lambda ds: coordination(ds, walls=walls), [(None, "z")],
@@ -31,7 +31,7 @@ def plot_coordination(data, ax=None, label=None, walls: bool = False, **line_kw)
 
 def plot_persistence(data, ax=None, label=None, reference: int = 0, **line_kw):
     """Fraction gamma of the contacts of snapshot ``reference`` still present, against eps_q
-    (paper Fig. 6b, ERRATA 8; :func:`grainview.persistence.persistence`)."""
+    (paper Fig. 6b, docs/conventions.md §8; :func:`grainview.persistence.persistence`)."""
     from ..persistence import persistence
     ax = get_axes(ax)
     draw_evolutions(ax, datasets(data, label), lambda ds: persistence(ds, reference=reference), [(None, None)],
@@ -78,7 +78,7 @@ def full_turn(theta, r):
 
 def plot_fabric_anisotropy(data, ax=None, label=None, walls: bool = False, **line_kw):
     """Signed fabric anisotropy a' = a cos 2(theta_F - theta_sigma) against eps_q (paper
-    Fig. 9, ERRATA 2; :func:`grainview.fabric.fabric_anisotropy`)."""
+    Fig. 9, docs/conventions.md §2; :func:`grainview.fabric.fabric_anisotropy`)."""
     ax = get_axes(ax)
     draw_evolutions(ax, datasets(data, label), lambda ds: fabric_anisotropy(ds, walls=walls),
                     [(None, "a_prime")], **line_kw)
