@@ -1,0 +1,257 @@
+"""The fidelity study: which preparation and counting reproduce which of the paper's values.
+
+    python benchmarks/fidelity/run.py                      # every section (hours on 2 cores)
+    python benchmarks/fidelity/run.py --only relations     # the twelve relations
+    python benchmarks/fidelity/run.py --quick              # tiny sizes: checks the script
+
+Sections (each a table in ``benchmarks/fidelity/RESULTS.md``, read with docs/fidelity.md):
+
+* ``preparations``: initial states (solid fraction, z) of each preparation, both shapes;
+* ``rates``: q/p, a, z against the top wall's speed (is the test quasi-static?);
+* ``sizes``: residual values at 400, 1000 and 4000 particles;
+* ``counting``: z, very weak fraction, fabric a with near pairs counted up to a gap;
+* ``relations``: the paper's twelve pentagon-versus-disk relations, N = 1000, eps_q >= 0.4,
+  three seeds (mean ± spread), per preparation and counting convention.
+
+Runs are cached in ``benchmarks/_data/fidelity`` (``runs.py``), so sections share them and a
+second call only recomputes the tables.
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import sys
+import time
+
+import numpy as np
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+sys.path.insert(0, HERE)
+sys.path.insert(0, os.path.dirname(HERE))
+
+import measure  # noqa: E402
+import relations  # noqa: E402
+import runs as runs_module  # noqa: E402
+from runs import Run, ensure  # noqa: E402
+
+SECTIONS = ["preparations", "rates", "sizes", "counting", "relations"]
+D_MIN = 0.025  # m, the smallest circumscribed diameter of the paper's size mix
+NEAR = (0.0025, 0.005, 0.01, 0.02)
+"""Near-contact gap thresholds as fractions of D_MIN (0.02 = the solver's alert distance)."""
+RELATION_NEAR = 0.01
+"""The near-contact threshold (fraction of D_MIN) of the relations' second counting column."""
+RESIDUAL = (0.4, np.inf)
+"""Residual window of the sizes, counting and relations sections (eps_q)."""
+
+
+class Config:
+    """Sizes of every section; ``quick`` shrinks them to check the script in minutes."""
+
+    def __init__(self, quick=False):
+        self.quick = quick
+        self.strain = 0.02 if quick else 0.28
+        self.residual = (0.0, np.inf) if quick else RESIDUAL
+        self.relation_particles = 60 if quick else 1000
+        self.seeds = (0, 1) if quick else (0, 1, 2)
+        self.preparation_particles = (60,) if quick else (400, 1000)
+        self.preparations = ("paper", "frictionless") if quick else ("paper", "frictionless", "quasistatic")
+        self.rate_particles = 60 if quick else 400
+        self.velocities = {"pentagon": (0.01, 0.04) if quick else (0.005, 0.01, 0.02, 0.04, 0.08),
+                           "disk": (0.01, 0.04) if quick else (0.01, 0.02, 0.04, 0.08)}
+        self.sizes = (30, 60) if quick else (400, 1000, 4000)
+        self.every = 20 if quick else 400
+
+    def velocity(self, particles):
+        """Top-wall speed (m s-1) that shears ``particles`` at the study's strain rate: the rate
+        of 400 particles at the paper's 1 cm/s, about 0.01 s-1 (the box height grows as the
+        square root of N at a fixed aspect ratio), rounded to 1 mm/s."""
+        return round(0.01 * np.sqrt(particles / 400), 3)
+
+    def run(self, **kw) -> Run:
+        kw.setdefault("strain", self.strain)
+        kw.setdefault("every", self.every)
+        kw.setdefault("velocity", self.velocity(kw.get("particles", Run.particles)))
+        return Run(**kw)
+
+
+def _table(header, rows):
+    lines = ["| " + " | ".join(header) + " |", "|" + "---|" * len(header)]
+    lines += ["| " + " | ".join(str(c) for c in row) + " |" for row in rows]
+    return "\n".join(lines)
+
+
+def _f(value, digits=3):
+    return "-" if value is None or (isinstance(value, float) and not np.isfinite(value)) else f"{value:.{digits}f}"
+
+
+# -- sections -----------------------------------------------------------------------------------
+
+def section_preparations(cfg, jobs):
+    runs = [cfg.run(shape=shape, particles=n, preparation=prep, seed=seed)
+            for n in cfg.preparation_particles for prep in cfg.preparations for shape in ("pentagon", "disk")
+            for seed in (cfg.seeds if n == cfg.preparation_particles[0] else cfg.seeds[:1])]
+    from runs import make_sample
+    from concurrent.futures import ProcessPoolExecutor
+
+    missing = [r for r in runs if not os.path.exists(r.sample_path())]
+    if missing:
+        with ProcessPoolExecutor(max_workers=jobs) as pool:
+            list(pool.map(make_sample, missing))
+    rows = []
+    near = 0.01 * D_MIN
+    for r in runs:
+        s = measure.initial_state(r.sample_path(), near=near)
+        rows.append([r.shape, r.particles, r.preparation, r.seed, _f(s["solid fraction"]), _f(s["z"], 2),
+                     _f(s["z near"], 2), _f(s["z points"], 2), _f(s["k_d"], 2), s["compaction steps"],
+                     "yes" if s["settled"] else "NO", f"{s['largest I']:.1e}", _f(s["compaction s"], 0)])
+    text = ("Initial states after isotropic compaction at 10 kPa (paper: S1 pentagons solid fraction 0.80, "
+            "z 3.20; S2 disks 0.82, z 3.95). z: force-bearing contacts (the paper's rule); z near: also the "
+            f"pairs within {near * 1e3:g} mm (1% of the smallest diameter); z points: a double contact counts "
+            "twice; largest I: the largest inertia number I = (v/L) d sqrt(rho/sigma0) of a closing wall.\n\n")
+    return text + _table(["shape", "N", "preparation", "seed", "solid fraction", "z", "z near", "z points", "k_d",
+                          "steps", "settled", "largest I", "time (s)"], rows)
+
+
+def _window(w):
+    return f"{w[0]:.1f}+" if w[1] == np.inf else f"{w[0]:.1f}-{w[1]:.1f}"
+
+
+def _windows(path, windows, near=None):
+    return [measure.window_means(path, w, near) for w in windows]
+
+
+def section_rates(cfg, jobs):
+    runs = [cfg.run(shape=shape, particles=cfg.rate_particles, velocity=v)
+            for shape in ("pentagon", "disk") for v in cfg.velocities[shape]]
+    paths = ensure(runs, jobs)
+    windows = [(0.1, 0.2), (0.2, 0.3), (0.3, 0.4), (0.4, np.inf)] if not cfg.quick else [(0.0, np.inf)]
+    rows = []
+    for r in runs:
+        import grainview
+
+        with grainview.open_dataset(paths[r], chunks=None) as ds:
+            inertia = float(ds.grain.inertia_number().median())
+        for w, s in zip(windows, _windows(paths[r], windows)):
+            if s["snapshots"]:
+                rows.append([r.shape, f"{r.velocity * 100:g}", f"{inertia:.1e}", _window(w),
+                             _f(s["q/p"]), _f(s["a"]), _f(s["a_n"]), _f(s["z"], 2), _f(s["solid fraction"])])
+    text = (f"Biaxial tests of the same compacted {cfg.rate_particles}-particle samples (preparation 'paper', seed 0) "
+            "with the top wall at several speeds; window means over eps_q. I: the median inertia parameter of "
+            "the test as the paper defines it (eps_dot sqrt(m/p), m the total mass per unit thickness).\n\n")
+    return text + _table(["shape", "wall speed (cm/s)", "I", "eps_q", "q/p", "a", "a_n", "z", "solid fraction"], rows)
+
+
+def section_sizes(cfg, jobs):
+    runs = [cfg.run(shape=shape, particles=n) for n in cfg.sizes for shape in ("pentagon", "disk")]
+    paths = ensure(runs, jobs)
+    rows = []
+    windows = [(0.3, 0.4), cfg.residual] if not cfg.quick else [cfg.residual]
+    for r in runs:
+        for w, s in zip(windows, _windows(paths[r], windows)):
+            if s["snapshots"]:
+                rows.append([r.shape, r.particles, _window(w),
+                             s["snapshots"], _f(s["q/p"]), _f(s["prediction"]), _f(s["a"]), _f(s["a_n"]),
+                             _f(s["a_t"]), _f(s["z"], 2), _f(s["k_d"], 2), _f(s["very weak"])])
+    text = ("Residual values against the number of particles (preparation 'paper', seed 0, force-bearing "
+            "contacts), all sheared at the same strain rate (~0.01 s-1: the top wall at 1 cm/s for 400 "
+            f"particles, {cfg.velocity(1000) * 100:g} cm/s for 1000, {cfg.velocity(4000) * 100:g} cm/s for 4000). Paper: N = 14,400 pentagons (q/p 0.35, z 3.75) and 10,000 disks "
+            "(q/p 0.28, z 3.85).\n\n")
+    return text + _table(["shape", "N", "eps_q", "snapshots", "q/p", "(a'+a_n+a_t)/2", "a", "a_n", "a_t", "z", "k_d",
+                          "very weak"], rows)
+
+
+def _relation_runs(cfg, preparation="paper"):
+    return {shape: [cfg.run(shape=shape, particles=cfg.relation_particles, preparation=preparation, seed=seed)
+                    for seed in cfg.seeds] for shape in ("pentagon", "disk")}
+
+
+def section_counting(cfg, jobs):
+    groups = _relation_runs(cfg)
+    paths = ensure([r for runs in groups.values() for r in runs], jobs)
+    rows = []
+    for shape, runs in groups.items():
+        for near in (None, *NEAR):
+            gap = None if near is None else near * D_MIN
+            summaries = [measure.window_means(paths[r], cfg.residual, gap) for r in runs]
+            rows.append([shape, "force-bearing" if near is None else f"gap <= {near:.2%} d_min ({gap * 1e3:.2g} mm)",
+                         relations.fmt(summaries, "z"), relations.fmt(summaries, "z points"),
+                         relations.fmt(summaries, "very weak"), relations.fmt(summaries, "weak"),
+                         relations.fmt(summaries, "a"), relations.fmt(summaries, "prediction"),
+                         relations.fmt(summaries, "q/p")])
+    text = (f"Residual state (eps_q >= {cfg.residual[0]:g}) of {cfg.relation_particles} particles, "
+            f"{len(cfg.seeds)} seeds (mean ± spread), preparation 'paper', counted four ways: force-bearing contacts only, "
+            "or also every pair whose gap is within a threshold (written by the solver up to its alert distance, "
+            f"2% of d_min = {0.02 * D_MIN * 1e3:g} mm). Paper (pentagons): z 3.75, very weak 0.32, weak 0.58, a "
+            "small; (disks): z 3.85, weak 0.62, a ~0.3.\n\n")
+    return text + _table(["shape", "counted", "z", "z points", "very weak", "weak", "a", "(a'+a_n+a_t)/2", "q/p"], rows)
+
+
+def _summaries(cfg, runs, paths, near):
+    out = []
+    for r in runs:
+        s = measure.window_means(paths[r], cfg.residual, near)
+        s["solid fraction initial"] = measure.initial_state(r.sample_path())["solid fraction"]
+        out.append(s)
+    return out
+
+
+def section_relations(cfg, jobs):
+    columns = []
+    for preparation in ("paper", "frictionless"):
+        groups = _relation_runs(cfg, preparation)
+        paths = ensure([r for runs in groups.values() for r in runs], jobs)
+        for near in (None, RELATION_NEAR * D_MIN):
+            label = f"'{preparation}', " + ("force-bearing" if near is None else f"near {RELATION_NEAR:.0%} d_min")
+            results = relations.evaluate(_summaries(cfg, groups["pentagon"], paths, near),
+                                         _summaries(cfg, groups["disk"], paths, near))
+            columns.append((label, results))
+    header = ["relation", "paper"] + [label for label, _ in columns]
+    rows = []
+    for k, (name, paper, *_rest) in enumerate(columns[0][1]):
+        rows.append([name, paper] + [f"{'holds' if res[k][3] else 'FAILS'}: {res[k][2]}" for _, res in columns])
+    held = ", ".join(f"{label}: {sum(r[3] for r in res)}/12" for label, res in columns)
+    text = (f"N = {cfg.relation_particles} per shape, residual window eps_q >= {cfg.residual[0]:g}, seeds "
+            f"{', '.join(map(str, cfg.seeds))} (mean ± sample standard deviation), top wall at "
+            f"{cfg.velocity(cfg.relation_particles) * 100:g} cm/s (strain rate ~0.01 s-1). "
+            f"Relations that hold: {held}. The independent engines' column is in docs/fidelity.md "
+            "(benchmarks/crosscheck, 400 particles).\n\n")
+    return text + _table(header, rows)
+
+
+def main(argv=None):
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("--quick", action="store_true", help="tiny sizes, to check the script")
+    parser.add_argument("--only", default=",".join(SECTIONS), help="comma-separated sections: " + ",".join(SECTIONS))
+    parser.add_argument("--jobs", type=int, default=2, help="simulations run side by side (default 2)")
+    parser.add_argument("--output", default=None, help="default: benchmarks/fidelity/RESULTS.md for a full run, "
+                        "benchmarks/_data/fidelity/RESULTS-*.md otherwise")
+    args = parser.parse_args(argv)
+    wanted = [s.strip() for s in args.only.split(",") if s.strip()]
+    unknown = set(wanted) - set(SECTIONS)
+    if unknown:
+        parser.error(f"unknown sections {sorted(unknown)}; expected some of {SECTIONS}")
+    cfg = Config(quick=args.quick)
+    if args.quick:
+        runs_module.CACHE = os.path.join(runs_module.CACHE, "quick")
+    output = args.output or (os.path.join(HERE, "RESULTS.md") if not args.quick and wanted == SECTIONS
+                             else os.path.join(runs_module.CACHE, f"RESULTS-{'quick-' if args.quick else ''}{'-'.join(wanted)}.md"))
+    os.makedirs(os.path.dirname(output), exist_ok=True)
+    from common import machine_description
+
+    start = time.perf_counter()
+    parts = ["# Fidelity study", "", f"Generated by `python benchmarks/fidelity/run.py"
+             f"{' --quick' if args.quick else ''}{'' if wanted == SECTIONS else ' --only ' + ','.join(wanted)}`; "
+             "read with docs/fidelity.md.", "", machine_description(), ""]
+    for name in wanted:
+        print(f"== {name}", flush=True)
+        t0 = time.perf_counter()
+        text = globals()[f"section_{name}"](cfg, args.jobs)
+        parts += [f"## {name}", "", text, "", f"_Section time: {time.perf_counter() - t0:.0f} s._", ""]
+        with open(output, "w") as fh:
+            fh.write("\n".join(parts) + "\n")
+    print(f"wrote {output} in {time.perf_counter() - start:.0f} s")
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,122 @@
+"""The simulations of the fidelity study, built once and cached.
+
+A :class:`Run` names one sample and test: shape, size, preparation, seed, wall speed and
+strain. :func:`ensure` simulates the runs whose files are missing, several at a time in
+separate processes, and returns their paths. Each run keeps two files of the data contract in
+the cache folder: the compacted sample (``*_sample.nc``, reused by every test of the same
+sample) and the biaxial test (``*.nc``), written with near contacts so that every counting
+convention can be applied afterwards.
+"""
+
+from __future__ import annotations
+
+import os
+import time
+import warnings
+from concurrent.futures import ProcessPoolExecutor
+from dataclasses import dataclass, replace
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+CACHE = os.path.join(os.path.dirname(HERE), "_data", "fidelity")
+
+
+@dataclass(frozen=True)
+class Run:
+    """One simulation of the study (see the module docstring)."""
+
+    shape: str = "pentagon"
+    particles: int = 1000
+    preparation: str = "paper"
+    seed: int = 0
+    velocity: float = 0.01  # m s-1, top wall
+    strain: float = 0.28  # eps_1 of the biaxial test
+    every: int = 400  # steps between snapshots
+
+    @property
+    def sample_name(self) -> str:
+        return f"{self.shape}_{self.particles}_{self.preparation}_s{self.seed}"
+
+    @property
+    def name(self) -> str:
+        return f"{self.sample_name}_v{self.velocity * 100:g}cm_e{self.strain:g}"
+
+    def sample_path(self, cache=None) -> str:
+        return os.path.join(cache or CACHE, "samples", self.sample_name + ".nc")
+
+    def path(self, cache=None) -> str:
+        return os.path.join(cache or CACHE, "runs", self.name + ".nc")
+
+    def with_(self, **changes) -> "Run":
+        return replace(self, **changes)
+
+
+def _log(message):
+    print(f"[{time.strftime('%H:%M:%S')}] {message}", flush=True)
+
+
+def make_sample(run: Run, cache=None) -> str:
+    """The compacted sample of ``run`` (built and written unless cached); returns its path."""
+    from solver.output import Recorder
+    from solver.preparation import preparation, prepare_sample
+
+    path = run.sample_path(cache)
+    if os.path.exists(path):
+        return path
+    os.makedirs(os.path.dirname(path), exist_ok=True)
+    prep = preparation(run.preparation, particles=run.particles, shape=run.shape, seed=run.seed)
+    start = time.perf_counter()
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        sim = prepare_sample(prep, progress=False)
+    attrs = {"scene": "isotropic", **prep.attrs(), "preparation_name": run.preparation, "sigma0_Pa": prep.sigma0,
+             "compaction_steps": sim.compaction_steps, "compaction_settled": int(sim.settled),
+             "compaction_inertia_number": sim.compaction_inertia_number,
+             "compaction_seconds": time.perf_counter() - start}
+    with Recorder(path + ".part", sim, attrs=attrs, near_contacts=True, overwrite=True) as rec:
+        rec.write()
+    os.replace(path + ".part", path)
+    _log(f"{run.sample_name}: compacted in {sim.compaction_steps} steps, {time.perf_counter() - start:.0f} s")
+    return path
+
+
+def simulate(run: Run, cache=None) -> str:
+    """The biaxial test of ``run`` (simulated unless cached); returns its path."""
+    import solver
+
+    path = run.path(cache)
+    if os.path.exists(path):
+        return path
+    sample = make_sample(run, cache)
+    os.makedirs(os.path.dirname(path), exist_ok=True)
+    sim = solver.load_sample(sample)
+    attrs = sample_attrs(sample)
+    start = time.perf_counter()
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        steps = solver.biaxial_test(sim, path + ".part", strain=run.strain, velocity=run.velocity, every=run.every,
+                                    overwrite=True, progress=False, near_contacts=True, attrs=attrs)
+    os.replace(path + ".part", path)
+    _log(f"{run.name}: {steps} steps in {time.perf_counter() - start:.0f} s")
+    return path
+
+
+def sample_attrs(path) -> dict:
+    """The preparation and compaction attributes of a sample file, to carry into its tests."""
+    import grainview
+
+    with grainview.open_dataset(path, chunks=None) as ds:
+        return {k: v for k, v in ds.attrs.items() if k.startswith(("preparation_", "compaction_"))}
+
+
+def ensure(runs, jobs=2, cache=None) -> dict:
+    """Simulate the missing ``runs`` (``jobs`` processes) and return {run: path}. Samples are
+    built first, so that two tests of one sample never compact it twice."""
+    runs = list(dict.fromkeys(runs))
+    missing = [r for r in runs if not os.path.exists(r.path(cache))]
+    if missing:
+        samples = list({r.sample_name: r for r in missing if not os.path.exists(r.sample_path(cache))}.values())
+        _log(f"{len(missing)} runs to simulate ({len(samples)} samples to compact), {jobs} at a time")
+        with ProcessPoolExecutor(max_workers=jobs) as pool:
+            list(pool.map(make_sample, samples, [cache] * len(samples)))
+            list(pool.map(simulate, missing, [cache] * len(missing)))
+    return {r: r.path(cache) for r in runs}
