@@ -15,8 +15,9 @@ from .errors import GrainviewError
 RESIDUAL_STRAIN = 0.3
 """Default start of the residual window (eps_q); the same as grainview.strain.RESIDUAL_STRAIN,
 repeated here so that ``--help`` does not import xarray."""
-DEFAULT_STRAIN = 0.25
-"""Default vertical strain of a biaxial test: eps_q ~0.45, into the residual state."""
+DEFAULT_STRAIN = 0.2
+"""Default vertical strain eps_1 of a biaxial test: eps_q reaches ~0.55-0.65, well into the
+residual state (eps_q >= 0.3)."""
 
 
 def _info(args) -> int:
@@ -209,7 +210,7 @@ def build_parser() -> argparse.ArgumentParser:
 
         p.add_argument("--particles", type=int, default=particles, help=f"particles per sample (default {particles})")
         p.add_argument("--strain", type=float, default=strain,
-                       help=f"vertical strain eps_1 of the biaxial test (default {strain}: eps_q ~0.45, "
+                       help=f"vertical strain eps_1 of the biaxial test (default {strain}: eps_q ~0.6, "
                        "into the residual state)")
         p.add_argument("--velocity", type=float, default=0.01,
                        help="speed of the top wall in m/s (default 0.01, the paper's)")

@@ -25,12 +25,14 @@ def points_coordination(ds, near=None):
     return ((c_all + c_double).where(active).sum("particle") / active.sum("particle")).compute()
 
 
-def window_means(path, window=(0.4, np.inf), near=None, xi_cut=1.0) -> dict:
+def window_means(path, window=(0.4, np.inf), near=None) -> dict:
     """Means over the snapshots with window[0] <= eps_q < window[1] of: q/p, the harmonic
     prediction and a', a (fabric), a_n, a_t, z (with and without walls, and counting points),
     alpha, the weak, very weak (simple, double) fractions, k_d, f_s, f_d, k_s^S, k_d^S, q_s/p,
-    q_d/p, q(xi = xi_cut)/p, the solid fraction; plus the window's snapshot count and eps_q
-    range. ``near``: the counting convention (module docstring)."""
+    q_d/p, q(xi = 1)/p (the weak network's deviator), a'(xi = 0.1) (the signed fabric
+    anisotropy of the very weak contacts: < 0 when they lie across the major principal
+    stress), the solid fraction; plus the window's snapshot count and eps_q range. ``near``:
+    the counting convention (module docstring)."""
     from grainview.force_pdf import pooled_force_pdf, strong_force_exponent
 
     ds = grainview.open_dataset(path, chunks=None)
@@ -44,7 +46,7 @@ def window_means(path, window=(0.4, np.inf), near=None, xi_cut=1.0) -> dict:
     inv = res.grain.stress_invariants()
     hp = res.grain.harmonic_prediction(near=near)
     prop = res.grain.contact_proportions(near=near)
-    xi = res.grain.xi_network(xi=[xi_cut], near=near)
+    xi = res.grain.xi_network(xi=[0.1, 1.0], near=near)
     alpha = strong_force_exponent(pooled_force_pdf(res, scale="linear", bins=40, range=(0.0, 6.0), near=near))
     everything = slice(None)
     out.update({
@@ -72,7 +74,8 @@ def window_means(path, window=(0.4, np.inf), near=None, xi_cut=1.0) -> dict:
         "k_d^W": _mean(prop["k_d_weak"], everything),
         "q_s/p": _mean(res.grain.stress_invariants(kind="simple")["q_over_p"], everything),
         "q_d/p": _mean(res.grain.stress_invariants(kind="double")["q_over_p"], everything),
-        "q(xi<1)/p": _mean(xi["q_over_p"].isel(xi=0), everything),
+        "q(xi<1)/p": _mean(xi["q_over_p"].sel(xi=1.0), everything),
+        "a'(very weak)": float(xi["a_prime"].sel(xi=0.1).mean("time", skipna=True)),
         "solid fraction": _mean(res.grain.solid_fraction(), everything),
     })
     ds.close()

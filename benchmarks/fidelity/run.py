@@ -30,6 +30,7 @@ HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, HERE)
 sys.path.insert(0, os.path.dirname(HERE))
 
+import figures  # noqa: E402
 import measure  # noqa: E402
 import relations  # noqa: E402
 import runs as runs_module  # noqa: E402
@@ -50,12 +51,13 @@ class Config:
 
     def __init__(self, quick=False):
         self.quick = quick
-        self.strain = 0.02 if quick else 0.28
+        self.strain = 0.02 if quick else 0.2
         self.residual = (0.0, np.inf) if quick else RESIDUAL
         self.relation_particles = 60 if quick else 1000
         self.seeds = (0, 1) if quick else (0, 1, 2)
         self.preparation_particles = (60,) if quick else (400, 1000)
-        self.preparations = ("paper", "frictionless") if quick else ("paper", "frictionless", "quasistatic")
+        self.preparations = (("paper", "frictionless") if quick else
+                             ("paper", "frictionless", "quasistatic", "mu0.1", "mu0.2"))
         self.rate_particles = 60 if quick else 400
         self.velocities = {"pentagon": (0.01, 0.04) if quick else (0.005, 0.01, 0.02, 0.04, 0.08),
                            "disk": (0.01, 0.04) if quick else (0.01, 0.02, 0.04, 0.08)}
@@ -98,19 +100,26 @@ def section_preparations(cfg, jobs):
     if missing:
         with ProcessPoolExecutor(max_workers=jobs) as pool:
             list(pool.map(make_sample, missing))
-    rows = []
+    rows, points = [], []
     near = 0.01 * D_MIN
+    frictions = {"paper": 0.4, "quasistatic": None, "frictionless": 0.0, "mu0.1": 0.1, "mu0.2": 0.2}
     for r in runs:
         s = measure.initial_state(r.sample_path(), near=near)
+        if frictions.get(r.preparation) is not None and r.particles == cfg.preparation_particles[0]:
+            points.append({"shape": r.shape, "friction": frictions[r.preparation], **s})
         rows.append([r.shape, r.particles, r.preparation, r.seed, _f(s["solid fraction"]), _f(s["z"], 2),
                      _f(s["z near"], 2), _f(s["z points"], 2), _f(s["k_d"], 2), s["compaction steps"],
                      "yes" if s["settled"] else "NO", f"{s['largest I']:.1e}", _f(s["compaction s"], 0)])
     text = ("Initial states after isotropic compaction at 10 kPa (paper: S1 pentagons solid fraction 0.80, "
-            "z 3.20; S2 disks 0.82, z 3.95). z: force-bearing contacts (the paper's rule); z near: also the "
+            "z 3.20; S2 disks 0.82, z 3.95). Preparations: 'paper' compacts with the test's friction 0.4, walls "
+            "closing at up to 5 cm/s; 'frictionless' with friction 0; 'mu0.1', 'mu0.2' with friction 0.1, 0.2; "
+            "'quasistatic' as 'paper' with the closing walls capped at I = 2e-4. z: force-bearing contacts (the paper's rule); z near: also the "
             f"pairs within {near * 1e3:g} mm (1% of the smallest diameter); z points: a double contact counts "
             "twice; largest I: the largest inertia number I = (v/L) d sqrt(rho/sigma0) of a closing wall.\n\n")
-    return text + _table(["shape", "N", "preparation", "seed", "solid fraction", "z", "z near", "z points", "k_d",
-                          "steps", "settled", "largest I", "time (s)"], rows)
+    figure = figures.preparations(points, figures.figure_path(cfg.output, "preparations"))
+    return (text + f"![initial states]({os.path.basename(figure)})\n\n"
+            + _table(["shape", "N", "preparation", "seed", "solid fraction", "z", "z near", "z points", "k_d",
+                      "steps", "settled", "largest I", "time (s)"], rows))
 
 
 def _window(w):
@@ -139,7 +148,11 @@ def section_rates(cfg, jobs):
     text = (f"Biaxial tests of the same compacted {cfg.rate_particles}-particle samples (preparation 'paper', seed 0) "
             "with the top wall at several speeds; window means over eps_q. I: the median inertia parameter of "
             "the test as the paper defines it (eps_dot sqrt(m/p), m the total mass per unit thickness).\n\n")
-    return text + _table(["shape", "wall speed (cm/s)", "I", "eps_q", "q/p", "a", "a_n", "z", "solid fraction"], rows)
+    curves = [(f"{r.shape}s, {r.velocity * 100:g} cm/s", r.shape, measure.strain_series(paths[r])) for r in runs]
+    figure = figures.evolutions(curves, figures.figure_path(cfg.output, "rates"),
+                                f"{cfg.rate_particles} particles, seed 0: top wall speed")
+    return (text + f"![wall speeds]({os.path.basename(figure)})\n\n"
+            + _table(["shape", "wall speed (cm/s)", "I", "eps_q", "q/p", "a", "a_n", "z", "solid fraction"], rows))
 
 
 def section_sizes(cfg, jobs):
@@ -157,8 +170,12 @@ def section_sizes(cfg, jobs):
             "contacts), all sheared at the same strain rate (~0.01 s-1: the top wall at 1 cm/s for 400 "
             f"particles, {cfg.velocity(1000) * 100:g} cm/s for 1000, {cfg.velocity(4000) * 100:g} cm/s for 4000). Paper: N = 14,400 pentagons (q/p 0.35, z 3.75) and 10,000 disks "
             "(q/p 0.28, z 3.85).\n\n")
-    return text + _table(["shape", "N", "eps_q", "snapshots", "q/p", "(a'+a_n+a_t)/2", "a", "a_n", "a_t", "z", "k_d",
-                          "very weak"], rows)
+    curves = [(f"{r.shape}s, N = {r.particles}", r.shape, measure.strain_series(paths[r])) for r in runs]
+    figure = figures.evolutions(curves, figures.figure_path(cfg.output, "sizes"),
+                                "Number of particles (same strain rate, seed 0)")
+    return (text + f"![sizes]({os.path.basename(figure)})\n\n"
+            + _table(["shape", "N", "eps_q", "snapshots", "q/p", "(a'+a_n+a_t)/2", "a", "a_n", "a_t", "z", "k_d",
+                      "very weak"], rows))
 
 
 def _relation_runs(cfg, preparation="paper"):
@@ -169,22 +186,29 @@ def _relation_runs(cfg, preparation="paper"):
 def section_counting(cfg, jobs):
     groups = _relation_runs(cfg)
     paths = ensure([r for runs in groups.values() for r in runs], jobs)
-    rows = []
+    rows, points = [], []
     for shape, runs in groups.items():
         for near in (None, *NEAR):
             gap = None if near is None else near * D_MIN
             summaries = [measure.window_means(paths[r], cfg.residual, gap) for r in runs]
+            points.append({"shape": shape, "near": near or 0.0,
+                           **{k: relations.stats(summaries, k) for k in ("z", "very weak", "a")}})
             rows.append([shape, "force-bearing" if near is None else f"gap <= {near:.2%} d_min ({gap * 1e3:.2g} mm)",
                          relations.fmt(summaries, "z"), relations.fmt(summaries, "z points"),
-                         relations.fmt(summaries, "very weak"), relations.fmt(summaries, "weak"),
+                         relations.fmt(summaries, "very weak"), relations.fmt(summaries, "a'(very weak)"),
+                         relations.fmt(summaries, "weak"),
                          relations.fmt(summaries, "a"), relations.fmt(summaries, "prediction"),
                          relations.fmt(summaries, "q/p")])
     text = (f"Residual state (eps_q >= {cfg.residual[0]:g}) of {cfg.relation_particles} particles, "
             f"{len(cfg.seeds)} seeds (mean ± spread), preparation 'paper', counted four ways: force-bearing contacts only, "
             "or also every pair whose gap is within a threshold (written by the solver up to its alert distance, "
-            f"2% of d_min = {0.02 * D_MIN * 1e3:g} mm). Paper (pentagons): z 3.75, very weak 0.32, weak 0.58, a "
-            "small; (disks): z 3.85, weak 0.62, a ~0.3.\n\n")
-    return text + _table(["shape", "counted", "z", "z points", "very weak", "weak", "a", "(a'+a_n+a_t)/2", "q/p"], rows)
+            f"2% of d_min = {0.02 * D_MIN * 1e3:g} mm). a' of very weak: the signed fabric anisotropy of the "
+            "contacts with f_n < 0.1 <f_n> (negative: across the major principal stress). Paper (pentagons): "
+            "z 3.75, very weak 0.32 with a' < 0, weak 0.58, a small; (disks): z 3.85, weak 0.62, a ~0.3.\n\n")
+    figure = figures.counting(points, figures.figure_path(cfg.output, "counting"))
+    return (text + f"![counting]({os.path.basename(figure)})\n\n"
+            + _table(["shape", "counted", "z", "z points", "very weak", "a' of very weak", "weak", "a",
+                      "(a'+a_n+a_t)/2", "q/p"], rows))
 
 
 def _summaries(cfg, runs, paths, near):
@@ -237,6 +261,7 @@ def main(argv=None):
     output = args.output or (os.path.join(HERE, "RESULTS.md") if not args.quick and wanted == SECTIONS
                              else os.path.join(runs_module.CACHE, f"RESULTS-{'quick-' if args.quick else ''}{'-'.join(wanted)}.md"))
     os.makedirs(os.path.dirname(output), exist_ok=True)
+    cfg.output = output
     from common import machine_description
 
     start = time.perf_counter()

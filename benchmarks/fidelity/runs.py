@@ -29,7 +29,7 @@ class Run:
     preparation: str = "paper"
     seed: int = 0
     velocity: float = 0.01  # m s-1, top wall
-    strain: float = 0.28  # eps_1 of the biaxial test
+    strain: float = 0.2  # eps_1 of the biaxial test (eps_q ~0.6)
     every: int = 400  # steps between snapshots
 
     @property
@@ -50,6 +50,19 @@ class Run:
         return replace(self, **changes)
 
 
+LADDER = {"mu0.1": dict(compaction_friction=0.1), "mu0.2": dict(compaction_friction=0.2)}
+"""Preparations of the study beyond solver.preparation.PRESETS: compaction friction between the
+'frictionless' (0) and 'paper' (0.4) presets."""
+
+
+def preparation_of(run: Run):
+    """The :class:`solver.preparation.Preparation` of ``run`` (a preset, or one of LADDER)."""
+    from solver.preparation import preparation
+
+    base, changes = (run.preparation, {}) if run.preparation not in LADDER else ("paper", LADDER[run.preparation])
+    return preparation(base, particles=run.particles, shape=run.shape, seed=run.seed, **changes)
+
+
 def _log(message):
     print(f"[{time.strftime('%H:%M:%S')}] {message}", flush=True)
 
@@ -57,13 +70,13 @@ def _log(message):
 def make_sample(run: Run, cache=None) -> str:
     """The compacted sample of ``run`` (built and written unless cached); returns its path."""
     from solver.output import Recorder
-    from solver.preparation import preparation, prepare_sample
+    from solver.preparation import prepare_sample
 
     path = run.sample_path(cache)
     if os.path.exists(path):
         return path
     os.makedirs(os.path.dirname(path), exist_ok=True)
-    prep = preparation(run.preparation, particles=run.particles, shape=run.shape, seed=run.seed)
+    prep = preparation_of(run)
     start = time.perf_counter()
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
