@@ -1,0 +1,182 @@
+"""Between the data contract and the peer engines: the sample out, the peers' snapshots in.
+
+Runs in the project's environment (grainview). :func:`sample_to_npz` writes the last snapshot
+of a compacted sample (``grainview run isotropic ...``) as the plain arrays the peer engines
+read; :func:`raw_to_contract` turns a peer's raw snapshots (``peer_common.py``) into a netCDF
+file of the grainview data contract (``docs/schema.md``).
+
+Contract conventions applied here, once for both engines:
+
+* one entry per body pair; ``i < j`` for particle pairs; for a wall contact ``i`` is the
+  particle and ``j = N + w`` (walls bottom, right, top, left), which ``i = min, j = max``
+  gives as well;
+* ``normal``: the unit vector from i to j (the engine's normal, reversed when the engine's
+  first body is j); ``fn``, ``ft``: the components along ``normal`` and ``t = (-n_y, n_x)`` of
+  the resultant force (N) exerted by i on j, i.e. the engine's force on its second body,
+  reversed when its first body is j (fn and ft themselves do not change with the order, only
+  the normal does); ``fn > 0`` is compressive and only pairs with ``fn > 0`` are written;
+* ``kind``: 2 (double) when the engine's manifold holds two points (Box2D ``pointCount == 2``,
+  pymunk ``len(contact_point_set.points) == 2``), else 1 (simple) -- a geometric criterion,
+  as the project's solver's edge-to-edge test, not whether both points carry force;
+* ``point``: the application point of the resultant, the points weighted by their normal
+  forces;
+* ``branch``: ``x_j - x_i`` for particle pairs, ``point - x_i`` for wall contacts.
+
+Besides the required variables the files hold ``velocity``, ``angular_velocity``,
+``wall_position``, ``wall_velocity``, ``wall_force`` (the sum of the contact forces exerted by
+the particles on each wall), ``normal_impulse`` (N s: the normal force of each manifold point
+times dt, 0 for a simple contact's second point, so that a double contact whose two points
+both carry force can be told from one that carries it at one point), ``step`` and
+``max_interpenetration`` (the largest overlap of the configuration measured by this project's
+narrow phase: one metric for every engine).
+"""
+
+from __future__ import annotations
+
+import glob
+import json
+import os
+
+import numpy as np
+
+from grainview.errors import GrainviewError
+
+WALLS = ("bottom", "right", "top", "left")
+WALL_NORMALS = np.array([[0.0, 1.0], [-1.0, 0.0], [0.0, -1.0], [1.0, 0.0]])
+OPTIONAL = ("velocity", "angular_velocity", "wall_position", "wall_velocity", "wall_force", "normal_impulse", "step",
+            "max_interpenetration")
+
+
+def sample_to_npz(nc_path, npz_path):
+    """Write the last snapshot of the compacted sample ``nc_path`` to ``npz_path`` for the peers.
+
+    Keys (SI): position (N, 2) m, angle rad, velocity m/s, angular_velocity rad/s, radius
+    (circumscribed) m, n_vertices (0 disk), mass kg, inertia kg m2, wall_position and
+    wall_velocity (4, 2) for bottom, right, top, left; right_wall_mass kg; sigma0 Pa (the
+    stress of the right wall); friction, wall_friction; time_step s; thickness m.
+    Returns the dict written. Raises GrainviewError (one line) for a file that is not a
+    four-wall box with a stress-driven right wall.
+    """
+    import grainview
+
+    with grainview.open_dataset(nc_path, chunks=None) as ds:
+        names = tuple(str(w) for w in ds["wall"].values) if "wall" in ds.coords else ()
+        if names != WALLS or "wall_position" not in ds or "wall_stress_Pa" not in ds.attrs:
+            raise GrainviewError(f"{nc_path}: not a compacted sample of this project (needs the walls {WALLS}, "
+                                 "wall_position and wall_stress_Pa); make one with `grainview run isotropic`")
+        last = ds.isel(time=-1)
+        out = {name: last[name].values.astype(float) for name in ("position", "angle", "wall_position")}
+        for name, shape in (("velocity", out["position"].shape), ("angular_velocity", out["angle"].shape),
+                            ("wall_velocity", (4, 2))):
+            out[name] = last[name].values.astype(float) if name in ds else np.zeros(shape)
+        for name in ("radius", "mass", "inertia"):
+            out[name] = ds[name].values.astype(float)
+        out["n_vertices"] = ds["n_vertices"].values.astype(np.int32)
+        attrs = ds.attrs
+        out["right_wall_mass"] = float(np.asarray(attrs["wall_mass_kg"])[1])
+        out["sigma0"] = float(np.asarray(attrs["wall_stress_Pa"])[1])
+        out["friction"] = float(attrs["solver_friction"])
+        out["wall_friction"] = float(attrs["solver_wall_friction"])
+        out["time_step"] = float(attrs["solver_time_step"])
+        out["thickness"] = float(attrs.get("thickness_m", 1.0))
+    if out["wall_friction"] != 0.0:
+        raise GrainviewError(f"{nc_path}: wall friction {out['wall_friction']}; the cross-check's walls are "
+                             "frictionless")
+    np.savez(npz_path, **out)
+    return out
+
+
+def contract_contacts(raw, position, dt):
+    """The contract's contact arrays (dict) from one raw snapshot's pair arrays (module doc),
+    with ``normal_impulse`` (M, 2) = the points' normal forces times the time step ``dt`` (s)."""
+    a, b = raw["a"].astype(np.int64), raw["b"].astype(np.int64)
+    n = len(position)
+    swap = a > b
+    i, j = np.where(swap, b, a), np.where(swap, a, b)
+    sign = np.where(swap, -1.0, 1.0)[:, None]
+    normal = raw["normal"] * sign
+    force = raw["force"] * sign  # exerted by i on j
+    normal = normal / np.linalg.norm(normal, axis=1, keepdims=True)
+    tangent = np.stack([-normal[:, 1], normal[:, 0]], -1)
+    fn = np.sum(force * normal, axis=1)
+    ft = np.sum(force * tangent, axis=1)
+    present = np.arange(2)[None, :] < raw["n_points"][:, None]
+    weights = np.where(present, np.maximum(raw["point_fn"], 0.0), 0.0)
+    weights = np.where((weights.sum(1) > 0)[:, None], weights, present.astype(float))
+    points = np.where(present[..., None], raw["points"], 0.0)
+    point = np.sum(points * weights[..., None], axis=1) / np.sum(weights, axis=1)[:, None]
+    centre_i = position[i]
+    branch = np.where((j >= n)[:, None], point - centre_i, position[np.minimum(j, n - 1)] - centre_i)
+    kind = np.where(raw["n_points"] == 2, 2, 1).astype(np.int8)
+    keep = fn > 0
+    order = np.lexsort((j[keep], i[keep]))
+    contacts = dict(i=i, j=j, kind=kind, normal=normal, fn=fn, ft=ft, point=point, branch=branch,
+                    normal_impulse=np.where(present, raw["point_fn"], 0.0) * dt)
+    return {name: value[keep][order] for name, value in contacts.items()}
+
+
+def wall_forces(contacts, n):
+    """(4, 2) total force (N) exerted by the particles on each wall."""
+    out = np.zeros((4, 2))
+    wall = contacts["j"] >= n
+    normal = contacts["normal"][wall]
+    force = (contacts["fn"][wall, None] * normal
+             + contacts["ft"][wall, None] * np.stack([-normal[:, 1], normal[:, 0]], -1))
+    np.add.at(out, contacts["j"][wall] - n, force)
+    return out
+
+
+def largest_overlap(snap, radius, n_vertices):
+    """Largest interpenetration (m) of a snapshot's configuration, by this project's narrow
+    phase (particle pairs within 2 % of the smallest diameter, and the walls)."""
+    from solver import broadphase, narrowphase
+
+    position, angle = snap["position"], snap["angle"]
+    margin = 0.02 * 2 * float(np.min(radius))
+    wall_point, wall_normal = snap["wall_position"], WALL_NORMALS
+    pi, pj = broadphase.candidate_pairs(position, radius, margin)
+    wp, ww = broadphase.wall_candidates(position, radius, wall_point, wall_normal, margin)
+    pts = narrowphase.detect(position, angle, radius, n_vertices, wall_point, wall_normal, margin, pi, pj, wp, ww)
+    return float(max(0.0, -pts.gap.min())) if len(pts.gap) else 0.0
+
+
+def raw_to_contract(raw_dir, sample_npz, out_path, attrs=None):
+    """Write the raw snapshots of ``raw_dir`` (a peer's output) as the contract file
+    ``out_path`` (replaced if it exists); ``attrs`` go to the global attributes with the
+    engine's ``meta.json``. Returns the number of snapshots."""
+    from grainview.schema import SnapshotWriter
+
+    files = sorted(glob.glob(os.path.join(raw_dir, "snap_*.npz")))
+    if not files:
+        raise GrainviewError(f"{raw_dir}: no snapshots (did the engine run?)")
+    with open(os.path.join(raw_dir, "meta.json")) as fh:
+        meta = json.load(fh)
+    with np.load(sample_npz) as data:
+        sample = {k: data[k] for k in data.files}
+    radius, n_vertices = sample["radius"], sample["n_vertices"]
+    n = len(radius)
+    run_attrs = {f"engine_{k}": v for k, v in meta.items()}
+    run_attrs.update({"scene": "biaxial", "sigma0_Pa": float(sample["sigma0"]), "strain_target": meta["strain"],
+                      "wall_velocity_m_s": meta["velocity"], "snapshot_every": meta["every"],
+                      "biaxial_steps": meta["n_steps"], "time_step_s": float(sample["time_step"]),
+                      "friction": float(sample["friction"]), "wall_friction": float(sample["wall_friction"])})
+    run_attrs.update(attrs or {})
+    with SnapshotWriter.create(out_path, radius=radius, n_vertices=n_vertices, mass=sample["mass"],
+                               inertia=sample["inertia"], n_walls=4, wall_names=WALLS, wall_normal=WALL_NORMALS,
+                               optional=OPTIONAL, attrs=run_attrs, overwrite=True) as writer:
+        for path in files:
+            with np.load(path) as data:
+                snap = {k: data[k] for k in data.files}
+            contacts = contract_contacts(snap, snap["position"], float(sample["time_step"]))
+            normal_impulse = np.zeros((writer.n_slots, 2))
+            normal_impulse[:len(contacts["i"])] = contacts.pop("normal_impulse")
+            walls = snap["wall_position"]
+            box_min = np.array([walls[3, 0], walls[0, 1]])
+            box_max = np.array([walls[1, 0], walls[2, 1]])
+            writer.append(time=float(snap["time"]), position=snap["position"], angle=snap["angle"], contacts=contacts,
+                          box_min=box_min, box_max=box_max, velocity=snap["velocity"],
+                          angular_velocity=snap["angular_velocity"], wall_position=walls,
+                          wall_velocity=snap["wall_velocity"], wall_force=wall_forces(contacts, n),
+                          normal_impulse=normal_impulse,
+                          step=int(snap["step"]), max_interpenetration=largest_overlap(snap, radius, n_vertices))
+    return len(files)
