@@ -178,6 +178,7 @@ def _study(args) -> int:
             if path.exists():
                 raise GrainviewError(f"{path} exists; pass --overwrite to replace it")
     out.mkdir(parents=True, exist_ok=True)
+    args.near_contacts = True  # the report counts near pairs as well (docs/fidelity.md)
     kwargs = _simulation_kwargs(args)
     if args.jobs == 1:
         for label in samples:
@@ -227,16 +228,15 @@ def build_parser() -> argparse.ArgumentParser:
         prep.add_argument("--aspect", type=float, default=None, help="h/l of the sample box (default 2)")
         prep.add_argument("--pressure-ramp", type=float, default=None,
                           help="time in s over which sigma0 rises from 0 (default 0: applied at once)")
-        p.add_argument("--near-contacts", action="store_true",
-                       help="also write the pairs within the alert distance that carry no force (with their "
-                       "gap), for the analyses' near= counting")
         p.add_argument("--overwrite", action="store_true", help="replace existing output files")
         p.add_argument("--progress", choices=["auto", "on", "off"], default="auto",
                        help="progress bars (default: on in a terminal)")
 
     study = sub.add_parser("study", help="the paper's study: pentagons vs disks, simulated, analysed, plotted",
                            description="Deposit, compact (10 kPa) and shear an S1-like pentagon sample and an "
-                           "S2-like disk sample, then write the report (table vs the paper, figures).")
+                           "S2-like disk sample into the residual state, side by side, then write the report "
+                           "(table vs the paper, figures). The files hold the near contacts too, so the table "
+                           "also counts them (docs/fidelity.md).")
     study.add_argument("--out", default="study", help="output folder (default: study)")
     study.add_argument("--jobs", type=int, default=2, help="processes: the two samples side by side (default 2)")
     residual_option(study)
@@ -250,6 +250,9 @@ def build_parser() -> argparse.ArgumentParser:
                      help="biaxial (default) or isotropic (writes the compacted state)")
     run.add_argument("--shape", default="pentagon", help="pentagon (default), disk, or a number of vertices")
     run.add_argument("--out", default="run.nc", help="output netCDF file (default: run.nc)")
+    run.add_argument("--near-contacts", action="store_true",
+                     help="also write the pairs within the alert distance that carry no force (with their "
+                     "gap), for the analyses' near= counting (the study always does)")
     simulation_options(run)
     run.set_defaults(func=_run)
 

@@ -34,6 +34,7 @@ PAPER = {
         "a_n (residual)": "larger than disks", "a_t (residual)": "close to a_n",
         "(a' + a_n + a_t)/2 (residual)": "~q/p", "alpha (strong-force pdf)": 0.74, "weak fraction": 0.58,
         "very weak fraction": 0.32, "very weak simple": 0.25, "very weak double": 0.07,
+        "z, near pairs (residual)": 3.75, "very weak fraction, near pairs": 0.32, "a, near pairs (residual)": "small",
         "k_s": "> k_d", "k_d": "~0.47 (implied)", "q_s/p": "q_d/p / 2-3", "q_d/p": "2-3 q_s/p", "f_d / f_s": 1.5,
         "k_s^S / k_d^S": 0.5, "k_s^W / k_d^W": 2.0,
     },
@@ -43,6 +44,7 @@ PAPER = {
         "a_n (residual)": "smaller than pentagons", "a_t (residual)": "about a_n/2",
         "(a' + a_n + a_t)/2 (residual)": "~q/p", "alpha (strong-force pdf)": 1.4, "weak fraction": 0.62,
         "very weak fraction": "-", "very weak simple": "-", "very weak double": "-",
+        "z, near pairs (residual)": 3.85, "very weak fraction, near pairs": "-", "a, near pairs (residual)": "~0.3",
         "k_s": 1.0, "k_d": 0.0, "q_s/p": "= q/p", "q_d/p": 0.0, "f_d / f_s": "-", "k_s^S / k_d^S": "-",
         "k_s^W / k_d^W": "-",
     },
@@ -54,6 +56,10 @@ for _paper in PAPER.values():
                    "double-contact criterion": "LMGC90 shadow overlap (docs/fidelity.md)"})
 
 INITIAL_ROWS = ("solid fraction (initial)", "z (initial)")
+NEAR_FRACTION = 0.01
+"""The report's near-contact rows count the pairs within this fraction of the smallest
+diameter (docs/fidelity.md, section 5)."""
+NEAR_ROWS = ("z, near pairs (residual)", "very weak fraction, near pairs", "a, near pairs (residual)")
 """Rows read on the first snapshot; every other number row is a residual-state mean."""
 
 
@@ -133,7 +139,27 @@ def run_summary(ds: xr.Dataset, residual_strain: float = RESIDUAL_STRAIN) -> dic
         "k_s^S / k_d^S": _ratio(prop["k_s_strong"], prop["k_d_strong"]),
         "k_s^W / k_d^W": _ratio(prop["k_s_weak"], prop["k_d_weak"]),
     })
+    out.update(_near_rows(res))
     return out
+
+
+def _near_rows(res: xr.Dataset) -> dict:
+    """The residual z, very weak fraction and fabric a with the near pairs within
+    :data:`NEAR_FRACTION` of the smallest diameter counted, when the file holds them ("-"
+    otherwise)."""
+    from .contacts import check_near
+
+    gap = NEAR_FRACTION * 2.0 * float(res["radius"].min())
+    try:
+        check_near(res, gap)
+    except ParameterError:
+        return {key: "- (no near pairs in the file)" for key in NEAR_ROWS}
+    prop = res.grain.contact_proportions(near=gap).mean("time").compute()
+    return {
+        "z, near pairs (residual)": float(res.grain.coordination(near=gap)["z"].mean("time")),
+        "very weak fraction, near pairs": float(prop["very_weak_fraction"]),
+        "a, near pairs (residual)": float(res.grain.fabric_anisotropy(near=gap)["a"].mean("time")),
+    }
 
 
 def headline_table(runs: dict, residual_strain: float = RESIDUAL_STRAIN) -> pd.DataFrame:

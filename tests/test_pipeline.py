@@ -51,6 +51,13 @@ def test_table_equals_the_accessors(study):
         assert column["weak fraction"] == pytest.approx(float(prop["weak_fraction"]), rel=1e-12)
         assert column["k_s"] == pytest.approx(float(prop["k_s"]), rel=1e-12)
         assert column["k_d"] == pytest.approx(float(prop["k_d"]), rel=1e-12)
+        # the study writes near pairs, and the table counts those within 1% of d_min too
+        gap = 0.01 * 2 * float(ds.radius.min())
+        assert column["z, near pairs (residual)"] == pytest.approx(
+            float(res.grain.coordination(near=gap)["z"].mean()), rel=1e-12)
+        # counting near pairs adds contacts to every snapshot, never removes one
+        counted = res.grain.contact_proportions(near=gap)["n_contacts"].values
+        assert np.all(counted >= res.grain.contact_proportions()["n_contacts"].values)
         q_d = res.grain.stress_invariants(kind="double")["q_over_p"].mean()
         assert column["q_d/p"] == pytest.approx(float(q_d), rel=1e-12)
     assert table.loc["q/p (residual)", "pentagons (paper)"] == "0.35"

@@ -220,26 +220,64 @@ def _summaries(cfg, runs, paths, near):
     return out
 
 
+RELATION_COLUMNS = [
+    ("paper", "paper", None), ("paper", "paper", RELATION_NEAR), ("frictionless", "frictionless", None),
+    ("paper", "frictionless", None), ("paper", "frictionless", RELATION_NEAR),
+]
+"""(pentagons' preparation, disks' preparation, near-contact threshold as a fraction of D_MIN) of
+each column: both shapes prepared alike, and the mix that gives the paper's S1 and S2 initial
+states (pentagons compacted with friction, disks without; see the preparations section)."""
+
+
+def _engine_summaries(cfg):
+    """Per-shape summaries of the independent engines' runs of benchmarks/crosscheck (the largest
+    iteration budget of each engine), when that command has been run; else {}."""
+    import glob
+
+    root = os.path.join(os.path.dirname(HERE), "_data", "crosscheck", "runs")
+    out = {}
+    for engine in ("box2d", "pymunk"):
+        per_shape = {}
+        for shape in ("pentagon", "disk"):
+            files = sorted(glob.glob(os.path.join(root, f"{shape}400_seed0_strain0.2*_every*", f"{engine}_*.nc")))
+            files = [f for f in files if os.path.isfile(f)]
+            if not files:
+                break
+            best = max(files, key=lambda f: int("".join(c for c in os.path.basename(f).split("_")[1] if c.isdigit())))
+            summary = measure.window_means(best, cfg.residual)
+            summary["solid fraction initial"] = measure.initial_state(best)["solid fraction"]
+            per_shape[shape] = ([summary], os.path.basename(best)[:-3])
+        if len(per_shape) == 2:
+            out[engine] = per_shape
+    return out
+
+
 def section_relations(cfg, jobs):
+    groups = {prep: _relation_runs(cfg, prep) for prep in ("paper", "frictionless")}
+    paths = ensure([r for g in groups.values() for runs in g.values() for r in runs], jobs)
     columns = []
-    for preparation in ("paper", "frictionless"):
-        groups = _relation_runs(cfg, preparation)
-        paths = ensure([r for runs in groups.values() for r in runs], jobs)
-        for near in (None, RELATION_NEAR * D_MIN):
-            label = f"'{preparation}', " + ("force-bearing" if near is None else f"near {RELATION_NEAR:.0%} d_min")
-            results = relations.evaluate(_summaries(cfg, groups["pentagon"], paths, near),
-                                         _summaries(cfg, groups["disk"], paths, near))
-            columns.append((label, results))
+    for p_prep, d_prep, near in RELATION_COLUMNS:
+        gap = None if near is None else near * D_MIN
+        prep = f"'{p_prep}'" if p_prep == d_prep else f"P '{p_prep}', D '{d_prep}' (S1/S2)"
+        label = f"{prep}, " + ("force-bearing" if near is None else f"near {near:.0%} d_min")
+        results = relations.evaluate(_summaries(cfg, groups[p_prep]["pentagon"], paths, gap),
+                                     _summaries(cfg, groups[d_prep]["disk"], paths, gap))
+        columns.append((label, results))
+    if not cfg.quick:
+        for engine, per_shape in _engine_summaries(cfg).items():
+            label = f"{engine} ({per_shape['pentagon'][1]}, 400 particles, 1 seed)"
+            columns.append((label, relations.evaluate(per_shape["pentagon"][0], per_shape["disk"][0])))
     header = ["relation", "paper"] + [label for label, _ in columns]
     rows = []
     for k, (name, paper, *_rest) in enumerate(columns[0][1]):
         rows.append([name, paper] + [f"{'holds' if res[k][3] else 'FAILS'}: {res[k][2]}" for _, res in columns])
-    held = ", ".join(f"{label}: {sum(r[3] for r in res)}/12" for label, res in columns)
+    held = "; ".join(f"{label}: {sum(r[3] for r in res)}/12" for label, res in columns)
     text = (f"N = {cfg.relation_particles} per shape, residual window eps_q >= {cfg.residual[0]:g}, seeds "
             f"{', '.join(map(str, cfg.seeds))} (mean ± sample standard deviation), top wall at "
-            f"{cfg.velocity(cfg.relation_particles) * 100:g} cm/s (strain rate ~0.01 s-1). "
-            f"Relations that hold: {held}. The independent engines' column is in docs/fidelity.md "
-            "(benchmarks/crosscheck, 400 particles).\n\n")
+            f"{cfg.velocity(cfg.relation_particles) * 100:g} cm/s (strain rate ~0.01 s-1). Columns: the preparation "
+            "of each shape and the counting convention; the last columns, where present, are the independent "
+            "engines of benchmarks/crosscheck on this solver's 400-particle samples. Relations that hold: "
+            f"{held}.\n\n")
     return text + _table(header, rows)
 
 
