@@ -38,7 +38,8 @@ class Run:
 
     @property
     def name(self) -> str:
-        return f"{self.sample_name}_v{self.velocity * 100:g}cm_e{self.strain:g}"
+        every = "" if self.every == Run.every else f"_k{self.every}"
+        return f"{self.sample_name}_v{self.velocity * 100:g}cm_e{self.strain:g}{every}"
 
     def sample_path(self, cache=None) -> str:
         return os.path.join(cache or CACHE, "samples", self.sample_name + ".nc")
