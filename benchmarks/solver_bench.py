@@ -645,7 +645,7 @@ def _stress_run(sim, steps, source):
                     and np.all(np.isfinite(sim.impulse))):
                 finite = False
                 break
-    warned = sum("did not converge" in str(w.message) for w in caught)
+    warned = sum(issubclass(w.category, ConvergenceWarning) for w in caught)
     energy = np.array(energy)
     return ["yes" if finite else "NO", fmt(overlap / d), fmt(sim.last.max_interpenetration / d),
             f"{bad} / {steps} ({warned} warned)", iters, fmt(energy.max()), fmt(energy[-1]), source,

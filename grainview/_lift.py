@@ -8,7 +8,6 @@ dimension (``time``) is broadcast, and a dask-backed input gives a lazy result c
 
 from __future__ import annotations
 
-import numpy as np
 import xarray as xr
 
 TENSOR_DIMS = ("xy_a", "xy_b")
@@ -55,9 +54,4 @@ def with_attrs(da: xr.DataArray, name: str, units: str, long_name: str, **extra)
     return da
 
 
-def scalar_ufunc(func, *args):
-    """Elementwise numpy ``func`` on DataArrays, lazily (attributes are dropped)."""
-    return xr.apply_ufunc(func, *args, dask="allowed")
-
-
-__all__ = ["apply", "with_attrs", "scalar_ufunc", "TENSOR_DIMS", "np"]
+__all__ = ["apply", "with_attrs", "TENSOR_DIMS"]

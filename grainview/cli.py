@@ -10,7 +10,7 @@ import argparse
 import sys
 from pathlib import Path
 
-from .errors import GrainviewError
+from .errors import ConvergenceWarning, GrainviewError
 
 RESIDUAL_STRAIN = 0.3
 """Default start of the residual window (eps_q); the same as grainview.strain.RESIDUAL_STRAIN,
@@ -115,7 +115,7 @@ def _simulate(prep, path, *, strain, every, velocity, near_contacts, overwrite, 
             print(f"{name}: biaxial compression to eps_1 = {strain} at {velocity:g} m/s ...", flush=True)
             biaxial_test(sim, path, strain=strain, every=every, velocity=velocity, overwrite=overwrite,
                          progress=progress, attrs=attrs, near_contacts=near_contacts)
-    unconverged = sum("did not converge" in str(w.message) for w in caught)
+    unconverged = sum(issubclass(w.category, ConvergenceWarning) for w in caught)
     if unconverged:
         print(f"{name}: warning: NLGS reached its iteration limit in {unconverged} step(s)", file=sys.stderr)
     print(f"{name}: wrote {path}", flush=True)

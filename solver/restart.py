@@ -41,7 +41,7 @@ from dataclasses import fields
 
 import numpy as np
 
-from grainview.errors import FileFormatError, GrainviewError
+from grainview.errors import ConvergenceWarning, FileFormatError, GrainviewError
 
 from .stepper import Parameters, Simulation
 from .walls import Walls
@@ -222,9 +222,9 @@ def main(argv=None) -> int:
     except KeyboardInterrupt:
         return 130
     for w in caught:
-        if "did not converge" not in str(w.message):
+        if not issubclass(w.category, ConvergenceWarning):
             warnings.showwarning(w.message, w.category, w.filename, w.lineno)
-    unconverged = sum("did not converge" in str(w.message) for w in caught)
+    unconverged = sum(issubclass(w.category, ConvergenceWarning) for w in caught)
     if unconverged:
         print(f"warning: NLGS reached its iteration limit in {unconverged} step(s)", file=sys.stderr)
     print(f"{args.path}: {'already complete' if steps == 0 else f'resumed for {steps} steps, complete'}")

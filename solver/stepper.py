@@ -27,7 +27,7 @@ from grainview.errors import ConvergenceWarning, ParameterError
 
 from . import broadphase, narrowphase, nlgs
 from .shapes import mass_and_inertia
-from .walls import STRESS, VELOCITY, Walls
+from .walls import FIXED, STRESS, VELOCITY, Walls
 
 
 def _cross2(r, normal):
@@ -144,7 +144,6 @@ class Simulation:
         self.skin = p.skin if p.skin is not None else 0.1 * diameter
         self.time = 0.0
         self.step_index = 0
-        self.has_polygons = bool(np.any(self.n_vertices > 0))
         self._anchor = None  # positions at the last broad phase
         self._wall_anchor = None  # wall positions at the last broad phase
         self.reuse_detection = True  # reuse broad-phase candidates while nothing moved skin/2
@@ -262,7 +261,7 @@ class Simulation:
     def step(self) -> StepInfo:
         p = self.parameters
         h, theta = p.time_step, p.theta
-        n, w = self.n_particles, self.n_walls
+        n = self.n_particles
         self.step_alert = self.alert_for_step()
         pts = self.detect()
         keys = self._point_keys(pts)
@@ -322,7 +321,7 @@ class Simulation:
                           ConvergenceWarning, stacklevel=2)
         v_end = np.stack([vx, vy], -1)
         v_end[n + velocity_walls] = self.walls.velocity[velocity_walls]
-        fixed = np.flatnonzero(self.walls.mode == 0)
+        fixed = np.flatnonzero(self.walls.mode == FIXED)
         v_end[n + fixed] = 0.0
         if stress_walls.size:  # cap the inward speed of pushed walls (closing a loose sample)
             inward = np.sum(v_end[n + stress_walls] * self.walls.normal[stress_walls], axis=1)

@@ -96,11 +96,6 @@ class Walls:
         self.mass[k] = mass
         self.max_speed[k] = max_speed
 
-    def fix(self, name):
-        k = self.index(name)
-        self.mode[k] = FIXED
-        self.velocity[k] = 0.0
-
     def box_bounds(self):
         """(box_min, box_max) from the box walls; from the walls' points otherwise."""
         if set(BOX_NAMES) <= set(self.names):

@@ -33,6 +33,7 @@ def main(argv=None):
     args = parser.parse_args(argv)
 
     import solver
+    from grainview.errors import ConvergenceWarning
 
     sim = solver.load_sample(args.sample)
     if not math.isfinite(sim.sigma0):  # samples written before isotropic files recorded sigma0_Pa
@@ -44,7 +45,7 @@ def main(argv=None):
                                       overwrite=True, progress=False,
                                       attrs={"engine_engine": "project", "engine_version": solver.__version__})
     elapsed = time.perf_counter() - start
-    capped = sum("did not converge" in str(w.message) for w in caught)
+    capped = sum(issubclass(w.category, ConvergenceWarning) for w in caught)
     meta = dict(engine="project", version=solver.__version__, n_steps=n_steps, wall_s=elapsed,
                 nlgs_capped_steps=capped, tolerance=sim.parameters.tolerance,
                 max_iterations=sim.parameters.max_iterations, sweeps=sim.counters["sweeps"],

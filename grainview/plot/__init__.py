@@ -123,12 +123,6 @@ class PlotAccessor:
     contact_kinds = _delegate(plot_contact_kinds)
 
 
-def attach(accessor_cls) -> None:
-    """Give ``accessor_cls`` (e.g. GrainAccessor, which holds the dataset as ``_ds``) a
-    ``plot`` property returning :class:`PlotAccessor` of its dataset."""
-    accessor_cls.plot = property(lambda self: PlotAccessor(self._ds), doc=PlotAccessor.__doc__)
-
-
-__all__ = ["PlotAccessor", "attach", "save_figure", "FIGURES", *(f.__name__ for f in FIGURES.values()),
+__all__ = ["PlotAccessor", "save_figure", "FIGURES", *(f.__name__ for f in FIGURES.values()),
            "plot_particles", "plot_normal_force_polar", "plot_tangential_force_polar", "plot_force_anisotropy",
            "plot_force_pdf", "plot_force_pdf_by_kind"]
