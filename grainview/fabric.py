@@ -33,7 +33,9 @@ def fabric_tensor(ds: xr.Dataset, kind="all", walls: bool = False, near=None) ->
                  names=["fabric"], attrs={"units": "1", "long_name": f"fabric tensor{label}"})
 
 
-def _reference_direction(ds, reference):
+def reference_direction(ds, reference):
+    """The reference direction theta' of a signed anisotropy (rad): ``"stress"``/None for the
+    major principal stress direction of the whole sample, an angle, or a DataArray over time."""
     if reference is None or (isinstance(reference, str) and reference == "stress"):
         return stress_direction(ds)
     if isinstance(reference, (int, float, np.floating)):
@@ -53,7 +55,7 @@ def fabric_anisotropy(ds: xr.Dataset, kind="all", walls: bool = False, reference
     """
     f1, f2, theta = apply(principal, fabric_tensor(ds, kind, walls, near), core_dims=[TENSOR_DIMS],
                           output_core_dims=[(), (), ()])
-    ref = _reference_direction(ds, reference)
+    ref = reference_direction(ds, reference)
     a_prime = signed_anisotropy(f1, f2, theta, ref, normalisation=1.0)
     return xr.Dataset({
         "a": with_attrs(2 * (f1 - f2), "a", "1", "fabric anisotropy a = 2 (F1 - F2)"),
@@ -65,7 +67,7 @@ def fabric_anisotropy(ds: xr.Dataset, kind="all", walls: bool = False, reference
 def orientation_pdf(ds: xr.Dataset, bins: int = 36, kind="all", walls: bool = False, near=None) -> xr.DataArray:
     """P(theta) (time, theta): density of contact-normal orientations on [0, pi), rad-1,
     normalised so that sum P dtheta = 1 (paper Fig. 8)."""
-    bins = _check_bins(bins)
+    bins = check_bins(bins)
     mask = selection(ds, walls=walls, kind=kind, near=near)
     da = apply(_fabric.orientation_pdf, ds["normal"], mask, core_dims=[("contact", "xy"), ("contact",)],
                output_core_dims=[("theta",)], output_sizes={"theta": bins}, kwargs={"n_bins": bins},
@@ -80,7 +82,8 @@ def theta_coord(bins: int) -> xr.DataArray:
     return xr.DataArray(centres, dims="theta", attrs={"units": "rad", "long_name": "contact orientation theta"})
 
 
-def _check_bins(bins) -> int:
+def check_bins(bins) -> int:
+    """Validate a number of angular sectors (a positive integer)."""
     if not isinstance(bins, (int, np.integer)) or bins < 1:
         raise ParameterError(f"bins={bins!r}: expected a positive integer number of angular sectors")
     return int(bins)

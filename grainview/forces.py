@@ -14,7 +14,7 @@ from ._lift import TENSOR_DIMS, apply, with_attrs
 from .arrays import forces as _forces
 from .arrays.tensors import principal
 from .contacts import selection
-from .fabric import _check_bins, _reference_direction, fabric_anisotropy, theta_coord
+from .fabric import check_bins, reference_direction, fabric_anisotropy, theta_coord
 from .stress import stress_invariants
 
 CONTACT_ARGS = [("contact",), ("contact",), ("contact", "xy"), ("contact",)]
@@ -24,7 +24,7 @@ def angular_force_averages(ds: xr.Dataset, bins: int = 36, kind="all", walls: bo
     """<f_n>(theta), <f_t>(theta) (N) and N_c(theta) on ``bins`` sectors of [0, pi)
     (paper Eq. fnft, Fig. 10); NaN in empty sectors. ``near``: which pairs are contacts
     (:func:`grainview.contacts.in_network`; default force-bearing only)."""
-    bins = _check_bins(bins)
+    bins = check_bins(bins)
     mask = selection(ds, walls=walls, kind=kind, near=near)
     fn, ft, count = apply(_forces.angular_averages, ds["fn"], ds["ft"], ds["normal"], mask,
                           core_dims=CONTACT_ARGS, output_core_dims=[("theta",)] * 3,
@@ -38,7 +38,7 @@ def angular_force_averages(ds: xr.Dataset, bins: int = 36, kind="all", walls: bo
 
 def force_tensors(ds: xr.Dataset, bins: int = 36, kind="all", walls: bool = False, near=None) -> xr.Dataset:
     """H^(n) and H^(t) (time, xy_a, xy_b) in N (docs/conventions.md §3)."""
-    bins = _check_bins(bins)
+    bins = check_bins(bins)
     mask = selection(ds, walls=walls, kind=kind, near=near)
     h_n, h_t = apply(_forces.force_tensors, ds["fn"], ds["ft"], ds["normal"], mask,
                      core_dims=CONTACT_ARGS, output_core_dims=[TENSOR_DIMS, TENSOR_DIMS],
@@ -58,7 +58,7 @@ def force_anisotropies(ds: xr.Dataset, bins: int = 36, kind="all", walls: bool =
     n1, n2, theta_n = apply(principal, h["H_n"], core_dims=[TENSOR_DIMS], output_core_dims=[(), (), ()])
     t1, t2, theta_t = apply(principal, h["H_t"], core_dims=[TENSOR_DIMS], output_core_dims=[(), (), ()])
     trace = n1 + n2
-    ref = _reference_direction(ds, reference)
+    ref = reference_direction(ds, reference)
     a_n = 2 * (n1 - n2) / trace
     a_t = 2 * (t1 - t2) / trace
     return xr.Dataset({
