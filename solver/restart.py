@@ -34,7 +34,6 @@ from __future__ import annotations
 
 import argparse
 import os
-import shlex
 import sys
 import warnings
 from dataclasses import fields
@@ -43,6 +42,8 @@ import numpy as np
 
 from grainview.errors import ConvergenceWarning, FileFormatError, GrainviewError
 
+from .output import Recorder
+from .scenes import biaxial_steps
 from .stepper import Parameters, Simulation
 from .walls import Walls
 
@@ -51,13 +52,6 @@ STATE_VARIABLES = ("velocity", "angular_velocity", "wall_normal", "wall_position
 """Variables a file needs, besides the required ones, to be resumed."""
 WALL_ATTRIBUTES = ("wall_mode", "wall_stress_Pa", "wall_mass_kg", "wall_max_speed_m_s", "wall_length_axis")
 BIAXIAL_ATTRIBUTES = ("strain_target", "wall_velocity_m_s", "snapshot_every", "biaxial_steps")
-
-
-def resume_instructions(path) -> str:
-    """How to resume the run written to ``path``: the shell command and the Python call."""
-    path = os.path.abspath(os.fspath(path))
-    return (f"resume it with:  {shlex.quote(sys.executable)} -m solver.restart {shlex.quote(path)}\n"
-            f"or in Python:    from solver.restart import resume; resume({path!r})")
 
 
 def _parameters(attrs, source) -> Parameters:
@@ -193,9 +187,6 @@ def resume(path, progress=None) -> int:
     docstring). Ctrl-C stops again after the current step, with instructions to resume.
     ``progress``: a tqdm bar (None: when stderr is a terminal).
     """
-    from .output import Recorder
-    from .scenes import biaxial_steps
-
     sim, test = load_state(path)
     first = sim.step_index - test["first_step"] + 1
     if first > test["n_steps"]:

@@ -6,15 +6,12 @@ parameter whose default is the paper's.
 
 from __future__ import annotations
 
-import contextlib
-import signal
 import sys
 
 import numpy as np
-from tqdm.auto import tqdm
-
 from grainview.errors import ParameterError
 
+from .interrupt import interruptible, progress_bar, resume_instructions
 from .output import Recorder
 from .packing import PAPER_DIAMETERS, PAPER_FRACTIONS, box_width_for, deposit
 from .stepper import Parameters, Simulation
@@ -33,29 +30,6 @@ def n_vertices_of(shape) -> int:
     if n != 0 and n < 3:
         raise ParameterError(f"shape={shape!r}: a polygon needs at least 3 vertices (0 for disks)")
     return n
-
-
-@contextlib.contextmanager
-def interruptible():
-    """Turn Ctrl-C into a flag checked between steps, so a run stops after a whole step."""
-    state = {"stop": False}
-    if sys.platform == "win32" or signal.getsignal(signal.SIGINT) is None:
-        yield state
-        return
-    try:
-        previous = signal.signal(signal.SIGINT, lambda *_: state.__setitem__("stop", True))
-    except ValueError:  # not the main thread
-        yield state
-        return
-    try:
-        yield state
-    finally:
-        signal.signal(signal.SIGINT, previous)
-
-
-def _progress(total, desc, progress):
-    enabled = sys.stderr.isatty() if progress is None else bool(progress)
-    return tqdm(total=total, desc=desc, unit="step", disable=not enabled, leave=False)
 
 
 def gravity_scene(position, angle, radius, n_vertices, *, gravity=9.81, tilt=0.0, sides=None,
@@ -158,7 +132,7 @@ def isotropic_compaction(sim: Simulation, *, max_steps=40000, window=200, stress
     stresses, rates = deque(maxlen=window), deque(maxlen=window)
     largest_inertia = 0.0
     sim.settled = False
-    with interruptible() as flag, _progress(max_steps, "isotropic compaction", progress) as bar:
+    with interruptible() as flag, progress_bar(max_steps, "isotropic compaction", progress) as bar:
         for k in range(max_steps):
             if k < ramp_steps:
                 sim.walls.stress[driven] = target * (k + 1) / ramp_steps
@@ -228,9 +202,7 @@ def biaxial_steps(sim: Simulation, recorder, *, first, n_steps, every, progress=
     with a snapshot every ``every`` steps and at the last one; shared by :func:`biaxial_test`
     and :func:`solver.restart.resume`. Ctrl-C stops after the current step (its snapshot
     written if one is due) and prints how to resume; then raises KeyboardInterrupt."""
-    from .restart import resume_instructions
-
-    with interruptible() as flag, _progress(n_steps, "biaxial test", progress) as bar:
+    with interruptible() as flag, progress_bar(n_steps, "biaxial test", progress) as bar:
         bar.update(first - 1)
         for k in range(first, n_steps + 1):
             sim.step()
