@@ -122,15 +122,23 @@ def sample_attrs(path) -> dict:
         return {k: v for k, v in ds.attrs.items() if k.startswith(("preparation_", "compaction_"))}
 
 
+def _simulate_sample_group(group, cache=None):
+    """Compact one sample (unless cached) and run every test of it, one after the other."""
+    return [simulate(run, cache) for run in group]
+
+
 def ensure(runs, jobs=2, cache=None) -> dict:
-    """Simulate the missing ``runs`` (``jobs`` processes) and return {run: path}. Samples are
-    built first, so that two tests of one sample never compact it twice."""
+    """Simulate the missing ``runs`` (``jobs`` processes) and return {run: path}. The runs of
+    one sample go to one process, so that no sample is compacted twice; the longest groups
+    start first."""
     runs = list(dict.fromkeys(runs))
     missing = [r for r in runs if not os.path.exists(r.path(cache))]
     if missing:
-        samples = list({r.sample_name: r for r in missing if not os.path.exists(r.sample_path(cache))}.values())
-        _log(f"{len(missing)} runs to simulate ({len(samples)} samples to compact), {jobs} at a time")
+        groups = {}
+        for r in missing:
+            groups.setdefault(r.sample_name, []).append(r)
+        order = sorted(groups.values(), key=lambda g: -sum(r.particles / r.velocity for r in g))
+        _log(f"{len(missing)} runs to simulate ({len(groups)} samples), {jobs} at a time")
         with ProcessPoolExecutor(max_workers=jobs) as pool:
-            list(pool.map(make_sample, samples, [cache] * len(samples)))
-            list(pool.map(simulate, missing, [cache] * len(missing)))
+            list(pool.map(_simulate_sample_group, order, [cache] * len(order)))
     return {r: r.path(cache) for r in runs}
