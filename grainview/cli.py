@@ -123,7 +123,7 @@ def _simulate(prep, path, *, strain, every, velocity, near_contacts, overwrite, 
 
 
 def prep_name(prep) -> str:
-    """The preset a preparation is, or "custom"."""
+    """The preset a preparation is (the first that matches), or "custom"."""
     from solver.preparation import PRESETS
 
     core = {k: v for k, v in prep.__dict__.items() if k not in ("particles", "shape", "seed")}
@@ -207,7 +207,7 @@ def build_parser() -> argparse.ArgumentParser:
                        "a run short of it reports 'not reached'")
 
     def simulation_options(p, particles=400, strain=DEFAULT_STRAIN, every=200):
-        from solver.preparation import PRESETS
+        from solver.preparation import preset_names
 
         p.add_argument("--particles", type=int, default=particles, help=f"particles per sample (default {particles})")
         p.add_argument("--strain", type=float, default=strain,
@@ -218,9 +218,10 @@ def build_parser() -> argparse.ArgumentParser:
         p.add_argument("--every", type=int, default=every, help=f"steps between snapshots (default {every})")
         p.add_argument("--seed", type=int, default=0, help="random seed of the deposit (default 0)")
         prep = p.add_argument_group("sample preparation (docs/fidelity.md)")
-        prep.add_argument("--preparation", choices=sorted(PRESETS), default="paper",
+        prep.add_argument("--preparation", choices=preset_names(), default="paper",
                           help="named preparation (default paper: compaction with friction 0.4, walls closing "
-                          "at up to 5 cm/s); the options below change it")
+                          "at up to 5 cm/s; s1s2: pentagons so, disks frictionless, the paper's initial "
+                          "states); the options below change it")
         prep.add_argument("--compaction-friction", type=float, default=None,
                           help="grain friction during compaction (default: the test's 0.4)")
         prep.add_argument("--max-inertia-number", type=float, default=None,

@@ -92,14 +92,33 @@ friction 0 (then 0.4 for the test); ``quasistatic`` caps the closing walls at I 
 (about 6 mm/s for 400 particles, ten times slower than ``paper``)."""
 
 
+BY_SHAPE = {"s1s2": {"pentagon": "paper", "disk": "frictionless"}}
+"""Presets that differ by shape: ``s1s2`` gives each shape the preparation that reproduces the
+paper's initial state of its sample (S1 pentagons: compaction friction 0.4; S2 disks: 0;
+docs/fidelity.md, section 2)."""
+
+
+def preset_names():
+    """Every name :func:`preparation` accepts."""
+    return sorted(PRESETS) + sorted(BY_SHAPE)
+
+
 def preparation(name_or_prep="paper", **changes) -> Preparation:
-    """A :class:`Preparation` from a preset name (or an instance) with ``changes`` applied."""
+    """A :class:`Preparation` from a preset name (or an instance) with ``changes`` applied.
+    A preset of :data:`BY_SHAPE` needs ``shape`` among the changes."""
     if isinstance(name_or_prep, Preparation):
         prep = name_or_prep
     elif name_or_prep in PRESETS:
         prep = PRESETS[name_or_prep]
+    elif name_or_prep in BY_SHAPE:
+        shape = changes.get("shape")
+        key = {"disks": "disk", "pentagons": "pentagon"}.get(shape, shape)
+        if key not in BY_SHAPE[name_or_prep]:
+            raise ParameterError(f"preparation={name_or_prep!r} is defined for the shapes "
+                                 f"{sorted(BY_SHAPE[name_or_prep])}, not for shape={shape!r}")
+        prep = PRESETS[BY_SHAPE[name_or_prep][key]]
     else:
-        raise ParameterError(f"preparation={name_or_prep!r}: expected one of {sorted(PRESETS)} or a Preparation")
+        raise ParameterError(f"preparation={name_or_prep!r}: expected one of {preset_names()} or a Preparation")
     return replace(prep, **{k: v for k, v in changes.items() if v is not None}).validate()
 
 

@@ -93,3 +93,10 @@ def test_bad_preparations_say_what_is_wrong(changes, match):
 def test_unknown_preset():
     with pytest.raises(ParameterError, match="expected one of"):
         preparation("dense")
+
+
+def test_the_s1s2_preset_prepares_each_shape_as_the_paper_s_sample():
+    assert preparation("s1s2", shape="pentagon").compaction_friction is None  # the test's 0.4
+    assert preparation("s1s2", shape="disk", particles=50).compaction_friction == 0.0
+    with pytest.raises(ParameterError, match="s1s2"):
+        preparation("s1s2", shape=7)
