@@ -224,24 +224,25 @@ def _slug(label: str) -> str:
     return "".join(c if c.isalnum() else "_" for c in label).strip("_").lower() or "run"
 
 
-def caption(label: str, ds: xr.Dataset, snapshot: bool, residual_strain: float = RESIDUAL_STRAIN,
-            time=-1) -> str:
+def caption(label: str, ds: xr.Dataset, what: str, residual_strain: float = RESIDUAL_STRAIN, time=-1) -> str:
     """One line saying what a figure shows of run ``label``: N and shape, seed, preparation,
-    and the snapshot (maps) or the residual window the distributions average over."""
+    and, by ``what``: "map" the snapshot drawn, "distribution" the residual window averaged
+    over, anything else the range of the evolution."""
     from .plot._style import residual_snapshots
+    from .strain import strains
 
     n_vertices = ds["n_vertices"].values
     shape = "disks" if not n_vertices.any() else f"{int(n_vertices.max())}-gons"
     seed = ds.attrs.get("preparation_seed", ds.attrs.get("solver_seed", "?"))
     preparation = ds.attrs.get("preparation_name", "unknown")
-    if snapshot:
-        from .strain import strains
-
-        eps_q = float(strains(ds)["eps_q"].isel(time=time))
-        what = f"snapshot {time} (eps_q = {eps_q:.3f})"
+    eps_q = strains(ds)["eps_q"]
+    if what == "map":
+        shown = f"snapshot {time} (eps_q = {float(eps_q.isel(time=time)):.3f})"
+    elif what == "distribution":
+        shown = f"averaged over the {residual_snapshots(ds, residual_strain).attrs['window']}"
     else:
-        what = f"distributions: {residual_snapshots(ds, residual_strain).attrs['window']}"
-    return f"{label}: N = {ds.sizes['particle']} {shape}, seed {seed}, preparation '{preparation}'; {what}"
+        shown = f"every snapshot, eps_q 0-{float(eps_q.max()):.2f} ({ds.sizes['time']} snapshots)"
+    return f"{label}: N = {ds.sizes['particle']} {shape}, seed {seed}, preparation '{preparation}'; {shown}"
 
 
 def write_figures(runs: dict, out: Path, time=-1, residual_strain: float = RESIDUAL_STRAIN) -> list[Path]:
@@ -278,8 +279,8 @@ def write_figures(runs: dict, out: Path, time=-1, residual_strain: float = RESID
                 kwargs["time"] = Residual(residual_strain)
             result = func(data if number not in MAP_FIGURES else next(iter(data.values())), **kwargs)
             fig = result if hasattr(result, "savefig") else result.figure
-            add_caption(fig, [caption(label, ds, number in MAP_FIGURES, residual_strain, time)
-                              for label, ds in data.items()])
+            what = "map" if number in MAP_FIGURES else "distribution" if number in DISTRIBUTION_FIGURES else "evolution"
+            add_caption(fig, [caption(label, ds, what, residual_strain, time) for label, ds in data.items()])
             save_figure(fig, out / stem)
             plt.close(fig)
             written += [out / f"{stem}.png", out / f"{stem}.pdf"]
