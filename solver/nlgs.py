@@ -35,8 +35,46 @@ converged when no impulse changed.
 
 from __future__ import annotations
 
+from typing import NamedTuple
+
 import numpy as np
 from numba import njit
+
+
+class ContactProblem(NamedTuple):
+    """The frictional contact problem of one time step, one entry per contact point
+    (structure of arrays; body arrays indexed by body id, particles then walls).
+
+    a, b : int64 (P,) the two bodies of each point (the force acts on b, its reaction on a);
+    nx, ny : (P,) unit normal from a to b; rax, ray, rbx, rby : (P,) lever arms (m) from each
+    body's centre to the point (0 for walls); bias : (P,) Signorini shift b_k (m s-1, module
+    docstring); mu : (P,) friction coefficient; minv_xx, minv_xy, minv_yy : (B,) inverse mass
+    matrix of each body (kg-1; a wall pushed by a stress translates along its normal only);
+    iinv : (B,) inverse moment of inertia (kg-1 m-2).
+    """
+
+    a: np.ndarray
+    b: np.ndarray
+    nx: np.ndarray
+    ny: np.ndarray
+    rax: np.ndarray
+    ray: np.ndarray
+    rbx: np.ndarray
+    rby: np.ndarray
+    bias: np.ndarray
+    mu: np.ndarray
+    minv_xx: np.ndarray
+    minv_xy: np.ndarray
+    minv_yy: np.ndarray
+    iinv: np.ndarray
+
+
+class NLGSResult(NamedTuple):
+    """Sweeps run and the quadratic and max norms of the last sweep (module docstring)."""
+
+    iterations: int
+    residual: float
+    max_residual: float
 
 
 @njit(cache=True, inline="always")
@@ -170,3 +208,16 @@ def solve(a, b, nx, ny, rax, ray, rbx, rby, bias, mu, pn, pt, vx, vy, w,
         if quad <= tol and worst <= max_tol:
             return it, quad, worst
     return max_iterations, quad, worst
+
+
+def solve_problem(problem: ContactProblem, pn, pt, vx, vy, w, *, tolerance, max_tolerance, max_iterations,
+                  shuffle=False, seed=0) -> NLGSResult:
+    """Solve ``problem`` by NLGS sweeps until both norms are within their tolerances or
+    ``max_iterations`` sweeps have run. ``pn, pt`` (P,) hold the warm-start impulses (N s) and
+    ``vx, vy, w`` (B,) the free velocities on entry; all five are updated in place to the
+    solution. ``shuffle`` visits the points in a random order seeded by ``seed``."""
+    iterations, residual, worst = solve(
+        problem.a, problem.b, problem.nx, problem.ny, problem.rax, problem.ray, problem.rbx, problem.rby,
+        problem.bias, problem.mu, pn, pt, vx, vy, w, problem.minv_xx, problem.minv_xy, problem.minv_yy,
+        problem.iinv, tolerance, max_tolerance, int(max_iterations), bool(shuffle), int(seed))
+    return NLGSResult(int(iterations), float(residual), float(worst))

@@ -1,14 +1,19 @@
 """Moreau–Jean time stepping of rigid disks and polygons between walls.
 
-One step of length h (the theta-scheme, theta = 1/2 by default):
+One step of length h (the theta-scheme, theta = 1/2 by default), each stage a method of
+:class:`Simulation` called in turn by :meth:`Simulation.step`:
 
-1. contact detection: the cell-list broad phase is reused while no particle has moved more
-   than half the ``skin`` since it ran; the narrow phase runs every step;
-2. free velocities: v_free = v- + h M^-1 F_ext (gravity, wall stresses);
-3. NLGS (``solver.nlgs``) for the impulses p and the end-of-step velocities v+, warm-started
-   with the previous step's impulses of the same contact points (matched by body pair and
-   point rank);
-4. positions: x+ = x- + h [(1 - theta) v- + theta v+], likewise angles and wall positions.
+1. ``detect``: the cell-list broad phase is reused while no particle has moved more than half
+   the ``skin`` since it ran; the narrow phase runs every step;
+2. ``_matched_impulses``: the warm start, the previous step's impulses of the same contact
+   points (matched by body pair and point rank, :meth:`Simulation._point_keys`);
+3. ``_free_velocities``: v_free = v- + h M^-1 F_ext (gravity, wall stresses);
+4. ``_contact_problem``: the points' geometry, Delassus data and Signorini shifts as one
+   :class:`solver.nlgs.ContactProblem`;
+5. ``nlgs.solve_problem`` for the impulses p and the end-of-step velocities v+;
+6. ``_end_velocities``: walls driven as they are (imposed, fixed, capped);
+7. ``_integrate``: x+ = x- + h [(1 - theta) v- + theta v+], likewise angles and wall
+   positions, with the split-impulse removal of remaining overlaps.
 
 Forces are impulses divided by h. Nothing here loops over particles or contacts in Python:
 each stage is one numba kernel or one vectorised numpy expression.
@@ -259,12 +264,39 @@ class Simulation:
 
     # -- one step ---------------------------------------------------------------------------
     def step(self) -> StepInfo:
-        p = self.parameters
-        h, theta = p.time_step, p.theta
-        n = self.n_particles
+        """One Moreau–Jean step, in the stages of the module docstring."""
         self.step_alert = self.alert_for_step()
         pts = self.detect()
         keys = self._point_keys(pts)
+        impulse = self._matched_impulses(keys)
+        v_start, omega_start, v_free, omega_free = self._free_velocities()
+        problem, ra, rb = self._contact_problem(pts, v_start, omega_start)
+        solve_start = time.perf_counter()
+        vx, vy, om = v_free[:, 0].copy(), v_free[:, 1].copy(), omega_free.copy()
+        pn, pt = impulse[:, 0].copy(), impulse[:, 1].copy()
+        p = self.parameters
+        result = nlgs.solve_problem(problem, pn, pt, vx, vy, om, tolerance=p.tolerance,
+                                    max_tolerance=p.max_tolerance, max_iterations=p.max_iterations,
+                                    shuffle=p.shuffle, seed=p.seed + self.step_index)
+        self.timings["solve"] += time.perf_counter() - solve_start
+        update_start = time.perf_counter()
+        converged = self._count_solve(result, len(keys))
+        v_end, om = self._end_velocities(vx, vy, om)
+        self._integrate(pts, problem, ra, rb, v_start, omega_start, v_end, om)
+        self.points = pts
+        self.impulse = np.stack([pn, pt], -1)
+        self._keys, self._impulse = keys, self.impulse
+        self.time += p.time_step
+        self.step_index += 1
+        self.counters["steps"] += 1
+        self.timings["update"] += time.perf_counter() - update_start
+        overlap = float(max(0.0, -pts.gap.min())) if len(pts.gap) else 0.0
+        self.last = StepInfo(result.iterations, result.residual, result.max_residual, converged, len(keys), overlap)
+        return self.last
+
+    def _matched_impulses(self, keys):
+        """Warm start: the last step's impulses (P, 2) of the same contact points (keys of
+        :meth:`_point_keys`), 0 for new points."""
         impulse = np.zeros((len(keys), 2))
         if len(self._keys) and len(keys):
             order = np.argsort(self._keys)
@@ -273,7 +305,13 @@ class Simulation:
             where = np.minimum(where, len(sorted_keys) - 1)
             hit = sorted_keys[where] == keys
             impulse[hit] = self._impulse[order[where[hit]]]
-        # free velocities
+        return impulse
+
+    def _free_velocities(self):
+        """Start-of-step velocities (bodies, 2) and (bodies,) with the imposed wall velocities,
+        and the free velocities v- + h M^-1 F_ext (gravity on particles, stress on pushed walls)."""
+        p = self.parameters
+        h, n = p.time_step, self.n_particles
         v_start = self.velocity.copy()
         omega_start = self.angular_velocity.copy()
         v = v_start.copy()
@@ -287,75 +325,88 @@ class Simulation:
         if stress_walls.size:
             force = (self.walls.stress * self.wall_lengths() * p.thickness)[stress_walls, None] * self.walls.normal[stress_walls]
             v[n + stress_walls] += h * force / self.walls.mass[stress_walls, None]
-        # contact geometry
+        return v_start, omega_start, v, omega
+
+    def _contact_problem(self, pts, v_start, omega_start):
+        """The step's :class:`solver.nlgs.ContactProblem` from the detected points, and the
+        lever arms ra, rb (P, 2) m. The Signorini shift comes from the gaps predicted to
+        mid-step with the start velocities (:meth:`contact_bias`)."""
+        p = self.parameters
+        h, theta, n = p.time_step, p.theta, self.n_particles
         centre = np.concatenate([self.position, self.walls.point])
         a, b = pts.body_i.astype(np.int64), pts.body_j.astype(np.int64)
         ra = pts.point - centre[a]
         rb = pts.point - centre[b]
         rb[b >= n] = 0.0
         nx, ny = pts.normal[:, 0].copy(), pts.normal[:, 1].copy()
-        # gap predicted to mid-step with the start velocities (IQS bias)
         u0 = (v_start[b] + omega_start[b, None] * np.stack([-rb[:, 1], rb[:, 0]], -1)
               - v_start[a] - omega_start[a, None] * np.stack([-ra[:, 1], ra[:, 0]], -1))
         un0 = u0[:, 0] * nx + u0[:, 1] * ny
         g_star = pts.gap + h * (1 - theta) * un0
-        bias = self.contact_bias(g_star)
-        mu = np.where(b >= n, p.wall_friction, p.friction)
         minv, iinv = self._mobility()
-        solve_start = time.perf_counter()
-        vx, vy, om = v[:, 0].copy(), v[:, 1].copy(), omega.copy()
-        pn, pt = impulse[:, 0].copy(), impulse[:, 1].copy()
-        iterations, residual, worst = nlgs.solve(
-            a, b, nx, ny, ra[:, 0].copy(), ra[:, 1].copy(), rb[:, 0].copy(), rb[:, 1].copy(), bias, mu, pn, pt,
-            vx, vy, om, minv[:, 0].copy(), minv[:, 1].copy(), minv[:, 2].copy(), iinv, p.tolerance,
-            p.max_tolerance, int(p.max_iterations), p.shuffle, p.seed + self.step_index)
-        self.timings["solve"] += time.perf_counter() - solve_start
-        update_start = time.perf_counter()
-        self.counters["sweeps"] += int(iterations)
-        self.counters["point_sweeps"] += int(iterations) * len(keys)
-        converged = iterations < p.max_iterations or (residual <= p.tolerance and worst <= p.max_tolerance)
+        problem = nlgs.ContactProblem(
+            a, b, nx, ny, ra[:, 0].copy(), ra[:, 1].copy(), rb[:, 0].copy(), rb[:, 1].copy(),
+            self.contact_bias(g_star), np.where(b >= n, p.wall_friction, p.friction),
+            minv[:, 0].copy(), minv[:, 1].copy(), minv[:, 2].copy(), iinv)
+        return problem, ra, rb
+
+    def _count_solve(self, result, n_points):
+        """Count the sweeps; warn (ConvergenceWarning) when the sweep cap stopped the NLGS
+        before both norms were met. Returns whether it converged."""
+        p = self.parameters
+        self.counters["sweeps"] += result.iterations
+        self.counters["point_sweeps"] += result.iterations * n_points
+        converged = result.iterations < p.max_iterations or (result.residual <= p.tolerance
+                                                              and result.max_residual <= p.max_tolerance)
         if not converged:
             warnings.warn(f"NLGS did not converge at step {self.step_index} (t = {self.time:.6g} s): "
-                          f"{iterations} iterations, quadratic residual {residual:.3g} (tolerance "
-                          f"{p.tolerance:g}), max residual {worst:.3g} (tolerance {p.max_tolerance:g})",
-                          ConvergenceWarning, stacklevel=2)
+                          f"{result.iterations} iterations, quadratic residual {result.residual:.3g} (tolerance "
+                          f"{p.tolerance:g}), max residual {result.max_residual:.3g} (tolerance {p.max_tolerance:g})",
+                          ConvergenceWarning, stacklevel=3)
+        return converged
+
+    def _end_velocities(self, vx, vy, om):
+        """End-of-step velocities from the solution: imposed walls keep their velocity, fixed
+        walls stay at rest, pushed walls are capped at their ``max_speed`` inwards, and no
+        wall rotates."""
+        n = self.n_particles
         v_end = np.stack([vx, vy], -1)
+        velocity_walls = np.flatnonzero(self.walls.mode == VELOCITY)
         v_end[n + velocity_walls] = self.walls.velocity[velocity_walls]
         fixed = np.flatnonzero(self.walls.mode == FIXED)
         v_end[n + fixed] = 0.0
+        stress_walls = np.flatnonzero(self.walls.mode == STRESS)
         if stress_walls.size:  # cap the inward speed of pushed walls (closing a loose sample)
             inward = np.sum(v_end[n + stress_walls] * self.walls.normal[stress_walls], axis=1)
             excess = np.maximum(inward - self.walls.max_speed[stress_walls], 0.0)
             v_end[n + stress_walls] -= excess[:, None] * self.walls.normal[stress_walls]
         om[n:] = 0.0
-        # theta-scheme update of positions
+        return v_end, om
+
+    def _integrate(self, pts, problem, ra, rb, v_start, omega_start, v_end, om):
+        """theta-scheme update of positions, angles and walls, with the split-impulse removal of
+        remaining overlaps (:meth:`_recover_overlaps`); stores the end velocities."""
+        p = self.parameters
+        h, theta, n = p.time_step, p.theta, self.n_particles
+        a, b = problem.a, problem.b
         step_v = (1 - theta) * v_start + theta * v_end
         step_om = (1 - theta) * omega_start + theta * om
-        g_end = pts.gap + h * ((step_v[b] - step_v[a]) * pts.normal).sum(1) if len(keys) else pts.gap
-        if p.overlap_recovery_speed > 0 and len(keys):
+        g_end = pts.gap + h * ((step_v[b] - step_v[a]) * pts.normal).sum(1) if len(a) else pts.gap
+        if p.overlap_recovery_speed > 0 and len(a):
             # the end-of-step gaps (first order) tell which overlaps remain
             g_end = g_end + h * (step_om[b] * _cross2(rb, pts.normal) - step_om[a] * _cross2(ra, pts.normal))
             if g_end.min() < -p.overlap_recovery_threshold * 2 * float(self.radius.min()):
-                pseudo_v, pseudo_om = self._recover_overlaps(a, b, nx, ny, ra, rb, g_end, minv, iinv)
+                pseudo_v, pseudo_om = self._recover_overlaps(problem, g_end)
                 pseudo_v[n + np.flatnonzero(self.walls.mode != STRESS)] = 0.0
                 step_v = step_v + pseudo_v
                 step_om = step_om + pseudo_om
         self.position += h * step_v[:n]
         self.angle += h * step_om[:n]
         self.walls.point += h * step_v[n:]
+        stress_walls = np.flatnonzero(self.walls.mode == STRESS)
         self.walls.velocity[stress_walls] = v_end[n + stress_walls]
         self.velocity = v_end
         self.angular_velocity = om
-        self.points = pts
-        self.impulse = np.stack([pn, pt], -1)
-        self._keys, self._impulse = keys, self.impulse
-        self.time += h
-        self.step_index += 1
-        self.counters["steps"] += 1
-        self.timings["update"] += time.perf_counter() - update_start
-        overlap = float(max(0.0, -pts.gap.min())) if len(pts.gap) else 0.0
-        self.last = StepInfo(int(iterations), float(residual), float(worst), bool(converged), len(keys), overlap)
-        return self.last
 
     def contact_bias(self, g_star):
         """The shift b of Signorini's condition u_n + b >= 0 for gaps g* predicted to mid-step:
@@ -364,7 +415,7 @@ class Simulation:
         p = self.parameters
         return np.maximum(g_star, 0.0) / (p.theta * p.time_step)
 
-    def _recover_overlaps(self, a, b, nx, ny, ra, rb, g_end, minv, iinv):
+    def _recover_overlaps(self, problem, g_end):
         """Split-impulse removal of overlaps: pseudo-velocities that move the bodies apart at
         most at ``overlap_recovery_speed``, removing ``overlap_recovery_rate`` of each overlap
         per step, frictionless, added to the positions only. The real velocities (momentum,
@@ -373,16 +424,14 @@ class Simulation:
         p = self.parameters
         h = p.time_step
         recover = np.minimum(p.overlap_recovery_rate * np.maximum(-g_end, 0.0) / h, p.overlap_recovery_speed)
-        bias = np.where(g_end >= 0.0, g_end / h, -recover)
-        m = len(a)
+        m = len(problem.a)
+        recovery = problem._replace(bias=np.where(g_end >= 0.0, g_end / h, -recover), mu=np.zeros(m))
         bodies = self.n_particles + self.n_walls
         vx, vy, om = np.zeros(bodies), np.zeros(bodies), np.zeros(bodies)
-        pn, pt = np.zeros(m), np.zeros(m)
-        iterations, _, _ = nlgs.solve(
-            a, b, nx, ny, ra[:, 0].copy(), ra[:, 1].copy(), rb[:, 0].copy(), rb[:, 1].copy(), bias, np.zeros(m), pn, pt,
-            vx, vy, om, minv[:, 0].copy(), minv[:, 1].copy(), minv[:, 2].copy(), iinv, p.overlap_recovery_tolerance,
-            1.0, int(p.overlap_recovery_iterations), False, 0)
-        self.counters["recovery_sweeps"] += int(iterations)
+        result = nlgs.solve_problem(recovery, np.zeros(m), np.zeros(m), vx, vy, om,
+                                    tolerance=p.overlap_recovery_tolerance, max_tolerance=1.0,
+                                    max_iterations=p.overlap_recovery_iterations)
+        self.counters["recovery_sweeps"] += result.iterations
         return np.stack([vx, vy], -1), om
 
     # -- derived quantities ------------------------------------------------------------------

@@ -106,9 +106,10 @@ def test_sweeps_match_the_enumerated_frictionless_solution(seed):
     expected = _lcp_by_enumeration(W, q)
     vx, vy, w = v_free[:, 0].copy(), v_free[:, 1].copy(), v_free[:, 2].copy()
     pn, pt = np.zeros(4), np.zeros(4)
-    it, quad, worst = nlgs.solve(a, b, nx, ny, ra[:, 0].copy(), ra[:, 1].copy(), rb[:, 0].copy(), rb[:, 1].copy(),
-                                 bias, np.zeros(4), pn, pt, vx, vy, w, inv_mass, np.zeros(4), inv_mass.copy(),
-                                 inv_inertia, 1e-14, 1e-14, 100_000, False, 0)
+    problem = nlgs.ContactProblem(a, b, nx, ny, ra[:, 0].copy(), ra[:, 1].copy(), rb[:, 0].copy(), rb[:, 1].copy(),
+                                  bias, np.zeros(4), inv_mass, np.zeros(4), inv_mass.copy(), inv_inertia)
+    it, quad, worst = nlgs.solve_problem(problem, pn, pt, vx, vy, w, tolerance=1e-14, max_tolerance=1e-14,
+                                         max_iterations=100_000)
     assert quad <= 1e-14 and worst <= 1e-14 and it < 100_000
     np.testing.assert_allclose(pn, expected, rtol=1e-8, atol=1e-10 * np.abs(expected).max())
     assert np.all(pt == 0.0)
