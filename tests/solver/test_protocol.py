@@ -1,5 +1,6 @@
-"""The paper's protocol: compaction and biaxial test written in the data contract; parameter
-errors; determinism. The 400-particle runs of the issue are marked slow."""
+"""The paper's protocol (solver/scenes.py): isotropic compaction under sigma_0 on the right and
+top walls, biaxial compression at constant lateral stress written in the data contract;
+parameter errors; determinism. The 400-particle runs are marked slow."""
 
 import hashlib
 import warnings
@@ -10,7 +11,10 @@ import pytest
 import grainview
 from grainview.errors import ParameterError
 from grainview.schema import particle_area
-from solver import Parameters, Simulation, Walls, biaxial_test, compaction_sample, isotropic_compaction
+from solver import (Parameters, Simulation, Walls, biaxial_test, compaction_sample, is_equilibrium,
+                    isotropic_compaction)
+
+SIGMA0 = 1e4
 
 
 def _compact(n, shape, seed=0, max_steps=20000):
@@ -24,6 +28,35 @@ def _compact(n, shape, seed=0, max_steps=20000):
 def _solid_fraction(sim):
     lo, hi = sim.walls.box_bounds()
     return float(particle_area(sim.radius, sim.n_vertices).sum() / np.prod(hi - lo))
+
+
+def test_is_equilibrium_on_hand_made_windows():
+    stresses = np.array([[1.0e4, 0.99e4], [1.005e4, 1.0e4]])
+    assert is_equilibrium(stresses, np.zeros((2, 2)), SIGMA0)
+    assert not is_equilibrium(stresses * 1.02, np.zeros((2, 2)), SIGMA0)  # 2% off
+    assert not is_equilibrium(stresses, np.full((2, 2), 2e-3), SIGMA0)  # walls still moving
+
+
+@pytest.mark.parametrize("shape", ["disk", "pentagon"])
+def test_small_isotropic_compaction_reaches_sigma0(shape):
+    sim = _compact(40, shape, seed=1)
+    assert sim.settled
+    np.testing.assert_allclose(sim.compaction_stress, SIGMA0, rtol=0.01)  # right and top walls
+    assert sim.last.max_interpenetration < 1e-3 * 2 * sim.radius.mean()
+    assert 0.65 < _solid_fraction(sim) < 0.9
+
+
+def test_the_top_wall_moves_down_at_one_centimetre_per_second(tmp_path):
+    sim = _compact(40, "pentagon", seed=1)
+    top0 = sim.walls.point[2, 1]
+    path = tmp_path / "biaxial.nc"
+    steps = biaxial_test(sim, path, strain=0.002, every=5, progress=False)
+    ds = grainview.open_dataset(path, chunks=None, validate=True)
+    h = sim.parameters.time_step
+    assert ds.sizes["time"] == 1 + int(np.ceil(steps / 5))
+    np.testing.assert_allclose(ds["box_max"].values[:, 1], top0 - 0.01 * (ds["step"] - ds["step"][0]) * h,
+                               rtol=1e-12)
+    ds.close()
 
 
 def test_small_biaxial_test_writes_a_valid_file_with_both_contact_kinds(tmp_path):
@@ -125,3 +158,4 @@ def test_biaxial_test_of_400_pentagons(tmp_path):
         biaxial_test(sim, path, strain=0.01, every=50, progress=False)
     ds = grainview.open_dataset(path, validate=True)
     assert set(np.unique(ds.kind.values)) - {0} == {1, 2}
+    assert float(ds["max_interpenetration"].max()) < 1e-3 * 2 * float(ds["radius"].mean())
