@@ -116,14 +116,3 @@ def selection(ds: xr.Dataset, *, walls: bool = False, kind="all", near=None) -> 
     if code is not None:
         mask = mask & (ds["kind"] == code)
     return mask
-
-
-def force_vectors(fn, ft, normal):
-    """Force f = fn n + ft t with t = (-n_y, n_x), as (..., 2) arrays (docs/conventions.md §0)."""
-    nx, ny = normal[..., 0], normal[..., 1]
-    return np.stack([fn * nx - ft * ny, fn * ny + ft * nx], axis=-1)
-
-
-def angle_of(normal):
-    """Orientation theta of each normal folded into [0, pi) (docs/conventions.md §0), rad."""
-    return np.mod(np.arctan2(normal[..., 1], normal[..., 0]), np.pi)

@@ -67,3 +67,13 @@ def test_no_import_cycle_in_the_packages():
     assert "solver.scenes" in graph and "grainview.report" in graph
     assert "solver.output" in graph["solver.scenes"]
     assert find_cycles(graph) == []
+
+
+def test_the_array_layer_imports_nothing_of_the_labelled_layer():
+    """grainview/arrays holds the physics on plain arrays: it may use its own modules, the
+    numba kernels and the contract's constants, never the xarray topic modules."""
+    graph = import_graph()
+    allowed = ("grainview.arrays", "grainview._kernels", "grainview.schema")
+    for module, deps in graph.items():
+        if module.startswith("grainview.arrays"):
+            assert all(dep.startswith(allowed) for dep in deps), (module, sorted(deps))

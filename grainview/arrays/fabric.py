@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..contacts import angle_of
+from .vectors import angle_of
 from .binning import batched_bincount
 
 

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..contacts import force_vectors
+from .vectors import force_vectors
 
 
 def stress_tensor(fn, ft, normal, branch, mask, volume):

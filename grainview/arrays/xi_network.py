@@ -12,7 +12,7 @@ from __future__ import annotations
 import numpy as np
 
 from .._kernels.xi_network import count_below
-from ..contacts import force_vectors
+from .vectors import force_vectors
 from .force_pdf import mean_normal_force
 from .tensors import principal, signed_anisotropy
 
