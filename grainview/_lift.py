@@ -40,7 +40,7 @@ def apply(func, *args, core_dims, output_core_dims=((),), output_sizes=None,
         if TENSOR_DIMS[0] in da.dims:
             da = da.assign_coords({d: list("xy") for d in TENSOR_DIMS})
         if at:
-            da.attrs.update(at)
+            da.attrs = dict(at)
         if name:
             da.name = name
         out.append(da)
@@ -48,9 +48,10 @@ def apply(func, *args, core_dims, output_core_dims=((),), output_sizes=None,
 
 
 def with_attrs(da: xr.DataArray, name: str, units: str, long_name: str, **extra) -> xr.DataArray:
-    """Name ``da`` and set its units and long_name (and any further attributes)."""
+    """Name ``da`` and give it exactly these attributes: units, long_name and ``extra`` (any
+    attribute it carried over from its inputs is dropped: it described something else)."""
     da = da.rename(name)
-    da.attrs.update({"units": units, "long_name": long_name, **extra})
+    da.attrs = {"units": units, "long_name": long_name, **extra}
     return da
 
 
