@@ -3,12 +3,13 @@
     python benchmarks/fidelity/run.py                      # every section (hours on 2 cores)
     python benchmarks/fidelity/run.py --only relations     # the twelve relations
     python benchmarks/fidelity/run.py --quick              # tiny sizes: checks the script
+    python benchmarks/fidelity/run.py --large              # adds 4000 particles to 'sizes'
 
 Sections (each a table in ``benchmarks/fidelity/RESULTS.md``, read with docs/fidelity.md):
 
 * ``preparations``: initial states (solid fraction, z) of each preparation, both shapes;
 * ``rates``: q/p, a, z against the top wall's speed (is the test quasi-static?);
-* ``sizes``: residual values at 400, 1000 and 4000 particles;
+* ``sizes``: residual values at 400 and 1000 particles (and 4000 with ``--large``);
 * ``counting``: z, very weak fraction, fabric a with near pairs counted up to a gap;
 * ``relations``: the paper's twelve pentagon-versus-disk relations, N = 1000, eps_q >= 0.4,
   three seeds (mean ± spread), per preparation and counting convention.
@@ -49,7 +50,7 @@ RESIDUAL = (0.4, np.inf)
 class Config:
     """Sizes of every section; ``quick`` shrinks them to check the script in minutes."""
 
-    def __init__(self, quick=False):
+    def __init__(self, quick=False, large=False):
         self.quick = quick
         self.strain = 0.02 if quick else 0.2
         self.residual = (0.0, np.inf) if quick else RESIDUAL
@@ -61,7 +62,7 @@ class Config:
         self.rate_particles = 60 if quick else 400
         self.velocities = {"pentagon": (0.01, 0.04) if quick else (0.005, 0.01, 0.02, 0.04, 0.08),
                            "disk": (0.01, 0.04) if quick else (0.01, 0.02, 0.04, 0.08)}
-        self.sizes = (30, 60) if quick else (400, 1000, 4000)
+        self.sizes = (30, 60) if quick else (400, 1000, 4000) if large else (400, 1000)
         self.every = 20 if quick else 400
 
     def velocity(self, particles):
@@ -135,7 +136,7 @@ def _windows(path, windows, near=None):
 
 
 def section_rates(cfg, jobs):
-    runs = [cfg.run(shape=shape, particles=cfg.rate_particles, velocity=v)
+    runs = [cfg.run(shape=shape, particles=cfg.rate_particles, velocity=v, every=cfg.every)
             for shape in ("pentagon", "disk") for v in cfg.velocities[shape]]
     paths = ensure(runs, jobs)
     windows = [(0.1, 0.2), (0.2, 0.3), (0.3, 0.4), (0.4, np.inf)] if not cfg.quick else [(0.0, np.inf)]
@@ -147,16 +148,17 @@ def section_rates(cfg, jobs):
             inertia = float(ds.grain.inertia_number().median())
         for w, s in zip(windows, _windows(paths[r], windows)):
             if s["snapshots"]:
-                rows.append([r.shape, f"{r.velocity * 100:g}", f"{inertia:.1e}", _window(w),
+                rows.append([r.shape, f"{r.velocity * 100:g}", f"{inertia:.1e}", _window(w), s["snapshots"],
                              _f(s["q/p"]), _f(s["a"]), _f(s["a_n"]), _f(s["z"], 2), _f(s["solid fraction"])])
     text = (f"Biaxial tests of the same compacted {cfg.rate_particles}-particle samples (preparation 'paper', seed 0) "
             "with the top wall at several speeds; window means over eps_q. I: the median inertia parameter of "
-            "the test as the paper defines it (eps_dot sqrt(m/p), m the total mass per unit thickness).\n\n")
+            "the test as the paper defines it (eps_dot sqrt(m/p), m the total mass per unit thickness). Every test "
+            f"writes a snapshot every {cfg.every} steps, so the faster tests have fewer snapshots per window.\n\n")
     curves = [(f"{r.shape}s, {r.velocity * 100:g} cm/s", r.shape, measure.strain_series(paths[r])) for r in runs]
     figure = figures.evolutions(curves, figures.figure_path(cfg.output, "rates"),
                                 f"{cfg.rate_particles} particles, seed 0: top wall speed")
     return (text + f"![wall speeds]({os.path.basename(figure)})\n\n"
-            + _table(["shape", "wall speed (cm/s)", "I", "eps_q", "q/p", "a", "a_n", "z", "solid fraction"], rows))
+            + _table(["shape", "wall speed (cm/s)", "I", "eps_q", "snapshots", "q/p", "a", "a_n", "z", "solid fraction"], rows))
 
 
 def section_sizes(cfg, jobs):
@@ -170,9 +172,11 @@ def section_sizes(cfg, jobs):
                 rows.append([r.shape, r.particles, _window(w),
                              s["snapshots"], _f(s["q/p"]), _f(s["prediction"]), _f(s["a"]), _f(s["a_n"]),
                              _f(s["a_t"]), _f(s["z"], 2), _f(s["k_d"], 2), _f(s["very weak"])])
+    speeds = ", ".join(f"{cfg.velocity(n) * 100:g} cm/s for {n}" for n in cfg.sizes[1:])
     text = ("Residual values against the number of particles (preparation 'paper', seed 0, force-bearing "
-            "contacts), all sheared at the same strain rate (~0.01 s-1: the top wall at 1 cm/s for 400 "
-            f"particles, {cfg.velocity(1000) * 100:g} cm/s for 1000, {cfg.velocity(4000) * 100:g} cm/s for 4000). Paper: N = 14,400 pentagons (q/p 0.35, z 3.75) and 10,000 disks "
+            f"contacts), all sheared at the same strain rate (~0.01 s-1: the top wall at "
+            f"{cfg.velocity(cfg.sizes[0]) * 100:g} cm/s for {cfg.sizes[0]} particles, {speeds}). Paper: "
+            "N = 14,400 pentagons (q/p 0.35, z 3.75) and 10,000 disks "
             "(q/p 0.28, z 3.85).\n\n")
     curves = [(f"{r.shape}s, N = {r.particles}", r.shape, measure.strain_series(paths[r])) for r in runs]
     figure = figures.evolutions(curves, figures.figure_path(cfg.output, "sizes"),
@@ -225,7 +229,7 @@ def _summaries(cfg, runs, paths, near):
 
 
 RELATION_COLUMNS = [
-    ("paper", "paper", None), ("paper", "paper", RELATION_NEAR), ("frictionless", "frictionless", None),
+    ("paper", "paper", None), ("paper", "paper", RELATION_NEAR),
     ("paper", "frictionless", None), ("paper", "frictionless", RELATION_NEAR),
 ]
 """(pentagons' preparation, disks' preparation, near-contact threshold as a fraction of D_MIN) of
@@ -257,8 +261,9 @@ def _engine_summaries(cfg):
 
 
 def section_relations(cfg, jobs):
-    groups = {prep: _relation_runs(cfg, prep) for prep in ("paper", "frictionless")}
-    paths = ensure([r for g in groups.values() for runs in g.values() for r in runs], jobs)
+    groups = {prep: _relation_runs(cfg, prep) for prep in {p for column in RELATION_COLUMNS for p in column[:2]}}
+    needed = [groups[p_prep]["pentagon"] + groups[d_prep]["disk"] for p_prep, d_prep, _ in RELATION_COLUMNS]
+    paths = ensure([r for runs in needed for r in runs], jobs)
     columns = []
     for p_prep, d_prep, near in RELATION_COLUMNS:
         gap = None if near is None else near * D_MIN
@@ -289,6 +294,8 @@ def main(argv=None):
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--quick", action="store_true", help="tiny sizes, to check the script")
     parser.add_argument("--only", default=",".join(SECTIONS), help="comma-separated sections: " + ",".join(SECTIONS))
+    parser.add_argument("--large", action="store_true", help="add 4000 particles to the sizes section "
+                        "(about 2.5 h per pentagon test on one core)")
     parser.add_argument("--jobs", type=int, default=2, help="simulations run side by side (default 2)")
     parser.add_argument("--output", default=None, help="default: benchmarks/fidelity/RESULTS.md for a full run, "
                         "benchmarks/_data/fidelity/RESULTS-*.md otherwise")
@@ -297,7 +304,7 @@ def main(argv=None):
     unknown = set(wanted) - set(SECTIONS)
     if unknown:
         parser.error(f"unknown sections {sorted(unknown)}; expected some of {SECTIONS}")
-    cfg = Config(quick=args.quick)
+    cfg = Config(quick=args.quick, large=args.large)
     if args.quick:
         runs_module.CACHE = os.path.join(runs_module.CACHE, "quick")
     output = args.output or (os.path.join(HERE, "RESULTS.md") if not args.quick and wanted == SECTIONS
