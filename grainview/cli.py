@@ -70,8 +70,19 @@ def _preparation(args, shape):
     from solver.preparation import preparation
 
     return preparation(args.preparation, particles=args.particles, shape=shape, seed=args.seed,
+                       friction=args.friction, sigma0=args.sigma0,
                        compaction_friction=args.compaction_friction, max_inertia_number=args.max_inertia_number,
                        aspect=args.aspect, pressure_ramp=args.pressure_ramp)
+
+
+def _solver_parameters(args) -> dict:
+    """The :class:`solver.Parameters` the command line sets (the others keep their defaults)."""
+    from solver import Parameters
+
+    given = {"wall_friction": args.wall_friction, "time_step": args.time_step, "tolerance": args.tolerance}
+    parameters = {k: v for k, v in given.items() if v is not None}
+    Parameters(**parameters).validate()  # one clear line before anything is simulated
+    return parameters
 
 
 def _check_test(args):
@@ -84,9 +95,11 @@ def _check_test(args):
         raise GrainviewError(f"--velocity {args.velocity}: expected a positive wall speed in m s-1")
 
 
-def _simulate(prep, path, *, strain, every, velocity, near_contacts, overwrite, progress, scene="biaxial"):
+def _simulate(prep, path, *, strain, every, velocity, near_contacts, overwrite, progress, scene="biaxial",
+              parameters=None):
     """Deposit, compact isotropically (as ``prep`` says) and, for ``scene="biaxial"``, shear
-    one sample into ``path``; returns the path. An isotropic run writes its compacted state."""
+    one sample into ``path``; returns the path. An isotropic run writes its compacted state.
+    ``parameters``: solver settings (:class:`solver.Parameters` fields) other than the defaults."""
     import warnings
 
     from solver import biaxial_test
@@ -100,7 +113,7 @@ def _simulate(prep, path, *, strain, every, velocity, near_contacts, overwrite, 
     print(f"{name}: depositing {prep.particles} particles and compacting under {prep.sigma0:g} Pa ...", flush=True)
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
-        sim = prepare_sample(prep, progress=progress)
+        sim = prepare_sample(prep, progress=progress, **(parameters or {}))
         settled = "settled" if sim.settled else "NOT settled (step limit reached)"
         print(f"{name}: compaction {settled} after {sim.compaction_steps} steps; wall stresses "
               f"{', '.join(f'{s:.0f}' for s in sim.compaction_stress)} Pa", flush=True)
@@ -139,7 +152,7 @@ def _progress_flag(args):
 
 def _simulation_kwargs(args):
     return dict(strain=args.strain, every=args.every, velocity=args.velocity, near_contacts=args.near_contacts,
-                overwrite=args.overwrite, progress=_progress_flag(args))
+                overwrite=args.overwrite, progress=_progress_flag(args), parameters=_solver_parameters(args))
 
 
 def _run(args) -> int:
@@ -199,6 +212,9 @@ def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(prog="grainview", description=(
         "Contact dynamics of disks and polygons, and the force-transmission analyses of "
         "Azema et al., Phys. Rev. E 76, 011301 (2007)."))
+    from . import __version__
+
+    parser.add_argument("--version", action="version", version=f"%(prog)s {__version__}")
     sub = parser.add_subparsers(dest="command", required=True)
 
     def residual_option(p):
@@ -217,6 +233,16 @@ def build_parser() -> argparse.ArgumentParser:
                        help="speed of the top wall in m/s (default 0.01, the paper's)")
         p.add_argument("--every", type=int, default=every, help=f"steps between snapshots (default {every})")
         p.add_argument("--seed", type=int, default=0, help="random seed of the deposit (default 0)")
+        physics = p.add_argument_group("physics and numerics (defaults: the paper's)")
+        physics.add_argument("--friction", type=float, default=None,
+                             help="grain-grain friction coefficient of the test (default 0.4)")
+        physics.add_argument("--wall-friction", type=float, default=None,
+                             help="grain-wall friction coefficient (default 0)")
+        physics.add_argument("--sigma0", type=float, default=None, help="confining stress in Pa (default 1e4)")
+        physics.add_argument("--time-step", type=float, default=None, help="time step in s (default 5e-4)")
+        physics.add_argument("--tolerance", type=float, default=None,
+                             help="NLGS tolerance, quadratic norm of the velocity changes over a sweep "
+                             "(default 1.7e-4; docs/solver.md)")
         prep = p.add_argument_group("sample preparation (docs/fidelity.md)")
         prep.add_argument("--preparation", choices=preset_names(), default="paper",
                           help="named preparation (default paper: compaction with friction 0.4, walls closing "
@@ -245,8 +271,8 @@ def build_parser() -> argparse.ArgumentParser:
     study.set_defaults(func=_study)
 
     run = sub.add_parser("run", help="simulate one sample into a netCDF file",
-                         description="Geometric deposit, isotropic compaction under sigma_0 = 10 kPa, then "
-                         "(scene biaxial) compression at 1 cm/s with sigma_0 held laterally.")
+                         description="Geometric deposit, isotropic compaction under sigma0 (10 kPa), then "
+                         "(scene biaxial) compression by the top wall (1 cm/s) with sigma0 held on the right wall.")
     run.add_argument("scene", nargs="?", choices=["biaxial", "isotropic"], default="biaxial",
                      help="biaxial (default) or isotropic (writes the compacted state)")
     run.add_argument("--shape", default="pentagon", help="pentagon (default), disk, or a number of vertices")
@@ -257,7 +283,10 @@ def build_parser() -> argparse.ArgumentParser:
     simulation_options(run)
     run.set_defaults(func=_run)
 
-    report = sub.add_parser("report", help="analyse runs: headline table vs the paper and all figures")
+    report = sub.add_parser("report", help="analyse runs: headline table vs the paper and all figures",
+                            description="Analyse one or more files of the data contract: the headline table "
+                            "(residual state next to the paper's values), the paper's figures, a CSV of the "
+                            "table. Runs labelled with 'pent' or 'disk' are compared with S1 or S2.")
     report.add_argument("files", nargs="+", help="netCDF files of the grainview contract")
     report.add_argument("--labels", default=None, help="comma-separated labels (default: file names); "
                         "labels containing 'pent' or 'disk' are compared with the paper's S1/S2 values")
@@ -265,10 +294,15 @@ def build_parser() -> argparse.ArgumentParser:
     report.add_argument("--overwrite", action="store_true", help="replace an existing report in --out")
     residual_option(report)
     report.set_defaults(func=_report)
-    info = sub.add_parser("info", help="validate a grainview netCDF file and print its summary")
+    info = sub.add_parser("info", help="validate a grainview netCDF file and print its summary",
+                          description="Check a file against the data contract and print its size, snapshots "
+                          "and settings; exits with 2 and one line naming the fault when it is not valid.")
     info.add_argument("file", help="path of a netCDF file of the grainview data contract")
     info.set_defaults(func=_info)
-    demo = sub.add_parser("demo", help="write a synthetic harmonic-model series and analyse it lazily")
+    demo = sub.add_parser("demo", help="write a synthetic harmonic-model series and analyse it lazily",
+                          description="Write a synthetic series drawn from the harmonic model (no simulation, "
+                          "seconds) and compare q/p with the prediction (a' + a_n + a_t)/2 computed lazily "
+                          "from the file.")
     demo.add_argument("--out", default="demo-out", help="output folder (default: demo-out)")
     demo.add_argument("--snapshots", type=int, default=11, help="number of snapshots (default 11)")
     demo.add_argument("--contacts", type=int, default=20000, help="contacts per snapshot (default 20000)")

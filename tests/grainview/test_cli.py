@@ -42,3 +42,42 @@ def test_harmonic_series_grows_its_anisotropy():
     ds = harmonic_series(n_snapshots=3, n_contacts=20000, anisotropy=(0.3, 0.4, 0.2), seed=1)
     fab = ds.grain.fabric_anisotropy()["a"].values
     assert fab[0] == pytest.approx(0.0, abs=0.03) and fab[-1] == pytest.approx(0.3, abs=0.03)
+
+
+def test_physics_options_reach_the_solver_and_act(tmp_path, capsys):
+    """--friction, --wall-friction, --sigma0, --time-step and --tolerance are recorded in the
+    file and obeyed: no contact exceeds its Coulomb cone, some slide on it, and the lateral
+    stress is the requested sigma0."""
+    path = tmp_path / "run.nc"
+    argv = ["run", "--shape", "disk", "--particles", "30", "--strain", "0.01", "--every", "20",
+            "--friction", "0.2", "--wall-friction", "0.1", "--sigma0", "5000", "--time-step", "4e-4",
+            "--tolerance", "1e-5", "--out", str(path), "--progress", "off"]
+    assert main(argv) == 0
+    with grainview.open_dataset(path, chunks=None) as ds:
+        attrs = ds.attrs
+        assert attrs["solver_friction"] == 0.2 and attrs["preparation_friction"] == 0.2
+        assert attrs["solver_wall_friction"] == 0.1
+        assert attrs["solver_time_step"] == 4e-4 and attrs["solver_tolerance"] == 1e-5
+        assert attrs["sigma0_Pa"] == 5000.0
+        used = ds.kind.values > 0
+        wall = ds.j.values >= ds.sizes["particle"]
+        ratio = np.abs(ds.ft.values) / np.maximum(ds.fn.values, 1e-300)
+        for mu, which in ((0.2, used & ~wall), (0.1, used & wall)):
+            assert ratio[which].max() <= mu * (1 + 1e-9)
+            assert (ratio[which] > 0.99 * mu).mean() > 0.1  # sliding contacts exist at this friction
+        sigma_xx = ds.grain.stress_tensor().sel(xy_a="x", xy_b="x")
+        assert abs(float(sigma_xx.mean()) / 5000.0 - 1) < 0.2
+
+
+def test_bad_solver_option_is_one_line_before_simulating(tmp_path, capsys):
+    assert main(["run", "--particles", "10", "--time-step", "-1", "--out", str(tmp_path / "x.nc")]) == 2
+    err = capsys.readouterr().err.strip()
+    assert err.count("\n") == 0 and "time_step=-1.0" in err and "positive number of seconds" in err
+    assert not (tmp_path / "x.nc").exists()
+
+
+def test_version(capsys):
+    with pytest.raises(SystemExit) as exit_info:
+        main(["--version"])
+    assert exit_info.value.code == 0
+    assert capsys.readouterr().out.startswith("grainview 0.")
