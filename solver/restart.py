@@ -152,7 +152,9 @@ def load_sample(path, index=-1) -> Simulation:
         if not -ds.sizes["time"] <= int(index) < ds.sizes["time"]:
             raise FileFormatError(f"{source}: index={index!r} is outside its {ds.sizes['time']} snapshots")
         state = _snapshot_state(ds, int(index), source)
-    return _simulation(state, source)
+    sim = _simulation(state, source)
+    sim.show_warm_start()  # a test's first snapshot shows the sample's contacts and forces
+    return sim
 
 
 def load_state(path):

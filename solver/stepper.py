@@ -250,6 +250,15 @@ class Simulation:
         self._impulse = np.stack([np.asarray(normal_impulse, float).reshape(2 * m),
                                   np.asarray(tangential_impulse, float).reshape(2 * m)], -1)
 
+    def show_warm_start(self):
+        """Detect the contacts at the current positions and give them their warm-start
+        impulses, without stepping: the contacts a snapshot written before the next step holds
+        (e.g. the first snapshot of a test started from a file, :func:`solver.load_sample`).
+        The next step is unchanged by it."""
+        pts = self.detect()
+        self.points = pts
+        self.impulse = self._matched_impulses(self._point_keys(pts))
+
     def scale_warm_start(self, factor):
         """Multiply the warm-start impulses by ``factor`` (e.g. h_new / h_old when the time step
         changes: the same forces over a different step)."""

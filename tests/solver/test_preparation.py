@@ -100,3 +100,31 @@ def test_the_s1s2_preset_prepares_each_shape_as_the_paper_s_sample():
     assert preparation("s1s2", shape="disk", particles=50).compaction_friction == 0.0
     with pytest.raises(ParameterError, match="s1s2"):
         preparation("s1s2", shape=7)
+
+
+def test_a_test_started_from_a_saved_sample_shows_the_samples_contacts_first(tmp_path):
+    """load_sample + biaxial_test: the test's first snapshot holds the contacts and forces of
+    the sample's last snapshot (same pairs, same forces), and the test goes on from there."""
+    import grainview
+    from solver import biaxial_test, load_sample
+    from solver.output import Recorder
+
+    sim = _quiet(prepare_sample, preparation("paper", particles=30, shape="pentagon", seed=2, max_steps=3000),
+                 progress=False)
+    sample = tmp_path / "sample.nc"
+    with Recorder(sample, sim, attrs={"sigma0_Pa": 1e4}) as rec:
+        rec.write()
+    test = tmp_path / "test.nc"
+    _quiet(biaxial_test, load_sample(sample), test, strain=0.002, every=5, progress=False)
+    with grainview.open_dataset(sample, chunks=None) as a, grainview.open_dataset(test, chunks=None) as b:
+        first, last = b.isel(time=0), a.isel(time=-1)
+        n = int(last.contact_count)
+        assert n > 20 and int(first.contact_count) == n
+        pairs = lambda s: {(int(i), int(j)): (float(fn), float(ft))  # noqa: E731
+                           for i, j, fn, ft in zip(s.i.values[:n], s.j.values[:n], s.fn.values[:n], s.ft.values[:n])}
+        before, after = pairs(last), pairs(first)
+        assert before.keys() == after.keys()
+        for key, (fn, ft) in before.items():
+            assert after[key] == pytest.approx((fn, ft), rel=1e-12, abs=1e-12)
+        np.testing.assert_array_equal(first.position.values, last.position.values)
+        assert b.sizes["time"] > 2 and int(b.contact_count[-1]) > 20
