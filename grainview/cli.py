@@ -10,6 +10,8 @@ import argparse
 import sys
 from pathlib import Path
 
+import numpy as np
+
 from .errors import ConvergenceWarning, GrainviewError
 
 RESIDUAL_STRAIN = 0.3
@@ -24,21 +26,68 @@ def _info(args) -> int:
     from .io import open_dataset
     from .validation import validate
 
-    ds = open_dataset(args.file)
-    print(f"{args.file}: {ds.sizes.get('time', 0)} snapshots, {ds.sizes['particle']} particles, "
-          f"{ds.sizes.get('wall', 0)} walls, {ds.sizes['contact']} contact slots")
-    n_vertices = ds["n_vertices"].values
-    shapes = {int(k): int((n_vertices == k).sum()) for k in sorted(set(n_vertices.tolist()))}
-    print("shapes: " + ", ".join(f"{c} {'disks' if k == 0 else f'{k}-gons'}" for k, c in shapes.items()))
-    if ds.sizes.get("time", 0):
-        t = ds["time"].values
-        print(f"time: {t[0]:g} .. {t[-1]:g} s; contacts per snapshot: "
-              f"{int(ds['contact_count'].min())} .. {int(ds['contact_count'].max())}")
-    for key, value in ds.attrs.items():
-        print(f"  {key} = {value}")
+    ds = open_dataset(args.file, chunks=None)
     validate(ds, source=str(args.file))
+    for line in info_lines(ds):
+        print(line)
+    if args.attrs:
+        for key, value in ds.attrs.items():
+            print(f"  {key} = {value}")
     print("valid: follows grainview data contract " + str(ds.attrs.get("grainview_schema_version", "?")))
     return 0
+
+
+def info_lines(ds) -> list:
+    """A reader's summary of a dataset of the contract: size and shapes, snapshots, strain and
+    q/p reached, and the settings a physicist asks for first, in readable units."""
+    a = ds.attrs
+    n_vertices = ds["n_vertices"].values
+    shapes = {int(k): int((n_vertices == k).sum()) for k in sorted(set(n_vertices.tolist()))}
+    lines = [f"{ds.sizes['particle']} particles ("
+             + ", ".join(f"{c} {'disks' if k == 0 else f'{k}-gons'}" for k, c in shapes.items())
+             + f"), {ds.sizes.get('wall', 0)} walls, {ds.sizes['contact']} contact slots"]
+    snapshots = ds.sizes.get("time", 0)
+    if snapshots:
+        t = ds["time"].values
+        count = ds["contact_count"].values
+        phi = ds.grain.solid_fraction().values if "box_min" in ds else None
+        lines.append(f"{snapshots} snapshot{'s' * (snapshots > 1)}, t = {t[0]:g} .. {t[-1]:g} s; contacts per "
+                     f"snapshot {int(count.min())} .. {int(count.max())}"
+                     + (f"; solid fraction {phi[0]:.3f} .. {phi[-1]:.3f}" if phi is not None else ""))
+        if "box_min" in ds and snapshots > 1:
+            eps = ds.grain.strains()
+            q_over_p = ds.grain.stress_invariants()["q_over_p"].values
+            finite = q_over_p[np.isfinite(q_over_p)]
+            lines.append(f"strain reached: eps_1 {float(eps['eps_1'][-1]):.3f}, eps_q {float(eps['eps_q'][-1]):.3f}"
+                         + (f"; q/p {finite.min():.3f} .. {finite.max():.3f}, last {q_over_p[-1]:.3f}"
+                            if finite.size else ""))
+    def number(key, scale=1.0):
+        try:
+            return float(a[key]) * scale
+        except (KeyError, TypeError, ValueError):  # absent, or "none"
+            return None
+
+    settings = [f"scene {a['scene']}"] if "scene" in a else []
+    for key, scale, text in (("sigma0_Pa", 1e-3, "sigma0 {:g} kPa"), ("wall_velocity_m_s", 100, "top wall {:g} cm/s")):
+        if number(key) is not None:
+            settings.append(text.format(number(key, scale)))
+    if "preparation_name" in a:
+        settings.append(f"preparation {a['preparation_name']} (seed {a.get('preparation_seed', '?')})")
+    if settings:
+        lines.append("test: " + ", ".join(settings))
+    solver = []
+    if number("solver_friction") is not None:
+        solver.append(f"friction {number('solver_friction'):g} (walls {number('solver_wall_friction') or 0:g})")
+    for key, scale, text in (("solver_time_step", 1e3, "time step {:g} ms"),
+                             ("solver_tolerance", 1, "NLGS tolerance {:.2g}"),
+                             ("solver_alert", 1e3, "alert distance {:.3g} mm"),
+                             ("near_contacts_m", 1e3, "near contacts written up to {:.3g} mm")):
+        if number(key) is not None:
+            solver.append(text.format(number(key, scale)))
+    if solver:
+        lines.append("solver: " + ", ".join(solver))
+    lines.append(f"{len(a)} global attributes (--attrs lists them)")
+    return lines
 
 
 def _demo(args) -> int:
@@ -298,6 +347,7 @@ def build_parser() -> argparse.ArgumentParser:
                           description="Check a file against the data contract and print its size, snapshots "
                           "and settings; exits with 2 and one line naming the fault when it is not valid.")
     info.add_argument("file", help="path of a netCDF file of the grainview data contract")
+    info.add_argument("--attrs", action="store_true", help="also list every global attribute")
     info.set_defaults(func=_info)
     demo = sub.add_parser("demo", help="write a synthetic harmonic-model series and analyse it lazily",
                           description="Write a synthetic series drawn from the harmonic model (no simulation, "

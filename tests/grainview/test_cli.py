@@ -27,7 +27,10 @@ def test_info_prints_summary_and_validates(tmp_path, capsys):
     ds.to_netcdf(path, encoding=grainview.schema.netcdf_encoding(ds))
     assert main(["info", str(path)]) == 0
     out = capsys.readouterr().out
-    assert "2 snapshots, 100 particles" in out and "valid" in out
+    assert "100 particles" in out and "2 snapshots" in out and "valid" in out
+    assert "grainview_schema_version" not in out
+    assert main(["info", str(path), "--attrs"]) == 0
+    assert "grainview_schema_version = " in capsys.readouterr().out
 
 
 def test_errors_are_one_line_without_traceback(tmp_path, capsys):
@@ -67,6 +70,12 @@ def test_physics_options_reach_the_solver_and_act(tmp_path, capsys):
             assert (ratio[which] > 0.99 * mu).mean() > 0.1  # sliding contacts exist at this friction
         sigma_xx = ds.grain.stress_tensor().sel(xy_a="x", xy_b="x")
         assert abs(float(sigma_xx.mean()) / 5000.0 - 1) < 0.2
+        eps_1 = float(ds.grain.strains()["eps_1"][-1])
+    capsys.readouterr()
+    assert main(["info", str(path)]) == 0
+    out = capsys.readouterr().out
+    assert f"strain reached: eps_1 {eps_1:.3f}" in out and abs(eps_1 - 0.01) < 0.002
+    assert "sigma0 5 kPa" in out and "friction 0.2 (walls 0.1)" in out and "time step 0.4 ms" in out
 
 
 def test_bad_solver_option_is_one_line_before_simulating(tmp_path, capsys):
