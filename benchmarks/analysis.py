@@ -36,7 +36,7 @@ def _persistence(ds):
 
 def write_series(path, n_snapshots, n_contacts, seed=0):
     """Stream a harmonic-model series of ``n_snapshots`` x ``n_contacts`` to ``path``."""
-    from grainview.schema import SnapshotWriter
+    from grainview.writer import SnapshotWriter
     from grainview.synthetic import PAIR_LENGTH_M, harmonic_contacts
 
     rng = np.random.default_rng(seed)

@@ -9,18 +9,40 @@ Open a file of the data contract (docs/schema.md) and use the ``ds.grain`` acces
 
 The formulas follow Azema, Radjai, Peyroux & Saussine, Phys. Rev. E 76, 011301 (2007), with
 the corrected forms of docs/conventions.md, as each function's docstring says.
+
+Importing the package is light: the contract and the error types load at once; xarray, dask
+and the analyses load when first used (``open_dataset`` and friends are imported on first
+access, and ``ds.grain`` is registered as soon as xarray is imported, :mod:`grainview._register`),
+so that the solver, which writes files of the contract, does not load them.
 """
 
-from . import accessor as _accessor  # noqa: F401  (registers ds.grain)
+import importlib
+
+from . import _register
 from .errors import ConvergenceWarning, FileFormatError, GrainviewError, ParameterError, SchemaError
-from .io import open_dataset
-from .schema import SCHEMA_VERSION, SnapshotWriter, make_dataset
-from .validation import validate
+from .schema import SCHEMA_VERSION
 
 __version__ = "0.1.0"
+
+_LAZY = {"open_dataset": "io", "validate": "validation", "make_dataset": "dataset", "SnapshotWriter": "writer"}
+"""Public names imported from their module on first access (PEP 562)."""
 
 __all__ = [
     "open_dataset", "validate", "make_dataset", "SnapshotWriter", "SCHEMA_VERSION",
     "GrainviewError", "SchemaError", "FileFormatError", "ParameterError", "ConvergenceWarning",
     "__version__",
 ]
+
+_register.register()
+
+
+def __getattr__(name):
+    if name in _LAZY:
+        value = getattr(importlib.import_module(f".{_LAZY[name]}", __name__), name)
+        globals()[name] = value
+        return value
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+
+
+def __dir__():
+    return sorted(set(globals()) | set(_LAZY))

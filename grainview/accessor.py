@@ -8,21 +8,36 @@ lives; the accessor shows that docstring too. Nothing is computed here.
 from __future__ import annotations
 
 import functools
+import importlib
 
 import xarray as xr
 
-from . import connectivity, fabric, force_networks, forces, sample, strain, stress, validation
-from . import force_pdf as _force_pdf
-from . import persistence as _persistence
-from . import xi_network as _xi_network
 
+class _Delegate:
+    """An accessor method that calls the function of the same name in topic module
+    ``grainview.<module>`` on the accessor's dataset, with that function's docstring and
+    signature. The topic module is imported on first use, so registering the accessor (which
+    happens whenever xarray is imported after grainview) loads no analysis code."""
 
-def _delegate(func):
-    @functools.wraps(func)
-    def method(self, *args, **kwargs):
-        self._check_structure()
-        return func(self._ds, *args, **kwargs)
-    return method
+    def __init__(self, module: str):
+        self.module = module
+
+    def __set_name__(self, owner, name):
+        self.name = name
+
+    def function(self):
+        return getattr(importlib.import_module(f"grainview.{self.module}"), self.name)
+
+    def __get__(self, accessor, owner=None):
+        func = self.function()
+        if accessor is None:
+            return func
+
+        @functools.wraps(func)
+        def method(*args, **kwargs):
+            accessor._check_structure()
+            return func(accessor._ds, *args, **kwargs)
+        return method
 
 
 @xr.register_dataset_accessor("grain")
@@ -37,41 +52,45 @@ class GrainAccessor:
         """Structural check (no data read) before any analysis, so that a malformed dataset
         gives a :class:`~grainview.errors.SchemaError` naming the problem, not a KeyError."""
         if not self._structure_ok:
-            validation.check_structure(self._ds)
+            from .validation import check_structure
+
+            check_structure(self._ds)
             self._structure_ok = True
 
     def validate(self):
         """Check the dataset against the contract (:func:`grainview.validation.validate`)."""
-        return validation.validate(self._ds)
+        from .validation import validate
+
+        return validate(self._ds)
 
     # stress and strain
-    stress_tensor = _delegate(stress.stress_tensor)
-    stress_invariants = _delegate(stress.stress_invariants)
-    strains = _delegate(strain.strains)
-    friction_and_dilatancy = _delegate(strain.friction_and_dilatancy)
-    inertia_number = _delegate(strain.inertia_number)
-    solid_fraction = _delegate(sample.solid_fraction)
+    stress_tensor = _Delegate("stress")
+    stress_invariants = _Delegate("stress")
+    strains = _Delegate("strain")
+    friction_and_dilatancy = _Delegate("strain")
+    inertia_number = _Delegate("strain")
+    solid_fraction = _Delegate("sample")
     # texture
-    fabric_tensor = _delegate(fabric.fabric_tensor)
-    fabric_anisotropy = _delegate(fabric.fabric_anisotropy)
-    orientation_pdf = _delegate(fabric.orientation_pdf)
-    contact_numbers = _delegate(connectivity.contact_numbers)
-    coordination = _delegate(connectivity.coordination)
-    connectivity_pdf = _delegate(connectivity.connectivity_pdf)
-    joint_connectivity_pdf = _delegate(connectivity.joint_connectivity_pdf)
+    fabric_tensor = _Delegate("fabric")
+    fabric_anisotropy = _Delegate("fabric")
+    orientation_pdf = _Delegate("fabric")
+    contact_numbers = _Delegate("connectivity")
+    coordination = _Delegate("connectivity")
+    connectivity_pdf = _Delegate("connectivity")
+    joint_connectivity_pdf = _Delegate("connectivity")
     # forces
-    angular_force_averages = _delegate(forces.angular_force_averages)
-    force_tensors = _delegate(forces.force_tensors)
-    force_anisotropies = _delegate(forces.force_anisotropies)
-    harmonic_prediction = _delegate(forces.harmonic_prediction)
-    force_pdf = _delegate(_force_pdf.force_pdf)
-    pooled_force_pdf = _delegate(_force_pdf.pooled_force_pdf)
-    force_class = _delegate(force_networks.force_class)
-    contact_proportions = _delegate(force_networks.contact_proportions)
-    xi_network = _delegate(_xi_network.xi_network)
+    angular_force_averages = _Delegate("forces")
+    force_tensors = _Delegate("forces")
+    force_anisotropies = _Delegate("forces")
+    harmonic_prediction = _Delegate("forces")
+    force_pdf = _Delegate("force_pdf")
+    pooled_force_pdf = _Delegate("force_pdf")
+    force_class = _Delegate("force_networks")
+    contact_proportions = _Delegate("force_networks")
+    xi_network = _Delegate("xi_network")
     # contact history (these compute, one time-chunk at a time)
-    persistence = _delegate(_persistence.persistence)
-    type_transitions = _delegate(_persistence.type_transitions)
+    persistence = _Delegate("persistence")
+    type_transitions = _Delegate("persistence")
 
     @property
     def plot(self):

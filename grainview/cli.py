@@ -92,7 +92,7 @@ def info_lines(ds) -> list:
 
 def _demo(args) -> int:
     from . import open_dataset
-    from .schema import netcdf_encoding
+    from .dataset import netcdf_encoding
     from .synthetic import harmonic_series
 
     out = Path(args.out)

@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .schema import make_dataset
+from .dataset import make_dataset
 
 PAIR_LENGTH_M = 0.02
 

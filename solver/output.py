@@ -1,5 +1,5 @@
 """Writing a simulation into a netCDF file of the grainview data contract, snapshot by
-snapshot (through :class:`grainview.schema.SnapshotWriter`).
+snapshot (through :class:`grainview.writer.SnapshotWriter`).
 
 Contacts are written per body pair: a double contact's two points become one slot with the
 resultant force and its application point (the fn-weighted mean of the two points, their
@@ -25,7 +25,8 @@ import warnings
 
 import numpy as np
 
-from grainview.schema import DIAGNOSTICS, SnapshotWriter
+from grainview.schema import DIAGNOSTICS
+from grainview.writer import SnapshotWriter
 
 from . import __version__
 

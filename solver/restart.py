@@ -1,7 +1,7 @@
 """Resuming a biaxial test from its own output file, and starting a test from any saved snapshot.
 
 A run killed at any moment (SIGKILL, a cluster's wall-time limit, Ctrl-C) leaves a file whose
-complete snapshots all open (:class:`grainview.schema.SnapshotWriter` syncs the file after each
+complete snapshots all open (:class:`grainview.writer.SnapshotWriter` syncs the file after each
 one and marks it ``complete`` last). The last complete snapshot holds the whole state of the
 run, so :func:`resume` rebuilds the :class:`~solver.stepper.Simulation` from it and goes on
 appending to the same file:

@@ -77,3 +77,38 @@ def test_the_array_layer_imports_nothing_of_the_labelled_layer():
     for module, deps in graph.items():
         if module.startswith("grainview.arrays"):
             assert all(dep.startswith(allowed) for dep in deps), (module, sorted(deps))
+
+
+def _modules_after(code: str) -> set:
+    """The heavy third-party modules loaded by ``code`` in a fresh interpreter."""
+    import json
+    import subprocess
+    import sys
+
+    probe = (f"{code}\nimport json, sys\n"
+             "print(json.dumps(sorted(m for m in ('xarray', 'dask', 'matplotlib', 'pandas', 'grainview.accessor', "
+             "'grainview.stress') if m in sys.modules)))")
+    out = subprocess.run([sys.executable, "-c", probe], capture_output=True, text=True, check=True, cwd=ROOT)
+    return set(json.loads(out.stdout.strip().splitlines()[-1]))
+
+
+def test_importing_the_solver_loads_no_xarray_dask_or_matplotlib():
+    assert _modules_after("import solver") == set()
+
+
+def test_reading_files_loads_no_analysis_dask_or_plotting():
+    loaded = _modules_after("import grainview.io")
+    assert {"dask", "matplotlib", "grainview.stress"}.isdisjoint(loaded)
+    assert "xarray" in loaded and "grainview.accessor" in loaded  # ds.grain is registered
+
+
+def test_the_accessor_is_registered_whichever_is_imported_first(tmp_path):
+    """``import grainview`` before or after ``import xarray``: ``ds.grain`` works either way."""
+    import subprocess
+    import sys
+
+    for order in ("import grainview, xarray", "import xarray, grainview"):
+        code = (f"{order}\nimport numpy as np\nds = xarray.Dataset({{'radius': ('particle', np.ones(3))}})\n"
+                "print(type(ds.grain).__name__)")
+        out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True, cwd=ROOT)
+        assert out.stdout.strip() == "GrainAccessor", order

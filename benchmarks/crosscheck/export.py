@@ -144,7 +144,7 @@ def raw_to_contract(raw_dir, sample_npz, out_path, attrs=None):
     """Write the raw snapshots of ``raw_dir`` (a peer's output) as the contract file
     ``out_path`` (replaced if it exists); ``attrs`` go to the global attributes with the
     engine's ``meta.json``. Returns the number of snapshots."""
-    from grainview.schema import SnapshotWriter
+    from grainview.writer import SnapshotWriter
 
     files = sorted(glob.glob(os.path.join(raw_dir, "snap_*.npz")))
     if not files:

@@ -24,7 +24,7 @@ def test_demo_writes_a_valid_file_and_a_table_equal_to_the_accessors(tmp_path, c
 def test_info_prints_summary_and_validates(tmp_path, capsys):
     ds = harmonic_series(n_snapshots=2, n_contacts=50)
     path = tmp_path / "s.nc"
-    ds.to_netcdf(path, encoding=grainview.schema.netcdf_encoding(ds))
+    ds.to_netcdf(path, encoding=grainview.dataset.netcdf_encoding(ds))
     assert main(["info", str(path)]) == 0
     out = capsys.readouterr().out
     assert "100 particles" in out and "2 snapshots" in out and "valid" in out

@@ -9,7 +9,8 @@ from hypothesis import HealthCheck, given, settings, strategies as st
 
 import grainview
 from grainview.errors import FileFormatError, GrainviewError, SchemaError
-from grainview.schema import VARIABLES, netcdf_encoding
+from grainview.dataset import netcdf_encoding
+from grainview.schema import VARIABLES
 
 from . import builders
 

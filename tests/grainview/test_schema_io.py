@@ -8,7 +8,8 @@ import xarray as xr
 
 import grainview
 from grainview.errors import FileFormatError, SchemaError
-from grainview.schema import SnapshotWriter, contact_slots
+from grainview.schema import contact_slots
+from grainview.writer import SnapshotWriter
 
 from . import builders
 
@@ -107,7 +108,7 @@ def test_newer_schema_version_is_refused(tmp_path):
     ds = builders.two_disks()
     ds.attrs["grainview_schema_version"] = "99.0"
     path = tmp_path / "future.nc"
-    ds.to_netcdf(path, encoding=grainview.schema.netcdf_encoding(ds))
+    ds.to_netcdf(path, encoding=grainview.dataset.netcdf_encoding(ds))
     with pytest.raises(SchemaError, match="newer than this grainview"):
         grainview.open_dataset(path)
 
@@ -115,7 +116,7 @@ def test_newer_schema_version_is_refused(tmp_path):
 def test_to_netcdf_with_contract_encoding_round_trips(tmp_path):
     ds = builders.mixed_contacts()
     path = tmp_path / "x.nc"
-    ds.to_netcdf(path, encoding=grainview.schema.netcdf_encoding(ds))
+    ds.to_netcdf(path, encoding=grainview.dataset.netcdf_encoding(ds))
     back = grainview.open_dataset(path, chunks=None)
     xr.testing.assert_equal(back[["i", "j", "kind", "fn"]], ds[["i", "j", "kind", "fn"]])
 

@@ -276,14 +276,14 @@ def test_files_that_cannot_be_resumed_say_why(reference, tmp_path):
 
 CREATE_AND_DIE = """
 import os, signal, sys
-import grainview.schema as schema
+import grainview.writer as writer
 from solver import compaction_sample
 from solver.output import Recorder
 
 def die(*args, **kwargs):  # SIGKILL in the middle of creating the file, its header half written
     os.kill(os.getpid(), signal.SIGKILL)
 
-schema.global_attrs = die
+writer.global_attrs = die
 Recorder(sys.argv[1], compaction_sample(6, "disk", seed=0))
 """
 

@@ -1,0 +1,152 @@
+"""Building an in-memory :class:`xarray.Dataset` of the data contract from plain arrays, and
+the encoding that writes one to netCDF with the contract's sentinels intact.
+
+:func:`make_dataset` is how tests, demos and other codes' converters produce a dataset that
+every analysis accepts; the contract itself (names, dims, units) is :mod:`grainview.schema`.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import xarray as xr
+
+from .errors import ParameterError
+from .schema import (CONTACT_VARIABLES, DEFAULT_WALL_NAMES, OPTIONAL_CONTACT_VARIABLES, VARIABLES, XY,
+                     contact_slots, empty_slots, global_attrs, variable_attrs)
+
+__all__ = ["make_dataset", "netcdf_encoding"]
+
+
+def _coords(times, n_walls, wall_names):
+    coords = {"time": ("time", np.asarray(times, dtype="f8"), {"units": "s", "long_name": "simulated time", "axis": "T"}),
+              "xy": ("xy", np.array(XY), {"long_name": "Cartesian component"})}
+    if n_walls:
+        names = tuple(wall_names) if wall_names is not None else DEFAULT_WALL_NAMES[:n_walls]
+        if len(names) != n_walls:
+            raise ParameterError(f"wall_names has {len(names)} names, expected one per wall ({n_walls})")
+        coords["wall"] = ("wall", np.array(names), {"long_name": "wall name"})
+    return coords
+
+
+def make_dataset(
+    *,
+    radius,
+    position,
+    contacts,
+    box_min,
+    box_max,
+    time=None,
+    n_vertices=None,
+    mass=None,
+    inertia=None,
+    angle=None,
+    density: float = 2600.0,
+    n_walls: int = 0,
+    wall_names=None,
+    attrs: dict | None = None,
+    n_contact_slots: int | None = None,
+    **optional,
+) -> xr.Dataset:
+    """Assemble a dataset of the contract from plain arrays.
+
+    Parameters
+    ----------
+    radius : (N,) array, m
+    position : (T, N, 2) array, m (a (N, 2) array is taken as a single snapshot)
+    contacts : list of T dicts with keys ``i, j, kind, normal, fn, ft`` and optionally
+        ``point``, ``branch`` and ``gap`` (one entry per contact; a double contact is one
+        entry; ``gap`` in m, given for every snapshot or none).
+        ``branch`` defaults to ``x_j - x_i`` for particle pairs; ``point`` defaults to the
+        point on the segment i-j at distance ``r_i`` from i (exact for disks). For wall
+        contacts (``j >= N``) both ``point`` and ``branch`` must be given.
+    box_min, box_max : (T, 2) or (2,) arrays, m
+    n_vertices, mass, inertia, angle : defaults are disks of ``density`` (kg m-3) in a slab of
+        unit thickness at zero angle.
+    optional : any optional contract variable (``velocity``, ``wall_force``, ``step``...).
+    """
+    radius = np.asarray(radius, dtype="f8")
+    n = radius.shape[0]
+    position = np.asarray(position, dtype="f8")
+    if position.ndim == 2:
+        position = position[None]
+    t = position.shape[0]
+    if len(contacts) != t:
+        raise ParameterError(f"contacts has {len(contacts)} snapshots, position has {t}")
+    n_vertices = np.zeros(n, "i4") if n_vertices is None else np.broadcast_to(np.asarray(n_vertices, "i4"), (n,))
+    area = np.pi * radius**2
+    mass = density * area if mass is None else np.broadcast_to(np.asarray(mass, "f8"), (n,))
+    inertia = 0.5 * mass * radius**2 if inertia is None else np.broadcast_to(np.asarray(inertia, "f8"), (n,))
+    angle = np.zeros((t, n)) if angle is None else np.broadcast_to(np.asarray(angle, "f8"), (t, n))
+    slots = n_contact_slots or contact_slots(n, n_walls)
+
+    names = CONTACT_VARIABLES + tuple(v for v in OPTIONAL_CONTACT_VARIABLES if contacts and v in contacts[0])
+    data = {name: empty_slots((t, slots) + ((2,) if VARIABLES[name].dims[-1] == "xy" else ()), name)
+            for name in names}
+    count = np.zeros(t, "i4")
+    for k, snap in enumerate(contacts):
+        i = np.asarray(snap["i"], "i4")
+        m = i.shape[0]
+        if m > slots:
+            raise ParameterError(f"snapshot {k} has {m} contacts, more than the {slots} contact slots")
+        j = np.asarray(snap["j"], "i4")
+        count[k] = m
+        data["i"][k, :m] = i
+        data["j"][k, :m] = j
+        data["kind"][k, :m] = np.asarray(snap.get("kind", np.ones(m)), "i1")
+        normal = np.asarray(snap["normal"], "f8").reshape(m, 2)
+        data["normal"][k, :m] = normal
+        data["fn"][k, :m] = snap["fn"]
+        data["ft"][k, :m] = snap.get("ft", np.zeros(m))
+        for name in names[len(CONTACT_VARIABLES):]:
+            if name not in snap:
+                raise ParameterError(f"snapshot {k} lacks {name!r}: give it for every snapshot or none")
+            data[name][k, :m] = snap[name]
+        wall = j >= n
+        if "branch" in snap:
+            data["branch"][k, :m] = np.asarray(snap["branch"], "f8").reshape(m, 2)
+        else:
+            if wall.any():
+                raise ParameterError("wall contacts need an explicit 'branch' (particle centre to contact point)")
+            data["branch"][k, :m] = position[k, j] - position[k, i]
+        if "point" in snap:
+            data["point"][k, :m] = np.asarray(snap["point"], "f8").reshape(m, 2)
+        else:
+            if wall.any():
+                raise ParameterError("wall contacts need an explicit 'point'")
+            data["point"][k, :m] = position[k, i] + radius[i, None] * normal
+
+    box_min = np.broadcast_to(np.asarray(box_min, "f8"), (t, 2))
+    box_max = np.broadcast_to(np.asarray(box_max, "f8"), (t, 2))
+    arrays = {
+        "radius": radius, "n_vertices": n_vertices, "mass": mass, "inertia": inertia,
+        "position": position, "angle": angle, "contact_count": count, **data,
+        "box_min": box_min, "box_max": box_max,
+    }
+    for name, value in optional.items():
+        if name not in VARIABLES or VARIABLES[name].required:
+            raise ParameterError(f"unknown optional variable {name!r}; expected one of "
+                                 f"{[v for v in VARIABLES if not VARIABLES[v].required]}")
+        arrays[name] = np.asarray(value)
+    variables = {}
+    for name, value in arrays.items():
+        var = VARIABLES[name]
+        variables[name] = (var.dims, np.asarray(value).astype(var.dtype, copy=False), variable_attrs(name))
+    ds = xr.Dataset(variables, coords=_coords(np.arange(t, dtype="f8") if time is None else time, n_walls, wall_names))
+    ds.attrs = global_attrs(n, n_walls, attrs)
+    return ds
+
+
+def netcdf_encoding(ds: xr.Dataset) -> dict:
+    """Encoding for ``Dataset.to_netcdf`` that keeps the contract's integer sentinels.
+
+    Integers get no ``_FillValue`` (xarray would turn masked integers into floats on
+    reading); floats use NaN as fill value.
+    """
+    enc = {}
+    for name in ds.variables:
+        if name in VARIABLES:
+            floating = ds[name].dtype.kind == "f"
+            enc[name] = {"_FillValue": np.nan} if floating else {"_FillValue": None}
+    if "time" in ds.variables:
+        enc["time"] = {"_FillValue": np.nan}
+    return enc

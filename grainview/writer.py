@@ -1,0 +1,198 @@
+"""Writing a netCDF file of the data contract snapshot by snapshot, safe against a killed run.
+
+:class:`SnapshotWriter` is what the solver writes through (:mod:`solver.output`); it needs
+netCDF4 and numpy only. The contract it writes is :mod:`grainview.schema`.
+"""
+
+from __future__ import annotations
+
+import os
+
+import numpy as np
+
+from .errors import FileFormatError, ParameterError
+from .schema import (CONTACT_VARIABLES, DEFAULT_WALL_NAMES, OPTIONAL_CONTACT_VARIABLES, REQUIRED, VARIABLES,
+                     complete_snapshots, contact_slots, empty_slots, global_attrs, variable_attrs)
+
+__all__ = ["SnapshotWriter"]
+
+
+def _move_into_place(temporary: str, path: str, overwrite: bool) -> None:
+    """Rename ``temporary`` to ``path`` atomically; without ``overwrite`` an existing ``path``
+    (even one created meanwhile by another process) is kept and FileExistsError raised."""
+    if overwrite:
+        os.replace(temporary, path)
+        return
+    try:
+        os.link(temporary, path)  # fails if path exists: no check-then-rename race
+    except FileExistsError:
+        raise FileExistsError(f"{path} exists; pass overwrite=True to replace it") from None
+    except OSError:  # file systems without hard links
+        if os.path.exists(path):
+            raise FileExistsError(f"{path} exists; pass overwrite=True to replace it") from None
+        os.replace(temporary, path)
+        return
+    os.remove(temporary)
+
+
+class SnapshotWriter:
+    """Create a netCDF file of the contract and append snapshots while a run goes on.
+
+    The file is synced to disk after every snapshot; ``time`` and then the flag ``complete``
+    are written last (``complete`` is the last variable of each netCDF-3 record, so a record
+    cut short reads 0 there), so a reader (:func:`grainview.open_dataset`) sees every
+    completed snapshot and drops a trailing incomplete one. The format is netCDF-3 (64-bit
+    offset) by default: its fixed layout survives a killed writer better than HDF5's.
+
+    Use as a context manager::
+
+        with SnapshotWriter.create(path, radius=r, n_vertices=nv, mass=m, inertia=I,
+                                   n_walls=4, attrs=params) as w:
+            w.append(time=t, position=x, angle=a, contacts=c, box_min=lo, box_max=hi)
+    """
+
+    def __init__(self, nc, path):
+        self._nc = nc
+        self.path = path
+        self.n_particles = nc.dimensions["particle"].size
+        self.n_slots = nc.dimensions["contact"].size
+        self.n_walls = nc.dimensions["wall"].size if "wall" in nc.dimensions else 0
+
+    @classmethod
+    def create(cls, path, *, radius, n_vertices, mass, inertia, n_walls=0, wall_names=None,
+               wall_normal=None, optional=(),
+               attrs=None, n_contact_slots=None, overwrite=False, format="NETCDF3_64BIT_OFFSET"):
+        """Create ``path`` with the static particle data; ``optional`` names the optional
+        per-snapshot variables this file will hold (e.g. ``("velocity", *DIAGNOSTICS)``);
+        the others are not written at all."""
+        import netCDF4
+
+        path = os.fspath(path)
+        if os.path.exists(path) and not overwrite:
+            raise FileExistsError(f"{path} exists; pass overwrite=True to replace it")
+        radius = np.asarray(radius, "f8")
+        n = radius.shape[0]
+        slots = n_contact_slots or contact_slots(n, n_walls)
+        unknown = [o for o in optional if o not in VARIABLES or VARIABLES[o].required]
+        if unknown:
+            raise ParameterError(f"unknown optional variables {unknown}")
+        if not n_walls:
+            optional = [o for o in optional if "wall" not in VARIABLES[o].dims]
+        # The header and the static data are written under a temporary name and the file is
+        # moved into place once they are on disk: a run killed while the file is being created
+        # leaves either no file or a valid empty one, never a partial header.
+        directory, base = os.path.split(os.path.abspath(path))
+        temporary = os.path.join(directory, f".{base}.{os.getpid()}.part")
+        nc = netCDF4.Dataset(temporary, "w", format=format)
+        try:
+            nc.set_auto_mask(False)
+            nc.createDimension("time", None)
+            nc.createDimension("particle", n)
+            nc.createDimension("contact", slots)
+            if any("contact_point" in VARIABLES[o].dims for o in optional):
+                nc.createDimension("contact_point", 2)  # the two points of a double contact
+            nc.createDimension("xy", 2)
+            nc.createDimension("xy_strlen", 1)
+            xy = nc.createVariable("xy", "S1", ("xy", "xy_strlen"))
+            xy[:] = np.array([[b"x"], [b"y"]])
+            xy.long_name = "Cartesian component"
+            xy._Encoding = "utf-8"
+            tvar = nc.createVariable("time", "f8", ("time",), fill_value=np.nan)
+            tvar.units, tvar.long_name, tvar.axis = "s", "simulated time", "T"
+            if n_walls:
+                names = tuple(wall_names) if wall_names is not None else DEFAULT_WALL_NAMES[:n_walls]
+                width = max(len(s) for s in names)
+                nc.createDimension("wall", n_walls)
+                nc.createDimension("wall_strlen", width)
+                wv = nc.createVariable("wall", "S1", ("wall", "wall_strlen"))
+                wv[:] = netCDF4.stringtochar(np.array(names, dtype=f"S{width}"))
+                wv.long_name = "wall name"
+                wv._Encoding = "utf-8"
+            names = [*REQUIRED, *optional]
+            if n_walls and wall_normal is not None:
+                names.append("wall_normal")
+            names.append("complete")  # defined last: the last bytes of each record
+            for name in dict.fromkeys(names):
+                var = VARIABLES[name]
+                fill = None if var.is_integer else np.nan
+                v = nc.createVariable(name, var.dtype, var.dims, fill_value=fill)
+                v.setncatts(variable_attrs(name))
+            static = {"radius": radius, "n_vertices": n_vertices, "mass": mass, "inertia": inertia}
+            if "wall_normal" in nc.variables:
+                static["wall_normal"] = wall_normal
+            for name, value in static.items():
+                nc.variables[name][:] = np.broadcast_to(np.asarray(value, VARIABLES[name].dtype),
+                                                        nc.variables[name].shape)
+            nc.setncatts(global_attrs(n, n_walls, attrs))
+            nc.close()
+            _move_into_place(temporary, path, overwrite)
+        except BaseException:
+            if nc.isopen():
+                nc.close()
+            if os.path.exists(temporary):
+                os.remove(temporary)
+            raise
+        nc = netCDF4.Dataset(path, "a")
+        nc.set_auto_mask(False)
+        return cls(nc, path)
+
+    @classmethod
+    def open_append(cls, path):
+        """Open an existing file of the contract to append further snapshots."""
+        import netCDF4
+
+        try:
+            nc = netCDF4.Dataset(os.fspath(path), "a")
+        except OSError as exc:
+            raise FileFormatError(f"cannot open {path} for appending: {exc}") from exc
+        nc.set_auto_mask(False)
+        return cls(nc, path)
+
+    def attribute(self, name, default=None):
+        """The file's global attribute ``name`` (``default`` when it has none)."""
+        return self._nc.getncattr(name) if name in self._nc.ncattrs() else default
+
+    @property
+    def n_snapshots(self) -> int:
+        """Number of complete snapshots (trailing ones with no time are not counted)."""
+        complete = np.flatnonzero(complete_snapshots(self._nc.variables))
+        return int(complete[-1] + 1) if complete.size else 0
+
+    def append(self, *, time, position, angle, contacts, box_min, box_max, **optional):
+        """Write one snapshot; ``contacts`` is a dict of the contact variables with one
+        entry per contact (any length up to the number of slots)."""
+        nc = self._nc
+        k = self.n_snapshots
+        m = len(contacts["i"])
+        if m > self.n_slots:
+            raise ParameterError(f"{m} contacts exceed the file's {self.n_slots} contact slots")
+        nc.variables["position"][k] = position
+        nc.variables["angle"][k] = angle
+        nc.variables["box_min"][k] = box_min
+        nc.variables["box_max"][k] = box_max
+        for name in CONTACT_VARIABLES + tuple(v for v in OPTIONAL_CONTACT_VARIABLES
+                                              if v in contacts and v in nc.variables):
+            var = VARIABLES[name]
+            shape = (self.n_slots, 2) if var.dims[-1] == "xy" else (self.n_slots,)
+            buf = empty_slots(shape, name)
+            buf[:m] = np.asarray(contacts[name], var.dtype).reshape((m,) + shape[1:])
+            nc.variables[name][k] = buf
+        nc.variables["contact_count"][k] = m
+        for name, value in optional.items():
+            if name in nc.variables:
+                nc.variables[name][k] = value
+            elif name not in VARIABLES:
+                raise ParameterError(f"unknown variable {name!r}")
+        nc.variables["time"][k] = time
+        nc.variables["complete"][k] = 1  # last: marks the snapshot complete
+        nc.sync()
+
+    def close(self):
+        if self._nc.isopen():
+            self._nc.close()
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc):
+        self.close()
