@@ -72,7 +72,18 @@ def force_anisotropies(ds: xr.Dataset, bins: int = 36, kind="all", walls: bool =
 
 
 def harmonic_prediction(ds: xr.Dataset, bins: int = 36, walls: bool = False, near=None) -> xr.Dataset:
-    """q/p and its harmonic prediction (a' + a_n + a_t)/2 (paper Eq. qa, Fig. 12).
+    """q/p and its harmonic predictions (paper Eq. qa, Fig. 12; docs/conventions.md §3).
+
+    ``prediction`` is the paper's first-order form (a' + a_n + a_t)/2.
+    ``prediction_cross_term`` keeps the one cross product that survives the angular
+    integration of the harmonic model: with P(theta) = [1 + a cos 2 theta]/pi and
+    <f_n>(theta) = <f>[1 + a_n cos 2 theta], the mean stress is p ~ (1 + a a_n / 2), so
+
+        q/p = (a' + a_n + a_t) / (2 + a' a_n),
+
+    exact for the harmonic model with coaxial directions and equal branch lengths; the two
+    forms differ by the factor 1 + a' a_n / 2 (a few percent for the paper's anisotropies,
+    ~15% when a' and a_n are near 0.55).
 
     The anisotropies use the contacts selected by ``walls`` (default particle–particle);
     q/p is the stress of the whole sample (wall contacts included). ``near``: which pairs are
@@ -80,9 +91,12 @@ def harmonic_prediction(ds: xr.Dataset, bins: int = 36, walls: bool = False, nea
     """
     fab = fabric_anisotropy(ds, walls=walls, near=near)
     frc = force_anisotropies(ds, bins, walls=walls, near=near)
-    prediction = (fab["a_prime"] + frc["a_n"] + frc["a_t"]) / 2
+    total = fab["a_prime"] + frc["a_n"] + frc["a_t"]
+    cross = total / (2 + fab["a_prime"] * frc["a_n"])
     return xr.Dataset({
         "q_over_p": stress_invariants(ds)["q_over_p"],
-        "prediction": with_attrs(prediction, "prediction", "1", "harmonic prediction (a' + a_n + a_t)/2"),
+        "prediction": with_attrs(total / 2, "prediction", "1", "harmonic prediction (a' + a_n + a_t)/2"),
+        "prediction_cross_term": with_attrs(cross, "prediction_cross_term", "1",
+                                            "harmonic prediction with the cross term (a' + a_n + a_t)/(2 + a' a_n)"),
         "a_prime": fab["a_prime"], "a_n": frc["a_n"], "a_t": frc["a_t"],
     })

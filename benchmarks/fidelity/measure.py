@@ -53,6 +53,7 @@ def window_means(path, window=(0.4, np.inf), near=None) -> dict:
         "eps_q": (float(eps_q[keep].min()), float(eps_q[keep].max())),
         "q/p": _mean(inv["q_over_p"], everything),
         "prediction": _mean(hp["prediction"], everything),
+        "prediction cross": _mean(hp["prediction_cross_term"], everything),
         "a'": _mean(hp["a_prime"], everything),
         "a": _mean(res.grain.fabric_anisotropy(near=near)["a"], everything),
         "a_n": _mean(hp["a_n"], everything),

@@ -46,10 +46,15 @@ def _a_t(p, d):
 
 
 def _harmonic(p, d):
+    """The paper's first-order form decides; the text adds the form with the cross term
+    a' a_n (docs/conventions.md §3), where the summaries have it."""
     texts, holds = [], True
     for name, s in (("P", p), ("D", d)):
         off = np.mean([x["prediction"] / x["q/p"] - 1 for x in s])
-        texts.append(f"{name} {off:+.0%}")
+        text = f"{name} {off:+.0%}"
+        if all("prediction cross" in x for x in s):
+            text += f" ({np.mean([x['prediction cross'] / x['q/p'] - 1 for x in s]):+.0%} with the cross term)"
+        texts.append(text)
         holds &= abs(off) <= 0.10
     return "prediction / (q/p) - 1: " + ", ".join(texts), bool(holds)
 

@@ -53,11 +53,13 @@ def plot_stress_dilatancy(data, ax=None, label=None, incremental: bool = False, 
 
 
 def plot_harmonic_prediction(data, ax=None, label=None, bins: int = 36, **line_kw):
-    """q/p (solid) and its harmonic prediction (a' + a_n + a_t)/2 (dashed) against eps_q
-    (paper Eq. qa, Fig. 12; :func:`grainview.forces.harmonic_prediction`, ``bins`` angular
-    sectors). Two lines per sample, in that order."""
+    """q/p (solid), its harmonic prediction (a' + a_n + a_t)/2 (paper Eq. qa, Fig. 12) and the
+    same with the cross term, (a' + a_n + a_t)/(2 + a' a_n), against eps_q
+    (:func:`grainview.forces.harmonic_prediction`, ``bins`` angular sectors). Three lines per
+    sample, in that order."""
     ax = get_axes(ax)
-    curves = [("$q/p$", "q_over_p"), ("$(a' + a_n + a_t)/2$", "prediction")]
+    curves = [("$q/p$", "q_over_p"), ("$(a' + a_n + a_t)/2$", "prediction"),
+              ("$(a' + a_n + a_t)/(2 + a' a_n)$", "prediction_cross_term")]
     draw_evolutions(ax, datasets(data, label), lambda ds: harmonic_prediction(ds, bins), curves, **line_kw)
     set_labels(ax, EPS_Q_LABEL, "$q/p$")
     return finish(ax, None)

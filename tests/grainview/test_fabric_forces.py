@@ -97,6 +97,20 @@ def test_harmonic_model_anisotropies_are_recovered():
     assert float(pred.q_over_p) == pytest.approx(float(pred.prediction), abs=0.05)
 
 
+@pytest.mark.parametrize("a, a_n, a_t", [(0.3, 0.4, 0.25), (0.6, 0.6, 0.2), (0.6, 0.55, 0.18)])
+def test_the_cross_term_makes_the_harmonic_prediction_exact(a, a_n, a_t):
+    """For the harmonic model with coaxial directions and equal branch lengths, integrating
+    P(theta) <f_n>(theta) over the angles gives p ~ 1 + a a_n / 2 and q ~ (a + a_n + a_t)/2:
+    q/p = (a + a_n + a_t)/(2 + a a_n) exactly, while the first-order form is off by the
+    factor 1 + a a_n / 2 (18% at a = a_n = 0.6)."""
+    pred = harmonic_sample(a=a, a_n=a_n, a_t=a_t, theta_0=0.3).grain.harmonic_prediction().isel(time=0)
+    exact = (a + a_n + a_t) / (2 + a * a_n)
+    assert float(pred.q_over_p) == pytest.approx(exact, abs=0.005)
+    assert float(pred.prediction_cross_term) == pytest.approx(float(pred.q_over_p), abs=0.005)
+    first_order_error = float(pred.prediction) / float(pred.q_over_p) - 1
+    assert first_order_error == pytest.approx(a * a_n / 2, abs=0.01)
+
+
 @settings(max_examples=25, deadline=None)
 @given(seed=st.integers(0, 10_000))
 def test_partial_fabrics_add_up(seed):

@@ -85,7 +85,7 @@ EVOLUTIONS = {
     "q_over_p": (gp.plot_q_over_p, {}, "$q/p$", lambda ds: [stress_invariants(ds)["q_over_p"]]),
     "eps_p": (gp.plot_volumetric_strain, {}, r"$\varepsilon_p$", lambda ds: [strains(ds)["eps_p"]]),
     "harmonic": (gp.plot_harmonic_prediction, {}, "$q/p$",
-                 lambda ds: [harmonic_prediction(ds)[v] for v in ("q_over_p", "prediction")]),
+                 lambda ds: [harmonic_prediction(ds)[v] for v in ("q_over_p", "prediction", "prediction_cross_term")]),
     "partial_q": (gp.plot_partial_q_over_p, {}, "$q/p$",
                   lambda ds: [stress_invariants(ds, k)["q_over_p"] for k in ("simple", "double", "all")]),
     "z": (gp.plot_coordination, {}, "$z$", lambda ds: [coordination(ds)["z"]]),
