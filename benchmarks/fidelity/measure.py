@@ -119,3 +119,50 @@ def strain_series(path, quantities=("q/p", "a", "z"), near=None):
         series[name] = getters[name]().values
     ds.close()
     return series
+
+
+def boundary_checks(path, window=(0.4, np.inf), margin=3.0) -> dict:
+    """Two computations of q/p independent of the contact stress of the whole sample, means
+    over the snapshots of a shear-strain window:
+
+    * ``q/p central``: the stress of the particles whose centres lie farther than ``margin``
+      largest diameters from every wall, sum over those particles p and their contacts c of
+      f_c(on p) (x) (x_c - x_p) (the volume cancels in q/p);
+    * ``q/p walls``: sigma_1 = mean force of the top and bottom walls over the box width,
+      sigma_2 = mean force of the left and right walls over the box height (walls named as
+      the solver names them), q/p = (sigma_1 - sigma_2)/(sigma_1 + sigma_2).
+    """
+    with grainview.open_dataset(path, chunks=None) as ds:
+        n_particles = ds.sizes["particle"]
+        walls = [str(w) for w in ds["wall"].values]
+        d_max = 2 * float(ds["radius"].max())
+        eps_q = ds.grain.strains()["eps_q"].values
+        keep = np.flatnonzero((eps_q >= window[0]) & (eps_q < window[1]))
+        central, at_walls, inside_counts = [], [], []
+        for k in keep:
+            s = ds.isel(time=k)
+            x, lo, hi = s["position"].values, s["box_min"].values, s["box_max"].values
+            inside = np.all((x - lo > margin * d_max) & (hi - x > margin * d_max), axis=1)
+            used = s["kind"].values > 0
+            i, j = s["i"].values[used], s["j"].values[used]
+            n = s["normal"].values[used]
+            force = s["fn"].values[used][:, None] * n + s["ft"].values[used][:, None] * np.stack([-n[:, 1], n[:, 0]], 1)
+            point = s["point"].values[used]
+            on_j = (j < n_particles) & inside[np.minimum(j, n_particles - 1)]
+            on_i = inside[i]
+            moment = (np.einsum("ca,cb->ab", force[on_j], point[on_j] - x[j[on_j]])
+                      - np.einsum("ca,cb->ab", force[on_i], point[on_i] - x[i[on_i]]))
+            low, high = np.linalg.eigvalsh(-(moment + moment.T) / 2)
+            central.append((high - low) / (high + low))
+            inside_counts.append(int(inside.sum()))
+
+            def wall_force(name):
+                w = n_particles + walls.index(name)
+                return float(np.nan_to_num(s["fn"].values[used][j == w]).sum())
+            width, height = hi - lo
+            sigma_1 = (wall_force("top") + wall_force("bottom")) / 2 / width
+            sigma_2 = (wall_force("left") + wall_force("right")) / 2 / height
+            at_walls.append((sigma_1 - sigma_2) / (sigma_1 + sigma_2))
+    return {"q/p central": float(np.mean(central)) if central else np.nan,
+            "q/p walls": float(np.mean(at_walls)) if at_walls else np.nan,
+            "central particles": int(np.mean(inside_counts)) if inside_counts else 0}

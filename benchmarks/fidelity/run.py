@@ -169,20 +169,26 @@ def section_sizes(cfg, jobs):
     for r in runs:
         for w, s in zip(windows, _windows(paths[r], windows)):
             if s["snapshots"]:
+                checks = measure.boundary_checks(paths[r], w)
                 rows.append([r.shape, r.particles, _window(w),
-                             s["snapshots"], _f(s["q/p"]), _f(s["prediction"]), _f(s["a"]), _f(s["a_n"]),
+                             s["snapshots"], _f(s["q/p"]), _f(checks["q/p central"]), checks["central particles"],
+                             _f(checks["q/p walls"]), _f(s["prediction"]), _f(s["prediction cross"]),
+                             _f(s["a"]), _f(s["a_n"]),
                              _f(s["a_t"]), _f(s["z"], 2), _f(s["k_d"], 2), _f(s["very weak"])])
     speeds = ", ".join(f"{cfg.velocity(n) * 100:g} cm/s for {n}" for n in cfg.sizes[1:])
     text = ("Residual values against the number of particles (preparation 'paper', seed 0, force-bearing "
             f"contacts), all sheared at the same strain rate (~0.01 s-1: the top wall at "
             f"{cfg.velocity(cfg.sizes[0]) * 100:g} cm/s for {cfg.sizes[0]} particles, {speeds}). Paper: "
             "N = 14,400 pentagons (q/p 0.35, z 3.75) and 10,000 disks "
-            "(q/p 0.28, z 3.85).\n\n")
+            "(q/p 0.28, z 3.85). q/p central: the stress of the particles farther than three largest diameters "
+            "from every wall; q/p walls: from the wall forces alone (measure.boundary_checks).\n\n")
     curves = [(f"{r.shape}s, N = {r.particles}", r.shape, measure.strain_series(paths[r])) for r in runs]
     figure = figures.evolutions(curves, figures.figure_path(cfg.output, "sizes"),
                                 "Number of particles (same strain rate, seed 0)")
     return (text + f"![sizes]({os.path.basename(figure)})\n\n"
-            + _table(["shape", "N", "eps_q", "snapshots", "q/p", "(a'+a_n+a_t)/2", "a", "a_n", "a_t", "z", "k_d",
+            + _table(["shape", "N", "eps_q", "snapshots", "q/p", "q/p central", "central particles", "q/p walls",
+                      "(a'+a_n+a_t)/2", "(a'+a_n+a_t)/(2+a'a_n)",
+                      "a", "a_n", "a_t", "z", "k_d",
                       "very weak"], rows))
 
 
@@ -206,7 +212,7 @@ def section_counting(cfg, jobs):
                          relations.fmt(summaries, "very weak"), relations.fmt(summaries, "a'(very weak)"),
                          relations.fmt(summaries, "weak"),
                          relations.fmt(summaries, "a"), relations.fmt(summaries, "prediction"),
-                         relations.fmt(summaries, "q/p")])
+                         relations.fmt(summaries, "prediction cross"), relations.fmt(summaries, "q/p")])
     text = (f"Residual state (eps_q >= {cfg.residual[0]:g}) of {cfg.relation_particles} particles, "
             f"{len(cfg.seeds)} seeds (mean ± spread), preparation 'paper', counted four ways: force-bearing contacts only, "
             "or also every pair whose gap is within a threshold (written by the solver up to its alert distance, "
@@ -216,7 +222,7 @@ def section_counting(cfg, jobs):
     figure = figures.counting(points, figures.figure_path(cfg.output, "counting"))
     return (text + f"![counting]({os.path.basename(figure)})\n\n"
             + _table(["shape", "counted", "z", "z points", "very weak", "a' of very weak", "weak", "a",
-                      "(a'+a_n+a_t)/2", "q/p"], rows))
+                      "(a'+a_n+a_t)/2", "(a'+a_n+a_t)/(2+a'a_n)", "q/p"], rows))
 
 
 def _summaries(cfg, runs, paths, near):
