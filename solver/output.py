@@ -29,6 +29,7 @@ from grainview.schema import DIAGNOSTICS
 from grainview.writer import SnapshotWriter
 
 from . import __version__
+from .contact_points import point_forces, rank_in_pair
 
 OPTIONAL = ("velocity", "angular_velocity", "wall_position", "wall_velocity", "wall_force",
             "normal_impulse", "tangential_impulse", "gap", *DIAGNOSTICS)
@@ -84,9 +85,9 @@ def pair_contacts(sim, near=None, n_slots=None):
         empty = np.empty(0)
         return dict(i=np.empty(0, "i4"), j=np.empty(0, "i4"), kind=np.empty(0, "i1"), normal=np.empty((0, 2)),
                     fn=empty, ft=empty, point=np.empty((0, 2)), branch=np.empty((0, 2)), gap=empty)
-    fn_pt = sim.impulse[:, 0] / h
+    fn_pt, ft_pt = point_forces(sim.impulse, h)
     fn = _pair_sums(pts, fn_pt)
-    ft = _pair_sums(pts, sim.impulse[:, 1] / h)
+    ft = _pair_sums(pts, ft_pt)
     weight = _pair_sums(pts, np.ones_like(fn_pt))
     loaded = np.stack([_pair_sums(pts, fn_pt * pts.point[:, 0]), _pair_sums(pts, fn_pt * pts.point[:, 1])], -1)
     middle = np.stack([_pair_sums(pts, pts.point[:, 0]), _pair_sums(pts, pts.point[:, 1])], -1)
@@ -120,8 +121,7 @@ def point_impulses(sim, n_slots, near=None):
     pair = pts.pair
     keep = written_pairs(sim, near, n_slots)
     slot = np.cumsum(keep) - 1
-    rank = np.zeros(len(pair), np.int64)
-    rank[1:] = pair[1:] == pair[:-1]
+    rank = rank_in_pair(pair)
     written = keep[pair]
     normal[slot[pair[written]], rank[written]] = sim.impulse[written, 0]
     tangential[slot[pair[written]], rank[written]] = sim.impulse[written, 1]

@@ -24,13 +24,13 @@ from __future__ import annotations
 import time
 import warnings
 from dataclasses import asdict, dataclass
-from typing import NamedTuple
 
 import numpy as np
 
 from grainview.errors import ConvergenceWarning, ParameterError
 
 from . import broadphase, narrowphase, nlgs
+from .contact_points import PairIndex, force_vectors, point_keys
 from .shapes import mass_and_inertia
 from .walls import FIXED, STRESS, VELOCITY, Walls
 
@@ -87,14 +87,6 @@ class Parameters:
         if bad:
             raise ParameterError("invalid solver parameters: " + "; ".join(bad))
         return self
-
-
-class _Points(NamedTuple):
-    """The fields of a contact-point set that :meth:`Simulation._point_keys` reads."""
-
-    pair: np.ndarray
-    body_i: np.ndarray
-    body_j: np.ndarray
 
 
 @dataclass
@@ -160,6 +152,13 @@ class Simulation:
         self.points = None
         self.impulse = np.empty((0, 2))
         self.last = None
+        # What the scenes that prepared this simulation found (solver.scenes, solver.preparation)
+        self.sigma0 = np.nan  # Pa, the confining stress the sample was compacted under
+        self.settled = None  # whether the isotropic compaction reached its equilibrium test
+        self.compaction_steps = None  # steps the compaction took
+        self.compaction_stress = None  # Pa, mean stress on each stress-driven wall at its end
+        self.compaction_inertia_number = None  # the largest inertia number of the closing walls
+        self.preparation = None  # the solver.preparation.Preparation that made the sample
         self.timings = {"broad_phase": 0.0, "narrow_phase": 0.0, "solve": 0.0, "update": 0.0}
         self.counters = {"steps": 0, "broad_phase_runs": 0, "sweeps": 0, "point_sweeps": 0, "recovery_sweeps": 0}
 
@@ -244,8 +243,8 @@ class Simulation:
         """
         m = len(i)
         pair = np.repeat(np.arange(m), 2)
-        points = _Points(pair=pair, body_i=np.repeat(np.asarray(i, np.int64), 2),
-                         body_j=np.repeat(np.asarray(j, np.int64), 2))
+        points = PairIndex(pair=pair, body_i=np.repeat(np.asarray(i, np.int64), 2),
+                           body_j=np.repeat(np.asarray(j, np.int64), 2))
         self._keys = self._point_keys(points)
         self._impulse = np.stack([np.asarray(normal_impulse, float).reshape(2 * m),
                                   np.asarray(tangential_impulse, float).reshape(2 * m)], -1)
@@ -265,11 +264,8 @@ class Simulation:
         self._impulse = self._impulse * float(factor)
 
     def _point_keys(self, pts):
-        bodies = self.n_particles + self.n_walls
-        rank = np.zeros(len(pts.pair), np.int64)
-        if len(pts.pair) > 1:
-            rank[1:] = (pts.pair[1:] == pts.pair[:-1]).astype(np.int64)
-        return (pts.body_i.astype(np.int64) * bodies + pts.body_j) * 2 + rank
+        """The identity of each point across steps (:func:`solver.contact_points.point_keys`)."""
+        return point_keys(pts, self.n_particles + self.n_walls)
 
     # -- one step ---------------------------------------------------------------------------
     def step(self) -> StepInfo:
@@ -456,8 +452,7 @@ class Simulation:
         if self.points is None or not len(self.points.gap):
             return out
         pts = self.points
-        f = (self.impulse[:, 0:1] * pts.normal + self.impulse[:, 1:2] * np.stack([-pts.normal[:, 1], pts.normal[:, 0]], -1))
-        f /= self.parameters.time_step
+        f = force_vectors(pts.normal, self.impulse, self.parameters.time_step)
         on_wall = pts.body_j >= self.n_particles
         np.add.at(out, pts.body_j[on_wall] - self.n_particles, f[on_wall])
         return out
