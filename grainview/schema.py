@@ -127,6 +127,17 @@ def particle_area(radius, n_vertices):
     return np.where(n >= 3, polygon, np.pi * radius**2)
 
 
+def polygon_vertices(position, radius, angle, n_vertices: int) -> np.ndarray:
+    """(P, n, 2) vertices in m of P regular n-gons of one vertex count ``n_vertices``: vertex k
+    at position + R (cos(angle + 2 pi k/n), sin(angle + 2 pi k/n)), counter-clockwise, R the
+    circumscribed radius. Part of the contract's shape definition (what ``angle`` means)."""
+    position = np.asarray(position, dtype=float).reshape(-1, 2)
+    radius = np.asarray(radius, dtype=float).reshape(-1)
+    angle = np.broadcast_to(np.asarray(angle, dtype=float), radius.shape)
+    phase = angle[:, None] + 2.0 * np.pi * np.arange(n_vertices) / n_vertices
+    return position[:, None, :] + radius[:, None, None] * np.stack([np.cos(phase), np.sin(phase)], -1)
+
+
 def complete_snapshots(variables) -> np.ndarray:
     """Boolean per snapshot: ``time`` finite and, where the file has it, ``complete == 1``.
 

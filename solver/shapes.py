@@ -26,7 +26,7 @@ from __future__ import annotations
 import numpy as np
 
 from grainview.errors import ParameterError
-from grainview.schema import particle_area
+from grainview.schema import particle_area, polygon_vertices
 
 __all__ = ["polygon_area", "polygon_inertia_per_mass", "mass_and_inertia", "vertices", "inradius",
            "check_shapes"]
@@ -114,11 +114,8 @@ def vertices(pos, angle, radius, nvert):
     if pos.shape[0] != radius.shape[0]:
         raise ParameterError(f"pos must have shape (N, 2) with N = {radius.shape[0]}, got {pos.shape}")
     maxn = int(nvert.max()) if nvert.size else 0
-    k = np.arange(maxn)
-    safe_n = np.where(nvert >= 3, nvert, 1)[:, None]
-    phi = angle[:, None] + 2.0 * np.pi * k[None, :] / safe_n
-    out = np.empty((radius.shape[0], maxn, 2))
-    out[..., 0] = pos[:, 0, None] + radius[:, None] * np.cos(phi)
-    out[..., 1] = pos[:, 1, None] + radius[:, None] * np.sin(phi)
-    out[k[None, :] >= nvert[:, None]] = np.nan
+    out = np.full((radius.shape[0], maxn, 2), np.nan)
+    for n in np.unique(nvert[nvert >= 3]):
+        sel = nvert == n
+        out[sel, :n] = polygon_vertices(pos[sel], radius[sel], angle[sel], int(n))
     return out

@@ -16,6 +16,7 @@ import xarray as xr
 from matplotlib.collections import EllipseCollection, LineCollection, PolyCollection
 
 from ..contacts import selection
+from ..schema import polygon_vertices
 from ._style import axis_label, get_axes, single_dataset, snapshot_index
 
 PARTICLE_FACE = "0.92"
@@ -24,13 +25,6 @@ CLASS_COLOURS = {1: "tab:blue", 2: "tab:green", 3: "tab:red"}
 """Colours of the tricolor map: very weak (blue), weak (green), strong (red) (paper Fig. 17)."""
 KIND_COLOURS = {1: "tab:blue", 2: "tab:red"}
 """Colours of the kind map: simple (blue), double (red) (paper Fig. 24)."""
-
-
-def polygon_vertices(position, radius, angle, n_vertices: int) -> np.ndarray:
-    """(P, n, 2) vertices of P regular n-gons: vertex k at
-    position + radius (cos(angle + 2 pi k/n), sin(angle + 2 pi k/n)), m."""
-    phase = angle[:, None] + 2 * np.pi * np.arange(n_vertices) / n_vertices
-    return position[:, None, :] + radius[:, None, None] * np.stack([np.cos(phase), np.sin(phase)], -1)
 
 
 def plot_particles(data, ax=None, time: int = -1, facecolor=PARTICLE_FACE, edgecolor=PARTICLE_EDGE,
@@ -167,4 +161,4 @@ def _legend(ax, entries):
 
 
 __all__ = ["plot_particles", "plot_force_chains", "plot_force_classes", "plot_contact_kinds",
-           "polygon_vertices", "contact_segments", "force_linewidths", "contact_collection"]
+           "contact_segments", "force_linewidths", "contact_collection"]

@@ -8,6 +8,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from grainview.schema import polygon_vertices
+
 
 def all_pairs(pos, radius, alert):
     """Every pair i < j with |x_i - x_j| <= r_i + r_j + alert, as a sorted list of tuples."""
@@ -19,9 +21,8 @@ def all_pairs(pos, radius, alert):
 
 
 def polygon(x, y, r, theta, n):
-    """(n, 2) vertices of a regular n-gon, counter-clockwise."""
-    phi = theta + 2 * np.pi * np.arange(n) / n
-    return np.column_stack([x + r * np.cos(phi), y + r * np.sin(phi)])
+    """(n, 2) vertices of a regular n-gon, counter-clockwise (the contract's convention)."""
+    return polygon_vertices([[x, y]], [r], theta, n)[0]
 
 
 def outward_normals(verts):
