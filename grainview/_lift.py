@@ -4,24 +4,39 @@ One helper, :func:`apply`, wraps :func:`xarray.apply_ufunc` with ``dask="paralle
 that every topic module gets the same behaviour: the named core dimensions (``contact``,
 ``particle``, ``xy``...) are moved last and must be whole in each chunk, every other
 dimension (``time``) is broadcast, and a dask-backed input gives a lazy result chunked like it.
+The core dimensions of each array function are declared beside it
+(:mod:`grainview.arrays.signature`), so a topic module names only the sizes that depend on
+its call (the number of angular bins...).
 """
 
 from __future__ import annotations
 
 import xarray as xr
 
-TENSOR_DIMS = ("xy_a", "xy_b")
+from .arrays.signature import SIZES, TENSOR
+
+TENSOR_DIMS = TENSOR
 """Dimension names of a 2x2 tensor result; both have coordinates ("x", "y")."""
 
 
-def apply(func, *args, core_dims, output_core_dims=((),), output_sizes=None,
+def apply(func, *args, core_dims=None, output_core_dims=None, output_sizes=None,
           output_dtypes=None, kwargs=None, attrs=None, names=None):
-    """``xr.apply_ufunc(func, *args)`` with core dims, lazily over dask chunks.
+    """``xr.apply_ufunc(func, *args)`` over the core dims ``func`` declares, lazily over dask
+    chunks.
 
-    ``core_dims`` lists the core dims of each argument; ``output_core_dims`` those of each
-    output. Returns a DataArray, or a tuple of them when several outputs are declared;
-    ``attrs`` and ``names`` (one per output) are set on the results.
+    ``core_dims`` (one tuple per argument) and ``output_core_dims`` (one per output) default to
+    the function's declaration (:func:`grainview.arrays.signature.core_dims`). Returns a
+    DataArray, or a tuple of them when several outputs are declared; ``attrs`` and ``names``
+    (one per output) are set on the results.
     """
+    core_dims = func.core_dims if core_dims is None else core_dims
+    output_core_dims = getattr(func, "output_core_dims", ((),)) if output_core_dims is None else output_core_dims
+    if len(core_dims) != len(args):
+        raise TypeError(f"{getattr(func, '__name__', func)} declares {len(core_dims)} core-dim inputs, "
+                        f"got {len(args)} arguments")
+    sizes = {d: n for d, n in SIZES.items() if any(d in dims for dims in output_core_dims)}
+    sizes.update(output_sizes or {})
+    output_sizes = sizes
     n_out = len(output_core_dims)
     result = xr.apply_ufunc(
         func, *args,

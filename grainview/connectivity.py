@@ -17,15 +17,12 @@ from .arrays import connectivity as _conn
 from .contacts import selection
 from .errors import ParameterError
 
-PAIR_DIMS = [("contact",), ("contact",), ("contact",)]
-
 
 def contact_numbers(ds: xr.Dataset, kind="all", walls: bool = False, near=None) -> xr.DataArray:
     """c_i (time, particle): number of contacts of each particle, force-bearing ones by default
     (``near``: :func:`grainview.contacts.in_network`)."""
     mask = selection(ds, walls=walls, kind=kind, near=near)
-    da = apply(_conn.contact_numbers, ds["i"], ds["j"], mask, core_dims=PAIR_DIMS,
-               output_core_dims=[("particle",)], output_sizes={"particle": ds.sizes["particle"]},
+    da = apply(_conn.contact_numbers, ds["i"], ds["j"], mask, output_sizes={"particle": ds.sizes["particle"]},
                kwargs={"n_particles": ds.sizes["particle"]}, output_dtypes=[np.int64])
     return with_attrs(da, "contact_number", "1", "number of force-bearing contacts per particle")
 
@@ -38,8 +35,7 @@ def _check_min(min_contacts):
 def coordination(ds: xr.Dataset, walls: bool = False, min_contacts: int = 1, near=None) -> xr.Dataset:
     """z = sum_i c_i / N' (time) over the N' non-rattler particles, and N'."""
     _check_min(min_contacts)
-    z, kept = apply(_conn.coordination, contact_numbers(ds, walls=walls, near=near), core_dims=[("particle",)],
-                    output_core_dims=[(), ()], kwargs={"min_contacts": min_contacts},
+    z, kept = apply(_conn.coordination, contact_numbers(ds, walls=walls, near=near), kwargs={"min_contacts": min_contacts},
                     output_dtypes=[float, np.int64])
     return xr.Dataset({
         "z": with_attrs(z, "z", "1", "coordination number z (rattlers excluded)"),
@@ -51,8 +47,7 @@ def connectivity_pdf(ds: xr.Dataset, max_c: int = 10, walls: bool = False, min_c
                      near=None) -> xr.DataArray:
     """P(c) (time, c): fraction of non-rattler particles with exactly c contacts (Fig. 7)."""
     _check_min(min_contacts)
-    da = apply(_conn.connectivity_pdf, contact_numbers(ds, walls=walls, near=near), core_dims=[("particle",)],
-               output_core_dims=[("c",)], output_sizes={"c": max_c + 1},
+    da = apply(_conn.connectivity_pdf, contact_numbers(ds, walls=walls, near=near), output_sizes={"c": max_c + 1},
                kwargs={"max_c": max_c, "min_contacts": min_contacts})
     da = da.assign_coords(c=np.arange(max_c + 1))
     return with_attrs(da, "P_c", "1", "fraction of particles with exactly c contacts P(c)")
@@ -64,8 +59,7 @@ def joint_connectivity_pdf(ds: xr.Dataset, max_m: int = 8, walls: bool = False, 
     and m_d double force-bearing contacts (paper Fig. 21)."""
     _check_min(min_contacts)
     da = apply(_conn.joint_connectivity_pdf, contact_numbers(ds, "simple", walls, near),
-               contact_numbers(ds, "double", walls, near), core_dims=[("particle",), ("particle",)],
-               output_core_dims=[("m_s", "m_d")], output_sizes={"m_s": max_m + 1, "m_d": max_m + 1},
+               contact_numbers(ds, "double", walls, near), output_sizes={"m_s": max_m + 1, "m_d": max_m + 1},
                kwargs={"max_m": max_m, "min_contacts": min_contacts})
     da = da.assign_coords(m_s=np.arange(max_m + 1), m_d=np.arange(max_m + 1))
     return with_attrs(da, "P_ms_md", "1", "fraction of particles with m_s simple and m_d double contacts")

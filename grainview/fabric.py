@@ -9,7 +9,7 @@ from __future__ import annotations
 import numpy as np
 import xarray as xr
 
-from ._lift import TENSOR_DIMS, apply, with_attrs
+from ._lift import apply, with_attrs
 from .arrays import fabric as _fabric
 from .arrays.tensors import principal, signed_anisotropy
 from .contacts import kind_code, selection
@@ -27,10 +27,7 @@ def fabric_tensor(ds: xr.Dataset, kind="all", walls: bool = False, near=None) ->
     mask_all = selection(ds, walls=walls, near=near)
     mask = selection(ds, walls=walls, kind=kind, near=near)
     label = {None: "", 1: " of simple contacts", 2: " of double contacts"}[kind_code(kind)]
-    return apply(_fabric.fabric_tensor, ds["normal"], mask, mask_all,
-                 core_dims=[("contact", "xy"), ("contact",), ("contact",)],
-                 output_core_dims=[TENSOR_DIMS], output_sizes={d: 2 for d in TENSOR_DIMS},
-                 names=["fabric"], attrs={"units": "1", "long_name": f"fabric tensor{label}"})
+    return apply(_fabric.fabric_tensor, ds["normal"], mask, mask_all, names=["fabric"], attrs={"units": "1", "long_name": f"fabric tensor{label}"})
 
 
 def reference_direction(ds, reference):
@@ -53,8 +50,7 @@ def fabric_anisotropy(ds: xr.Dataset, kind="all", walls: bool = False, reference
     partial tensor (kind simple/double) the anisotropies a_s, a'_s are those of F_s, whose
     trace is k_s (paper Fig. 22).
     """
-    f1, f2, theta = apply(principal, fabric_tensor(ds, kind, walls, near), core_dims=[TENSOR_DIMS],
-                          output_core_dims=[(), (), ()])
+    f1, f2, theta = apply(principal, fabric_tensor(ds, kind, walls, near))
     ref = reference_direction(ds, reference)
     a_prime = signed_anisotropy(f1, f2, theta, ref, normalisation=1.0)
     return xr.Dataset({
@@ -69,8 +65,7 @@ def orientation_pdf(ds: xr.Dataset, bins: int = 36, kind="all", walls: bool = Fa
     normalised so that sum P dtheta = 1 (paper Fig. 8)."""
     bins = check_bins(bins)
     mask = selection(ds, walls=walls, kind=kind, near=near)
-    da = apply(_fabric.orientation_pdf, ds["normal"], mask, core_dims=[("contact", "xy"), ("contact",)],
-               output_core_dims=[("theta",)], output_sizes={"theta": bins}, kwargs={"n_bins": bins},
+    da = apply(_fabric.orientation_pdf, ds["normal"], mask, output_sizes={"theta": bins}, kwargs={"n_bins": bins},
                names=["orientation_pdf"],
                attrs={"units": "rad-1", "long_name": "probability density of contact orientations P(theta)"})
     return da.assign_coords(theta=theta_coord(bins))

@@ -37,8 +37,8 @@ def force_class(ds: xr.Dataset, very_weak: float = 0.1, strong: float = 1.0, wal
     force-bearing ones; with a gap threshold the near pairs, f_n = 0, are very weak).
     """
     very_weak, strong = _check_thresholds(very_weak, strong)
-    da = apply(_net.force_classes, ds["fn"], selection(ds, walls=walls, near=near), core_dims=[("contact",)] * 2,
-               output_core_dims=[("contact",)], kwargs={"very_weak": very_weak, "strong": strong},
+    da = apply(_net.force_classes, ds["fn"], selection(ds, walls=walls, near=near),
+               kwargs={"very_weak": very_weak, "strong": strong},
                output_dtypes=[np.int8])
     return with_attrs(da, "force_class", "1", "force class of the contact",
                       flag_values=np.array([0, 1, 2, 3], dtype="i1"),
@@ -90,7 +90,6 @@ def contact_proportions(ds: xr.Dataset, walls: bool = False, very_weak: float = 
     very_weak, strong = _check_thresholds(very_weak, strong)
     names = _net.PROPORTIONS
     outputs = apply(_net.proportions, ds["fn"], ds["kind"], selection(ds, walls=walls, near=near),
-                    core_dims=[("contact",)] * 3, output_core_dims=[()] * len(names),
                     kwargs={"very_weak": very_weak, "strong": strong},
                     output_dtypes=[np.int64] + [float] * (len(names) - 1))
     out = xr.Dataset({name: with_attrs(da, name, *_ATTRS[name]) for name, da in zip(names, outputs)})

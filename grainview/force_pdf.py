@@ -48,7 +48,7 @@ def _histogram(ds, bins, scale, value_range, kind, walls, near=None):
     edges = _pdf.bin_edges(bins, scale, value_range)
     counts, n_selected, n_zero = apply(
         _pdf.force_histogram, ds["fn"], selection(ds, walls=walls, kind=kind, near=near), selection(ds, walls=walls, near=near),
-        core_dims=[("contact",)] * 3, output_core_dims=[("bin",), (), ()], output_sizes={"bin": bins},
+        output_sizes={"bin": bins},
         kwargs={"edges": edges}, output_dtypes=[np.int64, np.int64, np.int64])
     return counts, n_selected, n_zero, edges, scale
 

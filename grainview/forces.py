@@ -10,14 +10,12 @@ from __future__ import annotations
 import numpy as np
 import xarray as xr
 
-from ._lift import TENSOR_DIMS, apply, with_attrs
+from ._lift import apply, with_attrs
 from .arrays import forces as _forces
 from .arrays.tensors import principal
 from .contacts import selection
 from .fabric import check_bins, reference_direction, fabric_anisotropy, theta_coord
 from .stress import stress_invariants
-
-CONTACT_ARGS = [("contact",), ("contact",), ("contact", "xy"), ("contact",)]
 
 
 def angular_force_averages(ds: xr.Dataset, bins: int = 36, kind="all", walls: bool = False, near=None) -> xr.Dataset:
@@ -27,7 +25,6 @@ def angular_force_averages(ds: xr.Dataset, bins: int = 36, kind="all", walls: bo
     bins = check_bins(bins)
     mask = selection(ds, walls=walls, kind=kind, near=near)
     fn, ft, count = apply(_forces.angular_averages, ds["fn"], ds["ft"], ds["normal"], mask,
-                          core_dims=CONTACT_ARGS, output_core_dims=[("theta",)] * 3,
                           output_sizes={"theta": bins}, kwargs={"n_bins": bins})
     return xr.Dataset({
         "fn_mean": with_attrs(fn, "fn_mean", "N", "mean normal force <f_n>(theta)"),
@@ -41,8 +38,7 @@ def force_tensors(ds: xr.Dataset, bins: int = 36, kind="all", walls: bool = Fals
     bins = check_bins(bins)
     mask = selection(ds, walls=walls, kind=kind, near=near)
     h_n, h_t = apply(_forces.force_tensors, ds["fn"], ds["ft"], ds["normal"], mask,
-                     core_dims=CONTACT_ARGS, output_core_dims=[TENSOR_DIMS, TENSOR_DIMS],
-                     output_sizes={d: 2 for d in TENSOR_DIMS}, kwargs={"n_bins": bins})
+                     kwargs={"n_bins": bins})
     return xr.Dataset({
         "H_n": with_attrs(h_n, "H_n", "N", "normal force tensor H^(n)"),
         "H_t": with_attrs(h_t, "H_t", "N", "tangential force tensor H^(t) (symmetric part)"),
@@ -55,8 +51,8 @@ def force_anisotropies(ds: xr.Dataset, bins: int = 36, kind="all", walls: bool =
     signed by cos 2(theta - theta') with theta' the ``reference`` direction (default: major
     principal stress direction); also theta_n, theta_t and the unsigned magnitudes."""
     h = force_tensors(ds, bins, kind, walls, near)
-    n1, n2, theta_n = apply(principal, h["H_n"], core_dims=[TENSOR_DIMS], output_core_dims=[(), (), ()])
-    t1, t2, theta_t = apply(principal, h["H_t"], core_dims=[TENSOR_DIMS], output_core_dims=[(), (), ()])
+    n1, n2, theta_n = apply(principal, h["H_n"])
+    t1, t2, theta_t = apply(principal, h["H_t"])
     trace = n1 + n2
     ref = reference_direction(ds, reference)
     a_n = 2 * (n1 - n2) / trace

@@ -12,12 +12,10 @@ import numpy as np
 import xarray as xr
 
 from . import sample
-from ._lift import TENSOR_DIMS, apply, with_attrs
+from ._lift import apply, with_attrs
 from .arrays import stress as _stress
 from .arrays.tensors import principal
 from .contacts import kind_code, selection
-
-CONTACT_XY = ("contact", "xy")
 
 
 def stress_tensor(ds: xr.Dataset, kind="all", walls: bool = True) -> xr.DataArray:
@@ -32,15 +30,13 @@ def stress_tensor(ds: xr.Dataset, kind="all", walls: bool = True) -> xr.DataArra
     label = {None: "", 1: " of simple contacts", 2: " of double contacts"}[kind_code(kind)]
     return apply(_stress.stress_tensor, ds["fn"], ds["ft"], ds["normal"], ds["branch"], mask,
                  sample.volume(ds),
-                 core_dims=[("contact",), ("contact",), CONTACT_XY, CONTACT_XY, ("contact",), ()],
-                 output_core_dims=[TENSOR_DIMS], output_sizes={d: 2 for d in TENSOR_DIMS},
                  names=["stress"],
                  attrs={"units": "Pa", "long_name": f"stress tensor{label}",
                         "comment": "sigma = (1/V) sum_c f (x) l, compression positive"})
 
 
 def _principal_parts(sigma: xr.DataArray):
-    return apply(principal, sigma, core_dims=[TENSOR_DIMS], output_core_dims=[(), (), ()])
+    return apply(principal, sigma)
 
 
 def stress_invariants(ds: xr.Dataset, kind="all", walls: bool = True,

@@ -62,9 +62,7 @@ def xi_network(ds: xr.Dataset, xi=DEFAULT_XI, walls: bool = False, near=None) ->
     whole = stress_invariants(ds)
     outputs = apply(_xi.xi_network, ds["fn"], ds["ft"], ds["normal"], ds["branch"], selection(ds, walls=walls, near=near),
                     volume(ds), whole["p"], whole["theta_sigma"],
-                    core_dims=[("contact",), ("contact",), ("contact", "xy"), ("contact", "xy"), ("contact",),
-                               (), (), ()],
-                    output_core_dims=[("xi",)] * 4, output_sizes={"xi": xi.size}, kwargs={"xi": xi},
+                    output_sizes={"xi": xi.size}, kwargs={"xi": xi},
                     output_dtypes=[float, float, float, np.int64])
     q_over_p, a_prime, fraction, count = outputs
     out = xr.Dataset({

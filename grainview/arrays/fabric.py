@@ -7,8 +7,10 @@ import numpy as np
 
 from .vectors import angle_of
 from .binning import batched_bincount
+from .signature import CONTACT, CONTACT_XY, TENSOR, core_dims
 
 
+@core_dims(CONTACT_XY, CONTACT, CONTACT, out=(TENSOR,))
 def fabric_tensor(normal, mask, count_mask=None):
     """F_ab = (1/N_c) sum_c n_a n_b over the contacts of ``mask`` (paper Eq. F).
 
@@ -38,6 +40,7 @@ def orientation_bins(normal, n_bins):
     return np.floor(theta * (n_bins / np.pi) + 0.5).astype(np.int64) % n_bins
 
 
+@core_dims(CONTACT_XY, CONTACT, out=(("theta",),))
 def orientation_pdf(normal, mask, n_bins):
     """P(theta) (..., n_bins): density of contact orientations on [0, pi), rad^-1, so that
     sum P dtheta = 1 (paper Fig. 8; harmonic model P = (1/pi)[1 + a cos 2(theta - theta_a)])."""

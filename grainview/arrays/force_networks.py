@@ -7,11 +7,13 @@ import numpy as np
 
 from ..schema import KIND_DOUBLE, KIND_SIMPLE
 from .force_pdf import mean_normal_force
+from .signature import CONTACT, SCALAR, core_dims
 
 UNSELECTED, VERY_WEAK, WEAK, STRONG = 0, 1, 2, 3
 """Labels of :func:`force_classes`."""
 
 
+@core_dims(CONTACT, CONTACT, out=(CONTACT,))
 def force_classes(fn, mask, very_weak=0.1, strong=1.0):
     """Force class of each contact (..., C) as int8, with <f_n> the mean over ``mask``:
 
@@ -33,6 +35,7 @@ PROPORTIONS = (
 """Names of the outputs of :func:`proportions`, in order."""
 
 
+@core_dims(CONTACT, CONTACT, CONTACT, out=(SCALAR,) * len(PROPORTIONS))
 def proportions(fn, kind, mask, very_weak=0.1, strong=1.0):
     """Proportions of simple (s) and double (d), weak and strong contacts (docs/conventions.md §4).
 

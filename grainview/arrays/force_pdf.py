@@ -10,6 +10,7 @@ from __future__ import annotations
 import numpy as np
 
 from .binning import batched_bincount
+from .signature import CONTACT, SCALAR, core_dims
 
 
 def mean_normal_force(fn, mask):
@@ -47,6 +48,7 @@ def bin_index(values, edges):
     return np.where(values == edges[-1], edges.size - 2, index)
 
 
+@core_dims(CONTACT, CONTACT, CONTACT, out=(("bin",), SCALAR, SCALAR))
 def force_histogram(fn, mask, mean_mask, edges):
     """Counts of f_n/<f_n> per bin, per snapshot.
 

@@ -7,8 +7,10 @@ import numpy as np
 
 from .binning import batched_bincount
 from .fabric import orientation_bins
+from .signature import CONTACT, CONTACT_XY, TENSOR, core_dims
 
 
+@core_dims(CONTACT, CONTACT, CONTACT_XY, CONTACT, out=(("theta",),) * 3)
 def angular_averages(fn, ft, normal, mask, n_bins):
     """<f_n>(theta), <f_t>(theta) and N_c(theta) on ``n_bins`` sectors of [0, pi).
 
@@ -44,6 +46,7 @@ def sector_integrals(n_bins):
     return nn(edges[1:]) - nn(edges[:-1]), nt(edges[1:]) - nt(edges[:-1])
 
 
+@core_dims(CONTACT, CONTACT, CONTACT_XY, CONTACT, out=(TENSOR, TENSOR))
 def force_tensors(fn, ft, normal, mask, n_bins):
     """H^(n) and H^(t) (..., 2, 2) in N (docs/conventions.md §3, which corrects the printed H^(t)).
 

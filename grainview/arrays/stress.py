@@ -5,8 +5,10 @@ from __future__ import annotations
 import numpy as np
 
 from .vectors import force_vectors
+from .signature import CONTACT, CONTACT_XY, SCALAR, TENSOR, core_dims
 
 
+@core_dims(CONTACT, CONTACT, CONTACT_XY, CONTACT_XY, CONTACT, SCALAR, out=(TENSOR,))
 def stress_tensor(fn, ft, normal, branch, mask, volume):
     """sigma_ab = (1/V) sum_c f_a^c l_b^c over the contacts selected by ``mask``.
 

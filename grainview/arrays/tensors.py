@@ -4,7 +4,10 @@ from __future__ import annotations
 
 import numpy as np
 
+from .signature import SCALAR, TENSOR, core_dims
 
+
+@core_dims(TENSOR, out=(SCALAR, SCALAR, SCALAR))
 def principal(tensor):
     """Principal values and major direction of the symmetric part of ``tensor`` (..., 2, 2).
 

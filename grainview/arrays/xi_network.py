@@ -15,6 +15,7 @@ from .._kernels.xi_network import count_below
 from .vectors import force_vectors
 from .force_pdf import mean_normal_force
 from .tensors import principal, signed_anisotropy
+from .signature import CONTACT, CONTACT_XY, SCALAR, core_dims
 
 
 def prefix_lengths(sorted_forces, thresholds):
@@ -60,6 +61,7 @@ def subset_sums(fn, ft, normal, branch, mask, xi):
     return count, stress_sum, fabric_sum.reshape(sums.shape[:-1] + (2, 2))
 
 
+@core_dims(CONTACT, CONTACT, CONTACT_XY, CONTACT_XY, CONTACT, SCALAR, SCALAR, SCALAR, out=(("xi",),) * 4)
 def xi_network(fn, ft, normal, branch, mask, volume, p, theta_sigma, xi):
     """q(xi)/p, a'(xi), N(xi)/N_c and N(xi) of the xi-networks (docs/conventions.md §5).
 
