@@ -1,4 +1,4 @@
-"""Peer engines on the same pile (issue 5, item 5): pymunk (Chipmunk2D) and Box2D 2.3.
+"""Peer engines on the same pile: pymunk (Chipmunk2D) and Box2D 2.3.
 
 Run in the peers' own environment (``benchmarks/requirements-peers.txt``; they are not project
 dependencies)::
@@ -7,7 +7,7 @@ dependencies)::
 
 The pile (``PILE.npz``: position (N, 2), angle, radius (circumscribed, m), n_vertices,
 density, box (x0, y0, x1, y1), gravity, dt, friction) is settled once and saved by
-``benchmarks/solver_bench.py``; every engine is timed on the same reloaded pile, as
+``benchmarks/solver_bench/peer_engines.py``; every engine is timed on the same reloaded pile, as
 ``../shared/PEERS.md`` recommends. The engine steps ``--steps`` times with a fixed iteration
 budget and writes the final positions and angles (the caller measures the overlaps with this
 project's narrow phase, one metric for all engines), the wall time per step, and the mean

@@ -1,0 +1,128 @@
+"""Section c: this solver against pymunk and Box2D on the same settled pile (benchmarks/peers.py
+runs the peers in their own environment)."""
+
+from __future__ import annotations
+
+import os
+import subprocess
+
+import numpy as np
+
+from common import in_fresh_process, markdown_table
+
+from .config import Config, DATA, HERE, PEER_PYTHON
+from .helpers import fmt, largest_overlap, reset_meters, run_steps
+
+
+def settle_pile(n, shape, steps, seed=0):
+    """Deposit ``n`` particles (paper size mix) between side walls and settle them under
+    gravity with this solver; returns the pile as a dict in the format benchmarks/peers.py reads."""
+    from solver import gravity_scene
+    from solver.packing import box_width_for, deposit
+    from solver.scenes import n_vertices_of
+
+    width = box_width_for(n, aspect_ratio=1.0)
+    pos, ang, rad, nv, height = deposit(n, nvert=n_vertices_of(shape), width=width, seed=seed)
+    sim = gravity_scene(pos, ang, rad, nv, sides=(0.0, width))
+    weight_scale = float(sim.mass.sum()) * 9.81 * 2 * float(rad.mean())  # J
+    for k in range(0, steps, 50):  # settle until E_kin < 1e-6 m g d (or ``steps``)
+        run_steps(sim, 50)
+        if sim.kinetic_energy() < 1e-6 * weight_scale:
+            break
+    p = sim.parameters
+    return dict(position=sim.position.copy(), angle=sim.angle.copy(), radius=rad, n_vertices=nv.astype(np.int64),
+                density=p.density, box=np.array([0.0, 0.0, width, height]), gravity=np.array(p.gravity),
+                dt=p.time_step, friction=p.friction, kinetic_energy=sim.kinetic_energy())
+
+
+def _ours_on_pile(path, steps, iterations, default_tolerance):
+    from solver import gravity_scene
+
+    pile = dict(np.load(path))
+    x0, _, x1, _ = pile["box"]
+    kwargs = dict(max_iterations=iterations, tolerance=1e-30, max_tolerance=1e-30)
+    if default_tolerance:
+        kwargs = {}
+    sim = gravity_scene(pile["position"], pile["angle"], pile["radius"], pile["n_vertices"], sides=(x0, x1),
+                        gravity=float(-pile["gravity"][1]), time_step=float(pile["dt"]), **kwargs)
+    run_steps(sim, 2)  # numba caches loaded
+    reset_meters(sim)
+    elapsed, bad, _, _ = run_steps(sim, steps)
+    sweeps = sim.counters["sweeps"] / steps
+    recovery_sweeps = sim.counters["recovery_sweeps"] / steps
+    point_sweeps = sim.counters["point_sweeps"]
+    floor = []
+    for _ in range(max(steps // 10, 1)):
+        sim.step()
+        floor.append(-sim.wall_forces()[0, 1])
+    ratio = float(np.mean(floor)) / (sim.mass.sum() * abs(pile["gravity"][1]))
+    parts = {k: 1e3 * v / steps for k, v in sim.timings.items()}
+    return dict(position=sim.position, angle=sim.angle, per_step=elapsed / steps, floor=ratio, sweeps=sweeps, parts=parts,
+                recovery_sweeps=recovery_sweeps, ns=1e9 * sim.timings["solve"] / max(point_sweeps, 1), points=sim.last.n_points,
+                pairs=sim.points.n_pairs)
+
+
+def section_peers(cfg: Config, log=print):
+    from solver import Walls
+
+    os.makedirs(DATA, exist_ok=True)
+    have_peers = os.path.exists(PEER_PYTHON)
+    rows, settled_note = [], []
+    for shape in ("pentagon", "disk"):
+        pile = settle_pile(cfg.peer_particles, shape, cfg.peer_settle_steps)
+        path = os.path.join(DATA, f"pile_{shape}_{cfg.peer_particles}.npz")
+        np.savez(path, **{k: v for k, v in pile.items() if k != "kinetic_energy"})
+        n = len(pile["radius"])
+        diameter = 2 * float(pile["radius"].mean())
+        x0, _, x1, _ = pile["box"]
+        walls = Walls.floor(sides=(x0, x1))
+        log(f"pile {shape}: N = {n}, kinetic energy after settling {pile['kinetic_energy']:.3g} J")
+        settled_note.append(f"{shape} pile: E_kin {pile['kinetic_energy']:.2g} J after settling")
+        cases = [("this solver", b, False) for b in cfg.peer_budgets] + [("this solver (default tol.)", None, True)]
+        cases += [(e, b, None) for e in ("pymunk", "box2d") for b in cfg.peer_budgets]
+        for engine, budget, default in cases:
+            try:
+                if engine.startswith("this solver"):
+                    r, _ = in_fresh_process(_ours_on_pile, path, cfg.peer_steps, budget or 2000, default)
+                    q = r["parts"]
+                    extra = (f"{r['sweeps']:.0f} sweeps/step, {r['ns']:.0f} ns/point/sweep, "
+                             f"{r['points']} points / {r['pairs']} pairs; ms/step: NLGS {q['solve']:.2f}, "
+                             f"overlap recovery {q['update']:.2f} ({r['recovery_sweeps']:.0f} sweeps), detection {q['broad_phase'] + q['narrow_phase']:.2f}")
+                    budget_text = "tol. 1.7e-4 (<= 2000)" if default else f"{budget} sweeps"
+                else:
+                    if not have_peers:
+                        rows.append([shape, engine, f"{budget}", "-", "-", "-", "-", "peer venv missing"])
+                        continue
+                    out = os.path.join(DATA, f"peer_{engine}_{shape}_{budget}.npz")
+                    subprocess.run([PEER_PYTHON, os.path.join(HERE, "peers.py"), path, out, "--engine", engine,
+                                    "--steps", str(cfg.peer_steps), "--iterations", str(budget)], check=True,
+                                   capture_output=True, text=True, timeout=900)
+                    res = dict(np.load(out))
+                    r = dict(position=res["position"], angle=res["angle"], per_step=float(res["time_per_step"]),
+                             floor=float(res["floor_over_weight"]))
+                    extra = ("velocity = position iterations" if engine == "box2d" else "") + "; fixed budget"
+                    budget_text = f"{budget} iterations"
+                overlap = largest_overlap(r["position"], r["angle"], pile["radius"], pile["n_vertices"], walls.point,
+                                          walls.normal)
+                rows.append([shape, engine, budget_text, f"{1e3 * r['per_step']:.2f}", f"{1e6 * r['per_step'] / n:.1f}",
+                             fmt(abs(r["floor"] - 1)), fmt(overlap / diameter), extra])
+            except Exception as exc:  # a peer failing must not stop the run
+                rows.append([shape, engine, f"{budget}", "-", "-", "-", "-", f"failed: {str(exc)[:100]}"])
+            log(rows[-1])
+    header = ["pile", "engine", "budget", "ms / step", "us / step / particle", "|floor force / weight - 1|",
+              "largest overlap / mean d", "notes"]
+    text = (f"Piles of {cfg.peer_particles} particles (paper size mix, box width for h/l ~ 1, side walls, friction "
+            f"0.4 between grains, 0 with walls) deposited geometrically and settled by this solver for "
+            f"up to {cfg.peer_settle_steps} steps (until E_kin < 1e-6 m g d; {'; '.join(settled_note)}), saved to .npz and reloaded into every engine in a fresh process "
+            f"(PEERS.md). Each engine then runs {cfg.peer_steps} timed steps at dt = 5e-4 s with the stated "
+            f"budget; floor force averaged over {max(cfg.peer_steps // 10, 1)} further steps (not timed); overlap "
+            f"measured on each engine's final positions with this project's narrow phase (same metric for all). "
+            f"This solver at a fixed budget: tolerance 1e-30 so it always spends max_iterations sweeps; its "
+            f"overlap-recovery pass keeps its own settings (tolerance 1e-2, at most 50 sweeps, run only where an "
+            f"overlap exceeds 1e-4 d); where a settled pile keeps overlaps of ~1% d (pentagons), which recovery "
+            f"removes at <= 1 mm/s, it runs every step (its ms/step and sweeps in the notes). Box2D "
+            f"runs in units of 2.5 cm; pymunk collision_slop 1e-5 m (benchmarks/peers.py).\n\n")
+    if not have_peers:
+        text += (f"**Peer engines not run**: {PEER_PYTHON} not found; create it with `python3 -m venv /tmp/peervenv && "
+                 "/tmp/peervenv/bin/pip install -r benchmarks/requirements-peers.txt`.\n\n")
+    return text + markdown_table(header, rows), rows
