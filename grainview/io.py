@@ -32,7 +32,13 @@ def _check_netcdf3_length(path: str) -> None:
     with netcdf_file(path, "r", mmap=True) as nc:
         header = nc.fp.tell()
         fixed = sum((v.data.nbytes + 3) // 4 * 4 for v in nc.variables.values() if not v.isrec)
-        expected = header + fixed + nc._recs * nc._recsize
+        records = [v for v in nc.variables.values() if v.isrec]
+        # the classic format's record: each record variable's slice, padded to 4 bytes unless
+        # it is the only record variable
+        slices = [v.itemsize() * int(np.prod(v.shape[1:], dtype=np.int64)) for v in records]
+        record_size = sum(slices) if len(slices) == 1 else sum((s + 3) // 4 * 4 for s in slices)
+        n_records = max((v.shape[0] for v in records), default=0)
+        expected = header + fixed + n_records * record_size
         for v in nc.variables.values():  # drop the mmap references before closing
             v.data = None
     size = os.path.getsize(path)

@@ -255,10 +255,7 @@ def write_figures(runs: dict, out: Path, time=-1, residual_strain: float = RESID
     (snapshot ``time``, default the last); the simple-versus-double figures only the runs
     that contain polygons. Returns the paths written.
     """
-    import matplotlib
-
-    matplotlib.use("Agg", force=False)
-    import matplotlib.pyplot as plt
+    import matplotlib.pyplot as plt  # any backend: matplotlib falls back to Agg without a display
 
     from .plot import FIGURES, save_figure
     from .plot._style import Residual, add_caption

@@ -158,6 +158,27 @@ def _apply(k, dpn, dpt, a, b, nx, ny, rax, ray, rbx, rby, vx, vy, w, minv_xx, mi
 
 
 @njit(cache=True)
+def _next_random(state):
+    """xorshift64* (Vigna 2016): the next state and a 64-bit pseudo-random integer. The NLGS
+    keeps its own generator so that shuffling never touches numba's global one."""
+    x = state
+    x ^= x >> np.uint64(12)
+    x ^= x << np.uint64(25)
+    x ^= x >> np.uint64(27)
+    return x, x * np.uint64(2685821657736338717)
+
+
+@njit(cache=True)
+def _shuffle(order, state):
+    """Fisher-Yates shuffle of ``order`` in place; returns the generator's next state."""
+    for i in range(order.size - 1, 0, -1):
+        state, r = _next_random(state)
+        j = np.int64(r % np.uint64(i + 1))
+        order[i], order[j] = order[j], order[i]
+    return state
+
+
+@njit(cache=True)
 def solve(a, b, nx, ny, rax, ray, rbx, rby, bias, mu, pn, pt, vx, vy, w,
           minv_xx, minv_xy, minv_yy, iinv, tol, max_tol, max_iterations, shuffle, seed):
     """Run NLGS sweeps until convergence; impulses (pn, pt) and velocities are updated in place.
@@ -170,13 +191,12 @@ def solve(a, b, nx, ny, rax, ray, rbx, rby, bias, mu, pn, pt, vx, vy, w,
     for k in range(m):  # velocities consistent with the warm-start impulses
         _apply(k, pn[k], pt[k], a, b, nx, ny, rax, ray, rbx, rby, vx, vy, w, minv_xx, minv_xy, minv_yy, iinv)
     order = np.arange(m)
-    if shuffle:
-        np.random.seed(seed)
+    state = np.uint64(seed) * np.uint64(0x9E3779B97F4A7C15) + np.uint64(1)  # never 0
     quad = 0.0
     worst = 0.0
     for it in range(1, max_iterations + 1):
         if shuffle:
-            order = np.random.permutation(m)
+            state = _shuffle(order, state)
         sum_dv2 = 0.0
         max_dv2 = 0.0
         for q in range(m):

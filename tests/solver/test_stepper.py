@@ -141,3 +141,36 @@ def test_invalid_bodies_are_refused():
         Simulation([[0.0, 0.0]], [0.0], [R], [2], Walls.floor())
     with pytest.raises(ParameterError, match="radius"):
         Simulation([[0.0, 0.0]], [0.0], [-R], [0], Walls.floor())
+
+
+def test_shuffled_sweeps_are_random_permutations_and_leave_numbas_generator_alone():
+    from numba import njit
+
+    from solver.nlgs import _shuffle
+
+    @njit
+    def draws(seed):
+        np.random.seed(seed)
+        return np.random.random()
+
+    @njit
+    def next_draw():
+        return np.random.random()
+
+    order = np.arange(50)
+    state = _shuffle(order, np.uint64(12345))
+    assert sorted(order.tolist()) == list(range(50)) and order.tolist() != list(range(50))
+    again = np.arange(50)
+    _shuffle(again, np.uint64(12345))
+    np.testing.assert_array_equal(order, again)  # the same seed, the same order
+    other = np.arange(50)
+    _shuffle(other, state)
+    assert other.tolist() != order.tolist()
+    # a shuffled NLGS step between two draws of numba's global generator does not move it
+    draws(7)
+    expected = next_draw()
+    draws(7)
+    sim = gravity_scene(np.stack([np.zeros(4), R + 2 * R * np.arange(4)], -1), np.zeros(4), np.full(4, R),
+                        np.zeros(4), shuffle=True, seed=3, **EXACT)
+    sim.step()
+    assert next_draw() == expected
