@@ -153,7 +153,7 @@ def _simulate(prep, path, *, strain, every, velocity, near_contacts, overwrite, 
 
     from solver import biaxial_test
     from solver.output import Recorder
-    from solver.preparation import prepare_sample
+    from solver.preparation import prepare_sample, record
 
     path = Path(path)
     if path.exists() and not overwrite:
@@ -166,9 +166,7 @@ def _simulate(prep, path, *, strain, every, velocity, near_contacts, overwrite, 
         settled = "settled" if sim.settled else "NOT settled (step limit reached)"
         print(f"{name}: compaction {settled} after {sim.compaction_steps} steps; wall stresses "
               f"{', '.join(f'{s:.0f}' for s in sim.compaction_stress)} Pa", flush=True)
-        attrs = {**prep.attrs(), "preparation_name": prep_name(prep), "sigma0_Pa": prep.sigma0,
-                 "compaction_steps": sim.compaction_steps, "compaction_settled": int(sim.settled),
-                 "compaction_inertia_number": sim.compaction_inertia_number}
+        attrs = record(sim)
         if scene == "isotropic":
             with Recorder(path, sim, attrs={"scene": "isotropic", **attrs}, overwrite=overwrite,
                           near_contacts=near_contacts) as rec:
@@ -182,17 +180,6 @@ def _simulate(prep, path, *, strain, every, velocity, near_contacts, overwrite, 
         print(f"{name}: warning: NLGS reached its iteration limit in {unconverged} step(s)", file=sys.stderr)
     print(f"{name}: wrote {path}", flush=True)
     return path
-
-
-def prep_name(prep) -> str:
-    """The preset a preparation is (the first that matches), or "custom"."""
-    from solver.preparation import PRESETS
-
-    core = {k: v for k, v in prep.__dict__.items() if k not in ("particles", "shape", "seed")}
-    for name, preset in PRESETS.items():
-        if core == {k: v for k, v in preset.__dict__.items() if k not in ("particles", "shape", "seed")}:
-            return name
-    return "custom"
 
 
 def _progress_flag(args):

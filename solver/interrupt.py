@@ -9,8 +9,6 @@ import shlex
 import signal
 import sys
 
-from tqdm.auto import tqdm
-
 
 @contextlib.contextmanager
 def interruptible():
@@ -33,6 +31,14 @@ def interruptible():
 def progress_bar(total, desc, progress):
     """A tqdm bar of ``total`` steps; ``progress`` None: shown when stderr is a terminal."""
     enabled = sys.stderr.isatty() if progress is None else bool(progress)
+    from tqdm.std import tqdm
+
+    if enabled:
+        try:  # a widget in Jupyter when ipywidgets is there; tqdm.auto warns otherwise
+            import ipywidgets  # noqa: F401
+            from tqdm.auto import tqdm
+        except ImportError:
+            pass
     return tqdm(total=total, desc=desc, unit="step", disable=not enabled, leave=False)
 
 

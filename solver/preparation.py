@@ -98,6 +98,25 @@ paper's initial state of its sample (S1 pentagons: compaction friction 0.4; S2 d
 docs/fidelity.md, section 2)."""
 
 
+def preset_name(prep: Preparation) -> str:
+    """The first preset ``prep`` is (whatever its particles, shape and seed), or "custom"."""
+    def core(p):
+        return {k: v for k, v in asdict(p).items() if k not in ("particles", "shape", "seed")}
+    return next((name for name, preset in PRESETS.items() if core(preset) == core(prep)), "custom")
+
+
+def record(sim) -> dict:
+    """File attributes of how ``sim`` was prepared: the :class:`Preparation` (``preparation_*``,
+    with ``preparation_name``) and the compaction's outcome (``compaction_*``); {} for a
+    simulation that :func:`prepare_sample` did not make."""
+    prep = sim.preparation
+    if prep is None:
+        return {}
+    return {**prep.attrs(), "preparation_name": preset_name(prep), "sigma0_Pa": prep.sigma0,
+            "compaction_steps": sim.compaction_steps, "compaction_settled": int(bool(sim.settled)),
+            "compaction_inertia_number": sim.compaction_inertia_number}
+
+
 def preset_names():
     """Every name :func:`preparation` accepts."""
     return sorted(PRESETS) + sorted(BY_SHAPE)
@@ -135,4 +154,5 @@ def prepare_sample(prep: Preparation, progress=None, **parameters):
                                                 pressure_ramp=prep.pressure_ramp, progress=progress)
     sim.parameters.friction = prep.friction
     sim.preparation = prep
+    sim.preparation_attrs = record(sim)
     return sim

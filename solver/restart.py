@@ -123,6 +123,7 @@ def _simulation(state, source) -> Simulation:
                               "of its solver parameters (density, thickness)")
     sim.time, sim.step_index = state["time"], state["step"]
     sim.sigma0 = float(attrs.get("sigma0_Pa", np.nan))
+    sim.preparation_attrs = {k: v for k, v in attrs.items() if k.startswith(("preparation_", "compaction_"))}
     sim.set_warm_start(state["i"], state["j"], state["normal_impulse"], state["tangential_impulse"])
     return sim
 

@@ -174,7 +174,10 @@ def biaxial_test(sim: Simulation, path, *, strain=0.1, velocity=0.01, every=20, 
     ``strain``; the right wall keeps the confining stress sigma0; bottom and left are fixed.
     The snapshot at the start of the test is written first. Ctrl-C stops after the current
     step, with every written snapshot kept. ``near_contacts``: also write the pairs within the
-    alert distance that carry no force (:class:`solver.output.Recorder`).
+    alert distance that carry no force (:class:`solver.output.Recorder`). The file records the
+    test's settings and how the sample was prepared (``sim.preparation_attrs``: set by
+    :func:`solver.preparation.prepare_sample` and :func:`solver.load_sample`); ``attrs`` adds
+    to them.
     """
     if not (0 < strain < 1):
         raise ParameterError(f"strain={strain!r}: expected a vertical strain in (0, 1)")
@@ -188,8 +191,8 @@ def biaxial_test(sim: Simulation, path, *, strain=0.1, velocity=0.01, every=20, 
     n_steps = int(np.ceil(travel / velocity / sim.parameters.time_step))
     sim.walls.drive_velocity("top", (0.0, -velocity))
     run_attrs = {"scene": "biaxial", "strain_target": strain, "wall_velocity_m_s": velocity,
-                 "sigma0_Pa": getattr(sim, "sigma0", np.nan), "snapshot_every": int(every),
-                 "biaxial_steps": n_steps}
+                 "sigma0_Pa": sim.sigma0, "snapshot_every": int(every), "biaxial_steps": n_steps,
+                 **sim.preparation_attrs}
     run_attrs.update(attrs or {})
     with Recorder(path, sim, attrs=run_attrs, overwrite=overwrite, near_contacts=near_contacts) as rec:
         rec.write()

@@ -159,6 +159,7 @@ class Simulation:
         self.compaction_stress = None  # Pa, mean stress on each stress-driven wall at its end
         self.compaction_inertia_number = None  # the largest inertia number of the closing walls
         self.preparation = None  # the solver.preparation.Preparation that made the sample
+        self.preparation_attrs = {}  # the same and the compaction's outcome, as file attributes
         self.timings = {"broad_phase": 0.0, "narrow_phase": 0.0, "solve": 0.0, "update": 0.0}
         self.counters = {"steps": 0, "broad_phase_runs": 0, "sweeps": 0, "point_sweeps": 0, "recovery_sweeps": 0}
 

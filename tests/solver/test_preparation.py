@@ -128,3 +128,23 @@ def test_a_test_started_from_a_saved_sample_shows_the_samples_contacts_first(tmp
             assert after[key] == pytest.approx((fn, ft), rel=1e-12, abs=1e-12)
         np.testing.assert_array_equal(first.position.values, last.position.values)
         assert b.sizes["time"] > 2 and int(b.contact_count[-1]) > 20
+
+
+def test_a_test_records_how_its_sample_was_prepared(tmp_path):
+    """biaxial_test writes the preparation (preset name included) and the compaction's outcome
+    without being told, from prepare_sample and again from a saved sample."""
+    import grainview
+    from solver import biaxial_test, load_sample
+    from solver.output import Recorder
+
+    sim = _quiet(prepare_sample, preparation("frictionless", particles=20, shape="disk", seed=4), progress=False)
+    sample = tmp_path / "sample.nc"
+    with Recorder(sample, sim, attrs=sim.preparation_attrs) as rec:
+        rec.write()
+    for start, name in ((sim, "direct.nc"), (load_sample(sample), "from_file.nc")):
+        _quiet(biaxial_test, start, tmp_path / name, strain=0.001, every=5, progress=False)
+        with grainview.open_dataset(tmp_path / name, chunks=None) as ds:
+            assert ds.attrs["preparation_name"] == "frictionless"
+            assert ds.attrs["preparation_compaction_friction"] == 0.0 and ds.attrs["solver_friction"] == 0.4
+            assert ds.attrs["compaction_steps"] == sim.compaction_steps
+            assert ds.attrs["compaction_settled"] == int(sim.settled)
