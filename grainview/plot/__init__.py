@@ -50,7 +50,7 @@ from ._style import save_figure
 from .forces import (plot_angular_forces, plot_contact_proportions, plot_force_anisotropies,
                      plot_force_anisotropy, plot_force_pdf, plot_force_pdf_by_kind, plot_force_pdfs,
                      plot_force_pdfs_by_kind, plot_normal_force_polar, plot_strong_weak_proportions,
-                     plot_tangential_force_polar, plot_type_transitions, plot_xi_anisotropy, plot_xi_stress)
+                     plot_tangential_force, plot_tangential_force_polar, plot_type_transitions, plot_xi_anisotropy, plot_xi_stress)
 from .macroscopic import (plot_harmonic_prediction, plot_partial_q_over_p, plot_q_over_p,
                           plot_stress_dilatancy, plot_volumetric_strain)
 from .maps import plot_contact_kinds, plot_force_chains, plot_force_classes, plot_particles
@@ -104,6 +104,7 @@ class PlotAccessor:
     # forces (Figs. 10, 11, 14, 15, 16, 19, 20, 23, 25)
     normal_force_polar = _delegate(plot_normal_force_polar)
     tangential_force_polar = _delegate(plot_tangential_force_polar)
+    tangential_force = _delegate(plot_tangential_force)
     angular_forces = _delegate(plot_angular_forces)
     force_anisotropy = _delegate(plot_force_anisotropy)
     force_anisotropies = _delegate(plot_force_anisotropies)
@@ -124,5 +125,6 @@ class PlotAccessor:
 
 
 __all__ = ["PlotAccessor", "save_figure", "FIGURES", *(f.__name__ for f in FIGURES.values()),
-           "plot_particles", "plot_normal_force_polar", "plot_tangential_force_polar", "plot_force_anisotropy",
+           "plot_particles", "plot_normal_force_polar", "plot_tangential_force_polar", "plot_tangential_force",
+           "plot_force_anisotropy",
            "plot_force_pdf", "plot_force_pdf_by_kind"]

@@ -156,12 +156,18 @@ def get_axes(ax=None, polar: bool = False):
     return ax
 
 
-def new_figure(n_panels: int, polar: bool = False, width: float = 4.5, height: float = 3.6):
-    """A figure with ``n_panels`` axes side by side; returns (figure, list of axes)."""
+def new_figure(n_panels: int, polar=False, width: float = 4.5, height: float = 3.6):
+    """A figure with ``n_panels`` axes side by side, marked (a), (b), ...; ``polar`` is one
+    flag for all panels or one per panel. Returns (figure, list of axes)."""
     import matplotlib.pyplot as plt
-    fig, axes = plt.subplots(1, n_panels, figsize=(width * n_panels, height), squeeze=False,
-                             subplot_kw={"projection": "polar"} if polar else None, layout="constrained")
-    return fig, list(axes[0])
+    flags = list(polar) if isinstance(polar, (list, tuple)) else [bool(polar)] * n_panels
+    fig = plt.figure(figsize=(width * n_panels, height), layout="constrained")
+    axes = [fig.add_subplot(1, n_panels, k + 1, projection="polar" if flag else None)
+            for k, flag in enumerate(flags)]
+    for k, ax in enumerate(axes):
+        ax.text(-0.14 if flags[k] else -0.18, 1.06, f"({chr(ord('a') + k)})", transform=ax.transAxes,
+                fontweight="bold", va="bottom")
+    return fig, axes
 
 
 def format_units(units) -> str:

@@ -72,11 +72,28 @@ def _polar(data, ax, label, component, symbol, time, bins, kind, walls, normalis
     return finish(ax, None, title=axis_label(title, units_of(profile)))
 
 
+def plot_tangential_force(data, ax=None, label=None, time="residual", bins: int = 36, kind="all",
+                          walls: bool = False, normalise: bool = True, **line_kw):
+    """The angle-averaged tangential force <f_t>(theta) against theta in [0, pi), with its sign
+    (paper Fig. 10b; harmonic form -<f> a_t sin 2(theta - theta_t), docs/conventions.md §3),
+    divided by <f_n> unless ``normalise=False`` (then N). Cartesian axes: a polar radius could
+    not show the sign."""
+    ax = get_axes(ax)
+    for lab, ds in datasets(data, label):
+        profile = angular_profile(ds, "ft", time, bins, kind, walls, normalise)
+        ax.plot(profile["theta"].values, values(profile), "o-", color=next_colour(ax), label=lab, **line_kw)
+    ax.axhline(0.0, color="0.6", linewidth=0.8)
+    ax.set_xlim(0.0, np.pi)
+    symbol = r"$\langle f_t\rangle(\theta)" + (r"/\langle f_n\rangle$" if normalise else "$")
+    set_labels(ax, axis_label(r"$\theta$", "rad"), axis_label(symbol, units_of(profile)))
+    return finish(ax, None)
+
+
 def plot_angular_forces(data, label=None, **kw):
-    """Figure of paper Fig. 10: (a) <f_n>(theta) and (b) |<f_t>(theta)| in polar axes."""
-    fig, (ax_n, ax_t) = new_figure(2, polar=True)
+    """Figure of paper Fig. 10: (a) <f_n>(theta) in polar axes, (b) <f_t>(theta) with its sign."""
+    fig, (ax_n, ax_t) = new_figure(2, polar=[True, False])
     plot_normal_force_polar(data, ax_n, label, **kw)
-    plot_tangential_force_polar(data, ax_t, label, **kw)
+    plot_tangential_force(data, ax_t, label, **kw)
     return fig
 
 
@@ -259,7 +276,7 @@ def plot_contact_proportions(data, ax=None, label=None, **line_kw):
     ax = get_axes(ax)
     curves = [("$k_s$", "k_s"), ("$k_d$", "k_d"), ("$f_s$", "f_s"), ("$f_d$", "f_d")]
     draw_evolutions(ax, datasets(data, label), contact_proportions, curves, **line_kw)
-    set_labels(ax, EPS_Q_LABEL, "proportion")
+    set_labels(ax, EPS_Q_LABEL, "$k$: share of contacts, $f$: share of normal force")
     return finish(ax, None)
 
 
@@ -289,7 +306,7 @@ def plot_strong_weak_proportions(data, ax=None, label=None, **line_kw):
     return finish(ax, None)
 
 
-__all__ = ["plot_normal_force_polar", "plot_tangential_force_polar", "plot_angular_forces",
+__all__ = ["plot_normal_force_polar", "plot_tangential_force_polar", "plot_tangential_force", "plot_angular_forces",
            "plot_force_anisotropy", "plot_force_anisotropies", "plot_force_pdf", "plot_force_pdfs",
            "plot_force_pdf_by_kind", "plot_force_pdfs_by_kind", "plot_xi_stress", "plot_xi_anisotropy",
            "plot_contact_proportions", "plot_type_transitions", "plot_strong_weak_proportions",

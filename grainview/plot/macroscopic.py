@@ -8,13 +8,14 @@ every sample on the same axes (one colour per sample), returning the axes.
 
 from __future__ import annotations
 
+import numpy as np
 import xarray as xr
 
 from ..strain import friction_and_dilatancy, strains
 from ..stress import stress_invariants
 from ..forces import harmonic_prediction
-from ._style import (EPS_Q_LABEL, axis_label, datasets, draw_evolutions, finish, get_axes,
-                     next_colour, set_labels, values)
+from ._style import (EPS_Q_LABEL, axis_label, datasets, draw_evolutions, finish, get_axes, next_colour,
+                     series_label, set_labels, values)
 
 
 def plot_q_over_p(data, ax=None, label=None, **line_kw):
@@ -40,13 +41,24 @@ def plot_stress_dilatancy(data, ax=None, label=None, incremental: bool = False, 
     """Stress–dilatancy diagram: dilatancy angle psi against friction angle phi, in rad
     (paper Fig. 5): sin phi = q/p, sin psi = eps_p/eps_q (cumulative) or, with
     ``incremental=True``, d eps_p/d eps_q (:func:`grainview.strain.friction_and_dilatancy`).
-    Snapshots where psi is undefined (eps_q = 0) leave a gap."""
+    Snapshots where psi is undefined (eps_q = 0) leave a gap.
+
+    The paper's point is that both shapes follow phi ~ phi_0 + psi (Taylor's stress–dilatancy
+    relation, phi_0 the friction angle at zero dilatancy): each sample gets a dashed line of
+    slope 1 with phi_0 the median of phi - psi over its snapshots, given in the legend."""
     ax = get_axes(ax)
     name = "psi_incremental" if incremental else "psi"
     for lab, ds in datasets(data, label):
         angles = friction_and_dilatancy(ds).compute()
-        ax.plot(values(angles["phi"]), values(angles[name]), "o-", markersize=3, color=next_colour(ax),
-                label=lab, **line_kw)
+        phi, psi = values(angles["phi"]), values(angles[name])
+        colour = next_colour(ax)
+        ax.plot(phi, psi, "o-", markersize=3, color=colour, label=lab, **line_kw)
+        both = np.isfinite(phi) & np.isfinite(psi)
+        if both.any():
+            phi_0 = float(np.median(phi[both] - psi[both]))
+            ends = np.array([np.nanmin(phi), np.nanmax(phi)])
+            ax.plot(ends, ends - phi_0, "--", color=colour, linewidth=1,
+                    label=series_label(lab, rf"$\varphi = \varphi_0 + \psi$, $\varphi_0$ = {phi_0:.2f} rad"))
     set_labels(ax, axis_label(r"$\varphi$", angles["phi"].attrs["units"]),
                axis_label(r"$\psi$", angles[name].attrs["units"]))
     return finish(ax, None)

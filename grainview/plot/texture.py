@@ -44,11 +44,12 @@ def plot_connectivity_pdf(data, ax=None, label=None, time="residual", max_c: int
                           **line_kw):
     """P(c), the fraction of (non-rattler) particles with exactly c force-bearing contacts,
     against c, averaged over the snapshots ``time`` (paper Fig. 7;
-    :func:`grainview.connectivity.connectivity_pdf`). One line with markers per sample."""
+    :func:`grainview.connectivity.connectivity_pdf`). Markers only, c >= 1 (P(c) is discrete,
+    and P(0) = 0 by definition once rattlers are left out); one marker series per sample."""
     ax = get_axes(ax)
     for lab, ds in datasets(data, label):
-        pdf = time_mean(connectivity_pdf(select_snapshots(ds, time), max_c=max_c, walls=walls))
-        ax.plot(pdf["c"].values, values(pdf), "o-", color=next_colour(ax), label=lab, **line_kw)
+        pdf = time_mean(connectivity_pdf(select_snapshots(ds, time), max_c=max_c, walls=walls)).sel(c=slice(1, None))
+        ax.plot(pdf["c"].values, values(pdf), "o", linestyle="none", color=next_colour(ax), label=lab, **line_kw)
     set_labels(ax, "$c$", "$P(c)$")
     return finish(ax, None)
 

@@ -141,6 +141,12 @@ def test_stress_dilatancy_draws_psi_against_phi_in_rad(series):
     np.testing.assert_allclose(ax.lines[0].get_xdata(), angles["phi"].values)
     np.testing.assert_allclose(ax.lines[0].get_ydata(), angles["psi"].values, equal_nan=True)
     assert ax.get_xlabel() == r"$\varphi$ (rad)" and ax.get_ylabel() == r"$\psi$ (rad)"
+    # Taylor's line phi = phi_0 + psi: slope 1, phi_0 the median offset of the points
+    phi, psi = angles["phi"].values, angles["psi"].values
+    ok = np.isfinite(phi) & np.isfinite(psi)
+    x, y = ax.lines[1].get_xdata(), ax.lines[1].get_ydata()
+    assert (y[1] - y[0]) / (x[1] - x[0]) == pytest.approx(1.0)
+    assert x[0] - y[0] == pytest.approx(np.median(phi[ok] - psi[ok]))
     ax = gp.plot_stress_dilatancy(series, incremental=True)
     np.testing.assert_allclose(ax.lines[0].get_ydata(), angles["psi_incremental"].values, equal_nan=True)
 
@@ -177,8 +183,9 @@ def test_residual_state_is_the_last_snapshots(series):
 def test_connectivity_pdf_of_a_square_lattice():
     # 4 x 3 grid: 4 corners with 2 contacts, 6 border particles with 3, 2 interior with 4.
     ax = gp.plot_connectivity_pdf(builders.square_lattice(4, 3), max_c=6)
-    np.testing.assert_allclose(ax.lines[0].get_xdata(), np.arange(7))
-    np.testing.assert_allclose(ax.lines[0].get_ydata(), [0, 0, 4 / 12, 6 / 12, 2 / 12, 0, 0], atol=1e-15)
+    np.testing.assert_allclose(ax.lines[0].get_xdata(), np.arange(1, 7))  # P(0) = 0 by definition: not drawn
+    np.testing.assert_allclose(ax.lines[0].get_ydata(), [0, 4 / 12, 6 / 12, 2 / 12, 0, 0], atol=1e-15)
+    assert ax.lines[0].get_linestyle() == "None"  # a discrete distribution: markers only
     assert ax.get_xlabel() == "$c$" and ax.get_ylabel() == "$P(c)$"
 
 
@@ -186,7 +193,7 @@ def test_connectivity_pdf_averages_the_residual_snapshots(series, other_series):
     ax = gp.plot_connectivity_pdf({"a": series, "b": other_series})
     assert len(ax.lines) == 2
     for line, ds in zip(ax.lines, (series, other_series)):
-        want = connectivity_pdf(select_snapshots(ds, "residual")).mean("time")
+        want = connectivity_pdf(select_snapshots(ds, "residual")).mean("time").sel(c=slice(1, None))
         np.testing.assert_allclose(line.get_ydata(), want.values)
 
 
@@ -243,9 +250,19 @@ def test_polar_tangential_force_is_its_magnitude():
     ax = gp.plot_tangential_force_polar(ds, bins=4, time=0)
     np.testing.assert_allclose(ax.lines[0].get_ydata()[[0, 4, 8]], [0.5, 0.5, 0.5])
     fig = gp.plot_angular_forces({"a": ds, "b": ds}, bins=4, time=0)
-    assert len(fig.axes) == 2 and all(a.name == "polar" and len(a.lines) == 2 for a in fig.axes)
+    assert len(fig.axes) == 2 and fig.axes[0].name == "polar" and fig.axes[1].name == "rectilinear"
+    assert len(fig.axes[0].lines) == 2 and len(fig.axes[1].lines) == 3  # two samples and the zero line
+    assert [t.get_text() for ax in fig.axes for t in ax.texts] == ["(a)", "(b)"]
     with pytest.raises(ParameterError, match="polar"):
         gp.plot_tangential_force_polar(ds, ax=plt.subplots()[1])
+
+
+def test_tangential_force_keeps_its_sign():
+    ds = builders.two_disks(force=3.0, tangential=-1.5)
+    ax = gp.plot_tangential_force(ds, bins=4, time=0)
+    y = ax.lines[0].get_ydata()
+    assert np.nanmin(y) == pytest.approx(-0.5) and np.all(np.isnan(y) | (y <= 0))
+    assert ax.get_xlim() == pytest.approx((0.0, np.pi))
 
 
 # -- maps -------------------------------------------------------------------------------------
