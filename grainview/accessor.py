@@ -36,7 +36,7 @@ class _Delegate:
         @functools.wraps(func)
         def method(*args, **kwargs):
             accessor._check_structure()
-            return func(accessor._ds, *args, **kwargs)
+            return accessor._with_strains(func(accessor._ds, *args, **kwargs))
         return method
 
 
@@ -56,6 +56,25 @@ class GrainAccessor:
 
             check_structure(self._ds)
             self._structure_ok = True
+
+    STRAIN_COORDS = ("eps_1", "eps_p", "eps_q")
+    """Strains attached to every time series the accessor returns, as non-index coordinates
+    along ``time``, so that ``result.plot(x="eps_q")`` and ``result.swap_dims(time="eps_q")``
+    need no merge."""
+
+    def _with_strains(self, result):
+        """``result`` with :data:`STRAIN_COORDS` as coordinates along ``time`` when it is a time
+        series of this dataset (and does not hold strains itself)."""
+        ds = self._ds
+        if (not isinstance(result, (xr.Dataset, xr.DataArray)) or result.sizes.get("time") != ds.sizes.get("time")
+                or any(name in result.coords or name in getattr(result, "data_vars", {})
+                       or name == getattr(result, "name", None) for name in self.STRAIN_COORDS)
+                or not {"box_min", "box_max"} <= set(ds.variables)):
+            return result
+        from .strain import strains
+
+        eps = strains(ds)
+        return result.assign_coords({name: eps[name] for name in self.STRAIN_COORDS})
 
     def validate(self):
         """Check the dataset against the contract (:func:`grainview.validation.validate`)."""

@@ -66,8 +66,8 @@ def open_dataset(path, chunks: int | dict | None = "auto", validate: bool = Fals
     Parameters
     ----------
     path : str or path-like
-    chunks : number of snapshots per dask chunk, ``"auto"`` (about 64 MiB per chunk of the
-        largest variable), or ``None`` for eager numpy arrays. Only ``time`` is ever chunked:
+    chunks : number of snapshots per dask chunk, ``"auto"`` (see :func:`time_chunks`), or
+        ``None`` for eager numpy arrays. Only ``time`` is ever chunked:
         ``particle`` and ``contact`` stay whole in each chunk, as the analysis kernels need.
     validate : run :func:`grainview.validation.validate` before returning.
 
@@ -107,8 +107,16 @@ def open_dataset(path, chunks: int | dict | None = "auto", validate: bool = Fals
     return ds
 
 
+MIN_CHUNK_SNAPSHOTS = 10
+"""Smallest number of snapshots per chunk that ``chunks="auto"`` makes."""
+
+
 def time_chunks(ds: xr.Dataset, chunks="auto") -> dict:
-    """The chunking used by :func:`open_dataset`: ``time`` only, everything else whole."""
+    """The chunking used by :func:`open_dataset`: ``time`` only, everything else whole.
+
+    ``"auto"`` takes enough chunks to keep every core busy — about four per core, of at least
+    :data:`MIN_CHUNK_SNAPSHOTS` snapshots (a chunk's overhead is a few ms) — and never more than
+    64 MiB of the largest variable per chunk."""
     if isinstance(chunks, dict):
         bad = [d for d in chunks if d != "time"]
         if bad:
@@ -117,5 +125,7 @@ def time_chunks(ds: xr.Dataset, chunks="auto") -> dict:
     if chunks == "auto":
         per_snapshot = max((v.dtype.itemsize * int(np.prod([ds.sizes[d] for d in v.dims if d != "time"] or [1]))
                             for v in ds.data_vars.values() if "time" in v.dims), default=1)
-        return {"time": max(1, int(64 * 2**20 // per_snapshot))}
+        by_memory = max(1, int(64 * 2**20 // per_snapshot))
+        by_cores = max(MIN_CHUNK_SNAPSHOTS, -(-ds.sizes["time"] // (4 * (os.cpu_count() or 1))))
+        return {"time": min(by_memory, by_cores)}
     return {"time": int(chunks)}

@@ -49,3 +49,35 @@ def test_a_result_does_not_inherit_the_attributes_of_its_input(series):
     q_over_p = series.grain.stress_invariants()["q_over_p"]
     assert q_over_p.attrs == {"units": "1", "long_name": "normalised shear stress q/p"}
     assert np.isfinite(q_over_p.values).all()
+
+
+def test_time_series_carry_the_strains_as_coordinates():
+    from grainview.synthetic import harmonic_series
+
+    ds = harmonic_series(n_snapshots=30, n_contacts=200)
+    eps = ds.grain.strains()
+    for result in (ds.grain.coordination()["z"], ds.grain.stress_invariants(), ds.grain.fabric_anisotropy()):
+        for name in ("eps_1", "eps_p", "eps_q"):
+            assert result[name].dims == ("time",)
+            np.testing.assert_allclose(result[name].values, eps[name].values)
+    assert "eps_q" not in ds.grain.strains().coords  # the strains themselves stay variables
+    z = ds.grain.coordination()["z"].swap_dims(time="eps_q")
+    assert z.dims == ("eps_q",)
+    assert ds.grain.orientation_pdf(bins=8).isel(time=0).coords["eps_q"].ndim == 0
+
+
+def test_long_series_open_in_several_chunks(tmp_path):
+    import os
+
+    import grainview
+    from grainview.dataset import netcdf_encoding
+    from grainview.io import MIN_CHUNK_SNAPSHOTS
+    from grainview.synthetic import harmonic_series
+
+    ds = harmonic_series(n_snapshots=200, n_contacts=50)
+    path = tmp_path / "long.nc"
+    ds.to_netcdf(path, encoding=netcdf_encoding(ds))
+    chunks = grainview.open_dataset(path)["fn"].chunks[0]
+    assert sum(chunks) == 200 and len(chunks) >= 2
+    assert max(chunks) >= min(MIN_CHUNK_SNAPSHOTS, 200)
+    assert len(chunks) >= min(4 * (os.cpu_count() or 1), 200 // MIN_CHUNK_SNAPSHOTS) - 1
