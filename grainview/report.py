@@ -190,11 +190,13 @@ def paper_key(label: str) -> str | None:
 
 
 def write_table(table: pd.DataFrame, out: Path) -> list[Path]:
-    """Write ``table`` as ``headline.csv`` and ``headline.md`` in ``out``."""
+    """Write ``table`` as ``headline.md`` (everything, prose included) and ``headline.csv``
+    (numbers only: a cell that is not a number — "not reached", a qualitative statement of the
+    paper, a description of the run — is empty there, so the file loads as floats)."""
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
     csv, md = out / "headline.csv", out / "headline.md"
-    table.to_csv(csv)
+    table.apply(pd.to_numeric, errors="coerce").to_csv(csv)
 
     def fmt(v):
         return f"{v:.3f}" if isinstance(v, (float, np.floating)) and np.isfinite(v) else str(v)
@@ -248,12 +250,14 @@ def caption(label: str, ds: xr.Dataset, what: str, residual_strain: float = RESI
     return f"{label}: N = {ds.sizes['particle']} {shape}, seed {seed}, preparation '{preparation}'; {shown}"
 
 
-def write_figures(runs: dict, out: Path, time=-1, residual_strain: float = RESIDUAL_STRAIN) -> list[Path]:
+def write_figures(runs: dict, out: Path, time=-1, residual_strain: float = RESIDUAL_STRAIN, log=None,
+                  captions: dict | None = None) -> list[Path]:
     """Draw every figure of the paper the runs support into ``out`` (PNG and PDF).
 
     Comparative figures get all runs on one axes; the maps and P(m_s, m_d) one file per run
     (snapshot ``time``, default the last); the simple-versus-double figures only the runs
-    that contain polygons. Returns the paths written.
+    that contain polygons. Returns the paths written. ``log``: called with one line per figure
+    (progress); ``captions``: filled with {file stem: caption lines}.
     """
     import matplotlib.pyplot as plt  # any backend: matplotlib falls back to Agg without a display
 
@@ -280,23 +284,57 @@ def write_figures(runs: dict, out: Path, time=-1, residual_strain: float = RESID
             result = func(data if number not in MAP_FIGURES else next(iter(data.values())), **kwargs)
             fig = result if hasattr(result, "savefig") else result.figure
             what = "map" if number in MAP_FIGURES else "distribution" if number in DISTRIBUTION_FIGURES else "evolution"
-            add_caption(fig, [caption(label, ds, what, residual_strain, time) for label, ds in data.items()])
+            lines = [caption(label, ds, what, residual_strain, time) for label, ds in data.items()]
+            add_caption(fig, lines)
+            if captions is not None:
+                captions[stem] = lines
+            if log is not None:
+                log(f"figure {number} ({FIGURE_NAMES[number]}): {stem}.png")
             save_figure(fig, out / stem)
             plt.close(fig)
             written += [out / f"{stem}.png", out / f"{stem}.pdf"]
     return written
 
 
-def write_report(runs: dict, out, residual_strain: float = RESIDUAL_STRAIN, overwrite: bool = False) -> dict:
+def write_report(runs: dict, out, residual_strain: float = RESIDUAL_STRAIN, overwrite: bool = False,
+                 log=None) -> dict:
     """The whole report of ``runs`` ({label: dataset}) in folder ``out``: the headline table
-    (CSV, Markdown) and every figure. Returns {"table": DataFrame, "files": [paths]}.
+    (CSV, Markdown), every figure, and ``index.md`` (each run's settings, the table, every
+    figure with its caption). Returns {"table": DataFrame, "files": [paths]}. ``log``: called
+    with a line per stage and figure (the command line prints them).
 
     A folder that already holds a report is refused unless ``overwrite`` is True, so that
     nothing a user owns is replaced by accident."""
     out = Path(out)
     if not overwrite and (out / "headline.csv").exists():
         raise FileExistsError(f"{out} already holds a report; pass --overwrite (overwrite=True) to replace it")
+    if log is not None:
+        log(f"headline table of {len(runs)} run(s) (residual window eps_q >= {residual_strain:g}) ...")
     table = headline_table(runs, residual_strain)
     files = write_table(table, out)
-    files += write_figures(runs, out / "figures", residual_strain=residual_strain)
+    captions = {}
+    files += write_figures(runs, out / "figures", residual_strain=residual_strain, log=log, captions=captions)
+    files.append(write_index(runs, out, captions, residual_strain))
     return {"table": table, "files": files}
+
+
+def write_index(runs: dict, out: Path, captions: dict, residual_strain: float = RESIDUAL_STRAIN) -> Path:
+    """``out/index.md``: the runs (their settings, :func:`grainview.summary.describe`), the
+    headline table, and every figure file with its caption, in the paper's order."""
+    from .summary import describe
+
+    out = Path(out)
+    lines = ["# Report", "", "Force transmission in the runs below, next to Azema, Radjai, Peyroux & Saussine, "
+             "Phys. Rev. E 76, 011301 (2007). Residual state: eps_q >= " + f"{residual_strain:g}.", "", "## Runs", ""]
+    for label, ds in runs.items():
+        source = ds.encoding.get("source", "(in memory)")
+        lines += [f"### {label}", "", f"File: `{source}`", ""] + [f"- {line}" for line in describe(ds)] + [""]
+    lines += ["## Headline table", "", "[headline.md](headline.md) (numbers only: [headline.csv](headline.csv))", "",
+              "## Figures", ""]
+    for stem, caption_lines in captions.items():
+        number = stem[3:].split("_")[0]
+        lines += [f"- **Fig. {number.lstrip('0')}** [{stem}.png](figures/{stem}.png) ([pdf](figures/{stem}.pdf)): "
+                  + "; ".join(caption_lines)]
+    path = out / "index.md"
+    path.write_text("\n".join(lines) + "\n")
+    return path
