@@ -301,7 +301,7 @@ def main(argv=None):
     parser.add_argument("--quick", action="store_true", help="tiny sizes, to check the script")
     parser.add_argument("--only", default=",".join(SECTIONS), help="comma-separated sections: " + ",".join(SECTIONS))
     parser.add_argument("--large", action="store_true", help="add 4000 particles to the sizes section "
-                        "(about 2.5 h per pentagon test on one core)")
+                        "(about 2-2.5 h per pentagon test on one core)")
     parser.add_argument("--jobs", type=int, default=2, help="simulations run side by side (default 2)")
     parser.add_argument("--output", default=None, help="default: benchmarks/fidelity/RESULTS.md for a full run, "
                         "benchmarks/_data/fidelity/RESULTS-*.md otherwise")
