@@ -47,6 +47,7 @@ class GrainAccessor:
     def __init__(self, ds: xr.Dataset):
         self._ds = ds
         self._structure_ok = False
+        self._strains = None  # the strain coordinates, built once per dataset (see _with_strains)
 
     def _check_structure(self):
         """Structural check (no data read) before any analysis, so that a malformed dataset
@@ -71,10 +72,12 @@ class GrainAccessor:
                        or name == getattr(result, "name", None) for name in self.STRAIN_COORDS)
                 or not {"box_min", "box_max"} <= set(ds.variables)):
             return result
-        from .strain import strains
+        if self._strains is None:
+            from .strain import strains
 
-        eps = strains(ds)
-        return result.assign_coords({name: eps[name] for name in self.STRAIN_COORDS})
+            eps = strains(ds)
+            self._strains = {name: eps[name] for name in self.STRAIN_COORDS}
+        return result.assign_coords(self._strains)
 
     def validate(self):
         """Check the dataset against the contract (:func:`grainview.validation.validate`)."""
