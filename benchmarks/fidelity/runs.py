@@ -71,7 +71,7 @@ def _log(message):
 def make_sample(run: Run, cache=None) -> str:
     """The compacted sample of ``run`` (built and written unless cached); returns its path."""
     from solver.output import Recorder
-    from solver.preparation import prepare_sample
+    from solver.preparation import prepare_sample, record
 
     path = run.sample_path(cache)
     if os.path.exists(path):
@@ -82,9 +82,8 @@ def make_sample(run: Run, cache=None) -> str:
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         sim = prepare_sample(prep, progress=False)
-    attrs = {"scene": "isotropic", **prep.attrs(), "preparation_name": run.preparation, "sigma0_Pa": prep.sigma0,
-             "compaction_steps": sim.compaction_steps, "compaction_settled": int(sim.settled),
-             "compaction_inertia_number": sim.compaction_inertia_number,
+    # the study's own preparation names (the LADDER's are not presets)
+    attrs = {"scene": "isotropic", **record(sim), "preparation_name": run.preparation,
              "compaction_seconds": time.perf_counter() - start}
     with Recorder(path + ".part", sim, attrs=attrs, near_contacts=True, overwrite=True) as rec:
         rec.write()
@@ -102,24 +101,15 @@ def simulate(run: Run, cache=None) -> str:
         return path
     sample = make_sample(run, cache)
     os.makedirs(os.path.dirname(path), exist_ok=True)
-    sim = solver.load_sample(sample)
-    attrs = sample_attrs(sample)
+    sim = solver.load_sample(sample)  # carries the sample's preparation_* and compaction_* attributes
     start = time.perf_counter()
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         steps = solver.biaxial_test(sim, path + ".part", strain=run.strain, velocity=run.velocity, every=run.every,
-                                    overwrite=True, progress=False, near_contacts=True, attrs=attrs)
+                                    overwrite=True, progress=False, near_contacts=True)
     os.replace(path + ".part", path)
     _log(f"{run.name}: {steps} steps in {time.perf_counter() - start:.0f} s")
     return path
-
-
-def sample_attrs(path) -> dict:
-    """The preparation and compaction attributes of a sample file, to carry into its tests."""
-    import grainview
-
-    with grainview.open_dataset(path, chunks=None) as ds:
-        return {k: v for k, v in ds.attrs.items() if k.startswith(("preparation_", "compaction_"))}
 
 
 def _simulate_sample_group(group, cache=None):
