@@ -6,6 +6,7 @@ dependencies)::
     python benchmarks/peers.py PILE.npz OUT.npz --engine pymunk --steps 200 --iterations 50
 
 The pile (``PILE.npz``: position (N, 2), angle, radius (circumscribed, m), n_vertices,
+first_vertex and local_vertices (the shape table's body-frame vertices),
 density, box (x0, y0, x1, y1), gravity, dt, friction) is settled once and saved by
 ``benchmarks/solver_bench/peer_engines.py``; every engine is timed on the same reloaded pile, as
 ``../shared/PEERS.md`` recommends. The engine steps ``--steps`` times with a fixed iteration
@@ -27,9 +28,11 @@ import time
 import numpy as np
 
 
-def polygon_vertices(radius, n, angle=0.0):
-    k = np.arange(n)
-    return np.stack([radius * np.cos(angle + 2 * np.pi * k / n), radius * np.sin(angle + 2 * np.pi * k / n)], -1)
+def local_vertices(pile, p):
+    """(n, 2) m, the vertices of particle ``p`` in its own frame, as the project's shape table
+    (``solver.shapes.Shapes``) wrote them into the pile."""
+    first = pile["first_vertex"]
+    return pile["local_vertices"][first[p]:first[p + 1]]
 
 
 def run_pymunk(pile, steps, iterations):
@@ -58,8 +61,8 @@ def run_pymunk(pile, steps, iterations):
             body = pymunk.Body(mass, pymunk.moment_for_circle(mass, 0, r))
             shape = pymunk.Circle(body, r)
         else:
-            verts = [tuple(v) for v in polygon_vertices(r, n)]
-            area = 0.5 * n * r * r * math.sin(2 * math.pi / n)
+            verts = [tuple(v) for v in local_vertices(pile, p)]
+            area = pymunk.area_for_poly(verts)
             mass = float(pile["density"]) * area
             body = pymunk.Body(mass, pymunk.moment_for_poly(mass, verts))
             shape = pymunk.Poly(body, verts, radius=0.0)
@@ -117,7 +120,7 @@ def run_box2d(pile, steps, iterations):
         if n == 0:
             body.CreateCircleFixture(radius=r, density=1.0, friction=mu_shape, restitution=0.0)
         else:
-            body.CreatePolygonFixture(vertices=[tuple(v) for v in polygon_vertices(r, n)], density=1.0,
+            body.CreatePolygonFixture(vertices=[tuple(v) for v in local_vertices(pile, p) / unit], density=1.0,
                                       friction=mu_shape, restitution=0.0)
         bodies.append(body)
 

@@ -127,6 +127,14 @@ def particle_area(radius, n_vertices):
     return np.where(n >= 3, polygon, np.pi * radius**2)
 
 
+def vertex_phases(n_vertices: int) -> np.ndarray:
+    """(n,) body-frame polar angles (rad) of the vertices of a regular n-gon: 2 pi k/n,
+    k = 0 .. n-1, so that vertex 0 lies at the particle's ``angle`` and the vertices run
+    counter-clockwise. Part of the contract's shape definition (what ``angle`` means); the
+    solver's shape table (``solver.shapes.Shapes``) and :func:`polygon_vertices` both read it."""
+    return 2.0 * np.pi * np.arange(n_vertices) / n_vertices
+
+
 def polygon_vertices(position, radius, angle, n_vertices: int) -> np.ndarray:
     """(P, n, 2) vertices in m of P regular n-gons of one vertex count ``n_vertices``: vertex k
     at position + R (cos(angle + 2 pi k/n), sin(angle + 2 pi k/n)), counter-clockwise, R the
@@ -134,7 +142,7 @@ def polygon_vertices(position, radius, angle, n_vertices: int) -> np.ndarray:
     position = np.asarray(position, dtype=float).reshape(-1, 2)
     radius = np.asarray(radius, dtype=float).reshape(-1)
     angle = np.broadcast_to(np.asarray(angle, dtype=float), radius.shape)
-    phase = angle[:, None] + 2.0 * np.pi * np.arange(n_vertices) / n_vertices
+    phase = angle[:, None] + vertex_phases(n_vertices)
     return position[:, None, :] + radius[:, None, None] * np.stack([np.cos(phase), np.sin(phase)], -1)
 
 

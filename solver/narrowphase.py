@@ -87,7 +87,7 @@ from grainview.errors import ParameterError
 from grainview.schema import KIND_DOUBLE, KIND_SIMPLE
 
 from .broadphase import check_walls
-from .shapes import check_shapes
+from .shapes import Shapes
 
 __all__ = ["ContactPoints", "detect", "KIND_SIMPLE", "KIND_DOUBLE", "DOUBLE_MIN_OVERLAP",
            "DOUBLE_GAP_TOLERANCE"]
@@ -168,9 +168,11 @@ def _disk_wall(x, y, r, px, py, wnx, wny, c, normal, point, gap):
 
 
 @njit(cache=True)
-def _polygon_geometry(pos, angle, radius, nvert):
-    """Vertices (N, maxn, 2) and outward unit edge normals (N, maxn, 2) of every polygon:
-    vertex k at angle + 2 pi k/n, normal of edge k (vertex k -> k+1) at angle + pi (2k+1)/n."""
+def _polygon_geometry(pos, angle, nvert, first_vertex, vertex_radius, vertex_angle, normal_angle):
+    """World vertices (N, maxn, 2) and outward unit edge normals (N, maxn, 2) of every polygon
+    from the shape table (:class:`solver.shapes.Shapes`): vertex k at the polar angle
+    angle + vertex_angle[k] and distance vertex_radius[k], the normal of edge k (vertex k -> k+1)
+    at angle + normal_angle[k]."""
     n = pos.shape[0]
     maxn = 1
     for p in range(n):
@@ -178,12 +180,12 @@ def _polygon_geometry(pos, angle, radius, nvert):
     verts = np.zeros((n, maxn, 2))
     norms = np.zeros((n, maxn, 2))
     for p in range(n):
-        m = nvert[p]
-        for k in range(m):
-            phi = angle[p] + 2.0 * math.pi * k / m
-            verts[p, k, 0] = pos[p, 0] + radius[p] * math.cos(phi)
-            verts[p, k, 1] = pos[p, 1] + radius[p] * math.sin(phi)
-            psi = angle[p] + math.pi * (2 * k + 1) / m
+        s = first_vertex[p]
+        for k in range(nvert[p]):
+            phi = angle[p] + vertex_angle[s + k]
+            verts[p, k, 0] = pos[p, 0] + vertex_radius[s + k] * math.cos(phi)
+            verts[p, k, 1] = pos[p, 1] + vertex_radius[s + k] * math.sin(phi)
+            psi = angle[p] + normal_angle[s + k]
             norms[p, k, 0] = math.cos(psi)
             norms[p, k, 1] = math.sin(psi)
     return verts, norms
@@ -437,7 +439,8 @@ def _pair_points(a, b, pos, radius, nvert, verts, norms, double_alert, c, normal
 
 
 @njit(cache=True)
-def _detect_kernel(pos, angle, radius, nvert, wall_point, wall_normal, alert, double_alert, pi, pj, wp, ww):
+def _detect_kernel(pos, angle, radius, nvert, first_vertex, vertex_radius, vertex_angle, normal_angle,
+                   wall_point, wall_normal, alert, double_alert, pi, pj, wp, ww):
     """Pass 1: up to two points per candidate into fixed slots (each candidate writes only its
     own slot); pass 2: compaction of the kept ones at prefix-sum offsets."""
     n_particles = pos.shape[0]
@@ -448,7 +451,7 @@ def _detect_kernel(pos, angle, radius, nvert, wall_point, wall_normal, alert, do
     point = np.empty((m, 2, 2))
     gap = np.empty((m, 2))
     kind = np.empty(m, np.int8)
-    verts, norms = _polygon_geometry(pos, angle, radius, nvert)
+    verts, norms = _polygon_geometry(pos, angle, nvert, first_vertex, vertex_radius, vertex_angle, normal_angle)
     # pass 1: geometry of every candidate into its own slot
     for c in range(m):
         if c < m_pairs:
@@ -520,14 +523,15 @@ def _index_array(name, value, upper):
     return arr
 
 
-def detect(pos, angle, radius, nvert, wall_point, wall_normal, alert, pi, pj, wp, ww, double_alert=None):
+def detect(pos, angle, shapes, wall_point, wall_normal, alert, pi, pj, wp, ww, double_alert=None):
     """Contact points of the candidate particle pairs (pi, pj) and particle-wall candidates
     (wp, ww) (from :mod:`solver.broadphase`), keeping the contacts with gap <= alert.
 
     Parameters
     ----------
-    pos : (N, 2) m; angle : (N,) rad; radius : (N,) circumscribed radii, m;
-    nvert : (N,) int, 0 = disk, >= 3 = regular polygon;
+    pos : (N, 2) m; angle : (N,) rad;
+    shapes : :class:`solver.shapes.Shapes`, the bodies' shapes (e.g. ``Shapes.regular(radius,
+    n_vertices)``: circumscribed radii in m, 0 vertices for a disk);
     wall_point : (W, 2) m, a point of each wall line; wall_normal : (W, 2) unit, into the sample;
     alert : m, >= 0; pi, pj : particle pairs (any order, pi != pj);
     wp, ww : particle and wall index of each wall candidate;
@@ -540,8 +544,10 @@ def detect(pos, angle, radius, nvert, wall_point, wall_normal, alert, pi, pj, wp
     ContactPoints (see its docstring): particle pairs first, in candidate order, then wall
     contacts; body ids are as passed (i = pi, j = pj; wall contacts i = particle, j = N + w).
     """
-    radius, nvert = check_shapes(radius, nvert)
-    n = radius.shape[0]
+    if not isinstance(shapes, Shapes):
+        raise ParameterError(f"shapes must be a solver.shapes.Shapes (e.g. Shapes.regular(radius, n_vertices)), "
+                             f"got {type(shapes).__name__}")
+    n = len(shapes)
     pos = np.ascontiguousarray(pos, dtype=np.float64)
     if pos.shape != (n, 2):
         raise ParameterError(f"pos must have shape ({n}, 2), got {pos.shape}")
@@ -565,5 +571,7 @@ def detect(pos, angle, radius, nvert, wall_point, wall_normal, alert, pi, pj, wp
     ww = _index_array("ww", ww, wall_point.shape[0])
     if wp.shape != ww.shape:
         raise ParameterError(f"wp and ww must have the same length, got {wp.size} and {ww.size}")
-    out = _detect_kernel(pos, angle, radius, nvert, wall_point, wall_normal, alert, double_alert, pi, pj, wp, ww)
+    out = _detect_kernel(pos, angle, shapes.radius, shapes.n_vertices, shapes.first_vertex, shapes.vertex_radius,
+                         shapes.vertex_angle, shapes.normal_angle, wall_point, wall_normal, alert, double_alert,
+                         pi, pj, wp, ww)
     return ContactPoints(*out[:7], int(out[7]))

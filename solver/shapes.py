@@ -19,16 +19,24 @@ apex angle alpha = 2 pi / n):
             about the centroid (disk: R^2 / 2). Each triangle O-a-b of the fan has the polar
             moment (A_t/6)(|a|^2 + |b|^2 + a.b) about its apex O.
 * mass      m = rho A t for a slab of thickness t (m) and density rho (kg m-3); I = m (I/m).
+
+The shape table (:class:`Shapes`) holds all of this once per simulation: each body's vertices
+and edge normals in its own frame (polar angles measured from the body's ``angle``), its
+inradius, area and inertia per unit mass. Detection, mass and inertia, plotting in tests and
+the peers' exports read the table; nothing else rebuilds a vertex. A new shape (an irregular
+convex polygon) is a new constructor of the table: the kernels read vertex lists of any length.
 """
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 import numpy as np
 
 from grainview.errors import ParameterError
-from grainview.schema import particle_area, polygon_vertices
+from grainview.schema import particle_area, vertex_phases
 
-__all__ = ["polygon_area", "polygon_inertia_per_mass", "mass_and_inertia", "vertices", "inradius",
+__all__ = ["Shapes", "polygon_area", "polygon_inertia_per_mass", "mass_and_inertia", "vertices", "inradius",
            "check_shapes"]
 
 
@@ -82,17 +90,10 @@ def mass_and_inertia(radius, nvert, density, thickness=1.0):
 
     m = density * area * thickness (a slab of the given thickness, m; density in kg m-3),
     I = m * (I/m) with I/m from :func:`polygon_inertia_per_mass`. Vectorised over bodies;
-    ``density`` may be a scalar or one value per body.
+    ``density`` may be a scalar or one value per body. Shorthand for
+    ``Shapes.regular(radius, nvert).mass_and_inertia(density, thickness)``.
     """
-    radius, nvert = check_shapes(radius, nvert)
-    density = np.asarray(density, dtype=np.float64)
-    if not np.all(np.isfinite(density)) or np.any(density <= 0):
-        raise ParameterError("density must be finite and > 0 (kg m-3)")
-    if not np.isfinite(thickness) or thickness <= 0:
-        raise ParameterError(f"thickness={thickness!r}: expected a finite slab thickness > 0 (m)")
-    mass = np.broadcast_to(density, radius.shape) * particle_area(radius, nvert) * float(thickness)
-    inertia = mass * polygon_inertia_per_mass(radius, nvert)
-    return np.ascontiguousarray(mass, dtype=np.float64), np.ascontiguousarray(inertia, dtype=np.float64)
+    return Shapes.regular(radius, nvert).mass_and_inertia(density, thickness)
 
 
 def inradius(radius, nvert):
@@ -107,15 +108,148 @@ def vertices(pos, angle, radius, nvert):
     """Vertices (N, maxn, 2) in m of every body, counter-clockwise, vertex k at
     pos + R (cos(angle + 2 pi k/n), sin(angle + 2 pi k/n)); rows beyond a body's own n (and
     all rows of disks) are NaN. ``maxn`` is the largest ``nvert`` (0 if all are disks).
-    For plotting and tests; kernels compute vertices on the fly."""
-    radius, nvert = check_shapes(radius, nvert)
-    pos = np.asarray(pos, dtype=np.float64).reshape(-1, 2)
-    angle = np.broadcast_to(np.asarray(angle, dtype=np.float64), radius.shape)
-    if pos.shape[0] != radius.shape[0]:
-        raise ParameterError(f"pos must have shape (N, 2) with N = {radius.shape[0]}, got {pos.shape}")
-    maxn = int(nvert.max()) if nvert.size else 0
-    out = np.full((radius.shape[0], maxn, 2), np.nan)
-    for n in np.unique(nvert[nvert >= 3]):
-        sel = nvert == n
-        out[sel, :n] = polygon_vertices(pos[sel], radius[sel], angle[sel], int(n))
-    return out
+    Shorthand for ``Shapes.regular(radius, nvert).world_vertices(pos, angle)``."""
+    return Shapes.regular(radius, nvert).world_vertices(pos, angle)
+
+
+@dataclass(frozen=True, eq=False)
+class Shapes:
+    """The shape of every body, built once: what detection, dynamics and drawing read.
+
+    Body b owns the vertices ``first_vertex[b]:first_vertex[b + 1]`` of the flat vertex
+    arrays (none for a disk). Vertex k of body b, at rotation ``angle`` and centre ``pos``, is
+
+        pos + vertex_radius[k] (cos(angle + vertex_angle[k]), sin(angle + vertex_angle[k])),
+
+    and edge k (vertex k -> k+1, cyclically) has the outward unit normal of angle
+    ``angle + normal_angle[k]``. The polar form makes a world vertex one addition and one
+    cosine/sine away from the body's angle, with the same arithmetic as the contract's
+    definition (``grainview.schema.polygon_vertices``), and it describes any polygon that is
+    star-shaped about its centroid (every convex polygon).
+
+    Attributes
+    ----------
+    radius : (N,) m, the circumscribed (bounding) radius; a disk's radius.
+    n_vertices : (N,) int32, 0 for a disk.
+    first_vertex : (N + 1,) int64, offsets into the vertex arrays.
+    vertex_radius, vertex_angle, normal_angle : (V,) m, rad, rad.
+    inradius : (N,) m, the distance from the centre to the nearest edge line (R for a disk).
+    area : (N,) m2.
+    inertia_per_mass : (N,) m2, I/m about the centroid.
+    """
+
+    radius: np.ndarray
+    n_vertices: np.ndarray
+    first_vertex: np.ndarray
+    vertex_radius: np.ndarray
+    vertex_angle: np.ndarray
+    normal_angle: np.ndarray
+    inradius: np.ndarray
+    area: np.ndarray
+    inertia_per_mass: np.ndarray
+
+    @classmethod
+    def regular(cls, radius, n_vertices) -> "Shapes":
+        """Disks (n = 0) and regular n-gons of circumscribed radius R (module docstring):
+        vertex k at the polar angle 2 pi k/n (the contract's ``vertex_phases``), the normal of
+        edge k at pi (2k + 1)/n, area and inertia from their closed forms."""
+        radius, nvert = check_shapes(radius, n_vertices)
+        first = np.zeros(radius.size + 1, np.int64)
+        np.cumsum(nvert, out=first[1:])
+        vertex_radius = np.repeat(radius, nvert)
+        vertex_angle = np.empty(int(first[-1]))
+        normal_angle = np.empty(int(first[-1]))
+        for n in np.unique(nvert[nvert >= 3]):
+            rows = (first[:-1][nvert == n, None] + np.arange(n)).ravel()
+            vertex_angle[rows] = np.tile(vertex_phases(int(n)), rows.size // n)
+            normal_angle[rows] = np.tile(np.pi * (2 * np.arange(n) + 1) / n, rows.size // n)
+        return cls(radius, nvert, first, vertex_radius, vertex_angle, normal_angle,
+                   inradius(radius, nvert), polygon_area(radius, nvert), polygon_inertia_per_mass(radius, nvert))
+
+    @classmethod
+    def convex(cls, polygons) -> "Shapes":
+        """Convex polygons of any shape, each given by its vertices in its own frame: a list of
+        (n, 2) arrays in m, counter-clockwise, centroid at the origin. The area is the
+        shoelace sum, I/m the fan sum of (A_t/6)(|a|^2 + |b|^2 + a.b) over the triangles
+        centre-a-b divided by the area (module docstring), the bounding radius the farthest
+        vertex, the inradius the nearest edge line. Detection reads these tables as it reads
+        regular ones; the data contract itself stores regular polygons only."""
+        tables = []
+        for b, vertices in enumerate(polygons):
+            v = np.asarray(vertices, dtype=np.float64)
+            if v.ndim != 2 or v.shape[1] != 2 or v.shape[0] < 3 or not np.all(np.isfinite(v)):
+                raise ParameterError(f"polygon {b}: expected an (n, 2) array of n >= 3 finite vertices (m), "
+                                     f"got shape {v.shape}")
+            edge = np.roll(v, -1, axis=0) - v
+            turn = edge[:, 0] * np.roll(edge, -1, axis=0)[:, 1] - edge[:, 1] * np.roll(edge, -1, axis=0)[:, 0]
+            if np.any(turn <= 0):
+                raise ParameterError(f"polygon {b}: the vertices must run counter-clockwise around a convex polygon")
+            cross = v[:, 0] * np.roll(v, -1, axis=0)[:, 1] - v[:, 1] * np.roll(v, -1, axis=0)[:, 0]
+            area = 0.5 * cross.sum()
+            centroid = (cross[:, None] * (v + np.roll(v, -1, axis=0))).sum(0) / (6.0 * area)
+            size = np.abs(v).max()
+            if np.hypot(*centroid) > 1e-9 * size:
+                raise ParameterError(f"polygon {b}: its centroid {centroid.tolist()} m must be at the origin")
+            nxt = np.roll(v, -1, axis=0)
+            polar = (cross / 2.0 / 6.0 * ((v ** 2).sum(1) + (nxt ** 2).sum(1) + (v * nxt).sum(1))).sum()
+            outward = np.column_stack([edge[:, 1], -edge[:, 0]]) / np.hypot(edge[:, 0], edge[:, 1])[:, None]
+            tables.append((v, outward, area, polar / area))
+        n_vertices = np.array([len(t[0]) for t in tables], np.int32)
+        first = np.zeros(n_vertices.size + 1, np.int64)
+        np.cumsum(n_vertices, out=first[1:])
+        v = np.concatenate([t[0] for t in tables]) if tables else np.empty((0, 2))
+        outward = np.concatenate([t[1] for t in tables]) if tables else np.empty((0, 2))
+        body = np.repeat(np.arange(n_vertices.size), n_vertices)
+        vertex_radius = np.hypot(v[:, 0], v[:, 1])
+        radius = np.zeros(n_vertices.size)
+        np.maximum.at(radius, body, vertex_radius)
+        inradius = np.full(n_vertices.size, np.inf)
+        np.minimum.at(inradius, body, (outward * v).sum(1))
+        return cls(radius, n_vertices, first, vertex_radius, np.arctan2(v[:, 1], v[:, 0]),
+                   np.arctan2(outward[:, 1], outward[:, 0]), inradius,
+                   np.array([t[2] for t in tables]), np.array([t[3] for t in tables]))
+
+    def __len__(self) -> int:
+        return int(self.radius.size)
+
+    @property
+    def max_vertices(self) -> int:
+        """The largest vertex count (0 if every body is a disk)."""
+        return int(self.n_vertices.max()) if self.n_vertices.size else 0
+
+    def local_vertices(self, body: int | None = None) -> np.ndarray:
+        """Vertices in the bodies' own frames (centre at the origin, angle 0), m: (n, 2) for
+        ``body``, or the whole (V, 2) table (rows ``first_vertex[b]:first_vertex[b + 1]`` for
+        body b) — the form other engines and file exports take."""
+        rows = (slice(None) if body is None
+                else slice(int(self.first_vertex[body]), int(self.first_vertex[body + 1])))
+        r, phi = self.vertex_radius[rows], self.vertex_angle[rows]
+        return np.stack([r * np.cos(phi), r * np.sin(phi)], -1)
+
+    def world_vertices(self, pos, angle) -> np.ndarray:
+        """(N, maxn, 2) m, every body's vertices at centres ``pos`` (N, 2) m and rotations
+        ``angle`` (N,) rad, counter-clockwise; rows beyond a body's own count are NaN."""
+        n = len(self)
+        pos = np.asarray(pos, dtype=np.float64).reshape(-1, 2)
+        if pos.shape[0] != n:
+            raise ParameterError(f"pos must have shape (N, 2) with N = {n}, got {pos.shape}")
+        angle = np.broadcast_to(np.asarray(angle, dtype=np.float64), (n,))
+        out = np.full((n, self.max_vertices, 2), np.nan)
+        body = np.repeat(np.arange(n), self.n_vertices)
+        slot = np.arange(self.vertex_radius.size) - self.first_vertex[body]
+        phase = angle[body] + self.vertex_angle
+        out[body, slot, 0] = pos[body, 0] + self.vertex_radius * np.cos(phase)
+        out[body, slot, 1] = pos[body, 1] + self.vertex_radius * np.sin(phase)
+        return out
+
+    def mass_and_inertia(self, density, thickness=1.0):
+        """Mass (kg) and moment of inertia about the centroid (kg m2) of every body for a slab
+        of ``thickness`` (m) and ``density`` (kg m-3, scalar or per body): m = rho A t, I = m (I/m)."""
+        density = np.asarray(density, dtype=np.float64)
+        if not np.all(np.isfinite(density)) or np.any(density <= 0):
+            raise ParameterError("density must be finite and > 0 (kg m-3)")
+        if not np.isfinite(thickness) or thickness <= 0:
+            raise ParameterError(f"thickness={thickness!r}: expected a finite slab thickness > 0 (m)")
+        mass = np.broadcast_to(density, self.radius.shape) * self.area * float(thickness)
+        inertia = mass * self.inertia_per_mass
+        return np.ascontiguousarray(mass, dtype=np.float64), np.ascontiguousarray(inertia, dtype=np.float64)

@@ -31,7 +31,7 @@ from grainview.errors import ConvergenceWarning, ParameterError
 
 from . import broadphase, narrowphase, nlgs
 from .contact_points import PairIndex, force_vectors, point_keys
-from .shapes import mass_and_inertia
+from .shapes import Shapes
 from .walls import FIXED, STRESS, VELOCITY, Walls
 
 
@@ -126,7 +126,8 @@ class Simulation:
         if np.any((self.n_vertices != 0) & (self.n_vertices < 3)):
             raise ParameterError("n_vertices must be 0 (disk) or >= 3 (regular polygon)")
         self.walls = walls
-        self.mass, self.inertia = mass_and_inertia(self.radius, self.n_vertices, p.density, p.thickness)
+        self.shapes = Shapes.regular(self.radius, self.n_vertices)
+        self.mass, self.inertia = self.shapes.mass_and_inertia(p.density, p.thickness)
         w = len(walls)
         self.n_particles, self.n_walls = n, w
         self.velocity = np.zeros((n + w, 2))
@@ -200,7 +201,7 @@ class Simulation:
             self.counters["broad_phase_runs"] += 1
         middle = time.perf_counter()
         pi, pj, wp, ww = self._candidates
-        points = narrowphase.detect(self.position, self.angle, self.radius, self.n_vertices, self.walls.point,
+        points = narrowphase.detect(self.position, self.angle, self.shapes, self.walls.point,
                                     self.walls.normal, alert, pi, pj, wp, ww, double_alert=self.alert)
         self.timings["broad_phase"] += middle - start
         self.timings["narrow_phase"] += time.perf_counter() - middle

@@ -56,12 +56,15 @@ def series(path) -> xr.Dataset:
     inv = g.stress_invariants()
     harmonic = g.harmonic_prediction()
     height = ds["box_max"].sel(xy="y") - ds["box_min"].sel(xy="y")
-    out = xr.Dataset({
+    columns = {
         "eps_1": eps["eps_1"], "eps_q": eps["eps_q"], "p": inv["p"], "q_over_p": inv["q_over_p"],
         "sigma_xx": g.stress_tensor().isel(xy_a=0, xy_b=0, drop=True),
         "a": g.fabric_anisotropy()["a"], "a_n": harmonic["a_n"], "a_t": harmonic["a_t"],
         "z": g.coordination()["z"], "k_d": g.contact_proportions()["k_d"],
-    })
+    }
+    # the accessors' results carry the strains as coordinates: keep only time, so that eps_1
+    # and eps_q are variables of the series like the others
+    out = xr.Dataset({name: v.drop_vars([c for c in v.coords if c != "time"]) for name, v in columns.items()})
     if "wall_force" in ds and "wall_position" in ds:
         thickness = float(ds.attrs.get("thickness_m", 1.0))
         out["right_stress"] = ds["wall_force"].sel(wall="right", xy="x", drop=True) / (height * thickness)

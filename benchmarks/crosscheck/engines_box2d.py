@@ -32,7 +32,6 @@ The protocol and the raw snapshots are described in ``peer_common.py``. Box2D sp
 
 from __future__ import annotations
 
-import math
 import sys
 
 import numpy as np
@@ -87,8 +86,11 @@ class Box2DBiaxial:
         if n == 0:
             body.CreateCircleFixture(radius=radius, **common)
         else:
-            core = radius - self.skin / math.cos(math.pi / n)  # edges of core + skin = the sample's edges
-            body.CreatePolygonFixture(vertices=[tuple(v) for v in pc.polygon_vertices(core, n)], **common)
+            # core + skin = the sample's edges: shrink about the centre so that every edge line moves in by
+            # the skin (exact for polygons whose edges all touch the inscribed circle, as regular ones do)
+            shrink = 1.0 - self.skin / (float(s["inradius"][p]) / UNIT)
+            core = pc.local_vertices(s, p) / UNIT * shrink
+            body.CreatePolygonFixture(vertices=[tuple(v) for v in core], **common)
         body.massData = b2.b2MassData(mass=float(s["mass"][p]), I=float(s["inertia"][p]) / UNIT**2, center=(0, 0))
         body.userData = p
         return body

@@ -85,7 +85,7 @@ class PymunkBiaxial:
             if n == 0:
                 shape = pymunk.Circle(body, r)
             else:
-                shape = pymunk.Poly(body, [tuple(v) for v in pc.polygon_vertices(r, n)], radius=0.0)
+                shape = pymunk.Poly(body, [tuple(v) for v in pc.local_vertices(sample, p)], radius=0.0)
             shape.friction, shape.elasticity = mu, 0.0
             space.add(body, shape)
             self.ids[shape] = p

@@ -53,7 +53,8 @@ def sample_to_npz(nc_path, npz_path):
     Keys (SI): position (N, 2) m, angle rad, velocity m/s, angular_velocity rad/s, radius
     (circumscribed) m, n_vertices (0 disk), mass kg, inertia kg m2, wall_position and
     wall_velocity (4, 2) for bottom, right, top, left; right_wall_mass kg; sigma0 Pa (the
-    stress of the right wall); friction, wall_friction; time_step s; thickness m.
+    stress of the right wall); friction, wall_friction; time_step s; thickness m; the shape
+    table's body-frame vertices (first_vertex (N + 1,), local_vertices (V, 2) m) and inradius m.
     Returns the dict written. Raises GrainviewError (one line) for a file that is not a
     four-wall box with a stress-driven right wall.
     """
@@ -82,6 +83,11 @@ def sample_to_npz(nc_path, npz_path):
     if out["wall_friction"] != 0.0:
         raise GrainviewError(f"{nc_path}: wall friction {out['wall_friction']}; the cross-check's walls are "
                              "frictionless")
+    from solver.shapes import Shapes
+
+    shapes = Shapes.regular(out["radius"], out["n_vertices"])
+    out["first_vertex"], out["local_vertices"], out["inradius"] = (shapes.first_vertex, shapes.local_vertices(),
+                                                                   shapes.inradius)
     np.savez(npz_path, **out)
     return out
 
@@ -130,13 +136,15 @@ def largest_overlap(snap, radius, n_vertices):
     """Largest interpenetration (m) of a snapshot's configuration, by this project's narrow
     phase (particle pairs within 2 % of the smallest diameter, and the walls)."""
     from solver import broadphase, narrowphase
+    from solver.shapes import Shapes
 
     position, angle = snap["position"], snap["angle"]
     margin = 0.02 * 2 * float(np.min(radius))
     wall_point, wall_normal = snap["wall_position"], WALL_NORMALS
     pi, pj = broadphase.candidate_pairs(position, radius, margin)
     wp, ww = broadphase.wall_candidates(position, radius, wall_point, wall_normal, margin)
-    pts = narrowphase.detect(position, angle, radius, n_vertices, wall_point, wall_normal, margin, pi, pj, wp, ww)
+    shapes = Shapes.regular(radius, n_vertices)
+    pts = narrowphase.detect(position, angle, shapes, wall_point, wall_normal, margin, pi, pj, wp, ww)
     return float(max(0.0, -pts.gap.min())) if len(pts.gap) else 0.0
 
 

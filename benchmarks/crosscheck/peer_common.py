@@ -42,15 +42,14 @@ WALLS = ("bottom", "right", "top", "left")
 BOTTOM, RIGHT, TOP, LEFT = range(4)
 SAMPLE_KEYS = ("position", "angle", "velocity", "angular_velocity", "radius", "n_vertices", "mass", "inertia",
                "wall_position", "wall_velocity", "right_wall_mass", "sigma0", "friction", "wall_friction",
-               "time_step", "thickness")
+               "time_step", "thickness", "first_vertex", "local_vertices", "inradius")
 
 
-def polygon_vertices(radius, n, angle=0.0):
-    """Vertices (n, 2) of a regular n-gon of circumscribed radius ``radius`` centred at the
-    origin, counter-clockwise, vertex k at angle + 2 pi k/n: the data contract's convention
-    (``docs/schema.md``; ``solver.shapes.vertices`` in the project's environment)."""
-    phi = angle + 2.0 * np.pi * np.arange(n) / n
-    return np.stack([radius * np.cos(phi), radius * np.sin(phi)], -1)
+def local_vertices(sample, p):
+    """(n, 2) m, the vertices of particle ``p`` in its own frame, counter-clockwise, as the
+    project's shape table (``solver.shapes.Shapes``) exported them (``export.sample_to_npz``)."""
+    first = sample["first_vertex"]
+    return sample["local_vertices"][first[p]:first[p + 1]]
 
 
 def load_sample(path):

@@ -58,11 +58,13 @@ def largest_overlap(position, angle, radius, n_vertices, wall_point, wall_normal
     """Largest interpenetration (m) of a configuration, by this project's narrow phase: one
     metric for every engine."""
     from solver import broadphase, narrowphase
+    from solver.shapes import Shapes
 
     margin = 0.02 * 2 * float(np.min(radius))
     pi, pj = broadphase.candidate_pairs(position, radius, margin)
     wp, ww = broadphase.wall_candidates(position, radius, wall_point, wall_normal, margin)
-    pts = narrowphase.detect(position, angle, radius, n_vertices, wall_point, wall_normal, margin, pi, pj, wp, ww)
+    shapes = Shapes.regular(radius, n_vertices)
+    pts = narrowphase.detect(position, angle, shapes, wall_point, wall_normal, margin, pi, pj, wp, ww)
     return float(max(0.0, -pts.gap.min())) if len(pts.gap) else 0.0
 
 

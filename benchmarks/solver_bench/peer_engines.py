@@ -31,6 +31,7 @@ def settle_pile(n, shape, steps, seed=0):
             break
     p = sim.parameters
     return dict(position=sim.position.copy(), angle=sim.angle.copy(), radius=rad, n_vertices=nv.astype(np.int64),
+                first_vertex=sim.shapes.first_vertex, local_vertices=sim.shapes.local_vertices(),
                 density=p.density, box=np.array([0.0, 0.0, width, height]), gravity=np.array(p.gravity),
                 dt=p.time_step, friction=p.friction, kinetic_energy=sim.kinetic_energy())
 

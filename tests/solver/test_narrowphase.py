@@ -11,6 +11,7 @@ from hypothesis import strategies as st
 from grainview.errors import ParameterError
 from solver.broadphase import candidate_pairs, wall_candidates
 from solver.narrowphase import ContactPoints, detect
+from solver.shapes import Shapes
 
 from . import naive_geometry as naive
 
@@ -26,16 +27,16 @@ def box_walls(width, height):
 
 def pair_contact(pos, angle, radius, nvert, alert=0.0, i=0, j=1):
     """Contacts of the single pair (i, j)."""
-    return detect(np.asarray(pos, float), np.asarray(angle, float), np.asarray(radius, float),
-                  np.asarray(nvert), *NO_WALLS, alert, [i], [j], [], [])
+    shapes = Shapes.regular(np.asarray(radius, float), np.asarray(nvert))
+    return detect(np.asarray(pos, float), np.asarray(angle, float), shapes, *NO_WALLS, alert, [i], [j], [], [])
 
 
 def wall_contact(pos, angle, radius, nvert, wall_point, wall_normal, alert=0.0):
     """Contacts of particle 0 with every wall."""
     w = len(wall_point)
-    return detect(np.asarray(pos, float).reshape(-1, 2), np.atleast_1d(angle).astype(float),
-                  np.atleast_1d(radius).astype(float), np.atleast_1d(nvert), wall_point, wall_normal,
-                  alert, [], [], np.zeros(w, int), np.arange(w))
+    shapes = Shapes.regular(np.atleast_1d(radius).astype(float), np.atleast_1d(nvert))
+    return detect(np.asarray(pos, float).reshape(-1, 2), np.atleast_1d(angle).astype(float), shapes, wall_point,
+                  wall_normal, alert, [], [], np.zeros(w, int), np.arange(w))
 
 
 def check_layout(c: ContactPoints):
@@ -108,7 +109,7 @@ def test_disks_against_numpy_oracle():
     radius = rng.uniform(0.02, 0.06, n)
     alert = 0.01
     pi, pj = candidate_pairs(pos, radius, alert)
-    c = detect(pos, np.zeros(n), radius, np.zeros(n, int), *NO_WALLS, alert, pi, pj, [], [])
+    c = detect(pos, np.zeros(n), Shapes.regular(radius, np.zeros(n, int)), *NO_WALLS, alert, pi, pj, [], [])
     check_layout(c)
     d = np.linalg.norm(pos[:, None] - pos[None], axis=-1) - radius[:, None] - radius[None]
     ei, ej = np.nonzero(np.triu(d <= alert, 1))
@@ -169,13 +170,13 @@ def test_tilted_pentagon_on_wall_is_simple_unless_within_alert():
 def test_invalid_detect_inputs():
     pos, angle, radius, nvert = np.zeros((2, 2)), np.zeros(2), np.ones(2), np.zeros(2, int)
     with pytest.raises(ParameterError, match="pj"):
-        detect(pos, angle, radius, nvert, *NO_WALLS, 0.0, [0], [5], [], [])
+        detect(pos, angle, Shapes.regular(radius, nvert), *NO_WALLS, 0.0, [0], [5], [], [])
     with pytest.raises(ParameterError, match="itself"):
-        detect(pos, angle, radius, nvert, *NO_WALLS, 0.0, [1], [1], [], [])
+        detect(pos, angle, Shapes.regular(radius, nvert), *NO_WALLS, 0.0, [1], [1], [], [])
     with pytest.raises(ParameterError, match="ww"):
-        detect(pos, angle, radius, nvert, *NO_WALLS, 0.0, [], [], [0], [0])
+        detect(pos, angle, Shapes.regular(radius, nvert), *NO_WALLS, 0.0, [], [], [0], [0])
     with pytest.raises(ParameterError, match="alert"):
-        detect(pos, angle, radius, nvert, *NO_WALLS, -1.0, [], [], [], [])
+        detect(pos, angle, Shapes.regular(radius, nvert), *NO_WALLS, -1.0, [], [], [], [])
 
 
 # ---------------------------------------------------------------- polygon-polygon
@@ -365,7 +366,7 @@ def test_random_scene_against_numpy_oracle(seed):
     pos, angle, radius, nvert = random_scene(seed)
     alert = 0.01
     pi, pj = candidate_pairs(pos, radius, alert)
-    c = detect(pos, angle, radius, nvert, *NO_WALLS, alert, pi, pj, [], [])
+    c = detect(pos, angle, Shapes.regular(radius, nvert), *NO_WALLS, alert, pi, pj, [], [])
     check_layout(c)
     kept = {(int(a), int(b)) for a, b in zip(c.body_i, c.body_j)}
     checked = {"pp": 0, "pd": 0, "overlap": 0}
@@ -415,8 +416,8 @@ def test_random_scene_against_numpy_oracle(seed):
 def test_swapping_bodies_flips_only_the_normal(seed):
     pos, angle, radius, nvert = random_scene(seed)
     pi, pj = candidate_pairs(pos, radius, 0.02)
-    c = detect(pos, angle, radius, nvert, *NO_WALLS, 0.02, pi, pj, [], [])
-    d = detect(pos, angle, radius, nvert, *NO_WALLS, 0.02, pj, pi, [], [])
+    c = detect(pos, angle, Shapes.regular(radius, nvert), *NO_WALLS, 0.02, pi, pj, [], [])
+    d = detect(pos, angle, Shapes.regular(radius, nvert), *NO_WALLS, 0.02, pj, pi, [], [])
     assert c.n_pairs > 10
     np.testing.assert_array_equal(c.body_i, d.body_j)
     np.testing.assert_array_equal(c.body_j, d.body_i)
@@ -512,7 +513,7 @@ def test_polygon_wall_against_numpy_oracle():
     tangent = np.array([wall_normal[0, 1], -wall_normal[0, 0]])
     pos = wall_point + along[:, None] * tangent + height[:, None] * wall_normal
     alert = 0.05
-    c = detect(pos, angle, radius, nvert, wall_point, wall_normal, alert, [], [],
+    c = detect(pos, angle, Shapes.regular(radius, nvert), wall_point, wall_normal, alert, [], [],
                np.arange(n), np.zeros(n, int))
     check_layout(c)
     assert np.all(c.body_j == n) and np.all(c.normal == -wall_normal)
@@ -546,7 +547,7 @@ def test_walls_and_pairs_together_are_numbered_in_order():
     radius = np.array([0.5, 0.5])
     pi, pj = candidate_pairs(pos, radius, 0.01)
     wp, ww = wall_candidates(pos, radius, wall_point, wall_normal, 0.01)
-    c = detect(pos, np.zeros(2), radius, np.zeros(2, int), wall_point, wall_normal, 0.01, pi, pj, wp, ww)
+    c = detect(pos, np.zeros(2), Shapes.regular(radius, np.zeros(2, int)), wall_point, wall_normal, 0.01, pi, pj, wp, ww)
     check_layout(c)
     assert list(zip(c.body_i.tolist(), c.body_j.tolist())) == [(0, 1), (0, 2), (1, 2)]
     assert c.pair.tolist() == [0, 1, 2] and c.n_pairs == 3
@@ -608,7 +609,7 @@ def test_extreme_configurations_stay_finite():
     alert = 0.01
     pi, pj = candidate_pairs(pos, radius, alert)
     wp, ww = wall_candidates(pos, radius, wall_point, wall_normal, alert)
-    c = detect(pos, angle, radius, nvert, wall_point, wall_normal, alert, pi, pj, wp, ww)
+    c = detect(pos, angle, Shapes.regular(radius, nvert), wall_point, wall_normal, alert, pi, pj, wp, ww)
     check_layout(c)
     # the nearest point of each contact is within the alert distance; the second point of a
     # double within max(s0, 0) + alert <= 2 alert
@@ -616,3 +617,53 @@ def test_extreme_configurations_stay_finite():
     first = np.r_[True, c.pair[1:] != c.pair[:-1]]
     nearest = np.minimum.reduceat(c.gap, np.flatnonzero(first))
     assert np.all(nearest <= alert + 1e-9)
+
+
+def _random_convex(rng, size):
+    """A random convex polygon (4-9 vertices, counter-clockwise) with its centroid at the origin."""
+    from scipy.spatial import ConvexHull
+
+    while True:
+        cloud = rng.normal(size=(rng.integers(5, 12), 2)) * size * rng.uniform(0.5, 1.5, 2)
+        hull = cloud[ConvexHull(cloud).vertices]
+        if len(hull) >= 4:
+            break
+    x, y = hull[:, 0], hull[:, 1]
+    cross = x * np.roll(y, -1) - y * np.roll(x, -1)
+    centroid = np.array([(cross * (x + np.roll(x, -1))).sum(), (cross * (y + np.roll(y, -1))).sum()])
+    return hull - centroid / (3.0 * cross.sum())
+
+
+@pytest.mark.parametrize("seed", [0, 1])
+def test_irregular_polygons_from_the_shape_table_against_numpy_oracle(seed):
+    """The kernels read the shape table's vertex lists of any length: irregular convex polygons
+    give the separating-axis separation of the oracle, which rotates the body-frame vertices itself."""
+    rng = np.random.default_rng(seed)
+    n = 40
+    local = [_random_convex(rng, 0.04) for _ in range(n)]
+    shapes = Shapes.convex(local)
+    pos, angle = rng.uniform(0, 0.8, (n, 2)), rng.uniform(0, 2 * np.pi, n)
+    alert = 0.01
+    pi, pj = candidate_pairs(pos, shapes.radius, alert)
+    c = detect(pos, angle, shapes, *NO_WALLS, alert, pi, pj, [], [])
+    check_layout(c)
+
+    def world(b):
+        rot = np.array([[np.cos(angle[b]), -np.sin(angle[b])], [np.sin(angle[b]), np.cos(angle[b])]])
+        return pos[b] + local[b] @ rot.T
+
+    checked = exact = 0
+    for a, b in zip(pi.tolist(), pj.tolist()):
+        sel = np.flatnonzero((c.body_i == a) & (c.body_j == b))
+        sat = naive.sat_separation(world(a), world(b))
+        assert (sel.size > 0) == (sat <= alert + 1e-13)
+        if sel.size:
+            checked += 1
+            assert c.gap[sel].min() >= sat - 1e-12
+            exact += abs(c.gap[sel].min() - sat) <= 1e-12
+    assert checked >= 10 and exact >= 0.8 * checked, (checked, exact)
+
+
+def test_detect_names_a_missing_shape_table():
+    with pytest.raises(ParameterError, match="Shapes"):
+        detect(np.zeros((2, 2)), np.zeros(2), np.ones(2), *NO_WALLS, 0.0, [0], [1], [], [])

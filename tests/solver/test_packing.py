@@ -12,6 +12,7 @@ from grainview.errors import ParameterError
 from solver.broadphase import candidate_pairs, wall_candidates
 from solver.narrowphase import detect
 from solver.packing import CLEARANCE, box_width_for, deposit, size_classes
+from solver.shapes import Shapes
 
 
 def naive_deposit(class_of, class_radius, width, clearance):
@@ -90,7 +91,7 @@ def test_no_interpenetration_and_inside_the_box(nvert):
     alert = 0.001
     pi, pj = candidate_pairs(pk.pos, pk.radius, alert)
     wp, ww = wall_candidates(pk.pos, pk.radius, wall_point, wall_normal, alert)
-    c = detect(pk.pos, pk.angle, pk.radius, pk.nvert, wall_point, wall_normal, alert, pi, pj, wp, ww)
+    c = detect(pk.pos, pk.angle, Shapes.regular(pk.radius, pk.nvert), wall_point, wall_normal, alert, pi, pj, wp, ww)
     assert c.n_pairs > (n if nvert == 0 else 10)
     assert c.gap.min() >= -1e-12
     if nvert:

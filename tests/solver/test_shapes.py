@@ -89,3 +89,64 @@ def test_invalid_density_and_thickness():
         shapes.mass_and_inertia([1.0], [5], density=-1.0)
     with pytest.raises(ParameterError, match="thickness"):
         shapes.mass_and_inertia([1.0], [5], density=1.0, thickness=0.0)
+
+
+# ---------------------------------------------------------------- the shape table
+
+
+def test_table_reproduces_the_contract_vertices_bit_for_bit():
+    rng = np.random.default_rng(4)
+    radius = rng.uniform(0.01, 0.03, 9)
+    nvert = np.array([5, 0, 3, 5, 6, 0, 4, 5, 3])
+    pos, angle = rng.uniform(-1, 1, (9, 2)), rng.uniform(-7, 7, 9)
+    table = shapes.Shapes.regular(radius, nvert)
+    assert table.first_vertex.tolist() == [0, 5, 5, 8, 13, 19, 19, 23, 28, 31]
+    world = table.world_vertices(pos, angle)
+    assert world.shape == (9, 6, 2)
+    for b in range(9):
+        n = nvert[b]
+        assert np.isnan(world[b, n:]).all()
+        if n:
+            expected = naive.polygon(*pos[b], radius[b], angle[b], n)
+            assert np.array_equal(world[b, :n], expected)
+
+
+@pytest.mark.parametrize("n", [3, 4, 5, 8])
+def test_table_normals_and_inradius_from_the_vertices(n):
+    table = shapes.Shapes.regular([0.02], [n])
+    local = table.local_vertices(0)
+    normals = naive.outward_normals(local)
+    angle = np.arctan2(normals[:, 1], normals[:, 0])
+    np.testing.assert_allclose(np.cos(angle - table.normal_angle), 1.0, atol=1e-15)
+    distance = (normals * local).sum(1)  # every edge line's distance from the centre
+    np.testing.assert_allclose(distance, table.inradius[0], rtol=1e-14)
+
+
+def test_convex_constructor_agrees_with_the_regular_closed_forms():
+    regular = shapes.Shapes.regular([0.7, 1.3, 0.02], [5, 3, 6])
+    general = shapes.Shapes.convex([regular.local_vertices(b) for b in range(3)])
+    for name in ("radius", "inradius", "area", "inertia_per_mass", "vertex_radius"):
+        np.testing.assert_allclose(getattr(general, name), getattr(regular, name), rtol=1e-14, err_msg=name)
+    for name in ("vertex_angle", "normal_angle"):
+        np.testing.assert_allclose(np.cos(getattr(general, name) - getattr(regular, name)), 1.0, atol=1e-15)
+
+
+def test_convex_constructor_on_a_rectangle():
+    # a 2 x 1 rectangle: area 2, I/m = (a^2 + b^2)/12 = 5/12, circumradius sqrt(5)/2, inradius 1/2
+    rect = shapes.Shapes.convex([[[1.0, -0.5], [1.0, 0.5], [-1.0, 0.5], [-1.0, -0.5]]])
+    assert rect.area[0] == pytest.approx(2.0, rel=1e-15)
+    assert rect.inertia_per_mass[0] == pytest.approx(5.0 / 12.0, rel=1e-15)
+    assert rect.radius[0] == pytest.approx(np.sqrt(5) / 2, rel=1e-15)
+    assert rect.inradius[0] == pytest.approx(0.5, rel=1e-15)
+    mass, inertia = rect.mass_and_inertia(density=3.0, thickness=0.5)
+    assert mass[0] == pytest.approx(3.0, rel=1e-15) and inertia[0] == pytest.approx(1.25, rel=1e-15)
+
+
+@pytest.mark.parametrize("vertices, match", [
+    ([[1.0, 0.0], [0.0, 1.0]], "n >= 3"),
+    ([[1.0, -0.5], [-1.0, -0.5], [-1.0, 0.5], [1.0, 0.5]], "counter-clockwise"),
+    ([[2.0, 0.0], [3.0, 0.0], [3.0, 1.0], [2.0, 1.0]], "centroid"),
+])
+def test_convex_constructor_rejects_bad_polygons(vertices, match):
+    with pytest.raises(ParameterError, match=match):
+        shapes.Shapes.convex([vertices])

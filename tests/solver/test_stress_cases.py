@@ -115,6 +115,7 @@ def test_widened_alert_never_makes_far_from_parallel_edges_double():
     """The alert distance of a fast step is widened, the double-contact tolerance is not: two
     pentagon edges 20 degrees apart, 3 mm apart, give a simple contact whatever the alert."""
     from solver import narrowphase
+    from solver.shapes import Shapes
 
     inradius = R * np.cos(np.pi / 5)
     tilt = np.radians(20.0)
@@ -123,13 +124,14 @@ def test_widened_alert_never_makes_far_from_parallel_edges_double():
     position = np.array([[0.0, 0.0], [0.0, 2 * inradius + 3e-3]])
     angle = np.array([np.radians(54.0), ON_EDGE + tilt])
     no_walls = (np.empty((0, 2)), np.empty((0, 2)))
-    wide = narrowphase.detect(position, angle, [R, R], [5, 5], *no_walls, 1e-2, [0], [1], [], [], double_alert=0.5e-3)
+    pair = Shapes.regular([R, R], [5, 5])
+    wide = narrowphase.detect(position, angle, pair, *no_walls, 1e-2, [0], [1], [], [], double_alert=0.5e-3)
     assert wide.kind.tolist() == [1]  # seen (gap 1.1 mm <= 10 mm), simple
     assert wide.gap[0] == pytest.approx(1.097e-3, rel=1e-3)
-    narrow = narrowphase.detect(position, angle, [R, R], [5, 5], *no_walls, 0.5e-3, [0], [1], [], [])
+    narrow = narrowphase.detect(position, angle, pair, *no_walls, 0.5e-3, [0], [1], [], [])
     assert narrow.n_pairs == 0  # the default alert alone does not see it
     # were the double tolerance widened with the alert, the same edges would be double
-    loose = narrowphase.detect(position, angle, [R, R], [5, 5], *no_walls, 1e-2, [0], [1], [], [])
+    loose = narrowphase.detect(position, angle, pair, *no_walls, 1e-2, [0], [1], [], [])
     assert loose.kind.tolist() == [2, 2]
 
 
