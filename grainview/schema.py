@@ -104,6 +104,10 @@ VARIABLES: dict[str, Var] = {
     "step": Var(("time",), "i4", "1", "time-step index of the snapshot", False),
     "nlgs_iterations": Var(("time",), "i4", "1", "NLGS iterations of the last step", False),
     "nlgs_residual": Var(("time",), "f8", "1", "final NLGS residual of the last step", False),
+    "local_law_residual": Var(("time",), "f8", "1", "natural-map residual |F|/|r| of the last step's impulses: "
+                              "zero for every solution of the Signorini-Coulomb laws", False),
+    "unbalanced_force": Var(("time",), "f8", "1", "largest net force on a particle over the mean force of a "
+                            "loaded contact point, last step", False),
     "max_interpenetration": Var(("time",), "f8", "m", "largest interpenetration between bodies", False),
     "kinetic_energy": Var(("time",), "f8", "J", "total kinetic energy", False),
     # written last in each snapshot by SnapshotWriter (the last bytes of a netCDF-3 record)
@@ -114,7 +118,8 @@ REQUIRED = tuple(name for name, var in VARIABLES.items() if var.required)
 CONTACT_VARIABLES = ("i", "j", "kind", "normal", "fn", "ft", "point", "branch")
 OPTIONAL_CONTACT_VARIABLES = ("gap",)
 """Optional variables given per contact, like the required ones, in a snapshot's ``contacts``."""
-DIAGNOSTICS = ("step", "nlgs_iterations", "nlgs_residual", "max_interpenetration", "kinetic_energy")
+DIAGNOSTICS = ("step", "nlgs_iterations", "nlgs_residual", "local_law_residual", "unbalanced_force",
+               "max_interpenetration", "kinetic_energy")
 
 
 def particle_area(radius, n_vertices):

@@ -201,6 +201,8 @@ class Recorder:
             wall_velocity=sim.walls.velocity, normal_impulse=normal_impulse, tangential_impulse=tangential_impulse,
             wall_force=sim.wall_forces(), step=sim.step_index,
             nlgs_iterations=info.iterations if info else 0, nlgs_residual=info.residual if info else 0.0,
+            local_law_residual=info.local_law_residual if info else 0.0,
+            unbalanced_force=info.unbalanced_force if info else 0.0,
             max_interpenetration=info.max_interpenetration if info else 0.0, kinetic_energy=sim.kinetic_energy())
 
     def close(self):

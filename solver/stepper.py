@@ -10,7 +10,8 @@ One step of length h (the theta-scheme, theta = 1/2 by default), each stage a me
 3. ``_free_velocities``: v_free = v- + h M^-1 F_ext (gravity, wall stresses);
 4. ``_contact_problem``: the points' geometry, Delassus data and Signorini shifts as one
    :class:`solver.nlgs.ContactProblem`;
-5. ``nlgs.solve_problem`` for the impulses p and the end-of-step velocities v+;
+5. ``nlgs.solve_problem`` for the impulses p and the end-of-step velocities v+, then the
+   solution's local-law residual and unbalanced force (:mod:`solver.residuals`) for the report;
 6. ``_end_velocities``: walls driven as they are (imposed, fixed, capped);
 7. ``_integrate``: x+ = x- + h [(1 - theta) v- + theta v+], likewise angles and wall
    positions, with the split-impulse removal of remaining overlaps.
@@ -29,7 +30,7 @@ import numpy as np
 
 from grainview.errors import ConvergenceWarning, ParameterError
 
-from . import broadphase, narrowphase, nlgs
+from . import broadphase, narrowphase, nlgs, residuals
 from .contact_points import PairIndex, force_vectors, point_keys
 from .shapes import Shapes
 from .walls import FIXED, STRESS, VELOCITY, Walls
@@ -91,12 +92,21 @@ class Parameters:
 
 @dataclass
 class StepInfo:
+    """What one step reports: the NLGS's sweeps and stopping norms (:mod:`solver.nlgs`),
+    whether it converged, the contact points, the largest overlap (m), and two measures that
+    are zero for every admissible solution (:mod:`solver.residuals`): the local-law
+    (natural-map) residual |F|/|r| of the impulses, and the largest unbalanced force and
+    torque on a particle over the mean impulse of a loaded point."""
+
     iterations: int
     residual: float
     max_residual: float
     converged: bool
     n_points: int
     max_interpenetration: float
+    local_law_residual: float = 0.0
+    unbalanced_force: float = 0.0
+    unbalanced_torque: float = 0.0
 
 
 class Simulation:
@@ -288,6 +298,8 @@ class Simulation:
         self.timings["solve"] += time.perf_counter() - solve_start
         update_start = time.perf_counter()
         converged = self._count_solve(result, len(keys))
+        law = residuals.local_law_residual(problem, pn, pt, vx, vy, om)
+        force, torque = self._unbalanced(problem, pn, pt)
         v_end, om = self._end_velocities(vx, vy, om)
         self._integrate(pts, problem, ra, rb, v_start, omega_start, v_end, om)
         self.points = pts
@@ -298,8 +310,16 @@ class Simulation:
         self.counters["steps"] += 1
         self.timings["update"] += time.perf_counter() - update_start
         overlap = float(max(0.0, -pts.gap.min())) if len(pts.gap) else 0.0
-        self.last = StepInfo(result.iterations, result.residual, result.max_residual, converged, len(keys), overlap)
+        self.last = StepInfo(result.iterations, result.residual, result.max_residual, converged, len(keys), overlap,
+                             law, force, torque)
         return self.last
+
+    def _unbalanced(self, problem, pn, pt):
+        """(force, torque) ratios of :func:`solver.residuals.unbalanced_ratios`, gravity the
+        particles' external impulse h m g."""
+        p = self.parameters
+        external = p.time_step * self.mass[:, None] * np.asarray(p.gravity, dtype=float)
+        return residuals.unbalanced_ratios(problem, pn, pt, external, self.radius)
 
     def _matched_impulses(self, keys):
         """Warm start: the last step's impulses (P, 2) of the same contact points (keys of

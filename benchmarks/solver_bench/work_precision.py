@@ -48,7 +48,7 @@ def _wp_run(base, time_step, tolerance, duration, record_every, max_iterations=5
     per_record = int(round(record_every / time_step))
     lo, hi = sim.walls.box_bounds()
     v0 = float(np.prod(hi - lo))
-    series, acc = [], []
+    series, acc, law, unbalanced = [], [], [], []
     bad = 0
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
@@ -57,6 +57,8 @@ def _wp_run(base, time_step, tolerance, duration, record_every, max_iterations=5
         for k in range(1, steps + 1):
             info = sim.step()
             bad += not info.converged
+            law.append(info.local_law_residual)
+            unbalanced.append(info.unbalanced_force)
             if k == 1:
                 first = sim.impulse / time_step  # forces of the first step, N
             m0 = time.perf_counter()
@@ -68,7 +70,9 @@ def _wp_run(base, time_step, tolerance, duration, record_every, max_iterations=5
                 acc = []
             elapsed_measure += time.perf_counter() - m0
         elapsed = time.perf_counter() - start - elapsed_measure
-    return elapsed, np.array(series), _pair_forces(sim), bad, sim.counters["sweeps"] / steps, first
+    measures = dict(law=float(np.median(law)), law90=float(np.percentile(law, 90)),
+                    unbalanced=float(np.median(unbalanced)))
+    return elapsed, np.array(series), _pair_forces(sim), bad, sim.counters["sweeps"] / steps, first, measures
 
 
 def _force_error(forces, reference):
@@ -85,7 +89,7 @@ def _wp_shape(cfg, shape, log):
     record = max(cfg.wp_time_steps)
     ref_tol = 1.7e-4 / 100  # 100x tighter than the default
     ref_dt = min(cfg.wp_time_steps)
-    t_ref, ref_series, ref_forces, ref_bad, ref_sweeps, _ = _wp_run(base, ref_dt, ref_tol, cfg.wp_duration, record,
+    t_ref, ref_series, ref_forces, ref_bad, ref_sweeps, _, _ = _wp_run(base, ref_dt, ref_tol, cfg.wp_duration, record,
                                                                     max_iterations=20_000)
     log(f"work-precision {shape}: reference {t_ref:.1f} s, {ref_sweeps:.0f} sweeps/step, {ref_bad} non-converged")
     # same-state reference per time step: the first step from the base state solved to 1e-10
@@ -102,25 +106,28 @@ def _wp_shape(cfg, shape, log):
     rows, points = [], []
     for dt in cfg.wp_time_steps:
         for tol in cfg.wp_tolerances:
-            elapsed, series, forces, bad, sweeps, first = _wp_run(base, dt, tol, cfg.wp_duration, record)
+            elapsed, series, forces, bad, sweeps, first, m = _wp_run(base, dt, tol, cfg.wp_duration, record)
             e_1, e_f, e_q, e_v = errors(series, forces, first, dt)
             default = dt == 5e-4 and tol == 1.7e-4
-            points.append(dict(dt=dt, tol=tol, budget=None, time=elapsed, e_f=e_f, e_q=e_q, e_v=e_v, e_1=e_1, default=default))
+            points.append(dict(dt=dt, tol=tol, budget=None, time=elapsed, e_f=e_f, e_q=e_q, e_v=e_v, e_1=e_1,
+                               e_law=m["law"], default=default))
             rows.append([f"{dt:g}", f"{tol:g}" + (" (default)" if default else ""), f"{elapsed:.2f}", f"{sweeps:.0f}",
-                         bad, fmt(e_1), fmt(e_f), fmt(e_q), fmt(e_v)])
+                         bad, fmt(m["law"]), fmt(m["law90"]), fmt(m["unbalanced"]), fmt(e_1), fmt(e_f), fmt(e_q),
+                         fmt(e_v)])
             log(rows[-1])
     # fixed budgets: no tolerance (1e-30), every step spends exactly `budget` sweeps
     dt = 5e-4
     for budget in cfg.wp_budgets if dt in cfg.wp_time_steps else ():
-        elapsed, series, forces, _, sweeps, first = _wp_run(base, dt, 1e-30, cfg.wp_duration, record,
-                                                            max_iterations=budget)
+        elapsed, series, forces, _, sweeps, first, m = _wp_run(base, dt, 1e-30, cfg.wp_duration, record,
+                                                               max_iterations=budget)
         e_1, e_f, e_q, e_v = errors(series, forces, first, dt)
         points.append(dict(dt=dt, tol=None, budget=budget, time=elapsed, e_f=e_f, e_q=e_q, e_v=e_v, e_1=e_1,
-                           default=False))
-        rows.append([f"{dt:g}", f"none: {budget} sweeps", f"{elapsed:.2f}", f"{sweeps:.0f}", "-", fmt(e_1), fmt(e_f),
-                     fmt(e_q), fmt(e_v)])
+                           e_law=m["law"], default=False))
+        rows.append([f"{dt:g}", f"none: {budget} sweeps", f"{elapsed:.2f}", f"{sweeps:.0f}", "-", fmt(m["law"]),
+                     fmt(m["law90"]), fmt(m["unbalanced"]), fmt(e_1), fmt(e_f), fmt(e_q), fmt(e_v)])
         log(rows[-1])
     header = ["dt (s)", "tolerance", "run time (s)", "sweeps / step", "non-converged steps",
+              "local-law residual (median)", "local-law residual (90th pct.)", "unbalanced force (median)",
               "force error, same state (rel. L2)", "force error, end of run (rel. L2)", "max |q/p - ref|",
               "max |eps_p - ref|"]
     n = base.n_particles
@@ -132,7 +139,10 @@ def _wp_shape(cfg, shape, log):
             f"'Same state': the forces of the first step from the common starting state against the same step "
             f"solved to tolerance 1e-10 (the solver's own error, free of trajectory divergence). 'End of run': per "
             f"pair forces after {cfg.wp_duration:g} s against the reference run's. q/p averaged over "
-            f"{record * 1e3:g} ms windows (wall stresses chatter from step to step), compared every {record * 1e3:g} ms.\n\n")
+            f"{record * 1e3:g} ms windows (wall stresses chatter from step to step), compared every {record * 1e3:g} ms. "
+            f"Local-law residual: |F|/|r| of the natural map over each step's points, zero for every admissible "
+            f"solution (solver.residuals); unbalanced force: the largest net force on a particle over the mean "
+            f"force of a loaded point (zero in static equilibrium whatever network carries the load).\n\n")
     return text + markdown_table(header, rows), points
 
 
@@ -142,11 +152,11 @@ def _wp_plot(all_points, path):
     import matplotlib.pyplot as plt
     import matplotlib.ticker
 
-    fig, axes = plt.subplots(1, 4, figsize=(17, 4))
+    fig, axes = plt.subplots(1, 5, figsize=(21, 4))
     for (shape, points), colour in zip(all_points.items(), ("C0", "C1")):
         for dt, marker in zip(sorted({p["dt"] for p in points}), ("o", "s", "^", "v")):
             sel = [p for p in points if p["dt"] == dt and p["budget"] is None]
-            for ax, key in zip(axes, ("e_1", "e_f", "e_q", "e_v")):
+            for ax, key in zip(axes, ("e_law", "e_1", "e_f", "e_q", "e_v")):
                 ax.loglog([max(p[key], 1e-12) for p in sel], [p["time"] for p in sel], marker=marker, color=colour,
                           label=f"{shape}, dt={dt:g}")
                 for p in sel:
@@ -154,10 +164,11 @@ def _wp_plot(all_points, path):
                         ax.plot(max(p[key], 1e-12), p["time"], "*", ms=18, color="red", mfc="none")
         fixed = [p for p in points if p["budget"] is not None]
         if fixed:
-            for ax, key in zip(axes, ("e_1", "e_f", "e_q", "e_v")):
+            for ax, key in zip(axes, ("e_law", "e_1", "e_f", "e_q", "e_v")):
                 ax.loglog([max(p[key], 1e-12) for p in fixed], [p["time"] for p in fixed], "x--", color=colour,
                           label=f"{shape}, dt=5e-4, fixed sweeps {fixed[0]['budget']}..{fixed[-1]['budget']}")
-    for ax, title in zip(axes, ("forces, same state (rel. L2)", "forces, end of run (rel. L2)", "max |q/p - ref|",
+    for ax, title in zip(axes, ("local-law residual |F|/|r| (median)", "forces, same state (rel. L2)",
+                                "forces, end of run (rel. L2)", "max |q/p - ref|",
                                 "max |eps_p - ref|")):
         ax.xaxis.set_minor_formatter(matplotlib.ticker.NullFormatter())  # decades only: minor labels collide
         ax.set_xlabel(f"error: {title}")
@@ -185,7 +196,8 @@ def section_work_precision(cfg: Config, log=print):
             continue
         d = d[0]
         same_dt = sorted([p for p in points if p["dt"] == 5e-4 and p["budget"] is None], key=lambda p: p["tol"])
-        verdict.append(f"- {shape}s: defaults cost {d['time']:.2f} s for a same-state force error {fmt(d['e_1'])}, "
+        verdict.append(f"- {shape}s: defaults cost {d['time']:.2f} s for a local-law residual {fmt(d['e_law'])} "
+                       f"and a same-state force error {fmt(d['e_1'])}, "
                        f"end-of-run force error {fmt(d['e_f'])}, q/p error {fmt(d['e_q'])}, eps_p error {fmt(d['e_v'])}; "
                        f"at dt = 5e-4 the tolerances from {same_dt[-1]['tol']:g} to {same_dt[0]['tol']:g} cost "
                        f"{same_dt[-1]['time']:.2f} .. {same_dt[0]['time']:.2f} s for same-state force errors "

@@ -1,0 +1,128 @@
+"""How well a step's impulses satisfy the contact laws and the particles' balance.
+
+The NLGS stops on the change of the impulses between two sweeps (:mod:`solver.nlgs`). That
+says when the iterations have stalled, not how far the impulses are from *a* solution; and
+the distance to one particular solution (the "same-state force error") is no measure either,
+since a hyperstatic packing admits many force networks. Two measures are zero for every
+admissible solution and for nothing else:
+
+**Local-law residual** (the natural map, as FCLIB defines it for frictional contact). For
+point k with impulse r = (r_n, r_t) (N s), relative velocity u = (u_n, u_t) (m s-1) at the end
+of the step and Signorini shift b_k (:mod:`solver.nlgs`), De Saxcé's modified velocity
+u^ = (u_n + b_k + mu |u_t|, u_t) turns Signorini and Coulomb together into one cone
+complementarity, K* ∋ u^ ⊥ r ∈ K, with K = {|r_t| <= mu r_n} the Coulomb cone. It holds if and
+only if
+
+    F_k = r - proj_K(r - rho_k u^) = 0,        rho_k = 1 / W_nn,k  (kg),
+
+W_nn,k the normal entry of the point's Delassus block; rho_k makes both terms impulses. The
+step's residual is ``|F| / |r|`` summed in squares over the points (0 with no impulse and no
+violation). Projection onto the 2D cone: z itself when |z_t| <= mu z_n; 0 when
+z_n <= -mu |z_t| (the polar cone); else onto the nearer edge, d (1, mu sign z_t) with
+d = (z_n + mu |z_t|) / (1 + mu^2).
+
+**Unbalanced force** (the quasi-static measure of DEM codes). The contact impulses on
+particle i plus its external impulse h m_i g give its momentum change over the step; the
+largest of their norms over the particles, divided by the mean impulse of a loaded point, is
+the step's unbalanced-force ratio (and likewise the torque over the mean impulse times the
+particle's circumscribed radius). It is zero in static equilibrium, whatever network carries
+the load, and measures how far from equilibrium a packing is, not the solver's error alone.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numba import njit
+
+from .nlgs import delassus
+
+__all__ = ["cone_projection", "local_law_residuals", "particle_imbalance", "local_law_residual",
+           "unbalanced_ratios"]
+
+
+@njit(cache=True)
+def cone_projection(zn, zt, mu):
+    """Euclidean projection of (zn, zt) onto the 2D Coulomb cone {|t| <= mu n}."""
+    at = abs(zt)
+    if zn >= 0.0 and at <= mu * zn:
+        return zn, zt
+    if mu * at <= -zn:
+        return 0.0, 0.0
+    d = (zn + mu * at) / (1.0 + mu * mu)
+    return d, (mu * d if zt >= 0.0 else -mu * d)
+
+
+@njit(cache=True)
+def local_law_residuals(a, b, nx, ny, rax, ray, rbx, rby, bias, mu, pn, pt, vx, vy, w, wnn):
+    """Natural-map residual (F_n, F_t) (N s) of every point (module docstring), from the
+    impulses ``pn, pt`` and the end-of-step body velocities ``vx, vy, w`` of the contact problem."""
+    m = a.size
+    fn = np.empty(m)
+    ft = np.empty(m)
+    for k in range(m):
+        ubx = vx[b[k]] - w[b[k]] * rby[k]
+        uby = vy[b[k]] + w[b[k]] * rbx[k]
+        uax = vx[a[k]] - w[a[k]] * ray[k]
+        uay = vy[a[k]] + w[a[k]] * rax[k]
+        dx, dy = ubx - uax, uby - uay
+        un = dx * nx[k] + dy * ny[k] + bias[k]
+        ut = -dx * ny[k] + dy * nx[k]
+        rho = 1.0 / wnn[k]
+        zn = pn[k] - rho * (un + mu[k] * abs(ut))
+        zt = pt[k] - rho * ut
+        qn, qt = cone_projection(zn, zt, mu[k])
+        fn[k] = pn[k] - qn
+        ft[k] = pt[k] - qt
+    return fn, ft
+
+
+@njit(cache=True)
+def particle_imbalance(a, b, nx, ny, rax, ray, rbx, rby, pn, pt, n_particles):
+    """Sum of the contact impulses (x, y; N s) and of their moments (N m s) on each particle."""
+    fx = np.zeros(n_particles)
+    fy = np.zeros(n_particles)
+    torque = np.zeros(n_particles)
+    for k in range(a.size):
+        px = pn[k] * nx[k] - pt[k] * ny[k]
+        py = pn[k] * ny[k] + pt[k] * nx[k]
+        if b[k] < n_particles:
+            fx[b[k]] += px
+            fy[b[k]] += py
+            torque[b[k]] += rbx[k] * py - rby[k] * px
+        if a[k] < n_particles:
+            fx[a[k]] -= px
+            fy[a[k]] -= py
+            torque[a[k]] -= rax[k] * py - ray[k] * px
+    return fx, fy, torque
+
+
+def local_law_residual(problem, pn, pt, vx, vy, w) -> float:
+    """The step's local-law residual |F| / |r| (module docstring) for a
+    :class:`solver.nlgs.ContactProblem` and its impulses and end velocities; 0 for no points."""
+    if problem.a.size == 0:
+        return 0.0
+    wnn = delassus(problem.a, problem.b, problem.nx, problem.ny, problem.rax, problem.ray, problem.rbx,
+                   problem.rby, problem.minv_xx, problem.minv_xy, problem.minv_yy, problem.iinv)[0]
+    fn, ft = local_law_residuals(problem.a, problem.b, problem.nx, problem.ny, problem.rax, problem.ray,
+                                 problem.rbx, problem.rby, problem.bias, problem.mu, pn, pt, vx, vy, w, wnn)
+    violation = float(np.sqrt(np.sum(fn * fn + ft * ft)))
+    scale = float(np.sqrt(np.sum(pn * pn + pt * pt)))
+    if scale > 0.0:
+        return violation / scale
+    return 0.0 if violation == 0.0 else float("inf")
+
+
+def unbalanced_ratios(problem, pn, pt, external_impulse, radius) -> tuple[float, float]:
+    """(force ratio, torque ratio) of the module docstring: the largest |sum of contact impulses
+    + external impulse| over the particles (``external_impulse`` (N, 2) N s, e.g. h m g) and the
+    largest |sum of contact moments| / R_i, both over the mean |r| of the loaded points. (0, 0)
+    when no point is loaded."""
+    n = len(radius)
+    loaded = pn > 0.0
+    if not loaded.any():
+        return 0.0, 0.0
+    mean = float(np.mean(np.hypot(pn[loaded], pt[loaded])))
+    fx, fy, torque = particle_imbalance(problem.a, problem.b, problem.nx, problem.ny, problem.rax, problem.ray,
+                                        problem.rbx, problem.rby, pn, pt, n)
+    force = np.hypot(fx + external_impulse[:, 0], fy + external_impulse[:, 1])
+    return float(force.max() / mean), float(np.max(np.abs(torque) / radius) / mean)
