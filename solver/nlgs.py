@@ -241,3 +241,64 @@ def solve_problem(problem: ContactProblem, pn, pt, vx, vy, w, *, tolerance, max_
         problem.bias, problem.mu, pn, pt, vx, vy, w, problem.minv_xx, problem.minv_xy, problem.minv_yy,
         problem.iinv, tolerance, max_tolerance, int(max_iterations), bool(shuffle), int(seed))
     return NLGSResult(int(iterations), float(residual), float(worst))
+
+
+@njit(cache=True)
+def solve_matrix(indptr, indices, data, q, mu, rn, rt, tol, max_tol, max_iterations):
+    """NLGS on a frictional contact problem given by its matrix: u = W r + q with W (2n x 2n,
+    CSR ``indptr, indices, data``), rows 2k and 2k+1 the normal and tangential velocity of
+    point k. Each point solves :func:`local_solve` (no Signorini shift: it is in q) with the
+    others frozen, reading its velocity from its two rows; the stopping norms are those of
+    :func:`solve` with W_k the diagonal 2x2 block. ``rn, rt`` (n,) hold the initial impulses
+    and are updated in place. Returns (iterations, quadratic norm, max norm)."""
+    n = mu.size
+    wnn = np.zeros(n)
+    wnt = np.zeros(n)
+    wtt = np.zeros(n)
+    for k in range(n):
+        for e in range(indptr[2 * k], indptr[2 * k + 1]):
+            if indices[e] == 2 * k:
+                wnn[k] += data[e]
+            elif indices[e] == 2 * k + 1:
+                wnt[k] += data[e]
+        for e in range(indptr[2 * k + 1], indptr[2 * k + 2]):
+            if indices[e] == 2 * k + 1:
+                wtt[k] += data[e]
+    quad = 0.0
+    worst = 0.0
+    for it in range(1, max_iterations + 1):
+        sum_dv2 = 0.0
+        max_dv2 = 0.0
+        for k in range(n):
+            un = q[2 * k]
+            for e in range(indptr[2 * k], indptr[2 * k + 1]):
+                c = indices[e]
+                un += data[e] * (rn[c // 2] if c % 2 == 0 else rt[c // 2])
+            ut = q[2 * k + 1]
+            for e in range(indptr[2 * k + 1], indptr[2 * k + 2]):
+                c = indices[e]
+                ut += data[e] * (rn[c // 2] if c % 2 == 0 else rt[c // 2])
+            ufn = un - wnn[k] * rn[k] - wnt[k] * rt[k]
+            uft = ut - wnt[k] * rn[k] - wtt[k] * rt[k]
+            new_n, new_t = local_solve(ufn, uft, 0.0, wnn[k], wnt[k], wtt[k], mu[k])
+            dpn, dpt = new_n - rn[k], new_t - rt[k]
+            dv2 = dpn * (wnn[k] * dpn + wnt[k] * dpt) + dpt * (wnt[k] * dpn + wtt[k] * dpt)
+            sum_dv2 += dv2
+            if dv2 > max_dv2:
+                max_dv2 = dv2
+            rn[k], rt[k] = new_n, new_t
+        scale = 0.0
+        n_active = 0
+        for k in range(n):
+            if rn[k] > 0.0:
+                n_active += 1
+                scale += rn[k] * (wnn[k] * rn[k] + wnt[k] * rt[k]) + rt[k] * (wnt[k] * rn[k] + wtt[k] * rt[k])
+        if scale > 0.0:
+            quad = np.sqrt(sum_dv2 / scale)
+            worst = np.sqrt(max_dv2 / (scale / n_active))
+        else:
+            quad = 0.0 if sum_dv2 == 0.0 else np.inf
+            worst = quad
+        if quad <= tol and worst <= max_tol:
+            return it, quad, worst
+    return max_iterations, quad, worst

@@ -36,8 +36,8 @@ from numba import njit
 
 from .nlgs import delassus
 
-__all__ = ["cone_projection", "local_law_residuals", "particle_imbalance", "local_law_residual",
-           "unbalanced_ratios"]
+__all__ = ["cone_projection", "natural_map", "natural_maps", "local_law_residuals", "particle_imbalance",
+           "local_law_residual", "unbalanced_ratios"]
 
 
 @njit(cache=True)
@@ -50,6 +50,26 @@ def cone_projection(zn, zt, mu):
         return 0.0, 0.0
     d = (zn + mu * at) / (1.0 + mu * mu)
     return d, (mu * d if zt >= 0.0 else -mu * d)
+
+
+@njit(cache=True)
+def natural_map(pn, pt, un, ut, mu, rho):
+    """F = r - proj_K(r - rho u^) of one point (module docstring): r = (pn, pt) N s, u = (un, ut)
+    the velocity with its Signorini shift included (m s-1), rho kg."""
+    zn = pn - rho * (un + mu * abs(ut))
+    zt = pt - rho * ut
+    qn, qt = cone_projection(zn, zt, mu)
+    return pn - qn, pt - qt
+
+
+@njit(cache=True)
+def natural_maps(pn, pt, un, ut, mu, rho):
+    """:func:`natural_map` of every point: arrays (P,) in, (F_n, F_t) (P,) out."""
+    fn = np.empty(pn.size)
+    ft = np.empty(pn.size)
+    for k in range(pn.size):
+        fn[k], ft[k] = natural_map(pn[k], pt[k], un[k], ut[k], mu[k], rho[k])
+    return fn, ft
 
 
 @njit(cache=True)
@@ -67,12 +87,7 @@ def local_law_residuals(a, b, nx, ny, rax, ray, rbx, rby, bias, mu, pn, pt, vx, 
         dx, dy = ubx - uax, uby - uay
         un = dx * nx[k] + dy * ny[k] + bias[k]
         ut = -dx * ny[k] + dy * nx[k]
-        rho = 1.0 / wnn[k]
-        zn = pn[k] - rho * (un + mu[k] * abs(ut))
-        zt = pt[k] - rho * ut
-        qn, qt = cone_projection(zn, zt, mu[k])
-        fn[k] = pn[k] - qn
-        ft[k] = pt[k] - qt
+        fn[k], ft[k] = natural_map(pn[k], pt[k], un, ut, mu[k], 1.0 / wnn[k])
     return fn, ft
 
 

@@ -547,7 +547,8 @@ def test_walls_and_pairs_together_are_numbered_in_order():
     radius = np.array([0.5, 0.5])
     pi, pj = candidate_pairs(pos, radius, 0.01)
     wp, ww = wall_candidates(pos, radius, wall_point, wall_normal, 0.01)
-    c = detect(pos, np.zeros(2), Shapes.regular(radius, np.zeros(2, int)), wall_point, wall_normal, 0.01, pi, pj, wp, ww)
+    disks = Shapes.regular(radius, np.zeros(2, int))
+    c = detect(pos, np.zeros(2), disks, wall_point, wall_normal, 0.01, pi, pj, wp, ww)
     check_layout(c)
     assert list(zip(c.body_i.tolist(), c.body_j.tolist())) == [(0, 1), (0, 2), (1, 2)]
     assert c.pair.tolist() == [0, 1, 2] and c.n_pairs == 3
