@@ -188,8 +188,8 @@ def solve(a, b, nx, ny, rax, ray, rbx, rby, bias, mu, pn, pt, vx, vy, w,
     """
     m = a.size
     wnn, wnt, wtt = delassus(a, b, nx, ny, rax, ray, rbx, rby, minv_xx, minv_xy, minv_yy, iinv)
-    for k in range(m):  # velocities consistent with the warm-start impulses
-        _apply(k, pn[k], pt[k], a, b, nx, ny, rax, ray, rbx, rby, vx, vy, w, minv_xx, minv_xy, minv_yy, iinv)
+    # velocities consistent with the warm-start impulses
+    velocities_from_impulses(a, b, nx, ny, rax, ray, rbx, rby, pn, pt, vx, vy, w, minv_xx, minv_xy, minv_yy, iinv)
     order = np.arange(m)
     state = np.uint64(seed) * np.uint64(0x9E3779B97F4A7C15) + np.uint64(1)  # never 0
     quad = 0.0
@@ -197,37 +197,60 @@ def solve(a, b, nx, ny, rax, ray, rbx, rby, bias, mu, pn, pt, vx, vy, w,
     for it in range(1, max_iterations + 1):
         if shuffle:
             state = _shuffle(order, state)
-        sum_dv2 = 0.0
-        max_dv2 = 0.0
-        for q in range(m):
-            k = order[q]
-            un, ut = _relative_velocity(k, a, b, nx, ny, rax, ray, rbx, rby, vx, vy, w)
-            ufn = un - wnn[k] * pn[k] - wnt[k] * pt[k]
-            uft = ut - wnt[k] * pn[k] - wtt[k] * pt[k]
-            new_n, new_t = local_solve(ufn, uft, bias[k], wnn[k], wnt[k], wtt[k], mu[k])
-            dpn, dpt = new_n - pn[k], new_t - pt[k]
-            if dpn != 0.0 or dpt != 0.0:
-                _apply(k, dpn, dpt, a, b, nx, ny, rax, ray, rbx, rby, vx, vy, w, minv_xx, minv_xy, minv_yy, iinv)
-                dv2 = dpn * (wnn[k] * dpn + wnt[k] * dpt) + dpt * (wnt[k] * dpn + wtt[k] * dpt)
-                sum_dv2 += dv2
-                if dv2 > max_dv2:
-                    max_dv2 = dv2
-            pn[k], pt[k] = new_n, new_t
-        scale = 0.0
-        n_active = 0
-        for k in range(m):
-            if pn[k] > 0.0:
-                n_active += 1
-                scale += pn[k] * (wnn[k] * pn[k] + wnt[k] * pt[k]) + pt[k] * (wnt[k] * pn[k] + wtt[k] * pt[k])
-        if scale > 0.0:
-            quad = np.sqrt(sum_dv2 / scale)
-            worst = np.sqrt(max_dv2 / (scale / n_active))
-        else:
-            quad = 0.0 if sum_dv2 == 0.0 else np.inf
-            worst = quad
+        sum_dv2, max_dv2 = sweep(order, a, b, nx, ny, rax, ray, rbx, rby, bias, mu, pn, pt, vx, vy, w,
+                                 minv_xx, minv_xy, minv_yy, iinv, wnn, wnt, wtt)
+        quad, worst = norms(sum_dv2, max_dv2, pn, pt, wnn, wnt, wtt)
         if quad <= tol and worst <= max_tol:
             return it, quad, worst
     return max_iterations, quad, worst
+
+
+@njit(cache=True)
+def sweep(order, a, b, nx, ny, rax, ray, rbx, rby, bias, mu, pn, pt, vx, vy, w,
+          minv_xx, minv_xy, minv_yy, iinv, wnn, wnt, wtt):
+    """One Gauss–Seidel sweep over the points in ``order``: each solves its local problem with
+    the others frozen and applies its impulse change to the bodies at once. Returns the sum and
+    the largest of dV_k^2 = dp_k . W_k dp_k over the sweep (module docstring)."""
+    sum_dv2 = 0.0
+    max_dv2 = 0.0
+    for q in range(order.size):
+        k = order[q]
+        un, ut = _relative_velocity(k, a, b, nx, ny, rax, ray, rbx, rby, vx, vy, w)
+        ufn = un - wnn[k] * pn[k] - wnt[k] * pt[k]
+        uft = ut - wnt[k] * pn[k] - wtt[k] * pt[k]
+        new_n, new_t = local_solve(ufn, uft, bias[k], wnn[k], wnt[k], wtt[k], mu[k])
+        dpn, dpt = new_n - pn[k], new_t - pt[k]
+        if dpn != 0.0 or dpt != 0.0:
+            _apply(k, dpn, dpt, a, b, nx, ny, rax, ray, rbx, rby, vx, vy, w, minv_xx, minv_xy, minv_yy, iinv)
+            dv2 = dpn * (wnn[k] * dpn + wnt[k] * dpt) + dpt * (wnt[k] * dpn + wtt[k] * dpt)
+            sum_dv2 += dv2
+            if dv2 > max_dv2:
+                max_dv2 = dv2
+        pn[k], pt[k] = new_n, new_t
+    return sum_dv2, max_dv2
+
+
+@njit(cache=True)
+def norms(sum_dv2, max_dv2, pn, pt, wnn, wnt, wtt):
+    """The quadratic and max norms of a sweep (module docstring) from its sum and largest dV^2."""
+    scale = 0.0
+    n_active = 0
+    for k in range(pn.size):
+        if pn[k] > 0.0:
+            n_active += 1
+            scale += pn[k] * (wnn[k] * pn[k] + wnt[k] * pt[k]) + pt[k] * (wnt[k] * pn[k] + wtt[k] * pt[k])
+    if scale > 0.0:
+        return np.sqrt(sum_dv2 / scale), np.sqrt(max_dv2 / (scale / n_active))
+    quad = 0.0 if sum_dv2 == 0.0 else np.inf
+    return quad, quad
+
+
+@njit(cache=True)
+def velocities_from_impulses(a, b, nx, ny, rax, ray, rbx, rby, pn, pt, vx, vy, w, minv_xx, minv_xy, minv_yy, iinv):
+    """Add the impulses (pn, pt) of every point to the body velocities (vx, vy, w) in place:
+    v = v_free + M^-1 H p when called on the free velocities."""
+    for k in range(a.size):
+        _apply(k, pn[k], pt[k], a, b, nx, ny, rax, ray, rbx, rby, vx, vy, w, minv_xx, minv_xy, minv_yy, iinv)
 
 
 def solve_problem(problem: ContactProblem, pn, pt, vx, vy, w, *, tolerance, max_tolerance, max_iterations,
@@ -287,18 +310,7 @@ def solve_matrix(indptr, indices, data, q, mu, rn, rt, tol, max_tol, max_iterati
             if dv2 > max_dv2:
                 max_dv2 = dv2
             rn[k], rt[k] = new_n, new_t
-        scale = 0.0
-        n_active = 0
-        for k in range(n):
-            if rn[k] > 0.0:
-                n_active += 1
-                scale += rn[k] * (wnn[k] * rn[k] + wnt[k] * rt[k]) + rt[k] * (wnt[k] * rn[k] + wtt[k] * rt[k])
-        if scale > 0.0:
-            quad = np.sqrt(sum_dv2 / scale)
-            worst = np.sqrt(max_dv2 / (scale / n_active))
-        else:
-            quad = 0.0 if sum_dv2 == 0.0 else np.inf
-            worst = quad
+        quad, worst = norms(sum_dv2, max_dv2, rn, rt, wnn, wnt, wtt)
         if quad <= tol and worst <= max_tol:
             return it, quad, worst
     return max_iterations, quad, worst

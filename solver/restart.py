@@ -54,11 +54,17 @@ WALL_ATTRIBUTES = ("wall_mode", "wall_stress_Pa", "wall_mass_kg", "wall_max_spee
 BIAXIAL_ATTRIBUTES = ("strain_target", "wall_velocity_m_s", "snapshot_every", "biaxial_steps")
 
 
+LATER_PARAMETERS = ("acceleration", "anderson_memory")
+"""Parameters added after files were first written: absent from a file, they take their default."""
+
+
 def _parameters(attrs, source) -> Parameters:
     """The solver parameters written as global attributes ``solver_<name>``."""
     values = {}
     for field in fields(Parameters):
         key = f"solver_{field.name}"
+        if key not in attrs and field.name in LATER_PARAMETERS:
+            continue  # a file from before the parameter existed ran with its default
         if key not in attrs:
             raise FileFormatError(f"{source}: cannot resume, global attribute {key!r} is missing")
         value = attrs[key]
@@ -68,7 +74,7 @@ def _parameters(attrs, source) -> Parameters:
             value = tuple(float(g) for g in np.atleast_1d(value))
         elif field.name == "shuffle":
             value = bool(value)
-        elif field.name in ("seed", "max_iterations"):
+        elif field.name in ("seed", "max_iterations", "anderson_memory"):
             value = int(value)
         else:
             value = float(value)

@@ -10,7 +10,8 @@ One step of length h (the theta-scheme, theta = 1/2 by default), each stage a me
 3. ``_free_velocities``: v_free = v- + h M^-1 F_ext (gravity, wall stresses);
 4. ``_contact_problem``: the points' geometry, Delassus data and Signorini shifts as one
    :class:`solver.nlgs.ContactProblem`;
-5. ``nlgs.solve_problem`` for the impulses p and the end-of-step velocities v+, then the
+5. ``nlgs.solve_problem`` (or its Anderson-accelerated form, :mod:`solver.acceleration`) for
+   the impulses p and the end-of-step velocities v+, then the
    solution's local-law residual and unbalanced force (:mod:`solver.residuals`) for the report;
 6. ``_end_velocities``: walls driven as they are (imposed, fixed, capped);
 7. ``_integrate``: x+ = x- + h [(1 - theta) v- + theta v+], likewise angles and wall
@@ -30,7 +31,7 @@ import numpy as np
 
 from grainview.errors import ConvergenceWarning, ParameterError
 
-from . import broadphase, narrowphase, nlgs, residuals
+from . import acceleration, broadphase, narrowphase, nlgs, residuals
 from .contact_points import PairIndex, force_vectors, point_keys
 from .shapes import Shapes
 from .walls import FIXED, STRESS, VELOCITY, Walls
@@ -39,6 +40,10 @@ from .walls import FIXED, STRESS, VELOCITY, Walls
 def _cross2(r, normal):
     """(omega x r) . n per unit omega: r_x n_y - r_y n_x, row by row."""
     return r[:, 0] * normal[:, 1] - r[:, 1] * normal[:, 0]
+
+
+ACCELERATIONS = ("off", "anderson")
+"""How the NLGS sweeps are combined: plain (``off``) or Anderson-extrapolated."""
 
 
 @dataclass
@@ -59,6 +64,8 @@ class Parameters:
     skin: float | None = None  # m; default: 10% of the smallest diameter
     shuffle: bool = False  # random NLGS ordering
     seed: int = 0
+    acceleration: str = "off"  # "anderson": Anderson-accelerated sweeps (solver.acceleration); no shuffling then
+    anderson_memory: int = 5  # past sweeps combined by the Anderson extrapolation
     overlap_recovery_speed: float = 1e-3  # m s-1, cap of the split-impulse separation of overlaps
     overlap_recovery_rate: float = 0.2  # fraction of an overlap removed per step, below the cap
     overlap_recovery_threshold: float = 1e-4  # fraction of the smallest diameter: smaller overlaps are left
@@ -76,6 +83,8 @@ class Parameters:
             ("tolerance", self.tolerance > 0, "> 0"),
             ("max_tolerance", self.max_tolerance > 0, "> 0"),
             ("max_iterations", int(self.max_iterations) >= 1, ">= 1"),
+            ("acceleration", self.acceleration in ACCELERATIONS, f"one of {ACCELERATIONS}"),
+            ("anderson_memory", 1 <= int(self.anderson_memory) <= 50, "an integer in 1..50"),
             ("gravity", len(self.gravity) == 2 and np.all(np.isfinite(self.gravity)), "a finite 2-vector in m s-2"),
             ("overlap_recovery_speed", self.overlap_recovery_speed >= 0, ">= 0 m s-1"),
             ("overlap_recovery_rate", 0 <= self.overlap_recovery_rate <= 1, "in [0, 1]"),
@@ -292,9 +301,14 @@ class Simulation:
         vx, vy, om = v_free[:, 0].copy(), v_free[:, 1].copy(), omega_free.copy()
         pn, pt = impulse[:, 0].copy(), impulse[:, 1].copy()
         p = self.parameters
-        result = nlgs.solve_problem(problem, pn, pt, vx, vy, om, tolerance=p.tolerance,
-                                    max_tolerance=p.max_tolerance, max_iterations=p.max_iterations,
-                                    shuffle=p.shuffle, seed=p.seed + self.step_index)
+        if p.acceleration == "anderson":
+            result = acceleration.solve_problem_anderson(problem, pn, pt, vx, vy, om, tolerance=p.tolerance,
+                                                         max_tolerance=p.max_tolerance,
+                                                         max_iterations=p.max_iterations, memory=p.anderson_memory)
+        else:
+            result = nlgs.solve_problem(problem, pn, pt, vx, vy, om, tolerance=p.tolerance,
+                                        max_tolerance=p.max_tolerance, max_iterations=p.max_iterations,
+                                        shuffle=p.shuffle, seed=p.seed + self.step_index)
         self.timings["solve"] += time.perf_counter() - solve_start
         update_start = time.perf_counter()
         converged = self._count_solve(result, len(keys))

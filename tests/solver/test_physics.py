@@ -11,13 +11,15 @@ from solver.shapes import mass_and_inertia
 G = 9.81
 R = 0.0125
 EXACT = dict(tolerance=1e-12, max_tolerance=1e-12, max_iterations=100_000)
+ACCELERATIONS = pytest.mark.parametrize("acceleration", ["off", "anderson"])  # every solver, same answers
 PENTAGON_ON_EDGE = np.radians(-54.0)  # vertices at -54 + 72 k degrees: an edge at the bottom
 
 
-def test_disk_and_pentagon_resting_on_the_floor():
+@ACCELERATIONS
+def test_disk_and_pentagon_resting_on_the_floor(acceleration):
     inradius = R * np.cos(np.pi / 5)
     sim = Simulation([[0.0, R], [0.1, inradius]], [0.0, PENTAGON_ON_EDGE], [R, R], [0, 5],
-                     Walls.floor(), Parameters(gravity=(0, -G), **EXACT))
+                     Walls.floor(), Parameters(gravity=(0, -G), acceleration=acceleration, **EXACT))
     for _ in range(10):
         sim.step()
     weight = sim.mass * G
@@ -35,11 +37,12 @@ def test_disk_and_pentagon_resting_on_the_floor():
     assert np.abs(sim.velocity[:2]).max() < 1e-12
 
 
-def test_column_of_ten_disks_carries_the_weight_above():
+@ACCELERATIONS
+def test_column_of_ten_disks_carries_the_weight_above(acceleration):
     n = 10
     y = R + 2 * R * np.arange(n)
     sim = Simulation(np.stack([np.zeros(n), y], -1), np.zeros(n), np.full(n, R), np.zeros(n),
-                     Walls.floor(), Parameters(gravity=(0, -G), **EXACT))
+                     Walls.floor(), Parameters(gravity=(0, -G), acceleration=acceleration, **EXACT))
     for _ in range(20):
         sim.step()
     pts = sim.points
@@ -54,14 +57,15 @@ def test_column_of_ten_disks_carries_the_weight_above():
         assert force[k] == pytest.approx(above * weight, rel=1e-6)
 
 
+@ACCELERATIONS
 @pytest.mark.parametrize("alpha_deg", [15.0, 30.0])
-def test_pentagon_on_a_tilted_plane(alpha_deg):
+def test_pentagon_on_a_tilted_plane(alpha_deg, acceleration):
     mu = 0.4
     alpha = np.radians(alpha_deg)
     gravity = (G * np.sin(alpha), -G * np.cos(alpha))  # the plane is the floor, gravity tilted
     inradius = R * np.cos(np.pi / 5)
     sim = Simulation([[0.0, inradius]], [PENTAGON_ON_EDGE], [R], [5], Walls.floor(),
-                     Parameters(gravity=gravity, wall_friction=mu, **EXACT))
+                     Parameters(gravity=gravity, wall_friction=mu, acceleration=acceleration, **EXACT))
     h = sim.parameters.time_step
     for _ in range(5):
         sim.step()
