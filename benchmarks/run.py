@@ -30,10 +30,11 @@ import analysis  # noqa: E402
 import solver_bench as sb  # noqa: E402
 from common import machine_description  # noqa: E402
 
-SECTIONS = ["scaling", "work_precision", "peers", "analysis", "skipping", "stress"]
+SECTIONS = ["scaling", "work_precision", "acceleration", "peers", "analysis", "skipping", "stress"]
 TITLES = {
     "scaling": "a. Scaling: time per step, per particle, per contact point per NLGS sweep, memory",
     "work_precision": "b. Work-precision: run time against error",
+    "acceleration": "b2. Fewer sweeps at equal accuracy: candidates against the NLGS",
     "peers": "c. Peers: pymunk and Box2D on the same settled piles",
     "analysis": "e. Analysis throughput (grainview)",
     "skipping": "d. Skipping what a scene does not need",

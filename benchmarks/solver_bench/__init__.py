@@ -1,5 +1,5 @@
-"""Solver benchmarks, one module per section (scaling, work_precision, peer_engines, skipping,
-stress), with their sizes in config.py and shared helpers in helpers.py.
+"""Solver benchmarks, one module per section (scaling, work_precision, acceleration,
+peer_engines, skipping, stress), with their sizes in config.py and shared helpers in helpers.py.
 
 Each ``section_*`` function runs one section and returns Markdown (text and tables) for
 ``benchmarks/RESULTS.md``; ``benchmarks/run.py`` calls them in turn. Sizes come from a
@@ -19,6 +19,7 @@ import sys
 sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))  # benchmarks/: common.py
 sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__)))))  # the repository
 
+from .acceleration import section_acceleration  # noqa: E402
 from .config import Config  # noqa: E402
 from .peer_engines import section_peers  # noqa: E402
 from .scaling import section_scaling  # noqa: E402
@@ -26,5 +27,5 @@ from .skipping import section_skipping  # noqa: E402
 from .stress import section_stress  # noqa: E402
 from .work_precision import section_work_precision  # noqa: E402
 
-__all__ = ["Config", "section_scaling", "section_work_precision", "section_peers", "section_skipping",
-           "section_stress"]
+__all__ = ["Config", "section_scaling", "section_work_precision", "section_acceleration", "section_peers",
+           "section_skipping", "section_stress"]

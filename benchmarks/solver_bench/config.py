@@ -41,6 +41,11 @@ class Config:
     skip_steps: int = 40
     # stress
     stress_scale: int = 1
+    # acceleration: candidates against the NLGS on one dense sheared state
+    acc_particles: int = 1000
+    acc_strain: float = 0.08
+    acc_steps: int = 1000
+    acc_compaction_steps: int = 400
 
     def __post_init__(self):
         if self.quick:
@@ -58,6 +63,8 @@ class Config:
             self.peer_steps = 20
             self.peer_budgets = (10,)
             self.skip_particles = 200
+            self.acc_particles = 80
+            self.acc_steps = 20
             self.skip_steps = 10
             self.stress_scale = 0
         else:
