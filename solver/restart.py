@@ -54,8 +54,9 @@ WALL_ATTRIBUTES = ("wall_mode", "wall_stress_Pa", "wall_mass_kg", "wall_max_spee
 BIAXIAL_ATTRIBUTES = ("strain_target", "wall_velocity_m_s", "snapshot_every", "biaxial_steps")
 
 
-LATER_PARAMETERS = ("acceleration", "anderson_memory")
-"""Parameters added after files were first written: absent from a file, they take their default."""
+LATER_PARAMETERS = {"acceleration": "off", "anderson_memory": 5}
+"""Parameters added after files were first written, with the value every older file ran with
+(not the current default, which may change): absent from a file, they take that value."""
 
 
 def _parameters(attrs, source) -> Parameters:
@@ -64,7 +65,8 @@ def _parameters(attrs, source) -> Parameters:
     for field in fields(Parameters):
         key = f"solver_{field.name}"
         if key not in attrs and field.name in LATER_PARAMETERS:
-            continue  # a file from before the parameter existed ran with its default
+            values[field.name] = LATER_PARAMETERS[field.name]  # a file from before the parameter existed
+            continue
         if key not in attrs:
             raise FileFormatError(f"{source}: cannot resume, global attribute {key!r} is missing")
         value = attrs[key]

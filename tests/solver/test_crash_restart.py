@@ -300,3 +300,24 @@ def test_a_run_killed_while_creating_its_file_leaves_no_partial_file(tmp_path):
     assert not path.exists()
     leftovers = [p.name for p in tmp_path.iterdir()]  # only the hidden temporary file
     assert len(leftovers) == 1 and leftovers[0].startswith(".new.nc.") and leftovers[0].endswith(".part")
+
+
+@pytest.mark.parametrize("method", ["off", "anderson"])
+def test_the_sweep_method_is_recorded_and_older_files_load_with_plain_sweeps(tmp_path, method):
+    from solver import load_sample
+
+    sim = compaction_sample(20, "disk", seed=1, acceleration=method, anderson_memory=4)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        for _ in range(5):
+            sim.step()
+    path = tmp_path / "sample.nc"
+    with Recorder(str(path), sim, attrs={"scene": "isotropic"}) as rec:
+        rec.write()
+    loaded = load_sample(path)
+    assert loaded.parameters.acceleration == method and loaded.parameters.anderson_memory == 4
+    with netCDF4.Dataset(path, "a") as nc:  # a file written before the parameters existed
+        nc.delncattr("solver_acceleration")
+        nc.delncattr("solver_anderson_memory")
+    older = load_sample(path)
+    assert older.parameters.acceleration == "off" and older.parameters.anderson_memory == 5
