@@ -75,7 +75,8 @@ def _solver_parameters(args) -> dict:
     """The :class:`solver.Parameters` the command line sets (the others keep their defaults)."""
     from solver import Parameters
 
-    given = {"wall_friction": args.wall_friction, "time_step": args.time_step, "tolerance": args.tolerance}
+    given = {"wall_friction": args.wall_friction, "time_step": args.time_step, "tolerance": args.tolerance,
+             "acceleration": args.acceleration}
     parameters = {k: v for k, v in given.items() if v is not None}
     Parameters(**parameters).validate()  # one clear line before anything is simulated
     return parameters
@@ -227,6 +228,9 @@ def build_parser() -> argparse.ArgumentParser:
         physics.add_argument("--tolerance", type=float, default=None,
                              help="NLGS tolerance, quadratic norm of the velocity changes over a sweep "
                              "(default 1.7e-4; docs/solver.md)")
+        physics.add_argument("--acceleration", choices=("off", "anderson"), default=None,
+                             help="'anderson': Anderson-accelerated NLGS sweeps, same accuracy in 1.7-2.6x less "
+                             "solve time on dense sheared samples (default off; docs/solver.md)")
         prep = p.add_argument_group("sample preparation (docs/fidelity.md)")
         prep.add_argument("--preparation", choices=preset_names(), default="paper",
                           help="named preparation (default paper: compaction with friction 0.4, walls closing "

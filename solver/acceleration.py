@@ -27,6 +27,7 @@ import numpy as np
 from numba import njit
 
 from .nlgs import NLGSResult, delassus, norms, sweep, velocities_from_impulses
+from .residuals import cone_projection
 
 __all__ = ["solve_anderson", "solve_problem_anderson"]
 
@@ -62,17 +63,6 @@ def _small_solve(matrix, rhs, size):
             acc -= a[row, j] * x[j]
         x[row] = acc / a[row, row]
     return x, True
-
-
-@njit(cache=True)
-def _project_onto_cone(zn, zt, mu):
-    at = abs(zt)
-    if zn >= 0.0 and at <= mu * zn:
-        return zn, zt
-    if mu * at <= -zn:
-        return 0.0, 0.0
-    d = (zn + mu * at) / (1.0 + mu * mu)
-    return d, (mu * d if zt >= 0.0 else -mu * d)
 
 
 @njit(cache=True)
@@ -150,7 +140,7 @@ def solve_anderson(a, b, nx, ny, rax, ray, rbx, rby, bias, mu, pn, pt, vx, vy, w
             for j in range(count):
                 en -= d_g[j, i] * gamma[j]
                 et -= d_g[j, m + i] * gamma[j]
-            pn[i], pt[i] = _project_onto_cone(en, et, mu[i])
+            pn[i], pt[i] = cone_projection(en, et, mu[i])
         vx[:] = free_x
         vy[:] = free_y
         w[:] = free_w

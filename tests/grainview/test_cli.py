@@ -48,19 +48,20 @@ def test_harmonic_series_grows_its_anisotropy():
 
 
 def test_physics_options_reach_the_solver_and_act(tmp_path, capsys):
-    """--friction, --wall-friction, --sigma0, --time-step and --tolerance are recorded in the
+    """--friction, --wall-friction, --sigma0, --time-step, --tolerance and --acceleration are recorded in the
     file and obeyed: no contact exceeds its Coulomb cone, some slide on it, and the lateral
     stress is the requested sigma0."""
     path = tmp_path / "run.nc"
     argv = ["run", "--shape", "disk", "--particles", "30", "--strain", "0.01", "--every", "20",
             "--friction", "0.2", "--wall-friction", "0.1", "--sigma0", "5000", "--time-step", "4e-4",
-            "--tolerance", "1e-5", "--out", str(path), "--progress", "off"]
+            "--tolerance", "1e-5", "--acceleration", "anderson", "--out", str(path), "--progress", "off"]
     assert main(argv) == 0
     with grainview.open_dataset(path, chunks=None) as ds:
         attrs = ds.attrs
         assert attrs["solver_friction"] == 0.2 and attrs["preparation_friction"] == 0.2
         assert attrs["solver_wall_friction"] == 0.1
         assert attrs["solver_time_step"] == 4e-4 and attrs["solver_tolerance"] == 1e-5
+        assert attrs["solver_acceleration"] == "anderson"
         assert attrs["sigma0_Pa"] == 5000.0
         used = ds.kind.values > 0
         wall = ds.j.values >= ds.sizes["particle"]
