@@ -113,6 +113,11 @@ class GrainAccessor:
     # contact history (these compute, one time-chunk at a time)
     persistence = _Delegate("persistence")
     type_transitions = _Delegate("persistence")
+    contact_events = _Delegate("lifetimes")
+    lifetime_survival = _Delegate("lifetimes")
+    # one snapshot in other tools' forms
+    contacts_table = _Delegate("tables")
+    contact_graph = _Delegate("tables")
 
     @property
     def plot(self):

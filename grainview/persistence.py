@@ -48,12 +48,14 @@ def time_blocks(ds: xr.Dataset):
         start += size
 
 
-def _blocks(ds, walls, near, start=0):
+def _blocks(ds, walls, near, start=0, force=False):
     """Yield ``(block slice, keys (T, C) int64, present (T, C) bool, kind (T, C))`` per time
-    block from the block holding snapshot ``start`` on; each block is computed on its own."""
+    block from the block holding snapshot ``start`` on, and ``fn (T, C)`` as a fifth item when
+    ``force``; each block is computed on its own."""
     stride = body_count(ds)
     present = selection(ds, walls=walls, near=near)
-    small = xr.Dataset({"i": ds["i"], "j": ds["j"], "kind": ds["kind"], "present": present})
+    small = xr.Dataset({"i": ds["i"], "j": ds["j"], "kind": ds["kind"], "present": present,
+                        **({"fn": ds["fn"]} if force else {})})
     small = small.transpose("time", "contact")
     for block in time_blocks(ds):
         if block.stop <= start:
@@ -61,7 +63,10 @@ def _blocks(ds, walls, near, start=0):
         values = small.isel(time=block).compute()
         present = values["present"].values
         keys = np.where(present, pair_keys(values["i"].values, values["j"].values, stride), -1)
-        yield block, keys, present, values["kind"].values
+        if force:
+            yield block, keys, present, values["kind"].values, values["fn"].values
+        else:
+            yield block, keys, present, values["kind"].values
 
 
 def _check_flag(name, value):

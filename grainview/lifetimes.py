@@ -1,0 +1,195 @@
+"""Contact lifetimes: every contact followed from birth to death, and its survival curve.
+
+A contact is a pair of bodies {i, j} (particle–particle, and particle–wall with ``walls``)
+present in the network (force-bearing, f_n > 0, unless ``near`` adds the pairs within that gap;
+:func:`grainview.contacts.in_network`), identified as in :mod:`grainview.persistence`. A
+*life* is a run of consecutive snapshots b, b+1, ..., d-1 in which the pair is present, with
+the pair absent at d: it is born at t_b and dies at t_d, and its lifetime is
+
+    tau = t_d - t_b                   (s; in strain units eps_q(t_d) - eps_q(t_b)).
+
+Lifetimes are resolved only to the snapshot interval: the contact may have formed any time
+after t_{b-1} and broken any time before t_d. A pair that breaks and forms again has two lives.
+A life still running at the last snapshot is *right-censored* (its lifetime is at least
+t_last - t_b); one already present at the first snapshot is *left-censored* (its birth is
+unknown).
+
+Survival S(tau), the probability that a contact lives longer than tau, is the Kaplan–Meier
+estimate over the lives born within the series (left-censored lives are left out: their
+lifetimes are not measured from birth):
+
+    S(tau) = prod_{u <= tau} (1 - d_u / n_u),
+
+u the distinct observed lifetimes, d_u the lives ending with lifetime u and n_u the lives
+whose observed duration is at least u (deaths and censored alike: "at risk").
+
+Coupling snapshots, these are computed (not lazy), one time-chunk at a time.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import xarray as xr
+
+from ._lift import with_attrs
+from .contacts import check_near, n_particles, near_attr
+from .errors import ParameterError
+from .persistence import _blocks, _check_flag, body_count
+
+__all__ = ["contact_events", "kaplan_meier", "lifetime_survival"]
+
+_FIELDS = ("key", "birth", "kind_at_birth", "last_kind", "switches", "sum_fn", "max_fn", "count")
+
+
+def _empty_open():
+    return {"key": np.empty(0, np.int64), "birth": np.empty(0, np.int64), "kind_at_birth": np.empty(0, np.int8),
+            "last_kind": np.empty(0, np.int8), "switches": np.empty(0, np.int64), "sum_fn": np.empty(0),
+            "max_fn": np.empty(0), "count": np.empty(0, np.int64)}
+
+
+def _take(state, mask):
+    return {name: values[mask] for name, values in state.items()}
+
+
+def _events(ds, walls, near):
+    """The lives of every pair as a dict of arrays (one entry per life), scanning snapshots in
+    order: per snapshot one sort and one ``np.searchsorted`` against the open lives."""
+    open_ = _empty_open()
+    ended = []
+    for block, keys, present, kind, fn in _blocks(ds, walls, near, force=True):
+        for r in range(keys.shape[0]):
+            t = block.start + r
+            k, kd, f = keys[r][present[r]], kind[r][present[r]].astype(np.int8), fn[r][present[r]]
+            k, first = np.unique(k, return_index=True)  # the contract stores a pair once per snapshot
+            kd, f = kd[first], f[first]
+            if open_["key"].size:
+                position = np.minimum(np.searchsorted(open_["key"], k), open_["key"].size - 1)
+                found = open_["key"][position] == k
+            else:
+                position, found = np.zeros(k.size, np.int64), np.zeros(k.size, bool)
+            alive = np.zeros(open_["key"].size, bool)
+            alive[position[found]] = True
+            if (~alive).any():
+                ended.append({**_take(open_, ~alive), "death": np.full((~alive).sum(), t, np.int64)})
+            index = position[found]
+            open_["switches"][index] += open_["last_kind"][index] != kd[found]
+            open_["last_kind"][index] = kd[found]
+            open_["sum_fn"][index] += f[found]
+            open_["max_fn"][index] = np.maximum(open_["max_fn"][index], f[found])
+            open_["count"][index] += 1
+            born = ~found
+            new = {"key": k[born], "birth": np.full(born.sum(), t, np.int64), "kind_at_birth": kd[born],
+                   "last_kind": kd[born], "switches": np.zeros(born.sum(), np.int64), "sum_fn": f[born].astype(float),
+                   "max_fn": f[born].astype(float), "count": np.ones(born.sum(), np.int64)}
+            kept = _take(open_, alive)
+            merged = {name: np.concatenate([kept[name], new[name]]) for name in _FIELDS}
+            order = np.argsort(merged["key"], kind="stable")
+            open_ = _take(merged, order)
+    ended.append({**open_, "death": np.full(open_["key"].size, -1, np.int64)})  # right-censored
+    return {name: np.concatenate([e[name] for e in ended]) for name in (*_FIELDS, "death")}
+
+
+def contact_events(ds: xr.Dataset, walls: bool = True, near=None) -> xr.Dataset:
+    """Every life of every contact (module docstring) along a ``contact_event`` dimension,
+    ordered by birth then pair.
+
+    Variables: ``i``, ``j`` (the pair, i < j; j >= N for a wall), ``birth`` and ``death`` (s;
+    death NaN when right-censored), ``lifetime`` (s: t_death - t_birth, or the observed
+    duration t_last - t_birth when censored), ``censored`` (right), ``left_censored`` (present at
+    the first snapshot), ``kind_at_birth`` (1 simple, 2 double), ``kind_switches`` (simple <->
+    double changes during the life), ``mean_fn`` and ``max_fn`` (N, over the snapshots of the
+    life), and, when the file has its box, ``lifetime_eps_q`` (the shear strain eps_q over the
+    life, 1). Snapshot times must increase. Computed one time-chunk at a time.
+    """
+    _check_flag("walls", walls)
+    check_near(ds, near)
+    times = np.asarray(ds["time"].values, dtype=float)
+    if times.size > 1 and not np.all(np.diff(times) > 0):
+        raise ParameterError("contact_events needs snapshot times that increase; sort the dataset by time first")
+    e = _events(ds, walls, near)
+    stride = body_count(ds)
+    censored = e["death"] < 0
+    last = times.size - 1
+    end_index = np.where(censored, last, e["death"])
+    order = np.lexsort((e["key"], e["birth"]))
+    e = {name: values[order] for name, values in e.items()}
+    censored, end_index = censored[order], end_index[order]
+    birth_t, end_t = times[e["birth"]], times[end_index]
+    dim = "contact_event"
+    out = xr.Dataset({
+        "i": (dim, e["key"] // stride), "j": (dim, e["key"] % stride),
+        "birth": (dim, birth_t), "death": (dim, np.where(censored, np.nan, end_t)),
+        "lifetime": (dim, end_t - birth_t), "censored": (dim, censored),
+        "left_censored": (dim, e["birth"] == 0), "kind_at_birth": (dim, e["kind_at_birth"]),
+        "kind_switches": (dim, e["switches"]),
+        "mean_fn": (dim, e["sum_fn"] / np.maximum(e["count"], 1)), "max_fn": (dim, e["max_fn"]),
+    })
+    if "box_min" in ds and "box_max" in ds:
+        eps_q = np.asarray(ds.grain.strains()["eps_q"].values, dtype=float)
+        out["lifetime_eps_q"] = with_attrs(xr.DataArray(eps_q[end_index] - eps_q[e["birth"]], dims=dim),
+                                           "lifetime_eps_q", "1", "shear strain eps_q over the life")
+    for name, units, long_name in (("birth", "s", "time of the first snapshot of the life"),
+                                   ("death", "s", "time of the first snapshot without the contact"),
+                                   ("lifetime", "s", "lifetime t_death - t_birth (observed duration if censored)"),
+                                   ("mean_fn", "N", "mean normal force over the life"),
+                                   ("max_fn", "N", "largest normal force over the life")):
+        out[name] = with_attrs(out[name], name, units, long_name)
+    out.attrs.update(walls=int(walls), near=near_attr(near), n_particles=n_particles(ds),
+                     comment="lifetimes resolved to the snapshot interval (grainview.lifetimes)")
+    return out
+
+
+def kaplan_meier(durations, observed):
+    """Kaplan–Meier survival: (u, S(u)) at the distinct observed durations u of ``durations``
+    whose ``observed`` flag is True (False = right-censored), S(u) = prod_{v <= u} (1 - d_v/n_v)."""
+    durations = np.asarray(durations, dtype=float)
+    observed = np.asarray(observed, dtype=bool)
+    if durations.shape != observed.shape:
+        raise ParameterError("durations and observed must have the same length")
+    u = np.unique(durations[observed])
+    ordered = np.sort(durations)
+    at_risk = ordered.size - np.searchsorted(ordered, u, side="left")
+    deaths = np.searchsorted(np.sort(durations[observed]), u, side="right") - np.searchsorted(
+        np.sort(durations[observed]), u, side="left")
+    return u, np.cumprod(1.0 - deaths / at_risk)
+
+
+def lifetime_survival(ds: xr.Dataset, walls: bool = True, near=None, by=None, unit: str = "time") -> xr.DataArray:
+    """Survival S(tau) of the contacts' lives (Kaplan–Meier, module docstring), left-censored
+    lives left out, as a step function on the grid of every observed lifetime.
+
+    ``by``: None (all lives), ``"kind"`` (simple / double at birth) or ``"force"`` (strong /
+    weak: mean normal force over the life above or below the mean of all lives); ``unit``:
+    ``"time"`` (tau in s) or ``"strain"`` (tau in eps_q). Returns (group, lifetime).
+    """
+    if by not in (None, "kind", "force"):
+        raise ParameterError(f"by={by!r}: expected None, 'kind' or 'force'")
+    if unit not in ("time", "strain"):
+        raise ParameterError(f"unit={unit!r}: expected 'time' or 'strain'")
+    events = contact_events(ds, walls=walls, near=near)
+    events = events.isel(contact_event=~events["left_censored"].values)
+    column = "lifetime" if unit == "time" else "lifetime_eps_q"
+    if column not in events:
+        raise ParameterError("unit='strain' needs the file's box (box_min, box_max)")
+    tau = events[column].values
+    observed = ~events["censored"].values
+    if by is None:
+        groups = {"all": np.ones(tau.size, bool)}
+    elif by == "kind":
+        groups = {"simple": events["kind_at_birth"].values == 1, "double": events["kind_at_birth"].values == 2}
+    else:
+        mean = float(events["mean_fn"].mean()) if tau.size else np.nan
+        groups = {"strong": events["mean_fn"].values > mean, "weak": events["mean_fn"].values <= mean}
+    grid = np.unique(tau[observed])
+    survival = np.ones((len(groups), grid.size))
+    for row, mask in enumerate(groups.values()):
+        u, s = kaplan_meier(tau[mask], observed[mask])
+        step = np.searchsorted(u, grid, side="right") - 1  # last event time <= tau
+        survival[row] = np.where(step >= 0, s[np.maximum(step, 0)] if s.size else 1.0, 1.0)
+    da = xr.DataArray(survival, dims=("group", "lifetime"),
+                      coords={"group": list(groups), "lifetime": grid,
+                              "lives": ("group", [int(m.sum()) for m in groups.values()])})
+    da["lifetime"].attrs.update(units="s" if unit == "time" else "1",
+                                long_name="lifetime tau" + ("" if unit == "time" else " in shear strain eps_q"))
+    return with_attrs(da, "survival", "1", "Kaplan-Meier survival S(tau) of the contacts' lives",
+                      walls=int(walls), near=near_attr(near), by=str(by), unit=unit)

@@ -1,0 +1,77 @@
+"""One snapshot's contacts in the forms other tools take: a tidy table and a sparse graph.
+
+The contract stores contacts in padded slots (``contact`` dimension, empty slots with kind 0),
+so a plain ``to_dataframe`` holds many empty rows and splits vectors across a ``xy``
+dimension. :func:`contacts_table` gives one row per occupied slot with the vectors as columns;
+:func:`contact_graph` the bodies' adjacency weighted by the normal force, as a
+``scipy.sparse`` matrix (or a networkx graph, when networkx is installed).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import xarray as xr
+
+from .contacts import n_particles, occupied
+from .errors import ParameterError
+from .persistence import body_count
+
+__all__ = ["contacts_table", "contact_graph"]
+
+
+def _snapshot(ds: xr.Dataset, time: int) -> xr.Dataset:
+    n = ds.sizes["time"]
+    if isinstance(time, bool) or not isinstance(time, (int, np.integer)) or not -n <= time < n:
+        raise ParameterError(f"time={time!r}: expected a snapshot index in [{-n}, {n})")
+    snap = ds.isel(time=int(time))
+    return snap.isel(contact=np.flatnonzero(occupied(snap).values))
+
+
+def contacts_table(ds: xr.Dataset, time: int = -1):
+    """A pandas DataFrame of the occupied contact slots of snapshot ``time`` (index; default the
+    last): one row per contact, columns i, j, kind (1 simple, 2 double), wall (j >= N), fn, ft
+    (N), normal_x, normal_y (unit, i -> j), point_x, point_y, branch_x, branch_y (m) and gap (m)
+    where the file has it. Units are in ``df.attrs["units"]``."""
+    snap = _snapshot(ds, time)
+    columns = {"i": snap["i"].values, "j": snap["j"].values, "kind": snap["kind"].values,
+               "wall": snap["j"].values >= n_particles(ds), "fn": snap["fn"].values, "ft": snap["ft"].values}
+    units = {"fn": "N", "ft": "N"}
+    for name in ("normal", "point", "branch"):
+        for axis, label in enumerate(("x", "y")):
+            columns[f"{name}_{label}"] = snap[name].values[:, axis]
+            units[f"{name}_{label}"] = "1" if name == "normal" else "m"
+    if "gap" in snap:
+        columns["gap"] = snap["gap"].values
+        units["gap"] = "m"
+    import pandas as pd
+
+    table = pd.DataFrame(columns)
+    table.attrs.update(units=units, time=float(snap["time"].values))
+    return table
+
+
+def contact_graph(ds: xr.Dataset, time: int = -1, as_networkx: bool = False):
+    """The contact network of snapshot ``time`` as a symmetric (N + W) x (N + W) scipy.sparse
+    CSR matrix of normal forces (N; bodies 0..N-1 particles, then walls), or with
+    ``as_networkx`` a networkx Graph whose edges carry fn, ft and kind. Only contacts with
+    f_n > 0 are edges (the force-bearing network)."""
+    from scipy import sparse
+
+    snap = _snapshot(ds, time)
+    loaded = snap["fn"].values > 0
+    i, j = snap["i"].values[loaded].astype(np.int64), snap["j"].values[loaded].astype(np.int64)
+    fn = snap["fn"].values[loaded]
+    size = body_count(ds)
+    if as_networkx:
+        try:
+            import networkx as nx
+        except ImportError:
+            raise ParameterError("as_networkx=True needs networkx (pip install networkx)") from None
+        graph = nx.Graph()
+        graph.add_nodes_from(range(size))
+        graph.add_edges_from((int(a), int(b), {"fn": float(f), "ft": float(t), "kind": int(k)})
+                             for a, b, f, t, k in zip(i, j, fn, snap["ft"].values[loaded], snap["kind"].values[loaded]))
+        return graph
+    matrix = sparse.coo_matrix((np.concatenate([fn, fn]), (np.concatenate([i, j]), np.concatenate([j, i]))),
+                               shape=(size, size))
+    return matrix.tocsr()

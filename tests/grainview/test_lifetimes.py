@@ -1,0 +1,116 @@
+"""Contact lifetimes and their survival: hand-made series whose lives are known, Kaplan–Meier
+by hand, chunked equal to eager under a scheduler that counts computes."""
+
+import numpy as np
+import pytest
+
+from grainview.errors import ParameterError
+from grainview.lifetimes import contact_events, kaplan_meier, lifetime_survival
+
+from .conftest import raise_if_dask_computes
+from .test_persistence import N, S, D, sequence_dataset
+
+# snapshots at t = 0, 1, 2, 3, 4, 5 (make_dataset's default times are the indices)
+SERIES = [
+    [(0, 1, S, 2.0), (4, N, S, 1.0)],                                   # t0
+    [(0, 1, S, 4.0), (1, 2, S, 1.0), (4, N, S, 1.0)],                   # t1: (1,2) born
+    [(0, 1, D, 6.0), (1, 2, S, 1.0), (2, 3, S, 3.0), (4, N, S, 1.0)],   # t2: (0,1) turns double; (2,3) born
+    [(1, 2, S, 3.0), (2, 3, S, 3.0), (4, N, S, 1.0)],                   # t3: (0,1) dies
+    [(2, 3, D, 3.0), (4, N, S, 1.0)],                                   # t4: (1,2) dies; (2,3) switches
+    [(1, 2, S, 5.0), (2, 3, S, 3.0), (4, N, S, 1.0)],                   # t5: (1,2) reborn; (2,3) switches back
+]
+
+
+def test_lives_by_hand(prepare):
+    ds = prepare(sequence_dataset(SERIES))
+    ev = contact_events(ds)
+    lives = {(int(i), int(j), float(b)): k for k, (i, j, b) in
+             enumerate(zip(ev.i.values, ev.j.values, ev.birth.values))}
+    assert set(lives) == {(0, 1, 0.0), (4, N, 0.0), (1, 2, 1.0), (2, 3, 2.0), (1, 2, 5.0)}
+    first = lives[(0, 1, 0.0)]  # present t0-t2, gone at t3; left-censored; one s->d switch
+    assert ev.death.values[first] == 3.0 and ev.lifetime.values[first] == 3.0
+    assert ev.left_censored.values[first] and not ev.censored.values[first]
+    assert ev.kind_at_birth.values[first] == S and ev.kind_switches.values[first] == 1
+    assert ev.mean_fn.values[first] == pytest.approx(4.0) and ev.max_fn.values[first] == 6.0
+    once = lives[(1, 2, 1.0)]  # t1-t3, dies at t4, reborn at t5 as a second life
+    assert ev.death.values[once] == 4.0 and ev.lifetime.values[once] == 3.0 and not ev.censored.values[once]
+    assert ev.mean_fn.values[once] == pytest.approx(5.0 / 3.0)
+    again = lives[(1, 2, 5.0)]  # censored at the last snapshot, observed duration 0
+    assert ev.censored.values[again] and np.isnan(ev.death.values[again]) and ev.lifetime.values[again] == 0.0
+    chain = lives[(2, 3, 2.0)]  # t2-t5, censored, switches s->d->s
+    assert ev.censored.values[chain] and ev.lifetime.values[chain] == 3.0 and ev.kind_switches.values[chain] == 2
+    wall = lives[(4, N, 0.0)]  # the wall contact: both censored
+    assert ev.censored.values[wall] and ev.left_censored.values[wall] and ev.lifetime.values[wall] == 5.0
+    # without walls the wall contact is gone; ordered by birth
+    no_walls = contact_events(ds, walls=False)
+    assert no_walls.sizes["contact_event"] == 4 and np.all(np.diff(no_walls.birth.values) >= 0)
+
+
+def test_kaplan_meier_by_hand():
+    # durations 1, 2+, 3, 3, 4+ (+ censored): at u = 1, 5 at risk, 1 dies -> 4/5;
+    # u = 3: 3 at risk (3, 3, 4+), 2 die -> 4/5 * 1/3
+    u, s = kaplan_meier([1, 2, 3, 3, 4], [True, False, True, True, False])
+    np.testing.assert_allclose(u, [1, 3])
+    np.testing.assert_allclose(s, [4 / 5, 4 / 15])
+    u, s = kaplan_meier([2.0, 2.0], [False, False])  # everything censored: no drop
+    assert u.size == 0 and s.size == 0
+
+
+def test_survival_of_the_hand_series(prepare):
+    ds = prepare(sequence_dataset(SERIES))
+    # lives born within the series: (1,2) 3 (dies), (2,3) 3+ (censored), (1,2) 0+ (censored)
+    # at u = 3: at risk (3, 3+) = 2, one dies -> S = 1/2 from tau = 3 on
+    s = lifetime_survival(ds, walls=False)
+    np.testing.assert_allclose(s.lifetime.values, [3.0])
+    np.testing.assert_allclose(s.sel(group="all").values, [0.5])
+    assert int(s.lives.sel(group="all")) == 3
+    by_kind = lifetime_survival(ds, walls=False, by="kind")
+    assert list(by_kind.group.values) == ["simple", "double"] and int(by_kind.lives.sel(group="double")) == 0
+
+
+def test_against_a_set_oracle_and_streaming():
+    from .test_persistence import evolving_dataset
+
+    eager = evolving_dataset(seed=3)
+    # oracle: walk the snapshots with Python sets
+    times = eager.time.values
+    present = []
+    for t in range(eager.sizes["time"]):
+        snap = eager.isel(time=t)
+        used = snap.kind.values > 0
+        present.append({(min(a, b), max(a, b)) for a, b, f in zip(snap.i.values[used], snap.j.values[used],
+                                                                  snap.fn.values[used]) if f > 0})
+    expected = []
+    for pair in set().union(*present):
+        t = 0
+        while t < len(present):
+            if pair in present[t]:
+                b = t
+                while t < len(present) and pair in present[t]:
+                    t += 1
+                expected.append((pair, times[b], times[t] if t < len(present) else np.nan))
+            t += 1
+    got = contact_events(eager)
+    found = [((int(i), int(j)), b, d) for i, j, b, d in zip(got.i.values, got.j.values, got.birth.values,
+                                                              got.death.values)]
+    found.sort(key=lambda e: (e[0], e[1]))
+    expected.sort(key=lambda e: (e[0], e[1]))
+    assert [(p, b) for p, b, _ in found] == [(p, b) for p, b, _ in expected]
+    np.testing.assert_array_equal([d for *_, d in found], [d for *_, d in expected])  # NaN = censored
+    assert len(found) > 14 and np.isfinite([d for *_, d in found]).sum() > 3  # deaths and rebirths occur
+    chunked = eager.chunk({"time": 2})
+    n_chunks = len(chunked.chunks["time"])
+    with raise_if_dask_computes(max_computes=n_chunks + 1):
+        streamed = contact_events(chunked, walls=True)
+    for name in ("i", "j", "birth", "death", "lifetime", "kind_switches", "mean_fn"):
+        np.testing.assert_array_equal(streamed[name].values, contact_events(eager, walls=True)[name].values)
+
+
+def test_bad_arguments():
+    ds = sequence_dataset(SERIES)
+    with pytest.raises(ParameterError, match="by="):
+        lifetime_survival(ds, by="colour")
+    with pytest.raises(ParameterError, match="unit="):
+        lifetime_survival(ds, unit="days")
+    with pytest.raises(ParameterError, match="increase"):
+        contact_events(ds.isel(time=[1, 0, 2]))
