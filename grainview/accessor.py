@@ -100,6 +100,7 @@ class GrainAccessor:
     coordination = _Delegate("connectivity")
     connectivity_pdf = _Delegate("connectivity")
     joint_connectivity_pdf = _Delegate("connectivity")
+    particle_fields = _Delegate("particle_fields")
     # forces
     angular_force_averages = _Delegate("forces")
     force_tensors = _Delegate("forces")

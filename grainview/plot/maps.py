@@ -16,6 +16,7 @@ import xarray as xr
 from matplotlib.collections import EllipseCollection, LineCollection, PolyCollection
 
 from ..contacts import selection
+from ..errors import ParameterError
 from ..schema import polygon_vertices
 from ._style import axis_label, get_axes, single_dataset, snapshot_index
 
@@ -28,10 +29,11 @@ KIND_COLOURS = {1: "tab:blue", 2: "tab:red"}
 
 
 def plot_particles(data, ax=None, time: int = -1, facecolor=PARTICLE_FACE, edgecolor=PARTICLE_EDGE,
-                   linewidth: float = 0.5):
+                   linewidth: float = 0.5, values=None, cmap=None, norm=None):
     """Draw the particles of snapshot ``time``: disks as one EllipseCollection, the polygons of
-    each vertex count as one PolyCollection. Sets equal aspect, the box as limits, x and y
-    labels in m. Returns the axes."""
+    each vertex count as one PolyCollection. With ``values`` (one number per particle) the
+    faces are coloured by them through ``cmap`` and ``norm`` (a matplotlib Normalize) instead of
+    ``facecolor``. Sets equal aspect, the box as limits, x and y labels in m. Returns the axes."""
     _, ds = single_dataset(data)
     ax = get_axes(ax)
     k = snapshot_index(ds, time)
@@ -39,18 +41,77 @@ def plot_particles(data, ax=None, time: int = -1, facecolor=PARTICLE_FACE, edgec
     angle = np.asarray(ds["angle"].isel(time=k).values, float)
     radius = np.asarray(ds["radius"].values, float)
     n_vertices = np.asarray(ds["n_vertices"].values, int)
-    style = dict(facecolors=facecolor, edgecolors=edgecolor, linewidths=linewidth, zorder=1)
+    style = dict(edgecolors=edgecolor, linewidths=linewidth, zorder=1)
+
+    def faces(collection, sel):
+        if values is None:
+            collection.set_facecolor(facecolor)
+        else:
+            collection.set_array(np.asarray(values, float)[sel])
+            collection.set_cmap(cmap)
+            collection.set_norm(norm)
+        ax.add_collection(collection)
+
     disks = n_vertices == 0
     if disks.any():
-        ax.add_collection(EllipseCollection(2 * radius[disks], 2 * radius[disks], np.zeros(disks.sum()),
-                                            units="xy", offsets=position[disks], offset_transform=ax.transData,
-                                            **style))
+        faces(EllipseCollection(2 * radius[disks], 2 * radius[disks], np.zeros(disks.sum()), units="xy",
+                                offsets=position[disks], offset_transform=ax.transData, **style), disks)
     for n in np.unique(n_vertices[~disks]):
         sel = n_vertices == n
-        ax.add_collection(PolyCollection(polygon_vertices(position[sel], radius[sel], angle[sel], int(n)),
-                                         **style))
+        faces(PolyCollection(polygon_vertices(position[sel], radius[sel], angle[sel], int(n)), **style), sel)
     _frame(ax, ds, k)
     return ax
+
+
+PARTICLE_FIELDS = {"c": "contacts c", "m_s": "simple contacts m_s", "m_d": "double contacts m_d",
+                   "strong": "strong contacts", "rattler": "rattler (1) or not (0)",
+                   "rotation": "rotation (rad)", "displacement": "displacement (m)"}
+"""Fields a particle map can show (:func:`grainview.particle_fields.particle_fields`)."""
+
+
+def plot_particle_map(data, field: str = "c", ax=None, time: int = -1, reference: int = 0, walls: bool = True,
+                      cmap: str = "cividis"):
+    """Particles of snapshot ``time`` coloured by a per-particle ``field`` (one of
+    :data:`PARTICLE_FIELDS`: contacts, simple/double contacts, strong contacts, rattlers,
+    rotation or displacement since ``reference``), with a colour bar; ``cividis`` is
+    colour-blind safe (integer fields get one colour per value). Returns the axes."""
+    import matplotlib as mpl
+
+    from ..particle_fields import particle_fields
+
+    if field not in PARTICLE_FIELDS:
+        raise ParameterError(f"field={field!r}: expected one of {sorted(PARTICLE_FIELDS)}")
+    _, ds = single_dataset(data)
+    ax = get_axes(ax)
+    k = snapshot_index(ds, time)
+    values = np.asarray(particle_fields(ds, reference=reference, walls=walls)[field].isel(time=k).values, float)
+    if field in ("rotation", "displacement"):
+        norm = mpl.colors.Normalize(vmin=np.nanmin(values), vmax=max(np.nanmax(values), np.nanmin(values) + 1e-12))
+        ticks = None
+    else:
+        top = max(int(np.nanmax(values)), 1)
+        norm = mpl.colors.BoundaryNorm(np.arange(-0.5, top + 1.5), ncolors=mpl.colormaps[cmap].N)
+        ticks = np.arange(top + 1)
+    plot_particles(ds, ax=ax, time=k, values=values, cmap=cmap, norm=norm)
+    bar = ax.figure.colorbar(mpl.cm.ScalarMappable(norm=norm, cmap=cmap), ax=ax, ticks=ticks)
+    bar.set_label(PARTICLE_FIELDS[field])
+    ax.set_title(f"{PARTICLE_FIELDS[field]}, snapshot {k} (N = {ds.sizes['particle']})")
+    return ax
+
+
+def plot_connectivity_map(data, ax=None, time: int = -1, **options):
+    """:func:`plot_particle_map` of the contacts c of each particle."""
+    return plot_particle_map(data, "c", ax=ax, time=time, **options)
+
+
+def plot_rattler_map(data, ax=None, time: int = -1, **options):
+    """:func:`plot_particle_map` of the rattlers (particles without force-bearing contacts)."""
+    return plot_particle_map(data, "rattler", ax=ax, time=time, **options)
+
+
+def plot_rotation_map(data, ax=None, time: int = -1, **options):
+    """:func:`plot_particle_map` of each particle's rotation since the ``reference`` snapshot."""
+    return plot_particle_map(data, "rotation", ax=ax, time=time, **options)
 
 
 def _frame(ax, ds, k):
