@@ -37,6 +37,22 @@ def _info(args) -> int:
     return 0
 
 
+def _export(args) -> int:
+    from .export import write_csv, write_vtk
+    from .io import open_dataset
+    from .validation import validate
+
+    ds = open_dataset(args.file)
+    validate(ds, source=str(args.file))
+    if args.to == "vtk":
+        paths = write_vtk(ds, args.out, every=args.every, overwrite=args.overwrite, progress=args.progress != "off")
+        print(f"wrote {len(paths) - 2} VTK files and particles.pvd, contacts.pvd (open in ParaView) to {args.out}")
+    else:
+        path = write_csv(ds, args.out, every=args.every, overwrite=args.overwrite)
+        print(f"wrote {path}")
+    return 0
+
+
 def _demo(args) -> int:
     from . import open_dataset
     from .dataset import netcdf_encoding
@@ -288,6 +304,18 @@ def build_parser() -> argparse.ArgumentParser:
     info.add_argument("file", help="path of a netCDF file of the grainview data contract")
     info.add_argument("--attrs", action="store_true", help="also list every global attribute")
     info.set_defaults(func=_info)
+    export = sub.add_parser("export", help="write snapshots as VTK (ParaView, OVITO) or CSV",
+                            description="Export a file of the data contract: --to vtk writes particles "
+                            "(polygons, disks as points with a radius) and contacts (lines with fn, ft, kind, "
+                            "force class) per snapshot plus .pvd time collections; --to csv one tidy contact "
+                            "table (docs/analysis.md).")
+    export.add_argument("file", help="netCDF file of the grainview contract")
+    export.add_argument("--to", choices=("vtk", "csv"), required=True, help="output format")
+    export.add_argument("--out", required=True, help="output folder (created if needed)")
+    export.add_argument("--every", type=int, default=1, help="export every k-th snapshot (and the last; default 1)")
+    export.add_argument("--overwrite", action="store_true", help="replace existing files in --out")
+    export.add_argument("--progress", choices=("on", "off"), default="on", help="progress bar (default on)")
+    export.set_defaults(func=_export)
     demo = sub.add_parser("demo", help="write a synthetic harmonic-model series and analyse it lazily",
                           description="Write a synthetic series drawn from the harmonic model (no simulation, "
                           "seconds) and compare q/p with the prediction (a' + a_n + a_t)/2 computed lazily "
