@@ -53,6 +53,7 @@ from .forces import (plot_angular_forces, plot_contact_proportions, plot_force_a
                      plot_tangential_force, plot_tangential_force_polar, plot_type_transitions, plot_xi_anisotropy, plot_xi_stress)
 from .macroscopic import (plot_harmonic_prediction, plot_partial_q_over_p, plot_q_over_p,
                           plot_stress_dilatancy, plot_volumetric_strain)
+from .movies import animate
 from .maps import (plot_connectivity_map, plot_contact_kinds, plot_force_chains, plot_force_classes,
                    plot_particle_map, plot_particles, plot_rattler_map, plot_rotation_map)
 from .texture import (plot_connectivity_pdf, plot_coordination, plot_fabric_anisotropy,
@@ -128,9 +129,11 @@ class PlotAccessor:
     connectivity_map = _delegate(plot_connectivity_map)
     rattler_map = _delegate(plot_rattler_map)
     rotation_map = _delegate(plot_rotation_map)
+    # movies
+    animate = _delegate(animate)
 
 
-__all__ = ["PlotAccessor", "save_figure", "FIGURES", *(f.__name__ for f in FIGURES.values()),
+__all__ = ["PlotAccessor", "save_figure", "FIGURES", "animate", *(f.__name__ for f in FIGURES.values()),
            "plot_particles", "plot_particle_map", "plot_connectivity_map", "plot_rattler_map", "plot_rotation_map",
            "plot_normal_force_polar", "plot_tangential_force_polar", "plot_tangential_force",
            "plot_force_anisotropy",

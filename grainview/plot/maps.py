@@ -135,21 +135,24 @@ def contact_segments(ds: xr.Dataset, k: int, mask) -> tuple[np.ndarray, np.ndarr
     return np.stack([start, end], axis=1), slots
 
 
-def force_linewidths(fn, max_linewidth: float) -> np.ndarray:
-    """Line widths proportional to the normal force: max_linewidth * f_n / max f_n (points)."""
+def force_linewidths(fn, max_linewidth: float, force_scale=None) -> np.ndarray:
+    """Line widths proportional to the normal force: max_linewidth * f_n / F (points), F the
+    largest f_n drawn or, for maps that must compare (a movie's frames), ``force_scale`` (N)."""
     fn = np.asarray(fn, float)
-    top = fn.max() if fn.size else 0.0
+    top = float(force_scale) if force_scale is not None else (fn.max() if fn.size else 0.0)
     return max_linewidth * fn / top if top > 0 else np.zeros_like(fn)
 
 
-def _network(ds, k, mask, colours, ax, max_linewidth, width_by_force, linewidth, particles, zorder=2):
+def _network(ds, k, mask, colours, ax, max_linewidth, width_by_force, linewidth, particles, zorder=2,
+             force_scale=None):
     if particles:
         plot_particles(ds, ax, time=k)
     else:
         _frame(ax, ds, k)
     segments, slots = contact_segments(ds, k, mask)
     fn = np.asarray(ds["fn"].isel(time=k).values, float)[slots]
-    widths = force_linewidths(fn, max_linewidth) if width_by_force else np.full(slots.size, linewidth)
+    widths = (force_linewidths(fn, max_linewidth, force_scale) if width_by_force
+              else np.full(slots.size, linewidth))
     colours = colours(slots) if callable(colours) else colours
     lines = LineCollection(segments, linewidths=widths, colors=colours, capstyle="round", zorder=zorder)
     lines.set_gid("contacts")
@@ -166,16 +169,16 @@ def contact_collection(ax) -> LineCollection:
 
 
 def plot_force_chains(data, ax=None, time: int = -1, walls: bool = False, max_linewidth: float = 3.0,
-                      colour="k", particles: bool = True):
+                      colour="k", particles: bool = True, force_scale=None):
     """Map of the normal forces of snapshot ``time`` (paper Fig. 13): each force-bearing
     contact (f_n > 0) a segment along its branch vector, of width proportional to f_n
-    (``max_linewidth`` points for the largest force), over the particles. Wall contacts only
-    with ``walls=True``. Returns the axes."""
+    (``max_linewidth`` points for the largest force, or for ``force_scale`` N when given),
+    over the particles. Wall contacts only with ``walls=True``. Returns the axes."""
     _, ds = single_dataset(data)
     ax = get_axes(ax)
     k = snapshot_index(ds, time)
     mask = selection(ds.isel(time=k), walls=walls).values
-    _network(ds, k, mask, colour, ax, max_linewidth, True, None, particles)
+    _network(ds, k, mask, colour, ax, max_linewidth, True, None, particles, force_scale=force_scale)
     return ax
 
 

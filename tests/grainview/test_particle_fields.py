@@ -57,3 +57,24 @@ def test_maps_draw_with_a_colour_bar(name):
 def test_unknown_field_is_named():
     with pytest.raises(ParameterError, match="field="):
         sequence_dataset(SERIES).grain.plot.particle_map(field="colour")
+
+
+@pytest.mark.parametrize("kind", ["force_chains", "force_classes", "connectivity"])
+def test_movie_frames(tmp_path, kind):
+    from PIL import Image
+
+    ds = sequence_dataset(SERIES)
+    path = ds.grain.plot.animate(tmp_path / f"{kind}.gif", kind=kind, every=2, progress=False)
+    with Image.open(path) as gif:
+        assert gif.n_frames == 4  # snapshots 0, 2, 4 and the last
+    assert not list(tmp_path.glob("*.part*"))
+    with pytest.raises(ParameterError, match="exists"):
+        ds.grain.plot.animate(path, kind=kind)
+
+
+def test_movie_bad_arguments(tmp_path):
+    ds = sequence_dataset(SERIES)
+    with pytest.raises(ParameterError, match="kind="):
+        ds.grain.plot.animate(tmp_path / "m.gif", kind="colour")
+    with pytest.raises(ParameterError, match=".gif or .mp4"):
+        ds.grain.plot.animate(tmp_path / "m.avi")

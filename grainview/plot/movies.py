@@ -1,0 +1,95 @@
+"""Movies of a series: force chains, force classes or connectivity, one frame per snapshot.
+
+Each frame is the map of :mod:`grainview.plot.maps` for that snapshot, titled with its shear
+strain eps_q and time, on scales fixed for the whole movie (the force of the widest line, the
+connectivity colours), so that frames compare. GIF through Pillow (always available with
+matplotlib); MP4 through ffmpeg when it is installed. The movie is written under a temporary
+name and moved into place when complete.
+"""
+
+from __future__ import annotations
+
+import os
+
+import numpy as np
+
+from ..contacts import selection
+from ..errors import ParameterError
+from ._style import single_dataset
+
+KINDS = ("force_chains", "force_classes", "connectivity")
+
+
+def _writer(path, fps):
+    from matplotlib import animation
+
+    ext = os.path.splitext(str(path))[1].lower()
+    if ext == ".gif":
+        return animation.PillowWriter(fps=fps)
+    if ext == ".mp4":
+        if not animation.writers.is_available("ffmpeg"):
+            raise ParameterError(f"{path}: MP4 needs ffmpeg, which is not installed; write a .gif instead")
+        return animation.FFMpegWriter(fps=fps)
+    raise ParameterError(f"{path}: expected a .gif or .mp4 file name")
+
+
+def animate(data, path, kind: str = "force_chains", every: int = 1, fps: int = 8, walls: bool = False,
+            max_linewidth: float = 3.0, dpi: int = 90, progress: bool = True, overwrite: bool = False) -> str:
+    """Write a movie of every ``every``-th snapshot (and the last) to ``path`` (.gif or .mp4).
+
+    ``kind``: ``"force_chains"`` (line width proportional to f_n, the largest force of the whole
+    movie at ``max_linewidth`` points), ``"force_classes"`` (very weak / weak / strong, paper
+    Fig. 17) or ``"connectivity"`` (particles coloured by their contacts, one colour bar for the
+    movie). Returns the path written."""
+    import matplotlib.pyplot as plt
+
+    from ..export import snapshot_indices
+    from ..strain import strains
+    from .maps import plot_force_chains, plot_force_classes, plot_particles
+
+    if kind not in KINDS:
+        raise ParameterError(f"kind={kind!r}: expected one of {KINDS}")
+    if os.path.exists(path) and not overwrite:
+        raise ParameterError(f"{path} exists; pass overwrite=True to replace it")
+    writer = _writer(path, fps)
+    _, ds = single_dataset(data)
+    frames = snapshot_indices(ds, every)
+    eps_q = np.asarray(strains(ds)["eps_q"].values, float) if {"box_min", "box_max"} <= set(ds.variables) else None
+    times = np.asarray(ds["time"].values, float)
+    force_scale = float(ds["fn"].where(selection(ds, walls=walls)).isel(time=frames).max())
+    fig, ax = plt.subplots(figsize=(5, 7))
+    norm = cmap = None
+    if kind == "connectivity":
+        import matplotlib as mpl
+
+        from ..particle_fields import particle_fields
+
+        contacts = particle_fields(ds, walls=True)["c"].isel(time=frames).values
+        top = max(int(contacts.max()), 1)
+        cmap = "cividis"
+        norm = mpl.colors.BoundaryNorm(np.arange(-0.5, top + 1.5), ncolors=mpl.colormaps[cmap].N)
+        fig.colorbar(mpl.cm.ScalarMappable(norm=norm, cmap=cmap), ax=ax, ticks=np.arange(top + 1),
+                     label="contacts c")
+    iterator = list(enumerate(frames))
+    if progress:
+        from tqdm.auto import tqdm
+
+        iterator = tqdm(iterator, desc=f"movie ({kind})", unit="frame")
+    root, ext = os.path.splitext(str(path))
+    temporary = f"{root}.part{ext}"
+    with writer.saving(fig, temporary, dpi):
+        for row, k in iterator:
+            ax.clear()
+            k = int(k)
+            if kind == "force_chains":
+                plot_force_chains(ds, ax=ax, time=k, walls=walls, max_linewidth=max_linewidth, force_scale=force_scale)
+            elif kind == "force_classes":
+                plot_force_classes(ds, ax=ax, time=k, walls=walls)
+            else:
+                plot_particles(ds, ax=ax, time=k, values=contacts[row], cmap=cmap, norm=norm)
+            strain = f"$\\varepsilon_q$ = {eps_q[k]:.3f}, " if eps_q is not None else ""
+            ax.set_title(f"{strain}t = {times[k]:.3g} s (snapshot {k})", fontsize="small")
+            writer.grab_frame()
+    plt.close(fig)
+    os.replace(temporary, path)
+    return str(path)
