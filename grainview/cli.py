@@ -172,8 +172,17 @@ def _report(args) -> int:
     runs = {label: open_dataset(f, validate=True) for label, f in zip(labels, args.files)}
     result = write_report(runs, args.out, residual_strain=args.residual_strain, overwrite=args.overwrite,
                           log=lambda line: print(f"report: {line}", flush=True))
+    files = list(result["files"])
+    if getattr(args, "movie", False):  # the study reports without movies
+        from .plot.movies import animate
+
+        for label, ds in runs.items():
+            path = Path(args.out) / f"force_chains_{label}.gif"
+            print(f"report: movie of {label} ...", flush=True)
+            files.append(animate(ds, path, kind="force_chains", every=args.movie_every, overwrite=args.overwrite,
+                                 progress=False))
     print(result["table"].to_string())
-    print(f"wrote {len(result['files'])} files in {args.out}")
+    print(f"wrote {len(files)} files in {args.out}")
     return 0
 
 
@@ -296,6 +305,9 @@ def build_parser() -> argparse.ArgumentParser:
                         "labels containing 'pent' or 'disk' are compared with the paper's S1/S2 values")
     report.add_argument("--out", default="report", help="output folder (default: report)")
     report.add_argument("--overwrite", action="store_true", help="replace an existing report in --out")
+    report.add_argument("--movie", action="store_true", help="also a force-chain movie of each run "
+                        "(force_chains_<label>.gif)")
+    report.add_argument("--movie-every", type=int, default=1, help="one movie frame every k snapshots (default 1)")
     residual_option(report)
     report.set_defaults(func=_report)
     info = sub.add_parser("info", help="validate a grainview netCDF file and print its summary",

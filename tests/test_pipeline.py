@@ -85,7 +85,13 @@ def test_the_report_index_lists_every_figure_and_the_runs(study):
 def test_a_run_short_of_the_residual_window_reports_not_reached(study, tmp_path):
     paths = [str(study / f"{label}.nc") for label in ("pentagons", "disks")]
     out = tmp_path / "report"
-    assert main(["report", *paths, "--labels", "pentagons,disks", "--out", str(out)]) == 0  # window 0.3
+    assert main(["report", *paths, "--labels", "pentagons,disks", "--out", str(out), "--movie",
+                 "--movie-every", "4"]) == 0  # window 0.3
+    for label in ("pentagons", "disks"):  # --movie: one GIF per run
+        from PIL import Image
+
+        with Image.open(out / f"force_chains_{label}.gif") as gif:
+            assert gif.n_frames >= 2
     table = pd.read_csv(out / "headline.csv", index_col=0)
     md = (out / "headline.md").read_text()
     for label in ("pentagons", "disks"):
