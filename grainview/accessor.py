@@ -116,6 +116,8 @@ class GrainAccessor:
     type_transitions = _Delegate("persistence")
     contact_events = _Delegate("lifetimes")
     lifetime_survival = _Delegate("lifetimes")
+    median_lifetime_by_force = _Delegate("lifetimes")
+    strong_persistence = _Delegate("lifetimes")
     # one snapshot in other tools' forms
     contacts_table = _Delegate("tables")
     contact_graph = _Delegate("tables")

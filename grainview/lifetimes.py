@@ -36,7 +36,7 @@ from .contacts import check_near, n_particles, near_attr
 from .errors import ParameterError
 from .persistence import _blocks, _check_flag, body_count
 
-__all__ = ["contact_events", "kaplan_meier", "lifetime_survival"]
+__all__ = ["contact_events", "kaplan_meier", "lifetime_survival", "median_lifetime_by_force", "strong_persistence"]
 
 _FIELDS = ("key", "birth", "kind_at_birth", "last_kind", "switches", "sum_fn", "max_fn", "count")
 
@@ -193,3 +193,69 @@ def lifetime_survival(ds: xr.Dataset, walls: bool = True, near=None, by=None, un
                                 long_name="lifetime tau" + ("" if unit == "time" else " in shear strain eps_q"))
     return with_attrs(da, "survival", "1", "Kaplan-Meier survival S(tau) of the contacts' lives",
                       walls=int(walls), near=near_attr(near), by=str(by), unit=unit)
+
+
+def median_lifetime_by_force(ds: xr.Dataset, bins=(0.0, 0.5, 1.0, 1.5, 2.0, np.inf), walls: bool = True,
+                             near=None) -> xr.DataArray:
+    """Do strong contacts live longer? The median lifetime (s) of the lives whose mean normal
+    force over the life, over the mean of all lives, falls in each of ``bins``: the tau at which
+    the bin's Kaplan–Meier survival first drops to 1/2 or below (censoring handled; NaN when it
+    never does). Left-censored lives are left out. Returns (force_bin,) with the number of
+    lives per bin as a coordinate."""
+    bins = np.asarray(bins, dtype=float)
+    if bins.ndim != 1 or bins.size < 2 or np.any(np.diff(bins) <= 0):
+        raise ParameterError(f"bins={bins.tolist()}: expected increasing edges of at least one bin")
+    events = contact_events(ds, walls=walls, near=near)
+    events = events.isel(contact_event=~events["left_censored"].values)
+    relative = events["mean_fn"].values / (float(events["mean_fn"].mean()) if events.sizes["contact_event"] else 1)
+    which = np.digitize(relative, bins) - 1
+    medians, counts = [], []
+    for b in range(bins.size - 1):
+        members = which == b
+        u, s = kaplan_meier(events["lifetime"].values[members], ~events["censored"].values[members])
+        below = np.flatnonzero(s <= 0.5)
+        medians.append(u[below[0]] if below.size else np.nan)
+        counts.append(int(members.sum()))
+    labels = [f"{lo:g}-{hi:g}" for lo, hi in zip(bins[:-1], bins[1:])]
+    da = xr.DataArray(np.array(medians, float), dims="force_bin",
+                      coords={"force_bin": labels, "lives": ("force_bin", counts)})
+    return with_attrs(da, "median_lifetime", "s", "median lifetime of the lives whose mean force / <f> is in the bin",
+                      walls=int(walls), near=near_attr(near))
+
+
+def strong_persistence(ds: xr.Dataset, max_lag: int = 20, strong: float = 1.0, walls: bool = False,
+                       near=None) -> xr.DataArray:
+    """Survival of the strong network: of the contacts strong at t (f_n > ``strong`` <f_n(t)>,
+    paper Sec. V), the fraction still strong at t + lag, pooled over every t (sum of the kept
+    over sum of the strong), for lag = 0 .. ``max_lag`` snapshots. Computed one time-chunk at a
+    time, carrying the strong sets of the last ``max_lag`` snapshots. Returns (lag,) with the
+    mean time interval of each lag (s) as the coordinate ``lag_time``."""
+    from collections import deque
+
+    if isinstance(max_lag, bool) or not isinstance(max_lag, (int, np.integer)) or max_lag < 1:
+        raise ParameterError(f"max_lag={max_lag!r}: expected an integer >= 1")
+    if not (np.isfinite(strong) and strong > 0):
+        raise ParameterError(f"strong={strong!r}: expected a positive multiple of the mean force")
+    _check_flag("walls", walls)
+    check_near(ds, near)
+    kept = np.zeros(max_lag + 1)
+    total = np.zeros(max_lag + 1)
+    window = deque(maxlen=max_lag)
+    for block, keys, present, _, fn in _blocks(ds, walls, near, force=True):
+        for r in range(keys.shape[0]):
+            f = fn[r][present[r]]
+            sets = np.unique(keys[r][present[r]][f > strong * f.mean()]) if f.size else np.empty(0, np.int64)
+            total[0] += sets.size
+            kept[0] += sets.size
+            for lag, earlier in enumerate(reversed(window), start=1):
+                total[lag] += earlier.size
+                kept[lag] += np.isin(earlier, sets, assume_unique=True).sum()
+            window.append(sets)
+    times = np.asarray(ds["time"].values, float)
+    lag_time = [float(np.mean(times[lag:] - times[:times.size - lag])) if times.size > lag else np.nan
+                for lag in range(max_lag + 1)]
+    with np.errstate(invalid="ignore", divide="ignore"):
+        da = xr.DataArray(kept / total, dims="lag", coords={"lag": np.arange(max_lag + 1), "lag_time": ("lag", lag_time)})
+    da["lag_time"].attrs.update(units="s", long_name="mean time between snapshots lag apart")
+    return with_attrs(da, "strong_persistence", "1", "fraction of strong contacts still strong after lag snapshots",
+                      strong=strong, walls=int(walls), near=near_attr(near))

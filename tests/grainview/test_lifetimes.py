@@ -114,3 +114,27 @@ def test_bad_arguments():
         lifetime_survival(ds, unit="days")
     with pytest.raises(ParameterError, match="increase"):
         contact_events(ds.isel(time=[1, 0, 2]))
+
+
+def test_strong_persistence_by_hand(prepare):
+    ds = prepare(sequence_dataset(SERIES))
+    # strong: f_n > mean f_n of the snapshot (walls out; a force equal to the mean is not strong)
+    # t0 {} (one contact, at the mean); t1 {01} (4 > 2.5); t2 {01} (6 > 10/3); t3 {} (3 = 3);
+    # t4 {}; t5 {12} (5 > 4)
+    # lag 1: t1->t2 keeps 01, t2->t3 loses it: 1 of 2; lag 2: t1->t3, t2->t4 lose it: 0 of 2
+    sp = ds.grain.strong_persistence(max_lag=2)
+    np.testing.assert_allclose(sp.values, [1.0, 1 / 2, 0.0])
+    np.testing.assert_allclose(sp.lag_time.values, [0.0, 1.0, 2.0])
+    # with the strong threshold at half the mean: t0 {01}, t1 {01}, t2 {01, 23}, t3 {12, 23},
+    # t4 {23}, t5 {12, 23}; lag 1 keeps 1 + 1 + 1 + 1 + 1 of 1 + 1 + 2 + 2 + 1 = 5/7
+    np.testing.assert_allclose(ds.grain.strong_persistence(max_lag=1, strong=0.5).values, [1.0, 5 / 7])
+
+
+def test_median_lifetime_by_force_by_hand():
+    ds = sequence_dataset(SERIES)
+    # lives born within the series, walls in: (1,2) born t1 mean 5/3 N, dies after 3 s; (2,3) born
+    # t2 mean 3 N censored; (1,2) reborn t5 mean 5 N censored. Mean of the three: 29/9 N.
+    # relative: 0.517 (bin 0.5-1), 0.931 (0.5-1), 1.55 (1.5-2): bin 0.5-1 has KM S = 1/2 at 3 s
+    m = ds.grain.median_lifetime_by_force()
+    assert m.sel(force_bin="0.5-1").item() == 3.0 and int(m.lives.sel(force_bin="0.5-1")) == 2
+    assert np.isnan(m.sel(force_bin="1.5-2").item()) and int(m.lives.sel(force_bin="1.5-2")) == 1
