@@ -1,5 +1,5 @@
-"""Analysis throughput (issue 5, item 4): contacts per second of stress, fabric, force
-tensors, the xi-network (K = 100) and persistence on a synthetic series opened lazily from
+"""Analysis throughput: contacts per second of stress, fabric, force tensors, the xi-network
+(K = 100), persistence and contact lifetimes on a synthetic series opened lazily from
 netCDF, with the peak memory of each measurement; eager (loaded) against dask (lazy).
 
 The series is drawn from the harmonic model (grainview.synthetic) and streamed to disk one
@@ -21,6 +21,7 @@ CASES = {
     "force tensors (a_n, a_t)": lambda ds: ds.grain.force_anisotropies(reference=0.0),
     "xi-network (K = 100)": lambda ds: _xi(ds),
     "persistence gamma(t)": lambda ds: _persistence(ds),
+    "contact lifetimes (every life)": lambda ds: _lifetimes(ds),
 }
 
 
@@ -32,6 +33,11 @@ def _xi(ds):
 def _persistence(ds):
     from grainview.persistence import persistence
     return persistence(ds)
+
+
+def _lifetimes(ds):
+    from grainview.lifetimes import contact_events
+    return contact_events(ds, walls=False)
 
 
 def write_series(path, n_snapshots, n_contacts, seed=0):
