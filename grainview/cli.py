@@ -353,6 +353,13 @@ def main(argv=None) -> int:
     except KeyboardInterrupt:
         print("grainview: interrupted", file=sys.stderr)
         return 130
+    except SystemExit as exc:
+        from solver.interrupt import Terminated  # the command line runs the solver; this is stdlib only
+
+        if not isinstance(exc, Terminated):
+            raise
+        print("grainview: terminated (SIGTERM)", file=sys.stderr)  # a batch scheduler's limit, after a whole step
+        return 143
 
 
 if __name__ == "__main__":

@@ -1,5 +1,6 @@
-"""Long runs that stop cleanly: Ctrl-C as a flag checked between whole steps, the progress
-bar, and the message that tells how to resume an interrupted biaxial test."""
+"""Long runs that stop cleanly: Ctrl-C (SIGINT) and SIGTERM (what batch schedulers send at a
+wall-time limit) as a flag checked between whole steps, the progress bar, and the message that
+tells how to resume an interrupted biaxial test."""
 
 from __future__ import annotations
 
@@ -10,22 +11,55 @@ import signal
 import sys
 
 
+class Terminated(SystemExit):
+    """A run stopped by SIGTERM after a whole step: a SystemExit with the shell's code for it,
+    143, so that a script ends quietly with that code once every ``with`` block has closed its
+    file (a Ctrl-C raises KeyboardInterrupt instead)."""
+
+    def __init__(self):
+        super().__init__(143)
+
+
+STOP_SIGNALS = (signal.SIGINT, signal.SIGTERM)
+
+
 @contextlib.contextmanager
 def interruptible():
-    """Turn Ctrl-C into a flag checked between steps, so a run stops after a whole step."""
-    state = {"stop": False}
+    """Turn Ctrl-C and SIGTERM into a flag checked between steps, so a run stops after a whole
+    step: ``state["stop"]`` becomes True and ``state["signal"]`` names the signal."""
+    state = {"stop": False, "signal": None}
     if sys.platform == "win32" or signal.getsignal(signal.SIGINT) is None:
         yield state
         return
+
+    def handler(signum, _frame):
+        state["stop"] = True
+        state["signal"] = signum
+
+    previous = {}
     try:
-        previous = signal.signal(signal.SIGINT, lambda *_: state.__setitem__("stop", True))
+        for signum in STOP_SIGNALS:
+            previous[signum] = signal.signal(signum, handler)
     except ValueError:  # not the main thread
+        for signum, old in previous.items():
+            signal.signal(signum, old)
         yield state
         return
     try:
         yield state
     finally:
-        signal.signal(signal.SIGINT, previous)
+        for signum, old in previous.items():
+            signal.signal(signum, old)
+
+
+def stop_exception(state) -> BaseException:
+    """The exception that ends a run stopped by ``state``'s signal: :class:`Terminated` for
+    SIGTERM, KeyboardInterrupt for Ctrl-C."""
+    return Terminated() if state.get("signal") == signal.SIGTERM else KeyboardInterrupt()
+
+
+def stop_reason(state) -> str:
+    return "terminated (SIGTERM)" if state.get("signal") == signal.SIGTERM else "interrupted"
 
 
 def progress_bar(total, desc, progress):

@@ -42,6 +42,7 @@ import numpy as np
 
 from grainview.errors import ConvergenceWarning, FileFormatError, GrainviewError
 
+from .interrupt import Terminated
 from .output import Recorder
 from .scenes import biaxial_steps
 from .stepper import Parameters, Simulation
@@ -221,6 +222,8 @@ def main(argv=None) -> int:
     except (GrainviewError, FileNotFoundError) as exc:
         print(f"solver.restart: error: {exc}", file=sys.stderr)
         return 2
+    except Terminated:
+        return 143
     except KeyboardInterrupt:
         return 130
     for w in caught:

@@ -11,7 +11,7 @@ import sys
 import numpy as np
 from grainview.errors import ParameterError
 
-from .interrupt import interruptible, progress_bar, resume_instructions
+from .interrupt import interruptible, progress_bar, resume_instructions, stop_exception, stop_reason
 from .output import Recorder
 from .packing import PAPER_DIAMETERS, PAPER_FRACTIONS, box_width_for, deposit
 from .stepper import Parameters, Simulation
@@ -152,7 +152,7 @@ def isotropic_compaction(sim: Simulation, *, max_steps=40000, window=200, stress
                 sim.settled = True
                 break
             if flag["stop"]:
-                raise KeyboardInterrupt
+                raise stop_exception(flag)
     sim.walls.stress[driven] = target
     sim.compaction_stress = np.mean(stresses, axis=0) if stresses else np.zeros(len(driven))
     sim.compaction_inertia_number = largest_inertia
@@ -203,8 +203,9 @@ def biaxial_test(sim: Simulation, path, *, strain=0.1, velocity=0.01, every=20, 
 def biaxial_steps(sim: Simulation, recorder, *, first, n_steps, every, progress=None):
     """Steps ``first`` .. ``n_steps`` (counted from the start of the test) of a biaxial test,
     with a snapshot every ``every`` steps and at the last one; shared by :func:`biaxial_test`
-    and :func:`solver.restart.resume`. Ctrl-C stops after the current step (its snapshot
-    written if one is due) and prints how to resume; then raises KeyboardInterrupt."""
+    and :func:`solver.restart.resume`. Ctrl-C or SIGTERM stops after the current step (its
+    snapshot written if one is due) and prints how to resume; then raises KeyboardInterrupt
+    (:class:`solver.interrupt.Terminated` for SIGTERM)."""
     with interruptible() as flag, progress_bar(n_steps, "biaxial test", progress) as bar:
         bar.update(first - 1)
         for k in range(first, n_steps + 1):
@@ -213,6 +214,6 @@ def biaxial_steps(sim: Simulation, recorder, *, first, n_steps, every, progress=
             if k % every == 0 or k == n_steps:
                 recorder.write()
             if flag["stop"] and k < n_steps:
-                print(f"interrupted after step {sim.step_index}: {recorder.writer.path} holds every snapshot "
-                      f"written so far\n{resume_instructions(recorder.writer.path)}", file=sys.stderr)
-                raise KeyboardInterrupt
+                print(f"{stop_reason(flag)} after step {sim.step_index}: {recorder.writer.path} holds every "
+                      f"snapshot written so far\n{resume_instructions(recorder.writer.path)}", file=sys.stderr)
+                raise stop_exception(flag)

@@ -91,3 +91,16 @@ def test_version(capsys):
         main(["--version"])
     assert exit_info.value.code == 0
     assert capsys.readouterr().out.startswith("grainview 0.")
+
+
+def test_interruptions_exit_with_the_shells_codes(monkeypatch, capsys):
+    """Ctrl-C -> 130, SIGTERM (solver.interrupt.Terminated, raised after a whole step) -> 143."""
+    import grainview.cli as cli
+    from solver.interrupt import Terminated
+
+    for exc, code, text in ((KeyboardInterrupt(), 130, "interrupted"), (Terminated(), 143, "terminated (SIGTERM)")):
+        def stopped(args, exc=exc):
+            raise exc
+        monkeypatch.setattr(cli, "_info", stopped)
+        assert cli.main(["info", "whatever.nc"]) == code
+        assert text in capsys.readouterr().err
