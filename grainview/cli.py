@@ -58,6 +58,9 @@ def _demo(args) -> int:
     from .dataset import netcdf_encoding
     from .synthetic import harmonic_series
 
+    if args.snapshots < 2 or args.contacts < 1:
+        raise GrainviewError(f"--snapshots {args.snapshots} --contacts {args.contacts}: expected at least 2 "
+                             "snapshots and 1 contact")
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
     path = out / "synthetic.nc"
@@ -155,8 +158,26 @@ def _simulation_kwargs(args):
                 overwrite=args.overwrite, progress=_progress_flag(args), parameters=_solver_parameters(args))
 
 
+def _check_output_file(path, overwrite):
+    """Check ``--out`` of a run before anything is simulated: a file name in a writable
+    folder, not a folder, not an existing file without --overwrite."""
+    import os
+
+    path = Path(path)
+    if path.is_dir():
+        raise GrainviewError(f"--out {path} is a folder; expected a file name such as {path / 'run.nc'}")
+    if path.exists() and not overwrite:
+        raise GrainviewError(f"--out {path} exists; pass --overwrite to replace it")
+    folder = path.parent if str(path.parent) else Path(".")
+    if not folder.is_dir():
+        raise GrainviewError(f"--out {path}: the folder {folder} does not exist")
+    if not os.access(folder, os.W_OK):
+        raise GrainviewError(f"--out {path}: the folder {folder} is not writable")
+
+
 def _run(args) -> int:
     _check_test(args)
+    _check_output_file(args.out, args.overwrite)
     prep = _preparation(args, args.shape)
     _simulate(prep, args.out, scene=args.scene, **_simulation_kwargs(args))
     return 0
@@ -349,6 +370,18 @@ def main(argv=None) -> int:
     except (GrainviewError, FileExistsError, FileNotFoundError) as exc:
         message = str(exc).replace("\n", "\n  ")
         print(f"grainview: error: {message}", file=sys.stderr)
+        return 2
+    except BrokenPipeError:  # e.g. `grainview info FILE | head`: the reader has gone, say nothing
+        import os
+
+        try:  # so that Python's own flush at exit does not complain either
+            os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+        except (OSError, ValueError):  # stdout without a file descriptor (captured)
+            pass
+        return 141
+    except OSError as exc:  # a full disk, a read-only folder, a permission: one line
+        where = f": {exc.filename}" if getattr(exc, "filename", None) else ""
+        print(f"grainview: error: {exc.strerror or exc}{where}", file=sys.stderr)
         return 2
     except KeyboardInterrupt:
         print("grainview: interrupted", file=sys.stderr)

@@ -104,3 +104,37 @@ def test_interruptions_exit_with_the_shells_codes(monkeypatch, capsys):
         monkeypatch.setattr(cli, "_info", stopped)
         assert cli.main(["info", "whatever.nc"]) == code
         assert text in capsys.readouterr().err
+
+
+@pytest.mark.parametrize("argv, fragment", [
+    (["run", "--particles", "10", "--out", "{tmp}"], "is a folder"),
+    (["run", "--particles", "10", "--out", "{tmp}/missing/run.nc"], "does not exist"),
+    (["demo", "--snapshots", "0", "--out", "{tmp}/d"], "at least 2 snapshots"),
+    (["demo", "--contacts", "-1", "--out", "{tmp}/d"], "at least 2 snapshots and 1 contact"),
+])
+def test_ordinary_mistakes_get_one_line_at_once(tmp_path, capsys, argv, fragment):
+    import time
+
+    start = time.perf_counter()
+    assert main([a.format(tmp=tmp_path) for a in argv]) == 2
+    err = capsys.readouterr().err
+    assert fragment in err and "Traceback" not in err and len(err.strip().splitlines()) == 1
+    assert time.perf_counter() - start < 5  # refused before any compaction
+
+
+def test_system_errors_are_one_line_and_a_closed_pipe_is_quiet(monkeypatch, capsys):
+    import errno
+
+    import grainview.cli as cli
+
+    def full(args):
+        raise OSError(errno.ENOSPC, "No space left on device", "run.nc")
+    monkeypatch.setattr(cli, "_info", full)
+    assert cli.main(["info", "x.nc"]) == 2
+    assert capsys.readouterr().err.strip() == "grainview: error: No space left on device: run.nc"
+
+    def closed(args):
+        raise BrokenPipeError
+    monkeypatch.setattr(cli, "_info", closed)
+    assert cli.main(["info", "x.nc"]) == 141
+    assert capsys.readouterr().err == ""
