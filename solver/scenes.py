@@ -183,8 +183,8 @@ def biaxial_test(sim: Simulation, path, *, strain=0.1, velocity=0.01, every=20, 
         raise ParameterError(f"strain={strain!r}: expected a vertical strain in (0, 1)")
     if not (velocity > 0):
         raise ParameterError(f"velocity={velocity!r}: expected a positive wall speed in m s-1")
-    if int(every) < 1:
-        raise ParameterError(f"every={every!r}: expected a positive number of steps between snapshots")
+    if isinstance(every, bool) or not isinstance(every, (int, np.integer)) or every < 1:
+        raise ParameterError(f"every={every!r}: expected a positive whole number of steps between snapshots")
     lo, hi = sim.walls.box_bounds()
     h0 = float(hi[1] - lo[1])
     travel = h0 * (np.exp(strain) - 1)

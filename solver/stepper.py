@@ -42,6 +42,10 @@ def _cross2(r, normal):
     return r[:, 0] * normal[:, 1] - r[:, 1] * normal[:, 0]
 
 
+MAX_FRICTION = 10.0
+"""Largest accepted friction coefficient: measured ones lie below ~1.5, and 10 already makes
+every contact stick; a larger number is a typing mistake (1e9 for 1e-9?)."""
+
 ACCELERATIONS = ("off", "anderson")
 """How the NLGS sweeps are combined: plain (``off``) or Anderson-extrapolated."""
 
@@ -76,8 +80,9 @@ class Parameters:
         checks = [
             ("time_step", self.time_step > 0 and np.isfinite(self.time_step), "a positive number of seconds"),
             ("theta", 0.5 <= self.theta <= 1, "in [0.5, 1]"),
-            ("friction", 0 <= self.friction and np.isfinite(self.friction), ">= 0"),
-            ("wall_friction", 0 <= self.wall_friction and np.isfinite(self.wall_friction), ">= 0"),
+            ("friction", 0 <= self.friction <= MAX_FRICTION, f"a Coulomb coefficient in [0, {MAX_FRICTION:g}]"),
+            ("wall_friction", 0 <= self.wall_friction <= MAX_FRICTION,
+             f"a Coulomb coefficient in [0, {MAX_FRICTION:g}]"),
             ("density", self.density > 0 and np.isfinite(self.density), "> 0 kg m-3"),
             ("thickness", self.thickness > 0, "> 0 m"),
             ("tolerance", self.tolerance > 0, "> 0"),

@@ -124,6 +124,8 @@ def test_invalid_samples_and_scenes():
     sim = compaction_sample(10, "disk")
     with pytest.raises(ParameterError, match="strain=1.5"):
         biaxial_test(sim, "unused.nc", strain=1.5)
+    with pytest.raises(ParameterError, match="every=2.5"):  # not silently 2
+        biaxial_test(sim, "unused.nc", every=2.5)
     with pytest.raises(ParameterError, match="no wall named 'ceiling'"):
         sim.walls.drive_velocity("ceiling", (0, -1))
 
