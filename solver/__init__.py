@@ -15,9 +15,18 @@ __version__ = "0.1.0"
 
 from .scenes import (biaxial_test, compaction_sample, gravity_scene, is_equilibrium, isotropic_compaction,  # noqa: E402
                      wall_state)
-from .restart import load_sample, resume  # noqa: E402
 from .stepper import Parameters, Simulation, StepInfo  # noqa: E402
 from .walls import Walls  # noqa: E402
+
+
+def __getattr__(name):
+    """``load_sample`` and ``resume`` on first use (PEP 562): ``python -m solver.restart`` then
+    runs the module once, not after ``import solver`` has imported it already."""
+    if name in ("load_sample", "resume"):
+        from . import restart
+
+        return getattr(restart, name)
+    raise AttributeError(f"module 'solver' has no attribute {name!r}")
 
 __all__ = ["Simulation", "Parameters", "StepInfo", "Walls", "compaction_sample", "isotropic_compaction",
            "biaxial_test", "resume", "load_sample", "gravity_scene", "is_equilibrium", "wall_state", "__version__"]

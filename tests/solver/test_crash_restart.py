@@ -325,3 +325,13 @@ def test_the_sweep_method_is_recorded_and_older_files_load_with_plain_sweeps(tmp
         nc.delncattr("solver_anderson_memory")
     older = load_sample(path)
     assert older.parameters.acceleration == "off" and older.parameters.anderson_memory == 5
+
+
+def test_the_resume_command_runs_without_warnings(tmp_path):
+    """``python -m solver.restart`` executes its module once (no runpy RuntimeWarning)."""
+    env = dict(os.environ, PYTHONPATH=os.pathsep.join([str(REPO), os.environ.get("PYTHONPATH", "")]))
+    done = subprocess.run([sys.executable, "-W", "error::RuntimeWarning", "-m", "solver.restart",
+                           str(tmp_path / "missing.nc")], cwd=tmp_path, env=env, capture_output=True, text=True,
+                          timeout=120)
+    assert done.returncode == 2 and done.stderr.strip().endswith("no such file"), done.stderr
+    assert "RuntimeWarning" not in done.stderr
