@@ -29,7 +29,12 @@ def _check_netcdf3_length(path: str) -> None:
         return
     from scipy.io import netcdf_file
 
-    with netcdf_file(path, "r", mmap=True) as nc:
+    try:
+        nc = netcdf_file(path, "r", mmap=True)
+    except (ValueError, TypeError, OSError, IndexError) as exc:  # the header points beyond the end
+        raise FileFormatError(f"{path}: truncated or damaged netCDF-3 file ({os.path.getsize(path)} bytes): "
+                              f"its header describes data beyond its end ({exc})") from exc
+    with nc:
         header = nc.fp.tell()
         fixed = sum((v.data.nbytes + 3) // 4 * 4 for v in nc.variables.values() if not v.isrec)
         records = [v for v in nc.variables.values() if v.isrec]
