@@ -53,6 +53,31 @@ def check_structure(ds: xr.Dataset, source: str | None = None) -> None:
         raise SchemaError(problems, source or ds.encoding.get("source"))
 
 
+def _duplicate_counts(keys):
+    """Per row (last axis: slots), how many occupied slots (key >= 0) repeat an earlier key."""
+    ordered = np.sort(keys, axis=-1)
+    same = (ordered[..., 1:] == ordered[..., :-1]) & (ordered[..., 1:] >= 0)
+    return same.sum(axis=-1)
+
+
+DIMENSIONLESS = ("1", "", "dimensionless")
+"""Spellings accepted for the contract's unit "1"."""
+
+
+def _unit_problems(ds: xr.Dataset) -> list[str]:
+    """Variables whose ``units`` attribute is missing or differs from the contract's."""
+    problems = []
+    for name, var in VARIABLES.items():
+        if name not in ds.variables or name == "complete":
+            continue
+        units = ds[name].attrs.get("units", ds[name].encoding.get("units"))
+        if units is None:
+            problems.append(f"variable {name!r} has no units attribute, expected {var.units!r}")
+        elif str(units).strip() != var.units and not (var.units == "1" and str(units).strip() in DIMENSIONLESS):
+            problems.append(f"variable {name!r} has units {units!r}, expected {var.units!r} (SI, as the contract says)")
+    return problems
+
+
 def _value_checks(ds: xr.Dataset) -> dict[str, xr.DataArray]:
     """Lazy counts of bad entries, keyed by the message to show when the count is > 0."""
     n = ds.sizes["particle"]
@@ -95,6 +120,11 @@ def _value_checks(ds: xr.Dataset) -> dict[str, xr.DataArray]:
                 checks[f"{name}: {{}} non-finite value(s) in occupied slots"] = bad.sum()
             else:
                 checks[f"{name}: {{}} non-finite value(s)"] = bad.sum()
+    keys = xr.where(occ, i.astype(np.int64) * (n + n_walls) + j.astype(np.int64), -1)
+    duplicates = xr.apply_ufunc(_duplicate_counts, keys, input_core_dims=[["contact"]], dask="parallelized",
+                                output_dtypes=[np.int64])
+    checks["i, j: {} slot(s) repeating a pair already stored in the same snapshot (a pair is stored once, "
+           "a double contact with its resultant)"] = duplicates.sum()
     box_ok = (np.isfinite(ds["box_min"]) & np.isfinite(ds["box_max"]) & (ds["box_max"] > ds["box_min"])).all("xy")
     checks["box_min, box_max: {} snapshot(s) where the box is not finite with box_max above box_min "
            "in x and y"] = (~box_ok).sum()
@@ -107,12 +137,13 @@ def validate(ds: xr.Dataset, source: str | None = None) -> xr.Dataset:
     Checked: every required variable present with its dims and an integer/float dtype as the
     contract says; no negative radius, mass or inertia; ``n_vertices`` 0 or >= 3; finite
     positions; ``contact_count`` within the slots; in occupied slots: ids in range and
-    ``i < j`` for particle pairs, kind 1 or 2, finite forces, points and branches, unit normals;
-    a box of positive size. Returns ``ds`` unchanged so calls can be chained.
+    ``i < j`` for particle pairs, each pair at most once per snapshot, kind 1 or 2, finite
+    forces, points and branches, unit normals; a box of positive size; every variable's
+    ``units`` those of the contract. Returns ``ds`` unchanged so calls can be chained.
     """
     source = source or (ds.encoding.get("source") if isinstance(ds, xr.Dataset) else None)
     check_structure(ds, source)  # values cannot be checked reliably on a malformed structure
-    problems = []
+    problems = _unit_problems(ds)
     checks = _value_checks(ds)
     (counts,) = dask.compute(list(checks.values()))
     for message, value in zip(checks, counts):

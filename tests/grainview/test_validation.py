@@ -82,3 +82,30 @@ def test_pair_order_and_particle_range():
 def test_not_a_dataset():
     with pytest.raises(SchemaError, match="expected an xarray.Dataset"):
         grainview.validate({"fn": 1})
+
+
+@pytest.mark.parametrize("chunked", [False, True])
+def test_a_pair_stored_twice_in_one_snapshot_is_reported(chunked):
+    from .test_persistence import S, sequence_dataset
+
+    ds = sequence_dataset([[(0, 1, S, 1.0), (1, 2, S, 1.0)], [(0, 1, S, 1.0), (0, 1, S, 2.0), (2, 3, S, 1.0)]])
+    ds = ds.chunk({"time": 1}) if chunked else ds
+    with pytest.raises(SchemaError, match=r"1 slot\(s\) repeating a pair"):
+        grainview.validate(ds)
+    # the same pair in two snapshots is normal
+    grainview.validate(sequence_dataset([[(0, 1, S, 1.0)], [(0, 1, S, 2.0)]]))
+
+
+def test_wrong_and_missing_units_are_reported():
+    ds = builders.mixed_contacts()
+    ds["fn"].attrs["units"] = "kN"
+    ds["radius"].attrs["units"] = "mm"
+    del ds["position"].attrs["units"]
+    with pytest.raises(SchemaError) as caught:
+        grainview.validate(ds)
+    message = str(caught.value)
+    assert "'fn' has units 'kN', expected 'N'" in message and "'radius' has units 'mm', expected 'm'" in message
+    assert "'position' has no units attribute" in message
+    ds = builders.mixed_contacts()
+    ds["kind"].attrs["units"] = ""  # another spelling of dimensionless
+    grainview.validate(ds)
