@@ -11,6 +11,7 @@ import os
 import numpy as np
 
 from .errors import FileFormatError, ParameterError
+from .locks import WriterLock
 from .schema import (CONTACT_VARIABLES, DEFAULT_WALL_NAMES, OPTIONAL_CONTACT_VARIABLES, REQUIRED, VARIABLES,
                      complete_snapshots, contact_slots, empty_slots, global_attrs, variable_attrs)
 
@@ -51,9 +52,10 @@ class SnapshotWriter:
             w.append(time=t, position=x, angle=a, contacts=c, box_min=lo, box_max=hi)
     """
 
-    def __init__(self, nc, path):
+    def __init__(self, nc, path, lock=None):
         self._nc = nc
         self.path = path
+        self._lock = lock
         self.n_particles = nc.dimensions["particle"].size
         self.n_slots = nc.dimensions["contact"].size
         self.n_walls = nc.dimensions["wall"].size if "wall" in nc.dimensions else 0
@@ -70,6 +72,7 @@ class SnapshotWriter:
         path = os.fspath(path)
         if os.path.exists(path) and not overwrite:
             raise FileExistsError(f"{path} exists; pass overwrite=True to replace it")
+        WriterLock.check_free(path)  # never replace a file another run is still writing
         radius = np.asarray(radius, "f8")
         n = radius.shape[0]
         slots = n_contact_slots or contact_slots(n, n_walls)
@@ -132,21 +135,30 @@ class SnapshotWriter:
             if os.path.exists(temporary):
                 os.remove(temporary)
             raise
-        nc = netCDF4.Dataset(path, "a")
+        lock = WriterLock(path)
+        try:
+            nc = netCDF4.Dataset(path, "a")
+        except BaseException:
+            lock.release()
+            raise
         nc.set_auto_mask(False)
-        return cls(nc, path)
+        return cls(nc, path, lock)
 
     @classmethod
     def open_append(cls, path):
-        """Open an existing file of the contract to append further snapshots."""
+        """Open an existing file of the contract to append further snapshots (refused with
+        :class:`grainview.locks.FileLockedError` while another process writes it)."""
         import netCDF4
 
+        lock = WriterLock(path) if os.path.exists(path) else None
         try:
             nc = netCDF4.Dataset(os.fspath(path), "a")
         except OSError as exc:
+            if lock is not None:
+                lock.release()
             raise FileFormatError(f"cannot open {path} for appending: {exc}") from exc
         nc.set_auto_mask(False)
-        return cls(nc, path)
+        return cls(nc, path, lock)
 
     def attribute(self, name, default=None):
         """The file's global attribute ``name`` (``default`` when it has none)."""
@@ -190,6 +202,9 @@ class SnapshotWriter:
     def close(self):
         if self._nc.isopen():
             self._nc.close()
+        if self._lock is not None:
+            self._lock.release()
+            self._lock = None
 
     def __enter__(self):
         return self

@@ -1,0 +1,62 @@
+"""One writer per file: a second writer or resumer is refused at once, naming the first; a
+killed writer leaves no lock behind."""
+
+import os
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from grainview.locks import FileLockedError
+from grainview.writer import SnapshotWriter
+
+pytest.importorskip("fcntl")
+REPO = Path(__file__).resolve().parents[2]
+
+HOLDER = """
+import sys, time
+import numpy as np
+from grainview.writer import SnapshotWriter
+w = SnapshotWriter.create(sys.argv[1], radius=np.ones(3), n_vertices=0, mass=1.0, inertia=1.0)
+print("ready", flush=True)
+time.sleep(60)
+"""
+
+
+def _holder(path):
+    env = dict(os.environ, PYTHONPATH=os.pathsep.join([str(REPO), os.environ.get("PYTHONPATH", "")]))
+    child = subprocess.Popen([sys.executable, "-c", HOLDER, str(path)], env=env, stdout=subprocess.PIPE, text=True)
+    assert child.stdout.readline().strip() == "ready"
+    return child
+
+
+def test_a_second_writer_is_refused_naming_the_first_and_the_file_is_untouched(tmp_path):
+    path = tmp_path / "run.nc"
+    child = _holder(path)
+    try:
+        before = path.read_bytes()
+        with pytest.raises(FileLockedError, match=f"process {child.pid}"):
+            SnapshotWriter.open_append(path)
+        with pytest.raises(FileLockedError, match="being written"):
+            SnapshotWriter.create(path, radius=np.ones(3), n_vertices=0, mass=1.0, inertia=1.0, overwrite=True)
+        assert path.read_bytes() == before
+    finally:
+        child.kill()
+        child.wait()
+    # killed: the kernel released the lock; the stale note does not matter
+    writer = SnapshotWriter.open_append(path)
+    writer.close()
+    assert not (tmp_path / ".run.nc.writer").exists()
+
+
+def test_the_lock_is_released_on_close(tmp_path):
+    path = tmp_path / "run.nc"
+    first = SnapshotWriter.create(path, radius=np.ones(3), n_vertices=0, mass=1.0, inertia=1.0)
+    with pytest.raises(FileLockedError):
+        SnapshotWriter.open_append(path)
+    first.close()
+    SnapshotWriter.open_append(path).close()
