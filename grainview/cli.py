@@ -368,7 +368,8 @@ def main(argv=None) -> int:
     try:
         return args.func(args)
     except (GrainviewError, FileExistsError, FileNotFoundError) as exc:
-        message = str(exc).replace("\n", "\n  ")
+        # the library's advice names its keyword; on the command line it is the flag
+        message = str(exc).replace("\n", "\n  ").replace("overwrite=True", "--overwrite")
         print(f"grainview: error: {message}", file=sys.stderr)
         return 2
     except BrokenPipeError:  # e.g. `grainview info FILE | head`: the reader has gone, say nothing

@@ -138,3 +138,13 @@ def test_system_errors_are_one_line_and_a_closed_pipe_is_quiet(monkeypatch, caps
     monkeypatch.setattr(cli, "_info", closed)
     assert cli.main(["info", "x.nc"]) == 141
     assert capsys.readouterr().err == ""
+
+
+def test_library_advice_is_given_as_the_flag(monkeypatch, capsys):
+    import grainview.cli as cli
+
+    def lost_race(args):
+        raise FileExistsError("run.nc exists; pass overwrite=True to replace it")
+    monkeypatch.setattr(cli, "_info", lost_race)
+    assert cli.main(["info", "run.nc"]) == 2
+    assert capsys.readouterr().err.strip() == "grainview: error: run.nc exists; pass --overwrite to replace it"
