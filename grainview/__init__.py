@@ -19,7 +19,7 @@ so that the solver, which writes files of the contract, does not load them.
 import importlib
 
 from . import _register
-from .errors import ConvergenceWarning, FileFormatError, GrainviewError, ParameterError, SchemaError
+from .errors import ConvergenceWarning, FileFormatError, GrainviewError, OutputError, ParameterError, SchemaError
 from .schema import SCHEMA_VERSION
 
 __version__ = "0.1.0"
@@ -29,7 +29,7 @@ _LAZY = {"open_dataset": "io", "validate": "validation", "make_dataset": "datase
 
 __all__ = [
     "open_dataset", "validate", "make_dataset", "SnapshotWriter", "SCHEMA_VERSION",
-    "GrainviewError", "SchemaError", "FileFormatError", "ParameterError", "ConvergenceWarning",
+    "GrainviewError", "SchemaError", "FileFormatError", "OutputError", "ParameterError", "ConvergenceWarning",
     "__version__",
 ]
 

@@ -33,6 +33,11 @@ class FileFormatError(GrainviewError, OSError):
     """A path cannot be read as a grainview netCDF file (missing, not netCDF, truncated)."""
 
 
+class OutputError(GrainviewError, OSError):
+    """A snapshot could not be written (a full disk, a lost network mount); the file keeps
+    every snapshot completed before it."""
+
+
 class ParameterError(GrainviewError, ValueError):
     """A parameter passed by the user is out of range or of the wrong form."""
 

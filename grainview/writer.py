@@ -10,7 +10,7 @@ import os
 
 import numpy as np
 
-from .errors import FileFormatError, ParameterError
+from .errors import FileFormatError, OutputError, ParameterError
 from .locks import WriterLock
 from .schema import (CONTACT_VARIABLES, DEFAULT_WALL_NAMES, OPTIONAL_CONTACT_VARIABLES, REQUIRED, VARIABLES,
                      complete_snapshots, contact_slots, empty_slots, global_attrs, variable_attrs)
@@ -170,7 +170,18 @@ class SnapshotWriter:
         complete = np.flatnonzero(complete_snapshots(self._nc.variables))
         return int(complete[-1] + 1) if complete.size else 0
 
-    def append(self, *, time, position, angle, contacts, box_min, box_max, **optional):
+    def append(self, **snapshot):
+        """Write one snapshot (:meth:`_append`'s arguments). An I/O failure (a full disk) raises
+        :class:`grainview.errors.OutputError` in one line; the snapshot is not marked complete,
+        so the file keeps the snapshots before it, readable and resumable."""
+        k = self.n_snapshots
+        try:
+            self._append(**snapshot)
+        except (RuntimeError, OSError) as exc:
+            raise OutputError(f"{self.path}: could not write snapshot {k} ({exc}); the file keeps its {k} "
+                              "complete snapshots: free space and resume the run") from exc
+
+    def _append(self, *, time, position, angle, contacts, box_min, box_max, **optional):
         """Write one snapshot; ``contacts`` is a dict of the contact variables with one
         entry per contact (any length up to the number of slots)."""
         nc = self._nc
@@ -201,7 +212,10 @@ class SnapshotWriter:
 
     def close(self):
         if self._nc.isopen():
-            self._nc.close()
+            try:
+                self._nc.close()
+            except (RuntimeError, OSError):  # after a failed write (a full disk): the data are synced
+                pass
         if self._lock is not None:
             self._lock.release()
             self._lock = None

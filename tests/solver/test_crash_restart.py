@@ -335,3 +335,42 @@ def test_the_resume_command_runs_without_warnings(tmp_path):
                           timeout=120)
     assert done.returncode == 2 and done.stderr.strip().endswith("no such file"), done.stderr
     assert "RuntimeWarning" not in done.stderr
+
+
+def test_a_full_disk_ends_in_one_line_and_a_valid_resumable_file(tmp_path, monkeypatch):
+    """ENOSPC simulated in the middle of a snapshot (netCDF4 reports it as RuntimeError): the
+    run stops with an OutputError naming the file and the snapshots kept; the file opens with
+    them and the run resumes."""
+    import grainview
+    from grainview.errors import OutputError
+    from grainview.writer import SnapshotWriter
+
+    sim = compaction_sample(RUN["n"], "pentagon", seed=RUN["seed"])
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        isotropic_compaction(sim, max_steps=RUN["compaction_steps"], progress=False)
+    path = tmp_path / "full.nc"
+    real = SnapshotWriter._append
+    calls = {"n": 0}
+
+    def filling(self, **snapshot):
+        calls["n"] += 1
+        if calls["n"] == 6:  # the disk fills during the sixth snapshot, after part of it is written
+            self._nc.variables["position"][self.n_snapshots] = snapshot["position"]
+            raise RuntimeError("NetCDF: HDF error (No space left on device)")
+        return real(self, **snapshot)
+
+    monkeypatch.setattr(SnapshotWriter, "_append", filling)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        with pytest.raises(OutputError, match="could not write snapshot 5 .*keeps its 5 complete snapshots"):
+            biaxial_test(sim, path, strain=RUN["strain"], every=RUN["every"], progress=False)
+    monkeypatch.setattr(SnapshotWriter, "_append", real)
+    ds = grainview.open_dataset(path, chunks=None, validate=True)
+    assert ds.sizes["time"] == 5
+    ds.close()
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        assert resume(path, progress=False) > 0
+    with grainview.open_dataset(path, chunks=None) as done:
+        assert done.sizes["time"] == SNAPSHOTS
