@@ -145,7 +145,11 @@ def validate(ds: xr.Dataset, source: str | None = None) -> xr.Dataset:
     check_structure(ds, source)  # values cannot be checked reliably on a malformed structure
     problems = _unit_problems(ds)
     checks = _value_checks(ds)
-    (counts,) = dask.compute(list(checks.values()))
+    values = list(checks.values())
+    if any(dask.is_dask_collection(v) for v in values):
+        (counts,) = dask.compute(values)  # one pass over the chunks
+    else:
+        counts = [v.values for v in values]
     for message, value in zip(checks, counts):
         value = int(np.asarray(value))
         if value:

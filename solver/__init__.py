@@ -13,20 +13,22 @@ biaxial compression, written as netCDF files of the grainview data contract.
 
 __version__ = "0.1.0"
 
-from .scenes import (biaxial_test, compaction_sample, gravity_scene, is_equilibrium, isotropic_compaction,  # noqa: E402
-                     wall_state)
-from .stepper import Parameters, Simulation, StepInfo  # noqa: E402
-from .walls import Walls  # noqa: E402
+_NAMES = {"biaxial_test": "scenes", "compaction_sample": "scenes", "gravity_scene": "scenes",
+          "is_equilibrium": "scenes", "isotropic_compaction": "scenes", "wall_state": "scenes",
+          "load_sample": "restart", "resume": "restart", "Parameters": "stepper", "Simulation": "stepper",
+          "StepInfo": "stepper", "Walls": "walls"}
 
 
 def __getattr__(name):
-    """``load_sample`` and ``resume`` on first use (PEP 562): ``python -m solver.restart`` then
-    runs the module once, not after ``import solver`` has imported it already."""
-    if name in ("load_sample", "resume"):
-        from . import restart
+    """The solver's names on first use (PEP 562): ``import solver.preparation`` (the command
+    line's presets) loads no numba kernel, and ``python -m solver.restart`` runs its module
+    once, not after ``import solver`` has imported it already."""
+    if name in _NAMES:
+        import importlib
 
-        return getattr(restart, name)
+        return getattr(importlib.import_module(f".{_NAMES[name]}", __name__), name)
     raise AttributeError(f"module 'solver' has no attribute {name!r}")
+
 
 __all__ = ["Simulation", "Parameters", "StepInfo", "Walls", "compaction_sample", "isotropic_compaction",
            "biaxial_test", "resume", "load_sample", "gravity_scene", "is_equilibrium", "wall_state", "__version__"]

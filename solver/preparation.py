@@ -32,7 +32,7 @@ import numpy as np
 
 from grainview.errors import ParameterError
 
-from .scenes import compaction_sample, isotropic_compaction, n_vertices_of
+from .shapes import n_vertices_of
 
 
 @dataclass(frozen=True)
@@ -148,6 +148,8 @@ def prepare_sample(prep: Preparation, progress=None, **parameters):
     ``parameters`` go to :class:`solver.Parameters` (time step, tolerances...)."""
     prep = prep.validate()
     compaction_friction = prep.friction if prep.compaction_friction is None else prep.compaction_friction
+    from .scenes import compaction_sample, isotropic_compaction  # the solver proper, on first use
+
     sim = compaction_sample(prep.particles, prep.shape, sigma0=prep.sigma0, friction=compaction_friction,
                             seed=prep.seed, aspect=prep.aspect, max_wall_speed=prep.max_wall_speed, **parameters)
     sim.compaction_steps = isotropic_compaction(sim, max_steps=prep.max_steps, max_inertia_number=prep.max_inertia_number,

@@ -14,22 +14,10 @@ from grainview.errors import ParameterError
 from .interrupt import interruptible, progress_bar, resume_instructions, stop_exception, stop_reason
 from .output import Recorder
 from .packing import PAPER_DIAMETERS, PAPER_FRACTIONS, box_width_for, deposit
+from .shapes import SHAPES, n_vertices_of  # noqa: F401 (SHAPES: part of this module's names)
 from .stepper import Parameters, Simulation
 from .walls import STRESS, Walls
 
-SHAPES = {"disk": 0, "disks": 0, "pentagon": 5, "pentagons": 5}
-
-
-def n_vertices_of(shape) -> int:
-    """0 for disks, n for regular n-gons; accepts "disk", "pentagon" or an integer."""
-    if isinstance(shape, str):
-        if shape not in SHAPES:
-            raise ParameterError(f"shape={shape!r}: expected 'disk', 'pentagon' or a number of vertices >= 3")
-        return SHAPES[shape]
-    n = int(shape)
-    if n != 0 and n < 3:
-        raise ParameterError(f"shape={shape!r}: a polygon needs at least 3 vertices (0 for disks)")
-    return n
 
 
 def gravity_scene(position, angle, radius, n_vertices, *, gravity=9.81, tilt=0.0, sides=None,

@@ -36,8 +36,24 @@ import numpy as np
 from grainview.errors import ParameterError
 from grainview.schema import particle_area, vertex_phases
 
-__all__ = ["Shapes", "polygon_area", "polygon_inertia_per_mass", "mass_and_inertia", "vertices", "inradius",
+__all__ = ["Shapes", "SHAPES", "n_vertices_of", "polygon_area", "polygon_inertia_per_mass", "mass_and_inertia", "vertices", "inradius",
            "check_shapes"]
+
+
+SHAPES = {"disk": 0, "disks": 0, "pentagon": 5, "pentagons": 5}
+"""Shape names the scenes and the command line accept, and their vertex counts."""
+
+
+def n_vertices_of(shape) -> int:
+    """0 for disks, n for regular n-gons; accepts "disk", "pentagon" or an integer."""
+    if isinstance(shape, str):
+        if shape not in SHAPES:
+            raise ParameterError(f"shape={shape!r}: expected 'disk', 'pentagon' or a number of vertices >= 3")
+        return SHAPES[shape]
+    n = int(shape)
+    if n != 0 and n < 3:
+        raise ParameterError(f"shape={shape!r}: a polygon needs at least 3 vertices (0 for disks)")
+    return n
 
 
 def check_shapes(radius, nvert):
