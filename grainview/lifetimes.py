@@ -38,13 +38,13 @@ from .persistence import _blocks, _check_flag, body_count
 
 __all__ = ["contact_events", "kaplan_meier", "lifetime_survival", "median_lifetime_by_force", "strong_persistence"]
 
-_FIELDS = ("key", "birth", "kind_at_birth", "last_kind", "switches", "sum_fn", "max_fn", "count")
+_FIELDS = ("key", "birth", "kind_at_birth", "last_kind", "switches", "sum_fn", "max_fn", "count", "birth_fn")
 
 
 def _empty_open():
     return {"key": np.empty(0, np.int64), "birth": np.empty(0, np.int64), "kind_at_birth": np.empty(0, np.int8),
             "last_kind": np.empty(0, np.int8), "switches": np.empty(0, np.int64), "sum_fn": np.empty(0),
-            "max_fn": np.empty(0), "count": np.empty(0, np.int64)}
+            "max_fn": np.empty(0), "count": np.empty(0, np.int64), "birth_fn": np.empty(0)}
 
 
 def _take(state, mask):
@@ -80,7 +80,8 @@ def _events(ds, walls, near):
             born = ~found
             new = {"key": k[born], "birth": np.full(born.sum(), t, np.int64), "kind_at_birth": kd[born],
                    "last_kind": kd[born], "switches": np.zeros(born.sum(), np.int64), "sum_fn": f[born].astype(float),
-                   "max_fn": f[born].astype(float), "count": np.ones(born.sum(), np.int64)}
+                   "max_fn": f[born].astype(float), "count": np.ones(born.sum(), np.int64),
+                   "birth_fn": f[born].astype(float)}
             kept = _take(open_, alive)
             merged = {name: np.concatenate([kept[name], new[name]]) for name in _FIELDS}
             order = np.argsort(merged["key"], kind="stable")
@@ -123,6 +124,7 @@ def contact_events(ds: xr.Dataset, walls: bool = True, near=None) -> xr.Dataset:
         "left_censored": (dim, e["birth"] == 0), "kind_at_birth": (dim, e["kind_at_birth"]),
         "kind_switches": (dim, e["switches"]),
         "mean_fn": (dim, e["sum_fn"] / np.maximum(e["count"], 1)), "max_fn": (dim, e["max_fn"]),
+        "birth_fn": (dim, e["birth_fn"]),
     })
     if "box_min" in ds and "box_max" in ds:
         eps_q = np.asarray(ds.grain.strains()["eps_q"].values, dtype=float)
@@ -132,7 +134,8 @@ def contact_events(ds: xr.Dataset, walls: bool = True, near=None) -> xr.Dataset:
                                    ("death", "s", "time of the first snapshot without the contact"),
                                    ("lifetime", "s", "lifetime t_death - t_birth (observed duration if censored)"),
                                    ("mean_fn", "N", "mean normal force over the life"),
-                                   ("max_fn", "N", "largest normal force over the life")):
+                                   ("max_fn", "N", "largest normal force over the life"),
+                                   ("birth_fn", "N", "normal force at the first snapshot of the life")):
         out[name] = with_attrs(out[name], name, units, long_name)
     out.attrs.update(walls=int(walls), near=near_attr(near), n_particles=n_particles(ds),
                      comment="lifetimes resolved to the snapshot interval (grainview.lifetimes)")
@@ -154,16 +157,21 @@ def kaplan_meier(durations, observed):
     return u, np.cumprod(1.0 - deaths / at_risk)
 
 
-def lifetime_survival(ds: xr.Dataset, walls: bool = True, near=None, by=None, unit: str = "time") -> xr.DataArray:
+def lifetime_survival(ds: xr.Dataset, walls: bool = True, near=None, by=None, unit: str = "time",
+                      force_at: str = "life", very_weak: float = 0.1) -> xr.DataArray:
     """Survival S(tau) of the contacts' lives (Kaplan–Meier, module docstring), left-censored
     lives left out, as a step function on the grid of every observed lifetime.
 
-    ``by``: None (all lives), ``"kind"`` (simple / double at birth) or ``"force"`` (strong /
-    weak: mean normal force over the life above or below the mean of all lives); ``unit``:
-    ``"time"`` (tau in s) or ``"strain"`` (tau in eps_q). Returns (group, lifetime).
+    ``by``: None (all lives), ``"kind"`` (simple / double at birth) or ``"force"``: strong
+    (f > <f>), weak (``very_weak`` <f> <= f <= <f>) and very weak (f < ``very_weak`` <f>;
+    paper Sec. V), f the mean normal force over the life (``force_at="life"``) or the force at
+    birth (``"birth"``) and <f> its mean over all lives; ``unit``: ``"time"`` (tau in s) or
+    ``"strain"`` (tau in eps_q). Returns (group, lifetime).
     """
     if by not in (None, "kind", "force"):
         raise ParameterError(f"by={by!r}: expected None, 'kind' or 'force'")
+    if force_at not in ("life", "birth"):
+        raise ParameterError(f"force_at={force_at!r}: expected 'life' or 'birth'")
     if unit not in ("time", "strain"):
         raise ParameterError(f"unit={unit!r}: expected 'time' or 'strain'")
     events = contact_events(ds, walls=walls, near=near)
@@ -178,8 +186,10 @@ def lifetime_survival(ds: xr.Dataset, walls: bool = True, near=None, by=None, un
     elif by == "kind":
         groups = {"simple": events["kind_at_birth"].values == 1, "double": events["kind_at_birth"].values == 2}
     else:
-        mean = float(events["mean_fn"].mean()) if tau.size else np.nan
-        groups = {"strong": events["mean_fn"].values > mean, "weak": events["mean_fn"].values <= mean}
+        f = events["mean_fn" if force_at == "life" else "birth_fn"].values
+        mean = float(f.mean()) if f.size else np.nan
+        groups = {"strong": f > mean, "weak": (f >= very_weak * mean) & (f <= mean),
+                  "very weak": f < very_weak * mean}
     grid = np.unique(tau[observed])
     survival = np.ones((len(groups), grid.size))
     for row, mask in enumerate(groups.values()):
@@ -192,7 +202,7 @@ def lifetime_survival(ds: xr.Dataset, walls: bool = True, near=None, by=None, un
     da["lifetime"].attrs.update(units="s" if unit == "time" else "1",
                                 long_name="lifetime tau" + ("" if unit == "time" else " in shear strain eps_q"))
     return with_attrs(da, "survival", "1", "Kaplan-Meier survival S(tau) of the contacts' lives",
-                      walls=int(walls), near=near_attr(near), by=str(by), unit=unit)
+                      walls=int(walls), near=near_attr(near), by=str(by), unit=unit, force_at=force_at)
 
 
 def median_lifetime_by_force(ds: xr.Dataset, bins=(0.0, 0.5, 1.0, 1.5, 2.0, np.inf), walls: bool = True,

@@ -138,3 +138,20 @@ def test_median_lifetime_by_force_by_hand():
     m = ds.grain.median_lifetime_by_force()
     assert m.sel(force_bin="0.5-1").item() == 3.0 and int(m.lives.sel(force_bin="0.5-1")) == 2
     assert np.isnan(m.sel(force_bin="1.5-2").item()) and int(m.lives.sel(force_bin="1.5-2")) == 1
+
+
+def test_survival_by_force_class_at_birth_and_over_the_life():
+    ds = sequence_dataset(SERIES)
+    # lives born within the series (walls in): (1,2) born t1 at 1 N, mean 5/3 N, dies after 3 s;
+    # (2,3) born t2 at 3 N, mean 3 N, censored; (1,2) reborn t5 at 5 N, censored
+    life = ds.grain.lifetime_survival(by="force")  # <f> = 29/9 N over the life
+    assert list(life.group.values) == ["strong", "weak", "very weak"]
+    assert [int(n) for n in life.lives.values] == [1, 2, 0]
+    np.testing.assert_allclose(life.sel(group="weak").values, [0.5])  # at tau = 3: 2 at risk, 1 dies
+    birth = ds.grain.lifetime_survival(by="force", force_at="birth")  # <f> = 3 N at birth
+    assert [int(n) for n in birth.lives.values] == [1, 2, 0]  # 5 N strong; 1 N and 3 N weak
+    very = ds.grain.lifetime_survival(by="force", force_at="birth", very_weak=0.5)  # 1 N < 1.5 N
+    assert [int(n) for n in very.lives.values] == [1, 1, 1]
+    np.testing.assert_allclose(very.sel(group="very weak").values, [0.0])  # its one life ends at 3 s
+    with pytest.raises(ParameterError, match="force_at"):
+        ds.grain.lifetime_survival(by="force", force_at="death")
