@@ -65,15 +65,16 @@ DIMENSIONLESS = ("1", "", "dimensionless")
 
 
 def _unit_problems(ds: xr.Dataset) -> list[str]:
-    """Variables whose ``units`` attribute is missing or differs from the contract's."""
+    """Variables whose ``units`` attribute differs from the contract's. A variable without one
+    is taken in the contract's units: xarray drops attributes in arithmetic, so a dataset edited
+    and saved by a user often has none, and refusing it would help nobody."""
     problems = []
     for name, var in VARIABLES.items():
         if name not in ds.variables or name == "complete":
             continue
         units = ds[name].attrs.get("units", ds[name].encoding.get("units"))
-        if units is None:
-            problems.append(f"variable {name!r} has no units attribute, expected {var.units!r}")
-        elif str(units).strip() != var.units and not (var.units == "1" and str(units).strip() in DIMENSIONLESS):
+        if units is not None and str(units).strip() != var.units and not (
+                var.units == "1" and str(units).strip() in DIMENSIONLESS):
             problems.append(f"variable {name!r} has units {units!r}, expected {var.units!r} (SI, as the contract says)")
     return problems
 
