@@ -106,6 +106,5 @@ def test_wrong_units_are_reported_missing_ones_are_taken_as_the_contracts():
     assert "'fn' has units 'kN', expected 'N'" in message and "'radius' has units 'mm', expected 'm'" in message
     ds = builders.mixed_contacts()
     ds["kind"].attrs["units"] = ""  # another spelling of dimensionless
-    ds["position"] = ds["position"] + 0.0  # xarray arithmetic drops the attribute
-    assert "units" not in ds["position"].attrs
+    del ds["position"].attrs["units"]  # as after an edit that dropped the attributes
     grainview.validate(ds)
