@@ -66,8 +66,8 @@ DIMENSIONLESS = ("1", "", "dimensionless")
 
 def _unit_problems(ds: xr.Dataset) -> list[str]:
     """Variables whose ``units`` attribute differs from the contract's. A variable without one
-    is taken in the contract's units: xarray drops attributes in arithmetic, so a dataset edited
-    and saved by a user often has none, and refusing it would help nobody."""
+    is taken in the contract's units: datasets built or edited by other tools often carry none,
+    and refusing them would help nobody."""
     problems = []
     for name, var in VARIABLES.items():
         if name not in ds.variables or name == "complete":
