@@ -21,10 +21,15 @@ from .errors import ParameterError
 def contact_numbers(ds: xr.Dataset, kind="all", walls: bool = False, near=None) -> xr.DataArray:
     """c_i (time, particle): number of contacts of each particle, force-bearing ones by default
     (``near``: :func:`grainview.contacts.in_network`)."""
-    mask = selection(ds, walls=walls, kind=kind, near=near)
-    da = apply(_conn.contact_numbers, ds["i"], ds["j"], mask, output_sizes={"particle": ds.sizes["particle"]},
-               kwargs={"n_particles": ds.sizes["particle"]}, output_dtypes=[np.int64])
-    return with_attrs(da, "contact_number", "1", "number of force-bearing contacts per particle")
+    return with_attrs(counts_of(ds, selection(ds, walls=walls, kind=kind, near=near)), "contact_number", "1",
+                      "number of force-bearing contacts per particle")
+
+
+def counts_of(ds: xr.Dataset, mask: xr.DataArray) -> xr.DataArray:
+    """(time, particle): how many of the slots selected by the boolean ``mask`` (time, contact)
+    touch each particle (a double contact once), lazily."""
+    return apply(_conn.contact_numbers, ds["i"], ds["j"], mask, output_sizes={"particle": ds.sizes["particle"]},
+                 kwargs={"n_particles": ds.sizes["particle"]}, output_dtypes=[np.int64])
 
 
 def _check_min(min_contacts):

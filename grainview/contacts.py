@@ -24,6 +24,15 @@ def n_particles(ds: xr.Dataset) -> int:
     return ds.sizes["particle"]
 
 
+def snapshot_index(ds: xr.Dataset, value, name: str = "time") -> int:
+    """``value`` as a snapshot index in [0, T) (negative counts from the end); one clear line
+    naming the argument ``name`` when it is not an integer in [-T, T)."""
+    n = ds.sizes["time"]
+    if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or not -n <= value < n:
+        raise ParameterError(f"{name}={value!r}: expected a snapshot index in [{-n}, {n})")
+    return int(value) % n
+
+
 def occupied(ds: xr.Dataset) -> xr.DataArray:
     """Boolean (time, contact): True in the slots that hold a contact."""
     slot = xr.DataArray(np.arange(ds.sizes["contact"], dtype="i4"), dims="contact")

@@ -33,7 +33,7 @@ import xarray as xr
 from .errors import ParameterError
 from .schema import polygon_vertices
 
-__all__ = ["write_vtk", "write_csv", "snapshot_indices"]
+__all__ = ["write_vtk", "write_csv", "snapshot_indices", "write_atomically"]
 
 
 def snapshot_indices(ds: xr.Dataset, every: int = 1) -> np.ndarray:
@@ -44,8 +44,10 @@ def snapshot_indices(ds: xr.Dataset, every: int = 1) -> np.ndarray:
     return np.unique(np.append(np.arange(0, n, every), n - 1)) if n else np.arange(0)
 
 
-def _replace(path, overwrite, write):
-    """Write ``path`` through ``write(temporary path)`` and move it into place."""
+def write_atomically(path, overwrite, write):
+    """Write ``path`` through ``write(temporary path)`` and move it into place, so that an
+    interrupted write never leaves a half-written file under the final name; an existing
+    ``path`` is refused unless ``overwrite``."""
     if os.path.exists(path) and not overwrite:
         raise ParameterError(f"{path} exists; pass overwrite=True (--overwrite) to replace it")
     root, ext = os.path.splitext(path)
@@ -109,7 +111,7 @@ def _collection(path, entries, overwrite):
     collection = ElementTree.SubElement(root, "Collection")
     for time, name in entries:
         ElementTree.SubElement(collection, "DataSet", timestep=repr(float(time)), group="", part="0", file=name)
-    _replace(path, overwrite, lambda temporary: ElementTree.ElementTree(root).write(temporary, xml_declaration=True))
+    write_atomically(path, overwrite, lambda temporary: ElementTree.ElementTree(root).write(temporary, xml_declaration=True))
 
 
 def write_vtk(ds: xr.Dataset, out_dir, every: int = 1, overwrite: bool = False, progress=None) -> list:
@@ -140,7 +142,7 @@ def write_vtk(ds: xr.Dataset, out_dir, every: int = 1, overwrite: bool = False, 
                 ("contacts", _contacts_mesh(snap, np.asarray(classes.isel(time=int(k)).values)), contacts)):
             name = f"{stem}_{int(k):05d}.vtu"
             path = os.path.join(out_dir, name)
-            _replace(path, overwrite, lambda temporary, mesh=mesh: meshio.write(temporary, mesh, file_format="vtu"))
+            write_atomically(path, overwrite, lambda temporary, mesh=mesh: meshio.write(temporary, mesh, file_format="vtu"))
             written.append(path)
             entries.append((time, name))
     for stem, entries in (("particles", particles), ("contacts", contacts)):
@@ -166,5 +168,5 @@ def write_csv(ds: xr.Dataset, out_dir, every: int = 1, overwrite: bool = False) 
         frames.append(table)
     path = os.path.join(out_dir, "contacts.csv")
     out = pd.concat(frames, ignore_index=True) if frames else pd.DataFrame()
-    _replace(path, overwrite, lambda temporary: out.to_csv(temporary, index=False))
+    write_atomically(path, overwrite, lambda temporary: out.to_csv(temporary, index=False))
     return path

@@ -15,44 +15,35 @@ from __future__ import annotations
 import numpy as np
 import xarray as xr
 
-from ._lift import apply, with_attrs
-from .arrays import connectivity as _conn
-from .connectivity import _check_min
-from .contacts import selection
-from .errors import ParameterError
-
-
-def _counts(ds, mask):
-    return apply(_conn.contact_numbers, ds["i"], ds["j"], mask, output_sizes={"particle": ds.sizes["particle"]},
-                 kwargs={"n_particles": ds.sizes["particle"]}, output_dtypes=[np.int64])
+from ._lift import with_attrs
+from .connectivity import _check_min, counts_of
+from .contacts import selection, snapshot_index
 
 
 def particle_fields(ds: xr.Dataset, reference: int = 0, walls: bool = True, near=None,
                     min_contacts: int = 1) -> xr.Dataset:
     """The per-particle fields of the module docstring as a Dataset (time, particle)."""
     _check_min(min_contacts)
-    n_time = ds.sizes["time"]
-    if isinstance(reference, bool) or not isinstance(reference, (int, np.integer)) or not -n_time <= reference < n_time:
-        raise ParameterError(f"reference={reference!r}: expected a snapshot index in [{-n_time}, {n_time})")
+    reference = snapshot_index(ds, reference, "reference")
     network = selection(ds, walls=walls, near=near)
     mean_fn = ds["fn"].where(network).mean("contact")
-    c = _counts(ds, network)
+    c = counts_of(ds, network)
     out = xr.Dataset({
         "c": with_attrs(c, "c", "1", "force-bearing contacts of the particle"),
-        "m_s": with_attrs(_counts(ds, selection(ds, walls=walls, kind="simple", near=near)), "m_s", "1",
+        "m_s": with_attrs(counts_of(ds, selection(ds, walls=walls, kind="simple", near=near)), "m_s", "1",
                           "simple contacts of the particle"),
-        "m_d": with_attrs(_counts(ds, selection(ds, walls=walls, kind="double", near=near)), "m_d", "1",
+        "m_d": with_attrs(counts_of(ds, selection(ds, walls=walls, kind="double", near=near)), "m_d", "1",
                           "double contacts of the particle"),
-        "strong": with_attrs(_counts(ds, network & (ds["fn"] > mean_fn)), "strong", "1",
+        "strong": with_attrs(counts_of(ds, network & (ds["fn"] > mean_fn)), "strong", "1",
                              "contacts of the particle carrying more than the mean normal force"),
         "rattler": with_attrs(c < min_contacts, "rattler", "1", f"fewer than {min_contacts} contacts"),
     })
-    start = ds.isel(time=int(reference))
+    start = ds.isel(time=reference)
     out["rotation"] = with_attrs(ds["angle"] - start["angle"], "rotation", "rad",
                                  "rotation since the reference snapshot")
     step = ds["position"] - start["position"]
     out["displacement"] = with_attrs(np.hypot(step.isel(xy=0, drop=True), step.isel(xy=1, drop=True)),
                                      "displacement", "m", "displacement since the reference snapshot")
     out = out.drop_vars([v for v in out.coords if v not in ("time", "particle")])
-    out.attrs.update(reference=int(reference) % n_time, walls=int(walls), min_contacts=min_contacts)
+    out.attrs.update(reference=reference, walls=int(walls), min_contacts=min_contacts)
     return out.transpose("time", "particle")

@@ -18,7 +18,7 @@ import numpy as np
 import xarray as xr
 
 from ._lift import with_attrs
-from .contacts import check_near, n_particles, near_attr, selection
+from .contacts import check_near, n_particles, near_attr, selection, snapshot_index
 from .errors import ParameterError
 from .schema import KIND_DOUBLE, KIND_SIMPLE
 
@@ -91,9 +91,7 @@ def persistence(ds: xr.Dataset, reference: int = 0, uninterrupted: bool = False,
     _check_flag("walls", walls)
     check_near(ds, near)
     n_time = ds.sizes["time"]
-    if isinstance(reference, bool) or not isinstance(reference, (int, np.integer)) or not -n_time <= reference < n_time:
-        raise ParameterError(f"reference={reference!r}: expected a snapshot index in [{-n_time}, {n_time})")
-    reference = int(reference) % n_time
+    reference = snapshot_index(ds, reference, "reference")
     gamma = np.full(n_time, np.nan)
     ref_keys = alive = None
     for block, keys, present, _ in _blocks(ds, walls, near, start=reference):

@@ -12,7 +12,7 @@ from __future__ import annotations
 import numpy as np
 import xarray as xr
 
-from .contacts import n_particles, occupied
+from .contacts import n_particles, occupied, snapshot_index
 from .errors import ParameterError
 from .persistence import body_count
 
@@ -20,10 +20,7 @@ __all__ = ["contacts_table", "contact_graph"]
 
 
 def _snapshot(ds: xr.Dataset, time: int) -> xr.Dataset:
-    n = ds.sizes["time"]
-    if isinstance(time, bool) or not isinstance(time, (int, np.integer)) or not -n <= time < n:
-        raise ParameterError(f"time={time!r}: expected a snapshot index in [{-n}, {n})")
-    snap = ds.isel(time=int(time))
+    snap = ds.isel(time=snapshot_index(ds, time))
     return snap.isel(contact=np.flatnonzero(occupied(snap).values))
 
 

@@ -34,7 +34,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from .nlgs import delassus
+from .nlgs import _relative_velocity, delassus
 
 __all__ = ["cone_projection", "natural_map", "natural_maps", "local_law_residuals", "particle_imbalance",
            "local_law_residual", "unbalanced_ratios"]
@@ -80,14 +80,8 @@ def local_law_residuals(a, b, nx, ny, rax, ray, rbx, rby, bias, mu, pn, pt, vx, 
     fn = np.empty(m)
     ft = np.empty(m)
     for k in range(m):
-        ubx = vx[b[k]] - w[b[k]] * rby[k]
-        uby = vy[b[k]] + w[b[k]] * rbx[k]
-        uax = vx[a[k]] - w[a[k]] * ray[k]
-        uay = vy[a[k]] + w[a[k]] * rax[k]
-        dx, dy = ubx - uax, uby - uay
-        un = dx * nx[k] + dy * ny[k] + bias[k]
-        ut = -dx * ny[k] + dy * nx[k]
-        fn[k], ft[k] = natural_map(pn[k], pt[k], un, ut, mu[k], 1.0 / wnn[k])
+        un, ut = _relative_velocity(k, a, b, nx, ny, rax, ray, rbx, rby, vx, vy, w)
+        fn[k], ft[k] = natural_map(pn[k], pt[k], un + bias[k], ut, mu[k], 1.0 / wnn[k])
     return fn, ft
 
 

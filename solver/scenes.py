@@ -14,7 +14,7 @@ from grainview.errors import ParameterError
 from .interrupt import interruptible, progress_bar, resume_instructions, stop_exception, stop_reason
 from .output import Recorder
 from .packing import PAPER_DIAMETERS, PAPER_FRACTIONS, box_width_for, deposit
-from .shapes import SHAPES, n_vertices_of  # noqa: F401 (SHAPES: part of this module's names)
+from .shapes import n_vertices_of
 from .stepper import Parameters, Simulation
 from .walls import STRESS, Walls
 

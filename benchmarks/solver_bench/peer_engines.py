@@ -19,7 +19,7 @@ def settle_pile(n, shape, steps, seed=0):
     gravity with this solver; returns the pile as a dict in the format benchmarks/peers.py reads."""
     from solver import gravity_scene
     from solver.packing import box_width_for, deposit
-    from solver.scenes import n_vertices_of
+    from solver.shapes import n_vertices_of
 
     width = box_width_for(n, aspect_ratio=1.0)
     pos, ang, rad, nv, height = deposit(n, nvert=n_vertices_of(shape), width=width, seed=seed)

@@ -120,10 +120,9 @@ def residual_snapshots(ds: xr.Dataset, residual_strain: float = RESIDUAL_STRAIN)
 
 def snapshot_index(ds: xr.Dataset, time=-1) -> int:
     """A single snapshot index (maps draw one snapshot); negative counts from the end."""
-    n = ds.sizes["time"]
-    if not isinstance(time, (int, np.integer)) or isinstance(time, bool) or not -n <= time < n:
-        raise ParameterError(f"time={time!r}: expected one snapshot index in [{-n}, {n})")
-    return int(time) % n
+    from ..contacts import snapshot_index as index
+
+    return index(ds, time)
 
 
 def time_mean(da: xr.DataArray) -> xr.DataArray:

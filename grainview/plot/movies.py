@@ -40,17 +40,17 @@ def animate(data, path, kind: str = "force_chains", every: int = 1, fps: int = 8
     ``kind``: ``"force_chains"`` (line width proportional to f_n, the largest force of the whole
     movie at ``max_linewidth`` points), ``"force_classes"`` (very weak / weak / strong, paper
     Fig. 17) or ``"connectivity"`` (particles coloured by their contacts, one colour bar for the
-    movie). Returns the path written."""
+    movie). Returns the path written (atomically: :func:`grainview.export.write_atomically`)."""
     import matplotlib.pyplot as plt
 
-    from ..export import snapshot_indices
+    from ..export import snapshot_indices, write_atomically
     from ..strain import strains
     from .maps import plot_force_chains, plot_force_classes, plot_particles
 
     if kind not in KINDS:
         raise ParameterError(f"kind={kind!r}: expected one of {KINDS}")
-    if os.path.exists(path) and not overwrite:
-        raise ParameterError(f"{path} exists; pass overwrite=True to replace it")
+    if os.path.exists(path) and not overwrite:  # before any drawing
+        raise ParameterError(f"{path} exists; pass overwrite=True (--overwrite) to replace it")
     writer = _writer(path, fps)
     _, ds = single_dataset(data)
     frames = snapshot_indices(ds, every)
@@ -75,21 +75,24 @@ def animate(data, path, kind: str = "force_chains", every: int = 1, fps: int = 8
         from tqdm.auto import tqdm
 
         iterator = tqdm(iterator, desc=f"movie ({kind})", unit="frame")
-    root, ext = os.path.splitext(str(path))
-    temporary = f"{root}.part{ext}"
-    with writer.saving(fig, temporary, dpi):
-        for row, k in iterator:
-            ax.clear()
-            k = int(k)
-            if kind == "force_chains":
-                plot_force_chains(ds, ax=ax, time=k, walls=walls, max_linewidth=max_linewidth, force_scale=force_scale)
-            elif kind == "force_classes":
-                plot_force_classes(ds, ax=ax, time=k, walls=walls)
-            else:
-                plot_particles(ds, ax=ax, time=k, values=contacts[row], cmap=cmap, norm=norm)
-            strain = f"$\\varepsilon_q$ = {eps_q[k]:.3f}, " if eps_q is not None else ""
-            ax.set_title(f"{strain}t = {times[k]:.3g} s (snapshot {k})", fontsize="small")
-            writer.grab_frame()
-    plt.close(fig)
-    os.replace(temporary, path)
+    def frames_to(temporary):
+        with writer.saving(fig, temporary, dpi):
+            for row, k in iterator:
+                ax.clear()
+                k = int(k)
+                if kind == "force_chains":
+                    plot_force_chains(ds, ax=ax, time=k, walls=walls, max_linewidth=max_linewidth,
+                                      force_scale=force_scale)
+                elif kind == "force_classes":
+                    plot_force_classes(ds, ax=ax, time=k, walls=walls)
+                else:
+                    plot_particles(ds, ax=ax, time=k, values=contacts[row], cmap=cmap, norm=norm)
+                strain = f"$\\varepsilon_q$ = {eps_q[k]:.3f}, " if eps_q is not None else ""
+                ax.set_title(f"{strain}t = {times[k]:.3g} s (snapshot {k})", fontsize="small")
+                writer.grab_frame()
+
+    try:
+        write_atomically(str(path), overwrite, frames_to)
+    finally:
+        plt.close(fig)
     return str(path)

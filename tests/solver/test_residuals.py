@@ -94,14 +94,20 @@ def test_every_admissible_split_of_a_hyperstatic_load_has_zero_residual():
     assert force == pytest.approx(2.0, rel=1e-14)
 
 
-def test_step_reports_the_measures_and_momentum_balances():
+def compacting(n, seed, steps):
+    """A compaction sample of ``n`` pentagons after ``steps`` steps (warnings of the collapse ignored)."""
     from solver import compaction_sample
 
-    sim = compaction_sample(40, "pentagon", seed=2)
+    sim = compaction_sample(n, "pentagon", seed=seed)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
-        for _ in range(150):
+        for _ in range(steps):
             sim.step()
+    return sim
+
+
+def test_step_reports_the_measures_and_momentum_balances():
+    sim = compacting(40, seed=2, steps=150)
     v_before = sim.velocity[:sim.n_particles].copy()
     info = sim.step()
     assert np.isfinite(info.local_law_residual) and info.unbalanced_force >= 0 and info.unbalanced_torque >= 0
@@ -122,13 +128,7 @@ def test_a_tighter_tolerance_gives_a_smaller_local_law_residual():
     import copy
     from dataclasses import replace
 
-    from solver import compaction_sample
-
-    sim = compaction_sample(60, "pentagon", seed=5)
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore")
-        for _ in range(600):
-            sim.step()
+    sim = compacting(60, seed=5, steps=600)
     found = []
     for tolerance in (1e-2, 1e-7):
         trial = copy.deepcopy(sim)
