@@ -40,8 +40,9 @@ def _lifetimes(ds):
     return contact_events(ds, walls=False)
 
 
-def write_series(path, n_snapshots, n_contacts, seed=0):
-    """Stream a harmonic-model series of ``n_snapshots`` x ``n_contacts`` to ``path``."""
+def write_series(path, n_snapshots, n_contacts, seed=0, attrs=None):
+    """Stream a harmonic-model series of ``n_snapshots`` x ``n_contacts`` to ``path`` (global
+    attributes ``attrs`` added)."""
     from grainview.writer import SnapshotWriter
     from grainview.synthetic import PAIR_LENGTH_M, harmonic_contacts
 
@@ -50,7 +51,8 @@ def write_series(path, n_snapshots, n_contacts, seed=0):
     i = np.arange(0, n_part, 2, dtype="i4")
     base = rng.uniform(-0.5, 0.5, (n_contacts, 2))
     with SnapshotWriter.create(path, radius=np.full(n_part, PAIR_LENGTH_M / 2), n_vertices=0,
-                               mass=1.0, inertia=1e-4, n_contact_slots=n_contacts, overwrite=True) as w:
+                               mass=1.0, inertia=1e-4, n_contact_slots=n_contacts, overwrite=True,
+                               attrs=attrs) as w:
         for k in range(n_snapshots):
             s = k / max(n_snapshots - 1, 1)
             normal, fn, ft, kind = harmonic_contacts(n_contacts, 0.3 * s, 0.4 * s, 0.25 * s, rng=rng, spread="exponential")

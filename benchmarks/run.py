@@ -30,7 +30,7 @@ import analysis  # noqa: E402
 import solver_bench as sb  # noqa: E402
 from common import machine_description  # noqa: E402
 
-SECTIONS = ["scaling", "work_precision", "acceleration", "peers", "analysis", "skipping", "stress"]
+SECTIONS = ["scaling", "work_precision", "acceleration", "peers", "analysis", "skipping", "stress", "ensemble"]
 TITLES = {
     "scaling": "a. Scaling: time per step, per particle, per contact point per NLGS sweep, memory",
     "work_precision": "b. Work-precision: run time against error",
@@ -39,6 +39,7 @@ TITLES = {
     "analysis": "e. Analysis throughput (grainview)",
     "skipping": "d. Skipping what a scene does not need",
     "stress": "f. Numerical stress tests at larger sizes",
+    "ensemble": "g. Ensembles on dask.distributed: runner efficiency, out-of-core analysis",
 }
 
 
@@ -98,6 +99,13 @@ def main(argv=None):
                     text = (f"**Scaled down** from the issue's 1000 x 30,000 to {snaps} x {contacts:,} "
                             "to fit the 25-minute run on 2 cores (contacts per second do not depend on the "
                             "number of snapshots; memory of the dask rows is per chunk).\n\n" + text)
+            elif name == "ensemble":
+                import ensemble
+
+                folder = os.path.join(HERE, "_data", "ensemble_quick" if args.quick else "ensemble")
+                os.makedirs(folder, exist_ok=True)
+                text = ensemble.runner_efficiency(folder, **ensemble.RUNNER_SIZES[args.quick]) + "\n\n" + \
+                    ensemble.out_of_core(folder, **ensemble.OUT_OF_CORE_SIZES[args.quick])
             elif name == "skipping":
                 if series_path is None:
                     candidates = sorted(f for f in os.listdir(os.path.join(HERE, "_data")) if f.startswith("series_"))

@@ -24,11 +24,12 @@ from .schema import SCHEMA_VERSION
 
 __version__ = "0.1.0"
 
-_LAZY = {"open_dataset": "io", "validate": "validation", "make_dataset": "dataset", "SnapshotWriter": "writer"}
+_LAZY = {"open_dataset": "io", "validate": "validation", "make_dataset": "dataset", "SnapshotWriter": "writer",
+         "open_ensemble": "ensemble"}
 """Public names imported from their module on first access (PEP 562)."""
 
 __all__ = [
-    "open_dataset", "validate", "make_dataset", "SnapshotWriter", "SCHEMA_VERSION",
+    "open_dataset", "open_ensemble", "validate", "make_dataset", "SnapshotWriter", "SCHEMA_VERSION",
     "GrainviewError", "SchemaError", "FileFormatError", "OutputError", "ParameterError", "ConvergenceWarning",
     "__version__",
 ]

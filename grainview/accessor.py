@@ -35,6 +35,10 @@ class _Delegate:
 
         @functools.wraps(func)
         def method(*args, **kwargs):
+            if "run" in accessor._ds.dims:  # an ensemble: the analysis of each run, along run
+                from .ensemble import map_runs
+
+                return map_runs(accessor._ds, lambda one: getattr(one.grain, self.name)(*args, **kwargs))
             accessor._check_structure()
             return accessor._with_strains(func(accessor._ds, *args, **kwargs))
         return method
@@ -83,6 +87,12 @@ class GrainAccessor:
         """Check the dataset against the contract (:func:`grainview.validation.validate`)."""
         from .validation import validate
 
+        if "run" in self._ds.dims:  # an ensemble: each run
+            from .ensemble import run_dataset
+
+            for k in range(self._ds.sizes["run"]):
+                validate(run_dataset(self._ds, k))
+            return None
         return validate(self._ds)
 
     # stress and strain

@@ -1,4 +1,5 @@
-"""The ``grainview`` command line: ``study``, ``run``, ``report``, ``info`` and ``demo``.
+"""The ``grainview`` command line: ``study``, ``run``, ``ensemble``, ``report``, ``info``, ``export`` and
+``demo``.
 
 Errors a user can cause are printed as one line (``grainview: error: ...``) with exit code 2,
 never as a traceback.
@@ -175,10 +176,19 @@ def _check_output_file(path, overwrite):
         raise GrainviewError(f"--out {path}: the folder {folder} is not writable")
 
 
+def _check_time_step(args, prep):
+    """The time step against the walls' speeds, before any work (solver.stepper.check_time_step)."""
+    from solver import Parameters
+
+    time_step = args.time_step if args.time_step is not None else Parameters().time_step
+    prep.check_time_step(time_step, args.velocity if getattr(args, "scene", "biaxial") == "biaxial" else None)
+
+
 def _run(args) -> int:
     _check_test(args)
     _check_output_file(args.out, args.overwrite)
     prep = _preparation(args, args.shape)
+    _check_time_step(args, prep)
     _simulate(prep, args.out, scene=args.scene, **_simulation_kwargs(args))
     return 0
 
@@ -186,6 +196,9 @@ def _run(args) -> int:
 def _report(args) -> int:
     from .io import open_dataset
     from .report import write_report
+
+    if getattr(args, "ensemble", False):
+        return _ensemble_report(args)
 
     labels = args.labels.split(",") if args.labels else [Path(f).stem for f in args.files]
     if len(labels) != len(args.files):
@@ -207,6 +220,63 @@ def _report(args) -> int:
     return 0
 
 
+def _ensemble_report(args) -> int:
+    from .ensemble import open_ensemble
+    from .ensemble_report import write_ensemble_report
+
+    ens = open_ensemble(args.files, validate=True)
+    result = write_ensemble_report(ens, args.out, residual_strain=args.residual_strain, overwrite=args.overwrite,
+                                   log=lambda line: print(f"report: {line}", flush=True))
+    print(result["table"].to_string())
+    print(f"wrote {len(result['files'])} files in {args.out}")
+    return 0
+
+
+def _split(text, kind, name):
+    """A comma-separated command-line list as values of ``kind``."""
+    try:
+        values = [kind(v) for v in str(text).split(",") if v.strip()]
+    except ValueError:
+        raise GrainviewError(f"--{name} {text}: expected a comma-separated list of {kind.__name__} values") from None
+    if not values:
+        raise GrainviewError(f"--{name} {text}: expected at least one value")
+    return values
+
+
+def _ensemble(args) -> int:
+    from solver.ensemble import describe_result, grid, run_ensemble
+
+    if args.seeds < 1:
+        raise GrainviewError(f"--seeds {args.seeds}: expected at least 1 seed")
+    if args.workers is not None and args.workers < 1:
+        raise GrainviewError(f"--workers {args.workers}: expected at least 1 worker process")
+    if args.workers is not None and args.scheduler is not None:
+        raise GrainviewError("--workers applies to the local cluster; an existing --scheduler has its own workers")
+    frictions = _split(args.friction, float, "friction") if args.friction else [None]
+    sigma0 = _split(args.sigma0, float, "sigma0") if args.sigma0 else [None]
+    specs = grid(shapes=_split(args.shapes, str, "shapes"), particles=_split(args.particles, int, "particles"),
+                 frictions=frictions, sigma0=sigma0, seeds=range(args.first_seed, args.first_seed + args.seeds),
+                 preparation=args.preparation, strain=args.strain, velocity=args.velocity, every=args.every,
+                 solver=tuple(sorted(_solver_parameters(args).items())))
+    out = Path(args.out)
+    where = args.scheduler or f"a local cluster of {args.workers or 'one worker per core'}"
+    print(f"ensemble: {len(specs)} runs on {where}; files in {out} (finished runs are skipped, unfinished "
+          "ones resumed)", flush=True)
+    results = run_ensemble(specs, out, scheduler=args.scheduler, workers=args.workers, overwrite=args.overwrite,
+                           progress=_progress_flag(args), log=lambda line: print(f"ensemble: {line}", flush=True))
+    failed = [r for r in results if "error" in r]
+    if failed:
+        print(f"grainview: error: {len(failed)} of {len(results)} runs failed (above); fix the cause and run the "
+              "same command again: finished runs are skipped, unfinished ones resumed", file=sys.stderr)
+        return 1
+    if args.no_report:
+        return 0
+    args.files = [r["path"] for r in results]
+    args.out = str(out / "report")
+    args.overwrite = True  # the report of these runs is regenerated with them
+    return _ensemble_report(args)
+
+
 def _study(args) -> int:
     from concurrent.futures import ProcessPoolExecutor
 
@@ -216,6 +286,8 @@ def _study(args) -> int:
     out = Path(args.out)
     samples = {"pentagons": "pentagon", "disks": "disk"}
     preps = {label: _preparation(args, shape) for label, shape in samples.items()}
+    for prep in preps.values():
+        _check_time_step(args, prep)
     paths = {label: out / f"{label}.nc" for label in samples}
     if not args.overwrite:
         for path in paths.values():
@@ -328,9 +400,41 @@ def build_parser() -> argparse.ArgumentParser:
     report.add_argument("--overwrite", action="store_true", help="replace an existing report in --out")
     report.add_argument("--movie", action="store_true", help="also a force-chain movie of each run "
                         "(force_chains_<label>.gif)")
+    report.add_argument("--ensemble", action="store_true", help="the files are seeds and settings of one "
+                        "ensemble: report mean +- spread over the seeds of each setting (docs/ensembles.md)")
     report.add_argument("--movie-every", type=int, default=1, help="one movie frame every k snapshots (default 1)")
     residual_option(report)
     report.set_defaults(func=_report)
+    ens = sub.add_parser("ensemble", help="many runs (settings x seeds) on a dask cluster, then their report",
+                         description="One biaxial test per (shape, particles, friction, sigma0, seed) on a "
+                         "dask.distributed cluster (a local one, one worker per core, or --scheduler), each into "
+                         "OUT/<run>.nc; a run whose worker dies is resumed by another; running the command again "
+                         "skips finished runs and resumes the others. Then the ensemble report: mean +- spread over "
+                         "seeds (docs/ensembles.md).")
+    ens.add_argument("--out", default="ensemble", help="output folder (default: ensemble)")
+    ens.add_argument("--shapes", default="pentagon", help="comma-separated shapes (default pentagon; e.g. pentagon,disk)")
+    ens.add_argument("--particles", default="400", help="comma-separated particle counts (default 400)")
+    ens.add_argument("--friction", default=None, help="comma-separated grain friction values (default: 0.4)")
+    ens.add_argument("--sigma0", default=None, help="comma-separated confining stresses in Pa (default: 1e4)")
+    ens.add_argument("--seeds", type=int, default=3, help="seeds per setting (default 3)")
+    ens.add_argument("--first-seed", type=int, default=0, help="first seed (default 0)")
+    ens.add_argument("--strain", type=float, default=DEFAULT_STRAIN, help=f"vertical strain eps_1 (default {DEFAULT_STRAIN})")
+    ens.add_argument("--velocity", type=float, default=0.01, help="speed of the top wall in m/s (default 0.01)")
+    ens.add_argument("--every", type=int, default=200, help="steps between snapshots (default 200)")
+    ens.add_argument("--preparation", default="paper", help="named preparation (default paper)")
+    ens.add_argument("--wall-friction", type=float, default=None, help="grain-wall friction (default 0)")
+    ens.add_argument("--time-step", type=float, default=None, help="time step in s (default 5e-4)")
+    ens.add_argument("--tolerance", type=float, default=None, help="NLGS tolerance (default 1.7e-4)")
+    ens.add_argument("--acceleration", choices=("off", "anderson"), default=None, help="NLGS acceleration")
+    ens.add_argument("--workers", type=int, default=None, help="worker processes of the local cluster "
+                     "(default: one per core; each single-threaded)")
+    ens.add_argument("--scheduler", default=None, help="address of an existing dask scheduler (tcp://host:8786); "
+                     "its workers must import grainview and see --out")
+    ens.add_argument("--no-report", action="store_true", help="run only; no report")
+    ens.add_argument("--overwrite", action="store_true", help="redo every run, replacing its file")
+    ens.add_argument("--progress", choices=["auto", "on", "off"], default="auto", help="a progress bar per run")
+    residual_option(ens)
+    ens.set_defaults(func=_ensemble)
     info = sub.add_parser("info", help="validate a grainview netCDF file and print its summary",
                           description="Check a file against the data contract and print its size, snapshots "
                           "and settings; exits with 2 and one line naming the fault when it is not valid.")

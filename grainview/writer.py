@@ -56,6 +56,7 @@ class SnapshotWriter:
         self._nc = nc
         self.path = path
         self._lock = lock
+        self._failed = False  # a write failed (a full disk): closed without flushing again
         self.n_particles = nc.dimensions["particle"].size
         self.n_slots = nc.dimensions["contact"].size
         self.n_walls = nc.dimensions["wall"].size if "wall" in nc.dimensions else 0
@@ -72,6 +73,9 @@ class SnapshotWriter:
         path = os.fspath(path)
         if os.path.exists(path) and not overwrite:
             raise FileExistsError(f"{path} exists; pass overwrite=True to replace it")
+        folder = os.path.dirname(os.path.abspath(path))
+        if not os.path.isdir(folder):  # named here, not by the hidden temporary file's name
+            raise FileNotFoundError(f"cannot write {path}: the folder {folder} does not exist")
         WriterLock.check_free(path)  # never replace a file another run is still writing
         radius = np.asarray(radius, "f8")
         n = radius.shape[0]
@@ -178,6 +182,7 @@ class SnapshotWriter:
         try:
             self._append(**snapshot)
         except (RuntimeError, OSError) as exc:
+            self._failed = True
             raise OutputError(f"{self.path}: could not write snapshot {k} ({exc}); the file keeps its {k} "
                               "complete snapshots: free space and resume the run") from exc
 
@@ -211,11 +216,24 @@ class SnapshotWriter:
         nc.sync()
 
     def close(self):
-        if self._nc.isopen():
-            try:
-                self._nc.close()
-            except (RuntimeError, OSError):  # after a failed write (a full disk): the data are synced
-                pass
+        nc = self._nc
+        if nc.isopen():
+            if not self._failed:
+                try:  # everything to disk first: a failure here leaves the handle whole
+                    nc.sync()
+                except (RuntimeError, OSError):
+                    self._failed = True
+            if self._failed:
+                # After a failed write (a full disk) netCDF-C's close fails as well and leaves the
+                # handle half freed; netCDF4-python then keeps it marked open and closes it again
+                # when the Dataset is finalised, which crashes the interpreter. One close that
+                # ignores the error (what the finaliser itself does) avoids the second one; the
+                # complete snapshots were synced before the failure.
+                closer = getattr(nc, "_close", None)
+                if closer is not None:
+                    closer(False)
+            else:
+                nc.close()
         if self._lock is not None:
             self._lock.release()
             self._lock = None

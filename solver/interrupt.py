@@ -63,7 +63,11 @@ def stop_reason(state) -> str:
 
 
 def progress_bar(total, desc, progress):
-    """A tqdm bar of ``total`` steps; ``progress`` None: shown when stderr is a terminal."""
+    """A tqdm bar of ``total`` steps; ``progress`` None: shown when stderr is a terminal, a
+    bool: shown or not, a callable: ``progress(total, desc)`` makes the bar (any context
+    manager with ``update(n)``; the ensemble runner reports its workers' steps so)."""
+    if callable(progress):
+        return progress(total, desc)
     enabled = sys.stderr.isatty() if progress is None else bool(progress)
     from tqdm.std import tqdm
 

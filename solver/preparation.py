@@ -76,6 +76,20 @@ class Preparation:
             raise ParameterError("invalid preparation: " + "; ".join(bad))
         return self
 
+    def check_time_step(self, time_step, test_velocity=None):
+        """Refuse, before any work, a time step in which the closing walls of the compaction
+        (at most ``max_wall_speed``) or the top wall of the test (``test_velocity``, m s-1)
+        travel farther than the smallest particle radius of the paper's size mix
+        (:func:`solver.stepper.check_time_step`)."""
+        from .packing import PAPER_DIAMETERS
+        from .stepper import check_time_step
+
+        smallest = 0.5 * min(PAPER_DIAMETERS)
+        check_time_step(time_step, self.max_wall_speed, smallest, "a closing wall of the compaction")
+        if test_velocity is not None:
+            check_time_step(time_step, test_velocity, smallest, "the top wall of the test")
+        return self
+
     def attrs(self) -> dict:
         """The preparation as file attributes ``preparation_<name>`` ("none" for None)."""
         return {f"preparation_{k}": ("none" if v is None else v) for k, v in asdict(self).items()}
@@ -152,6 +166,10 @@ def prepare_sample(prep: Preparation, progress=None, **parameters):
 
     sim = compaction_sample(prep.particles, prep.shape, sigma0=prep.sigma0, friction=compaction_friction,
                             seed=prep.seed, aspect=prep.aspect, max_wall_speed=prep.max_wall_speed, **parameters)
+    from .stepper import check_time_step
+
+    check_time_step(sim.parameters.time_step, prep.max_wall_speed, float(sim.radius.min()),
+                    "a closing wall of the compaction")
     sim.compaction_steps = isotropic_compaction(sim, max_steps=prep.max_steps, max_inertia_number=prep.max_inertia_number,
                                                 pressure_ramp=prep.pressure_ramp, progress=progress)
     sim.parameters.friction = prep.friction

@@ -15,7 +15,7 @@ from .interrupt import interruptible, progress_bar, resume_instructions, stop_ex
 from .output import Recorder
 from .packing import PAPER_DIAMETERS, PAPER_FRACTIONS, box_width_for, deposit
 from .shapes import n_vertices_of
-from .stepper import Parameters, Simulation
+from .stepper import Parameters, Simulation, check_time_step
 from .walls import STRESS, Walls
 
 
@@ -173,6 +173,7 @@ def biaxial_test(sim: Simulation, path, *, strain=0.1, velocity=0.01, every=20, 
         raise ParameterError(f"velocity={velocity!r}: expected a positive wall speed in m s-1")
     if isinstance(every, bool) or not isinstance(every, (int, np.integer)) or every < 1:
         raise ParameterError(f"every={every!r}: expected a positive whole number of steps between snapshots")
+    check_time_step(sim.parameters.time_step, velocity, float(sim.radius.min()), "the top wall")
     lo, hi = sim.walls.box_bounds()
     h0 = float(hi[1] - lo[1])
     travel = h0 * (np.exp(strain) - 1)

@@ -50,6 +50,24 @@ ACCELERATIONS = ("off", "anderson")
 """How the NLGS sweeps are combined: plain (``off``) or Anderson-extrapolated."""
 
 
+def check_time_step(time_step, speed, smallest_radius, what="a wall"):
+    """Refuse a time step in which a body driven at ``speed`` (m s-1) moves farther than the
+    smallest particle radius ``smallest_radius`` (m): the contacts it meets during a step would
+    be found deep inside the particles, or missed. This is the bound at which the stepper's
+    detection distance is capped (:meth:`Simulation.alert_for_step`), checked once before
+    any work instead of warned at every step. Raises :class:`ParameterError` naming the largest
+    time step allowed."""
+    speed = float(speed)
+    if not np.isfinite(speed) or speed <= 0:
+        return
+    travel = speed * float(time_step)
+    if travel > smallest_radius:
+        raise ParameterError(
+            f"time_step={time_step:g} s: {what} moving at {speed:g} m s-1 travels {travel:.3g} m per step, more "
+            f"than the smallest particle radius {smallest_radius:.3g} m, so contacts would be missed; expected "
+            f"time_step <= {smallest_radius / speed:.3g} s (the paper's is 5e-4 s)")
+
+
 @dataclass
 class Parameters:
     """Numerical and physical parameters; defaults are the paper's (Sec. II.B)."""

@@ -111,6 +111,15 @@ def test_interruptions_exit_with_the_shells_codes(monkeypatch, capsys):
     (["run", "--particles", "10", "--out", "{tmp}/missing/run.nc"], "does not exist"),
     (["demo", "--snapshots", "0", "--out", "{tmp}/d"], "at least 2 snapshots"),
     (["demo", "--contacts", "-1", "--out", "{tmp}/d"], "at least 2 snapshots and 1 contact"),
+    (["run", "--time-step", "1", "--out", "{tmp}/r.nc"], "contacts would be missed; expected time_step <= 0.25 s"),
+    (["study", "--time-step", "0.02", "--velocity", "1", "--out", "{tmp}/s"], "the top wall of the test"),
+    (["ensemble", "--seeds", "0", "--out", "{tmp}/e"], "at least 1 seed"),
+    (["ensemble", "--friction", "0.2,high", "--out", "{tmp}/e"], "comma-separated list of float"),
+    (["ensemble", "--workers", "0", "--out", "{tmp}/e"], "at least 1 worker"),
+    (["ensemble", "--workers", "2", "--scheduler", "tcp://x:1", "--out", "{tmp}/e"], "--workers applies"),
+    (["ensemble", "--strain", "2", "--out", "{tmp}/e"], "vertical strain"),
+    (["ensemble", "--shapes", "cube", "--out", "{tmp}/e"], "cube"),
+    (["report", "--ensemble", "{tmp}/none*.nc", "--out", "{tmp}/r"], "no such file"),
 ])
 def test_ordinary_mistakes_get_one_line_at_once(tmp_path, capsys, argv, fragment):
     import time
@@ -148,3 +157,22 @@ def test_library_advice_is_given_as_the_flag(monkeypatch, capsys):
     monkeypatch.setattr(cli, "_info", lost_race)
     assert cli.main(["info", "run.nc"]) == 2
     assert capsys.readouterr().err.strip() == "grainview: error: run.nc exists; pass --overwrite to replace it"
+
+
+def test_report_of_an_ensemble_shows_mean_and_spread(tmp_path, capsys):
+    from grainview.dataset import netcdf_encoding
+
+    paths = []
+    for seed in range(3):
+        ds = harmonic_series(n_snapshots=4, n_contacts=200, seed=seed)
+        ds.attrs.update(preparation_seed=np.int32(seed), preparation_shape="pentagon")
+        paths.append(tmp_path / f"p_s{seed}.nc")
+        ds.to_netcdf(paths[-1], encoding=netcdf_encoding(ds), format="NETCDF3_64BIT")
+    argv = ["report", "--ensemble", *map(str, paths), "--residual-strain", "0", "--out", str(tmp_path / "r")]
+    assert main(argv) == 0
+    stats = pd.read_csv(tmp_path / "r" / "headline.csv", header=[0, 1], index_col=0)["pentagon"]
+    per_run = pd.read_csv(tmp_path / "r" / "runs.csv", index_col=0)
+    q = per_run["q/p (residual)"].to_numpy()
+    assert stats.loc["q/p (residual)", "std"] == pytest.approx(np.std(q, ddof=1), rel=1e-9)
+    assert f"{q.mean():.3f} ± {np.std(q, ddof=1):.3f} (3 seeds)" in capsys.readouterr().out
+    assert main(argv) == 2  # the report exists: refused without --overwrite

@@ -95,6 +95,13 @@ def test_writer_refuses_to_overwrite(tmp_path):
     assert path.read_bytes() == b"precious"
 
 
+def test_writer_names_a_missing_folder_not_its_temporary_file(tmp_path):
+    ds = builders.two_disks()
+    with pytest.raises(FileNotFoundError, match=r"cannot write .*run.nc: the folder .*missing does not exist") as info:
+        _write(ds, tmp_path / "missing" / "run.nc")
+    assert ".part" not in str(info.value) and not (tmp_path / "missing").exists()
+
+
 def test_not_netcdf_and_missing_files_give_clear_errors(tmp_path):
     bad = tmp_path / "notes.nc"
     bad.write_text("this is not netCDF")

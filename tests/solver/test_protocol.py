@@ -11,6 +11,7 @@ import pytest
 import grainview
 from grainview.errors import ParameterError
 from grainview.schema import particle_area
+from solver.preparation import prepare_sample, preparation
 from solver import (Parameters, Simulation, Walls, biaxial_test, compaction_sample, is_equilibrium,
                     isotropic_compaction)
 
@@ -126,6 +127,11 @@ def test_invalid_samples_and_scenes():
         biaxial_test(sim, "unused.nc", strain=1.5)
     with pytest.raises(ParameterError, match="every=2.5"):  # not silently 2
         biaxial_test(sim, "unused.nc", every=2.5)
+    # at 30 m/s the top wall crosses 0.015 m > the smallest radius 0.0125 m in one 5e-4 s step
+    with pytest.raises(ParameterError, match=r"travels 0.015 m per step.*time_step <= 0.000417 s"):
+        biaxial_test(sim, "unused.nc", velocity=30.0)
+    with pytest.raises(ParameterError, match="a closing wall of the compaction"):
+        prepare_sample(preparation("paper", particles=10, shape="disk", max_wall_speed=50.0))
     with pytest.raises(ParameterError, match="no wall named 'ceiling'"):
         sim.walls.drive_velocity("ceiling", (0, -1))
 

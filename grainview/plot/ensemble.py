@@ -1,0 +1,30 @@
+"""Figures of an ensemble: a quantity against shear strain, mean and spread over seeds."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ._style import EPS_Q_LABEL
+
+
+def seed_bands(stats, ax=None, label: str = "", units: str = "1"):
+    """Draw :func:`grainview.ensemble.seed_statistics` binned on eps_q: per group the mean as
+    a line and mean +- one standard deviation as a band (none where
+    a bin has a single seed), the number of seeds in the legend.
+    Returns the Axes."""
+    import matplotlib.pyplot as plt
+
+    if ax is None:
+        _, ax = plt.subplots(figsize=(5, 3.5), constrained_layout=True)
+    x = stats["eps_q_bin"].values
+    for group in stats["group"].values:
+        s = stats.sel(group=group)
+        mean, std, n = s["mean"].values, s["std"].values, s["n"].values
+        seeds = int(n.max()) if n.size else 0
+        (line,) = ax.plot(x, mean, marker="o", ms=3, label=f"{group} ({seeds} seeds)")
+        ax.fill_between(x, mean - std, mean + std, color=line.get_color(), alpha=0.25,
+                        lw=0)
+    ax.set_xlabel(EPS_Q_LABEL)
+    ax.set_ylabel(label if units in ("", "1", None) else f"{label} ({units})")
+    ax.legend(fontsize=8, title="mean $\\pm$ std over seeds", title_fontsize=8)
+    return ax

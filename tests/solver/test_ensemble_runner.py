@@ -1,0 +1,118 @@
+"""The ensemble runner on a dask.distributed LocalCluster of processes: a worker killed in the
+middle of a run, the run resumed by the scheduler's retry and equal, snapshot for snapshot, to
+an uninterrupted run; open_ensemble equal to each file opened alone; a failing run reported
+while the others finish; a changed command line refused before anything runs."""
+
+from __future__ import annotations
+
+import os
+import signal
+
+import numpy as np
+import pytest
+import xarray as xr
+
+import grainview
+from grainview.ensemble import run_dataset
+from grainview.errors import ParameterError
+from solver import ensemble
+from solver.ensemble import RunSpec, grid, run_ensemble, run_one
+
+distributed = pytest.importorskip("distributed")
+
+TINY = dict(shapes=("disk",), particles=(40,), strain=0.03, every=25)
+COMPARED = ("position", "angle", "velocity", "fn", "ft", "i", "j", "normal_impulse", "wall_position", "step")
+
+
+@pytest.fixture(scope="module")
+def killed(tmp_path_factory):
+    """A 2-seed ensemble in which the worker running seed 0 is SIGKILLed once mid-test."""
+    folder = tmp_path_factory.mktemp("ensemble")
+    specs = grid(seeds=2, **TINY)
+    victim = specs[0].name
+    kills = []
+
+    def kill_once(event):
+        if (not kills and event["run"] == victim and event["stage"] == "biaxial test"
+                and 0 < event["n"] < event["total"] // 2):
+            kills.append(event["n"])
+            os.kill(event["pid"], signal.SIGKILL)
+
+    cluster = ensemble.local_cluster(workers=2)
+    with distributed.Client(cluster) as client:
+        results = run_ensemble(specs, folder, client=client, progress=False, on_event=kill_once)
+    cluster.close()
+    return specs, results, kills, folder
+
+
+def test_killed_worker_run_is_resumed_and_exact(killed, tmp_path):
+    specs, results, kills, folder = killed
+    assert len(kills) == 1, "the worker was not killed mid-test"
+    assert [r.get("error") for r in results] == [None, None]
+    assert results[0]["action"] == "resumed" and results[1]["action"] == "ran"
+    reference = run_one(specs[0], tmp_path)  # the same run, uninterrupted, in this process
+    assert reference["action"] == "ran"
+    resumed = grainview.open_dataset(results[0]["path"], chunks=None)
+    alone = grainview.open_dataset(reference["path"], chunks=None)
+    assert resumed.sizes == alone.sizes
+    for name in COMPARED:
+        np.testing.assert_array_equal(resumed[name].values, alone[name].values, err_msg=name)
+
+
+def test_open_ensemble_equals_each_file(killed):
+    specs, results, _, folder = killed
+    ens = grainview.open_ensemble(folder)
+    assert list(ens["run"].values) == sorted(s.name for s in specs)
+    assert list(ens["seed"].values) == [0, 1] and set(ens["group"].values) == {"disk"}
+    q = ens.grain.stress_invariants()["q_over_p"].compute()
+    for k, name in enumerate(ens["run"].values):
+        alone = grainview.open_dataset(folder / f"{name}.nc")
+        xr.testing.assert_identical(run_dataset(ens, k).compute(), alone.compute())
+        expected = alone.grain.stress_invariants()["q_over_p"].values
+        np.testing.assert_array_equal(q.isel(run=k, time=slice(0, expected.size)).values, expected)
+
+
+def test_rerun_skips_finished_and_refuses_changed_settings(killed):
+    specs, _, _, folder = killed
+    again = run_ensemble(specs, folder, workers=1, progress=False)
+    assert [r["action"] for r in again] == ["finished already"] * 2
+    changed = grid(seeds=1, **{**TINY, "strain": 0.04})
+    with pytest.raises(FileExistsError, match="strain_target"):
+        run_ensemble(changed, folder, workers=1, progress=False)
+
+
+def test_failed_run_reported_others_finish(tmp_path, monkeypatch):
+    """A run that raises is reported in one line; the other finishes; a second call runs only
+    the failed one (threads in this process, so that the failure can be injected)."""
+    specs = grid(seeds=2, **{**TINY, "strain": 0.01})
+    real = ensemble.run_one
+
+    def flaky(spec, folder, **kw):
+        if spec.seed == 1:
+            raise RuntimeError("disk full (simulated)")
+        return real(spec, folder, **kw)
+
+    monkeypatch.setattr(ensemble, "run_one", flaky)
+    with distributed.LocalCluster(n_workers=1, threads_per_worker=2, processes=False, dashboard_address=None) as cl, \
+            distributed.Client(cl) as client:
+        lines = []
+        first = run_ensemble(specs, tmp_path, client=client, progress=False, log=lines.append)
+        assert first[0]["action"] == "ran" and first[1]["error"] == "RuntimeError: disk full (simulated)"
+        assert any("FAILED (RuntimeError: disk full (simulated))" in line for line in lines)
+        monkeypatch.setattr(ensemble, "run_one", real)
+        second = run_ensemble(specs, tmp_path, client=client, progress=False)
+    assert [r["action"] for r in second] == ["finished already", "ran"]
+
+
+def test_specs_are_checked():
+    with pytest.raises(ParameterError, match="strain"):
+        RunSpec(strain=1.5).validate()
+    with pytest.raises(ParameterError, match="seed"):
+        RunSpec(seed=-1).validate()
+    with pytest.raises(ParameterError, match="time_step=0.0005 s: the top wall of the test"):
+        RunSpec(velocity=100.0).validate()  # 5 cm per step against radii of 1.25 cm
+    with pytest.raises(ParameterError, match="same run twice"):
+        grid(seeds=(0, 0))
+    with pytest.raises(ParameterError, match="workers"):
+        ensemble.local_cluster(workers=0)
+    assert RunSpec(shape="disk", particles=40, friction=0.2, seed=3).name == "disk_n40_mu0.2_s3"
