@@ -96,7 +96,7 @@ def _solver_parameters(args) -> dict:
     from solver import Parameters
 
     given = {"wall_friction": args.wall_friction, "time_step": args.time_step, "tolerance": args.tolerance,
-             "acceleration": args.acceleration}
+             "acceleration": args.acceleration, "domains": getattr(args, "domains", None)}
     parameters = {k: v for k, v in given.items() if v is not None}
     Parameters(**parameters).validate()  # one clear line before anything is simulated
     return parameters
@@ -349,6 +349,9 @@ def build_parser() -> argparse.ArgumentParser:
         physics.add_argument("--acceleration", choices=("off", "anderson"), default=None,
                              help="'anderson': Anderson-accelerated NLGS sweeps, same accuracy in 1.7-2.6x less "
                              "solve time on dense sheared samples (default off; docs/solver.md)")
+        physics.add_argument("--domains", type=int, default=None,
+                             help="NLGS domains swept at once, one per core (default 1: the serial sweep; "
+                             "deterministic for a given number; on free cores only; docs/solver.md)")
         prep = p.add_argument_group("sample preparation (docs/fidelity.md)")
         prep.add_argument("--preparation", choices=preset_names(), default="paper",
                           help="named preparation (default paper: compaction with friction 0.4, walls closing "

@@ -55,7 +55,7 @@ WALL_ATTRIBUTES = ("wall_mode", "wall_stress_Pa", "wall_mass_kg", "wall_max_spee
 BIAXIAL_ATTRIBUTES = ("strain_target", "wall_velocity_m_s", "snapshot_every", "biaxial_steps")
 
 
-LATER_PARAMETERS = {"acceleration": "off", "anderson_memory": 5}
+LATER_PARAMETERS = {"acceleration": "off", "anderson_memory": 5, "domains": 1}
 """Parameters added after files were first written, with the value every older file ran with
 (not the current default, which may change): absent from a file, they take that value."""
 
@@ -77,7 +77,7 @@ def _parameters(attrs, source) -> Parameters:
             value = tuple(float(g) for g in np.atleast_1d(value))
         elif field.name == "shuffle":
             value = bool(value)
-        elif field.name in ("seed", "max_iterations", "anderson_memory"):
+        elif field.name in ("seed", "max_iterations", "anderson_memory", "domains"):
             value = int(value)
         else:
             value = float(value)

@@ -113,6 +113,7 @@ def test_interruptions_exit_with_the_shells_codes(monkeypatch, capsys):
     (["demo", "--contacts", "-1", "--out", "{tmp}/d"], "at least 2 snapshots and 1 contact"),
     (["run", "--time-step", "1", "--out", "{tmp}/r.nc"], "contacts would be missed; expected time_step <= 0.25 s"),
     (["study", "--time-step", "0.02", "--velocity", "1", "--out", "{tmp}/s"], "the top wall of the test"),
+    (["run", "--domains", "0", "--out", "{tmp}/r.nc"], "domains=0: expected an integer in 1..64"),
     (["ensemble", "--seeds", "0", "--out", "{tmp}/e"], "at least 1 seed"),
     (["ensemble", "--friction", "0.2,high", "--out", "{tmp}/e"], "comma-separated list of float"),
     (["ensemble", "--workers", "0", "--out", "{tmp}/e"], "at least 1 worker"),

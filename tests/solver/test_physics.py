@@ -11,15 +11,16 @@ from solver.shapes import mass_and_inertia
 G = 9.81
 R = 0.0125
 EXACT = dict(tolerance=1e-12, max_tolerance=1e-12, max_iterations=100_000)
-ACCELERATIONS = pytest.mark.parametrize("acceleration", ["off", "anderson"])  # every solver, same answers
+SOLVERS = pytest.mark.parametrize("solver", [{}, {"acceleration": "anderson"}, {"domains": 2}],
+                                  ids=["nlgs", "anderson", "domains2"])  # every solver, same answers
 PENTAGON_ON_EDGE = np.radians(-54.0)  # vertices at -54 + 72 k degrees: an edge at the bottom
 
 
-@ACCELERATIONS
-def test_disk_and_pentagon_resting_on_the_floor(acceleration):
+@SOLVERS
+def test_disk_and_pentagon_resting_on_the_floor(solver):
     inradius = R * np.cos(np.pi / 5)
     sim = Simulation([[0.0, R], [0.1, inradius]], [0.0, PENTAGON_ON_EDGE], [R, R], [0, 5],
-                     Walls.floor(), Parameters(gravity=(0, -G), acceleration=acceleration, **EXACT))
+                     Walls.floor(), Parameters(gravity=(0, -G), **solver, **EXACT))
     for _ in range(10):
         sim.step()
     weight = sim.mass * G
@@ -37,12 +38,12 @@ def test_disk_and_pentagon_resting_on_the_floor(acceleration):
     assert np.abs(sim.velocity[:2]).max() < 1e-12
 
 
-@ACCELERATIONS
-def test_column_of_ten_disks_carries_the_weight_above(acceleration):
+@SOLVERS
+def test_column_of_ten_disks_carries_the_weight_above(solver):
     n = 10
     y = R + 2 * R * np.arange(n)
     sim = Simulation(np.stack([np.zeros(n), y], -1), np.zeros(n), np.full(n, R), np.zeros(n),
-                     Walls.floor(), Parameters(gravity=(0, -G), acceleration=acceleration, **EXACT))
+                     Walls.floor(), Parameters(gravity=(0, -G), **solver, **EXACT))
     for _ in range(20):
         sim.step()
     pts = sim.points
@@ -57,15 +58,15 @@ def test_column_of_ten_disks_carries_the_weight_above(acceleration):
         assert force[k] == pytest.approx(above * weight, rel=1e-6)
 
 
-@ACCELERATIONS
+@SOLVERS
 @pytest.mark.parametrize("alpha_deg", [15.0, 30.0])
-def test_pentagon_on_a_tilted_plane(alpha_deg, acceleration):
+def test_pentagon_on_a_tilted_plane(alpha_deg, solver):
     mu = 0.4
     alpha = np.radians(alpha_deg)
     gravity = (G * np.sin(alpha), -G * np.cos(alpha))  # the plane is the floor, gravity tilted
     inradius = R * np.cos(np.pi / 5)
     sim = Simulation([[0.0, inradius]], [PENTAGON_ON_EDGE], [R], [5], Walls.floor(),
-                     Parameters(gravity=gravity, wall_friction=mu, acceleration=acceleration, **EXACT))
+                     Parameters(gravity=gravity, wall_friction=mu, **solver, **EXACT))
     h = sim.parameters.time_step
     for _ in range(5):
         sim.step()
