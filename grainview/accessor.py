@@ -92,7 +92,7 @@ class GrainAccessor:
 
             for k in range(self._ds.sizes["run"]):
                 validate(run_dataset(self._ds, k))
-            return None
+            return self._ds
         return validate(self._ds)
 
     # stress and strain
@@ -136,6 +136,11 @@ class GrainAccessor:
     def plot(self):
         """The paper's figures drawn from this dataset: ``ds.grain.plot.<name>(...)``
         (:mod:`grainview.plot`; matplotlib is imported on first use)."""
+        if "run" in self._ds.dims:
+            from .errors import ParameterError
+
+            raise ParameterError("the figures draw runs, not an ensemble: plot run_dataset(ens, k) (or a dict of "
+                                 "them), or write the ensemble's report (grainview.ensemble_report)")
         from .plot import PlotAccessor
 
         return PlotAccessor(self._ds)

@@ -198,6 +198,8 @@ def _report(args) -> int:
     from .report import write_report
 
     if getattr(args, "ensemble", False):
+        if args.labels or args.movie:
+            raise GrainviewError("--labels and --movie do not apply to --ensemble (the runs are named by their files)")
         return _ensemble_report(args)
 
     labels = args.labels.split(",") if args.labels else [Path(f).stem for f in args.files]
@@ -283,6 +285,12 @@ def _study(args) -> int:
     _check_test(args)
     if args.jobs < 1:
         raise GrainviewError(f"--jobs {args.jobs}: expected at least 1 process")
+    import os
+
+    threads = min(args.jobs, 2) * (args.domains or 1)
+    if threads > (os.cpu_count() or 1):
+        raise GrainviewError(f"--domains {args.domains} with --jobs {args.jobs} needs {threads} cores, this machine has "
+                             f"{os.cpu_count()}: a busy core stalls every parallel sweep; pass --jobs 1")
     out = Path(args.out)
     samples = {"pentagons": "pentagon", "disks": "disk"}
     preps = {label: _preparation(args, shape) for label, shape in samples.items()}

@@ -10,11 +10,13 @@ may differ in everything a study varies — seed, friction, size, confining stre
 * ``particle`` and ``contact`` are padded to the largest run (``run_particles(run)``,
   ``run_contacts(run)`` give each run's own sizes); the padding takes the contract's empty-slot
   values (i, j = -1, kind = 0, NaN otherwise; integer variables along time or particle 0);
-* global attributes equal in every file stay attributes; those that differ become coordinates
-  along ``run``, named ``attr_<name>`` (``attr_preparation_seed``, ``attr_solver_friction``...), and the
-  parameters a user groups by get short names: :data:`RUN_PARAMETERS` (``shape``, ``particles``,
-  ``seed``, ``friction``, ``sigma0_Pa``, ``preparation``, ``velocity_m_s``), with ``group``, a
-  label of the parameters other than the seed that vary across the ensemble.
+* global attributes equal in every file stay attributes; those that differ (or that some files
+  lack: a file written by an older version) become coordinates along ``run`` named
+  ``attr_<name>``, holding each file's own value (object dtype, :data:`ABSENT` where a file
+  has none); the parameters a user groups by get short typed names: :data:`RUN_PARAMETERS`
+  (``shape``, ``particles``, ``seed``, ``friction``, ``sigma0_Pa``, ``preparation``,
+  ``velocity_m_s``), and ``group`` labels the runs that share every setting but the seed
+  (:data:`SETTING_PREFIXES`, :data:`SETTINGS`): the unit over which seeds are pooled.
 
 Nothing is lost: :func:`run_dataset` gives back run k exactly as :func:`grainview.open_dataset`
 opens its file alone (values, dtypes, attributes). The ``ds.grain`` accessor uses it: on an
@@ -51,6 +53,14 @@ PADDED_DIMS = ("time", "particle", "contact")
 """Dimensions whose size may differ between runs (padded to the largest)."""
 RUN_SIZES = {"time": "run_snapshots", "particle": "run_particles", "contact": "run_contacts"}
 """Per-run size coordinate of each padded dimension."""
+SETTING_PREFIXES = ("solver_", "preparation_")
+"""Global attributes that set up a run (the solver's parameters, the sample's preparation)..."""
+SETTINGS = ("strain_target", "wall_velocity_m_s", "sigma0_Pa", "scene", "snapshot_every")
+"""...and these: runs that differ in any of them (the seed and version aside) are not seeds of
+one setting."""
+NOT_SETTINGS = ("preparation_seed", "solver_seed", "solver_version")
+ABSENT = "<absent>"
+"""Value of an ``attr_<name>`` coordinate for a run whose file has no such attribute."""
 ATTR_PREFIX = "attr_"
 """Prefix of the coordinates along ``run`` that hold the global attributes differing between runs."""
 ENSEMBLE_ATTR = "grainview_ensemble_attrs"
@@ -99,14 +109,6 @@ def _pad(ds: xr.Dataset, sizes: dict) -> xr.Dataset:
     return padded
 
 
-def _as_attr(value):
-    """A coordinate value back as the attribute it was (numpy scalar, string or array)."""
-    value = np.asarray(value)
-    if value.ndim == 0:
-        return value.item() if value.dtype.kind in "UO" else value[()]
-    return value
-
-
 def _differs(a, b) -> bool:
     try:
         return not np.array_equal(np.asarray(a), np.asarray(b))
@@ -131,11 +133,15 @@ def open_ensemble(paths, chunks="auto", validate: bool = False, names=None) -> x
     from .io import open_dataset
 
     files = _paths(paths)
-    names = [Path(f).stem for f in files] if names is None else [str(n) for n in names]
+    if names is None:
+        names = [Path(f).stem for f in files]
+        if len(set(names)) != len(names):  # the same file name in several folders: the paths
+            names = [os.path.splitext(f)[0] for f in files]
+    names = [str(n) for n in names]
     if len(names) != len(files):
         raise ParameterError(f"names has {len(names)} entries for {len(files)} files")
     if len(set(names)) != len(names):
-        raise ParameterError(f"two runs share a name among {names}: pass names=[...] to tell them apart")
+        raise ParameterError(f"two runs share a name among {names} (the same file twice?)")
     runs = [open_dataset(f, chunks=chunks, validate=validate) for f in files]
     first = runs[0]
     for f, ds in zip(files, runs):
@@ -149,10 +155,6 @@ def open_ensemble(paths, chunks="auto", validate: bool = False, names=None) -> x
     sizes = {d: max(ds.sizes.get(d, 0) for ds in runs) for d in PADDED_DIMS}
     keys = list(dict.fromkeys(k for ds in runs for k in ds.attrs))
     varying = [k for k in keys if any(k not in ds.attrs or _differs(ds.attrs[k], first.attrs.get(k)) for ds in runs)]
-    missing_attr = [k for k in varying if any(k not in ds.attrs for ds in runs)]
-    if missing_attr:
-        raise ParameterError(f"global attributes {missing_attr} are in some files only; an ensemble needs "
-                             "files written the same way")
     pieces = []
     for ds in runs:
         times = ds["time"]
@@ -160,9 +162,6 @@ def open_ensemble(paths, chunks="auto", validate: bool = False, names=None) -> x
         one = _pad(one, sizes)
         coords = {RUN_SIZES[d]: ds.sizes[d] for d in PADDED_DIMS}
         coords["source"] = ds.encoding.get("source", "")
-        for k in varying:
-            value = np.asarray(ds.attrs[k])
-            coords[ATTR_PREFIX + k] = (tuple(f"{k}_entry" for _ in range(value.ndim)), value) if value.ndim else value
         pieces.append(one.assign_coords(coords))
     ens = xr.concat(pieces, dim="run", data_vars="all", coords="all", compat="equals", join="exact",
                     combine_attrs="override")  # the variables' attributes: the same in every file
@@ -173,12 +172,23 @@ def open_ensemble(paths, chunks="auto", validate: bool = False, names=None) -> x
     for name in ("xy", "wall"):  # index coordinates, the same in every run
         if name in first.coords:
             ens = ens.assign_coords({name: first[name]})
+    per_run = {}
+    for k in varying:  # each file's own value, type and all (object dtype), or ABSENT
+        values = np.empty(len(runs), dtype=object)
+        for r, ds in enumerate(runs):
+            values[r] = ds.attrs.get(k, ABSENT)
+        per_run[ATTR_PREFIX + k] = ("run", values)
+    ens = ens.assign_coords(per_run)
     ens.attrs = {k: v for k, v in first.attrs.items() if k not in varying}
     ens.attrs[ENSEMBLE_ATTR] = " ".join(varying)
-    return _with_parameters(ens, runs)
+    return _with_parameters(ens, runs, varying)
 
 
-def _with_parameters(ens: xr.Dataset, runs) -> xr.Dataset:
+def _is_setting(name: str) -> bool:
+    return (name.startswith(SETTING_PREFIXES) or name in SETTINGS) and name not in NOT_SETTINGS
+
+
+def _with_parameters(ens: xr.Dataset, runs, varying) -> xr.Dataset:
     """Add :data:`RUN_PARAMETERS` and ``group`` as coordinates along ``run``."""
     params = {}
     for short, sources in RUN_PARAMETERS.items():
@@ -193,9 +203,17 @@ def _with_parameters(ens: xr.Dataset, runs) -> xr.Dataset:
                       for ds in runs]
         params[short] = ("run", np.asarray(values))
     ens = ens.assign_coords(params)
-    varying = [k for k in RUN_PARAMETERS if k != "seed" and len(np.unique(ens[k].values.astype(str))) > 1]
-    shown = varying or ["shape"]
-    labels = [", ".join(_label(k, ens[k].values[r]) for k in shown) for r in range(ens.sizes["run"])]
+    short = [k for k in RUN_PARAMETERS if k != "seed" and len(np.unique(ens[k].values.astype(str))) > 1]
+    covered = {source for k in RUN_PARAMETERS for source in RUN_PARAMETERS[k]}
+    # a setting that some files lack but all others agree on is not a difference: files of an
+    # older version, written before the parameter existed, ran with what is now its default
+    others = [k for k in varying if _is_setting(k) and k not in covered
+              and len({repr(ds.attrs[k]) for ds in runs if k in ds.attrs}) > 1]
+    labels = []
+    for r in range(ens.sizes["run"]):
+        parts = [_label(k, ens[k].values[r]) for k in short or ["shape"]]
+        parts += [_label(k, runs[r].attrs.get(k, ABSENT)) for k in others]
+        labels.append(", ".join(parts))
     return ens.assign_coords(group=("run", np.asarray(labels)))
 
 
@@ -205,7 +223,9 @@ def _label(key, value) -> str:
     if key == "particles":
         return f"N={value}"
     if isinstance(value, (float, np.floating)):
-        return f"{key} {value:g}"
+        return f"{key} {value:.6g}"
+    if isinstance(value, np.ndarray):
+        return f"{key} {np.array2string(value, separator=',')}"
     return f"{key} {value}"
 
 
@@ -230,13 +250,14 @@ def run_dataset(ens: xr.Dataset, run) -> xr.Dataset:
     one = one.isel(trims)
     per_run = ens.attrs.get(ENSEMBLE_ATTR, "").split()
     attrs = {k: v for k, v in ens.attrs.items() if k != ENSEMBLE_ATTR}
-    attrs.update({k: _as_attr(one[ATTR_PREFIX + k].values) for k in per_run})
+    for k in per_run:
+        value = one[ATTR_PREFIX + k].values[()]
+        if not (isinstance(value, str) and value == ABSENT):
+            attrs[k] = value
     times = one["run_time"]
     drop = [name for name in one.coords
             if "run" in ens[name].dims and name not in one.dims or name.startswith(ATTR_PREFIX) or name == "run"]
-    drop += [name for name in one.coords if name.endswith("_entry")]
     one = one.drop_vars(list(dict.fromkeys(drop)))
-    one = one.drop_dims([d for d in one.dims if d.endswith("_entry")], errors="ignore")
     one = one.assign_coords(time=("time", times.values, times.attrs))
     one.attrs = attrs
     source = str(ens["source"].values[int(run)]) if "source" in ens.coords else ""
@@ -292,11 +313,14 @@ def _bin_strain(da: xr.DataArray, bins) -> xr.DataArray:
         raise ParameterError(f"{da.name or 'the result'} has no eps_q coordinate to bin (a time series of the "
                              "accessor has one)")
     bins = np.asarray(bins, dtype=float)
+    if bins.ndim != 1 or bins.size < 2 or not np.all(np.isfinite(bins)) or not np.all(np.diff(bins) > 0):
+        raise ParameterError(f"eps_q_bins={bins.tolist()}: expected at least two increasing finite edges")
     eps = da["eps_q"].broadcast_like(da).values
     values = da.values
     t = da.get_axis_num("time")
     values, eps = np.moveaxis(values, t, -1), np.moveaxis(eps, t, -1)
     which = np.digitize(eps, bins) - 1
+    which[eps == bins[-1]] = bins.size - 2  # the last bin is closed: [e_{n-1}, e_n]
     shape = values.shape[:-1] + (bins.size - 1,)
     total, count = np.zeros(shape), np.zeros(shape)
     ok = (which >= 0) & (which < bins.size - 1) & np.isfinite(values)
@@ -315,7 +339,7 @@ def seed_statistics(result, eps_q_bins=None) -> xr.Dataset:
     """Mean, spread and standard error over the runs of each ``group`` (the seeds of one
     setting) of a per-run result of an ensemble.
 
-    With ``eps_q_bins`` (edges), a time series is first averaged within each bin of shear
+    With ``eps_q_bins`` (increasing edges; each bin [e_k, e_k+1), the last one closed), a time series is first averaged within each bin of shear
     strain eps_q run by run, so that runs of different heights, rates or lengths share one
     strain axis; without, the runs are compared snapshot by snapshot (or the result has no
     ``time``). Returns, per group: ``mean``, ``std`` (sample standard deviation, ddof = 1),

@@ -99,7 +99,7 @@ def write_ensemble_report(ens, out, residual_strain: float = RESIDUAL_STRAIN, ov
 
     out = Path(out)
     if not overwrite and (out / "headline.csv").exists():
-        raise FileExistsError(f"{out} already holds a report; pass --overwrite (overwrite=True) to replace it")
+        raise FileExistsError(f"{out} already holds a report; pass overwrite=True to replace it")
     stats, runs = ensemble_table(ens, residual_strain, log)
     text = format_table(stats)
     out.mkdir(parents=True, exist_ok=True)
@@ -109,8 +109,9 @@ def write_ensemble_report(ens, out, residual_strain: float = RESIDUAL_STRAIN, ov
     lines = ["| quantity | " + " | ".join(text.columns) + " |", "|---" * (len(text.columns) + 1) + "|"]
     lines += ["| " + " | ".join([str(idx), *(str(v) for v in row)]) + " |" for idx, row in text.iterrows()]
     files[2].write_text("\n".join(lines) + "\n")
-    top = float(np.nanmax(ens.grain.strains()["eps_q"].values)) if bins is None else None
-    bins = np.arange(0.0, top + 0.025, 0.025) if bins is None else np.asarray(bins, float)
+    if bins is None:  # 0.025 wide, up to the first edge beyond the largest strain reached
+        top = float(np.nanmax(ens.grain.strains()["eps_q"].values))
+        bins = 0.025 * np.arange(0, int(np.floor(top / 0.025)) + 2)
     figures = {
         "q_over_p": (ens.grain.stress_invariants()["q_over_p"], "q/p"),
         "fabric_anisotropy": (ens.grain.fabric_anisotropy()["a"], "fabric anisotropy a"),

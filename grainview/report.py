@@ -307,7 +307,7 @@ def write_report(runs: dict, out, residual_strain: float = RESIDUAL_STRAIN, over
     nothing a user owns is replaced by accident."""
     out = Path(out)
     if not overwrite and (out / "headline.csv").exists():
-        raise FileExistsError(f"{out} already holds a report; pass --overwrite (overwrite=True) to replace it")
+        raise FileExistsError(f"{out} already holds a report; pass overwrite=True to replace it")
     if log is not None:
         log(f"headline table of {len(runs)} run(s) (residual window eps_q >= {residual_strain:g}) ...")
     table = headline_table(runs, residual_strain)

@@ -216,27 +216,43 @@ class SnapshotWriter:
         nc.sync()
 
     def close(self):
+        """Close the file and release its writer lock. A close that fails (a full disk) raises
+        :class:`OutputError` in one line; the complete snapshots were synced before."""
         nc = self._nc
-        if nc.isopen():
+        try:
+            if not nc.isopen():
+                return
             if not self._failed:
                 try:  # everything to disk first: a failure here leaves the handle whole
                     nc.sync()
                 except (RuntimeError, OSError):
                     self._failed = True
-            if self._failed:
-                # After a failed write (a full disk) netCDF-C's close fails as well and leaves the
-                # handle half freed; netCDF4-python then keeps it marked open and closes it again
-                # when the Dataset is finalised, which crashes the interpreter. One close that
-                # ignores the error (what the finaliser itself does) avoids the second one; the
-                # complete snapshots were synced before the failure.
-                closer = getattr(nc, "_close", None)
-                if closer is not None:
-                    closer(False)
-            else:
-                nc.close()
-        if self._lock is not None:
-            self._lock.release()
-            self._lock = None
+            if not self._failed:
+                try:
+                    nc.close()
+                    return
+                except (RuntimeError, OSError) as exc:
+                    self._abandon(nc)
+                    raise OutputError(f"{self.path}: could not close the file ({exc}); its complete snapshots "
+                                      "were written before") from exc
+            self._abandon(nc)
+        finally:
+            if self._lock is not None:
+                self._lock.release()
+                self._lock = None
+
+    @staticmethod
+    def _abandon(nc):
+        """After a failed write or close (a full disk), netCDF-C's close fails as well and leaves
+        the handle half freed; netCDF4-python keeps it marked open and closes it again when the
+        Dataset is finalised, which crashes the interpreter. One close that ignores the error
+        (what the finaliser itself does) marks it closed."""
+        closer = getattr(nc, "_close", None)
+        if closer is not None and nc.isopen():
+            try:
+                closer(False)
+            except (RuntimeError, OSError):
+                pass
 
     def __enter__(self):
         return self

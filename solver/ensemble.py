@@ -38,6 +38,8 @@ import warnings
 from dataclasses import dataclass, field
 from pathlib import Path
 
+import numpy as np
+
 from grainview.errors import ConvergenceWarning, FileFormatError, ParameterError
 
 EVENT_TOPIC = "grainview-ensemble"
@@ -93,8 +95,11 @@ class RunSpec:
             raise ParameterError(f"seed={self.seed!r}: expected a whole number >= 0")
         from .stepper import Parameters
 
-        time_step = dict(self.solver).get("time_step", Parameters().time_step)
-        self.sample().check_time_step(time_step, self.velocity)  # and the preparation's own checks
+        try:
+            parameters = Parameters(**dict(self.solver)).validate()
+        except TypeError as exc:
+            raise ParameterError(f"solver={self.solver!r}: {exc}; expected fields of solver.Parameters") from None
+        self.sample().check_time_step(parameters.time_step, self.velocity)  # and the preparation's own checks
         return self
 
     def sample(self):
@@ -105,11 +110,16 @@ class RunSpec:
                            friction=self.friction, sigma0=self.sigma0)
 
     def expected_attrs(self) -> dict:
-        """File attributes a file of this run holds (to recognise it when resuming)."""
+        """File attributes a file of this run holds (to recognise it when resuming): the test,
+        the whole preparation, and the solver parameters the spec sets."""
+        from .preparation import preset_name
+
         prep = self.sample()
-        return {"strain_target": self.strain, "wall_velocity_m_s": self.velocity, "snapshot_every": self.every,
-                "preparation_seed": prep.seed, "preparation_particles": prep.particles,
-                "solver_friction": prep.friction, "sigma0_Pa": prep.sigma0}
+        expected = {"strain_target": self.strain, "wall_velocity_m_s": self.velocity, "snapshot_every": self.every,
+                    "solver_friction": prep.friction, "sigma0_Pa": prep.sigma0,
+                    "preparation_name": preset_name(prep), **prep.attrs()}
+        expected.update({f"solver_{k}": v for k, v in self.solver})
+        return expected
 
 
 def grid(*, shapes=("pentagon",), frictions=(None,), seeds=1, particles=(400,), sigma0=(None,), **common):
@@ -153,8 +163,11 @@ def _check_settings(path, spec: RunSpec):
         attrs = dict(ds.attrs)
     for key, want in spec.expected_attrs().items():
         have = attrs.get(key)
-        same = have is not None and (math.isclose(float(have), float(want), rel_tol=1e-12)
-                                     if isinstance(want, (int, float)) else str(have) == str(want))
+        if isinstance(want, bool):
+            want = int(want)
+        numeric = isinstance(want, (int, float, np.integer, np.floating)) and not isinstance(have, str)
+        same = have is not None and (math.isclose(float(have), float(want), rel_tol=1e-12) if numeric
+                                     else str(have) == str(want))
         if not same:
             raise FileExistsError(f"{path} holds another run ({key} = {have}, this run's is {want}); "
                                   "pass overwrite=True to replace it")
@@ -174,7 +187,7 @@ def run_one(spec: RunSpec, folder, *, overwrite=False, progress=None) -> dict:
     start = time.perf_counter()
     state = "missing" if overwrite else file_state(path)
     with warnings.catch_warnings(record=True) as caught:
-        warnings.simplefilter("always", ConvergenceWarning)
+        warnings.simplefilter("always")
         if state == "finished":
             _check_settings(path, spec)
             action, steps = "finished already", 0
@@ -188,8 +201,10 @@ def run_one(spec: RunSpec, folder, *, overwrite=False, progress=None) -> dict:
                                  progress=progress, near_contacts=spec.near_contacts)
             action = "ran"
     unconverged = sum(issubclass(w.category, ConvergenceWarning) for w in caught)
+    others = list(dict.fromkeys(str(w.message).splitlines()[0] for w in caught
+                                if not issubclass(w.category, (ConvergenceWarning, DeprecationWarning))))
     return {"name": spec.name, "path": str(path), "action": action, "steps": int(steps),
-            "seconds": time.perf_counter() - start, "unconverged": unconverged}
+            "seconds": time.perf_counter() - start, "unconverged": unconverged, "warnings": others}
 
 
 class _EventBar:
@@ -220,10 +235,10 @@ class _EventBar:
                                             "pid": os.getpid()})
 
 
-def _run_on_worker(spec: RunSpec, folder: str, overwrite: bool) -> dict:
-    """The task of one run on a dask worker: :func:`run_one` reporting progress as events."""
-    return run_one(spec, folder, overwrite=overwrite,
-                   progress=lambda total, desc: _EventBar(spec.name, total, desc))
+def _run_on_worker(spec: RunSpec, folder: str) -> dict:
+    """The task of one run on a dask worker: :func:`run_one` (never overwriting: a retried task
+    resumes its file) reporting progress as events."""
+    return run_one(spec, folder, progress=lambda total, desc: _EventBar(spec.name, total, desc))
 
 
 class _Display:
@@ -304,11 +319,18 @@ def run_ensemble(specs, folder, *, scheduler=None, workers=None, client=None, ov
     if len(set(names)) != len(names):
         raise ParameterError("specs name the same run twice")
     folder = Path(folder)
-    if not overwrite:  # a changed command line must not resume, or skip, another run's file
-        for spec in specs:
-            path = folder / f"{spec.name}.nc"
+    for spec in specs:
+        path = folder / f"{spec.name}.nc"
+        if overwrite:  # removed here, once: a run retried after a lost worker then resumes its file
+            if path.exists():
+                path.unlink()
+            continue
+        try:  # a changed command line must not resume, or skip, another run's file
             if file_state(path) in ("partial", "finished"):
                 _check_settings(path, spec)
+        except FileFormatError as exc:
+            raise FileFormatError(f"{exc}; remove the file to run {spec.name} again, or pass overwrite=True to "
+                                  "redo every run") from None
     folder.mkdir(parents=True, exist_ok=True)
     own = client is None
     cluster = None
@@ -318,7 +340,7 @@ def run_ensemble(specs, folder, *, scheduler=None, workers=None, client=None, ov
     display = _Display(specs, enabled, on_event)
     try:
         client.subscribe_topic(EVENT_TOPIC, display)
-        futures = {client.submit(_run_on_worker, spec, str(folder.resolve()), overwrite, pure=False,
+        futures = {client.submit(_run_on_worker, spec, str(folder.resolve()), pure=False,
                                  key=f"grainview-run-{spec.name}-{time.time_ns()}"): spec for spec in specs}
         results = {}
         for future in as_completed(futures):
@@ -346,6 +368,9 @@ def describe_result(result: dict) -> str:
     if "error" in result:
         return f"{result['name']}: FAILED ({result['error']})"
     extra = f", NLGS iteration limit in {result['unconverged']} step(s)" if result.get("unconverged") else ""
+    warned = result.get("warnings") or []
+    if warned:
+        extra += f"; {len(warned)} warning(s), the first: {warned[0]}"
     if result["action"] == "finished already":
         return f"{result['name']}: finished already ({result['path']})"
     return f"{result['name']}: {result['action']}, {result['steps']} steps in {result['seconds']:.1f} s{extra}"

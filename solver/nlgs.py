@@ -149,12 +149,16 @@ def _apply(k, dpn, dpt, a, b, nx, ny, rax, ray, rbx, rby, vx, vy, w, minv_xx, mi
     px = dpn * nx[k] - dpt * ny[k]
     py = dpn * ny[k] + dpt * nx[k]
     bb, aa = b[k], a[k]
-    vx[bb] += minv_xx[bb] * px + minv_xy[bb] * py
-    vy[bb] += minv_xy[bb] * px + minv_yy[bb] * py
-    w[bb] += iinv[bb] * _cross(rbx[k], rby[k], px, py)
-    vx[aa] -= minv_xx[aa] * px + minv_xy[aa] * py
-    vy[aa] -= minv_xy[aa] * px + minv_yy[aa] * py
-    w[aa] -= iinv[aa] * _cross(rax[k], ray[k], px, py)
+    # a body that cannot move (fixed or velocity-driven wall) is never written: its velocity is
+    # imposed, and the parallel sweep's domains all share it (solver.parallel_nlgs)
+    if iinv[bb] != 0.0 or minv_xx[bb] != 0.0 or minv_yy[bb] != 0.0:
+        vx[bb] += minv_xx[bb] * px + minv_xy[bb] * py
+        vy[bb] += minv_xy[bb] * px + minv_yy[bb] * py
+        w[bb] += iinv[bb] * _cross(rbx[k], rby[k], px, py)
+    if iinv[aa] != 0.0 or minv_xx[aa] != 0.0 or minv_yy[aa] != 0.0:
+        vx[aa] -= minv_xx[aa] * px + minv_xy[aa] * py
+        vy[aa] -= minv_xy[aa] * px + minv_yy[aa] * py
+        w[aa] -= iinv[aa] * _cross(rax[k], ray[k], px, py)
 
 
 @njit(cache=True)

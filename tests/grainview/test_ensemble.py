@@ -137,5 +137,32 @@ def test_open_ensemble_errors(files, tmp_path):
         grainview.open_ensemble([files[0], tmp_path / "odd.nc"])
     with pytest.raises(ParameterError, match="not an ensemble"):
         run_dataset(grainview.open_dataset(files[0]), 0)
+    ens = grainview.open_ensemble(files)
+    with pytest.raises(ParameterError, match="increasing"):
+        seed_statistics(ens.grain.stress_invariants()["q_over_p"], eps_q_bins=[0.1, 0.0])
+    with pytest.raises(ParameterError, match="not an ensemble"):
+        ens.grain.plot
     with pytest.raises(ParameterError, match="per-run result"):
         seed_statistics(grainview.open_dataset(files[0]).grain.stress_invariants()["q_over_p"])
+
+
+def test_files_of_different_versions_and_settings(files, tmp_path):
+    """A file without an attribute the others have (an older version) opens as written and does
+    not split its group; a setting that differs (here the NLGS tolerance) does."""
+    paths = []
+    for k, (attrs, drop) in enumerate([({"solver_tolerance": 1e-4, "solver_domains": np.int32(1)}, False),
+                                       ({"solver_tolerance": 1e-4}, False),
+                                       ({"solver_tolerance": 1e-5, "solver_domains": np.int32(1)}, False)]):
+        ds = harmonic_series(n_snapshots=4, n_contacts=30, seed=k)
+        ds.attrs.update(preparation_seed=np.int32(k), preparation_shape="pentagon", **attrs)
+        paths.append(tmp_path / f"v{k}.nc")
+        ds.to_netcdf(paths[-1], encoding=netcdf_encoding(ds), format="NETCDF3_64BIT")
+    ens = grainview.open_ensemble(paths)
+    assert list(ens["attr_solver_domains"].values) == [1, "<absent>", 1]
+    assert list(ens["group"].values) == ["pentagon, solver_tolerance 0.0001"] * 2 + ["pentagon, solver_tolerance 1e-05"]
+    for k, path in enumerate(paths):
+        alone = grainview.open_dataset(path, chunks=None)
+        one = run_dataset(ens, k).compute()
+        xr.testing.assert_identical(one, alone)
+        assert one.attrs.keys() == alone.attrs.keys()
+        assert all(type(one.attrs[key]) is type(alone.attrs[key]) for key in alone.attrs)

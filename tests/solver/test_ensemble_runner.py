@@ -79,6 +79,9 @@ def test_rerun_skips_finished_and_refuses_changed_settings(killed):
     changed = grid(seeds=1, **{**TINY, "strain": 0.04})
     with pytest.raises(FileExistsError, match="strain_target"):
         run_ensemble(changed, folder, workers=1, progress=False)
+    redo = run_ensemble(changed, folder, workers=1, progress=False, overwrite=True)
+    assert [r["action"] for r in redo] == ["ran"]  # removed first, then run from its deposit
+    assert grainview.open_dataset(redo[0]["path"]).attrs["strain_target"] == 0.04
 
 
 def test_failed_run_reported_others_finish(tmp_path, monkeypatch):

@@ -24,7 +24,9 @@ def problem():
     """The contact problem of a step of 120 pentagons compacted under 10 kPa (a stress-driven
     right wall)."""
     sim = compaction_sample(120, "pentagon", seed=3)
-    isotropic_compaction(sim)
+    with warnings.catch_warnings():  # a few compaction steps hit the sweep cap: not what is tested
+        warnings.simplefilter("ignore", ConvergenceWarning)
+        isotropic_compaction(sim)
     pts = sim.detect()
     keys = sim._point_keys(pts)
     impulse = sim._matched_impulses(keys)
