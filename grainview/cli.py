@@ -34,6 +34,12 @@ def _info(args) -> int:
     if args.attrs:
         for key, value in ds.attrs.items():
             print(f"  {key} = {value}")
+    from .validation import missing_units
+
+    unitless = missing_units(ds)
+    if unitless:
+        print(f"note: {len(unitless)} variable(s) carry no units attribute and are read in the contract's units "
+              f"(docs/schema.md): {', '.join(unitless)}")
     print("valid: follows grainview data contract " + str(ds.attrs.get("grainview_schema_version", "?")))
     return 0
 

@@ -79,6 +79,13 @@ def _unit_problems(ds: xr.Dataset) -> list[str]:
     return problems
 
 
+def missing_units(ds: xr.Dataset) -> list[str]:
+    """Contract variables of ``ds`` that carry no ``units`` attribute (taken in the contract's
+    units by :func:`validate`; ``grainview info`` reports them)."""
+    return [name for name in VARIABLES if name in ds.variables and name != "complete"
+            and "units" not in ds[name].attrs and "units" not in ds[name].encoding]
+
+
 def _value_checks(ds: xr.Dataset) -> dict[str, xr.DataArray]:
     """Lazy counts of bad entries, keyed by the message to show when the count is > 0."""
     n = ds.sizes["particle"]

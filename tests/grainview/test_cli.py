@@ -177,3 +177,15 @@ def test_report_of_an_ensemble_shows_mean_and_spread(tmp_path, capsys):
     assert stats.loc["q/p (residual)", "std"] == pytest.approx(np.std(q, ddof=1), rel=1e-9)
     assert f"{q.mean():.3f} ± {np.std(q, ddof=1):.3f} (3 seeds)" in capsys.readouterr().out
     assert main(argv) == 2  # the report exists: refused without --overwrite
+
+
+def test_info_reports_variables_without_units(tmp_path, capsys):
+    from grainview.dataset import netcdf_encoding
+
+    ds = harmonic_series(n_snapshots=2, n_contacts=20)
+    del ds["fn"].attrs["units"], ds["radius"].attrs["units"]
+    path = tmp_path / "no_units.nc"
+    ds.to_netcdf(path, encoding=netcdf_encoding(ds))
+    assert main(["info", str(path)]) == 0  # accepted: taken in the contract's units...
+    out = capsys.readouterr().out
+    assert "note: 2 variable(s) carry no units attribute" in out and "radius, " in out and "fn" in out  # ...and said
