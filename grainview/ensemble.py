@@ -126,9 +126,19 @@ def open_ensemble(paths, chunks="auto", validate: bool = False, names=None) -> x
     validate : check every file against the contract first
     names : the ``run`` coordinate (default: the file names without ``.nc``)
 
-    Every file must have the same walls and the same contract version. Each accessor works on
-    the result per run (``ens.grain.stress_invariants()`` has a ``run`` dimension), and
-    :func:`run_dataset` gives one run back as its file opens alone.
+    Returns
+    -------
+    xarray.Dataset
+        The runs along ``run`` (its coordinate: ``names``), lazy unless ``chunks=None``.
+
+    Every file must have the same walls and variables. Each accessor works on the result per
+    run (``ens.grain.stress_invariants()`` has a ``run`` dimension), and :func:`run_dataset`
+    gives one run back as its file opens alone.
+
+    Examples
+    --------
+    >>> ens = open_ensemble("study/*.nc")                                   # doctest: +SKIP
+    >>> seed_statistics(ens.grain.fabric_anisotropy()["a"], eps_q_bins=np.arange(0, 0.7, 0.05))  # doctest: +SKIP
     """
     from .io import open_dataset
 
@@ -345,6 +355,20 @@ def seed_statistics(result, eps_q_bins=None) -> xr.Dataset:
     ``time``). Returns, per group: ``mean``, ``std`` (sample standard deviation, ddof = 1),
     ``sem`` = std / sqrt(n) and ``n`` (runs with a value); for a Dataset, ``<name>_mean``...
     for each variable. NaN values (a run without snapshots in a bin) are left out.
+
+    Parameters
+    ----------
+    result : xarray.DataArray or xarray.Dataset
+        A per-run result of an ensemble (``ens.grain.<analysis>()``): a ``run`` dimension and
+        the ``group`` coordinate.
+    eps_q_bins : array_like, optional
+        Increasing edges of the shear-strain bins (1); bins are [e_k, e_k+1), the last closed.
+
+    Returns
+    -------
+    xarray.Dataset
+        ``mean``, ``std``, ``sem`` (in the result's units) and ``n`` along ``group`` (and
+        ``eps_q_bin``, the bin centres, with bins).
     """
     if isinstance(result, xr.Dataset):
         out = xr.Dataset()
