@@ -11,14 +11,14 @@ import numpy as np
 import xarray as xr
 
 from .errors import ParameterError
-from .schema import (CONTACT_VARIABLES, DEFAULT_WALL_NAMES, OPTIONAL_CONTACT_VARIABLES, VARIABLES, XY,
-                     contact_slots, empty_slots, global_attrs, variable_attrs)
+from .schema import (CONTACT_VARIABLES, DEFAULT_WALL_NAMES, OPTIONAL_CONTACT_VARIABLES, TIME_ATTRS, VARIABLES,
+                     XY, contact_slots, empty_slots, global_attrs, variable_attrs)
 
 __all__ = ["make_dataset", "netcdf_encoding"]
 
 
 def _coords(times, n_walls, wall_names):
-    coords = {"time": ("time", np.asarray(times, dtype="f8"), {"units": "s", "long_name": "simulated time", "axis": "T"}),
+    coords = {"time": ("time", np.asarray(times, dtype="f8"), dict(TIME_ATTRS)),
               "xy": ("xy", np.array(XY), {"long_name": "Cartesian component"})}
     if n_walls:
         names = tuple(wall_names) if wall_names is not None else DEFAULT_WALL_NAMES[:n_walls]
@@ -136,17 +136,27 @@ def make_dataset(
     return ds
 
 
-def netcdf_encoding(ds: xr.Dataset) -> dict:
+def netcdf_encoding(ds: xr.Dataset, zlib: bool = False, complevel: int = 4) -> dict:
     """Encoding for ``Dataset.to_netcdf`` that keeps the contract's integer sentinels.
 
     Integers get no ``_FillValue`` (xarray would turn masked integers into floats on
-    reading); floats use NaN as fill value.
+    reading); floats use NaN as fill value. With ``zlib`` the contract's variables are also
+    deflated at ``complevel`` (1-9), for a NETCDF4 copy to archive or share
+    (docs/schema.md, "Why no compression"); :func:`grainview.open_dataset` reads it unchanged.
+
+    Examples
+    --------
+    >>> ds = grainview.open_dataset("run.nc")                                  # doctest: +SKIP
+    >>> ds.to_netcdf("run-zlib.nc", format="NETCDF4",
+    ...              encoding=grainview.dataset.netcdf_encoding(ds, zlib=True))  # doctest: +SKIP
     """
     enc = {}
     for name in ds.variables:
         if name in VARIABLES:
             floating = ds[name].dtype.kind == "f"
             enc[name] = {"_FillValue": np.nan} if floating else {"_FillValue": None}
+            if zlib:
+                enc[name].update(zlib=True, complevel=int(complevel))
     if "time" in ds.variables:
         enc["time"] = {"_FillValue": np.nan}
     return enc

@@ -46,6 +46,14 @@ KIND_ATTRS = {
 
 DEFAULT_WALL_NAMES = ("bottom", "right", "top", "left")
 
+TIME_ATTRS = {"units": "s", "long_name": "simulated time since the start of the simulation",
+              "comment": "elapsed model time, not a date: it has no reference time, so it carries no "
+                         "CF time axis (axis T would require units 'seconds since <date>')"}
+"""Attributes of the ``time`` coordinate. CF (section 4.4) identifies a time axis by units of the
+form ``<unit> since <reference date>``; a simulation's clock has no date, so ``time`` is a plain
+coordinate in seconds (no ``axis: T``, no ``standard_name: time``), which CF allows and which no
+CF reader decodes into dates."""
+
 
 @dataclass(frozen=True)
 class Var:

@@ -12,8 +12,8 @@ import numpy as np
 
 from .errors import FileFormatError, OutputError, ParameterError
 from .locks import WriterLock
-from .schema import (CONTACT_VARIABLES, DEFAULT_WALL_NAMES, OPTIONAL_CONTACT_VARIABLES, REQUIRED, VARIABLES,
-                     complete_snapshots, contact_slots, empty_slots, global_attrs, variable_attrs)
+from .schema import (CONTACT_VARIABLES, DEFAULT_WALL_NAMES, OPTIONAL_CONTACT_VARIABLES, REQUIRED, TIME_ATTRS,
+                     VARIABLES, complete_snapshots, contact_slots, empty_slots, global_attrs, variable_attrs)
 
 __all__ = ["SnapshotWriter"]
 
@@ -105,7 +105,7 @@ class SnapshotWriter:
             xy.long_name = "Cartesian component"
             xy._Encoding = "utf-8"
             tvar = nc.createVariable("time", "f8", ("time",), fill_value=np.nan)
-            tvar.units, tvar.long_name, tvar.axis = "s", "simulated time", "T"
+            tvar.setncatts(TIME_ATTRS)
             if n_walls:
                 names = tuple(wall_names) if wall_names is not None else DEFAULT_WALL_NAMES[:n_walls]
                 width = max(len(s) for s in names)

@@ -195,13 +195,21 @@ def set_labels(ax, xlabel: str | None = None, ylabel: str | None = None):
         ax.set_ylabel(ylabel)
 
 
+LEGEND_INSIDE_MAX = 3
+"""The most legend entries drawn inside the axes (:func:`finish`)."""
+
+
 def finish(ax, pairs, title: str | None = None):
-    """Legend when any curve is labelled, and the title."""
+    """Legend when any curve is labelled, and the title. A legend of more than
+    :data:`LEGEND_INSIDE_MAX` entries, or on polar axes, sits beside the axes, where it covers
+    no curve; a shorter one goes where matplotlib finds the most room inside."""
     polar = getattr(ax, "name", "") == "polar"
     handles, labels = ax.get_legend_handles_labels()
     if labels:
         if polar:
             ax.legend(fontsize="small", loc="upper left", bbox_to_anchor=(1.0, 1.1))
+        elif len(labels) > LEGEND_INSIDE_MAX:
+            ax.legend(fontsize="small", loc="upper left", bbox_to_anchor=(1.02, 1.0), borderaxespad=0.0)
         else:
             ax.legend(fontsize="small")
     if polar:

@@ -164,8 +164,10 @@ def plot_force_pdf(data, ax=None, label=None, scale: str = "log-linear", time="r
 
     With ``fit`` (log-linear only) a dashed line P = A exp(-alpha f_n/<f_n>) over the strong
     forces (f_n > <f_n>) is drawn after each sample's pdf, alpha from
-    :func:`grainview.force_pdf.strong_force_exponent` given in the legend. Empty bins are not
-    drawn. Lines per sample: the pdf, then the fit when drawn."""
+    :func:`grainview.force_pdf.strong_force_exponent` given in the legend, over the range of
+    the data. Empty bins are not drawn; each bin carries its counting error bar,
+    P / sqrt(n) for n contacts in it (:func:`counting_error`; upper bar only for n = 1). Lines per sample: the pdf, then
+    the fit when drawn."""
     from ..force_pdf import strong_force_exponent
     ax = get_axes(ax)
     for lab, ds in datasets(data, label):
@@ -178,17 +180,38 @@ def plot_force_pdf(data, ax=None, label=None, scale: str = "log-linear", time="r
     return finish(ax, None)
 
 
+def counting_error(pdf: xr.Dataset) -> np.ndarray:
+    """One standard deviation of each bin of a pooled pdf from counting statistics: a bin
+    holding n contacts has P = n / (N width) and sigma_P = sqrt(n) / (N width) = P / sqrt(n)
+    (Poisson). NaN where the bin is empty or the counts are not known."""
+    p = values(pdf["pdf"])
+    if "count" not in pdf:
+        return np.full_like(p, np.nan)
+    n = values(pdf["count"])
+    with np.errstate(divide="ignore", invalid="ignore"):
+        return np.where(n > 0, p / np.sqrt(n), np.nan)
+
+
 def _draw_pdf(ax, pdf, label, colour, line_kw, style="o-"):
+    """The non-empty bins with their counting error bars (:func:`counting_error`); a bin of a
+    single contact, whose lower bar would reach zero on the log axis, gets its upper bar only."""
     x = np.asarray(pdf["f_over_mean"].values, float)
     p = values(pdf["pdf"])
     keep = p > 0
+    error = counting_error(pdf)[keep]
+    lower = np.where(error < 0.999 * p[keep], error, 0.0)
+    ax.errorbar(x[keep], p[keep], yerr=np.vstack([lower, error]), fmt="none", ecolor=colour, elinewidth=0.7,
+                capsize=0)
     ax.plot(x[keep], p[keep], style, markersize=3, color=colour, label=label, **line_kw)
 
 
 def _draw_fit(ax, pdf, alpha, label, colour):
+    """The exponential fit over the strong forces, drawn from f_n = <f_n> to the last bin that
+    holds contacts (never beyond the data)."""
     prefactor = exponential_fit(pdf, alpha)
     x = np.asarray(pdf["f_over_mean"].values, float)
-    x = x[x > 1.0]
+    held = x[values(pdf["pdf"]) > 0]
+    x = x[(x > 1.0) & (x <= (held.max() if held.size else -np.inf))]
     ax.plot(x, prefactor * np.exp(-alpha * x), "--", color=colour, linewidth=1,
             label=series_label(label, rf"$\exp(-{alpha:.2f}\, f_n/\langle f_n\rangle)$"))
 
@@ -243,23 +266,29 @@ def xi_profile(ds: xr.Dataset, xi=None, time="residual") -> xr.Dataset:
     return result.mean("time", keep_attrs=True).compute()
 
 
-def plot_xi_stress(data, ax=None, label=None, xi=None, time="residual", **line_kw):
+def plot_xi_stress(data, ax=None, label=None, xi=None, time="residual", min_contacts: float = 10, **line_kw):
     """Partial shear stress q(xi)/p of the contacts f_n < xi <f_n> against the cutoff xi
-    (paper Fig. 15; divided by the p of the whole sample, docs/conventions.md §5)."""
-    return _xi(data, ax, label, xi, time, "q_over_p", r"$q(\xi)/p$", line_kw)
+    (paper Fig. 15; divided by the p of the whole sample, docs/conventions.md §5). Cutoffs
+    whose network holds fewer than ``min_contacts`` contacts per snapshot on average are not
+    drawn."""
+    return _xi(data, ax, label, xi, time, "q_over_p", r"$q(\xi)/p$", min_contacts, line_kw)
 
 
-def plot_xi_anisotropy(data, ax=None, label=None, xi=None, time="residual", **line_kw):
+def plot_xi_anisotropy(data, ax=None, label=None, xi=None, time="residual", min_contacts: float = 10,
+                       **line_kw):
     """Partial fabric anisotropy a'(xi) of the contacts f_n < xi <f_n> against the cutoff xi
-    (paper Fig. 16; signed against the whole sample's major stress direction, docs/conventions.md §5)."""
-    return _xi(data, ax, label, xi, time, "a_prime", r"$a'(\xi)$", line_kw)
+    (paper Fig. 16; signed against the whole sample's major stress direction, docs/conventions.md §5).
+    Cutoffs whose network holds fewer than ``min_contacts`` contacts per snapshot on average
+    are not drawn: the anisotropy of a handful of contacts is noise (it spans [-2, 2])."""
+    return _xi(data, ax, label, xi, time, "a_prime", r"$a'(\xi)$", min_contacts, line_kw)
 
 
-def _xi(data, ax, label, xi, time, name, ylabel, line_kw):
+def _xi(data, ax, label, xi, time, name, ylabel, min_contacts, line_kw):
     ax = get_axes(ax)
     for lab, ds in datasets(data, label):
         prof = xi_profile(ds, xi, time)
-        ax.plot(np.asarray(prof["xi"].values, float), values(prof[name]), "o-", markersize=3,
+        keep = values(prof["count"]) >= min_contacts
+        ax.plot(np.asarray(prof["xi"].values, float)[keep], values(prof[name])[keep], "o-", markersize=3,
                 color=next_colour(ax), label=lab, **line_kw)
     set_labels(ax, XI_LABEL, ylabel)
     return finish(ax, None)
@@ -310,4 +339,4 @@ __all__ = ["plot_normal_force_polar", "plot_tangential_force_polar", "plot_tange
            "plot_force_anisotropy", "plot_force_anisotropies", "plot_force_pdf", "plot_force_pdfs",
            "plot_force_pdf_by_kind", "plot_force_pdfs_by_kind", "plot_xi_stress", "plot_xi_anisotropy",
            "plot_contact_proportions", "plot_type_transitions", "plot_strong_weak_proportions",
-           "angular_profile", "force_pdf_of", "exponential_fit", "xi_profile"]
+           "angular_profile", "force_pdf_of", "exponential_fit", "counting_error", "xi_profile"]

@@ -11,6 +11,8 @@ one :class:`~matplotlib.collections.LineCollection` and all particles one collec
 
 from __future__ import annotations
 
+from typing import NamedTuple
+
 import numpy as np
 import xarray as xr
 from matplotlib.collections import EllipseCollection, LineCollection, PolyCollection
@@ -22,10 +24,12 @@ from ._style import axis_label, get_axes, single_dataset, snapshot_index
 
 PARTICLE_FACE = "0.92"
 PARTICLE_EDGE = "0.55"
-CLASS_COLOURS = {1: "tab:blue", 2: "tab:green", 3: "tab:red"}
-"""Colours of the tricolor map: very weak (blue), weak (green), strong (red) (paper Fig. 17)."""
-KIND_COLOURS = {1: "tab:blue", 2: "tab:red"}
-"""Colours of the kind map: simple (blue), double (red) (paper Fig. 24)."""
+CLASS_COLOURS = {1: "#56B4E9", 2: "#009E73", 3: "#D55E00"}
+"""Colours of the tricolor map, the paper's blue / green / red (Fig. 17) taken from the
+Okabe–Ito palette, which stays distinguishable with every common colour-vision deficiency: very
+weak (sky blue), weak (bluish green), strong (vermillion)."""
+KIND_COLOURS = {1: "#0072B2", 2: "#D55E00"}
+"""Colours of the kind map (paper Fig. 24), Okabe–Ito: simple (blue), double (vermillion)."""
 
 
 def plot_particles(data, ax=None, time: int = -1, facecolor=PARTICLE_FACE, edgecolor=PARTICLE_EDGE,
@@ -153,11 +157,28 @@ def _network(ds, k, mask, colours, ax, max_linewidth, width_by_force, linewidth,
     fn = np.asarray(ds["fn"].isel(time=k).values, float)[slots]
     widths = (force_linewidths(fn, max_linewidth, force_scale) if width_by_force
               else np.full(slots.size, linewidth))
+    key = None
+    if width_by_force and fn.size:
+        top = float(force_scale) if force_scale is not None else float(fn.max())
+        key = WidthKey(top, max_linewidth, float(fn.mean()))
     colours = colours(slots) if callable(colours) else colours
     lines = LineCollection(segments, linewidths=widths, colors=colours, capstyle="round", zorder=zorder)
     lines.set_gid("contacts")
     ax.add_collection(lines)
-    return lines
+    return lines, key
+
+
+def newtons(force: float) -> str:
+    """A force as a legend shows it: whole newtons from 1 N to 100 kN, else 3 significant digits."""
+    return f"{force:.0f} N" if 1.0 <= abs(force) < 1e5 else f"{force:.3g} N"
+
+
+class WidthKey(NamedTuple):
+    """What a map's line widths stand for: ``max_linewidth`` points for ``top_force`` N; the
+    mean force drawn, ``mean_force`` N, is one of the legend's sample widths."""
+    top_force: float
+    max_linewidth: float
+    mean_force: float
 
 
 def contact_collection(ax) -> LineCollection:
@@ -178,7 +199,8 @@ def plot_force_chains(data, ax=None, time: int = -1, walls: bool = False, max_li
     ax = get_axes(ax)
     k = snapshot_index(ds, time)
     mask = selection(ds.isel(time=k), walls=walls).values
-    _network(ds, k, mask, colour, ax, max_linewidth, True, None, particles, force_scale=force_scale)
+    _, key = _network(ds, k, mask, colour, ax, max_linewidth, True, None, particles, force_scale=force_scale)
+    _legend(ax, {}, key, colour)
     return ax
 
 
@@ -197,9 +219,12 @@ def plot_force_classes(data, ax=None, time: int = -1, walls: bool = False, very_
     classes = np.asarray(force_class(snap, very_weak=very_weak, strong=strong, walls=walls).isel(time=0).values, int)
     mask = selection(snap.isel(time=0), walls=walls).values & (classes > 0)
     palette = np.array([CLASS_COLOURS.get(c, "k") for c in range(4)], dtype=object)
-    _network(ds, k, mask, lambda slots: list(palette[classes[slots]]), ax, max_linewidth, width_by_force,
-             linewidth, particles)
-    _legend(ax, {"very weak": CLASS_COLOURS[1], "weak": CLASS_COLOURS[2], "strong": CLASS_COLOURS[3]})
+    _, key = _network(ds, k, mask, lambda slots: list(palette[classes[slots]]), ax, max_linewidth,
+                      width_by_force, linewidth, particles)
+    _legend(ax, {rf"very weak, $f_n < {very_weak:g}\langle f_n\rangle$": CLASS_COLOURS[1],
+                 rf"weak, ${very_weak:g}\langle f_n\rangle \leq f_n \leq {strong:g}\langle f_n\rangle$":
+                     CLASS_COLOURS[2],
+                 rf"strong, $f_n > {strong:g}\langle f_n\rangle$": CLASS_COLOURS[3]}, key)
     return ax
 
 
@@ -212,16 +237,25 @@ def plot_contact_kinds(data, ax=None, time: int = -1, walls: bool = False, max_l
     k = snapshot_index(ds, time)
     mask = selection(ds.isel(time=k), walls=walls).values
     kind = np.asarray(ds["kind"].isel(time=k).values, int)
-    _network(ds, k, mask, lambda slots: [KIND_COLOURS.get(c, "k") for c in kind[slots]], ax, max_linewidth,
-             True, None, particles)
-    _legend(ax, {"simple (s)": KIND_COLOURS[1], "double (d)": KIND_COLOURS[2]})
+    _, key = _network(ds, k, mask, lambda slots: [KIND_COLOURS.get(c, "k") for c in kind[slots]], ax,
+                      max_linewidth, True, None, particles)
+    _legend(ax, {"simple (s)": KIND_COLOURS[1], "double (d)": KIND_COLOURS[2]}, key)
     return ax
 
 
-def _legend(ax, entries):
+def _legend(ax, entries, key=None, key_colour="0.3"):
+    """A legend beside the map (never over the packing): one line per colour of ``entries``
+    ({label: colour}) and, when the widths stand for forces (``key``, a :class:`WidthKey`), three
+    sample widths labelled in N: the mean force, half the largest and the largest."""
     from matplotlib.lines import Line2D
     handles = [Line2D([], [], color=c, label=name) for name, c in entries.items()]
-    ax.legend(handles=handles, fontsize="small", loc="upper right")
+    if key is not None and key.top_force > 0:
+        for force in sorted({key.mean_force, key.top_force / 2, key.top_force}):
+            handles.append(Line2D([], [], color=key_colour, linewidth=key.max_linewidth * force / key.top_force,
+                                  label=f"$f_n$ = {newtons(force)}"))
+    if handles:
+        ax.legend(handles=handles, fontsize="small", loc="upper left", bbox_to_anchor=(1.02, 1.0),
+                  borderaxespad=0.0)
 
 
 __all__ = ["plot_particles", "plot_force_chains", "plot_force_classes", "plot_contact_kinds",

@@ -22,7 +22,7 @@ from grainview.fabric import fabric_anisotropy, orientation_pdf  # noqa: E402
 from grainview.forces import force_anisotropies, harmonic_prediction  # noqa: E402
 from grainview.plot import PlotAccessor, save_figure  # noqa: E402
 from grainview.plot._style import select_snapshots  # noqa: E402
-from grainview.plot.maps import contact_collection  # noqa: E402
+from grainview.plot.maps import CLASS_COLOURS, KIND_COLOURS, contact_collection, newtons  # noqa: E402
 from grainview.strain import friction_and_dilatancy, strains  # noqa: E402
 from grainview.stress import stress_invariants  # noqa: E402
 from grainview.synthetic import harmonic_series  # noqa: E402
@@ -115,6 +115,8 @@ def test_evolution_lines_hold_the_analysis_values(name, series, other_series):
     assert ax.get_xlabel() == r"$\varepsilon_q$" and ax.get_ylabel() == ylabel
     assert all(text.startswith(("pentagons", "disks")) for text in legend_texts(ax))
     assert len(legend_texts(ax)) == 2 * n_curves
+    if 2 * n_curves > 3:  # a long legend sits beside the axes, over no curve
+        assert ax.get_legend().get_bbox_to_anchor().transformed(ax.transAxes.inverted()).x0 >= 1.0
 
 
 def test_q_over_p_of_a_square_lattice_is_the_hand_value():
@@ -318,10 +320,28 @@ def test_kind_map_colours_simple_blue_and_double_red():
     fn, kind = ds["fn"].values[0, :c], ds["kind"].values[0, :c]
     kept = (fn > 0) & (ds["j"].values[0, :c] < ds.sizes["particle"])
     colours = np.asarray(lines.get_colors())
-    want = np.array([to_rgba("tab:blue") if k == 1 else to_rgba("tab:red") for k in kind[kept]])
+    want = np.array([to_rgba(KIND_COLOURS[1]) if k == 1 else to_rgba(KIND_COLOURS[2]) for k in kind[kept]])
     np.testing.assert_allclose(colours, want)
     np.testing.assert_allclose(lines.get_linewidths(), 3.0 * fn[kept] / fn[kept].max())
-    assert legend_texts(ax) == ["simple (s)", "double (d)"]
+    top, mean = fn[kept].max(), fn[kept].mean()
+    assert legend_texts(ax) == ["simple (s)", "double (d)",
+                                *(f"$f_n$ = {newtons(f)}" for f in sorted({mean, top / 2, top}))]
+
+
+def test_map_legends_sit_beside_the_packing_with_a_key_of_line_widths_in_newtons():
+    ds = pentagon_grid()
+    ax = gp.plot_force_chains(ds, max_linewidth=4.0)
+    c = int(ds["contact_count"][0])
+    fn = ds["fn"].values[0, :c]
+    fn = fn[(fn > 0) & (ds["j"].values[0, :c] < ds.sizes["particle"])]
+    legend = ax.get_legend()
+    handles = legend.legend_handles
+    forces = sorted({fn.mean(), fn.max() / 2, fn.max()})
+    assert legend_texts(ax) == [f"$f_n$ = {newtons(f)}" for f in forces]
+    assert newtons(1376.4) == "1376 N" and newtons(0.01234) == "0.0123 N"
+    np.testing.assert_allclose([h.get_linewidth() for h in handles], [4.0 * f / fn.max() for f in forces])
+    anchor = legend.get_bbox_to_anchor().transformed(ax.transAxes.inverted())
+    assert anchor.x0 >= 1.0  # outside the axes: it covers no particle
 
 
 def test_map_takes_one_sample_and_one_snapshot(series):
@@ -345,10 +365,13 @@ def test_tricolor_map_colours_match_force_classes():
     particle_pairs = ds["j"].values[0, :c] < ds.sizes["particle"]
     labels = classes[:c][particle_pairs]
     colours = [tuple(col) for col in np.asarray(contact_collection(ax).get_colors())]
-    for code, name in ((1, "tab:blue"), (2, "tab:green"), (3, "tab:red")):
-        assert colours.count(to_rgba(name)) == np.count_nonzero(labels == code)
+    for code in (1, 2, 3):
+        assert colours.count(to_rgba(CLASS_COLOURS[code])) == np.count_nonzero(labels == code)
+    assert len(set(CLASS_COLOURS.values())) == 3
     assert len(colours) == np.count_nonzero(labels > 0)
-    assert legend_texts(ax) == ["very weak", "weak", "strong"]
+    texts = legend_texts(ax)
+    assert [t.split(",")[0] for t in texts] == ["very weak", "weak", "strong"]
+    assert "0.1" in texts[0] and "0.1" in texts[1] and "1" in texts[2]  # the thresholds are stated
 
 
 def test_force_pdf_log_linear_with_exponential_fit(series, other_series):
@@ -361,9 +384,15 @@ def test_force_pdf_log_linear_with_exponential_fit(series, other_series):
     keep = p > 0
     np.testing.assert_allclose(ax.lines[0].get_ydata(), p[keep])
     np.testing.assert_allclose(ax.lines[0].get_xdata(), want["f_over_mean"].values[keep])
+    # counting error bars: sigma = P / sqrt(n)
+    bars = [c for c in ax.collections if c.get_segments()][0].get_segments()
+    upper = np.array([seg[1][1] for seg in bars])
+    n = want["count"].values[keep]
+    np.testing.assert_allclose(upper, p[keep] * (1 + 1 / np.sqrt(n)))
     alpha = float(force_pdf.strong_force_exponent(want))
     x, y = ax.lines[1].get_xdata(), ax.lines[1].get_ydata()
     assert (x > 1).all()
+    assert x.max() <= want["f_over_mean"].values[keep].max()  # never drawn past the data
     np.testing.assert_allclose(np.diff(np.log(y)) / np.diff(x), -alpha)  # exp(-alpha x)
     assert f"{alpha:.2f}" in legend_texts(ax)[1]
     assert ax.get_yscale() == "log" and ax.get_xscale() == "linear"
@@ -395,6 +424,11 @@ def test_xi_network_curves(series, func, name, ylabel):
     np.testing.assert_allclose(ax.lines[0].get_xdata(), xi)
     np.testing.assert_allclose(ax.lines[0].get_ydata(), want.values, equal_nan=True)
     assert ax.get_xlabel() == r"$\xi$" and ax.get_ylabel() == ylabel
+    # cutoffs whose network is too small to mean anything are left out
+    count = xi_network.xi_network(select_snapshots(series, "residual"), xi=xi)["count"].mean("time").values
+    threshold = count[1] + 0.5
+    ax = func(series, xi=xi, min_contacts=threshold)
+    np.testing.assert_allclose(ax.lines[0].get_xdata(), xi[count >= threshold])
 
 
 @pytest.mark.parametrize("func, names", [

@@ -8,7 +8,7 @@ import xarray as xr
 
 import grainview
 from grainview.errors import FileFormatError, SchemaError
-from grainview.schema import contact_slots
+from grainview.schema import TIME_ATTRS, contact_slots
 from grainview.writer import SnapshotWriter
 
 from . import builders
@@ -53,6 +53,26 @@ def test_round_trip_keeps_values_and_integer_types(tmp_path):
     assert back.attrs["mu"] == 0.4
     assert back.fn.attrs["units"] == "N" and back.kind.attrs["flag_meanings"] == "empty simple double"
     grainview.validate(back)
+
+
+def test_time_is_a_cf_coordinate_in_seconds_that_no_reader_turns_into_dates(tmp_path):
+    ds = builders.mixed_contacts(t=3)
+    path = _write(ds, tmp_path / "run.nc")
+    import netCDF4
+    with netCDF4.Dataset(path) as nc:
+        attrs = {k: nc["time"].getncattr(k) for k in nc["time"].ncattrs() if not k.startswith("_")}
+        assert nc.Conventions == "CF-1.8"
+        for name in nc.variables:  # CF 4.4: a time axis needs units "<unit> since <date>"
+            var = nc[name]
+            if getattr(var, "axis", None) == "T" or getattr(var, "standard_name", None) == "time":
+                assert " since " in var.units, name
+            assert hasattr(var, "long_name"), name
+    assert attrs == TIME_ATTRS
+    plain = xr.open_dataset(path)  # decode_times=True, as any user would open it
+    assert plain["time"].dtype == np.float64
+    np.testing.assert_array_equal(plain["time"].values, ds["time"].values)
+    plain.close()
+    assert builders.mixed_contacts(t=1)["time"].attrs == TIME_ATTRS  # in-memory datasets alike
 
 
 def test_open_dataset_is_lazy_and_chunked_along_time_only(tmp_path):
@@ -126,6 +146,20 @@ def test_to_netcdf_with_contract_encoding_round_trips(tmp_path):
     ds.to_netcdf(path, encoding=grainview.dataset.netcdf_encoding(ds))
     back = grainview.open_dataset(path, chunks=None)
     xr.testing.assert_equal(back[["i", "j", "kind", "fn"]], ds[["i", "j", "kind", "fn"]])
+
+
+def test_a_zlib_copy_is_smaller_and_opens_and_validates_unchanged(tmp_path):
+    from grainview.synthetic import harmonic_series
+    ds = harmonic_series(n_snapshots=4, n_contacts=2000)
+    plain, packed = tmp_path / "plain.nc", tmp_path / "zlib.nc"
+    ds.to_netcdf(plain, format="NETCDF4", encoding=grainview.dataset.netcdf_encoding(ds))
+    ds.to_netcdf(packed, format="NETCDF4", encoding=grainview.dataset.netcdf_encoding(ds, zlib=True))
+    assert packed.stat().st_size < plain.stat().st_size
+    back = grainview.open_dataset(packed, chunks=None)  # eager: no dask thread touches HDF5
+    assert back["fn"].encoding.get("zlib") is True
+    xr.testing.assert_identical(back[list(ds.data_vars)].reset_coords(drop=True),
+                                grainview.open_dataset(plain, chunks=None)[list(ds.data_vars)].reset_coords(drop=True))
+    grainview.validate(back)
 
 
 @pytest.mark.parametrize("fraction", [0.1, 0.5, 0.9, 0.999])
