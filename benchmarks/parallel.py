@@ -4,13 +4,16 @@ against the serial sweep on dense sheared samples.
     python benchmarks/parallel.py            # writes benchmarks/RESULTS-parallel.md
     python benchmarks/parallel.py --quick    # small sizes, checks the script (_data/)
 
-Each case starts from the same state — a snapshot in the residual state of a 4000-pentagon
-biaxial test of the fidelity study, and the compacted 4000-disk sample at the start of its test
-(benchmarks/_data/fidelity; built by ``python benchmarks/fidelity/run.py --large``) — and runs
+Each case starts from one dense state — the compacted 4000-pentagon and 4000-disk samples at the
+start of their tests (built by ``python benchmarks/samples.py --build --sizes 4000``), and, where
+the fidelity study's 4000-pentagon test is cached (``python benchmarks/fidelity/run.py --large``),
+a snapshot of its residual state — and runs
 the same biaxial steps once with the serial NLGS and once with D domains on D numba threads, in
 fresh processes, one after the other. Reported: sweeps per step (median and 90th percentile),
 solve time and whole-step time per particle per step, the speed-up of each, and the local-law
-(natural-map) residual, so that a speed-up comes with the accuracy it was bought at.
+(natural-map) residual, so that a speed-up comes with the accuracy it was bought at, and the
+cores left idle by other processes just before each measurement: a thread pool shares the cores with whatever else
+runs, so a number measured beside another busy process is not this solver's speed.
 """
 
 from __future__ import annotations
@@ -59,29 +62,70 @@ def _measure(path, index, domains, steps, velocity):
 
 
 def cases(quick):
+    """(label, file, snapshot, top-wall speed m/s, steps) of each measured state; the dense
+    compacted samples of benchmarks/samples.py, and the residual state of the fidelity study's
+    4000-pentagon test where that run is cached."""
     if quick:
-        return [("pentagons, 1000, residual state", os.path.join(RUNS, "pentagon_1000_paper_s0_v1.6cm_e0.2.nc"), -1,
-                 0.016, 20)]
-    return [("pentagons, 4000, residual state (eps_q ~ 0.45)",
-             os.path.join(RUNS, "pentagon_4000_paper_s0_v3.2cm_e0.2.nc"), 70, 0.032, 300),
-            ("disks, 4000, compacted (start of the test)", os.path.join(SAMPLES, "disk_4000_paper_s0.nc"), -1,
-             0.032, 300)]
+        return [("pentagons, 1000, compacted (start of the test)", os.path.join(SAMPLES, "pentagon_1000_paper_s0.nc"),
+                 -1, 0.016, 20)]
+    chosen = [("pentagons, 4000, compacted (start of the test)", os.path.join(SAMPLES, "pentagon_4000_paper_s0.nc"),
+               -1, 0.032, 300),
+              ("disks, 4000, compacted (start of the test)", os.path.join(SAMPLES, "disk_4000_paper_s0.nc"), -1,
+               0.032, 300)]
+    residual = os.path.join(RUNS, "pentagon_4000_paper_s0_v3.2cm_e0.2.nc")
+    if os.path.exists(residual):
+        chosen.insert(1, ("pentagons, 4000, residual state (eps_q ~ 0.45)", residual, 70, 0.032, 300))
+    return chosen
+
+
+def check_samples(chosen):
+    """Refuse, naming the command that builds them, when the samples are not cached."""
+    missing = [path for _, path, *_ in chosen if not os.path.exists(path)]
+    if missing:
+        sizes = "1000" if all("_1000_" in p for p in missing) else "4000"
+        raise SystemExit(f"parallel.py: missing dense sample(s) {', '.join(os.path.basename(p) for p in missing)}; "
+                         f"build them with: python benchmarks/samples.py --build --sizes {sizes} --jobs 2")
+
+
+def idle_cores(seconds=2.0):
+    """Cores left idle by every other process over the next ``seconds`` (from /proc/stat); nan
+    where /proc/stat cannot be read."""
+    import time
+
+    def sample():
+        with open("/proc/stat") as fh:
+            values = [float(v) for v in fh.readline().split()[1:]]
+        return values[3] + values[4], sum(values)  # idle + iowait, total
+
+    try:
+        idle0, total0 = sample()
+        time.sleep(seconds)
+        idle1, total1 = sample()
+    except OSError:
+        return float("nan")
+    return (idle1 - idle0) / (total1 - total0) * (os.cpu_count() or 1)
 
 
 def run(quick=False, domains=2):
     rows = []
-    for label, path, index, velocity, steps in cases(quick):
+    chosen = cases(quick)
+    check_samples(chosen)
+    for label, path, index, velocity, steps in chosen:
+        load = {"serial": idle_cores()}
         serial, _ = in_fresh_process(_measure, path, index, 1, steps, velocity)
+        load["parallel"] = idle_cores()
         parallel, _ = in_fresh_process(_measure, path, index, domains, steps, velocity)
         n = serial["particles"]
-        for name, r in (("serial NLGS", serial), (f"{domains} domains, {parallel['threads']} threads", parallel)):
+        for key, name, r in (("serial", "serial NLGS", serial),
+                             ("parallel", f"{domains} domains, {parallel['threads']} threads", parallel)):
             rows.append([label, name, steps, f"{np.median(r['sweeps']):.0f} ({np.percentile(r['sweeps'], 90):.0f})",
                          f"{r['solve'] / steps / n * 1e6:.1f}", f"{r['total'] / steps / n * 1e6:.1f}",
                          f"{serial['solve'] / r['solve']:.2f}", f"{serial['total'] / r['total']:.2f}",
-                         f"{np.median(r['law']):.2e}"])
+                         f"{np.median(r['law']):.2e}", f"{load[key]:.2f}"])
             print(rows[-1], flush=True)
     header = ["sample", "solver", "steps", "sweeps/step median (p90)", "solve µs/particle/step",
-              "step µs/particle/step", "solve speed-up", "step speed-up", "local-law residual (median)"]
+              "step µs/particle/step", "solve speed-up", "step speed-up", "local-law residual (median)",
+              "idle cores before"]
     return markdown_table(header, rows)
 
 
