@@ -57,7 +57,9 @@ def animate(data, path, kind: str = "force_chains", every: int = 1, fps: int = 8
     eps_q = np.asarray(strains(ds)["eps_q"].values, float) if {"box_min", "box_max"} <= set(ds.variables) else None
     times = np.asarray(ds["time"].values, float)
     force_scale = float(ds["fn"].where(selection(ds, walls=walls)).isel(time=frames).max())
-    fig, ax = plt.subplots(figsize=(5, 7))
+    fig, ax = plt.subplots(figsize=(5, 7) if kind == "connectivity" else (7.5, 7))
+    if kind != "connectivity":
+        fig.subplots_adjust(left=0.1, right=0.62)  # room for the legend beside the map
     norm = cmap = None
     if kind == "connectivity":
         import matplotlib as mpl
