@@ -97,7 +97,7 @@ def sweep_domains(ptr, points, interface, a, b, nx, ny, rax, ray, rbx, rby, bias
     partial = np.zeros((domains, 2))
     for d in prange(domains):
         s, top = sweep(points[ptr[d]:ptr[d + 1]], a, b, nx, ny, rax, ray, rbx, rby, bias, mu, pn, pt, vx, vy, w,
-                       minv_xx, minv_xy, minv_yy, iinv, wnn, wnt, wtt)
+                       minv_xx, minv_xy, minv_yy, iinv, wnn, wnt, wtt, True)  # walls are shared: never written
         partial[d, 0] = s
         partial[d, 1] = top
     sum_dv2, max_dv2 = sweep(interface, a, b, nx, ny, rax, ray, rbx, rby, bias, mu, pn, pt, vx, vy, w,
