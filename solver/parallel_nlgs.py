@@ -8,8 +8,13 @@ slabs, or on a wall pushed by a stress, which is shared by the whole sample) is 
 point. One sweep is then:
 
 1. the D domains swept at once, one per thread, each in the serial order of its own points
-   (no two domains share a moving body, so they never write the same velocity);
+   (no two domains share a moving body, and each works on its own copy of the walls that
+   never move, so no two threads ever write the same velocity);
 2. the interface points swept serially after them.
+
+The copies exist because the sweep writes every body of a point, a wall that cannot move with
+a zero change (:func:`solver.nlgs._apply`: guarding that write makes the sweep several times
+slower); a copy's velocity is the wall's imposed one before and after the solve.
 
 Within a domain the sweep is the serial NLGS (:func:`solver.nlgs.sweep`, the same local solver
 and the same stopping norms), so the method is a Gauss–Seidel sweep in another order: it
@@ -25,6 +30,8 @@ walls, a fraction ~ D / sqrt(N) of the points.
 """
 
 from __future__ import annotations
+
+from typing import NamedTuple
 
 import numpy as np
 from numba import njit, prange
@@ -97,7 +104,7 @@ def sweep_domains(ptr, points, interface, a, b, nx, ny, rax, ray, rbx, rby, bias
     partial = np.zeros((domains, 2))
     for d in prange(domains):
         s, top = sweep(points[ptr[d]:ptr[d + 1]], a, b, nx, ny, rax, ray, rbx, rby, bias, mu, pn, pt, vx, vy, w,
-                       minv_xx, minv_xy, minv_yy, iinv, wnn, wnt, wtt, True)  # walls are shared: never written
+                       minv_xx, minv_xy, minv_yy, iinv, wnn, wnt, wtt)
         partial[d, 0] = s
         partial[d, 1] = top
     sum_dv2, max_dv2 = sweep(interface, a, b, nx, ny, rax, ray, rbx, rby, bias, mu, pn, pt, vx, vy, w,
@@ -125,13 +132,51 @@ def solve_domains(ptr, points, interface, a, b, nx, ny, rax, ray, rbx, rby, bias
     return max_iterations, quad, worst
 
 
-def decompose(problem, x, domains):
-    """``(ptr, points, interface)`` of :func:`partition_points` for ``problem`` with the
-    particle centres' x (m) cut into ``domains`` slabs."""
+class Decomposition(NamedTuple):
+    """The points of each domain (CSR: ``points[ptr[d]:ptr[d + 1]]``), the interface points,
+    and the points' bodies ``a``, ``b`` with the domains' own wall copies
+    (:func:`wall_copies`), whose original body is ``source[body]``."""
+    ptr: np.ndarray
+    points: np.ndarray
+    interface: np.ndarray
+    a: np.ndarray
+    b: np.ndarray
+    source: np.ndarray
+
+
+def decompose(problem, x, domains) -> Decomposition:
+    """The :class:`Decomposition` of ``problem`` with the particle centres' x (m) cut into
+    ``domains`` slabs."""
     n_bodies = problem.minv_xx.size
     body_domain = body_domains(np.asarray(x, float), n_bodies, problem.minv_xx, problem.minv_yy, problem.iinv,
                                int(domains))
-    return partition_points(problem.a, problem.b, body_domain, int(domains))
+    ptr, points, interface = partition_points(problem.a, problem.b, body_domain, int(domains))
+    a, b, source = wall_copies(problem.a, problem.b, body_domain, ptr, points)
+    return Decomposition(ptr, points, interface, a, b, source)
+
+
+def wall_copies(a, b, body_domain, ptr, points):
+    """Bodies of every point with the walls that never move (:data:`FREE`) replaced, in each
+    domain's points, by that domain's own copy of the wall; interface points keep the walls.
+
+    Returns ``(a, b, source)``: the points' bodies, and for every body of the extended set its
+    original body (the first ``body_domain.size`` are themselves; the copy of free body f for
+    domain d is body ``n + d * n_free + rank(f)``)."""
+    n = body_domain.size
+    domains = ptr.size - 1
+    free = np.flatnonzero(body_domain == FREE)
+    rank = np.full(n, -1, dtype=np.int64)
+    rank[free] = np.arange(free.size)
+    owner = np.full(a.size, -1, dtype=np.int64)
+    owner[points] = np.repeat(np.arange(domains), np.diff(ptr))
+    out = []
+    for bodies in (a, b):
+        bodies = np.array(bodies, dtype=np.int64)
+        copy = (owner >= 0) & (rank[bodies] >= 0)
+        bodies[copy] = n + owner[copy] * free.size + rank[bodies[copy]]
+        out.append(bodies)
+    source = np.concatenate([np.arange(n), np.tile(free, domains)])
+    return out[0], out[1], source
 
 
 def solve_problem_domains(problem, x, pn, pt, vx, vy, w, *, domains, tolerance, max_tolerance,
@@ -140,9 +185,13 @@ def solve_problem_domains(problem, x, pn, pt, vx, vy, w, *, domains, tolerance, 
     (module docstring) with ``domains`` slabs of the particles whose centres have abscissae
     ``x`` (m, the first ``x.size`` bodies); arguments and result otherwise as
     :func:`solver.nlgs.solve_problem`."""
-    ptr, points, interface = decompose(problem, x, domains)
+    n_bodies = problem.minv_xx.size
+    ptr, points, interface, a, b, source = decompose(problem, x, domains)
+    vx_all, vy_all, w_all = vx[source], vy[source], w[source]
     iterations, residual, worst = solve_domains(
-        ptr, points, interface, problem.a, problem.b, problem.nx, problem.ny, problem.rax, problem.ray,
-        problem.rbx, problem.rby, problem.bias, problem.mu, pn, pt, vx, vy, w, problem.minv_xx, problem.minv_xy,
-        problem.minv_yy, problem.iinv, tolerance, max_tolerance, int(max_iterations))
+        ptr, points, interface, a, b, problem.nx, problem.ny, problem.rax, problem.ray,
+        problem.rbx, problem.rby, problem.bias, problem.mu, pn, pt, vx_all, vy_all, w_all, problem.minv_xx[source],
+        problem.minv_xy[source], problem.minv_yy[source], problem.iinv[source], tolerance, max_tolerance,
+        int(max_iterations))
+    vx[:], vy[:], w[:] = vx_all[:n_bodies], vy_all[:n_bodies], w_all[:n_bodies]
     return NLGSResult(int(iterations), float(residual), float(worst))
