@@ -14,7 +14,10 @@ point. One sweep is then:
 
 The copies exist because the sweep writes every body of a point, a wall that cannot move with
 a zero change (:func:`solver.nlgs._apply`: guarding that write makes the sweep several times
-slower); a copy's velocity is the wall's imposed one before and after the solve.
+slower); a copy's velocity is the wall's imposed one before and after the solve. The problem is
+also renumbered so that each domain's points and bodies are contiguous in memory
+(:class:`Decomposition`): with the bodies interleaved, the two threads kept writing the same
+cache lines and the parallel sweep ran slower than the serial one.
 
 Within a domain the sweep is the serial NLGS (:func:`solver.nlgs.sweep`, the same local solver
 and the same stopping norms), so the method is a Gauss–Seidel sweep in another order: it
@@ -133,50 +136,95 @@ def solve_domains(ptr, points, interface, a, b, nx, ny, rax, ray, rbx, rby, bias
 
 
 class Decomposition(NamedTuple):
-    """The points of each domain (CSR: ``points[ptr[d]:ptr[d + 1]]``), the interface points,
-    and the points' bodies ``a``, ``b`` with the domains' own wall copies
-    (:func:`wall_copies`), whose original body is ``source[body]``."""
+    """A contact problem laid out for the domain-decomposed sweep.
+
+    The points are renumbered so that each domain's points are contiguous — domain d holds
+    ``ptr[d] .. ptr[d + 1] - 1``, the interface ``ptr[-1] ..`` — and so are the bodies: each
+    domain's moving bodies, then its own copies of the walls that never move, domain after
+    domain, then the shared bodies (walls pushed by a stress) and the still walls the interface
+    uses. Two threads then never write one cache line of the impulses or of the velocities
+    (interleaved storage made the sweep several times slower than the serial one).
+
+    ``point_order[k]``: the original point of point k; ``source[j]``: the original body of body
+    j; ``a``, ``b``: the points' bodies in the new numbering; ``moving``: the new numbers of the
+    bodies that can move (each appears once), whose velocities the solve returns.
+    """
     ptr: np.ndarray
-    points: np.ndarray
-    interface: np.ndarray
+    point_order: np.ndarray
     a: np.ndarray
     b: np.ndarray
     source: np.ndarray
+    moving: np.ndarray
+
+    @property
+    def points(self):
+        """The domains' points in the new numbering (contiguous by domain)."""
+        return np.arange(self.ptr[-1])
+
+    @property
+    def interface(self):
+        """The interface points in the new numbering."""
+        return np.arange(self.ptr[-1], self.point_order.size)
+
+    def gather(self, problem, pn, pt, vx, vy, w):
+        """The problem's arrays in the new numbering: (geometry, masses, state) with geometry =
+        (a, b, nx, ny, rax, ray, rbx, rby, bias, mu), masses = (minv_xx, minv_xy, minv_yy, iinv)
+        and state = (pn, pt, vx, vy, w) (copies)."""
+        k, j = self.point_order, self.source
+        geometry = (self.a, self.b, *(np.ascontiguousarray(v[k]) for v in (
+            problem.nx, problem.ny, problem.rax, problem.ray, problem.rbx, problem.rby, problem.bias, problem.mu)))
+        masses = tuple(np.ascontiguousarray(m[j]) for m in (problem.minv_xx, problem.minv_xy, problem.minv_yy,
+                                                           problem.iinv))
+        return geometry, masses, (pn[k], pt[k], vx[j], vy[j], w[j])
+
+    def scatter(self, state, pn, pt, vx, vy, w):
+        """Write a solved ``state`` (new numbering) back into the original arrays, in place:
+        every impulse, and the velocities of the bodies that can move (a still wall's
+        velocity is imposed and stays as it was)."""
+        spn, spt, svx, svy, sw = state
+        pn[self.point_order], pt[self.point_order] = spn, spt
+        for original, solved in ((vx, svx), (vy, svy), (w, sw)):
+            original[self.source[self.moving]] = solved[self.moving]
 
 
 def decompose(problem, x, domains) -> Decomposition:
-    """The :class:`Decomposition` of ``problem`` with the particle centres' x (m) cut into
-    ``domains`` slabs."""
+    """The :class:`Decomposition` of ``problem`` with the particles (centres' abscissae ``x``,
+    m) cut into ``domains`` slabs."""
     n_bodies = problem.minv_xx.size
+    domains = int(domains)
     body_domain = body_domains(np.asarray(x, float), n_bodies, problem.minv_xx, problem.minv_yy, problem.iinv,
-                               int(domains))
-    ptr, points, interface = partition_points(problem.a, problem.b, body_domain, int(domains))
-    a, b, source = wall_copies(problem.a, problem.b, body_domain, ptr, points)
-    return Decomposition(ptr, points, interface, a, b, source)
-
-
-def wall_copies(a, b, body_domain, ptr, points):
-    """Bodies of every point with the walls that never move (:data:`FREE`) replaced, in each
-    domain's points, by that domain's own copy of the wall; interface points keep the walls.
-
-    Returns ``(a, b, source)``: the points' bodies, and for every body of the extended set its
-    original body (the first ``body_domain.size`` are themselves; the copy of free body f for
-    domain d is body ``n + d * n_free + rank(f)``)."""
-    n = body_domain.size
-    domains = ptr.size - 1
+                               domains)
+    ptr, points, interface = partition_points(problem.a, problem.b, body_domain, domains)
+    point_order = np.concatenate([points, interface])
     free = np.flatnonzero(body_domain == FREE)
-    rank = np.full(n, -1, dtype=np.int64)
-    rank[free] = np.arange(free.size)
-    owner = np.full(a.size, -1, dtype=np.int64)
+    free_rank = np.full(n_bodies, -1, dtype=np.int64)
+    free_rank[free] = np.arange(free.size)
+    # body groups in storage order: per domain its moving bodies and its copies of the still
+    # walls; then the shared bodies and the interface's still walls
+    groups, free_offset, new_of = [], [], np.full(n_bodies, -1, dtype=np.int64)
+    size = 0
+    for d in range(domains):
+        mine = np.flatnonzero(body_domain == d)
+        new_of[mine] = size + np.arange(mine.size)
+        free_offset.append(size + mine.size)
+        groups += [mine, free]
+        size += mine.size + free.size
+    shared = np.flatnonzero(body_domain == SHARED)
+    new_of[shared] = size + np.arange(shared.size)
+    free_offset.append(size + shared.size)
+    groups += [shared, free]
+    source = np.concatenate(groups)
+    owner = np.full(problem.a.size, domains, dtype=np.int64)  # the interface: the last "domain"
     owner[points] = np.repeat(np.arange(domains), np.diff(ptr))
-    out = []
-    for bodies in (a, b):
-        bodies = np.array(bodies, dtype=np.int64)
-        copy = (owner >= 0) & (rank[bodies] >= 0)
-        bodies[copy] = n + owner[copy] * free.size + rank[bodies[copy]]
-        out.append(bodies)
-    source = np.concatenate([np.arange(n), np.tile(free, domains)])
-    return out[0], out[1], source
+    free_offset = np.asarray(free_offset, dtype=np.int64)
+    renumbered = []
+    for bodies in (problem.a, problem.b):
+        bodies = np.asarray(bodies, dtype=np.int64)
+        new = new_of[bodies]
+        still = free_rank[bodies] >= 0
+        new[still] = free_offset[owner[still]] + free_rank[bodies[still]]
+        renumbered.append(np.ascontiguousarray(new[point_order]))
+    return Decomposition(ptr, point_order, renumbered[0], renumbered[1], source, np.sort(new_of[new_of >= 0]))
 
 
 def solve_problem_domains(problem, x, pn, pt, vx, vy, w, *, domains, tolerance, max_tolerance,
@@ -185,13 +233,9 @@ def solve_problem_domains(problem, x, pn, pt, vx, vy, w, *, domains, tolerance, 
     (module docstring) with ``domains`` slabs of the particles whose centres have abscissae
     ``x`` (m, the first ``x.size`` bodies); arguments and result otherwise as
     :func:`solver.nlgs.solve_problem`."""
-    n_bodies = problem.minv_xx.size
-    ptr, points, interface, a, b, source = decompose(problem, x, domains)
-    vx_all, vy_all, w_all = vx[source], vy[source], w[source]
-    iterations, residual, worst = solve_domains(
-        ptr, points, interface, a, b, problem.nx, problem.ny, problem.rax, problem.ray,
-        problem.rbx, problem.rby, problem.bias, problem.mu, pn, pt, vx_all, vy_all, w_all, problem.minv_xx[source],
-        problem.minv_xy[source], problem.minv_yy[source], problem.iinv[source], tolerance, max_tolerance,
-        int(max_iterations))
-    vx[:], vy[:], w[:] = vx_all[:n_bodies], vy_all[:n_bodies], w_all[:n_bodies]
+    dec = decompose(problem, x, domains)
+    geometry, masses, state = dec.gather(problem, pn, pt, vx, vy, w)
+    iterations, residual, worst = solve_domains(dec.ptr, dec.points, dec.interface, *geometry, *state, *masses,
+                                                tolerance, max_tolerance, int(max_iterations))
+    dec.scatter(state, pn, pt, vx, vy, w)
     return NLGSResult(int(iterations), float(residual), float(worst))

@@ -62,50 +62,51 @@ def test_decomposition_respects_bodies(problem):
     assert 0 < interface.size < prob.a.size // 2
 
 
-def test_each_domain_writes_its_own_copy_of_the_still_walls(problem):
+def test_each_domain_writes_its_own_contiguous_bodies_and_copies_of_the_still_walls(problem):
     sim, prob, *_ = problem
     n_bodies = prob.minv_xx.size
     dec = parallel_nlgs.decompose(prob, sim.position[:, 0], 3)
     domain = parallel_nlgs.body_domains(sim.position[:, 0], n_bodies, prob.minv_xx, prob.minv_yy, prob.iinv, 3)
-    np.testing.assert_array_equal(dec.source[dec.a], prob.a)  # every copy stands for its wall
-    np.testing.assert_array_equal(dec.source[dec.b], prob.b)
-    np.testing.assert_array_equal(dec.a[dec.interface], prob.a[dec.interface])  # the interface keeps the walls
-    np.testing.assert_array_equal(dec.b[dec.interface], prob.b[dec.interface])
-    written = [set(dec.a[dec.points[dec.ptr[d]:dec.ptr[d + 1]]]) | set(dec.b[dec.points[dec.ptr[d]:dec.ptr[d + 1]]])
-               for d in range(3)]
+    assert sorted(dec.point_order.tolist()) == list(range(prob.a.size))
+    np.testing.assert_array_equal(dec.source[dec.a], prob.a[dec.point_order])  # every body stands for its original
+    np.testing.assert_array_equal(dec.source[dec.b], prob.b[dec.point_order])
+    spans = []
     for d in range(3):
-        for e in range(d + 1, 3):
-            assert not written[d] & written[e]  # no body written by two threads
-    copies = set().union(*written) - set(range(n_bodies))
-    assert copies and all(domain[dec.source[c]] == FREE for c in copies)
+        mine = slice(dec.ptr[d], dec.ptr[d + 1])
+        written = np.union1d(dec.a[mine], dec.b[mine])
+        spans.append((written.min(), written.max()))
+        assert all(domain[dec.source[j]] in (d, FREE) for j in written)
+    for (lo, hi), (next_lo, _) in zip(spans, spans[1:]):
+        assert hi < next_lo  # each domain's bodies in a block of their own: no shared cache line but at the edge
+    moving = set(dec.source[dec.moving].tolist())
+    assert moving == {j for j in range(n_bodies) if domain[j] != FREE}
+    assert len(dec.moving) == len(moving)
 
 
 def test_parallel_sweep_is_the_serial_sweep_in_domain_order(problem):
     sim, prob, impulse, v_free, omega_free = problem
-    n_bodies = prob.minv_xx.size
     dec = parallel_nlgs.decompose(prob, sim.position[:, 0], 2)
-    order = np.concatenate([dec.points, dec.interface])
     wnn, wnt, wtt = nlgs.delassus(prob.a, prob.b, prob.nx, prob.ny, prob.rax, prob.ray, prob.rbx, prob.rby,
                                   prob.minv_xx, prob.minv_xy, prob.minv_yy, prob.iinv)
-    shape = (prob.nx, prob.ny, prob.rax, prob.ray, prob.rbx, prob.rby, prob.bias, prob.mu)
+    geometry = (prob.a, prob.b, prob.nx, prob.ny, prob.rax, prob.ray, prob.rbx, prob.rby, prob.bias, prob.mu)
     masses = (prob.minv_xx, prob.minv_xy, prob.minv_yy, prob.iinv)
-    copied = tuple(m[dec.source] for m in masses)
-    serial = _state(impulse, v_free, omega_free)
     pn, pt, vx, vy, w = _state(impulse, v_free, omega_free)
-    parallel = (pn, pt, vx[dec.source], vy[dec.source], w[dec.source])
-    nlgs.velocities_from_impulses(prob.a, prob.b, *shape[:6], *serial, *masses)
-    nlgs.velocities_from_impulses(dec.a, dec.b, *shape[:6], *parallel, *copied)
+    new_geometry, new_masses, parallel = dec.gather(prob, pn, pt, vx, vy, w)
+    nlgs.velocities_from_impulses(*new_geometry[:8], *parallel, *new_masses)
+    serial = _state(impulse, v_free, omega_free)  # the same start, laid out as the problem is
+    dec.scatter(parallel, *serial)
+    order = dec.point_order
     for _ in range(25):
-        a = nlgs.sweep(order, prob.a, prob.b, *shape, *serial, *masses, wnn, wnt, wtt)
-        b = parallel_nlgs.sweep_domains(dec.ptr, dec.points, dec.interface, dec.a, dec.b, *shape, *parallel,
-                                        *copied, wnn, wnt, wtt)
+        a = nlgs.sweep(order, *geometry, *serial, *masses, wnn, wnt, wtt)
+        b = parallel_nlgs.sweep_domains(dec.ptr, dec.points, dec.interface, *new_geometry, *parallel, *new_masses,
+                                        wnn[order], wnt[order], wtt[order])
         # the same updates; the sums differ only by the order of their terms
         assert b[0] == pytest.approx(a[0], rel=1e-12) and b[1] == a[1]
-    for x, y in zip(serial[:2], parallel[:2]):
+    dec.scatter(parallel, pn, pt, vx, vy, w)
+    for x, y in zip(serial, (pn, pt, vx, vy, w)):
         np.testing.assert_array_equal(x, y)
-    for x, y in zip(serial[2:], parallel[2:]):
-        np.testing.assert_array_equal(x, y[:n_bodies])
-        np.testing.assert_array_equal(y[n_bodies:], x[dec.source[n_bodies:]])  # the copies keep the walls' velocity
+    still = np.setdiff1d(np.arange(len(dec.source)), dec.moving)  # copies of the walls keep their velocity
+    np.testing.assert_array_equal(parallel[2][still], serial[2][dec.source[still]])
     assert serial[0].max() > 0
 
 
