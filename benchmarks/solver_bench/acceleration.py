@@ -46,7 +46,10 @@ def _state(cfg: Config, shape, log):
     from runs import simulate
 
     run = FidelityConfig().run(shape=shape, particles=cfg.acc_particles)
-    path = simulate(run)  # cached in benchmarks/_data/fidelity; else compacted and sheared here (an hour or two)
+    if not os.path.exists(run.path()):
+        log(f"acceleration {shape}: the fidelity run {os.path.basename(run.path())} is not cached; compacting and "
+            "shearing it now (30-60 min on one core; `python benchmarks/fidelity/run.py` builds it too)")
+    path = simulate(run)  # cached in benchmarks/_data/fidelity
     import grainview
 
     with grainview.open_dataset(path) as ds:
