@@ -150,6 +150,8 @@ def netcdf_encoding(ds: xr.Dataset, zlib: bool = False, complevel: int = 4) -> d
     >>> ds.to_netcdf("run-zlib.nc", format="NETCDF4",
     ...              encoding=grainview.dataset.netcdf_encoding(ds, zlib=True))  # doctest: +SKIP
     """
+    if zlib and not (isinstance(complevel, (int, np.integer)) and 1 <= complevel <= 9):
+        raise ParameterError(f"complevel={complevel!r}: expected an integer from 1 to 9")
     enc = {}
     for name in ds.variables:
         if name in VARIABLES:

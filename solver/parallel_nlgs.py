@@ -142,8 +142,9 @@ class Decomposition(NamedTuple):
     ``ptr[d] .. ptr[d + 1] - 1``, the interface ``ptr[-1] ..`` — and so are the bodies: each
     domain's moving bodies, then its own copies of the walls that never move, domain after
     domain, then the shared bodies (walls pushed by a stress) and the still walls the interface
-    uses. Two threads then never write one cache line of the impulses or of the velocities
-    (interleaved storage made the sweep several times slower than the serial one).
+    uses. Two threads then write the same cache line of the impulses or of the velocities at
+    most at the edge of two blocks (interleaved storage made the sweep several times slower
+    than the serial one).
 
     ``point_order[k]``: the original point of point k; ``source[j]``: the original body of body
     j; ``a``, ``b``: the points' bodies in the new numbering; ``moving``: the new numbers of the

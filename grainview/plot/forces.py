@@ -183,7 +183,9 @@ def plot_force_pdf(data, ax=None, label=None, scale: str = "log-linear", time="r
 def counting_error(pdf: xr.Dataset) -> np.ndarray:
     """One standard deviation of each bin of a pooled pdf from counting statistics: a bin
     holding n contacts has P = n / (N width) and sigma_P = sqrt(n) / (N width) = P / sqrt(n)
-    (Poisson). NaN where the bin is empty or the counts are not known."""
+    (Poisson). NaN where the bin is empty or the counts are not known. Contacts pooled over
+    successive snapshots are counted as independent; a contact that lasts across snapshots is
+    counted in each, so with closely spaced snapshots these bars are a lower bound."""
     p = values(pdf["pdf"])
     if "count" not in pdf:
         return np.full_like(p, np.nan)

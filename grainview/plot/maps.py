@@ -169,8 +169,9 @@ def _network(ds, k, mask, colours, ax, max_linewidth, width_by_force, linewidth,
 
 
 def newtons(force: float) -> str:
-    """A force as a legend shows it: whole newtons from 1 N to 100 kN, else 3 significant digits."""
-    return f"{force:.0f} N" if 1.0 <= abs(force) < 1e5 else f"{force:.3g} N"
+    """A force as a legend shows it, to at least 3 significant digits: whole newtons from 100 N
+    to 100 kN, else 3 significant digits."""
+    return f"{force:.0f} N" if 100.0 <= abs(force) < 1e5 else f"{force:.3g} N"
 
 
 class WidthKey(NamedTuple):

@@ -338,7 +338,8 @@ def test_map_legends_sit_beside_the_packing_with_a_key_of_line_widths_in_newtons
     handles = legend.legend_handles
     forces = sorted({fn.mean(), fn.max() / 2, fn.max()})
     assert legend_texts(ax) == [f"$f_n$ = {newtons(f)}" for f in forces]
-    assert newtons(1376.4) == "1376 N" and newtons(0.01234) == "0.0123 N"
+    assert newtons(1376.4) == "1376 N" and newtons(0.01234) == "0.0123 N" and newtons(3.6) == "3.6 N"
+    assert newtons(1.4) != newtons(1.2)
     np.testing.assert_allclose([h.get_linewidth() for h in handles], [4.0 * f / fn.max() for f in forces])
     anchor = legend.get_bbox_to_anchor().transformed(ax.transAxes.inverted())
     assert anchor.x0 >= 1.0  # outside the axes: it covers no particle
@@ -369,9 +370,12 @@ def test_tricolor_map_colours_match_force_classes():
         assert colours.count(to_rgba(CLASS_COLOURS[code])) == np.count_nonzero(labels == code)
     assert len(set(CLASS_COLOURS.values())) == 3
     assert len(colours) == np.count_nonzero(labels > 0)
-    texts = legend_texts(ax)
-    assert [t.split(",")[0] for t in texts] == ["very weak", "weak", "strong"]
-    assert "0.1" in texts[0] and "0.1" in texts[1] and "1" in texts[2]  # the thresholds are stated
+    assert legend_texts(ax) == [r"very weak, $f_n < 0.1\langle f_n\rangle$",
+                                r"weak, $0.1\langle f_n\rangle \leq f_n \leq 1\langle f_n\rangle$",
+                                r"strong, $f_n > 1\langle f_n\rangle$"]  # the thresholds are stated
+    ax = gp.plot_force_classes(ds, very_weak=0.05, strong=1.5)
+    assert legend_texts(ax)[0].endswith(r"$f_n < 0.05\langle f_n\rangle$")
+    assert legend_texts(ax)[2].endswith(r"$f_n > 1.5\langle f_n\rangle$")
 
 
 def test_force_pdf_log_linear_with_exponential_fit(series, other_series):
@@ -384,11 +388,13 @@ def test_force_pdf_log_linear_with_exponential_fit(series, other_series):
     keep = p > 0
     np.testing.assert_allclose(ax.lines[0].get_ydata(), p[keep])
     np.testing.assert_allclose(ax.lines[0].get_xdata(), want["f_over_mean"].values[keep])
-    # counting error bars: sigma = P / sqrt(n)
+    # counting error bars: sigma = P / sqrt(n); a bin of one contact gets no lower bar
     bars = [c for c in ax.collections if c.get_segments()][0].get_segments()
-    upper = np.array([seg[1][1] for seg in bars])
+    lower, upper = np.array([seg[0][1] for seg in bars]), np.array([seg[1][1] for seg in bars])
     n = want["count"].values[keep]
     np.testing.assert_allclose(upper, p[keep] * (1 + 1 / np.sqrt(n)))
+    np.testing.assert_allclose(lower, np.where(n > 1, p[keep] * (1 - 1 / np.sqrt(n)), p[keep]))
+    assert (n == 1).any() and (n > 1).any()  # both kinds of bin are exercised
     alpha = float(force_pdf.strong_force_exponent(want))
     x, y = ax.lines[1].get_xdata(), ax.lines[1].get_ydata()
     assert (x > 1).all()

@@ -160,6 +160,10 @@ def test_a_zlib_copy_is_smaller_and_opens_and_validates_unchanged(tmp_path):
     xr.testing.assert_identical(back[list(ds.data_vars)].reset_coords(drop=True),
                                 grainview.open_dataset(plain, chunks=None)[list(ds.data_vars)].reset_coords(drop=True))
     grainview.validate(back)
+    from grainview.errors import ParameterError
+    for bad in (0, 10, 4.5):
+        with pytest.raises(ParameterError, match="complevel"):
+            grainview.dataset.netcdf_encoding(ds, zlib=True, complevel=bad)
 
 
 @pytest.mark.parametrize("fraction", [0.1, 0.5, 0.9, 0.999])
