@@ -101,6 +101,26 @@ def contact_events(ds: xr.Dataset, walls: bool = True, near=None) -> xr.Dataset:
     double changes during the life), ``mean_fn`` and ``max_fn`` (N, over the snapshots of the
     life), and, when the file has its box, ``lifetime_eps_q`` (the shear strain eps_q over the
     life, 1). Snapshot times must increase. Computed one time-chunk at a time.
+
+    Parameters
+    ----------
+    ds : xarray.Dataset
+        A grainview dataset (eager or chunked along ``time``).
+    walls : bool, default True
+        Follow particle–wall contacts too (``j >= N``).
+    near : float, optional
+        Gap threshold (m) adding the unloaded pairs within it to the network
+        (:func:`grainview.contacts.in_network`); None counts force-bearing contacts only.
+
+    Returns
+    -------
+    xarray.Dataset
+        One entry per life along ``contact_event``, with the variables above.
+
+    References
+    ----------
+    Contact persistence and force classes: Azéma et al., Phys. Rev. E 75, 011301 (2007),
+    Sec. V; docs/analysis.md.
     """
     _check_flag("walls", walls)
     check_near(ds, near)
@@ -144,7 +164,23 @@ def contact_events(ds: xr.Dataset, walls: bool = True, near=None) -> xr.Dataset:
 
 def kaplan_meier(durations, observed):
     """Kaplan–Meier survival: (u, S(u)) at the distinct observed durations u of ``durations``
-    whose ``observed`` flag is True (False = right-censored), S(u) = prod_{v <= u} (1 - d_v/n_v)."""
+    whose ``observed`` flag is True (False = right-censored), S(u) = prod_{v <= u} (1 - d_v/n_v).
+
+    Parameters
+    ----------
+    durations : array_like of float
+        Observed durations (a death's lifetime, or a censored life's duration so far).
+    observed : array_like of bool
+        True where the duration ends in a death, False where it is right-censored.
+
+    Returns
+    -------
+    u : numpy.ndarray
+        The distinct durations that end in a death, increasing.
+    survival : numpy.ndarray
+        S(u) at each of them; every life still counts as at risk up to its own duration,
+        censored or not.
+    """
     durations = np.asarray(durations, dtype=float)
     observed = np.asarray(observed, dtype=bool)
     if durations.shape != observed.shape:
@@ -166,7 +202,28 @@ def lifetime_survival(ds: xr.Dataset, walls: bool = True, near=None, by=None, un
     (f > <f>), weak (``very_weak`` <f> <= f <= <f>) and very weak (f < ``very_weak`` <f>;
     paper Sec. V), f the mean normal force over the life (``force_at="life"``) or the force at
     birth (``"birth"``) and <f> its mean over all lives; ``unit``: ``"time"`` (tau in s) or
-    ``"strain"`` (tau in eps_q). Returns (group, lifetime).
+    ``"strain"`` (tau in eps_q).
+
+    Parameters
+    ----------
+    ds : xarray.Dataset
+        A grainview dataset.
+    walls, near
+        Which contacts are followed, as in :func:`contact_events`.
+    by : {None, "kind", "force"}
+        Grouping of the lives.
+    unit : {"time", "strain"}
+        Lifetimes in s, or in shear strain eps_q (needs the file's box).
+    force_at : {"life", "birth"}
+        The force that classifies a life for ``by="force"``.
+    very_weak : float, default 0.1
+        The very weak threshold, a multiple of <f>.
+
+    Returns
+    -------
+    xarray.DataArray
+        ``survival`` (group, lifetime), dimensionless, a step function on the grid of every
+        observed lifetime, with the number of lives per group as the coordinate ``lives``.
     """
     if by not in (None, "kind", "force"):
         raise ParameterError(f"by={by!r}: expected None, 'kind' or 'force'")
@@ -210,8 +267,23 @@ def median_lifetime_by_force(ds: xr.Dataset, bins=(0.0, 0.5, 1.0, 1.5, 2.0, np.i
     """Do strong contacts live longer? The median lifetime (s) of the lives whose mean normal
     force over the life, over the mean of all lives, falls in each of ``bins``: the tau at which
     the bin's Kaplan–Meier survival first drops to 1/2 or below (censoring handled; NaN when it
-    never does). Left-censored lives are left out. Returns (force_bin,) with the number of
-    lives per bin as a coordinate."""
+    never does). Left-censored lives are left out.
+
+    Parameters
+    ----------
+    ds : xarray.Dataset
+        A grainview dataset.
+    bins : sequence of float
+        Increasing edges of the bins of mean force / <f>.
+    walls, near
+        Which contacts are followed, as in :func:`contact_events`.
+
+    Returns
+    -------
+    xarray.DataArray
+        ``median_lifetime`` (force_bin,) in s, with the number of lives per bin as the
+        coordinate ``lives``.
+    """
     bins = np.asarray(bins, dtype=float)
     if bins.ndim != 1 or bins.size < 2 or np.any(np.diff(bins) <= 0):
         raise ParameterError(f"bins={bins.tolist()}: expected increasing edges of at least one bin")
@@ -238,8 +310,29 @@ def strong_persistence(ds: xr.Dataset, max_lag: int = 20, strong: float = 1.0, w
     """Survival of the strong network: of the contacts strong at t (f_n > ``strong`` <f_n(t)>,
     paper Sec. V), the fraction still strong at t + lag, pooled over every t (sum of the kept
     over sum of the strong), for lag = 0 .. ``max_lag`` snapshots. Computed one time-chunk at a
-    time, carrying the strong sets of the last ``max_lag`` snapshots. Returns (lag,) with the
-    mean time interval of each lag (s) as the coordinate ``lag_time``."""
+    time, carrying the strong sets of the last ``max_lag`` snapshots.
+
+    Parameters
+    ----------
+    ds : xarray.Dataset
+        A grainview dataset.
+    max_lag : int, default 20
+        The largest lag, in snapshots (>= 1).
+    strong : float, default 1.0
+        The strong threshold, a multiple of the snapshot's mean normal force.
+    walls, near
+        Which contacts count, as in :func:`contact_events`.
+
+    Returns
+    -------
+    xarray.DataArray
+        ``strong_persistence`` (lag,), dimensionless, 1 at lag 0, with the mean time between
+        snapshots ``lag`` apart (s) as the coordinate ``lag_time``.
+
+    References
+    ----------
+    Strong and weak networks: Azéma et al., Phys. Rev. E 75, 011301 (2007), Sec. V.
+    """
     from collections import deque
 
     if isinstance(max_lag, bool) or not isinstance(max_lag, (int, np.integer)) or max_lag < 1:

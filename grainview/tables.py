@@ -28,7 +28,26 @@ def contacts_table(ds: xr.Dataset, time: int = -1):
     """A pandas DataFrame of the occupied contact slots of snapshot ``time`` (index; default the
     last): one row per contact, columns i, j, kind (1 simple, 2 double), wall (j >= N), fn, ft
     (N), normal_x, normal_y (unit, i -> j), point_x, point_y, branch_x, branch_y (m) and gap (m)
-    where the file has it. Units are in ``df.attrs["units"]``."""
+    where the file has it. Units are in ``df.attrs["units"]``.
+
+    Parameters
+    ----------
+    ds : xarray.Dataset
+        A grainview dataset.
+    time : int, default -1
+        Index of the snapshot along ``time``.
+
+    Returns
+    -------
+    pandas.DataFrame
+        One row per occupied slot (no padding), with ``attrs["units"]`` and ``attrs["time"]``
+        (s).
+
+    Examples
+    --------
+    >>> table = ds.grain.contacts_table(time=-1)                  # doctest: +SKIP
+    >>> table[table.fn > table.fn.mean()].kind.value_counts()     # doctest: +SKIP
+    """
     snap = _snapshot(ds, time)
     columns = {"i": snap["i"].values, "j": snap["j"].values, "kind": snap["kind"].values,
                "wall": snap["j"].values >= n_particles(ds), "fn": snap["fn"].values, "ft": snap["ft"].values}
@@ -51,7 +70,22 @@ def contact_graph(ds: xr.Dataset, time: int = -1, as_networkx: bool = False):
     """The contact network of snapshot ``time`` as a symmetric (N + W) x (N + W) scipy.sparse
     CSR matrix of normal forces (N; bodies 0..N-1 particles, then walls), or with
     ``as_networkx`` a networkx Graph whose edges carry fn, ft and kind. Only contacts with
-    f_n > 0 are edges (the force-bearing network)."""
+    f_n > 0 are edges (the force-bearing network).
+
+    Parameters
+    ----------
+    ds : xarray.Dataset
+        A grainview dataset.
+    time : int, default -1
+        Index of the snapshot along ``time``.
+    as_networkx : bool, default False
+        Return a networkx Graph (networkx is an optional dependency).
+
+    Returns
+    -------
+    scipy.sparse.csr_matrix or networkx.Graph
+        The weighted adjacency of the force-bearing network.
+    """
     from scipy import sparse
 
     snap = _snapshot(ds, time)
