@@ -116,7 +116,27 @@ def _collection(path, entries, overwrite):
 
 def write_vtk(ds: xr.Dataset, out_dir, every: int = 1, overwrite: bool = False, progress=None) -> list:
     """Write the VTK files of the module docstring for every ``every``-th snapshot into
-    ``out_dir`` (created if needed); returns the paths written, the two ``.pvd`` last."""
+    ``out_dir`` (created if needed), for ParaView or OVITO.
+
+    Parameters
+    ----------
+    ds : xarray.Dataset
+        A grainview dataset.
+    out_dir : str or path-like
+        Output folder, created if needed.
+    every : int, default 1
+        Write every ``every``-th snapshot (the last always included).
+    overwrite : bool, default False
+        Replace files that exist; otherwise an existing file is refused before anything is
+        written.
+    progress : bool, optional
+        Show a progress bar (default: none).
+
+    Returns
+    -------
+    list of str
+        The paths written, the two ``.pvd`` collections (particles, contacts) last.
+    """
     try:
         import meshio
     except ImportError:
@@ -125,6 +145,12 @@ def write_vtk(ds: xr.Dataset, out_dir, every: int = 1, overwrite: bool = False, 
     from .particle_fields import particle_fields
 
     indices = snapshot_indices(ds, every)
+    targets = [os.path.join(out_dir, f"{stem}_{int(k):05d}.vtu") for k in indices for stem in ("particles", "contacts")]
+    targets += [os.path.join(out_dir, f"{stem}.pvd") for stem in ("particles", "contacts")]
+    existing = [t for t in targets if os.path.exists(t)]
+    if existing and not overwrite:  # before anything is written
+        raise ParameterError(f"{existing[0]} exists ({len(existing)} of the {len(targets)} files to write); "
+                             "pass overwrite=True (--overwrite) to replace them")
     os.makedirs(out_dir, exist_ok=True)
     fields = particle_fields(ds, walls=True)
     classes = force_class(ds, walls=True)
@@ -153,8 +179,25 @@ def write_vtk(ds: xr.Dataset, out_dir, every: int = 1, overwrite: bool = False, 
 
 
 def write_csv(ds: xr.Dataset, out_dir, every: int = 1, overwrite: bool = False) -> str:
-    """Write ``contacts.csv`` (the tidy contact table of every ``every``-th snapshot, with
-    columns ``snapshot`` and ``time`` first) into ``out_dir``; returns its path."""
+    """Write ``contacts.csv``: the tidy contact table (:func:`grainview.tables.contacts_table`)
+    of every ``every``-th snapshot, with columns ``snapshot`` and ``time`` (s) first.
+
+    Parameters
+    ----------
+    ds : xarray.Dataset
+        A grainview dataset.
+    out_dir : str or path-like
+        Output folder, created if needed.
+    every : int, default 1
+        Write every ``every``-th snapshot (the last always included).
+    overwrite : bool, default False
+        Replace an existing ``contacts.csv``.
+
+    Returns
+    -------
+    str
+        The path of ``contacts.csv``.
+    """
     import pandas as pd
 
     from .tables import contacts_table

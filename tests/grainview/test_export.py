@@ -62,6 +62,16 @@ def test_existing_files_are_not_overwritten(tmp_path):
     assert not [f for f in os.listdir(tmp_path) if ".part" in f]
 
 
+def test_one_existing_file_refuses_the_export_before_anything_is_written(tmp_path):
+    ds = polygons_and_disks()
+    last = ds.sizes["time"] - 1
+    (tmp_path / f"contacts_{last:05d}.vtu").write_text("mine")  # a file of the user's, written last by the export
+    with pytest.raises(ParameterError, match="exists"):
+        write_vtk(ds, tmp_path, every=1)
+    assert os.listdir(tmp_path) == [f"contacts_{last:05d}.vtu"]  # nothing else written
+    assert (tmp_path / f"contacts_{last:05d}.vtu").read_text() == "mine"
+
+
 def test_csv_is_the_tidy_table_of_every_snapshot(tmp_path):
     ds = sequence_dataset(SERIES)
     path = write_csv(ds, tmp_path)
