@@ -247,7 +247,25 @@ def is_ensemble(ds) -> bool:
 def run_dataset(ens: xr.Dataset, run) -> xr.Dataset:
     """Run ``run`` (an index, or a name of the ``run`` coordinate) of an ensemble, exactly as
     :func:`grainview.open_dataset` opens its file alone: padding removed, its own ``time``
-    coordinate, its global attributes."""
+    coordinate, its global attributes.
+
+    Parameters
+    ----------
+    ens : xarray.Dataset
+        An ensemble of :func:`open_ensemble`.
+    run : int or str
+        Position along ``run``, or a value of the ``run`` coordinate.
+
+    Returns
+    -------
+    xarray.Dataset
+        The run alone (lazy where the ensemble is), identical to opening its file.
+
+    Examples
+    --------
+    >>> ens = grainview.open_ensemble("ensemble/*.nc")            # doctest: +SKIP
+    >>> grainview.ensemble.run_dataset(ens, 0).grain.stress_invariants()  # doctest: +SKIP
+    """
     if not is_ensemble(ens):
         raise ParameterError("not an ensemble: expected a Dataset with a 'run' dimension (open_ensemble)")
     if isinstance(run, str):
@@ -292,7 +310,20 @@ def _positional(result):
 def combine_runs(results, ens: xr.Dataset):
     """Per-run xarray results along a new ``run`` dimension with the ensemble's run
     coordinates; dimensions without an index (``time``, ``contact_event``...) are padded with
-    NaN to the longest run."""
+    NaN to the longest run.
+
+    Parameters
+    ----------
+    results : sequence of xarray.Dataset or xarray.DataArray
+        One result per run, in the ensemble's run order.
+    ens : xarray.Dataset
+        The ensemble they come from (its ``run`` coordinates are attached).
+
+    Returns
+    -------
+    xarray.Dataset or xarray.DataArray
+        The results along a new leading ``run`` dimension.
+    """
     results = [_positional(r) for r in results]
     sizes = {}
     for r in results:
@@ -309,7 +340,20 @@ def combine_runs(results, ens: xr.Dataset):
 
 def map_runs(ens: xr.Dataset, func):
     """``func(run_dataset(ens, k))`` for every run: xarray results combined along ``run``
-    (:func:`combine_runs`), any other result as a dict {run name: result}."""
+    (:func:`combine_runs`), any other result as a dict {run name: result}.
+
+    Parameters
+    ----------
+    ens : xarray.Dataset
+        An ensemble of :func:`open_ensemble`.
+    func : callable
+        Called with each run's dataset.
+
+    Returns
+    -------
+    xarray.Dataset or xarray.DataArray or dict
+        The results along ``run`` (padded to the longest run), or {run name: result}.
+    """
     results = [func(run_dataset(ens, k)) for k in range(ens.sizes["run"])]
     if all(isinstance(r, (xr.DataArray, xr.Dataset)) for r in results):
         return combine_runs(results, ens)
