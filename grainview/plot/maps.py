@@ -143,8 +143,15 @@ def force_linewidths(fn, max_linewidth: float, force_scale=None) -> np.ndarray:
     """Line widths proportional to the normal force: max_linewidth * f_n / F (points), F the
     largest f_n drawn or, for maps that must compare (a movie's frames), ``force_scale`` (N)."""
     fn = np.asarray(fn, float)
-    top = float(force_scale) if force_scale is not None else (fn.max() if fn.size else 0.0)
+    top = width_force(fn, force_scale)
     return max_linewidth * fn / top if top > 0 else np.zeros_like(fn)
+
+
+def width_force(fn, force_scale=None) -> float:
+    """The force F (N) drawn at the largest line width: ``force_scale`` when given, else the
+    largest of ``fn`` (0 for none)."""
+    fn = np.asarray(fn, float)
+    return float(force_scale) if force_scale is not None else (float(fn.max()) if fn.size else 0.0)
 
 
 def _network(ds, k, mask, colours, ax, max_linewidth, width_by_force, linewidth, particles, zorder=2,
@@ -159,8 +166,7 @@ def _network(ds, k, mask, colours, ax, max_linewidth, width_by_force, linewidth,
               else np.full(slots.size, linewidth))
     key = None
     if width_by_force and fn.size:
-        top = float(force_scale) if force_scale is not None else float(fn.max())
-        key = WidthKey(top, max_linewidth, float(fn.mean()))
+        key = WidthKey(width_force(fn, force_scale), max_linewidth, float(fn.mean()))
     colours = colours(slots) if callable(colours) else colours
     lines = LineCollection(segments, linewidths=widths, colors=colours, capstyle="round", zorder=zorder)
     lines.set_gid("contacts")
