@@ -62,7 +62,7 @@ def _export(args) -> int:
 
 def _demo(args) -> int:
     from . import open_dataset
-    from .dataset import netcdf_encoding
+    from .dataset import netcdf_options
     from .synthetic import harmonic_series
 
     if args.snapshots < 2 or args.contacts < 1:
@@ -75,7 +75,7 @@ def _demo(args) -> int:
         raise GrainviewError(f"{path} exists; pass --overwrite to replace it")
     ds = harmonic_series(n_snapshots=args.snapshots, n_contacts=args.contacts, seed=args.seed)
     tmp = path.with_suffix(".nc.part")
-    ds.to_netcdf(tmp, encoding=netcdf_encoding(ds))
+    ds.to_netcdf(tmp, **netcdf_options(ds, compress=not args.no_compress))
     tmp.replace(path)
     lazy = open_dataset(path, chunks=5, validate=True)
     table = lazy.grain.harmonic_prediction().compute()
@@ -119,7 +119,7 @@ def _check_test(args):
 
 
 def _simulate(prep, path, *, strain, every, velocity, near_contacts, overwrite, progress, scene="biaxial",
-              parameters=None):
+              parameters=None, compress=True):
     """Deposit, compact isotropically (as ``prep`` says) and, for ``scene="biaxial"``, shear
     one sample into ``path``; returns the path. An isotropic run writes its compacted state.
     ``parameters``: solver settings (:class:`solver.Parameters` fields) other than the defaults."""
@@ -143,12 +143,12 @@ def _simulate(prep, path, *, strain, every, velocity, near_contacts, overwrite, 
         attrs = record(sim)
         if scene == "isotropic":
             with Recorder(path, sim, attrs={"scene": "isotropic", **attrs}, overwrite=overwrite,
-                          near_contacts=near_contacts) as rec:
+                          near_contacts=near_contacts, compress=compress) as rec:
                 rec.write()
         else:
             print(f"{name}: biaxial compression to eps_1 = {strain} at {velocity:g} m/s ...", flush=True)
             biaxial_test(sim, path, strain=strain, every=every, velocity=velocity, overwrite=overwrite,
-                         progress=progress, attrs=attrs, near_contacts=near_contacts)
+                         progress=progress, attrs=attrs, near_contacts=near_contacts, compress=compress)
     unconverged = sum(issubclass(w.category, ConvergenceWarning) for w in caught)
     if unconverged:
         print(f"{name}: warning: NLGS reached its iteration limit in {unconverged} step(s)", file=sys.stderr)
@@ -162,7 +162,8 @@ def _progress_flag(args):
 
 def _simulation_kwargs(args):
     return dict(strain=args.strain, every=args.every, velocity=args.velocity, near_contacts=args.near_contacts,
-                overwrite=args.overwrite, progress=_progress_flag(args), parameters=_solver_parameters(args))
+                overwrite=args.overwrite, progress=_progress_flag(args), parameters=_solver_parameters(args),
+                compress=not args.no_compress)
 
 
 def _check_output_file(path, overwrite):
@@ -334,6 +335,11 @@ def build_parser() -> argparse.ArgumentParser:
     parser.add_argument("--version", action="version", version=f"%(prog)s {__version__}")
     sub = parser.add_subparsers(dest="command", required=True)
 
+    def no_compress_option(p):
+        p.add_argument("--no-compress", action="store_true",
+                       help="leave the finished netCDF files uncompressed (default: zlib, about half the size; "
+                       "read the same either way)")
+
     def residual_option(p):
         p.add_argument("--residual-strain", type=float, default=RESIDUAL_STRAIN,
                        help=f"the residual state starts at this shear strain eps_q (default {RESIDUAL_STRAIN}); "
@@ -381,6 +387,7 @@ def build_parser() -> argparse.ArgumentParser:
         p.add_argument("--overwrite", action="store_true", help="replace existing output files")
         p.add_argument("--progress", choices=["auto", "on", "off"], default="auto",
                        help="progress bars (default: on in a terminal)")
+        no_compress_option(p)
 
     study = sub.add_parser("study", help="the paper's study: pentagons vs disks, simulated, analysed, plotted",
                            description="Deposit, compact (10 kPa) and shear an S1-like pentagon sample and an "
@@ -479,6 +486,7 @@ def build_parser() -> argparse.ArgumentParser:
     demo.add_argument("--contacts", type=int, default=20000, help="contacts per snapshot (default 20000)")
     demo.add_argument("--seed", type=int, default=0, help="random seed (default 0)")
     demo.add_argument("--overwrite", action="store_true", help="replace existing output files")
+    no_compress_option(demo)
     demo.set_defaults(func=_demo)
     return parser
 

@@ -14,7 +14,7 @@ from .errors import ParameterError
 from .schema import (CONTACT_VARIABLES, DEFAULT_WALL_NAMES, OPTIONAL_CONTACT_VARIABLES, TIME_ATTRS, VARIABLES,
                      XY, contact_slots, empty_slots, global_attrs, variable_attrs)
 
-__all__ = ["make_dataset", "netcdf_encoding"]
+__all__ = ["make_dataset", "netcdf_encoding", "netcdf_options"]
 
 
 def _coords(times, n_walls, wall_names):
@@ -141,16 +141,32 @@ def netcdf_encoding(ds: xr.Dataset, zlib: bool = False, complevel: int = 4) -> d
 
     Integers get no ``_FillValue`` (xarray would turn masked integers into floats on
     reading); floats use NaN as fill value. With ``zlib`` the contract's variables are also
-    deflated at ``complevel`` (1-9), for a NETCDF4 copy to archive or share
-    (docs/schema.md, "Why no compression"); :func:`grainview.open_dataset` reads it unchanged.
+    deflated at ``complevel`` (1-9, with byte shuffling), for a file in
+    :data:`grainview.writer.COMPRESSED_FORMAT` (docs/schema.md, "Compression");
+    :func:`grainview.open_dataset` reads it unchanged. :func:`netcdf_options` gives the format
+    and the encoding together.
+
+    Parameters
+    ----------
+    ds : xarray.Dataset
+        A dataset of the contract.
+    zlib : bool
+        Deflate the contract's variables.
+    complevel : int
+        zlib level, 1 (fastest) to 9 (smallest); used with ``zlib``.
+
+    Returns
+    -------
+    dict
+        Variable name -> encoding, for ``ds.to_netcdf(path, encoding=...)``.
 
     Examples
     --------
     >>> ds = grainview.open_dataset("run.nc")                                  # doctest: +SKIP
-    >>> ds.to_netcdf("run-zlib.nc", format="NETCDF4",
+    >>> ds.to_netcdf("run-zlib.nc", format="NETCDF4_CLASSIC",
     ...              encoding=grainview.dataset.netcdf_encoding(ds, zlib=True))  # doctest: +SKIP
     """
-    if zlib and not (isinstance(complevel, (int, np.integer)) and 1 <= complevel <= 9):
+    if zlib and (isinstance(complevel, bool) or not (isinstance(complevel, (int, np.integer)) and 1 <= complevel <= 9)):
         raise ParameterError(f"complevel={complevel!r}: expected an integer from 1 to 9")
     enc = {}
     for name in ds.variables:
@@ -158,7 +174,24 @@ def netcdf_encoding(ds: xr.Dataset, zlib: bool = False, complevel: int = 4) -> d
             floating = ds[name].dtype.kind == "f"
             enc[name] = {"_FillValue": np.nan} if floating else {"_FillValue": None}
             if zlib:
-                enc[name].update(zlib=True, complevel=int(complevel))
+                enc[name].update(zlib=True, complevel=int(complevel), shuffle=True)
     if "time" in ds.variables:
         enc["time"] = {"_FillValue": np.nan}
     return enc
+
+
+def netcdf_options(ds: xr.Dataset, compress: bool = True, complevel: int = 4) -> dict:
+    """Keyword arguments of ``Dataset.to_netcdf`` that write ``ds`` as the solver writes a
+    finished run: compressed (:data:`grainview.writer.COMPRESSED_FORMAT`, zlib at
+    ``complevel``) or, with ``compress=False``, netCDF-3 (:data:`grainview.writer.APPEND_FORMAT`);
+    the contract's integer sentinels kept either way (:func:`netcdf_encoding`).
+
+    Examples
+    --------
+    >>> ds.to_netcdf("copy.nc", **grainview.dataset.netcdf_options(ds))      # doctest: +SKIP
+    """
+    from .writer import APPEND_FORMAT, COMPRESSED_FORMAT
+
+    plain = APPEND_FORMAT.removesuffix("_OFFSET")  # xarray's name for the same format
+    return {"format": COMPRESSED_FORMAT if compress else plain,
+            "encoding": netcdf_encoding(ds, zlib=bool(compress), complevel=complevel)}

@@ -15,7 +15,21 @@ from .locks import WriterLock
 from .schema import (CONTACT_VARIABLES, DEFAULT_WALL_NAMES, OPTIONAL_CONTACT_VARIABLES, REQUIRED, TIME_ATTRS,
                      VARIABLES, complete_snapshots, contact_slots, empty_slots, global_attrs, variable_attrs)
 
-__all__ = ["SnapshotWriter"]
+__all__ = ["SnapshotWriter", "compress_file", "decompress_file", "is_compressed", "APPEND_FORMAT",
+           "COMPRESSED_FORMAT", "DEFAULT_COMPLEVEL"]
+
+APPEND_FORMAT = "NETCDF3_64BIT_OFFSET"
+"""The format a run is written in while it goes on: its records are appended in place, so a
+killed writer leaves every completed snapshot readable."""
+COMPRESSED_FORMAT = "NETCDF4_CLASSIC"
+"""The format a finished run is kept in: HDF5 storage with zlib, and the classic data model
+(strings as character arrays, as in netCDF-3). Not variable-length strings: with them, this
+project's netCDF4 1.7 / HDF5 2.2 can crash the interpreter when a file read before in the
+same process is opened again (docs/schema.md)."""
+DEFAULT_COMPLEVEL = 4
+"""zlib level (1-9) of :func:`compress_file`."""
+COPY_BLOCK_BYTES = 64 * 2**20
+"""At most this many bytes of one variable are held in memory while a file is converted."""
 
 
 def _move_into_place(temporary: str, path: str, overwrite: bool) -> None:
@@ -34,6 +48,89 @@ def _move_into_place(temporary: str, path: str, overwrite: bool) -> None:
         os.replace(temporary, path)
         return
     os.remove(temporary)
+
+
+def is_compressed(path) -> bool:
+    """True when ``path`` is an HDF5-based netCDF-4 file (what :func:`compress_file` writes),
+    False for netCDF-3, which the solver appends to."""
+    with open(path, "rb") as fh:
+        return fh.read(8) == b"\x89HDF\r\n\x1a\n"
+
+
+def _convert(path, fmt, complevel=None) -> None:
+    """Rewrite ``path`` in format ``fmt`` (deflated at ``complevel`` when given), holding the
+    writer's lock: written under a temporary name and renamed over ``path`` once complete, so
+    a failure or a kill at any moment leaves the original file as it was. Variables,
+    dimensions (the unlimited ``time`` too), values, fill values and attributes are copied as
+    they are, in the file's order; no value passes through a float conversion."""
+    import netCDF4
+
+    path = os.fspath(path)
+    directory, base = os.path.split(os.path.abspath(path))
+    temporary = os.path.join(directory, f".{base}.{os.getpid()}.convert")
+    # A netCDF-3 file may be appended to: hold its writer's lock while it is copied. A
+    # compressed file is never appended to, and HDF5 holds a shared lock of its own on it
+    # while it is read, which the writer's exclusive lock would collide with: no lock.
+    lock = None if is_compressed(path) else WriterLock(path)
+    try:
+        with netCDF4.Dataset(path) as src, netCDF4.Dataset(temporary, "w", format=fmt) as dst:
+            src.set_auto_maskandscale(False)
+            dst.set_auto_maskandscale(False)
+            for name, dim in src.dimensions.items():
+                dst.createDimension(name, None if dim.isunlimited() else len(dim))
+            for name, var in src.variables.items():
+                attrs = {k: var.getncattr(k) for k in var.ncattrs()}
+                fill = attrs.pop("_FillValue", None)
+                deflate = complevel is not None and var.dtype.kind != "S" and var.ndim > 0
+                out = dst.createVariable(name, var.dtype, var.dimensions, fill_value=fill,
+                                         **({"zlib": True, "complevel": complevel, "shuffle": True} if deflate else {}))
+                out.setncatts(attrs)
+                var.set_auto_chartostring(False)  # character arrays copied as characters
+                out.set_auto_chartostring(False)
+                if var.ndim == 0:
+                    out.assignValue(var.getValue())
+                    continue
+                rows = var.shape[0]
+                row_bytes = max(1, var.dtype.itemsize * int(np.prod(var.shape[1:], dtype=np.int64)))
+                step = max(1, COPY_BLOCK_BYTES // row_bytes)
+                for start in range(0, rows, step):
+                    stop = min(rows, start + step)
+                    out[start:stop] = var[start:stop]
+            dst.setncatts({k: src.getncattr(k) for k in src.ncattrs()})
+        os.replace(temporary, path)
+    except BaseException:
+        if os.path.exists(temporary):
+            os.remove(temporary)
+        raise
+    finally:
+        if lock is not None:
+            lock.release()
+
+
+def compress_file(path, complevel: int = DEFAULT_COMPLEVEL) -> None:
+    """Rewrite the finished file ``path`` compressed (:data:`COMPRESSED_FORMAT`, zlib at
+    ``complevel`` with byte shuffling), in place and atomically; :func:`grainview.open_dataset`
+    reads it unchanged. A file already compressed is left alone.
+
+    Parameters
+    ----------
+    path : str or path-like
+        A netCDF file of the contract that no other process is writing.
+    complevel : int
+        zlib level, 1 (fastest) to 9 (smallest).
+    """
+    if isinstance(complevel, bool) or not (isinstance(complevel, (int, np.integer)) and 1 <= complevel <= 9):
+        raise ParameterError(f"complevel={complevel!r}: expected an integer from 1 to 9")
+    if not is_compressed(path):
+        _convert(path, COMPRESSED_FORMAT, int(complevel))
+
+
+def decompress_file(path) -> None:
+    """Rewrite ``path`` uncompressed in :data:`APPEND_FORMAT`, in place and atomically, so that
+    a run can append snapshots to it again (:mod:`solver.restart`). A netCDF-3 file is left
+    alone."""
+    if is_compressed(path):
+        _convert(path, APPEND_FORMAT)
 
 
 class SnapshotWriter:
@@ -64,7 +161,7 @@ class SnapshotWriter:
     @classmethod
     def create(cls, path, *, radius, n_vertices, mass, inertia, n_walls=0, wall_names=None,
                wall_normal=None, optional=(),
-               attrs=None, n_contact_slots=None, overwrite=False, format="NETCDF3_64BIT_OFFSET"):
+               attrs=None, n_contact_slots=None, overwrite=False, format=APPEND_FORMAT):
         """Create ``path`` with the static particle data; ``optional`` names the optional
         per-snapshot variables this file will hold (e.g. ``("velocity", *DIAGNOSTICS)``);
         the others are not written at all."""
@@ -151,9 +248,12 @@ class SnapshotWriter:
     @classmethod
     def open_append(cls, path):
         """Open an existing file of the contract to append further snapshots (refused with
-        :class:`grainview.locks.FileLockedError` while another process writes it)."""
+        :class:`grainview.locks.FileLockedError` while another process writes it). A compressed
+        file is first rewritten uncompressed (:func:`decompress_file`)."""
         import netCDF4
 
+        if os.path.exists(path):
+            decompress_file(path)  # a finished, compressed run: netCDF-3 again, to append in place
         lock = WriterLock(path) if os.path.exists(path) else None
         try:
             nc = netCDF4.Dataset(os.fspath(path), "a")

@@ -26,7 +26,8 @@ import warnings
 import numpy as np
 
 from grainview.schema import DIAGNOSTICS
-from grainview.writer import SnapshotWriter
+from grainview.errors import ParameterError
+from grainview.writer import DEFAULT_COMPLEVEL, SnapshotWriter, compress_file
 
 from . import __version__
 from .contact_points import point_forces, rank_in_pair
@@ -160,9 +161,17 @@ class Recorder:
 
     ``near_contacts=True`` also writes the pairs within the alert distance that carry no force
     (:func:`written_pairs` with ``near = sim.alert``; attribute ``near_contacts_m``).
+
+    While the run goes on the file is netCDF-3, appended snapshot by snapshot (a killed run
+    keeps every completed snapshot). When the ``with`` block ends without an exception, the
+    finished file is rewritten compressed (:func:`grainview.writer.compress_file`, zlib at
+    ``compress``: True or a level 1-9; False, None or 0 keeps it uncompressed). A run stopped by Ctrl-C
+    or an error stays netCDF-3, ready to be resumed.
     """
 
-    def __init__(self, path, sim, attrs=None, overwrite=False, optional=OPTIONAL, near_contacts=False):
+    def __init__(self, path, sim, attrs=None, overwrite=False, optional=OPTIONAL, near_contacts=False,
+                 compress=DEFAULT_COMPLEVEL):
+        self.compress = compress_level(compress)
         params = {f"solver_{k}": (v if v is not None else "none") for k, v in sim.parameters_dict().items()}
         if sim.n_walls:
             params.update(wall_settings(sim.walls))
@@ -177,10 +186,12 @@ class Recorder:
             optional=optional, attrs=params, overwrite=overwrite)
 
     @classmethod
-    def append_to(cls, path, sim):
+    def append_to(cls, path, sim, compress=DEFAULT_COMPLEVEL):
         """Go on recording ``sim`` at the end of the existing file ``path`` (a resumed run,
-        :mod:`solver.restart`); the file's attributes are left as they are."""
+        :mod:`solver.restart`); the file's attributes are left as they are. A compressed file
+        is made netCDF-3 again to append to, and compressed again at the end (``compress``)."""
         recorder = cls.__new__(cls)
+        recorder.compress = compress_level(compress)
         recorder.sim = sim
         recorder.writer = SnapshotWriter.open_append(path)
         near = recorder.writer.attribute("near_contacts_m", "none")
@@ -211,5 +222,19 @@ class Recorder:
     def __enter__(self):
         return self
 
-    def __exit__(self, *exc):
+    def __exit__(self, exc_type, exc, traceback):
         self.close()
+        if exc_type is None and self.compress:
+            compress_file(self.writer.path, self.compress)
+
+
+def compress_level(compress) -> int:
+    """The zlib level of a ``compress`` argument: True the default level, a level 1-9 itself,
+    False, None or 0 none (0)."""
+    if compress is None or compress is False:
+        return 0
+    if compress is True:
+        return DEFAULT_COMPLEVEL
+    if not (isinstance(compress, (int, np.integer)) and 0 <= compress <= 9):
+        raise ParameterError(f"compress={compress!r}: expected True, False or a zlib level from 0 (none) to 9")
+    return int(compress)

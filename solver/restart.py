@@ -190,20 +190,22 @@ def load_state(path):
     return sim, test
 
 
-def resume(path, progress=None) -> int:
+def resume(path, progress=None, compress=True) -> int:
     """Continue the biaxial test written to ``path`` from its last complete snapshot until its
     strain target, appending the snapshots to the same file. Returns the number of steps
     taken (0 when the test had already finished).
 
     The snapshots written are those an uninterrupted run writes, bit for bit (see the module
     docstring). Ctrl-C stops again after the current step, with instructions to resume.
-    ``progress``: a tqdm bar (None: when stderr is a terminal).
+    ``progress``: a tqdm bar (None: when stderr is a terminal). A compressed file is made
+    netCDF-3 again to append to and, once the test has finished, compressed again
+    (``compress``: True, a zlib level 1-9, or False).
     """
     sim, test = load_state(path)
     first = sim.step_index - test["first_step"] + 1
     if first > test["n_steps"]:
         return 0
-    with Recorder.append_to(path, sim) as recorder:
+    with Recorder.append_to(path, sim, compress=compress) as recorder:
         biaxial_steps(sim, recorder, first=first, n_steps=test["n_steps"], every=test["every"], progress=progress)
     return test["n_steps"] - first + 1
 
@@ -213,12 +215,14 @@ def main(argv=None) -> int:
     parser = argparse.ArgumentParser(prog="python -m solver.restart", description=main.__doc__)
     parser.add_argument("path", help="the netCDF file of an interrupted biaxial test")
     parser.add_argument("--progress", choices=("auto", "on", "off"), default="auto", help="progress bar")
+    parser.add_argument("--no-compress", action="store_true",
+                        help="leave the finished file uncompressed netCDF-3 (default: compressed with zlib)")
     args = parser.parse_args(argv)
     progress = None if args.progress == "auto" else args.progress == "on"
     try:
         with warnings.catch_warnings(record=True) as caught:
             warnings.simplefilter("always")
-            steps = resume(args.path, progress=progress)
+            steps = resume(args.path, progress=progress, compress=not args.no_compress)
     except (GrainviewError, FileNotFoundError) as exc:
         print(f"solver.restart: error: {exc}", file=sys.stderr)
         return 2

@@ -155,7 +155,7 @@ def _box_size_across(sim):
 
 
 def biaxial_test(sim: Simulation, path, *, strain=0.1, velocity=0.01, every=20, overwrite=False,
-                 attrs=None, progress=None, near_contacts=False):
+                 attrs=None, progress=None, near_contacts=False, compress=True):
     """Biaxial compression of a compacted sample, written to ``path`` every ``every`` steps.
 
     The top wall moves down at ``velocity`` (m s-1) until eps_1 = ln(1 + dh/h0) reaches
@@ -165,7 +165,8 @@ def biaxial_test(sim: Simulation, path, *, strain=0.1, velocity=0.01, every=20, 
     alert distance that carry no force (:class:`solver.output.Recorder`). The file records the
     test's settings and how the sample was prepared (``sim.preparation_attrs``: set by
     :func:`solver.preparation.prepare_sample` and :func:`solver.load_sample`); ``attrs`` adds
-    to them.
+    to them. The file is netCDF-3 while the test runs and is compressed once it has finished
+    (``compress``: True, a zlib level 1-9, or False; :class:`solver.output.Recorder`).
     """
     if not (0 < strain < 1):
         raise ParameterError(f"strain={strain!r}: expected a vertical strain in (0, 1)")
@@ -183,7 +184,8 @@ def biaxial_test(sim: Simulation, path, *, strain=0.1, velocity=0.01, every=20, 
                  "sigma0_Pa": sim.sigma0, "snapshot_every": int(every), "biaxial_steps": n_steps,
                  **sim.preparation_attrs}
     run_attrs.update(attrs or {})
-    with Recorder(path, sim, attrs=run_attrs, overwrite=overwrite, near_contacts=near_contacts) as rec:
+    with Recorder(path, sim, attrs=run_attrs, overwrite=overwrite, near_contacts=near_contacts,
+                  compress=compress) as rec:
         rec.write()
         biaxial_steps(sim, rec, first=1, n_steps=n_steps, every=int(every), progress=progress)
     return n_steps

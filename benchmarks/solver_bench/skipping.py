@@ -70,7 +70,7 @@ def section_skipping(cfg: Config, series_path=None, log=print):
             write_time = 0.0
             with warnings.catch_warnings():
                 warnings.simplefilter("ignore")
-                with Recorder(path, sim, optional=optional) as rec:
+                with Recorder(path, sim, optional=optional, compress=False) as rec:
                     for _ in range(writes):
                         sim.step()
                         s = time.perf_counter()

@@ -3,10 +3,12 @@
 import numpy as np
 import pandas as pd
 import pytest
+import xarray as xr
 
 import grainview
 from grainview.cli import main
 from grainview.synthetic import harmonic_series
+from grainview.writer import is_compressed
 
 
 def test_demo_writes_a_valid_file_and_a_table_equal_to_the_accessors(tmp_path, capsys):
@@ -19,12 +21,21 @@ def test_demo_writes_a_valid_file_and_a_table_equal_to_the_accessors(tmp_path, c
     # a second run refuses to overwrite
     assert main(["demo", "--out", str(tmp_path), "--snapshots", "3", "--contacts", "2000"]) == 2
     assert "--overwrite" in capsys.readouterr().err
+    # written compressed by default; --no-compress keeps netCDF-3, read the same
+    packed = ds.load()
+    ds.close()
+    assert is_compressed(tmp_path / "synthetic.nc")
+    assert main(["demo", "--out", str(tmp_path), "--snapshots", "3", "--contacts", "2000", "--overwrite",
+                 "--no-compress"]) == 0
+    assert not is_compressed(tmp_path / "synthetic.nc")
+    with grainview.open_dataset(tmp_path / "synthetic.nc", chunks=None) as plain:
+        xr.testing.assert_identical(plain, packed)
 
 
 def test_info_prints_summary_and_validates(tmp_path, capsys):
     ds = harmonic_series(n_snapshots=2, n_contacts=50)
     path = tmp_path / "s.nc"
-    ds.to_netcdf(path, encoding=grainview.dataset.netcdf_encoding(ds))
+    ds.to_netcdf(path, **grainview.dataset.netcdf_options(ds))
     assert main(["info", str(path)]) == 0
     out = capsys.readouterr().out
     assert "100 particles" in out and "2 snapshots" in out and "valid" in out
@@ -72,6 +83,7 @@ def test_physics_options_reach_the_solver_and_act(tmp_path, capsys):
         sigma_xx = ds.grain.stress_tensor().sel(xy_a="x", xy_b="x")
         assert abs(float(sigma_xx.mean()) / 5000.0 - 1) < 0.2
         eps_1 = float(ds.grain.strains()["eps_1"][-1])
+    assert is_compressed(path)  # a finished run is kept compressed
     capsys.readouterr()
     assert main(["info", str(path)]) == 0
     out = capsys.readouterr().out
@@ -185,7 +197,7 @@ def test_info_reports_variables_without_units(tmp_path, capsys):
     ds = harmonic_series(n_snapshots=2, n_contacts=20)
     del ds["fn"].attrs["units"], ds["radius"].attrs["units"]
     path = tmp_path / "no_units.nc"
-    ds.to_netcdf(path, encoding=netcdf_encoding(ds))
+    ds.to_netcdf(path, encoding=netcdf_encoding(ds), format="NETCDF3_64BIT")
     assert main(["info", str(path)]) == 0  # accepted: taken in the contract's units...
     out = capsys.readouterr().out
     assert "note: 2 variable(s) carry no units attribute" in out and "radius, " in out and "fn" in out  # ...and said

@@ -3,6 +3,7 @@
 import os
 import xml.etree.ElementTree as ElementTree
 
+import grainview
 import numpy as np
 import pandas as pd
 import pytest
@@ -87,7 +88,7 @@ def test_export_command(tmp_path, capsys):
 
     ds = polygons_and_disks()
     source = tmp_path / "run.nc"
-    ds.to_netcdf(source)
+    ds.to_netcdf(source, **grainview.dataset.netcdf_options(ds))
     assert main(["export", str(source), "--to", "vtk", "--out", str(tmp_path / "vtk"), "--every", "3"]) == 0
     assert sorted(os.listdir(tmp_path / "vtk"))[:2] == ["contacts.pvd", "contacts_00000.vtu"]
     assert main(["export", str(source), "--to", "csv", "--out", str(tmp_path / "csv")]) == 0

@@ -63,7 +63,7 @@ def test_malformed_datasets_name_the_problem(tmp_path, case):
     path = tmp_path / f"{action}_{name}.nc"
     if path.exists():
         path.unlink()
-    ds.to_netcdf(path, encoding=netcdf_encoding(ds))
+    ds.to_netcdf(path, encoding=netcdf_encoding(ds), format="NETCDF3_64BIT")
     before = _sha(path)
     with pytest.raises(GrainviewError):
         grainview.open_dataset(path, validate=True)

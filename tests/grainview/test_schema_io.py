@@ -135,7 +135,7 @@ def test_newer_schema_version_is_refused(tmp_path):
     ds = builders.two_disks()
     ds.attrs["grainview_schema_version"] = "99.0"
     path = tmp_path / "future.nc"
-    ds.to_netcdf(path, encoding=grainview.dataset.netcdf_encoding(ds))
+    ds.to_netcdf(path, **grainview.dataset.netcdf_options(ds))
     with pytest.raises(SchemaError, match="newer than this grainview"):
         grainview.open_dataset(path)
 
@@ -143,7 +143,7 @@ def test_newer_schema_version_is_refused(tmp_path):
 def test_to_netcdf_with_contract_encoding_round_trips(tmp_path):
     ds = builders.mixed_contacts()
     path = tmp_path / "x.nc"
-    ds.to_netcdf(path, encoding=grainview.dataset.netcdf_encoding(ds))
+    ds.to_netcdf(path, **grainview.dataset.netcdf_options(ds, compress=False))
     back = grainview.open_dataset(path, chunks=None)
     xr.testing.assert_equal(back[["i", "j", "kind", "fn"]], ds[["i", "j", "kind", "fn"]])
 
@@ -152,8 +152,8 @@ def test_a_zlib_copy_is_smaller_and_opens_and_validates_unchanged(tmp_path):
     from grainview.synthetic import harmonic_series
     ds = harmonic_series(n_snapshots=4, n_contacts=2000)
     plain, packed = tmp_path / "plain.nc", tmp_path / "zlib.nc"
-    ds.to_netcdf(plain, format="NETCDF4", encoding=grainview.dataset.netcdf_encoding(ds))
-    ds.to_netcdf(packed, format="NETCDF4", encoding=grainview.dataset.netcdf_encoding(ds, zlib=True))
+    ds.to_netcdf(plain, format="NETCDF4_CLASSIC", encoding=grainview.dataset.netcdf_encoding(ds))
+    ds.to_netcdf(packed, format="NETCDF4_CLASSIC", encoding=grainview.dataset.netcdf_encoding(ds, zlib=True))
     assert packed.stat().st_size < plain.stat().st_size
     back = grainview.open_dataset(packed, chunks=None)  # eager: no dask thread touches HDF5
     assert back["fn"].encoding.get("zlib") is True

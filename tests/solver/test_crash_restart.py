@@ -107,6 +107,8 @@ def reference(tmp_path_factory):
 
 
 def test_reference_run_holds_the_restart_state(reference):
+    with netCDF4.Dataset(reference) as nc:
+        assert nc.data_model == "NETCDF4_CLASSIC"  # a finished run is kept compressed
     data, attrs = _variables(reference)
     assert data["time"].size == SNAPSHOTS
     np.testing.assert_array_equal(data["step"], data["step"][0] + 2 * np.arange(SNAPSHOTS))
@@ -241,6 +243,7 @@ def test_sigint_or_sigterm_stops_cleanly_and_prints_the_resume_command(reference
     n = _check_complete_snapshots(path, reference_data)
     with netCDF4.Dataset(path) as nc:
         assert nc.dimensions["time"].size == n
+        assert nc.data_model == "NETCDF3_64BIT_OFFSET"  # a stopped run is not compressed: it resumes in place
     last_step = int(reference_data["step"][n - 1])
     assert 0 <= stopped_at - last_step < RUN["every"]  # stopped after a whole step, no due snapshot skipped
     assert n < SNAPSHOTS

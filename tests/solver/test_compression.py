@@ -1,0 +1,178 @@
+"""Finished runs are kept compressed: netCDF-3 while a run appends, NETCDF4_CLASSIC with zlib
+once it has finished; read unchanged, rewritten atomically, resumable, and safe to open again
+and again in one process with dask's threads."""
+
+import os
+import subprocess
+import sys
+import warnings
+from pathlib import Path
+
+import netCDF4
+import numpy as np
+import pytest
+import xarray as xr
+
+import grainview
+from grainview.errors import ParameterError
+from grainview.locks import FileLockedError
+from grainview.writer import SnapshotWriter, compress_file, decompress_file, is_compressed
+from solver import compaction_sample, isotropic_compaction
+from solver.output import Recorder
+
+REPO = Path(__file__).resolve().parents[2]
+
+
+def _raw(path):
+    """Every variable's raw stored values (no masking, characters as characters), its dtype,
+    dims and attributes, the global attributes, and which dimension is unlimited."""
+    with netCDF4.Dataset(path) as nc:
+        nc.set_auto_maskandscale(False)
+        variables = {}
+        for name, var in nc.variables.items():
+            var.set_auto_chartostring(False)
+            variables[name] = (var[...].copy(), var.dtype, var.dimensions, {k: var.getncattr(k) for k in var.ncattrs()})
+        unlimited = [name for name, dim in nc.dimensions.items() if dim.isunlimited()]
+        return variables, {k: nc.getncattr(k) for k in nc.ncattrs()}, unlimited
+
+
+def _assert_same_content(a, b):
+    va, ga, ua = _raw(a)
+    vb, gb, ub = _raw(b)
+    assert list(va) == list(vb)  # the same variables in the same order ("complete" last)
+    for name in va:
+        (xa, ta, da, aa), (xb, tb, db, ab) = va[name], vb[name]
+        assert (ta, da) == (tb, db), name
+        np.testing.assert_array_equal(xa, xb, err_msg=name)  # NaN == NaN here, bit patterns of fills kept
+        assert aa.keys() == ab.keys(), name
+        for key in aa:
+            np.testing.assert_array_equal(aa[key], ab[key], err_msg=f"{name}.{key}")
+    assert ga.keys() == gb.keys() and ua == ub == ["time"]
+    for key in ga:
+        np.testing.assert_array_equal(ga[key], gb[key], err_msg=key)
+
+
+@pytest.fixture(scope="module")
+def run_file(tmp_path_factory):
+    """A netCDF-3 file of 25 snapshots of a compacting 60-pentagon sample, as the solver
+    writes it while running (compress=False)."""
+    path = tmp_path_factory.mktemp("run") / "plain.nc"
+    sim = compaction_sample(60, "pentagon", seed=3)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        isotropic_compaction(sim, max_steps=200, progress=False)
+        with Recorder(path, sim, attrs={"scene": "isotropic"}, near_contacts=True, compress=False) as rec:
+            for _ in range(25):
+                for _ in range(4):
+                    sim.step()
+                rec.write()
+    assert not is_compressed(path)
+    return path
+
+
+def test_compressing_keeps_every_value_and_attribute_and_decompressing_gives_them_back(run_file, tmp_path):
+    packed = tmp_path / "packed.nc"
+    packed.write_bytes(run_file.read_bytes())
+    compress_file(packed)
+    assert is_compressed(packed) and packed.stat().st_size < 0.8 * run_file.stat().st_size
+    with netCDF4.Dataset(packed) as nc:
+        assert nc.data_model == "NETCDF4_CLASSIC"
+        assert nc.variables["fn"].filters()["zlib"] and nc.variables["fn"].filters()["shuffle"]
+    _assert_same_content(run_file, packed)
+    with grainview.open_dataset(run_file, chunks=None) as a, grainview.open_dataset(packed, chunks=None) as b:
+        xr.testing.assert_identical(a, b)
+        grainview.validate(b)
+    compress_file(packed)  # already compressed: left alone
+    unpacked = tmp_path / "unpacked.nc"
+    unpacked.write_bytes(packed.read_bytes())
+    decompress_file(unpacked)
+    assert not is_compressed(unpacked)
+    with netCDF4.Dataset(unpacked) as nc:
+        assert nc.data_model == "NETCDF3_64BIT_OFFSET"
+    _assert_same_content(run_file, unpacked)
+    for bad in (0, 10, 2.5, True):
+        with pytest.raises(ParameterError, match="complevel"):
+            compress_file(packed, complevel=bad)
+
+
+def test_a_failed_conversion_leaves_the_file_as_it_was(run_file, tmp_path, monkeypatch):
+    path = tmp_path / "run.nc"
+    path.write_bytes(run_file.read_bytes())
+
+    def full_disk(*args):
+        raise OSError(28, "No space left on device")
+
+    monkeypatch.setattr(os, "replace", full_disk)
+    with pytest.raises(OSError, match="No space"):
+        compress_file(path)
+    monkeypatch.undo()
+    assert path.read_bytes() == run_file.read_bytes()
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["run.nc"]  # no temporary file left
+
+
+def test_a_file_being_written_is_not_converted(run_file, tmp_path):
+    path = tmp_path / "run.nc"
+    path.write_bytes(run_file.read_bytes())
+    with SnapshotWriter.open_append(path):
+        with pytest.raises(FileLockedError, match="being written"):
+            compress_file(path)
+    assert path.read_bytes() == run_file.read_bytes()
+
+
+def test_appending_to_a_compressed_file_makes_it_netcdf3_first(run_file, tmp_path):
+    path = tmp_path / "run.nc"
+    path.write_bytes(run_file.read_bytes())
+    compress_file(path)
+    with SnapshotWriter.open_append(path) as writer:
+        assert writer.n_snapshots == 25
+    assert not is_compressed(path)
+    _assert_same_content(run_file, path)
+
+
+def test_recorder_compresses_a_finished_run_only(tmp_path):
+    sim = compaction_sample(12, "disk", seed=0)
+    finished, stopped = tmp_path / "finished.nc", tmp_path / "stopped.nc"
+    with Recorder(finished, sim) as rec:
+        rec.write()
+    assert is_compressed(finished)
+    with pytest.raises(KeyboardInterrupt):
+        with Recorder(stopped, sim) as rec:
+            rec.write()
+            raise KeyboardInterrupt  # Ctrl-C: the file stays netCDF-3, ready to resume
+    assert not is_compressed(stopped)
+    for bad in (-1, 10, 2.5):
+        with pytest.raises(ParameterError, match="compress"):
+            Recorder(tmp_path / "bad.nc", sim, compress=bad)
+    assert not (tmp_path / "bad.nc").exists()
+
+
+REOPEN = """
+import sys, warnings
+warnings.simplefilter("ignore")
+import grainview
+for k in range(int(sys.argv[2])):
+    for path in sys.argv[3:]:
+        ds = grainview.open_dataset(path, chunks={"time": 2})
+        ds.grain.stress_invariants()["q_over_p"].mean().compute()
+        ds.close()
+print("ok", flush=True)
+"""
+
+
+def test_compressed_files_can_be_opened_again_and_again_with_dask_threads(tmp_path):
+    """Variable-length strings in an HDF5 file made this machine's netCDF4 1.7 / HDF5 2.2 crash
+    (a segmentation fault) when a file read by dask's threads was opened again in the same
+    process; the classic data model stores strings as characters. Run in a subprocess, so
+    that a crash fails this test instead of ending the test session."""
+    from grainview.dataset import netcdf_options
+    from grainview.synthetic import harmonic_series
+
+    paths = []
+    for seed in range(3):
+        ds = harmonic_series(n_snapshots=12, n_contacts=1500, seed=seed)
+        paths.append(tmp_path / f"s{seed}.nc")
+        ds.to_netcdf(paths[-1], **netcdf_options(ds))
+        assert is_compressed(paths[-1])
+    done = subprocess.run([sys.executable, "-c", REOPEN, "-", "12", *map(str, paths)], cwd=REPO,
+                          capture_output=True, text=True, timeout=300)
+    assert done.returncode == 0 and done.stdout.strip() == "ok", (done.returncode, done.stderr[-2000:])
