@@ -220,3 +220,57 @@ def global_attrs(n_particles: int, n_walls: int, attrs: dict | None = None) -> d
             value = np.asarray(value)
         out[key] = value
     return out
+
+
+DIMENSIONLESS = ("1", "", "dimensionless")
+"""Spellings accepted for the contract's unit "1"."""
+
+
+def structure_problems(variables: dict, sizes: dict) -> list[str]:
+    """The contract's structural problems of a file or dataset, from its metadata alone.
+
+    ``variables`` maps each variable name to ``(dims, dtype)``; ``sizes`` each dimension to
+    its length. Reported: a required variable missing, dims other than the contract's (or in
+    another order), an integer variable stored as floats or the reverse, an ``xy`` of size
+    other than 2. Shared by :func:`grainview.validation.validate` (xarray) and ``grainview
+    info`` (netCDF4 alone), so that both say the same."""
+    problems = []
+    for name, var in VARIABLES.items():
+        if name not in variables:
+            if var.required:
+                problems.append(f"variable {name!r} is missing (expected dims {var.dims})")
+            continue
+        dims, dtype = variables[name]
+        dims, dtype = tuple(dims), np.dtype(dtype)
+        if set(dims) != set(var.dims) or len(dims) != len(var.dims):
+            problems.append(f"variable {name!r} has dims {dims}, expected {var.dims}")
+        elif dims != var.dims:
+            problems.append(f"variable {name!r} has dims in order {dims}, expected {var.dims}")
+        if var.is_integer and dtype.kind not in "iu":
+            problems.append(f"variable {name!r} has dtype {dtype}, expected an integer type "
+                            f"({var.dtype}) with sentinels instead of a _FillValue")
+        if not var.is_integer and dtype.kind != "f":
+            problems.append(f"variable {name!r} has dtype {dtype}, expected floating point ({var.dtype})")
+    if "xy" in sizes and sizes["xy"] != 2:
+        problems.append(f"dimension 'xy' has size {sizes['xy']}, expected 2 (x, y)")
+    return problems
+
+
+def unit_problems(units: dict) -> list[str]:
+    """Variables whose ``units`` attribute differs from the contract's; ``units`` maps each
+    variable name of the file to its units attribute, or None when it has none (then it is
+    taken in the contract's units: files built or edited by other tools often carry none)."""
+    problems = []
+    for name, var in VARIABLES.items():
+        if name not in units or name == "complete" or units[name] is None:
+            continue
+        given = str(units[name]).strip()
+        if given != var.units and not (var.units == "1" and given in DIMENSIONLESS):
+            problems.append(f"variable {name!r} has units {units[name]!r}, expected {var.units!r} "
+                            "(SI, as the contract says)")
+    return problems
+
+
+def missing_units(units: dict) -> list[str]:
+    """Contract variables among ``units`` (name -> units attribute or None) without one."""
+    return [name for name in VARIABLES if name in units and name != "complete" and units[name] is None]

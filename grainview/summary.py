@@ -1,5 +1,6 @@
-"""A reader's summary of a dataset of the contract, in a few lines: what ``grainview info``
-prints and what the report's index says of each run."""
+"""A reader's summary of a dataset of the contract, in a few lines: what the report's index
+says of each run and, read from the file without xarray (:mod:`grainview.file_summary`), what
+``grainview info`` prints."""
 
 from __future__ import annotations
 
@@ -8,28 +9,50 @@ import numpy as np
 
 def describe(ds) -> list:
     """A reader's summary of a dataset of the contract: size and shapes, snapshots, strain and
-    q/p reached, and the settings a physicist asks for first, in readable units."""
-    a = ds.attrs
-    n_vertices = ds["n_vertices"].values
-    shapes = {int(k): int((n_vertices == k).sum()) for k in sorted(set(n_vertices.tolist()))}
-    lines = [f"{ds.sizes['particle']} particles ("
-             + ", ".join(f"{c} {'disks' if k == 0 else f'{k}-gons'}" for k, c in shapes.items())
-             + f"), {ds.sizes.get('wall', 0)} walls, {ds.sizes['contact']} contact slots"]
+    q/p reached, and the settings a physicist asks for first, in readable units (what the
+    report's index says of each run; ``grainview info`` prints the same lines from the file,
+    :func:`grainview.file_summary.describe_file`)."""
     snapshots = ds.sizes.get("time", 0)
+    facts = {"n_vertices": ds["n_vertices"].values, "n_walls": ds.sizes.get("wall", 0),
+             "n_slots": ds.sizes["contact"], "snapshots": snapshots}
     if snapshots:
-        t = ds["time"].values
-        count = ds["contact_count"].values
-        phi = ds.grain.solid_fraction().values if "box_min" in ds else None
+        facts.update(time=ds["time"].values, contact_count=ds["contact_count"].values)
+        if "box_min" in ds:
+            facts["solid_fraction"] = ds.grain.solid_fraction().values
+            if snapshots > 1:
+                eps = ds.grain.strains()
+                facts.update(eps_1=float(eps["eps_1"][-1]), eps_q=float(eps["eps_q"][-1]),
+                             q_over_p=ds.grain.stress_invariants()["q_over_p"].values)
+    return summary_lines(facts, ds.attrs)
+
+
+def summary_lines(facts: dict, attrs: dict) -> list:
+    """The summary's lines from its numbers: ``facts`` holds ``n_vertices`` (per particle),
+    ``n_walls``, ``n_slots``, ``snapshots`` and, when there are snapshots, ``time`` (s),
+    ``contact_count``, optionally ``solid_fraction`` (per snapshot) and, with more than one
+    snapshot, ``eps_1``, ``eps_q`` (last snapshot) and ``q_over_p`` (per snapshot); ``attrs``
+    the file's global attributes."""
+    a = attrs
+    n_vertices = np.asarray(facts["n_vertices"])
+    shapes = {int(k): int((n_vertices == k).sum()) for k in sorted(set(n_vertices.tolist()))}
+    lines = [f"{n_vertices.size} particles ("
+             + ", ".join(f"{c} {'disks' if k == 0 else f'{k}-gons'}" for k, c in shapes.items())
+             + f"), {facts['n_walls']} walls, {facts['n_slots']} contact slots"]
+    snapshots = facts["snapshots"]
+    if snapshots:
+        t = facts["time"]
+        count = facts["contact_count"]
+        phi = facts.get("solid_fraction")
         lines.append(f"{snapshots} snapshot{'s' * (snapshots > 1)}, t = {t[0]:g} .. {t[-1]:g} s; contacts per "
                      f"snapshot {int(count.min())} .. {int(count.max())}"
                      + (f"; solid fraction {phi[0]:.3f} .. {phi[-1]:.3f}" if phi is not None else ""))
-        if "box_min" in ds and snapshots > 1:
-            eps = ds.grain.strains()
-            q_over_p = ds.grain.stress_invariants()["q_over_p"].values
+        if "eps_1" in facts:
+            q_over_p = facts["q_over_p"]
             finite = q_over_p[np.isfinite(q_over_p)]
-            lines.append(f"strain reached: eps_1 {float(eps['eps_1'][-1]):.3f}, eps_q {float(eps['eps_q'][-1]):.3f}"
+            lines.append(f"strain reached: eps_1 {facts['eps_1']:.3f}, eps_q {facts['eps_q']:.3f}"
                          + (f"; q/p {finite.min():.3f} .. {finite.max():.3f}, last {q_over_p[-1]:.3f}"
                             if finite.size else ""))
+
     def number(key, scale=1.0):
         try:
             return float(a[key]) * scale

@@ -14,33 +14,22 @@ import xarray as xr
 
 from .contacts import occupied
 from .errors import SchemaError
-from .schema import KIND_DOUBLE, KIND_SIMPLE, VARIABLES
+from .schema import KIND_DOUBLE, KIND_SIMPLE, VARIABLES, structure_problems, unit_problems
+from .schema import missing_units as _missing_units
 
 UNIT_NORMAL_TOLERANCE = 1e-6
 """Largest accepted | |n| - 1 | for an occupied contact normal."""
 
 
+def _metadata(ds: xr.Dataset):
+    """(variables: name -> (dims, dtype), units: name -> units attribute or None) of ``ds``."""
+    variables = {name: (ds[name].dims, ds[name].dtype) for name in ds.variables}
+    units = {name: ds[name].attrs.get("units", ds[name].encoding.get("units")) for name in ds.variables}
+    return variables, units
+
+
 def _structure_problems(ds: xr.Dataset) -> list[str]:
-    problems = []
-    for name, var in VARIABLES.items():
-        if name not in ds.variables:
-            if var.required:
-                problems.append(f"variable {name!r} is missing (expected dims {var.dims})")
-            continue
-        dims = ds[name].dims
-        if set(dims) != set(var.dims) or len(dims) != len(var.dims):
-            problems.append(f"variable {name!r} has dims {dims}, expected {var.dims}")
-        elif dims != var.dims:
-            problems.append(f"variable {name!r} has dims in order {dims}, expected {var.dims}")
-        kind = ds[name].dtype.kind
-        if var.is_integer and kind not in "iu":
-            problems.append(f"variable {name!r} has dtype {ds[name].dtype}, expected an integer type "
-                            f"({var.dtype}) with sentinels instead of a _FillValue")
-        if not var.is_integer and kind != "f":
-            problems.append(f"variable {name!r} has dtype {ds[name].dtype}, expected floating point ({var.dtype})")
-    if "xy" in ds.dims and ds.sizes["xy"] != 2:
-        problems.append(f"dimension 'xy' has size {ds.sizes['xy']}, expected 2 (x, y)")
-    return problems
+    return structure_problems(_metadata(ds)[0], dict(ds.sizes))
 
 
 def check_structure(ds: xr.Dataset, source: str | None = None) -> None:
@@ -60,30 +49,16 @@ def _duplicate_counts(keys):
     return same.sum(axis=-1)
 
 
-DIMENSIONLESS = ("1", "", "dimensionless")
-"""Spellings accepted for the contract's unit "1"."""
-
-
 def _unit_problems(ds: xr.Dataset) -> list[str]:
-    """Variables whose ``units`` attribute differs from the contract's. A variable without one
-    is taken in the contract's units: datasets built or edited by other tools often carry none,
-    and refusing them would help nobody."""
-    problems = []
-    for name, var in VARIABLES.items():
-        if name not in ds.variables or name == "complete":
-            continue
-        units = ds[name].attrs.get("units", ds[name].encoding.get("units"))
-        if units is not None and str(units).strip() != var.units and not (
-                var.units == "1" and str(units).strip() in DIMENSIONLESS):
-            problems.append(f"variable {name!r} has units {units!r}, expected {var.units!r} (SI, as the contract says)")
-    return problems
+    """Variables whose ``units`` attribute differs from the contract's
+    (:func:`grainview.schema.unit_problems`)."""
+    return unit_problems(_metadata(ds)[1])
 
 
 def missing_units(ds: xr.Dataset) -> list[str]:
     """Contract variables of ``ds`` that carry no ``units`` attribute (taken in the contract's
     units by :func:`validate`; ``grainview info`` reports them)."""
-    return [name for name in VARIABLES if name in ds.variables and name != "complete"
-            and "units" not in ds[name].attrs and "units" not in ds[name].encoding]
+    return _missing_units(_metadata(ds)[1])
 
 
 def _value_checks(ds: xr.Dataset) -> dict[str, xr.DataArray]:

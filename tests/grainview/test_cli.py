@@ -201,3 +201,63 @@ def test_info_reports_variables_without_units(tmp_path, capsys):
     assert main(["info", str(path)]) == 0  # accepted: taken in the contract's units...
     out = capsys.readouterr().out
     assert "note: 2 variable(s) carry no units attribute" in out and "radius, " in out and "fn" in out  # ...and said
+
+
+INFO_IMPORTS = """
+import sys
+from grainview.cli import main
+assert main(["info", sys.argv[1]]) == 0
+print(sorted(m for m in ("xarray", "dask", "pandas", "scipy") if m in sys.modules))
+"""
+
+
+def test_info_reads_the_file_without_xarray_and_says_what_the_accessors_say(tmp_path, capsys):
+    """``info`` is fast because it imports neither xarray, dask nor pandas (checked in a fresh
+    interpreter); its lines, computed from netCDF4 and the pure array functions, are those of
+    the report's index, computed through the accessors (two computations of strain, solid
+    fraction and q/p)."""
+    import subprocess
+    import sys
+
+    from grainview.file_summary import describe_file
+    from grainview.summary import describe
+
+    path = tmp_path / "run.nc"
+    ds = harmonic_series(n_snapshots=4, n_contacts=300, anisotropy=(0.2, 0.3, 0.1), seed=3)
+    ds.attrs.update(scene="biaxial", sigma0_Pa=1e4, solver_friction=0.4, solver_time_step=5e-4)
+    ds.to_netcdf(path, **grainview.dataset.netcdf_options(ds))
+    done = subprocess.run([sys.executable, "-c", INFO_IMPORTS, str(path)], capture_output=True, text=True, timeout=120)
+    assert done.returncode == 0, done.stderr
+    assert done.stdout.strip().splitlines()[-1] == "[]"
+    with grainview.open_dataset(path, chunks=None) as opened:
+        expected = describe(opened)
+        q_over_p = opened.grain.stress_invariants()["q_over_p"].values
+    lines, attrs = describe_file(path)
+    assert lines == expected and attrs["sigma0_Pa"] == 1e4
+    assert f"last {q_over_p[-1]:.3f}" in lines[2] and q_over_p[-1] > 0.1
+    assert "sigma0 10 kPa" in lines[3] and "time step 0.5 ms" in lines[4]
+
+
+def test_info_checks_structure_at_once_and_every_value_with_check(tmp_path, capsys):
+    import netCDF4
+
+    ds = harmonic_series(n_snapshots=3, n_contacts=50)
+    path = tmp_path / "s.nc"
+    ds.to_netcdf(path, **grainview.dataset.netcdf_options(ds, compress=False))
+    with netCDF4.Dataset(path, "a") as nc:
+        nc.variables["kind"][1, 3] = 7  # a value fault: the structure is intact
+    assert main(["info", str(path)]) == 0
+    assert "--check also checks every value" in capsys.readouterr().out
+    assert main(["info", str(path), "--check"]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith("grainview: error:") and "kind: 1 occupied slot(s) with a kind other than 1" in err
+    # a structural fault is found without --check
+    bad = tmp_path / "bad.nc"
+    ds.drop_vars("fn").to_netcdf(bad, **grainview.dataset.netcdf_options(ds.drop_vars("fn")))
+    assert main(["info", str(bad)]) == 2
+    assert "variable 'fn' is missing" in capsys.readouterr().err
+    # a netCDF-3 file cut in half: refused, one line
+    cut = tmp_path / "cut.nc"
+    cut.write_bytes(path.read_bytes()[: path.stat().st_size // 2])
+    assert main(["info", str(cut)]) == 2
+    assert "truncated" in capsys.readouterr().err

@@ -1,0 +1,144 @@
+"""``grainview info`` in under a second: a file's summary read with netCDF4 and numpy alone.
+
+Importing xarray, pandas and dask takes about a second on its own, longer than the whole
+summary of a study's file. So the summary that ``grainview info`` prints is read here with
+netCDF4, computed with the pure array functions of :mod:`grainview.arrays` (the same physics
+as the accessors) and formatted by :func:`grainview.summary.summary_lines` (the same lines as
+the report's index). The checks made on the way are those that need no values: the file
+opens as netCDF, its structure and units follow the contract
+(:func:`grainview.schema.structure_problems`, :func:`grainview.schema.unit_problems`), and a
+netCDF-3 file is not shorter than its fixed data and records need. Every value is checked by
+:func:`grainview.validation.validate` (``grainview info --check``).
+"""
+
+from __future__ import annotations
+
+import os
+
+import numpy as np
+
+from .errors import FileFormatError, SchemaError
+from .schema import complete_snapshots, missing_units, particle_area, structure_problems, unit_problems
+
+__all__ = ["read_facts", "describe_file"]
+
+
+def _chars(var) -> list:
+    """The strings of a character variable (e.g. the wall names)."""
+    var.set_auto_chartostring(False)
+    raw = np.asarray(var[:])
+    return ["".join(c.decode() if isinstance(c, bytes) else str(c) for c in row).strip("\x00 ") for row in raw]
+
+
+def _minimum_netcdf3_size(nc) -> int:
+    """Bytes a netCDF-3 file needs at least: its fixed variables and its records (the header,
+    a few KiB, not counted). A file shorter than this was cut short."""
+    fixed = records = 0
+    for var in nc.variables.values():
+        size = var.dtype.itemsize * int(np.prod(var.shape[1:] if _is_record(nc, var) else var.shape, dtype=np.int64))
+        if _is_record(nc, var):
+            records += size
+        else:
+            fixed += size
+    n_records = len(nc.dimensions["time"]) if "time" in nc.dimensions else 0
+    return fixed + n_records * records
+
+
+def _is_record(nc, var) -> bool:
+    return bool(var.dimensions) and nc.dimensions[var.dimensions[0]].isunlimited()
+
+
+def read_facts(path) -> tuple[dict, dict]:
+    """The summary's numbers of the file ``path`` and its global attributes.
+
+    Parameters
+    ----------
+    path : str or path-like
+        A netCDF file of the contract (netCDF-3 or compressed).
+
+    Returns
+    -------
+    facts : dict
+        What :func:`grainview.summary.summary_lines` reads: ``n_vertices``, ``n_walls``,
+        ``n_slots``, ``snapshots`` (complete ones), ``time`` (s), ``contact_count``,
+        ``solid_fraction``, ``eps_1`` and ``eps_q`` of the last snapshot (log strains against
+        the first, docs/conventions.md §6) and ``q_over_p`` per snapshot (q/p of the stress
+        sigma = (1/V) sum_c f^c (x) l^c over every pair the file holds, paper Eq. M), plus
+        ``missing_units``.
+    attrs : dict
+        The file's global attributes.
+
+    Raises
+    ------
+    FileFormatError
+        Not a readable netCDF file, or a netCDF-3 file cut short.
+    SchemaError
+        The structure or the units differ from the contract's.
+    """
+    import netCDF4
+
+    from .arrays.stress import stress_tensor
+    from .arrays.tensors import principal
+
+    source = os.fspath(path)
+    if not os.path.exists(source):
+        raise FileFormatError(f"{source}: no such file")
+    try:
+        nc = netCDF4.Dataset(source)
+    except (OSError, RuntimeError, ValueError) as exc:
+        raise FileFormatError(f"{source}: not a readable netCDF file ({exc})") from exc
+    with nc:
+        nc.set_auto_maskandscale(False)
+        sizes = {name: len(dim) for name, dim in nc.dimensions.items()}
+        variables = {name: (var.dimensions, var.dtype) for name, var in nc.variables.items()
+                     if var.dtype is not str}
+        units = {name: (var.getncattr("units") if "units" in var.ncattrs() else None)
+                 for name, var in nc.variables.items()}
+        problems = structure_problems(variables, sizes) + unit_problems(units)
+        if problems:
+            raise SchemaError(problems, source)
+        if nc.data_model.startswith("NETCDF3"):
+            needed, size = _minimum_netcdf3_size(nc), os.path.getsize(source)
+            if size < needed:
+                raise FileFormatError(f"{source}: truncated file ({size} bytes, its data need at least {needed})")
+        attrs = {k: nc.getncattr(k) for k in nc.ncattrs()}
+        v = nc.variables
+        facts = {"n_vertices": np.asarray(v["n_vertices"][:]), "n_walls": sizes.get("wall", 0),
+                 "n_slots": sizes["contact"], "missing_units": missing_units(units)}
+        complete = complete_snapshots(v) if "time" in v and sizes.get("time", 0) else np.zeros(0, bool)
+        snapshots = int(np.argmin(complete)) if not complete.all() else complete.size
+        facts["snapshots"] = snapshots
+        if not snapshots:
+            return facts, attrs
+        k = slice(0, snapshots)
+        count = np.asarray(v["contact_count"][k])
+        facts.update(time=np.asarray(v["time"][k], dtype=float), contact_count=count)
+        box_min, box_max = np.asarray(v["box_min"][k]), np.asarray(v["box_max"][k])
+        length, height = box_max[:, 0] - box_min[:, 0], box_max[:, 1] - box_min[:, 1]
+        solid = float(particle_area(v["radius"][:], facts["n_vertices"]).sum())
+        facts["solid_fraction"] = solid / (length * height)
+        if snapshots > 1:
+            eps_1 = np.log(1 + (height[0] - height[-1]) / height[0])
+            eps_2 = np.log(1 + (length[0] - length[-1]) / length[0])
+            facts.update(eps_1=float(eps_1), eps_q=float(eps_1 - eps_2))
+            occupied = np.arange(sizes["contact"])[None, :] < count[:, None]
+            volume = length * height * float(attrs.get("thickness_m", 1.0))
+            sigma = stress_tensor(v["fn"][k], v["ft"][k], v["normal"][k], v["branch"][k], occupied, volume)
+            s1, s2, _ = principal(sigma)
+            with np.errstate(invalid="ignore", divide="ignore"):
+                facts["q_over_p"] = (s1 - s2) / (s1 + s2)
+    return facts, attrs
+
+
+def describe_file(path) -> tuple[list, dict]:
+    """The lines ``grainview info`` prints for ``path`` (:func:`read_facts`, formatted by
+    :func:`grainview.summary.summary_lines`, with a note on variables without units) and the
+    file's global attributes."""
+    from .summary import summary_lines
+
+    facts, attrs = read_facts(path)
+    lines = summary_lines(facts, attrs)
+    if facts["missing_units"]:
+        lines.append(f"note: {len(facts['missing_units'])} variable(s) carry no units attribute and are read in the "
+                     f"contract's units (docs/schema.md): {', '.join(facts['missing_units'])}")
+    return lines, attrs
