@@ -46,7 +46,24 @@ class _Delegate:
 
 @xr.register_dataset_accessor("grain")
 class GrainAccessor:
-    """Analyses of a packing dataset of the grainview contract: ``ds.grain.<name>(...)``."""
+    """Analyses of a packing dataset of the grainview contract: ``ds.grain.<name>(...)``.
+
+    Each analysis method calls the function of the same name in a topic module, whose
+    docstring it shows; on an ensemble (a ``run`` dimension) it runs per run
+    (:func:`grainview.ensemble.map_runs`). Time series come back with the strains
+    :data:`STRAIN_COORDS` as coordinates along ``time`` (when the file has its box).
+
+    Parameters
+    ----------
+    ds : xarray.Dataset
+        A dataset of the contract (docs/schema.md), or an ensemble of
+        :func:`grainview.ensemble.open_ensemble`.
+
+    References
+    ----------
+    Azéma, Radjai, Peyroux & Saussine, Phys. Rev. E 76, 011301 (2007),
+    the descriptors of Secs. III-VI; docs/analysis.md.
+    """
 
     def __init__(self, ds: xr.Dataset):
         self._ds = ds
@@ -84,7 +101,21 @@ class GrainAccessor:
         return result.assign_coords(self._strains)
 
     def validate(self):
-        """Check the dataset against the contract (:func:`grainview.validation.validate`)."""
+        """Check the dataset against the contract (:func:`grainview.validation.validate`).
+
+        On an ensemble (a ``run`` dimension) each run is checked as its file opens alone
+        (:func:`grainview.ensemble.run_dataset`).
+
+        Returns
+        -------
+        xarray.Dataset
+            The dataset unchanged, so that calls can be chained.
+
+        Raises
+        ------
+        grainview.errors.SchemaError
+            Listing every problem found (docs/schema.md).
+        """
         from .validation import validate
 
         if "run" in self._ds.dims:  # an ensemble: each run
@@ -134,8 +165,26 @@ class GrainAccessor:
 
     @property
     def plot(self):
-        """The paper's figures drawn from this dataset: ``ds.grain.plot.<name>(...)``
-        (:mod:`grainview.plot`; matplotlib is imported on first use)."""
+        """The paper's figures drawn from this dataset: ``ds.grain.plot.<name>(...)``.
+
+        :mod:`grainview.plot`; matplotlib is imported on first use.
+
+        Returns
+        -------
+        grainview.plot.PlotAccessor
+            The figures of this dataset, one method per figure function ``plot_<name>``.
+
+        Raises
+        ------
+        grainview.errors.ParameterError
+            On an ensemble: plot ``run_dataset(ens, k)`` (or a dict of them), or write the
+            ensemble's report.
+
+        References
+        ----------
+        Azéma, Radjai, Peyroux & Saussine, Phys. Rev. E 76, 011301 (2007),
+        Figs. 3-25 (the table in :mod:`grainview.plot`).
+        """
         if "run" in self._ds.dims:
             from .errors import ParameterError
 

@@ -17,17 +17,67 @@ from .arrays import connectivity as _conn
 from .contacts import selection
 from .errors import ParameterError
 
+__all__ = ["contact_numbers", "counts_of", "coordination", "connectivity_pdf",
+           "joint_connectivity_pdf"]
+
 
 def contact_numbers(ds: xr.Dataset, kind="all", walls: bool = False, near=None) -> xr.DataArray:
-    """c_i (time, particle): number of contacts of each particle, force-bearing ones by default
-    (``near``: :func:`grainview.contacts.in_network`)."""
+    """c_i (time, particle): number of contacts of each particle, force-bearing ones by default.
+
+    A double contact counts once (docs/conventions.md §7). ``near``:
+    :func:`grainview.contacts.in_network`.
+
+    Parameters
+    ----------
+    ds : xarray.Dataset
+        A dataset of the contract (docs/schema.md), eager or chunked along ``time``.
+    kind : {"all", "simple", "double"}, default "all"
+        The contacts used: all, simple (vertex–edge and disk contacts) or double (edge–edge)
+        ones (also 1, 2, "s", "d"; :func:`grainview.contacts.kind_code`).
+    walls : bool, default False
+        Include the particle–wall contacts (default: particle–particle only).
+    near : float, optional
+        Which pairs are contacts (:func:`grainview.contacts.in_network`): None (default) the
+        force-bearing ones, f_n > 0; a gap threshold in m adds the pairs with gap <= ``near``
+        (they carry f_n = 0); ``np.inf`` every pair the file holds.
+
+    Returns
+    -------
+    xarray.DataArray
+        ``contact_number`` (time, particle), integer counts; lazy on dask input.
+
+    References
+    ----------
+    Azéma, Radjai, Peyroux & Saussine, Phys. Rev. E 76, 011301 (2007),
+    Sec. IV.A; docs/conventions.md §7.
+    """
     return with_attrs(counts_of(ds, selection(ds, walls=walls, kind=kind, near=near)), "contact_number", "1",
                       "number of force-bearing contacts per particle")
 
 
 def counts_of(ds: xr.Dataset, mask: xr.DataArray) -> xr.DataArray:
-    """(time, particle): how many of the slots selected by the boolean ``mask`` (time, contact)
-    touch each particle (a double contact once), lazily."""
+    """Per particle, how many of the slots selected by ``mask`` touch it (time, particle).
+
+    (time, particle): how many of the slots selected by the boolean ``mask`` (time, contact)
+    touch each particle (a double contact once), lazily.
+
+    Parameters
+    ----------
+    ds : xarray.Dataset
+        A dataset of the contract (docs/schema.md), eager or chunked along ``time``.
+    mask : xarray.DataArray
+        Boolean (time, contact), e.g. :func:`grainview.contacts.selection`.
+
+    Returns
+    -------
+    xarray.DataArray
+        (time, particle), int64 counts.
+
+    References
+    ----------
+    Azéma, Radjai, Peyroux & Saussine, Phys. Rev. E 76, 011301 (2007),
+    Sec. IV.A; docs/conventions.md §7.
+    """
     return apply(_conn.contact_numbers, ds["i"], ds["j"], mask, output_sizes={"particle": ds.sizes["particle"]},
                  kwargs={"n_particles": ds.sizes["particle"]}, output_dtypes=[np.int64])
 
@@ -38,7 +88,43 @@ def _check_min(min_contacts):
 
 
 def coordination(ds: xr.Dataset, walls: bool = False, min_contacts: int = 1, near=None) -> xr.Dataset:
-    """z = sum_i c_i / N' (time) over the N' non-rattler particles, and N'."""
+    """Coordination number z (time) over the N' non-rattler particles, and N'.
+
+        z = sum_i c_i / N'
+
+    the sum over the N' particles with c_i >= ``min_contacts`` force-bearing contacts (a double
+    contact counts once); the others are rattlers, left out (docs/conventions.md §7). Wall
+    contacts are not counted unless ``walls=True``.
+
+    Parameters
+    ----------
+    ds : xarray.Dataset
+        A dataset of the contract (docs/schema.md), eager or chunked along ``time``.
+    walls : bool, default False
+        Include the particle–wall contacts (default: particle–particle only).
+    min_contacts : int, default 1
+        A particle with fewer such contacts is a rattler, left out (default 1: none at all).
+    near : float, optional
+        Which pairs are contacts (:func:`grainview.contacts.in_network`): None (default) the
+        force-bearing ones, f_n > 0; a gap threshold in m adds the pairs with gap <= ``near``
+        (they carry f_n = 0); ``np.inf`` every pair the file holds.
+
+    Returns
+    -------
+    xarray.Dataset
+        ``z`` (dimensionless) and ``n_active`` (N', the number of non-rattler particles) over
+        ``time``; lazy on dask input.
+
+    Raises
+    ------
+    grainview.errors.ParameterError
+        When ``min_contacts`` is not an integer >= 1.
+
+    References
+    ----------
+    Azéma, Radjai, Peyroux & Saussine, Phys. Rev. E 76, 011301 (2007),
+    Sec. IV.A, Fig. 6a; docs/conventions.md §7.
+    """
     _check_min(min_contacts)
     z, kept = apply(_conn.coordination, contact_numbers(ds, walls=walls, near=near), kwargs={"min_contacts": min_contacts},
                     output_dtypes=[float, np.int64])
@@ -50,7 +136,43 @@ def coordination(ds: xr.Dataset, walls: bool = False, min_contacts: int = 1, nea
 
 def connectivity_pdf(ds: xr.Dataset, max_c: int = 10, walls: bool = False, min_contacts: int = 1,
                      near=None) -> xr.DataArray:
-    """P(c) (time, c): fraction of non-rattler particles with exactly c contacts (Fig. 7)."""
+    """P(c) (time, c): fraction of non-rattler particles with exactly c contacts (Fig. 7).
+
+        P(c) = N(c) / N'
+
+    N(c) the number of particles with exactly c force-bearing contacts (a double contact once),
+    N' the number of non-rattler particles (c >= ``min_contacts``).
+
+    Parameters
+    ----------
+    ds : xarray.Dataset
+        A dataset of the contract (docs/schema.md), eager or chunked along ``time``.
+    max_c : int, default 10
+        The largest c of the result (c = 0 .. max_c).
+    walls : bool, default False
+        Include the particle–wall contacts (default: particle–particle only).
+    min_contacts : int, default 1
+        A particle with fewer such contacts is a rattler, left out (default 1: none at all).
+    near : float, optional
+        Which pairs are contacts (:func:`grainview.contacts.in_network`): None (default) the
+        force-bearing ones, f_n > 0; a gap threshold in m adds the pairs with gap <= ``near``
+        (they carry f_n = 0); ``np.inf`` every pair the file holds.
+
+    Returns
+    -------
+    xarray.DataArray
+        ``P_c`` (time, c), dimensionless, with the coordinate ``c``; lazy on dask input.
+
+    Raises
+    ------
+    grainview.errors.ParameterError
+        When ``min_contacts`` is not an integer >= 1.
+
+    References
+    ----------
+    Azéma, Radjai, Peyroux & Saussine, Phys. Rev. E 76, 011301 (2007),
+    Sec. IV.A, Fig. 7; docs/conventions.md §7.
+    """
     _check_min(min_contacts)
     da = apply(_conn.connectivity_pdf, contact_numbers(ds, walls=walls, near=near), output_sizes={"c": max_c + 1},
                kwargs={"max_c": max_c, "min_contacts": min_contacts})
@@ -60,8 +182,47 @@ def connectivity_pdf(ds: xr.Dataset, max_c: int = 10, walls: bool = False, min_c
 
 def joint_connectivity_pdf(ds: xr.Dataset, max_m: int = 8, walls: bool = False, min_contacts: int = 1,
                            near=None) -> xr.DataArray:
-    """P(m_s, m_d) (time, m_s, m_d): fraction of non-rattler particles with exactly m_s simple
-    and m_d double force-bearing contacts (paper Fig. 21)."""
+    """P(m_s, m_d): fraction of non-rattler particles with m_s simple and m_d double contacts.
+
+    (time, m_s, m_d), paper Fig. 21:
+
+        P(m_s, m_d) = N(m_s, m_d) / N'
+
+    N(m_s, m_d) the number of particles with exactly m_s simple and m_d double force-bearing
+    contacts, N' the number of non-rattler particles (c >= ``min_contacts``,
+    counting both kinds).
+
+    Parameters
+    ----------
+    ds : xarray.Dataset
+        A dataset of the contract (docs/schema.md), eager or chunked along ``time``.
+    max_m : int, default 8
+        The largest m_s and m_d of the result (0 .. max_m each).
+    walls : bool, default False
+        Include the particle–wall contacts (default: particle–particle only).
+    min_contacts : int, default 1
+        A particle with fewer such contacts is a rattler, left out (default 1: none at all).
+    near : float, optional
+        Which pairs are contacts (:func:`grainview.contacts.in_network`): None (default) the
+        force-bearing ones, f_n > 0; a gap threshold in m adds the pairs with gap <= ``near``
+        (they carry f_n = 0); ``np.inf`` every pair the file holds.
+
+    Returns
+    -------
+    xarray.DataArray
+        ``P_ms_md`` (time, m_s, m_d), dimensionless, with the coordinates ``m_s`` and ``m_d``;
+        lazy on dask input.
+
+    Raises
+    ------
+    grainview.errors.ParameterError
+        When ``min_contacts`` is not an integer >= 1.
+
+    References
+    ----------
+    Azéma, Radjai, Peyroux & Saussine, Phys. Rev. E 76, 011301 (2007),
+    Sec. VI, Fig. 21; docs/conventions.md §7.
+    """
     _check_min(min_contacts)
     da = apply(_conn.joint_connectivity_pdf, contact_numbers(ds, "simple", walls, near),
                contact_numbers(ds, "double", walls, near), output_sizes={"m_s": max_m + 1, "m_d": max_m + 1},

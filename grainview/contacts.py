@@ -16,17 +16,52 @@ import xarray as xr
 from .errors import ParameterError
 from .schema import KIND_DOUBLE, KIND_SIMPLE
 
+__all__ = ["n_particles", "snapshot_index", "occupied", "is_wall_contact", "kind_code",
+           "check_near", "in_network", "near_attr", "selection"]
+
 KINDS = {"all": None, "simple": KIND_SIMPLE, "double": KIND_DOUBLE, "s": KIND_SIMPLE, "d": KIND_DOUBLE}
 
 
 def n_particles(ds: xr.Dataset) -> int:
-    """Number of particles N (walls are bodies N, N+1, ...)."""
+    """Number of particles N (walls are bodies N, N+1, ...).
+
+    Parameters
+    ----------
+    ds : xarray.Dataset
+        A dataset of the contract.
+
+    Returns
+    -------
+    int
+        N, the size of the ``particle`` dimension.
+    """
     return ds.sizes["particle"]
 
 
 def snapshot_index(ds: xr.Dataset, value, name: str = "time") -> int:
-    """``value`` as a snapshot index in [0, T) (negative counts from the end); one clear line
-    naming the argument ``name`` when it is not an integer in [-T, T)."""
+    """``value`` as a snapshot index in [0, T) (negative counts from the end).
+
+    One clear line naming the argument ``name`` when it is not an integer in [-T, T).
+
+    Parameters
+    ----------
+    ds : xarray.Dataset
+        A dataset of the contract.
+    value : int
+        A snapshot index in [-T, T), T the number of snapshots.
+    name : str, default "time"
+        The argument's name, for the error message.
+
+    Returns
+    -------
+    int
+        The index in [0, T).
+
+    Raises
+    ------
+    grainview.errors.ParameterError
+        When ``value`` is not an integer in [-T, T).
+    """
     n = ds.sizes["time"]
     if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or not -n <= value < n:
         raise ParameterError(f"{name}={value!r}: expected a snapshot index in [{-n}, {n})")
@@ -34,18 +69,64 @@ def snapshot_index(ds: xr.Dataset, value, name: str = "time") -> int:
 
 
 def occupied(ds: xr.Dataset) -> xr.DataArray:
-    """Boolean (time, contact): True in the slots that hold a contact."""
+    """Boolean (time, contact): True in the slots that hold a contact.
+
+        slot < contact_count[time]
+
+    Parameters
+    ----------
+    ds : xarray.Dataset
+        A dataset of the contract (docs/schema.md), eager or chunked along ``time``.
+
+    Returns
+    -------
+    xarray.DataArray
+        Boolean (time, contact); lazy on dask input.
+    """
     slot = xr.DataArray(np.arange(ds.sizes["contact"], dtype="i4"), dims="contact")
     return slot < ds["contact_count"]
 
 
 def is_wall_contact(ds: xr.Dataset) -> xr.DataArray:
-    """Boolean (time, contact): True where body j is a wall (j >= N)."""
+    """Boolean (time, contact): True where body j is a wall (j >= N).
+
+    Parameters
+    ----------
+    ds : xarray.Dataset
+        A dataset of the contract (docs/schema.md), eager or chunked along ``time``.
+
+    Returns
+    -------
+    xarray.DataArray
+        Boolean (time, contact); lazy on dask input.
+    """
     return ds["j"] >= n_particles(ds)
 
 
 def kind_code(kind) -> int | None:
-    """Normalise a ``kind`` argument ("all", "simple", "double", 1, 2) to a code or None."""
+    """Normalise a ``kind`` argument ("all", "simple", "double", 1, 2) to a code or None.
+
+    Parameters
+    ----------
+    kind : {"all", "simple", "double", "s", "d", 1, 2} or None
+        The contact kind: all (None or "all"), simple (vertex–edge and disk contacts; "simple",
+        "s" or 1) or double (edge–edge; "double", "d" or 2).
+
+    Returns
+    -------
+    int or None
+        1 (simple), 2 (double) or None (all).
+
+    Raises
+    ------
+    grainview.errors.ParameterError
+        For any other value.
+
+    References
+    ----------
+    Azéma, Radjai, Peyroux & Saussine, Phys. Rev. E 76, 011301 (2007),
+    Sec. II.A and Fig. 1 (simple and double contacts); docs/conventions.md §0.
+    """
     if kind in (None, "all"):
         return None
     if isinstance(kind, str):
@@ -58,8 +139,28 @@ def kind_code(kind) -> int | None:
 
 
 def check_near(ds: xr.Dataset, near) -> float | None:
-    """Validate the ``near`` argument of the analyses (see :func:`in_network`); returns it as
-    a float, or None."""
+    """Validate the ``near`` argument of the analyses (see :func:`in_network`).
+
+    Parameters
+    ----------
+    ds : xarray.Dataset
+        A dataset of the contract.
+    near : float or None
+        None, a gap threshold >= 0 in m, or ``np.inf``.
+
+    Returns
+    -------
+    float or None
+        ``near`` as a float, or None.
+
+    Raises
+    ------
+    grainview.errors.ParameterError
+        When ``near`` is not None or a number >= 0; when a finite ``near`` is asked of a file
+        without the variable ``gap`` or without near pairs (attribute ``near_contacts_m``); when
+        ``near`` exceeds the gap up to which the file holds them (docs/analysis.md, "Near
+        contacts").
+    """
     if near is None:
         return None
     if isinstance(near, bool) or not isinstance(near, (int, float, np.integer, np.floating)) or np.isnan(near) \
@@ -93,6 +194,24 @@ def in_network(ds: xr.Dataset, near=None) -> xr.DataArray:
     they overlap) is <= g, as a code that keeps every pair within its alert distance as a
     contact counts them (docs/analysis.md, "Near contacts"); ``near=np.inf``: every pair the
     file holds. Combine with :func:`occupied`.
+
+    Parameters
+    ----------
+    ds : xarray.Dataset
+        A dataset of the contract (docs/schema.md), eager or chunked along ``time``.
+    near : float, optional
+        None, a gap threshold g >= 0 in m (at most the file's ``near_contacts_m``), or
+        ``np.inf`` (:func:`check_near`).
+
+    Returns
+    -------
+    xarray.DataArray
+        Boolean (time, contact); lazy on dask input.
+
+    References
+    ----------
+    Azéma, Radjai, Peyroux & Saussine, Phys. Rev. E 76, 011301 (2007),
+    Sec. IV (the force-bearing network); docs/conventions.md §7.
     """
     near = check_near(ds, near)
     loaded = ds["fn"] > 0
@@ -104,19 +223,50 @@ def in_network(ds: xr.Dataset, near=None) -> xr.DataArray:
 
 
 def near_attr(near) -> str | float:
-    """The ``near`` argument as a netCDF-friendly attribute value ("none" or the gap in m)."""
+    """The ``near`` argument as a netCDF-friendly attribute value ("none" or the gap in m).
+
+    Parameters
+    ----------
+    near : float or None
+        The ``near`` argument of an analysis.
+
+    Returns
+    -------
+    str or float
+        "none" for None, else ``float(near)`` (m).
+    """
     return "none" if near is None else float(near)
 
 
 def selection(ds: xr.Dataset, *, walls: bool = False, kind="all", near=None) -> xr.DataArray:
     """Boolean (time, contact) mask of the contacts an analysis uses.
 
+    The occupied slots (:func:`occupied`) that are contacts of the network
+    (:func:`in_network`), optionally restricted to particle–particle contacts and to one kind.
+
     Parameters
     ----------
-    walls : include particle–wall contacts (default: particle–particle only).
-    kind : "all", "simple" (vertex–edge and disk contacts) or "double" (edge–edge).
-    near : None (default) for the force-bearing contacts (f_n > 0); a gap threshold in m to
+    ds : xarray.Dataset
+        A dataset of the contract (docs/schema.md), eager or chunked along ``time``.
+    walls : bool, default False
+        Include particle–wall contacts (default: particle–particle only).
+    kind : {"all", "simple", "double"}, default "all"
+        "all", "simple" (vertex–edge and disk contacts) or "double" (edge–edge)
+        (:func:`kind_code`).
+    near : float, optional
+        None (default) for the force-bearing contacts (f_n > 0); a gap threshold in m to
         count also the pairs with gap <= near (:func:`in_network`).
+
+    Returns
+    -------
+    xarray.DataArray
+        Boolean (time, contact); lazy on dask input.
+
+    References
+    ----------
+    Azéma, Radjai, Peyroux & Saussine, Phys. Rev. E 76, 011301 (2007),
+    Sec. II.A (simple and double contacts) and Sec. IV (the force-bearing network);
+    docs/analysis.md, "Which contacts".
     """
     mask = occupied(ds) & in_network(ds, near)
     if not walls:

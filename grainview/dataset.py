@@ -49,20 +49,52 @@ def make_dataset(
 ) -> xr.Dataset:
     """Assemble a dataset of the contract from plain arrays.
 
+    T snapshots of N particles and ``n_walls`` walls; every argument is keyword-only.
+
     Parameters
     ----------
-    radius : (N,) array, m
-    position : (T, N, 2) array, m (a (N, 2) array is taken as a single snapshot)
-    contacts : list of T dicts with keys ``i, j, kind, normal, fn, ft`` and optionally
-        ``point``, ``branch`` and ``gap`` (one entry per contact; a double contact is one
-        entry; ``gap`` in m, given for every snapshot or none).
-        ``branch`` defaults to ``x_j - x_i`` for particle pairs; ``point`` defaults to the
-        point on the segment i-j at distance ``r_i`` from i (exact for disks). For wall
-        contacts (``j >= N``) both ``point`` and ``branch`` must be given.
-    box_min, box_max : (T, 2) or (2,) arrays, m
-    n_vertices, mass, inertia, angle : defaults are disks of ``density`` (kg m-3) in a slab of
+    radius : array_like, (N,)
+        Particle radii, m.
+    position : array_like, (T, N, 2)
+        Particle centres, m (a (N, 2) array is taken as a single snapshot).
+    contacts : list of dict
+        T dicts with keys ``i, j, kind, normal, fn, ft`` and optionally ``point``, ``branch``
+        and ``gap`` (one entry per contact; a double contact is one entry; forces in N, ``gap``
+        in m, given for every snapshot or none). ``branch`` defaults to ``x_j - x_i`` for
+        particle pairs; ``point`` defaults to the point on the segment i-j at distance ``r_i``
+        from i (exact for disks). For wall contacts (``j >= N``) both ``point`` and ``branch``
+        must be given.
+    box_min, box_max : array_like, (T, 2) or (2,)
+        Corners of the sample box, m.
+    time : array_like, (T,), optional
+        Snapshot times, s (default 0, 1, ..., T-1).
+    n_vertices, mass, inertia, angle : array_like, optional
+        Vertex counts (0 for a disk), masses (kg), moments of inertia (kg m2) and angles
+        (rad, broadcast to (T, N)); defaults are disks of ``density`` (kg m-3) in a slab of
         unit thickness at zero angle.
-    optional : any optional contract variable (``velocity``, ``wall_force``, ``step``...).
+    density : float, default 2600.0
+        Density of the default masses, kg m-3.
+    n_walls : int, default 0
+        Number of walls (bodies N, N+1, ...).
+    wall_names : sequence of str, optional
+        One name per wall (default: the contract's default names).
+    attrs : dict, optional
+        Global attributes added to the contract's.
+    n_contact_slots : int, optional
+        Size of the ``contact`` dimension (default: :func:`grainview.schema.contact_slots`).
+    **optional
+        Any optional contract variable (``velocity``, ``wall_force``, ``step``...).
+
+    Returns
+    -------
+    xarray.Dataset
+        An in-memory dataset of the contract (docs/schema.md) that every analysis accepts.
+
+    Raises
+    ------
+    grainview.errors.ParameterError
+        When the arrays disagree in size, a snapshot holds more contacts than slots, a wall
+        contact lacks ``point`` or ``branch``, or an optional variable is unknown.
     """
     radius = np.asarray(radius, dtype="f8")
     n = radius.shape[0]
@@ -181,10 +213,26 @@ def netcdf_encoding(ds: xr.Dataset, zlib: bool = False, complevel: int = 4) -> d
 
 
 def netcdf_options(ds: xr.Dataset, compress: bool = True, complevel: int = 4) -> dict:
-    """Keyword arguments of ``Dataset.to_netcdf`` that write ``ds`` as the solver writes a
-    finished run: compressed (:data:`grainview.writer.COMPRESSED_FORMAT`, zlib at
-    ``complevel``) or, with ``compress=False``, netCDF-3 (:data:`grainview.writer.APPEND_FORMAT`);
-    the contract's integer sentinels kept either way (:func:`netcdf_encoding`).
+    """Keyword arguments of ``Dataset.to_netcdf`` that write ``ds`` as the solver writes a finished run.
+
+    Compressed (:data:`grainview.writer.COMPRESSED_FORMAT`, zlib at ``complevel``) or, with
+    ``compress=False``, netCDF-3 (the format of :data:`grainview.writer.APPEND_FORMAT`, under
+    xarray's name ``NETCDF3_64BIT``); the contract's integer sentinels kept either way
+    (:func:`netcdf_encoding`).
+
+    Parameters
+    ----------
+    ds : xarray.Dataset
+        A dataset of the contract.
+    compress : bool, default True
+        Write compressed (NETCDF4_CLASSIC with zlib) rather than netCDF-3.
+    complevel : int, default 4
+        zlib level, 1 (fastest) to 9 (smallest); used with ``compress``.
+
+    Returns
+    -------
+    dict
+        ``format`` and ``encoding``, for ``ds.to_netcdf(path, **options)``.
 
     Examples
     --------

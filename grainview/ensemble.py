@@ -119,21 +119,31 @@ def _differs(a, b) -> bool:
 def open_ensemble(paths, chunks="auto", validate: bool = False, names=None) -> xr.Dataset:
     """Open runs of the contract as one lazy Dataset along ``run`` (see the module docstring).
 
+    Every file must have the same walls and variables. Each accessor works on the result per
+    run (``ens.grain.stress_invariants()`` has a ``run`` dimension), and :func:`run_dataset`
+    gives one run back as its file opens alone.
+
     Parameters
     ----------
-    paths : a list of files, a glob pattern (``"study/*.nc"``) or a folder (its ``*.nc``)
-    chunks : snapshots per dask chunk of each run, as :func:`grainview.open_dataset`
-    validate : check every file against the contract first
-    names : the ``run`` coordinate (default: the file names without ``.nc``)
+    paths : str, path-like or sequence of them
+        A list of files, a glob pattern (``"study/*.nc"``) or a folder (its ``*.nc``).
+    chunks : int, dict, "auto" or None, default "auto"
+        Snapshots per dask chunk of each run, as :func:`grainview.open_dataset`.
+    validate : bool, default False
+        Check every file against the contract first.
+    names : sequence of str, optional
+        The ``run`` coordinate (default: the file names without ``.nc``).
 
     Returns
     -------
     xarray.Dataset
         The runs along ``run`` (its coordinate: ``names``), lazy unless ``chunks=None``.
 
-    Every file must have the same walls and variables. Each accessor works on the result per
-    run (``ens.grain.stress_invariants()`` has a ``run`` dimension), and :func:`run_dataset`
-    gives one run back as its file opens alone.
+    Raises
+    ------
+    grainview.errors.ParameterError
+        When no file is found, ``names`` does not match the files, two runs share a name, or
+        the files differ in variables or walls.
 
     Examples
     --------
@@ -240,14 +250,26 @@ def _label(key, value) -> str:
 
 
 def is_ensemble(ds) -> bool:
-    """Whether ``ds`` is an ensemble of :func:`open_ensemble` (has a ``run`` dimension)."""
+    """Whether ``ds`` is an ensemble of :func:`open_ensemble` (has a ``run`` dimension).
+
+    Parameters
+    ----------
+    ds : object
+        Anything; a Dataset or DataArray is looked at for a ``run`` dimension.
+
+    Returns
+    -------
+    bool
+        True when ``ds`` has a ``run`` dimension.
+    """
     return "run" in getattr(ds, "dims", ())
 
 
 def run_dataset(ens: xr.Dataset, run) -> xr.Dataset:
-    """Run ``run`` (an index, or a name of the ``run`` coordinate) of an ensemble, exactly as
-    :func:`grainview.open_dataset` opens its file alone: padding removed, its own ``time``
-    coordinate, its global attributes.
+    """Run ``run`` of an ensemble, exactly as :func:`grainview.open_dataset` opens its file alone.
+
+    ``run`` is an index, or a name of the ``run`` coordinate. Padding is removed; the run gets
+    its own ``time`` coordinate and its global attributes.
 
     Parameters
     ----------
@@ -295,7 +317,18 @@ def run_dataset(ens: xr.Dataset, run) -> xr.Dataset:
 
 
 def run_parameters(ens: xr.Dataset) -> list[str]:
-    """Coordinates along ``run`` only (the run's parameters and sizes)."""
+    """Coordinates along ``run`` only (the run's parameters and sizes).
+
+    Parameters
+    ----------
+    ens : xarray.Dataset
+        An ensemble of :func:`open_ensemble`.
+
+    Returns
+    -------
+    list of str
+        The names of the coordinates whose only dimension is ``run``.
+    """
     return [name for name, c in ens.coords.items() if c.dims == ("run",)]
 
 
@@ -308,9 +341,10 @@ def _positional(result):
 
 
 def combine_runs(results, ens: xr.Dataset):
-    """Per-run xarray results along a new ``run`` dimension with the ensemble's run
-    coordinates; dimensions without an index (``time``, ``contact_event``...) are padded with
-    NaN to the longest run.
+    """Per-run xarray results along a new ``run`` dimension with the ensemble's run coordinates.
+
+    Dimensions without an index (``time``, ``contact_event``...) are padded with NaN to the
+    longest run.
 
     Parameters
     ----------
@@ -339,8 +373,10 @@ def combine_runs(results, ens: xr.Dataset):
 
 
 def map_runs(ens: xr.Dataset, func):
-    """``func(run_dataset(ens, k))`` for every run: xarray results combined along ``run``
-    (:func:`combine_runs`), any other result as a dict {run name: result}.
+    """``func(run_dataset(ens, k))`` for every run, combined along ``run``.
+
+    xarray results are combined along ``run`` (:func:`combine_runs`), any other result is
+    returned as a dict {run name: result}.
 
     Parameters
     ----------
@@ -390,15 +426,18 @@ def _bin_strain(da: xr.DataArray, bins) -> xr.DataArray:
 
 
 def seed_statistics(result, eps_q_bins=None) -> xr.Dataset:
-    """Mean, spread and standard error over the runs of each ``group`` (the seeds of one
-    setting) of a per-run result of an ensemble.
+    """Mean, spread and standard error over the seeds of each ``group`` of a per-run result.
 
-    With ``eps_q_bins`` (increasing edges; each bin [e_k, e_k+1), the last one closed), a time series is first averaged within each bin of shear
-    strain eps_q run by run, so that runs of different heights, rates or lengths share one
-    strain axis; without, the runs are compared snapshot by snapshot (or the result has no
-    ``time``). Returns, per group: ``mean``, ``std`` (sample standard deviation, ddof = 1),
-    ``sem`` = std / sqrt(n) and ``n`` (runs with a value); for a Dataset, ``<name>_mean``...
-    for each variable. NaN values (a run without snapshots in a bin) are left out.
+    The runs of a ``group`` are the seeds of one setting. With ``eps_q_bins`` (increasing
+    edges; each bin [e_k, e_k+1), the last one closed), a time series is first averaged within
+    each bin of shear strain eps_q run by run, so that runs of different heights, rates or
+    lengths share one strain axis; without, the runs are compared snapshot by snapshot (or the
+    result has no ``time``). Returns, per group:
+
+        mean,    std (sample standard deviation, ddof = 1),    sem = std / sqrt(n),
+
+    and ``n`` (runs with a value); for a Dataset, ``<name>_mean``... for each variable. NaN
+    values (a run without snapshots in a bin) are left out.
 
     Parameters
     ----------
@@ -413,6 +452,12 @@ def seed_statistics(result, eps_q_bins=None) -> xr.Dataset:
     xarray.Dataset
         ``mean``, ``std``, ``sem`` (in the result's units) and ``n`` along ``group`` (and
         ``eps_q_bin``, the bin centres, with bins).
+
+    Raises
+    ------
+    grainview.errors.ParameterError
+        When ``result`` has no ``run`` dimension or ``group`` coordinate, or, with
+        ``eps_q_bins``, no ``eps_q`` coordinate or bins that are not increasing finite edges.
     """
     if isinstance(result, xr.Dataset):
         out = xr.Dataset()

@@ -37,7 +37,25 @@ __all__ = ["write_vtk", "write_csv", "snapshot_indices", "write_atomically"]
 
 
 def snapshot_indices(ds: xr.Dataset, every: int = 1) -> np.ndarray:
-    """Indices 0, every, 2 every, ... of the snapshots to export (and always the last)."""
+    """Indices 0, every, 2 every, ... of the snapshots to export (and always the last).
+
+    Parameters
+    ----------
+    ds : xarray.Dataset
+        A grainview dataset.
+    every : int, default 1
+        The step between exported snapshots (>= 1).
+
+    Returns
+    -------
+    numpy.ndarray
+        Increasing snapshot indices, the last snapshot included (empty for no snapshot).
+
+    Raises
+    ------
+    grainview.errors.ParameterError
+        When ``every`` is not an integer >= 1.
+    """
     if isinstance(every, bool) or not isinstance(every, (int, np.integer)) or every < 1:
         raise ParameterError(f"every={every!r}: expected an integer >= 1")
     n = ds.sizes["time"]
@@ -45,9 +63,29 @@ def snapshot_indices(ds: xr.Dataset, every: int = 1) -> np.ndarray:
 
 
 def write_atomically(path, overwrite, write):
-    """Write ``path`` through ``write(temporary path)`` and move it into place, so that an
-    interrupted write never leaves a half-written file under the final name; an existing
-    ``path`` is refused unless ``overwrite``."""
+    """Write ``path`` through ``write(temporary path)`` and move it into place.
+
+    An interrupted write never leaves a half-written file under the final name; an existing
+    ``path`` is refused unless ``overwrite``.
+
+    Parameters
+    ----------
+    path : str
+        The final file name.
+    overwrite : bool
+        Replace an existing ``path``.
+    write : callable
+        Called with the temporary path (``<root>.part<ext>`` beside ``path``); writes the file.
+
+    Returns
+    -------
+    None
+
+    Raises
+    ------
+    grainview.errors.ParameterError
+        When ``path`` exists and ``overwrite`` is False.
+    """
     if os.path.exists(path) and not overwrite:
         raise ParameterError(f"{path} exists; pass overwrite=True (--overwrite) to replace it")
     root, ext = os.path.splitext(path)
@@ -115,8 +153,11 @@ def _collection(path, entries, overwrite):
 
 
 def write_vtk(ds: xr.Dataset, out_dir, every: int = 1, overwrite: bool = False, progress=None) -> list:
-    """Write the VTK files of the module docstring for every ``every``-th snapshot into
-    ``out_dir`` (created if needed), for ParaView or OVITO.
+    """Write the VTK files of the module docstring for every ``every``-th snapshot into ``out_dir``.
+
+    For ParaView or OVITO; ``out_dir`` is created if needed. Per snapshot k,
+    ``particles_<k>.vtu`` and ``contacts_<k>.vtu``, then the collections ``particles.pvd`` and
+    ``contacts.pvd``.
 
     Parameters
     ----------
@@ -136,6 +177,16 @@ def write_vtk(ds: xr.Dataset, out_dir, every: int = 1, overwrite: bool = False, 
     -------
     list of str
         The paths written, the two ``.pvd`` collections (particles, contacts) last.
+
+    Raises
+    ------
+    grainview.errors.ParameterError
+        When meshio is not installed, or a file to write exists and ``overwrite`` is False.
+
+    References
+    ----------
+    Azéma, Radjai, Peyroux & Saussine, Phys. Rev. E 76, 011301 (2007),
+    Fig. 17 and Secs. V.B-V.C (the force classes of the contacts); docs/conventions.md §4.
     """
     try:
         import meshio
@@ -179,8 +230,10 @@ def write_vtk(ds: xr.Dataset, out_dir, every: int = 1, overwrite: bool = False, 
 
 
 def write_csv(ds: xr.Dataset, out_dir, every: int = 1, overwrite: bool = False) -> str:
-    """Write ``contacts.csv``: the tidy contact table (:func:`grainview.tables.contacts_table`)
-    of every ``every``-th snapshot, with columns ``snapshot`` and ``time`` (s) first.
+    """Write ``contacts.csv``: the tidy contact table of every ``every``-th snapshot.
+
+    The table is :func:`grainview.tables.contacts_table`'s, with columns ``snapshot`` and
+    ``time`` (s) first.
 
     Parameters
     ----------
@@ -197,6 +250,17 @@ def write_csv(ds: xr.Dataset, out_dir, every: int = 1, overwrite: bool = False) 
     -------
     str
         The path of ``contacts.csv``.
+
+    Raises
+    ------
+    grainview.errors.ParameterError
+        When ``contacts.csv`` exists and ``overwrite`` is False.
+
+    References
+    ----------
+    Azéma, Radjai, Peyroux & Saussine, Phys. Rev. E 76, 011301 (2007),
+    Eqs. 1-2 and Sec. II.A (the contact frame, simple and double contacts);
+    docs/conventions.md §0.
     """
     import pandas as pd
 

@@ -16,13 +16,42 @@ from .contacts import kind_code, selection
 from .errors import ParameterError
 from .stress import stress_direction
 
+__all__ = ["fabric_tensor", "reference_direction", "fabric_anisotropy", "orientation_pdf",
+           "theta_coord", "check_bins"]
+
 
 def fabric_tensor(ds: xr.Dataset, kind="all", walls: bool = False, near=None) -> xr.DataArray:
-    """F (time, xy_a, xy_b) = (1/N_c) sum_c n (x) n, dimensionless, tr F = 1 (paper Eq. F).
+    """Fabric tensor F (time, xy_a, xy_b), dimensionless, tr F = 1 (paper Eq. F).
 
-    With ``kind="simple"`` or ``"double"`` the sum runs over that kind while N_c stays the
-    count of all contacts, so F = F_s + F_d exactly (paper Eq. fabricsd). ``near``: which
-    pairs are contacts (:func:`grainview.contacts.in_network`; default force-bearing only).
+        F = (1/N_c) sum_c n^c (x) n^c
+
+    over the N_c selected contacts, n^c the unit normal of contact c. With ``kind="simple"`` or
+    ``"double"`` the sum runs over that kind while N_c stays the count of all contacts, so
+    F = F_s + F_d exactly (paper Eq. fabricsd).
+
+    Parameters
+    ----------
+    ds : xarray.Dataset
+        A dataset of the contract (docs/schema.md), eager or chunked along ``time``.
+    kind : {"all", "simple", "double"}, default "all"
+        The contacts used: all, simple (vertex–edge and disk contacts) or double (edge–edge)
+        ones (also 1, 2, "s", "d"; :func:`grainview.contacts.kind_code`).
+    walls : bool, default False
+        Include the particle–wall contacts (default: particle–particle only).
+    near : float, optional
+        Which pairs are contacts (:func:`grainview.contacts.in_network`): None (default) the
+        force-bearing ones, f_n > 0; a gap threshold in m adds the pairs with gap <= ``near``
+        (they carry f_n = 0); ``np.inf`` every pair the file holds.
+
+    Returns
+    -------
+    xarray.DataArray
+        ``fabric`` (time, xy_a, xy_b), dimensionless; lazy on dask input.
+
+    References
+    ----------
+    Azéma, Radjai, Peyroux & Saussine, Phys. Rev. E 76, 011301 (2007),
+    Eq. F (Sec. IV.B) and Eq. fabricsd; docs/conventions.md §2.
     """
     mask_all = selection(ds, walls=walls, near=near)
     mask = selection(ds, walls=walls, kind=kind, near=near)
@@ -31,8 +60,34 @@ def fabric_tensor(ds: xr.Dataset, kind="all", walls: bool = False, near=None) ->
 
 
 def reference_direction(ds, reference):
-    """The reference direction theta' of a signed anisotropy (rad): ``"stress"``/None for the
-    major principal stress direction of the whole sample, an angle, or a DataArray over time."""
+    """The reference direction theta' of a signed anisotropy (rad).
+
+    ``"stress"``/None for the major principal stress direction of the whole sample, an angle, or
+    a DataArray over time.
+
+    Parameters
+    ----------
+    ds : xarray.Dataset
+        A dataset of the contract (docs/schema.md), eager or chunked along ``time``.
+    reference : "stress", None, float or xarray.DataArray
+        ``"stress"`` or None: :func:`grainview.stress.stress_direction`; a number: a fixed angle
+        in rad; a DataArray: the direction over time, rad.
+
+    Returns
+    -------
+    xarray.DataArray or float
+        theta', rad.
+
+    Raises
+    ------
+    grainview.errors.ParameterError
+        For any other ``reference``.
+
+    References
+    ----------
+    Azéma, Radjai, Peyroux & Saussine, Phys. Rev. E 76, 011301 (2007),
+    Eq. a' (theta'); docs/conventions.md §2 and §3, "Signs".
+    """
     if reference is None or (isinstance(reference, str) and reference == "stress"):
         return stress_direction(ds)
     if isinstance(reference, (int, float, np.floating)):
@@ -43,12 +98,45 @@ def reference_direction(ds, reference):
 
 
 def fabric_anisotropy(ds: xr.Dataset, kind="all", walls: bool = False, reference="stress", near=None) -> xr.Dataset:
-    """a = 2 (F_1 - F_2), theta_F and the signed a' = a cos 2(theta_F - theta') (paper Eq. a').
+    """Fabric anisotropy a = 2 (F_1 - F_2), theta_F and the signed a' (paper Eq. a').
 
-    ``reference`` is theta': ``"stress"`` (default, the major principal stress direction of
-    the whole sample, docs/conventions.md §3, "Signs"), a fixed angle in rad, or a DataArray over time. For a
-    partial tensor (kind simple/double) the anisotropies a_s, a'_s are those of F_s, whose
-    trace is k_s (paper Fig. 22).
+        a = 2 (F_1 - F_2),    a' = a cos 2(theta_F - theta')
+
+    F_1 >= F_2 the principal values of F (:func:`fabric_tensor`), theta_F its major direction
+    and theta' the ``reference`` direction: ``"stress"`` (default, the major principal stress
+    direction of the whole sample, docs/conventions.md §3, "Signs"), a fixed angle in rad, or a
+    DataArray over time. For a partial tensor (kind simple/double) the anisotropies a_s, a'_s
+    are those of F_s, whose trace is k_s (paper Fig. 22).
+
+    Parameters
+    ----------
+    ds : xarray.Dataset
+        A dataset of the contract (docs/schema.md), eager or chunked along ``time``.
+    kind : {"all", "simple", "double"}, default "all"
+        The contacts used: all, simple (vertex–edge and disk contacts) or double (edge–edge)
+        ones (also 1, 2, "s", "d"; :func:`grainview.contacts.kind_code`).
+    walls : bool, default False
+        Include the particle–wall contacts (default: particle–particle only).
+    reference : "stress", float or xarray.DataArray, default "stress"
+        The reference direction theta' (rad): ``"stress"`` (or None) the major principal stress
+        direction of the whole sample (docs/conventions.md §3, "Signs"), a fixed angle in rad,
+        or a DataArray over time.
+    near : float, optional
+        Which pairs are contacts (:func:`grainview.contacts.in_network`): None (default) the
+        force-bearing ones, f_n > 0; a gap threshold in m adds the pairs with gap <= ``near``
+        (they carry f_n = 0); ``np.inf`` every pair the file holds.
+
+    Returns
+    -------
+    xarray.Dataset
+        Over ``time``: ``a`` and ``a_prime`` (dimensionless) and ``theta_F`` (rad); lazy on
+        dask input.
+
+    References
+    ----------
+    Azéma, Radjai, Peyroux & Saussine, Phys. Rev. E 76, 011301 (2007),
+    Eqs. F and a' (Sec. IV.B), Fig. 9 and, for the partial tensors, Fig. 22;
+    docs/conventions.md §2.
     """
     f1, f2, theta = apply(principal, fabric_tensor(ds, kind, walls, near))
     ref = reference_direction(ds, reference)
@@ -61,8 +149,40 @@ def fabric_anisotropy(ds: xr.Dataset, kind="all", walls: bool = False, reference
 
 
 def orientation_pdf(ds: xr.Dataset, bins: int = 36, kind="all", walls: bool = False, near=None) -> xr.DataArray:
-    """P(theta) (time, theta): density of contact-normal orientations on [0, pi), rad-1,
-    normalised so that sum P dtheta = 1 (paper Fig. 8)."""
+    """P(theta) (time, theta): density of contact-normal orientations on [0, pi), rad-1.
+
+        P(theta_k) = N_c(theta_k) / (N_c dtheta),    dtheta = pi/bins
+
+    N_c(theta_k) the number of selected contacts whose normal (folded into [0, pi)) falls in the
+    sector centred on theta_k; normalised so that sum P dtheta = 1 (paper Fig. 8).
+
+    Parameters
+    ----------
+    ds : xarray.Dataset
+        A dataset of the contract (docs/schema.md), eager or chunked along ``time``.
+    bins : int, default 36
+        Number of angular sectors of [0, pi), centred on theta_k = k pi/bins.
+    kind : {"all", "simple", "double"}, default "all"
+        The contacts used: all, simple (vertex–edge and disk contacts) or double (edge–edge)
+        ones (also 1, 2, "s", "d"; :func:`grainview.contacts.kind_code`).
+    walls : bool, default False
+        Include the particle–wall contacts (default: particle–particle only).
+    near : float, optional
+        Which pairs are contacts (:func:`grainview.contacts.in_network`): None (default) the
+        force-bearing ones, f_n > 0; a gap threshold in m adds the pairs with gap <= ``near``
+        (they carry f_n = 0); ``np.inf`` every pair the file holds.
+
+    Returns
+    -------
+    xarray.DataArray
+        ``orientation_pdf`` (time, theta) in rad-1, with the sector centres as the coordinate
+        ``theta`` (rad); lazy on dask input.
+
+    References
+    ----------
+    Azéma, Radjai, Peyroux & Saussine, Phys. Rev. E 76, 011301 (2007),
+    Sec. IV and Fig. 8; docs/conventions.md §0 and §2.
+    """
     bins = check_bins(bins)
     mask = selection(ds, walls=walls, kind=kind, near=near)
     da = apply(_fabric.orientation_pdf, ds["normal"], mask, output_sizes={"theta": bins}, kwargs={"n_bins": bins},
@@ -72,13 +192,46 @@ def orientation_pdf(ds: xr.Dataset, bins: int = 36, kind="all", walls: bool = Fa
 
 
 def theta_coord(bins: int) -> xr.DataArray:
-    """Centres theta_k = k pi/bins of the ``bins`` angular sectors, rad."""
+    """Centres theta_k = k pi/bins of the ``bins`` angular sectors, rad.
+
+    Parameters
+    ----------
+    bins : int
+        Number of sectors of [0, pi).
+
+    Returns
+    -------
+    xarray.DataArray
+        The centres along dimension ``theta``, in rad.
+
+    References
+    ----------
+    Azéma, Radjai, Peyroux & Saussine, Phys. Rev. E 76, 011301 (2007),
+    Eq. fnft (Sec. V.A; the sectors S(theta) = [theta - dtheta/2, theta + dtheta/2]);
+    docs/analysis.md, "Conventions worth knowing".
+    """
     centres = np.arange(bins) * np.pi / bins
     return xr.DataArray(centres, dims="theta", attrs={"units": "rad", "long_name": "contact orientation theta"})
 
 
 def check_bins(bins) -> int:
-    """Validate a number of angular sectors (a positive integer)."""
+    """Validate a number of angular sectors (a positive integer).
+
+    Parameters
+    ----------
+    bins : int
+        Number of angular sectors.
+
+    Returns
+    -------
+    int
+        ``bins`` as a Python int.
+
+    Raises
+    ------
+    grainview.errors.ParameterError
+        When ``bins`` is not an integer >= 1.
+    """
     if not isinstance(bins, (int, np.integer)) or bins < 1:
         raise ParameterError(f"bins={bins!r}: expected a positive integer number of angular sectors")
     return int(bins)

@@ -15,6 +15,8 @@ from .arrays import force_networks as _net
 from .contacts import near_attr, selection
 from .errors import ParameterError
 
+__all__ = ["force_class", "contact_proportions"]
+
 
 def _check_thresholds(very_weak, strong):
     for name, value in (("very_weak", very_weak), ("strong", strong)):
@@ -28,13 +30,48 @@ def _check_thresholds(very_weak, strong):
 
 def force_class(ds: xr.Dataset, very_weak: float = 0.1, strong: float = 1.0, walls: bool = False,
                 near=None) -> xr.DataArray:
-    """Force class of each contact slot (time, contact), int8 (paper Fig. 17's tricolor map):
+    """Force class of each contact slot (time, contact), int8 (paper Fig. 17's tricolor map).
 
-    0 not selected (empty slot, or a wall contact with ``walls=False``); 1 very weak,
-    f_n < very_weak <f_n>; 2 weak (intermediate), very_weak <f_n> <= f_n <= strong <f_n>;
-    3 strong, f_n > strong <f_n>. Defaults 0.1 and 1 as in the paper (Secs. V.B and V.C).
-    ``near``: which pairs are contacts (:func:`grainview.contacts.in_network`; default the
-    force-bearing ones; with a gap threshold the near pairs, f_n = 0, are very weak).
+        0 not selected (empty slot, or a wall contact with ``walls=False``);
+        1 very weak, f_n < very_weak <f_n>;
+        2 weak (intermediate), very_weak <f_n> <= f_n <= strong <f_n>;
+        3 strong, f_n > strong <f_n>.
+
+    <f_n> is the snapshot's mean normal force over the selected contacts. Defaults 0.1 and 1 as
+    in the paper (Secs. V.B and V.C). ``near``: which pairs are contacts
+    (:func:`grainview.contacts.in_network`; default the force-bearing ones; with a gap threshold
+    the near pairs, f_n = 0, are very weak).
+
+    Parameters
+    ----------
+    ds : xarray.Dataset
+        A dataset of the contract (docs/schema.md), eager or chunked along ``time``.
+    very_weak : float, default 0.1
+        Very weak threshold, a multiple of <f_n> (finite, >= 0, <= ``strong``).
+    strong : float, default 1.0
+        Strong threshold, a multiple of <f_n> (finite, >= 0).
+    walls : bool, default False
+        Include the particle–wall contacts (default: particle–particle only).
+    near : float, optional
+        Which pairs are contacts (:func:`grainview.contacts.in_network`): None (default) the
+        force-bearing ones, f_n > 0; a gap threshold in m adds the pairs with gap <= ``near``
+        (they carry f_n = 0); ``np.inf`` every pair the file holds.
+
+    Returns
+    -------
+    xarray.DataArray
+        ``force_class`` (time, contact), int8 codes 0-3 (``flag_values``, ``flag_meanings``
+        attributes); lazy on dask input.
+
+    Raises
+    ------
+    grainview.errors.ParameterError
+        When a threshold is not a finite number >= 0, or ``very_weak > strong``.
+
+    References
+    ----------
+    Azéma, Radjai, Peyroux & Saussine, Phys. Rev. E 76, 011301 (2007),
+    Secs. V.B and V.C, Fig. 17; docs/conventions.md §4.
     """
     very_weak, strong = _check_thresholds(very_weak, strong)
     da = apply(_net.force_classes, ds["fn"], selection(ds, walls=walls, near=near),
@@ -78,14 +115,47 @@ def contact_proportions(ds: xr.Dataset, walls: bool = False, very_weak: float = 
       f_d = f_s = 0.5 in an isotropic state with equal means;
     * k_s_strong, k_s_weak, k_d_strong, k_d_weak (k_s^S, k_s^W, k_d^S, k_d^W, Fig. 25): fractions
       of all contacts that are simple/double and strong (f_n > strong <f_n>) or weak
-      (f_n <= strong <f_n>); weak_fraction = k_s^W + k_d^W (paper: ~0.58 pentagons, ~0.62 disks);
+      (f_n <= strong <f_n>); weak_fraction = k_s^W + k_d^W (the paper finds about 0.58 for
+      pentagons, 0.62 for disks);
     * very_weak_fraction (f_n < very_weak <f_n>) and its simple and double parts, fractions of
-      all contacts (paper: ~32 % = 25 % simple + 7 % double for pentagons);
+      all contacts (the paper finds about 0.32 = 0.25 simple + 0.07 double for pentagons);
     * n_contacts, and the means mean_fn, mean_fn_simple, mean_fn_double in N.
 
     ``near``: which pairs are contacts (:func:`grainview.contacts.in_network`): None (default)
     the force-bearing ones; with a gap threshold in m the near pairs count too, with f_n = 0
     (they are very weak). Lazy on dask input.
+
+    Parameters
+    ----------
+    ds : xarray.Dataset
+        A dataset of the contract (docs/schema.md), eager or chunked along ``time``.
+    walls : bool, default False
+        Include the particle–wall contacts (default: particle–particle only).
+    very_weak : float, default 0.1
+        Very weak threshold, a multiple of <f_n> (finite, >= 0, <= ``strong``).
+    strong : float, default 1.0
+        Strong threshold, a multiple of <f_n> (finite, >= 0).
+    near : float, optional
+        Which pairs are contacts (:func:`grainview.contacts.in_network`): None (default) the
+        force-bearing ones, f_n > 0; a gap threshold in m adds the pairs with gap <= ``near``
+        (they carry f_n = 0); ``np.inf`` every pair the file holds.
+
+    Returns
+    -------
+    xarray.Dataset
+        The variables above over ``time``: ``n_contacts``, the proportions and fractions
+        (dimensionless) and ``mean_fn``, ``mean_fn_simple``, ``mean_fn_double`` (N); the
+        attributes ``walls``, ``very_weak``, ``strong`` and ``near`` record the selection.
+
+    Raises
+    ------
+    grainview.errors.ParameterError
+        When a threshold is not a finite number >= 0, or ``very_weak > strong``.
+
+    References
+    ----------
+    Azéma, Radjai, Peyroux & Saussine, Phys. Rev. E 76, 011301 (2007),
+    Secs. V.C and VI, Figs. 19 and 25 (f_s, f_d with the correction of docs/conventions.md §4).
     """
     very_weak, strong = _check_thresholds(very_weak, strong)
     names = _net.PROPORTIONS

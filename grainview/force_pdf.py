@@ -18,6 +18,8 @@ from .arrays import force_pdf as _pdf
 from .contacts import kind_code, selection
 from .errors import ParameterError
 
+__all__ = ["force_pdf", "pooled_force_pdf", "strong_force_exponent"]
+
 SCALES = ("log", "linear")
 DEFAULT_RANGE = {"linear": (0.0, 10.0), "log": (1e-4, 10.0)}
 """Default range of f_n/<f_n> per scale (an exponential tail with alpha = 0.74 leaves about
@@ -86,23 +88,45 @@ def force_pdf(ds: xr.Dataset, bins: int = 50, scale: str = "log", range=None, ki
               walls: bool = False, near=None) -> xr.Dataset:
     """P(f_n/<f_n>) per snapshot (time, bin), dimensionless (paper Fig. 14; Fig. 23 by kind).
 
+        pdf = count / (N_in * width),    so that sum(pdf * bin_width) = 1
+
     Each snapshot's forces are divided by its mean normal force <f_n> over the contacts of
     ``walls`` (every kind); ``kind`` ("all", "simple", "double") chooses the contacts counted.
-    The density follows ``np.histogram(density=True)``: ``pdf = count / (N_in * width)`` with
-    N_in the contacts that fall in a bin, so ``sum(pdf * bin_width) = 1``.
+    The density follows ``np.histogram(density=True)``: N_in is the number of contacts that fall
+    in a bin and ``width`` the bin width.
 
     Parameters
     ----------
-    bins : number of bins (>= 1).
-    scale : "log" (log-spaced bins, geometric centres; contacts with f_n <= 0 are skipped and
+    ds : xarray.Dataset
+        A dataset of the contract (docs/schema.md), eager or chunked along ``time``.
+    bins : int, default 50
+        Number of bins (>= 1).
+    scale : {"log", "linear"}, default "log"
+        "log" (log-spaced bins, geometric centres; contacts with f_n <= 0 are skipped and
         reported by ``zero_fraction``) or "linear".
-    range : (low, high) of f_n/<f_n>; default (1e-4, 10) for log and (0, 10) for linear bins.
-    near : which pairs are contacts (:func:`grainview.contacts.in_network`): None (default)
-        the force-bearing ones; a gap threshold in m adds the near pairs (f_n = 0).
+    range : (float, float), optional
+        (low, high) of f_n/<f_n> (dimensionless); default (1e-4, 10) for log and (0, 10) for
+        linear bins.
+    kind : {"all", "simple", "double"}, default "all"
+        The contacts counted (the mean <f_n> is always that of every kind).
+    walls : bool, default False
+        Include the particle–wall contacts (default: particle–particle only).
+    near : float, optional
+        Which pairs are contacts (:func:`grainview.contacts.in_network`): None (default) the
+        force-bearing ones, f_n > 0; a gap threshold in m adds the pairs with gap <= ``near``
+        (they carry f_n = 0); ``np.inf`` every pair the file holds.
 
-    Returns a Dataset with ``pdf`` and ``count`` (time, bin), ``n_contacts``,
-    ``zero_fraction`` and ``outside_fraction`` (time), and the coordinates ``f_over_mean``
-    (bin centres), ``bin_width`` and ``bin_edges`` (dim ``edge``). Lazy on dask input.
+    Returns
+    -------
+    xarray.Dataset
+        ``pdf`` and ``count`` (time, bin), ``n_contacts``, ``zero_fraction`` and
+        ``outside_fraction`` (time), all dimensionless, and the coordinates ``f_over_mean`` (bin
+        centres), ``bin_width`` and ``bin_edges`` (dim ``edge``); lazy on dask input.
+
+    References
+    ----------
+    Azéma, Radjai, Peyroux & Saussine, Phys. Rev. E 76, 011301 (2007),
+    Sec. V.B, Figs. 14 and 23.
     """
     counts, n_selected, n_zero, edges, scale = _histogram(ds, bins, scale, range, kind, walls, near)
     return _pdf_dataset(counts, n_selected, n_zero, edges, scale, {"kind": str(kind), "walls": int(walls)})
@@ -117,6 +141,40 @@ def pooled_force_pdf(ds: xr.Dataset, bins: int = 50, scale: str = "log", range=N
     sums. On dask input the result is lazy and computing it sums the counts one time-chunk at
     a time (a dask reduction), so the file is never loaded whole. Select the snapshots to pool
     first, e.g. ``pooled_force_pdf(ds.isel(time=slice(-20, None)))`` for the residual state.
+
+    Parameters
+    ----------
+    ds : xarray.Dataset
+        A dataset of the contract (docs/schema.md), eager or chunked along ``time``.
+    bins : int, default 50
+        Number of bins (>= 1).
+    scale : {"log", "linear"}, default "log"
+        "log" (log-spaced bins, geometric centres; contacts with f_n <= 0 are skipped and
+        reported by ``zero_fraction``) or "linear".
+    range : (float, float), optional
+        (low, high) of f_n/<f_n> (dimensionless); default (1e-4, 10) for log and (0, 10) for
+        linear bins.
+    kind : {"all", "simple", "double"}, default "all"
+        The contacts counted (the mean <f_n> is always that of every kind).
+    walls : bool, default False
+        Include the particle–wall contacts (default: particle–particle only).
+    near : float, optional
+        Which pairs are contacts (:func:`grainview.contacts.in_network`): None (default) the
+        force-bearing ones, f_n > 0; a gap threshold in m adds the pairs with gap <= ``near``
+        (they carry f_n = 0); ``np.inf`` every pair the file holds.
+
+    Returns
+    -------
+    xarray.Dataset
+        ``pdf`` and ``count`` (bin), ``n_contacts``, ``zero_fraction`` and
+        ``outside_fraction`` (scalars), all dimensionless, and the coordinates ``f_over_mean`` (bin
+        centres), ``bin_width`` and ``bin_edges`` (dim ``edge``); lazy on dask input.
+        The attribute ``pooled_snapshots`` holds the number of snapshots pooled.
+
+    References
+    ----------
+    Azéma, Radjai, Peyroux & Saussine, Phys. Rev. E 76, 011301 (2007),
+    Sec. V.B, Figs. 14 and 23.
     """
     counts, n_selected, n_zero, edges, scale = _histogram(ds, bins, scale, range, kind, walls, near)
     return _pdf_dataset(counts.sum("time"), n_selected.sum("time"), n_zero.sum("time"), edges, scale,
@@ -126,13 +184,36 @@ def pooled_force_pdf(ds: xr.Dataset, bins: int = 50, scale: str = "log", range=N
 def strong_force_exponent(pdf: xr.Dataset, low: float = 1.0, high: float = np.inf) -> xr.DataArray:
     """alpha of the strong-force tail pdf ~ exp(-alpha f_n/<f_n>) (paper Eq. strong).
 
-    Fits ``ln pdf = c - alpha x`` on the bins of ``pdf`` (a result of :func:`force_pdf` or
-    :func:`pooled_force_pdf`) whose centre x = f_n/<f_n> lies in (``low``, ``high``) (default:
-    above the mean) and that hold at least one contact, by least squares weighted by the bin
-    counts (the inverse variance of ln pdf). Use linear bins: with log bins the bin average of
-    an exponential differs from its value at the geometric centre. Returns alpha over the
-    remaining dims (time, or none for a pooled pdf); NaN with fewer than two usable bins.
-    The paper finds alpha ~0.74 (pentagons) and ~1.4 (disks).
+        ln pdf = c - alpha x,    x = f_n/<f_n>
+
+    fitted on the bins of ``pdf`` (a result of :func:`force_pdf` or :func:`pooled_force_pdf`)
+    whose centre x lies in (``low``, ``high``) (default: above the mean) and that hold at least
+    one contact, by least squares weighted by the bin counts (the inverse variance of ln pdf).
+    Use linear bins: with log bins the bin average of an exponential differs from its value at
+    the geometric centre. The paper finds alpha ~0.74 (pentagons) and ~1.4 (disks).
+
+    Parameters
+    ----------
+    pdf : xarray.Dataset
+        The result of :func:`force_pdf` or :func:`pooled_force_pdf`.
+    low, high : float, default 1.0 and inf
+        The open interval of f_n/<f_n> (dimensionless) fitted; ``low < high``.
+
+    Returns
+    -------
+    xarray.DataArray
+        ``alpha``, dimensionless, over the remaining dims (time, or none for a pooled pdf); NaN
+        with fewer than two usable bins.
+
+    Raises
+    ------
+    grainview.errors.ParameterError
+        When ``pdf`` is not such a Dataset, or ``low >= high``.
+
+    References
+    ----------
+    Azéma, Radjai, Peyroux & Saussine, Phys. Rev. E 76, 011301 (2007),
+    Eq. strong (Sec. V.B), Figs. 14 and 23.
     """
     if not isinstance(pdf, xr.Dataset) or "pdf" not in pdf or "f_over_mean" not in pdf.coords:
         raise ParameterError("pdf: expected the Dataset returned by force_pdf or pooled_force_pdf")

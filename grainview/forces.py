@@ -17,11 +17,47 @@ from .contacts import selection
 from .fabric import check_bins, reference_direction, fabric_anisotropy, theta_coord
 from .stress import stress_invariants
 
+__all__ = ["angular_force_averages", "force_tensors", "force_anisotropies", "harmonic_prediction"]
+
 
 def angular_force_averages(ds: xr.Dataset, bins: int = 36, kind="all", walls: bool = False, near=None) -> xr.Dataset:
-    """<f_n>(theta), <f_t>(theta) (N) and N_c(theta) on ``bins`` sectors of [0, pi)
-    (paper Eq. fnft, Fig. 10); NaN in empty sectors. ``near``: which pairs are contacts
-    (:func:`grainview.contacts.in_network`; default force-bearing only)."""
+    """<f_n>(theta), <f_t>(theta) (N) and N_c(theta) on ``bins`` sectors of [0, pi) (paper Eq. fnft).
+
+        <f_n>(theta) = (1/N_c(theta)) sum_(c in S(theta)) f_n^c,
+        <f_t>(theta) = (1/N_c(theta)) sum_(c in S(theta)) f_t^c,
+
+    S(theta) = [theta - dtheta/2, theta + dtheta/2] with dtheta = pi/bins, N_c(theta) the
+    number of selected contacts whose normal falls in it (paper Eq. fnft, Fig. 10); NaN in
+    empty sectors. ``near``: which pairs are contacts (:func:`grainview.contacts.in_network`;
+    default force-bearing only).
+
+    Parameters
+    ----------
+    ds : xarray.Dataset
+        A dataset of the contract (docs/schema.md), eager or chunked along ``time``.
+    bins : int, default 36
+        Number of angular sectors of [0, pi), centred on theta_k = k pi/bins.
+    kind : {"all", "simple", "double"}, default "all"
+        The contacts used: all, simple (vertex–edge and disk contacts) or double (edge–edge)
+        ones (also 1, 2, "s", "d"; :func:`grainview.contacts.kind_code`).
+    walls : bool, default False
+        Include the particle–wall contacts (default: particle–particle only).
+    near : float, optional
+        Which pairs are contacts (:func:`grainview.contacts.in_network`): None (default) the
+        force-bearing ones, f_n > 0; a gap threshold in m adds the pairs with gap <= ``near``
+        (they carry f_n = 0); ``np.inf`` every pair the file holds.
+
+    Returns
+    -------
+    xarray.Dataset
+        Over (time, theta): ``fn_mean`` and ``ft_mean`` in N and ``count`` (dimensionless), with
+        the sector centres as the coordinate ``theta`` (rad); lazy on dask input.
+
+    References
+    ----------
+    Azéma, Radjai, Peyroux & Saussine, Phys. Rev. E 76, 011301 (2007),
+    Eq. fnft (Sec. V.A) and Fig. 10; docs/conventions.md §3.
+    """
     bins = check_bins(bins)
     mask = selection(ds, walls=walls, kind=kind, near=near)
     fn, ft, count = apply(_forces.angular_averages, ds["fn"], ds["ft"], ds["normal"], mask,
@@ -34,7 +70,42 @@ def angular_force_averages(ds: xr.Dataset, bins: int = 36, kind="all", walls: bo
 
 
 def force_tensors(ds: xr.Dataset, bins: int = 36, kind="all", walls: bool = False, near=None) -> xr.Dataset:
-    """H^(n) and H^(t) (time, xy_a, xy_b) in N (docs/conventions.md §3)."""
+    """Force tensors H^(n) and H^(t) (time, xy_a, xy_b) in N (docs/conventions.md §3).
+
+        H^(n)_ab = (1/pi) int_0^pi <f_n>(theta) n_a n_b dtheta,
+        H^(t)_ab = sym[(1/pi) int_0^pi <f_t>(theta) n_a t_b dtheta],
+
+    with <f_n>(theta), <f_t>(theta) the sector means of :func:`angular_force_averages`, taken
+    as constant on each sector while n (x) n and n (x) t are integrated exactly over it; empty
+    sectors contribute nothing, and tr H^(n) is the angular mean of <f_n>(theta). H^(t) uses
+    n_a t_b, as docs/conventions.md §3 explains (the printed paper writes n_a n_b).
+
+    Parameters
+    ----------
+    ds : xarray.Dataset
+        A dataset of the contract (docs/schema.md), eager or chunked along ``time``.
+    bins : int, default 36
+        Number of angular sectors of [0, pi), centred on theta_k = k pi/bins.
+    kind : {"all", "simple", "double"}, default "all"
+        The contacts used: all, simple (vertex–edge and disk contacts) or double (edge–edge)
+        ones (also 1, 2, "s", "d"; :func:`grainview.contacts.kind_code`).
+    walls : bool, default False
+        Include the particle–wall contacts (default: particle–particle only).
+    near : float, optional
+        Which pairs are contacts (:func:`grainview.contacts.in_network`): None (default) the
+        force-bearing ones, f_n > 0; a gap threshold in m adds the pairs with gap <= ``near``
+        (they carry f_n = 0); ``np.inf`` every pair the file holds.
+
+    Returns
+    -------
+    xarray.Dataset
+        ``H_n`` and ``H_t`` (the symmetric part), (time, xy_a, xy_b) in N; lazy on dask input.
+
+    References
+    ----------
+    Azéma, Radjai, Peyroux & Saussine, Phys. Rev. E 76, 011301 (2007),
+    Eq. HnHt (Sec. V.A), with the correction of docs/conventions.md §3.
+    """
     bins = check_bins(bins)
     mask = selection(ds, walls=walls, kind=kind, near=near)
     h_n, h_t = apply(_forces.force_tensors, ds["fn"], ds["ft"], ds["normal"], mask,
@@ -47,9 +118,47 @@ def force_tensors(ds: xr.Dataset, bins: int = 36, kind="all", walls: bool = Fals
 
 def force_anisotropies(ds: xr.Dataset, bins: int = 36, kind="all", walls: bool = False,
                        reference="stress", near=None) -> xr.Dataset:
-    """a_n = 2 (H^n_1 - H^n_2)/tr H^n and a_t = 2 (H^t_1 - H^t_2)/tr H^n (docs/conventions.md §3),
-    signed by cos 2(theta - theta') with theta' the ``reference`` direction (default: major
-    principal stress direction); also theta_n, theta_t and the unsigned magnitudes."""
+    """Signed normal and tangential force anisotropies a_n, a_t (docs/conventions.md §3).
+
+        a_n = 2 (H^n_1 - H^n_2) / tr H^n,    a_t = 2 (H^t_1 - H^t_2) / tr H^n,
+
+    H^n_1 >= H^n_2 and H^t_1 >= H^t_2 the principal values of the force tensors
+    (:func:`force_tensors`), each signed by cos 2(theta - theta'), theta the major direction of
+    its tensor (theta_n, theta_t) and theta' the ``reference`` direction (default: major
+    principal stress direction), so that (a' + a_n + a_t)/2 predicts q/p whatever the
+    directions (docs/conventions.md §3, "Signs"). The unsigned magnitudes are returned too.
+
+    Parameters
+    ----------
+    ds : xarray.Dataset
+        A dataset of the contract (docs/schema.md), eager or chunked along ``time``.
+    bins : int, default 36
+        Number of angular sectors of [0, pi), centred on theta_k = k pi/bins.
+    kind : {"all", "simple", "double"}, default "all"
+        The contacts used: all, simple (vertex–edge and disk contacts) or double (edge–edge)
+        ones (also 1, 2, "s", "d"; :func:`grainview.contacts.kind_code`).
+    walls : bool, default False
+        Include the particle–wall contacts (default: particle–particle only).
+    reference : "stress", float or xarray.DataArray, default "stress"
+        The reference direction theta' of the signs (rad): ``"stress"`` the major principal
+        stress direction of the whole sample, a fixed angle in rad, or a DataArray over time
+        (:func:`grainview.fabric.reference_direction`).
+    near : float, optional
+        Which pairs are contacts (:func:`grainview.contacts.in_network`): None (default) the
+        force-bearing ones, f_n > 0; a gap threshold in m adds the pairs with gap <= ``near``
+        (they carry f_n = 0); ``np.inf`` every pair the file holds.
+
+    Returns
+    -------
+    xarray.Dataset
+        Over ``time``: ``a_n``, ``a_t`` (signed), ``a_n_magnitude``, ``a_t_magnitude``
+        (dimensionless) and ``theta_n``, ``theta_t`` (rad); lazy on dask input.
+
+    References
+    ----------
+    Azéma, Radjai, Peyroux & Saussine, Phys. Rev. E 76, 011301 (2007),
+    Eq. anat (Sec. V.A) and Fig. 11, with the normalisation of docs/conventions.md §3.
+    """
     h = force_tensors(ds, bins, kind, walls, near)
     n1, n2, theta_n = apply(principal, h["H_n"])
     t1, t2, theta_t = apply(principal, h["H_t"])
@@ -70,7 +179,10 @@ def force_anisotropies(ds: xr.Dataset, bins: int = 36, kind="all", walls: bool =
 def harmonic_prediction(ds: xr.Dataset, bins: int = 36, walls: bool = False, near=None) -> xr.Dataset:
     """q/p and its harmonic predictions (paper Eq. qa, Fig. 12; docs/conventions.md §3).
 
-    ``prediction`` is the paper's first-order form (a' + a_n + a_t)/2.
+    ``prediction`` is the paper's first-order form
+
+        q/p ~ (a' + a_n + a_t)/2.
+
     ``prediction_cross_term`` keeps the one cross product that survives the angular
     integration of the harmonic model: with P(theta) = [1 + a cos 2 theta]/pi and
     <f_n>(theta) = <f>[1 + a_n cos 2 theta], the mean stress is p ~ (1 + a a_n / 2), so
@@ -79,11 +191,36 @@ def harmonic_prediction(ds: xr.Dataset, bins: int = 36, walls: bool = False, nea
 
     exact for the harmonic model with coaxial directions and equal branch lengths; the two
     forms differ by the factor 1 + a' a_n / 2 (a few percent for the paper's anisotropies,
-    ~15% when a' and a_n are near 0.55).
+    about 1.15 when a' and a_n are near 0.55).
 
     The anisotropies use the contacts selected by ``walls`` (default particle–particle);
     q/p is the stress of the whole sample (wall contacts included). ``near``: which pairs are
     contacts of the anisotropies (:func:`grainview.contacts.in_network`).
+
+    Parameters
+    ----------
+    ds : xarray.Dataset
+        A dataset of the contract (docs/schema.md), eager or chunked along ``time``.
+    bins : int, default 36
+        Number of angular sectors of [0, pi), centred on theta_k = k pi/bins.
+    walls : bool, default False
+        Include the particle–wall contacts (default: particle–particle only).
+    near : float, optional
+        Which pairs are contacts (:func:`grainview.contacts.in_network`): None (default) the
+        force-bearing ones, f_n > 0; a gap threshold in m adds the pairs with gap <= ``near``
+        (they carry f_n = 0); ``np.inf`` every pair the file holds.
+
+    Returns
+    -------
+    xarray.Dataset
+        Over ``time``, all dimensionless: ``q_over_p``, ``prediction``,
+        ``prediction_cross_term`` and the signed anisotropies ``a_prime``, ``a_n``, ``a_t``
+        they are made of; lazy on dask input.
+
+    References
+    ----------
+    Azéma, Radjai, Peyroux & Saussine, Phys. Rev. E 76, 011301 (2007),
+    Eq. qa (Sec. V.A) and Fig. 12; docs/conventions.md §3, "The cross term".
     """
     fab = fabric_anisotropy(ds, walls=walls, near=near)
     frc = force_anisotropies(ds, bins, walls=walls, near=near)

@@ -91,16 +91,21 @@ def _events(ds, walls, near):
 
 
 def contact_events(ds: xr.Dataset, walls: bool = True, near=None) -> xr.Dataset:
-    """Every life of every contact (module docstring) along a ``contact_event`` dimension,
-    ordered by birth then pair.
+    """Every life of every contact (module docstring), ordered by birth then pair.
+
+    One entry per life along a ``contact_event`` dimension; a life runs from its birth t_b to its
+    death t_d and lasts
+
+        tau = t_d - t_b    (s; in strain units eps_q(t_d) - eps_q(t_b)).
 
     Variables: ``i``, ``j`` (the pair, i < j; j >= N for a wall), ``birth`` and ``death`` (s;
     death NaN when right-censored), ``lifetime`` (s: t_death - t_birth, or the observed
     duration t_last - t_birth when censored), ``censored`` (right), ``left_censored`` (present at
     the first snapshot), ``kind_at_birth`` (1 simple, 2 double), ``kind_switches`` (simple <->
     double changes during the life), ``mean_fn`` and ``max_fn`` (N, over the snapshots of the
-    life), and, when the file has its box, ``lifetime_eps_q`` (the shear strain eps_q over the
-    life, 1). Snapshot times must increase. Computed one time-chunk at a time.
+    life), ``birth_fn`` (N, the normal force at the first snapshot of the life) and, when the
+    file has its box, ``lifetime_eps_q`` (the shear strain eps_q over the life, 1). Snapshot
+    times must increase. Computed one time-chunk at a time.
 
     Parameters
     ----------
@@ -115,12 +120,14 @@ def contact_events(ds: xr.Dataset, walls: bool = True, near=None) -> xr.Dataset:
     Returns
     -------
     xarray.Dataset
-        One entry per life along ``contact_event``, with the variables above.
+        One entry per life along ``contact_event``, with the variables above (times and
+        lifetimes in s, forces in N).
 
     References
     ----------
-    Contact persistence and force classes: Azéma et al., Phys. Rev. E 75, 011301 (2007),
-    Sec. V; docs/analysis.md.
+    Azéma, Radjai, Peyroux & Saussine, Phys. Rev. E 76, 011301 (2007),
+    Sec. IV.A (contact persistence) and Sec. V (force classes); docs/analysis.md, "Contact
+    lifetimes".
     """
     _check_flag("walls", walls)
     check_near(ds, near)
@@ -163,8 +170,12 @@ def contact_events(ds: xr.Dataset, walls: bool = True, near=None) -> xr.Dataset:
 
 
 def kaplan_meier(durations, observed):
-    """Kaplan–Meier survival: (u, S(u)) at the distinct observed durations u of ``durations``
-    whose ``observed`` flag is True (False = right-censored), S(u) = prod_{v <= u} (1 - d_v/n_v).
+    """Kaplan–Meier survival S(u) at the distinct observed durations u.
+
+        S(u) = prod_{v <= u} (1 - d_v/n_v)
+
+    (u, S(u)) at the distinct durations u of ``durations`` whose ``observed`` flag is True
+    (False = right-censored); d_v the deaths at v and n_v the durations of at least v (at risk).
 
     Parameters
     ----------
@@ -180,6 +191,11 @@ def kaplan_meier(durations, observed):
     survival : numpy.ndarray
         S(u) at each of them; every life still counts as at risk up to its own duration,
         censored or not.
+
+    Raises
+    ------
+    grainview.errors.ParameterError
+        When ``durations`` and ``observed`` differ in shape.
     """
     durations = np.asarray(durations, dtype=float)
     observed = np.asarray(observed, dtype=bool)
@@ -195,8 +211,12 @@ def kaplan_meier(durations, observed):
 
 def lifetime_survival(ds: xr.Dataset, walls: bool = True, near=None, by=None, unit: str = "time",
                       force_at: str = "life", very_weak: float = 0.1) -> xr.DataArray:
-    """Survival S(tau) of the contacts' lives (Kaplan–Meier, module docstring), left-censored
-    lives left out, as a step function on the grid of every observed lifetime.
+    """Survival S(tau) of the contacts' lives (Kaplan–Meier, module docstring).
+
+        S(tau) = prod_{u <= tau} (1 - d_u / n_u)
+
+    over the lives born within the series: left-censored lives left out, as a step function on
+    the grid of every observed lifetime.
 
     ``by``: None (all lives), ``"kind"`` (simple / double at birth) or ``"force"``: strong
     (f > <f>), weak (``very_weak`` <f> <= f <= <f>) and very weak (f < ``very_weak`` <f>;
@@ -224,6 +244,12 @@ def lifetime_survival(ds: xr.Dataset, walls: bool = True, near=None, by=None, un
     xarray.DataArray
         ``survival`` (group, lifetime), dimensionless, a step function on the grid of every
         observed lifetime, with the number of lives per group as the coordinate ``lives``.
+
+    References
+    ----------
+    Azéma, Radjai, Peyroux & Saussine, Phys. Rev. E 76, 011301 (2007),
+    Sec. V (strong, weak and very weak forces) and Sec. II.A (simple and double contacts);
+    docs/analysis.md, "Contact lifetimes".
     """
     if by not in (None, "kind", "force"):
         raise ParameterError(f"by={by!r}: expected None, 'kind' or 'force'")
@@ -264,7 +290,9 @@ def lifetime_survival(ds: xr.Dataset, walls: bool = True, near=None, by=None, un
 
 def median_lifetime_by_force(ds: xr.Dataset, bins=(0.0, 0.5, 1.0, 1.5, 2.0, np.inf), walls: bool = True,
                              near=None) -> xr.DataArray:
-    """Do strong contacts live longer? The median lifetime (s) of the lives whose mean normal
+    """Median lifetime (s) of the lives in each bin of mean normal force relative to the mean.
+
+    Do strong contacts live longer? The median lifetime (s) of the lives whose mean normal
     force over the life, over the mean of all lives, falls in each of ``bins``: the tau at which
     the bin's Kaplan–Meier survival first drops to 1/2 or below (censoring handled; NaN when it
     never does). Left-censored lives are left out.
@@ -283,6 +311,11 @@ def median_lifetime_by_force(ds: xr.Dataset, bins=(0.0, 0.5, 1.0, 1.5, 2.0, np.i
     xarray.DataArray
         ``median_lifetime`` (force_bin,) in s, with the number of lives per bin as the
         coordinate ``lives``.
+
+    References
+    ----------
+    Azéma, Radjai, Peyroux & Saussine, Phys. Rev. E 76, 011301 (2007),
+    Sec. V (forces relative to the mean); docs/analysis.md, "Contact lifetimes".
     """
     bins = np.asarray(bins, dtype=float)
     if bins.ndim != 1 or bins.size < 2 or np.any(np.diff(bins) <= 0):
@@ -307,10 +340,14 @@ def median_lifetime_by_force(ds: xr.Dataset, bins=(0.0, 0.5, 1.0, 1.5, 2.0, np.i
 
 def strong_persistence(ds: xr.Dataset, max_lag: int = 20, strong: float = 1.0, walls: bool = False,
                        near=None) -> xr.DataArray:
-    """Survival of the strong network: of the contacts strong at t (f_n > ``strong`` <f_n(t)>,
-    paper Sec. V), the fraction still strong at t + lag, pooled over every t (sum of the kept
-    over sum of the strong), for lag = 0 .. ``max_lag`` snapshots. Computed one time-chunk at a
-    time, carrying the strong sets of the last ``max_lag`` snapshots.
+    """Survival of the strong network: the fraction of strong contacts still strong after a lag.
+
+        P(lag) = sum_t |S(t) & S(t + lag)| / sum_t |S(t)|
+
+    S(t) the contacts strong at t (f_n > ``strong`` <f_n(t)>, paper Sec. V), the sums over every
+    t that has a snapshot t + lag (pooled: sum of the kept over sum of the strong), for
+    lag = 0 .. ``max_lag`` snapshots. Computed one time-chunk at a time, carrying the strong
+    sets of the last ``max_lag`` snapshots.
 
     Parameters
     ----------
@@ -331,7 +368,8 @@ def strong_persistence(ds: xr.Dataset, max_lag: int = 20, strong: float = 1.0, w
 
     References
     ----------
-    Strong and weak networks: Azéma et al., Phys. Rev. E 75, 011301 (2007), Sec. V.
+    Azéma, Radjai, Peyroux & Saussine, Phys. Rev. E 76, 011301 (2007),
+    Sec. V (strong and weak networks); docs/analysis.md, "Contact lifetimes".
     """
     from collections import deque
 

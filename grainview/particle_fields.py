@@ -19,10 +19,56 @@ from ._lift import with_attrs
 from .connectivity import _check_min, counts_of
 from .contacts import selection, snapshot_index
 
+__all__ = ["particle_fields"]
+
 
 def particle_fields(ds: xr.Dataset, reference: int = 0, walls: bool = True, near=None,
                     min_contacts: int = 1) -> xr.Dataset:
-    """The per-particle fields of the module docstring as a Dataset (time, particle)."""
+    """The per-particle fields of every snapshot as a Dataset (time, particle).
+
+    For each snapshot and particle, lazily like the input:
+
+    * ``c``: force-bearing contacts (a double contact counts once; walls with ``walls=True``);
+    * ``m_s``, ``m_d``: of which simple and double (paper Sec. VI, Fig. 21);
+    * ``strong``: contacts carrying more than the snapshot's mean normal force <f_n> (Sec. V);
+    * ``rattler``: c < ``min_contacts`` (the rattler rule of z and P(c), docs/conventions.md §7);
+    * ``rotation`` (rad) and ``displacement`` (m): the particle's rotation and the length of its
+      displacement since the ``reference`` snapshot.
+
+    Parameters
+    ----------
+    ds : xarray.Dataset
+        A dataset of the contract (docs/schema.md), eager or chunked along ``time``.
+    reference : int, default 0
+        Snapshot index the rotation and displacement are measured from (negative counts from
+        the end).
+    walls : bool, default True
+        Include the particle–wall contacts; ``False`` leaves them out.
+    near : float, optional
+        Which pairs are contacts (:func:`grainview.contacts.in_network`): None (default) the
+        force-bearing ones, f_n > 0; a gap threshold in m adds the pairs with gap <= ``near``
+        (they carry f_n = 0); ``np.inf`` every pair the file holds.
+    min_contacts : int, default 1
+        A particle with fewer contacts c is a rattler.
+
+    Returns
+    -------
+    xarray.Dataset
+        ``c``, ``m_s``, ``m_d``, ``strong`` (counts), ``rattler`` (boolean), ``rotation`` (rad)
+        and ``displacement`` (m) over (time, particle); the attributes record ``reference``,
+        ``walls`` and ``min_contacts``.
+
+    Raises
+    ------
+    grainview.errors.ParameterError
+        When ``min_contacts`` is not an integer >= 1, or ``reference`` not a snapshot index.
+
+    References
+    ----------
+    Azéma, Radjai, Peyroux & Saussine, Phys. Rev. E 76, 011301 (2007),
+    Sec. IV.A (connectivity and rattlers), Sec. V (strong contacts) and Sec. VI, Fig. 21
+    (m_s, m_d); docs/conventions.md §7.
+    """
     _check_min(min_contacts)
     reference = snapshot_index(ds, reference, "reference")
     network = selection(ds, walls=walls, near=near)

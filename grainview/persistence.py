@@ -22,24 +22,70 @@ from .contacts import check_near, n_particles, near_attr, selection, snapshot_in
 from .errors import ParameterError
 from .schema import KIND_DOUBLE, KIND_SIMPLE
 
+__all__ = ["body_count", "pair_keys", "time_blocks", "persistence", "type_transitions"]
+
 _MAX_KEY = np.iinfo(np.int64).max // 2
 
 
 def body_count(ds: xr.Dataset) -> int:
-    """N + W: particles plus walls, the stride of the pair keys."""
+    """N + W: particles plus walls, the stride of the pair keys.
+
+    W is the larger of the size of the ``wall`` dimension and the attribute ``n_walls``.
+
+    Parameters
+    ----------
+    ds : xarray.Dataset
+        A dataset of the contract.
+
+    Returns
+    -------
+    int
+        N + W.
+    """
     n_walls = max(ds.sizes.get("wall", 0), int(ds.attrs.get("n_walls", 0) or 0))
     return n_particles(ds) + n_walls
 
 
 def pair_keys(i, j, n_bodies):
-    """int64 key ``min(i, j) n_bodies + max(i, j)`` of each pair (unique for bodies < n_bodies)."""
+    """int64 key ``min(i, j) n_bodies + max(i, j)`` of each pair (unique for bodies < n_bodies).
+
+        key = min(i, j) n_bodies + max(i, j)
+
+    Parameters
+    ----------
+    i, j : array_like of int
+        The bodies of each contact (same shape).
+    n_bodies : int
+        The stride, N + W (:func:`body_count`).
+
+    Returns
+    -------
+    numpy.ndarray
+        int64 keys, the shape of ``i`` and ``j``.
+
+    References
+    ----------
+    Azéma, Radjai, Peyroux & Saussine, Phys. Rev. E 76, 011301 (2007),
+    Sec. IV.A (a contact as a pair of bodies); docs/conventions.md §8.
+    """
     i = np.asarray(i, np.int64)
     j = np.asarray(j, np.int64)
     return np.minimum(i, j) * n_bodies + np.maximum(i, j)
 
 
 def time_blocks(ds: xr.Dataset):
-    """Slices of ``time`` following the dataset's dask chunks (one slice when eager)."""
+    """Slices of ``time`` following the dataset's dask chunks (one slice when eager).
+
+    Parameters
+    ----------
+    ds : xarray.Dataset
+        A dataset of the contract.
+
+    Yields
+    ------
+    slice
+        Consecutive slices of snapshot indices covering ``time``.
+    """
     chunks = ds["fn"].chunksizes.get("time") if ds["fn"].chunks is not None else None
     sizes = chunks or (ds.sizes["time"],)
     start = 0
@@ -76,16 +122,47 @@ def _check_flag(name, value):
 
 def persistence(ds: xr.Dataset, reference: int = 0, uninterrupted: bool = False, walls: bool = False,
                 near=None) -> xr.DataArray:
-    """gamma(t): fraction of the contacts of the reference snapshot still present at t
-    (paper Sec. IV.A, Fig. 6b; docs/conventions.md §8).
+    """gamma(t): fraction of the contacts of the reference snapshot still present at t.
 
-    gamma(t) = |C(ref) & C(t)| / |C(ref)|, C(t) the set of pairs {i, j} in contact at t
-    (particle–particle unless ``walls``; force-bearing, f_n > 0, unless ``near`` adds the
-    pairs within that gap, :func:`grainview.contacts.in_network`).
-    With ``uninterrupted=True`` a contact counts only if present at every snapshot from the
-    reference to t. ``reference`` is a snapshot index (negative counts from the end); gamma is
-    1 there and NaN before it (and NaN if the reference holds no contact). Dimensionless.
-    Computed (not lazy), streaming one time-chunk at a time.
+        gamma(t) = |C(ref) & C(t)| / |C(ref)|
+
+    C(t) the set of pairs {i, j} in contact at t (particle–particle unless ``walls``;
+    force-bearing, f_n > 0, unless ``near`` adds the pairs within that gap,
+    :func:`grainview.contacts.in_network`). With ``uninterrupted=True`` a contact counts only if
+    present at every snapshot from the reference to t. gamma is 1 at the reference and NaN
+    before it (and NaN if the reference holds no contact). Computed (not lazy), streaming one
+    time-chunk at a time (paper Sec. IV.A, Fig. 6b; docs/conventions.md §8).
+
+    Parameters
+    ----------
+    ds : xarray.Dataset
+        A dataset of the contract (docs/schema.md), eager or chunked along ``time``.
+    reference : int, default 0
+        The reference snapshot index (negative counts from the end).
+    uninterrupted : bool, default False
+        Count a contact only if present at every snapshot from the reference to t.
+    walls : bool, default False
+        Include the particle–wall contacts (default: particle–particle only).
+    near : float, optional
+        Which pairs are contacts (:func:`grainview.contacts.in_network`): None (default) the
+        force-bearing ones, f_n > 0; a gap threshold in m adds the pairs with gap <= ``near``
+        (they carry f_n = 0); ``np.inf`` every pair the file holds.
+
+    Returns
+    -------
+    xarray.DataArray
+        ``gamma`` (time,), dimensionless, computed; its attributes record ``reference``,
+        ``uninterrupted``, ``walls`` and ``near``.
+
+    Raises
+    ------
+    grainview.errors.ParameterError
+        When ``uninterrupted`` or ``walls`` is not a bool, or ``reference`` not a snapshot index.
+
+    References
+    ----------
+    Azéma, Radjai, Peyroux & Saussine, Phys. Rev. E 76, 011301 (2007),
+    Sec. IV.A, Fig. 6b; docs/conventions.md §8.
     """
     _check_flag("uninterrupted", uninterrupted)
     _check_flag("walls", walls)
@@ -152,8 +229,7 @@ def _pair_transitions(prev_keys, prev_kind, prev_present, keys, kind, present, s
 
 
 def type_transitions(ds: xr.Dataset, walls: bool = False, near=None) -> xr.Dataset:
-    """Cumulative fractions Delta gamma_{s->d}(t) and Delta gamma_{d->s}(t) of contacts that
-    changed type (paper Sec. VI, Fig. 20; docs/conventions.md §8).
+    """Cumulative fractions Delta gamma_{s->d}(t) and Delta gamma_{d->s}(t) of contacts that changed type.
 
     Definition used here (the paper gives none in formula): for each pair of consecutive
     snapshots (t-1, t),
@@ -162,10 +238,40 @@ def type_transitions(ds: xr.Dataset, walls: bool = False, near=None) -> xr.Datas
                       / N_c(t-1),
 
     N_c(t-1) the number of contacts at t-1 (particle–particle unless ``walls``; force-bearing
-    unless ``near`` adds near pairs, :func:`grainview.contacts.in_network`); likewise g_{d->s}. Delta gamma(t) = sum_{t' <= t} g(t'),
-    with Delta gamma(0) = 0 (a step from a snapshot without contacts adds 0). Dimensionless.
-    Computed (not lazy), streaming one time-chunk at a time with the last snapshot of each
-    chunk carried over to the next.
+    unless ``near`` adds near pairs, :func:`grainview.contacts.in_network`); likewise
+    g_{d->s}. Then
+
+        Delta gamma(t) = sum_{t' <= t} g(t'),
+
+    with Delta gamma(0) = 0 (a step from a snapshot without contacts adds 0). Computed (not
+    lazy), streaming one time-chunk at a time with the last snapshot of each chunk carried over
+    to the next (paper Sec. VI, Fig. 20; docs/conventions.md §8).
+
+    Parameters
+    ----------
+    ds : xarray.Dataset
+        A dataset of the contract (docs/schema.md), eager or chunked along ``time``.
+    walls : bool, default False
+        Include the particle–wall contacts (default: particle–particle only).
+    near : float, optional
+        Which pairs are contacts (:func:`grainview.contacts.in_network`): None (default) the
+        force-bearing ones, f_n > 0; a gap threshold in m adds the pairs with gap <= ``near``
+        (they carry f_n = 0); ``np.inf`` every pair the file holds.
+
+    Returns
+    -------
+    xarray.Dataset
+        ``delta_gamma_s_to_d`` and ``delta_gamma_d_to_s`` (time,), dimensionless, computed.
+
+    Raises
+    ------
+    grainview.errors.ParameterError
+        When ``walls`` is not a bool.
+
+    References
+    ----------
+    Azéma, Radjai, Peyroux & Saussine, Phys. Rev. E 76, 011301 (2007),
+    Sec. VI, Fig. 20; docs/conventions.md §8.
     """
     _check_flag("walls", walls)
     check_near(ds, near)

@@ -7,36 +7,142 @@ import xarray as xr
 from ._lift import with_attrs
 from .schema import particle_area
 
+__all__ = ["thickness", "width", "height", "volume", "solid_fraction", "area"]
+
 
 def thickness(ds: xr.Dataset) -> float:
-    """Slab thickness of the 2D sample in m (global attribute ``thickness_m``, default 1)."""
+    """Slab thickness of the 2D sample in m (global attribute ``thickness_m``, default 1).
+
+    Parameters
+    ----------
+    ds : xarray.Dataset
+        A dataset of the contract.
+
+    Returns
+    -------
+    float
+        The thickness t, m.
+
+    References
+    ----------
+    Azéma, Radjai, Peyroux & Saussine, Phys. Rev. E 76, 011301 (2007),
+    Sec. III and Eq. 3 (the 2D setting); docs/conventions.md §0.
+    """
     return float(ds.attrs.get("thickness_m", 1.0))
 
 
 def width(ds: xr.Dataset) -> xr.DataArray:
-    """Box width l = x_max - x_min (m)."""
+    """Box width l = x_max - x_min (m).
+
+    Parameters
+    ----------
+    ds : xarray.Dataset
+        A dataset of the contract (docs/schema.md), eager or chunked along ``time``.
+
+    Returns
+    -------
+    xarray.DataArray
+        ``width`` (time,) in m.
+
+    References
+    ----------
+    Azéma, Radjai, Peyroux & Saussine, Phys. Rev. E 76, 011301 (2007),
+    Sec. III (the horizontal strain eps_2); docs/conventions.md §6.
+    """
     l = ds["box_max"].sel(xy="x") - ds["box_min"].sel(xy="x")
     return with_attrs(l.drop_vars("xy"), "width", "m", "sample width l")
 
 
 def height(ds: xr.Dataset) -> xr.DataArray:
-    """Box height h = y_max - y_min (m)."""
+    """Box height h = y_max - y_min (m).
+
+    Parameters
+    ----------
+    ds : xarray.Dataset
+        A dataset of the contract (docs/schema.md), eager or chunked along ``time``.
+
+    Returns
+    -------
+    xarray.DataArray
+        ``height`` (time,) in m.
+
+    References
+    ----------
+    Azéma, Radjai, Peyroux & Saussine, Phys. Rev. E 76, 011301 (2007),
+    Sec. III (the vertical strain eps_1); docs/conventions.md §6.
+    """
     h = ds["box_max"].sel(xy="y") - ds["box_min"].sel(xy="y")
     return with_attrs(h.drop_vars("xy"), "height", "m", "sample height h")
 
 
 def volume(ds: xr.Dataset) -> xr.DataArray:
-    """Sample volume V = l h times the slab thickness (m3); the V of the stress (docs/conventions.md §1)."""
+    """Sample volume V = l h times the slab thickness (m3); the V of the stress (docs/conventions.md §1).
+
+        V = l h t
+
+    Parameters
+    ----------
+    ds : xarray.Dataset
+        A dataset of the contract (docs/schema.md), eager or chunked along ``time``.
+
+    Returns
+    -------
+    xarray.DataArray
+        ``volume`` (time,) in m3.
+
+    References
+    ----------
+    Azéma, Radjai, Peyroux & Saussine, Phys. Rev. E 76, 011301 (2007),
+    Eq. M (Sec. III); docs/conventions.md §1.
+    """
     return with_attrs(width(ds) * height(ds) * thickness(ds), "volume", "m3", "sample volume V")
 
 
 def solid_fraction(ds: xr.Dataset) -> xr.DataArray:
-    """Solid fraction (time,): total particle area / box area l h (paper Sec. II.B: 0.80 for
-    the pentagons S1, 0.82 for the disks S2). Particles outside the box are counted too."""
+    """Solid fraction (time,): total particle area / box area l h.
+
+        solid fraction = sum_i A_i / (l h)
+
+    A_i the area of particle i (disk or regular polygon, m2). The paper reports 0.80 for the
+    pentagons S1 and 0.82 for the disks S2 (Sec. II.B). Particles outside the box are counted too.
+
+    Parameters
+    ----------
+    ds : xarray.Dataset
+        A dataset of the contract (docs/schema.md), eager or chunked along ``time``.
+
+    Returns
+    -------
+    xarray.DataArray
+        ``solid_fraction`` (time,), dimensionless.
+
+    References
+    ----------
+    Azéma, Radjai, Peyroux & Saussine, Phys. Rev. E 76, 011301 (2007),
+    Sec. II.B.
+    """
     solid = float(particle_area(ds["radius"].values, ds["n_vertices"].values).sum())
     return with_attrs(solid / area(ds), "solid_fraction", "1", "solid fraction")
 
 
 def area(ds: xr.Dataset) -> xr.DataArray:
-    """Sample area l h (m2)."""
+    """Sample area l h (m2).
+
+        A = l h
+
+    Parameters
+    ----------
+    ds : xarray.Dataset
+        A dataset of the contract (docs/schema.md), eager or chunked along ``time``.
+
+    Returns
+    -------
+    xarray.DataArray
+        ``area`` (time,) in m2.
+
+    References
+    ----------
+    Azéma, Radjai, Peyroux & Saussine, Phys. Rev. E 76, 011301 (2007),
+    Sec. III (the V of the volumetric strain eps_p); docs/conventions.md §6.
+    """
     return with_attrs(width(ds) * height(ds), "area", "m2", "sample area l h")

@@ -15,6 +15,9 @@ from ._lift import with_attrs
 from .errors import ParameterError
 from .stress import stress_invariants
 
+__all__ = ["time_derivative", "strains", "residual_window", "friction_and_dilatancy",
+           "inertia_number"]
+
 RESIDUAL_STRAIN = 0.3
 """Start of the residual state in shear strain eps_q (the paper reads its residual values at
 eps_q >= 0.3: Figs. 7, 8, 10 and the residual plateaus of Figs. 3, 6, 9, 11)."""
@@ -23,8 +26,28 @@ eps_q >= 0.3: Figs. 7, 8, 10 and the residual plateaus of Figs. 3, 6, 9, 11)."""
 def time_derivative(da: xr.DataArray) -> xr.DataArray:
     """d(da)/dt by centred differences (one-sided at both ends), lazily on any chunking.
 
-    Built from ``shift`` so dask handles the chunk overlaps (``differentiate`` cannot work on
-    one-snapshot chunks). NaN when there is a single snapshot.
+        d(da)/dt (t_k) = (da_(k+1) - da_(k-1)) / (t_(k+1) - t_(k-1))
+
+    with da_(k+1) replaced by da_k at the last snapshot and da_(k-1) by da_k at the first. Built
+    from ``shift`` so dask handles the chunk overlaps (``differentiate`` cannot work on
+    one-snapshot chunks). NaN when there is a single snapshot, and where two snapshots share a
+    time.
+
+    Parameters
+    ----------
+    da : xarray.DataArray
+        A quantity over ``time`` (its ``time`` coordinate in s).
+
+    Returns
+    -------
+    xarray.DataArray
+        The derivative, in the units of ``da`` per second, over the same dims.
+
+    References
+    ----------
+    Azéma, Radjai, Peyroux & Saussine, Phys. Rev. E 76, 011301 (2007),
+    Sec. III and Eq. 3 (the strain rate of the inertia parameter); docs/analysis.md,
+    "Conventions worth knowing".
     """
     t = da["time"].astype(float)
     ahead, behind = da.shift(time=-1), da.shift(time=1)
@@ -48,10 +71,31 @@ def _log_strain(size, reference):
 def strains(ds: xr.Dataset, reference: int = 0) -> xr.Dataset:
     """eps_1, eps_2, eps_p, eps_q (dimensionless) of every snapshot.
 
-    eps_1 = ln(1 + dh/h0) with dh = h0 - h (vertical, compression positive);
-    eps_2 = ln(1 + dl/l0) with dl = l0 - l (horizontal);
-    eps_p = ln(1 + dV/V0) with dV = V - V0 (volumetric, dilation positive);
-    eps_q = eps_1 - eps_2 (shear strain). docs/conventions.md §6.
+        eps_1 = ln(1 + dh/h0) with dh = h0 - h (vertical, compression positive);
+        eps_2 = ln(1 + dl/l0) with dl = l0 - l (horizontal);
+        eps_p = ln(1 + dV/V0) with dV = V - V0 (volumetric, dilation positive);
+        eps_q = eps_1 - eps_2 (shear strain). docs/conventions.md §6.
+
+    h, l are the box height and width (m) and V the box area l h (m2) of each snapshot; h0, l0,
+    V0 those of the snapshot ``reference``.
+
+    Parameters
+    ----------
+    ds : xarray.Dataset
+        A dataset of the contract (docs/schema.md), eager or chunked along ``time``.
+    reference : int, default 0
+        Index of the reference snapshot (h0, l0, V0) along ``time``.
+
+    Returns
+    -------
+    xarray.Dataset
+        ``eps_1``, ``eps_2``, ``eps_p``, ``eps_q`` over ``time``, dimensionless; lazy on dask
+        input.
+
+    References
+    ----------
+    Azéma, Radjai, Peyroux & Saussine, Phys. Rev. E 76, 011301 (2007),
+    Sec. III; docs/conventions.md §6.
     """
     h, l, v = sample.height(ds), sample.width(ds), sample.area(ds)
     eps_1 = _log_strain(h, reference)
@@ -72,6 +116,29 @@ def residual_window(ds: xr.Dataset, start: float = RESIDUAL_STRAIN) -> xr.DataAr
 
     A run that stops short of ``start`` has no residual snapshot (all False): its residual
     values are "not reached" rather than those of another state.
+
+    Parameters
+    ----------
+    ds : xarray.Dataset
+        A dataset of the contract (docs/schema.md), eager or chunked along ``time``.
+    start : float, default 0.3
+        Shear strain eps_q (dimensionless, >= 0) from which the state is residual
+        (:data:`RESIDUAL_STRAIN`).
+
+    Returns
+    -------
+    xarray.DataArray
+        ``residual`` (time,), boolean, computed (eps_q is read).
+
+    Raises
+    ------
+    grainview.errors.ParameterError
+        When ``start`` is not a finite number >= 0.
+
+    References
+    ----------
+    Azéma, Radjai, Peyroux & Saussine, Phys. Rev. E 76, 011301 (2007),
+    Figs. 7, 8 and 10 (residual values read at eps_q >= 0.3); docs/conventions.md §6.
     """
     if isinstance(start, bool) or not isinstance(start, (int, float, np.integer, np.floating)) \
             or not np.isfinite(start) or start < 0:
@@ -84,9 +151,29 @@ def residual_window(ds: xr.Dataset, start: float = RESIDUAL_STRAIN) -> xr.DataAr
 def friction_and_dilatancy(ds: xr.Dataset, reference: int = 0) -> xr.Dataset:
     """Friction angle phi, cumulative and incremental dilatancy angles psi (rad).
 
-    sin phi = q/p; sin psi = eps_p/eps_q (cumulative; NaN where eps_q = 0);
-    sin psi_incremental = d eps_p / d eps_q (centred differences in time). Values of the
-    sines outside [-1, 1] give NaN rather than a clipped angle.
+        sin phi = q/p;
+        sin psi = eps_p/eps_q (cumulative; NaN where eps_q = 0);
+        sin psi_incremental = d eps_p / d eps_q (centred differences in time).
+
+    Values of the sines outside [-1, 1] give NaN rather than a clipped angle. q/p is that of
+    the whole sample, wall contacts included (:func:`grainview.stress.stress_invariants`).
+
+    Parameters
+    ----------
+    ds : xarray.Dataset
+        A dataset of the contract (docs/schema.md), eager or chunked along ``time``.
+    reference : int, default 0
+        Index of the reference snapshot (h0, l0, V0) along ``time``.
+
+    Returns
+    -------
+    xarray.Dataset
+        ``phi``, ``psi`` and ``psi_incremental`` over ``time``, in rad; lazy on dask input.
+
+    References
+    ----------
+    Azéma, Radjai, Peyroux & Saussine, Phys. Rev. E 76, 011301 (2007),
+    Sec. III and Fig. 5 (the stress–dilatancy diagram); docs/conventions.md §6.
     """
     eps = strains(ds, reference)
     q_over_p = stress_invariants(ds)["q_over_p"]
@@ -106,8 +193,26 @@ def friction_and_dilatancy(ds: xr.Dataset, reference: int = 0) -> xr.Dataset:
 def inertia_number(ds: xr.Dataset) -> xr.DataArray:
     """Inertia parameter I = eps_dot sqrt(m/p) (paper Eq. 3), dimensionless.
 
-    eps_dot = |dh/dt|/h is the vertical strain rate (s-1), m the total mass of the particles
-    (kg) and p the mean stress times the slab thickness (N m-1), as in the paper's 2D setting.
+        I = eps_dot sqrt(m / p),    eps_dot = |dh/dt| / h
+
+    eps_dot is the vertical strain rate (s-1), m the total mass of the particles (kg) and p the
+    mean stress times the slab thickness (N m-1), as in the paper's 2D setting.
+
+    Parameters
+    ----------
+    ds : xarray.Dataset
+        A dataset of the contract (docs/schema.md), eager or chunked along ``time``.
+        The slab thickness is the global attribute ``thickness_m`` (m, default 1).
+
+    Returns
+    -------
+    xarray.DataArray
+        ``inertia_number`` (time,), dimensionless; lazy on dask input.
+
+    References
+    ----------
+    Azéma, Radjai, Peyroux & Saussine, Phys. Rev. E 76, 011301 (2007),
+    Eq. 3 (Sec. III); docs/conventions.md §6.
     """
     h = sample.height(ds)
     rate = abs(time_derivative(h)) / h

@@ -17,14 +17,44 @@ from .arrays import stress as _stress
 from .arrays.tensors import principal
 from .contacts import kind_code, selection
 
+__all__ = ["stress_tensor", "stress_invariants", "stress_direction"]
+
 
 def stress_tensor(ds: xr.Dataset, kind="all", walls: bool = True) -> xr.DataArray:
-    """sigma (time, xy_a, xy_b) in Pa: (1/V) sum_c f^c (x) l^c (paper Eq. M, docs/conventions.md §1).
+    """Stress tensor sigma of every snapshot, in Pa.
+
+        sigma = (1/V) sum_c f^c (x) l^c
+
+    with f^c = f_n n + f_t t the force of contact c (N), l^c its branch vector (m) and V the
+    volume of the sample box (:func:`grainview.sample.volume`, m3); compression positive
+    (paper Eq. M, docs/conventions.md §1).
 
     ``kind="simple"`` or ``"double"`` restricts the sum to one contact kind, so that
     ``stress_tensor(ds, "simple") + stress_tensor(ds, "double") == stress_tensor(ds)``
-    (paper Eq. sigmasd). ``walls=False`` leaves out the particle–wall contacts. Every pair
-    the file holds is summed (a pair without force adds nothing).
+    (paper Eq. sigmasd). ``walls=False`` leaves out the particle–wall contacts; with them the
+    sum equals the sum of the particles' tensorial moments, i.e. the stress the walls apply.
+    Every pair the file holds is summed (a pair without force adds nothing).
+
+    Parameters
+    ----------
+    ds : xarray.Dataset
+        A dataset of the contract (docs/schema.md), eager or chunked along ``time``.
+    kind : {"all", "simple", "double"}, default "all"
+        The contacts used: all, simple (vertex–edge and disk contacts) or double (edge–edge)
+        ones (also 1, 2, "s", "d"; :func:`grainview.contacts.kind_code`).
+    walls : bool, default True
+        Include the particle–wall contacts; ``False`` leaves them out.
+
+    Returns
+    -------
+    xarray.DataArray
+        ``stress`` (time, xy_a, xy_b) in Pa; lazy on dask input.
+
+    References
+    ----------
+    Azéma, Radjai, Peyroux & Saussine, Phys. Rev. E 76, 011301 (2007),
+    Eq. M (Sec. III) and, for the partial stresses, Eq. sigmasd;
+    docs/conventions.md §1.
     """
     mask = selection(ds, walls=walls, kind=kind, near=np.inf)
     label = {None: "", 1: " of simple contacts", 2: " of double contacts"}[kind_code(kind)]
@@ -43,10 +73,37 @@ def stress_invariants(ds: xr.Dataset, kind="all", walls: bool = True,
                       sigma: xr.DataArray | None = None) -> xr.Dataset:
     """p, q, q/p and theta_sigma of the stress tensor (paper Sec. III).
 
-    ``p = (s1 + s2)/2`` and ``q = (s1 - s2)/2`` with ``s1 >= s2`` the principal values of the
-    symmetric part of sigma (Pa); ``theta_sigma`` the major principal direction in [0, pi)
-    (rad). For a partial stress (``kind`` simple or double), ``q_over_p`` divides its deviator
-    by the p of the whole sample, as the paper's Fig. 18 does.
+        p = (s1 + s2)/2,    q = (s1 - s2)/2
+
+    with ``s1 >= s2`` the principal values of the symmetric part of sigma (Pa); ``theta_sigma``
+    the major principal direction in [0, pi) (rad). For a partial stress (``kind`` simple or
+    double), ``q_over_p`` divides its deviator by the p of the whole sample, as the paper's
+    Fig. 18 does.
+
+    Parameters
+    ----------
+    ds : xarray.Dataset
+        A dataset of the contract (docs/schema.md), eager or chunked along ``time``.
+    kind : {"all", "simple", "double"}, default "all"
+        The contacts used: all, simple (vertex–edge and disk contacts) or double (edge–edge)
+        ones (also 1, 2, "s", "d"; :func:`grainview.contacts.kind_code`).
+    walls : bool, default True
+        Include the particle–wall contacts; ``False`` leaves them out.
+    sigma : xarray.DataArray, optional
+        A stress tensor (time, xy_a, xy_b) in Pa to use instead of
+        ``stress_tensor(ds, kind, walls)``; ``kind`` still decides which p divides q in
+        ``q_over_p``.
+
+    Returns
+    -------
+    xarray.Dataset
+        Over ``time``: ``p``, ``q``, ``sigma_1``, ``sigma_2`` (the principal values s1, s2) in
+        Pa, ``q_over_p`` (dimensionless) and ``theta_sigma`` (rad); lazy on dask input.
+
+    References
+    ----------
+    Azéma, Radjai, Peyroux & Saussine, Phys. Rev. E 76, 011301 (2007),
+    Sec. III (p, q, q/p) and Fig. 18 (partial stresses); docs/conventions.md §1.
     """
     sigma = stress_tensor(ds, kind, walls) if sigma is None else sigma
     s1, s2, theta = _principal_parts(sigma)
@@ -68,6 +125,26 @@ def stress_invariants(ds: xr.Dataset, kind="all", walls: bool = True,
 
 
 def stress_direction(ds: xr.Dataset, walls: bool = True) -> xr.DataArray:
-    """Major principal stress direction theta_sigma (time,), rad: the reference direction of
-    the signed anisotropies a', a_n, a_t (docs/conventions.md §3, "Signs")."""
+    """Major principal stress direction theta_sigma (time,), rad.
+
+    The reference direction of the signed anisotropies a', a_n, a_t (docs/conventions.md §3,
+    "Signs"): :func:`stress_invariants`'s ``theta_sigma`` of the whole sample.
+
+    Parameters
+    ----------
+    ds : xarray.Dataset
+        A dataset of the contract (docs/schema.md), eager or chunked along ``time``.
+    walls : bool, default True
+        Include the particle–wall contacts; ``False`` leaves them out.
+
+    Returns
+    -------
+    xarray.DataArray
+        ``theta_sigma`` (time,) in rad, in [0, pi).
+
+    References
+    ----------
+    Azéma, Radjai, Peyroux & Saussine, Phys. Rev. E 76, 011301 (2007),
+    Sec. III and Eq. a' (the reference direction theta'); docs/conventions.md §1 and §3.
+    """
     return stress_invariants(ds, walls=walls)["theta_sigma"]

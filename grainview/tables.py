@@ -25,10 +25,11 @@ def _snapshot(ds: xr.Dataset, time: int) -> xr.Dataset:
 
 
 def contacts_table(ds: xr.Dataset, time: int = -1):
-    """A pandas DataFrame of the occupied contact slots of snapshot ``time`` (index; default the
-    last): one row per contact, columns i, j, kind (1 simple, 2 double), wall (j >= N), fn, ft
-    (N), normal_x, normal_y (unit, i -> j), point_x, point_y, branch_x, branch_y (m) and gap (m)
-    where the file has it. Units are in ``df.attrs["units"]``.
+    """A pandas DataFrame of the occupied contact slots of snapshot ``time``, one row per contact.
+
+    Columns i, j, kind (1 simple, 2 double), wall (j >= N), fn, ft (N), normal_x, normal_y
+    (unit, i -> j), point_x, point_y, branch_x, branch_y (m) and gap (m) where the file has it.
+    ``time`` is an index (default the last). Units are in ``df.attrs["units"]``.
 
     Parameters
     ----------
@@ -42,6 +43,12 @@ def contacts_table(ds: xr.Dataset, time: int = -1):
     pandas.DataFrame
         One row per occupied slot (no padding), with ``attrs["units"]`` and ``attrs["time"]``
         (s).
+
+    References
+    ----------
+    Azéma, Radjai, Peyroux & Saussine, Phys. Rev. E 76, 011301 (2007),
+    Eqs. 1-2 and Sec. II.A (the contact frame, simple and double contacts);
+    docs/conventions.md §0.
 
     Examples
     --------
@@ -67,10 +74,11 @@ def contacts_table(ds: xr.Dataset, time: int = -1):
 
 
 def contact_graph(ds: xr.Dataset, time: int = -1, as_networkx: bool = False):
-    """The contact network of snapshot ``time`` as a symmetric (N + W) x (N + W) scipy.sparse
-    CSR matrix of normal forces (N; bodies 0..N-1 particles, then walls), or with
-    ``as_networkx`` a networkx Graph whose edges carry fn, ft and kind. Only contacts with
-    f_n > 0 are edges (the force-bearing network).
+    """The force-bearing contact network of snapshot ``time`` as a weighted graph.
+
+    A symmetric (N + W) x (N + W) scipy.sparse CSR matrix of normal forces (N; bodies 0..N-1
+    particles, then walls), or with ``as_networkx`` a networkx Graph whose edges carry fn, ft
+    and kind. Only contacts with f_n > 0 are edges (the force-bearing network).
 
     Parameters
     ----------
@@ -84,7 +92,17 @@ def contact_graph(ds: xr.Dataset, time: int = -1, as_networkx: bool = False):
     Returns
     -------
     scipy.sparse.csr_matrix or networkx.Graph
-        The weighted adjacency of the force-bearing network.
+        The weighted adjacency of the force-bearing network (weights f_n in N).
+
+    Raises
+    ------
+    grainview.errors.ParameterError
+        With ``as_networkx=True`` when networkx is not installed.
+
+    References
+    ----------
+    Azéma, Radjai, Peyroux & Saussine, Phys. Rev. E 76, 011301 (2007),
+    Sec. IV (the force-bearing network); docs/conventions.md §7.
     """
     from scipy import sparse
 

@@ -19,6 +19,8 @@ from .errors import ParameterError
 from .sample import volume
 from .stress import stress_invariants
 
+__all__ = ["xi_network"]
+
 DEFAULT_XI = np.linspace(0.0, 5.0, 101)
 
 
@@ -52,11 +54,37 @@ def xi_network(ds: xr.Dataset, xi=DEFAULT_XI, walls: bool = False, near=None) ->
       paper Fig. 16 (NaN while the subset is empty);
     * ``contact_fraction``: N(xi)/N_c; ``count``: N(xi).
 
-    ``xi``: any 1-D sequence of cutoffs >= 0 (default 0, 0.05, ..., 5). Dimensionless results;
-    lazy on dask input. One sort per snapshot serves every xi (see
-    :mod:`grainview.arrays.xi_network`). ``near``: which pairs are contacts
-    (:func:`grainview.contacts.in_network`; default force-bearing only; near pairs carry
-    f_n = 0 and so belong to every xi-network with xi > 0).
+    One sort per snapshot serves every xi (see :mod:`grainview.arrays.xi_network`).
+
+    Parameters
+    ----------
+    ds : xarray.Dataset
+        A dataset of the contract (docs/schema.md), eager or chunked along ``time``.
+    xi : array_like of float, default 0, 0.05, ..., 5
+        Any 1-D sequence of cutoffs >= 0, multiples of <f_n> (dimensionless).
+    walls : bool, default False
+        Include the particle–wall contacts (default: particle–particle only).
+    near : float, optional
+        Which pairs are contacts (:func:`grainview.contacts.in_network`): None (default) the
+        force-bearing ones, f_n > 0; a gap threshold in m adds the pairs with gap <= ``near``
+        (they carry f_n = 0); ``np.inf`` every pair the file holds.
+        Near pairs carry f_n = 0 and so belong to every xi-network with xi > 0.
+
+    Returns
+    -------
+    xarray.Dataset
+        ``q_over_p``, ``a_prime``, ``contact_fraction`` (dimensionless) and ``count`` over
+        (time, xi), with the cutoffs as the coordinate ``xi``; lazy on dask input.
+
+    Raises
+    ------
+    grainview.errors.ParameterError
+        When ``xi`` is not a non-empty 1-D sequence of finite numbers >= 0.
+
+    References
+    ----------
+    Azéma, Radjai, Peyroux & Saussine, Phys. Rev. E 76, 011301 (2007),
+    Sec. V.C, Figs. 15 and 16; docs/conventions.md §5.
     """
     xi = _check_xi(xi)
     whole = stress_invariants(ds)

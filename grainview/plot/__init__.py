@@ -82,9 +82,21 @@ def _delegate(func):
 
 
 class PlotAccessor:
-    """The figures of one dataset: ``PlotAccessor(ds).q_over_p(ax=ax, label="pentagons")``,
-    or ``ds.grain.plot.q_over_p(...)`` once :class:`grainview.accessor.GrainAccessor` exposes
-    it. Each method is the function ``plot_<name>`` of this package applied to the dataset."""
+    """The figures of one dataset: ``PlotAccessor(ds).q_over_p(ax=ax, label="pentagons")``.
+
+    Or ``ds.grain.plot.q_over_p(...)`` once :class:`grainview.accessor.GrainAccessor` exposes
+    it. Each method is the function ``plot_<name>`` of this package applied to the dataset.
+
+    Parameters
+    ----------
+    ds : xarray.Dataset
+        A dataset of the contract.
+
+    References
+    ----------
+    Azéma, Radjai, Peyroux & Saussine, Phys. Rev. E 76, 011301 (2007),
+    Figs. 3-25 (the table of the module docstring).
+    """
 
     def __init__(self, ds: xr.Dataset):
         self._ds = ds

@@ -236,8 +236,30 @@ def series_label(dataset_label: str | None, curve: str | None) -> str | None:
 # -- saving ------------------------------------------------------------------------------------
 
 def save_figure(fig, path, dpi: int = 150) -> list[Path]:
-    """Write ``fig`` (a Figure, or Axes whose figure is meant) as ``path.png`` and
-    ``path.pdf``; ``path`` has no suffix. Parent folders are created. Returns both paths."""
+    """Write ``fig`` as ``path.png`` and ``path.pdf``.
+
+    ``fig`` is a Figure, or Axes whose figure is meant; ``path`` has no suffix (a ``.png`` or
+    ``.pdf`` suffix is dropped). Parent folders are created.
+
+    Parameters
+    ----------
+    fig : matplotlib.figure.Figure or matplotlib.axes.Axes
+        The figure to save.
+    path : str or path-like
+        The file name without suffix.
+    dpi : int, default 150
+        Resolution of the PNG, dots per inch.
+
+    Returns
+    -------
+    list of pathlib.Path
+        The PNG and PDF paths.
+
+    Raises
+    ------
+    grainview.errors.ParameterError
+        When ``fig`` is neither a Figure nor Axes.
+    """
     figure = getattr(fig, "figure", fig) if not hasattr(fig, "savefig") else fig
     if not hasattr(figure, "savefig"):
         raise ParameterError(f"fig={type(fig).__name__}: expected a matplotlib Figure or Axes")

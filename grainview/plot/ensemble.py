@@ -6,12 +6,32 @@ import numpy as np
 
 from ._style import EPS_Q_LABEL
 
+__all__ = ["seed_bands"]
+
 
 def seed_bands(stats, ax=None, label: str = "", units: str = "1"):
-    """Draw :func:`grainview.ensemble.seed_statistics` binned on eps_q: per group the mean as
-    a line and mean +- one standard deviation as a band (none where
-    a bin has a single seed), the number of seeds in the legend.
-    Returns the Axes."""
+    """Draw :func:`grainview.ensemble.seed_statistics` binned on eps_q: mean and spread per group.
+
+    Per group the mean as a line and mean +- one standard deviation as a band (none where a
+    bin has a single seed), the number of seeds in the legend.
+
+    Parameters
+    ----------
+    stats : xarray.Dataset
+        The result of :func:`grainview.ensemble.seed_statistics` with ``eps_q_bins``: ``mean``,
+        ``std``, ``n`` over (group, eps_q_bin).
+    ax : matplotlib.axes.Axes, optional
+        The axes to draw on (default: new axes on a new figure).
+    label : str, default ""
+        The quantity's symbol, the y-axis label.
+    units : str, default "1"
+        Its units, appended to the label unless dimensionless.
+
+    Returns
+    -------
+    matplotlib.axes.Axes
+        The axes drawn on.
+    """
     import matplotlib.pyplot as plt
 
     if ax is None:

@@ -27,10 +27,53 @@ XI_LABEL = r"$\xi$"
 
 def angular_profile(ds: xr.Dataset, component: str = "fn", time="residual", bins: int = 36, kind="all",
                     walls: bool = False, normalise: bool = True) -> xr.DataArray:
-    """<f_n>(theta) (``component="fn"``) or <f_t>(theta) (``"ft"``) on ``bins`` sectors of
-    [0, pi), averaged over the snapshots ``time`` (:func:`grainview.forces.angular_force_averages`,
-    paper Eq. fnft). With ``normalise`` each snapshot's profile is divided by that snapshot's
-    mean normal force <f_n> over the same contacts (dimensionless); otherwise in N."""
+    """<f_n>(theta) or <f_t>(theta) on ``bins`` sectors of [0, pi), averaged over the snapshots ``time``.
+
+    ``component="fn"`` gives <f_n>(theta), ``"ft"`` gives <f_t>(theta)
+    (:func:`grainview.forces.angular_force_averages`, paper Eq. fnft). With ``normalise`` each
+    snapshot's profile is divided by that snapshot's mean normal force
+
+        <f_n> = sum_k N_c(theta_k) <f_n>(theta_k) / sum_k N_c(theta_k)
+
+    over the same contacts (dimensionless); otherwise in N.
+
+    Parameters
+    ----------
+    ds : xarray.Dataset
+        A dataset of the contract.
+    component : {"fn", "ft"}, default "fn"
+        The normal or the tangential force.
+    time : str, int, slice or sequence of int, default "residual"
+        The snapshots averaged over (:func:`grainview.plot._style.select_snapshots`):
+        ``"residual"`` the residual state, eps_q >= 0.3 (for a run that stops short of it, the
+        last part of the run), ``"all"`` or None every snapshot, a snapshot index, a slice or a
+        sequence of indices.
+    bins : int, default 36
+        Number of angular sectors of [0, pi), centred on theta_k = k pi/bins.
+    kind : {"all", "simple", "double"}, default "all"
+        The contacts used: all, simple (vertex–edge and disk contacts) or double (edge–edge)
+        ones (also 1, 2, "s", "d"; :func:`grainview.contacts.kind_code`).
+    walls : bool, default False
+        Include the particle–wall contacts (default: particle–particle only).
+    normalise : bool, default True
+        Divide each snapshot's profile by its mean normal force <f_n> over the same contacts
+        (dimensionless); otherwise in N.
+
+    Returns
+    -------
+    xarray.DataArray
+        The profile over ``theta`` (rad), computed; dimensionless with ``normalise``, else N.
+
+    Raises
+    ------
+    grainview.errors.ParameterError
+        When ``component`` is neither "fn" nor "ft".
+
+    References
+    ----------
+    Azéma, Radjai, Peyroux & Saussine, Phys. Rev. E 76, 011301 (2007),
+    Eq. fnft (Sec. V.A) and Fig. 10; docs/conventions.md §3.
+    """
     if component not in ("fn", "ft"):
         raise ParameterError(f"component={component!r}: expected 'fn' or 'ft'")
     avg = angular_force_averages(select_snapshots(ds, time), bins=bins, kind=kind, walls=walls)
@@ -44,17 +87,99 @@ def angular_profile(ds: xr.Dataset, component: str = "fn", time="residual", bins
 
 def plot_normal_force_polar(data, ax=None, label=None, time="residual", bins: int = 36, kind="all",
                             walls: bool = False, normalise: bool = True, **line_kw):
-    """Polar plot of the angle-averaged normal force <f_n>(theta) (paper Fig. 10a), divided by
-    <f_n> unless ``normalise=False`` (then N). Drawn over the full turn (pi-periodic)."""
+    """Polar plot of the angle-averaged normal force <f_n>(theta) (paper Fig. 10a).
+
+    Divided by <f_n> unless ``normalise=False`` (then N) (:func:`angular_profile`). Drawn over
+    the full turn (pi-periodic).
+
+    Parameters
+    ----------
+    data : xarray.Dataset, dict or list
+        One dataset of the contract, or several to compare on the same axes as ``{label: ds}``
+        or ``[(label, ds), ...]``.
+    ax : matplotlib.axes.Axes, optional
+        Polar axes to draw on (default: new polar axes on a new figure).
+    label : str, optional
+        Legend label of a single dataset (None: no legend entry), so that successive calls on
+        the same axes build a comparison.
+    time : str, int, slice or sequence of int, default "residual"
+        The snapshots averaged over (:func:`grainview.plot._style.select_snapshots`):
+        ``"residual"`` the residual state, eps_q >= 0.3 (for a run that stops short of it, the
+        last part of the run), ``"all"`` or None every snapshot, a snapshot index, a slice or a
+        sequence of indices.
+    bins : int, default 36
+        Number of angular sectors of [0, pi), centred on theta_k = k pi/bins.
+    kind : {"all", "simple", "double"}, default "all"
+        The contacts used: all, simple (vertex–edge and disk contacts) or double (edge–edge)
+        ones (also 1, 2, "s", "d"; :func:`grainview.contacts.kind_code`).
+    walls : bool, default False
+        Include the particle–wall contacts (default: particle–particle only).
+    normalise : bool, default True
+        Divide each snapshot's profile by its mean normal force <f_n> over the same contacts
+        (dimensionless); otherwise in N.
+    **line_kw
+        Keyword arguments of ``matplotlib.axes.Axes.plot``.
+
+    Returns
+    -------
+    matplotlib.axes.Axes
+        The axes drawn on.
+
+    References
+    ----------
+    Azéma, Radjai, Peyroux & Saussine, Phys. Rev. E 76, 011301 (2007),
+    Eq. fnft (Sec. V.A) and Fig. 10a; docs/conventions.md §3.
+    """
     return _polar(data, ax, label, "fn", r"\langle f_n\rangle(\theta)", time, bins, kind, walls, normalise,
                   line_kw)
 
 
 def plot_tangential_force_polar(data, ax=None, label=None, time="residual", bins: int = 36, kind="all",
                                 walls: bool = False, normalise: bool = True, **line_kw):
-    """Polar plot of the magnitude |<f_t>(theta)| of the angle-averaged tangential force
-    (paper Fig. 10b), divided by <f_n> unless ``normalise=False`` (then N). A polar radius
-    cannot be negative: the sign of <f_t>(theta), that of -sin 2(theta - theta_t), is dropped."""
+    """Polar plot of the magnitude |<f_t>(theta)| of the angle-averaged tangential force (paper Fig. 10b).
+
+    Divided by <f_n> unless ``normalise=False`` (then N) (:func:`angular_profile`). A polar
+    radius cannot be negative: the sign of <f_t>(theta), that of -sin 2(theta - theta_t), is
+    dropped.
+
+    Parameters
+    ----------
+    data : xarray.Dataset, dict or list
+        One dataset of the contract, or several to compare on the same axes as ``{label: ds}``
+        or ``[(label, ds), ...]``.
+    ax : matplotlib.axes.Axes, optional
+        Polar axes to draw on (default: new polar axes on a new figure).
+    label : str, optional
+        Legend label of a single dataset (None: no legend entry), so that successive calls on
+        the same axes build a comparison.
+    time : str, int, slice or sequence of int, default "residual"
+        The snapshots averaged over (:func:`grainview.plot._style.select_snapshots`):
+        ``"residual"`` the residual state, eps_q >= 0.3 (for a run that stops short of it, the
+        last part of the run), ``"all"`` or None every snapshot, a snapshot index, a slice or a
+        sequence of indices.
+    bins : int, default 36
+        Number of angular sectors of [0, pi), centred on theta_k = k pi/bins.
+    kind : {"all", "simple", "double"}, default "all"
+        The contacts used: all, simple (vertex–edge and disk contacts) or double (edge–edge)
+        ones (also 1, 2, "s", "d"; :func:`grainview.contacts.kind_code`).
+    walls : bool, default False
+        Include the particle–wall contacts (default: particle–particle only).
+    normalise : bool, default True
+        Divide each snapshot's profile by its mean normal force <f_n> over the same contacts
+        (dimensionless); otherwise in N.
+    **line_kw
+        Keyword arguments of ``matplotlib.axes.Axes.plot``.
+
+    Returns
+    -------
+    matplotlib.axes.Axes
+        The axes drawn on.
+
+    References
+    ----------
+    Azéma, Radjai, Peyroux & Saussine, Phys. Rev. E 76, 011301 (2007),
+    Eq. fnft (Sec. V.A) and Fig. 10b; docs/conventions.md §3.
+    """
     return _polar(data, ax, label, "ft", r"|\langle f_t\rangle(\theta)|", time, bins, kind, walls, normalise,
                   line_kw)
 
@@ -74,10 +199,53 @@ def _polar(data, ax, label, component, symbol, time, bins, kind, walls, normalis
 
 def plot_tangential_force(data, ax=None, label=None, time="residual", bins: int = 36, kind="all",
                           walls: bool = False, normalise: bool = True, **line_kw):
-    """The angle-averaged tangential force <f_t>(theta) against theta in [0, pi), with its sign
-    (paper Fig. 10b; harmonic form -<f> a_t sin 2(theta - theta_t), docs/conventions.md §3),
-    divided by <f_n> unless ``normalise=False`` (then N). Cartesian axes: a polar radius could
-    not show the sign."""
+    """The angle-averaged tangential force <f_t>(theta), with its sign, against theta (paper Fig. 10b).
+
+    theta in [0, pi). Harmonic form (docs/conventions.md §3):
+
+        <f_t>(theta) = -<f> a_t sin 2(theta - theta_t)
+
+    Divided by <f_n> unless ``normalise=False`` (then N) (:func:`angular_profile`). Cartesian
+    axes: a polar radius could not show the sign.
+
+    Parameters
+    ----------
+    data : xarray.Dataset, dict or list
+        One dataset of the contract, or several to compare on the same axes as ``{label: ds}``
+        or ``[(label, ds), ...]``.
+    ax : matplotlib.axes.Axes, optional
+        The axes to draw on (default: new axes on a new figure).
+    label : str, optional
+        Legend label of a single dataset (None: no legend entry), so that successive calls on
+        the same axes build a comparison.
+    time : str, int, slice or sequence of int, default "residual"
+        The snapshots averaged over (:func:`grainview.plot._style.select_snapshots`):
+        ``"residual"`` the residual state, eps_q >= 0.3 (for a run that stops short of it, the
+        last part of the run), ``"all"`` or None every snapshot, a snapshot index, a slice or a
+        sequence of indices.
+    bins : int, default 36
+        Number of angular sectors of [0, pi), centred on theta_k = k pi/bins.
+    kind : {"all", "simple", "double"}, default "all"
+        The contacts used: all, simple (vertex–edge and disk contacts) or double (edge–edge)
+        ones (also 1, 2, "s", "d"; :func:`grainview.contacts.kind_code`).
+    walls : bool, default False
+        Include the particle–wall contacts (default: particle–particle only).
+    normalise : bool, default True
+        Divide each snapshot's profile by its mean normal force <f_n> over the same contacts
+        (dimensionless); otherwise in N.
+    **line_kw
+        Keyword arguments of ``matplotlib.axes.Axes.plot``.
+
+    Returns
+    -------
+    matplotlib.axes.Axes
+        The axes drawn on.
+
+    References
+    ----------
+    Azéma, Radjai, Peyroux & Saussine, Phys. Rev. E 76, 011301 (2007),
+    Eq. fnft (Sec. V.A) and Fig. 10b; docs/conventions.md §3.
+    """
     ax = get_axes(ax)
     for lab, ds in datasets(data, label):
         profile = angular_profile(ds, "ft", time, bins, kind, walls, normalise)
@@ -90,7 +258,31 @@ def plot_tangential_force(data, ax=None, label=None, time="residual", bins: int 
 
 
 def plot_angular_forces(data, label=None, **kw):
-    """Figure of paper Fig. 10: (a) <f_n>(theta) in polar axes, (b) <f_t>(theta) with its sign."""
+    """Figure of paper Fig. 10: (a) <f_n>(theta) in polar axes, (b) <f_t>(theta) with its sign.
+
+    Panels drawn by :func:`plot_normal_force_polar` and :func:`plot_tangential_force`.
+
+    Parameters
+    ----------
+    data : xarray.Dataset, dict or list
+        One dataset of the contract, or several to compare on the same axes as ``{label: ds}``
+        or ``[(label, ds), ...]``.
+    label : str, optional
+        Legend label of a single dataset (None: no legend entry), so that successive calls on
+        the same axes build a comparison.
+    **kw
+        Keyword arguments of the panel function, passed to both panels.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        The figure with panels (a) and (b).
+
+    References
+    ----------
+    Azéma, Radjai, Peyroux & Saussine, Phys. Rev. E 76, 011301 (2007),
+    Eq. fnft (Sec. V.A) and Fig. 10; docs/conventions.md §3.
+    """
     fig, (ax_n, ax_t) = new_figure(2, polar=[True, False])
     plot_normal_force_polar(data, ax_n, label, **kw)
     plot_tangential_force(data, ax_t, label, **kw)
@@ -101,8 +293,48 @@ def plot_angular_forces(data, label=None, **kw):
 
 def plot_force_anisotropy(data, ax=None, label=None, component: str = "a_n", bins: int = 36,
                           walls: bool = False, **line_kw):
-    """Signed force anisotropy a_n (``component="a_n"``) or a_t (``"a_t"``) against eps_q
-    (paper Fig. 11, docs/conventions.md §3 and "Signs"; :func:`grainview.forces.force_anisotropies`)."""
+    """Signed force anisotropy a_n or a_t against eps_q (paper Fig. 11).
+
+        a_n = 2 (H^n_1 - H^n_2) / tr H^n,    a_t = 2 (H^t_1 - H^t_2) / tr H^n,
+
+    signed by cos 2(theta - theta_sigma) (docs/conventions.md §3 and "Signs";
+    :func:`grainview.forces.force_anisotropies`). Dimensionless.
+
+    Parameters
+    ----------
+    data : xarray.Dataset, dict or list
+        One dataset of the contract, or several to compare on the same axes as ``{label: ds}``
+        or ``[(label, ds), ...]``.
+    ax : matplotlib.axes.Axes, optional
+        The axes to draw on (default: new axes on a new figure).
+    label : str, optional
+        Legend label of a single dataset (None: no legend entry), so that successive calls on
+        the same axes build a comparison.
+    component : {"a_n", "a_t"}, default "a_n"
+        The anisotropy drawn.
+    bins : int, default 36
+        Number of angular sectors of [0, pi), centred on theta_k = k pi/bins.
+    walls : bool, default False
+        Include the particle–wall contacts (default: particle–particle only).
+    **line_kw
+        Keyword arguments of ``matplotlib.axes.Axes.plot`` (``color`` applies when a single
+        sample is drawn).
+
+    Returns
+    -------
+    matplotlib.axes.Axes
+        The axes drawn on.
+
+    Raises
+    ------
+    grainview.errors.ParameterError
+        When ``component`` is neither "a_n" nor "a_t".
+
+    References
+    ----------
+    Azéma, Radjai, Peyroux & Saussine, Phys. Rev. E 76, 011301 (2007),
+    Eq. anat (Sec. V.A) and Fig. 11; docs/conventions.md §3.
+    """
     if component not in ("a_n", "a_t"):
         raise ParameterError(f"component={component!r}: expected 'a_n' or 'a_t'")
     ax = get_axes(ax)
@@ -113,7 +345,31 @@ def plot_force_anisotropy(data, ax=None, label=None, component: str = "a_n", bin
 
 
 def plot_force_anisotropies(data, label=None, **kw):
-    """Figure of paper Fig. 11: (a) a_n and (b) a_t against eps_q."""
+    """Figure of paper Fig. 11: (a) a_n and (b) a_t against eps_q.
+
+    Panels drawn by :func:`plot_force_anisotropy`.
+
+    Parameters
+    ----------
+    data : xarray.Dataset, dict or list
+        One dataset of the contract, or several to compare on the same axes as ``{label: ds}``
+        or ``[(label, ds), ...]``.
+    label : str, optional
+        Legend label of a single dataset (None: no legend entry), so that successive calls on
+        the same axes build a comparison.
+    **kw
+        Keyword arguments of the panel function, passed to both panels.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        The figure with panels (a) and (b).
+
+    References
+    ----------
+    Azéma, Radjai, Peyroux & Saussine, Phys. Rev. E 76, 011301 (2007),
+    Eq. anat (Sec. V.A) and Fig. 11; docs/conventions.md §3.
+    """
     fig, (ax_n, ax_t) = new_figure(2)
     plot_force_anisotropy(data, ax_n, label, "a_n", **kw)
     plot_force_anisotropy(data, ax_t, label, "a_t", **kw)
@@ -127,10 +383,50 @@ SCALES = {"log-linear": "linear", "log-log": "log"}
 
 def force_pdf_of(ds: xr.Dataset, scale: str = "log-linear", time="residual", bins: int = 40,
                  range=None, kind="all", walls: bool = False) -> xr.Dataset:
-    """The pdf of f_n/<f_n> over the snapshots ``time`` (contacts pooled over them), with linear
-    bins for ``scale="log-linear"`` and logarithmic bins for ``"log-log"``
-    (:func:`grainview.force_pdf.pooled_force_pdf`). Variables ``pdf`` (bin) and coordinate
-    ``f_over_mean`` (bin centres)."""
+    """The pdf of f_n/<f_n> over the snapshots ``time``, contacts pooled over them.
+
+    Linear bins for ``scale="log-linear"`` and logarithmic bins for ``"log-log"``
+    (:func:`grainview.force_pdf.pooled_force_pdf`).
+
+    Parameters
+    ----------
+    ds : xarray.Dataset
+        A dataset of the contract.
+    scale : {"log-linear", "log-log"}, default "log-linear"
+        Linear bins (on [0, 6] by default) on a logarithmic P axis, or logarithmic bins on
+        log-log axes.
+    time : str, int, slice or sequence of int, default "residual"
+        The snapshots averaged over (:func:`grainview.plot._style.select_snapshots`):
+        ``"residual"`` the residual state, eps_q >= 0.3 (for a run that stops short of it, the
+        last part of the run), ``"all"`` or None every snapshot, a snapshot index, a slice or a
+        sequence of indices.
+    bins : int, default 40
+        Number of bins.
+    range : (float, float), optional
+        (low, high) of f_n/<f_n>; default (0, 6) for ``"log-linear"`` and the default of
+        :func:`grainview.force_pdf.pooled_force_pdf` for ``"log-log"``.
+    kind : {"all", "simple", "double"}, default "all"
+        The contacts used: all, simple (vertex–edge and disk contacts) or double (edge–edge)
+        ones (also 1, 2, "s", "d"; :func:`grainview.contacts.kind_code`).
+    walls : bool, default False
+        Include the particle–wall contacts (default: particle–particle only).
+
+    Returns
+    -------
+    xarray.Dataset
+        Computed; variables ``pdf`` (bin) and ``count``, coordinate ``f_over_mean`` (bin
+        centres), all dimensionless.
+
+    Raises
+    ------
+    grainview.errors.ParameterError
+        When ``scale`` is neither "log-linear" nor "log-log".
+
+    References
+    ----------
+    Azéma, Radjai, Peyroux & Saussine, Phys. Rev. E 76, 011301 (2007),
+    Sec. V.B and Fig. 14 (Fig. 23 by kind).
+    """
     from ..force_pdf import pooled_force_pdf
     if scale not in SCALES:
         raise ParameterError(f"scale={scale!r}: expected 'log-linear' or 'log-log'")
@@ -144,10 +440,36 @@ def force_pdf_of(ds: xr.Dataset, scale: str = "log-linear", time="residual", bin
 
 
 def exponential_fit(pdf: xr.Dataset, alpha: float, threshold: float = 1.0) -> float:
-    """Prefactor A of P = A exp(-alpha f/<f_n>) given alpha
-    (:func:`grainview.force_pdf.strong_force_exponent`): the intercept of that weighted least
-    squares fit of ln P = ln A - alpha x, i.e. the count-weighted mean of ln P + alpha x over
-    the bins above ``threshold`` that hold contacts."""
+    """Prefactor A of P = A exp(-alpha f/<f_n>) given alpha.
+
+    The intercept of the weighted least squares fit ln P = ln A - alpha x of
+    :func:`grainview.force_pdf.strong_force_exponent`, i.e. the count-weighted mean
+
+        ln A = sum_k n_k (ln P_k + alpha x_k) / sum_k n_k
+
+    over the bins k above ``threshold`` that hold contacts (x_k = f_n/<f_n> the bin centre,
+    n_k its count).
+
+    Parameters
+    ----------
+    pdf : xarray.Dataset
+        A pdf of :func:`force_pdf_of` (or of :mod:`grainview.force_pdf`).
+    alpha : float
+        The exponent, dimensionless.
+    threshold : float, default 1.0
+        Only bins with f_n/<f_n> above it are used.
+
+    Returns
+    -------
+    float
+        A, in the units of the pdf (dimensionless); NaN without a usable bin or with a
+        non-finite ``alpha``.
+
+    References
+    ----------
+    Azéma, Radjai, Peyroux & Saussine, Phys. Rev. E 76, 011301 (2007),
+    Eq. strong (Sec. V.B) and Fig. 14.
+    """
     x = np.asarray(pdf["f_over_mean"].values, float)
     p = values(pdf["pdf"])
     weight = values(pdf["count"]) if "count" in pdf else np.ones_like(p)
@@ -159,15 +481,62 @@ def exponential_fit(pdf: xr.Dataset, alpha: float, threshold: float = 1.0) -> fl
 
 def plot_force_pdf(data, ax=None, label=None, scale: str = "log-linear", time="residual", bins: int = 40,
                    range=None, kind="all", walls: bool = False, fit: bool = True, **line_kw):
-    """Pdf P of the normal forces f_n/<f_n> (paper Fig. 14) in log-linear (``scale=
-    "log-linear"``, linear bins on [0, 6] by default) or log-log scales (logarithmic bins).
+    """Pdf P of the normal forces f_n/<f_n> (paper Fig. 14), log-linear or log-log.
 
-    With ``fit`` (log-linear only) a dashed line P = A exp(-alpha f_n/<f_n>) over the strong
-    forces (f_n > <f_n>) is drawn after each sample's pdf, alpha from
+    ``scale="log-linear"``: linear bins on [0, 6] by default; ``"log-log"``: logarithmic bins.
+    With ``fit`` (log-linear only) a dashed line
+
+        P = A exp(-alpha f_n/<f_n>)
+
+    over the strong forces (f_n > <f_n>) is drawn after each sample's pdf, alpha from
     :func:`grainview.force_pdf.strong_force_exponent` given in the legend, over the range of
-    the data. Empty bins are not drawn; each bin carries its counting error bar,
-    P / sqrt(n) for n contacts in it (:func:`counting_error`; upper bar only for n = 1). Lines per sample: the pdf, then
-    the fit when drawn."""
+    the data. Empty bins are not drawn; each bin carries its counting error bar, P / sqrt(n) for
+    n contacts in it (:func:`counting_error`; upper bar only for n = 1). Lines per sample: the
+    pdf, then the fit when drawn.
+
+    Parameters
+    ----------
+    data : xarray.Dataset, dict or list
+        One dataset of the contract, or several to compare on the same axes as ``{label: ds}``
+        or ``[(label, ds), ...]``.
+    ax : matplotlib.axes.Axes, optional
+        The axes to draw on (default: new axes on a new figure).
+    label : str, optional
+        Legend label of a single dataset (None: no legend entry), so that successive calls on
+        the same axes build a comparison.
+    scale : {"log-linear", "log-log"}, default "log-linear"
+        Linear bins (on [0, 6] by default) on a logarithmic P axis, or logarithmic bins on
+        log-log axes.
+    time : str, int, slice or sequence of int, default "residual"
+        The snapshots averaged over (:func:`grainview.plot._style.select_snapshots`):
+        ``"residual"`` the residual state, eps_q >= 0.3 (for a run that stops short of it, the
+        last part of the run), ``"all"`` or None every snapshot, a snapshot index, a slice or a
+        sequence of indices.
+    bins : int, default 40
+        Number of bins.
+    range : (float, float), optional
+        (low, high) of f_n/<f_n>; default (0, 6) for ``"log-linear"`` and the default of
+        :func:`grainview.force_pdf.pooled_force_pdf` for ``"log-log"``.
+    kind : {"all", "simple", "double"}, default "all"
+        The contacts used: all, simple (vertex–edge and disk contacts) or double (edge–edge)
+        ones (also 1, 2, "s", "d"; :func:`grainview.contacts.kind_code`).
+    walls : bool, default False
+        Include the particle–wall contacts (default: particle–particle only).
+    fit : bool, default True
+        Draw the exponential fit of the strong forces (log-linear only).
+    **line_kw
+        Keyword arguments of ``matplotlib.axes.Axes.plot``.
+
+    Returns
+    -------
+    matplotlib.axes.Axes
+        The axes drawn on.
+
+    References
+    ----------
+    Azéma, Radjai, Peyroux & Saussine, Phys. Rev. E 76, 011301 (2007),
+    Eq. strong (Sec. V.B) and Fig. 14.
+    """
     from ..force_pdf import strong_force_exponent
     ax = get_axes(ax)
     for lab, ds in datasets(data, label):
@@ -181,11 +550,31 @@ def plot_force_pdf(data, ax=None, label=None, scale: str = "log-linear", time="r
 
 
 def counting_error(pdf: xr.Dataset) -> np.ndarray:
-    """One standard deviation of each bin of a pooled pdf from counting statistics: a bin
-    holding n contacts has P = n / (N width) and sigma_P = sqrt(n) / (N width) = P / sqrt(n)
-    (Poisson). NaN where the bin is empty or the counts are not known. Contacts pooled over
-    successive snapshots are counted as independent; a contact that lasts across snapshots is
-    counted in each, so with closely spaced snapshots these bars are a lower bound."""
+    """One standard deviation of each bin of a pooled pdf from counting statistics.
+
+    A bin holding n contacts has P = n / (N width) and
+
+        sigma_P = sqrt(n) / (N width) = P / sqrt(n)    (Poisson).
+
+    NaN where the bin is empty or the counts are not known. Contacts pooled over successive
+    snapshots are counted as independent; a contact that lasts across snapshots is counted in
+    each, so with closely spaced snapshots these bars are a lower bound.
+
+    Parameters
+    ----------
+    pdf : xarray.Dataset
+        A pdf with ``pdf`` and, for the errors, ``count`` (:func:`force_pdf_of`).
+
+    Returns
+    -------
+    numpy.ndarray
+        sigma_P per bin, in the units of ``pdf`` (dimensionless).
+
+    References
+    ----------
+    Azéma, Radjai, Peyroux & Saussine, Phys. Rev. E 76, 011301 (2007),
+    Fig. 14 (Sec. V.B).
+    """
     p = values(pdf["pdf"])
     if "count" not in pdf:
         return np.full_like(p, np.nan)
@@ -226,7 +615,31 @@ def _pdf_axes(ax, scale):
 
 
 def plot_force_pdfs(data, label=None, **kw):
-    """Figure of paper Fig. 14: (a) log-linear and (b) log-log pdfs of f_n/<f_n>."""
+    """Figure of paper Fig. 14: (a) log-linear and (b) log-log pdfs of f_n/<f_n>.
+
+    Panels drawn by :func:`plot_force_pdf`.
+
+    Parameters
+    ----------
+    data : xarray.Dataset, dict or list
+        One dataset of the contract, or several to compare on the same axes as ``{label: ds}``
+        or ``[(label, ds), ...]``.
+    label : str, optional
+        Legend label of a single dataset (None: no legend entry), so that successive calls on
+        the same axes build a comparison.
+    **kw
+        Keyword arguments of the panel function, passed to both panels.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        The figure with panels (a) and (b).
+
+    References
+    ----------
+    Azéma, Radjai, Peyroux & Saussine, Phys. Rev. E 76, 011301 (2007),
+    Eq. strong (Sec. V.B) and Fig. 14.
+    """
     fig, (ax_lin, ax_log) = new_figure(2)
     plot_force_pdf(data, ax_lin, label, scale="log-linear", **kw)
     plot_force_pdf(data, ax_log, label, scale="log-log", **kw)
@@ -235,9 +648,49 @@ def plot_force_pdfs(data, label=None, **kw):
 
 def plot_force_pdf_by_kind(data, ax=None, label=None, scale: str = "log-linear", time="residual",
                            bins: int = 40, range=None, walls: bool = False, **line_kw):
-    """Pdfs of f_n/<f_n> for simple (s, solid) and double (d, dashed) contacts (paper Fig. 23),
-    each normalised over its own contacts (:func:`grainview.force_pdf.pooled_force_pdf` with
-    ``kind``). Two lines per sample: s then d."""
+    """Pdfs of f_n/<f_n> for simple (s, solid) and double (d, dashed) contacts (paper Fig. 23).
+
+    Each pdf is normalised over its own contacts (:func:`grainview.force_pdf.pooled_force_pdf`
+    with ``kind``). Two lines per sample: s then d.
+
+    Parameters
+    ----------
+    data : xarray.Dataset, dict or list
+        One dataset of the contract, or several to compare on the same axes as ``{label: ds}``
+        or ``[(label, ds), ...]``.
+    ax : matplotlib.axes.Axes, optional
+        The axes to draw on (default: new axes on a new figure).
+    label : str, optional
+        Legend label of a single dataset (None: no legend entry), so that successive calls on
+        the same axes build a comparison.
+    scale : {"log-linear", "log-log"}, default "log-linear"
+        Linear bins (on [0, 6] by default) on a logarithmic P axis, or logarithmic bins on
+        log-log axes.
+    time : str, int, slice or sequence of int, default "residual"
+        The snapshots averaged over (:func:`grainview.plot._style.select_snapshots`):
+        ``"residual"`` the residual state, eps_q >= 0.3 (for a run that stops short of it, the
+        last part of the run), ``"all"`` or None every snapshot, a snapshot index, a slice or a
+        sequence of indices.
+    bins : int, default 40
+        Number of bins.
+    range : (float, float), optional
+        (low, high) of f_n/<f_n>; default (0, 6) for ``"log-linear"`` and the default of
+        :func:`grainview.force_pdf.pooled_force_pdf` for ``"log-log"``.
+    walls : bool, default False
+        Include the particle–wall contacts (default: particle–particle only).
+    **line_kw
+        Keyword arguments of ``matplotlib.axes.Axes.plot``.
+
+    Returns
+    -------
+    matplotlib.axes.Axes
+        The axes drawn on.
+
+    References
+    ----------
+    Azéma, Radjai, Peyroux & Saussine, Phys. Rev. E 76, 011301 (2007),
+    Sec. V.B and Fig. 23.
+    """
     ax = get_axes(ax)
     for lab, ds in datasets(data, label):
         colour = next_colour(ax)
@@ -249,7 +702,31 @@ def plot_force_pdf_by_kind(data, ax=None, label=None, scale: str = "log-linear",
 
 
 def plot_force_pdfs_by_kind(data, label=None, **kw):
-    """Figure of paper Fig. 23: pdfs per contact kind, (a) log-linear and (b) log-log."""
+    """Figure of paper Fig. 23: pdfs per contact kind, (a) log-linear and (b) log-log.
+
+    Panels drawn by :func:`plot_force_pdf_by_kind`.
+
+    Parameters
+    ----------
+    data : xarray.Dataset, dict or list
+        One dataset of the contract, or several to compare on the same axes as ``{label: ds}``
+        or ``[(label, ds), ...]``.
+    label : str, optional
+        Legend label of a single dataset (None: no legend entry), so that successive calls on
+        the same axes build a comparison.
+    **kw
+        Keyword arguments of the panel function, passed to both panels.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        The figure with panels (a) and (b).
+
+    References
+    ----------
+    Azéma, Radjai, Peyroux & Saussine, Phys. Rev. E 76, 011301 (2007),
+    Sec. V.B and Fig. 23.
+    """
     fig, (ax_lin, ax_log) = new_figure(2)
     plot_force_pdf_by_kind(data, ax_lin, label, scale="log-linear", **kw)
     plot_force_pdf_by_kind(data, ax_log, label, scale="log-log", **kw)
@@ -259,9 +736,34 @@ def plot_force_pdfs_by_kind(data, label=None, **kw):
 # -- Figs. 15, 16: the xi-network --------------------------------------------------------------
 
 def xi_profile(ds: xr.Dataset, xi=None, time="residual") -> xr.Dataset:
-    """q(xi)/p, a'(xi) and the contact fraction of the xi-network (contacts f_n < xi <f_n>;
-    docs/conventions.md §5; :func:`grainview.xi_network.xi_network`, whose cutoffs are the default),
-    averaged over the snapshots ``time``."""
+    """q(xi)/p, a'(xi) and the contact fraction of the xi-network, averaged over the snapshots ``time``.
+
+    The xi-network holds the contacts with f_n < xi <f_n> (docs/conventions.md §5;
+    :func:`grainview.xi_network.xi_network`, whose cutoffs are the default).
+
+    Parameters
+    ----------
+    ds : xarray.Dataset
+        A dataset of the contract.
+    xi : array_like of float, optional
+        The cutoffs xi >= 0, multiples of <f_n>.
+    time : str, int, slice or sequence of int, default "residual"
+        The snapshots averaged over (:func:`grainview.plot._style.select_snapshots`):
+        ``"residual"`` the residual state, eps_q >= 0.3 (for a run that stops short of it, the
+        last part of the run), ``"all"`` or None every snapshot, a snapshot index, a slice or a
+        sequence of indices.
+
+    Returns
+    -------
+    xarray.Dataset
+        Computed; ``q_over_p``, ``a_prime``, ``contact_fraction`` (dimensionless) and ``count``
+        over ``xi``.
+
+    References
+    ----------
+    Azéma, Radjai, Peyroux & Saussine, Phys. Rev. E 76, 011301 (2007),
+    Sec. V.C, Figs. 15 and 16; docs/conventions.md §5.
+    """
     from ..xi_network import xi_network
     subset = select_snapshots(ds, time)
     result = xi_network(subset) if xi is None else xi_network(subset, xi=np.asarray(xi, float))
@@ -269,19 +771,90 @@ def xi_profile(ds: xr.Dataset, xi=None, time="residual") -> xr.Dataset:
 
 
 def plot_xi_stress(data, ax=None, label=None, xi=None, time="residual", min_contacts: float = 10, **line_kw):
-    """Partial shear stress q(xi)/p of the contacts f_n < xi <f_n> against the cutoff xi
-    (paper Fig. 15; divided by the p of the whole sample, docs/conventions.md §5). Cutoffs
-    whose network holds fewer than ``min_contacts`` contacts per snapshot on average are not
-    drawn."""
+    """Partial shear stress q(xi)/p of the contacts f_n < xi <f_n> against the cutoff xi (paper Fig. 15).
+
+    q(xi) is divided by the p of the whole sample (docs/conventions.md §5; :func:`xi_profile`).
+    Cutoffs whose network holds fewer than ``min_contacts`` contacts per snapshot on average
+    are not drawn. Dimensionless.
+
+    Parameters
+    ----------
+    data : xarray.Dataset, dict or list
+        One dataset of the contract, or several to compare on the same axes as ``{label: ds}``
+        or ``[(label, ds), ...]``.
+    ax : matplotlib.axes.Axes, optional
+        The axes to draw on (default: new axes on a new figure).
+    label : str, optional
+        Legend label of a single dataset (None: no legend entry), so that successive calls on
+        the same axes build a comparison.
+    xi : array_like of float, optional
+        The cutoffs xi >= 0, multiples of <f_n> (default: those of
+        :func:`grainview.xi_network.xi_network`).
+    time : str, int, slice or sequence of int, default "residual"
+        The snapshots averaged over (:func:`grainview.plot._style.select_snapshots`):
+        ``"residual"`` the residual state, eps_q >= 0.3 (for a run that stops short of it, the
+        last part of the run), ``"all"`` or None every snapshot, a snapshot index, a slice or a
+        sequence of indices.
+    min_contacts : float, default 10
+        Cutoffs whose network holds fewer contacts per snapshot on average are not drawn.
+    **line_kw
+        Keyword arguments of ``matplotlib.axes.Axes.plot``.
+
+    Returns
+    -------
+    matplotlib.axes.Axes
+        The axes drawn on.
+
+    References
+    ----------
+    Azéma, Radjai, Peyroux & Saussine, Phys. Rev. E 76, 011301 (2007),
+    Sec. V.C and Fig. 15; docs/conventions.md §5.
+    """
     return _xi(data, ax, label, xi, time, "q_over_p", r"$q(\xi)/p$", min_contacts, line_kw)
 
 
 def plot_xi_anisotropy(data, ax=None, label=None, xi=None, time="residual", min_contacts: float = 10,
                        **line_kw):
-    """Partial fabric anisotropy a'(xi) of the contacts f_n < xi <f_n> against the cutoff xi
-    (paper Fig. 16; signed against the whole sample's major stress direction, docs/conventions.md §5).
-    Cutoffs whose network holds fewer than ``min_contacts`` contacts per snapshot on average
-    are not drawn: the anisotropy of a handful of contacts is noise (it spans [-2, 2])."""
+    """Partial fabric anisotropy a'(xi) of the contacts f_n < xi <f_n> against the cutoff xi (paper Fig. 16).
+
+    a'(xi) is signed against the whole sample's major stress direction (docs/conventions.md §5;
+    :func:`xi_profile`). Cutoffs whose network holds fewer than ``min_contacts`` contacts per
+    snapshot on average are not drawn: the anisotropy of a handful of contacts is noise (it
+    spans [-2, 2]). Dimensionless.
+
+    Parameters
+    ----------
+    data : xarray.Dataset, dict or list
+        One dataset of the contract, or several to compare on the same axes as ``{label: ds}``
+        or ``[(label, ds), ...]``.
+    ax : matplotlib.axes.Axes, optional
+        The axes to draw on (default: new axes on a new figure).
+    label : str, optional
+        Legend label of a single dataset (None: no legend entry), so that successive calls on
+        the same axes build a comparison.
+    xi : array_like of float, optional
+        The cutoffs xi >= 0, multiples of <f_n> (default: those of
+        :func:`grainview.xi_network.xi_network`).
+    time : str, int, slice or sequence of int, default "residual"
+        The snapshots averaged over (:func:`grainview.plot._style.select_snapshots`):
+        ``"residual"`` the residual state, eps_q >= 0.3 (for a run that stops short of it, the
+        last part of the run), ``"all"`` or None every snapshot, a snapshot index, a slice or a
+        sequence of indices.
+    min_contacts : float, default 10
+        Cutoffs whose network holds fewer contacts per snapshot on average are not drawn.
+    **line_kw
+        Keyword arguments of ``matplotlib.axes.Axes.plot``.
+
+    Returns
+    -------
+    matplotlib.axes.Axes
+        The axes drawn on.
+
+    References
+    ----------
+    Azéma, Radjai, Peyroux & Saussine, Phys. Rev. E 76, 011301 (2007),
+    Sec. V.C and Fig. 16; docs/conventions.md §5.
+    """
     return _xi(data, ax, label, xi, time, "a_prime", r"$a'(\xi)$", min_contacts, line_kw)
 
 
@@ -299,10 +872,37 @@ def _xi(data, ax, label, xi, time, name, ylabel, min_contacts, line_kw):
 # -- Figs. 19, 20, 25: proportions and transitions ---------------------------------------------
 
 def plot_contact_proportions(data, ax=None, label=None, **line_kw):
-    """Proportions k_s, k_d of simple and double contacts and the relative force averages
-    f_s = k_s <f_n>_s/<f_n>, f_d = k_d <f_n>_d/<f_n> (docs/conventions.md §4) against eps_q (paper Fig. 19;
-    :func:`grainview.force_networks.contact_proportions`). Four lines per sample: k_s, k_d,
-    f_s, f_d."""
+    """Proportions k_s, k_d and relative force averages f_s, f_d against eps_q (paper Fig. 19).
+
+        k_s = N_s/N_c,   k_d = N_d/N_c,   f_s = k_s <f_n>_s/<f_n>,   f_d = k_d <f_n>_d/<f_n>
+
+    (docs/conventions.md §4; :func:`grainview.force_networks.contact_proportions`). Four lines
+    per sample: k_s, k_d, f_s, f_d. Dimensionless.
+
+    Parameters
+    ----------
+    data : xarray.Dataset, dict or list
+        One dataset of the contract, or several to compare on the same axes as ``{label: ds}``
+        or ``[(label, ds), ...]``.
+    ax : matplotlib.axes.Axes, optional
+        The axes to draw on (default: new axes on a new figure).
+    label : str, optional
+        Legend label of a single dataset (None: no legend entry), so that successive calls on
+        the same axes build a comparison.
+    **line_kw
+        Keyword arguments of ``matplotlib.axes.Axes.plot`` (``color`` applies when a single
+        sample is drawn).
+
+    Returns
+    -------
+    matplotlib.axes.Axes
+        The axes drawn on.
+
+    References
+    ----------
+    Azéma, Radjai, Peyroux & Saussine, Phys. Rev. E 76, 011301 (2007),
+    Sec. VI and Fig. 19 (f_s, f_d with the correction of docs/conventions.md §4).
+    """
     from ..force_networks import contact_proportions
     ax = get_axes(ax)
     curves = [("$k_s$", "k_s"), ("$k_d$", "k_d"), ("$f_s$", "f_s"), ("$f_d$", "f_d")]
@@ -312,9 +912,36 @@ def plot_contact_proportions(data, ax=None, label=None, **line_kw):
 
 
 def plot_type_transitions(data, ax=None, label=None, **line_kw):
-    """Cumulative proportions Delta gamma of simple contacts turned double (s->d) and double
-    turned simple (d->s) against eps_q (paper Fig. 20, docs/conventions.md §8;
-    :func:`grainview.persistence.type_transitions`). Two lines per sample."""
+    """Cumulative proportions Delta gamma of s->d and d->s transitions against eps_q (paper Fig. 20).
+
+    Simple contacts turned double (s->d) and double turned simple (d->s)
+    (docs/conventions.md §8; :func:`grainview.persistence.type_transitions`). Two lines per
+    sample. Dimensionless; computed.
+
+    Parameters
+    ----------
+    data : xarray.Dataset, dict or list
+        One dataset of the contract, or several to compare on the same axes as ``{label: ds}``
+        or ``[(label, ds), ...]``.
+    ax : matplotlib.axes.Axes, optional
+        The axes to draw on (default: new axes on a new figure).
+    label : str, optional
+        Legend label of a single dataset (None: no legend entry), so that successive calls on
+        the same axes build a comparison.
+    **line_kw
+        Keyword arguments of ``matplotlib.axes.Axes.plot`` (``color`` applies when a single
+        sample is drawn).
+
+    Returns
+    -------
+    matplotlib.axes.Axes
+        The axes drawn on.
+
+    References
+    ----------
+    Azéma, Radjai, Peyroux & Saussine, Phys. Rev. E 76, 011301 (2007),
+    Sec. VI and Fig. 20; docs/conventions.md §8.
+    """
     from ..persistence import type_transitions
     ax = get_axes(ax)
     curves = [(r"$s\rightarrow d$", "delta_gamma_s_to_d"), (r"$d\rightarrow s$", "delta_gamma_d_to_s")]
@@ -324,10 +951,37 @@ def plot_type_transitions(data, ax=None, label=None, **line_kw):
 
 
 def plot_strong_weak_proportions(data, ax=None, label=None, **line_kw):
-    """Fractions of all contacts that are simple and strong (k_s^S), simple and weak (k_s^W),
-    double and strong (k_d^S), double and weak (k_d^W), strong meaning f_n > <f_n> (docs/conventions.md §4),
-    against eps_q (paper Fig. 25; :func:`grainview.force_networks.contact_proportions`). Four
-    lines per sample in that order."""
+    """Fractions k_s^S, k_s^W, k_d^S, k_d^W of strong and weak contacts against eps_q (paper Fig. 25).
+
+    Fractions of all contacts that are simple and strong (k_s^S), simple and weak (k_s^W),
+    double and strong (k_d^S), double and weak (k_d^W), strong meaning f_n > <f_n>
+    (docs/conventions.md §4; :func:`grainview.force_networks.contact_proportions`). Four lines
+    per sample in that order. Dimensionless.
+
+    Parameters
+    ----------
+    data : xarray.Dataset, dict or list
+        One dataset of the contract, or several to compare on the same axes as ``{label: ds}``
+        or ``[(label, ds), ...]``.
+    ax : matplotlib.axes.Axes, optional
+        The axes to draw on (default: new axes on a new figure).
+    label : str, optional
+        Legend label of a single dataset (None: no legend entry), so that successive calls on
+        the same axes build a comparison.
+    **line_kw
+        Keyword arguments of ``matplotlib.axes.Axes.plot`` (``color`` applies when a single
+        sample is drawn).
+
+    Returns
+    -------
+    matplotlib.axes.Axes
+        The axes drawn on.
+
+    References
+    ----------
+    Azéma, Radjai, Peyroux & Saussine, Phys. Rev. E 76, 011301 (2007),
+    Sec. VI and Fig. 25; docs/conventions.md §4.
+    """
     from ..force_networks import contact_proportions
     ax = get_axes(ax)
     curves = [("$k_s^S$", "k_s_strong"), ("$k_s^W$", "k_s_weak"), ("$k_d^S$", "k_d_strong"),

@@ -21,8 +21,34 @@ from ._style import (EPS_Q_LABEL, axis_label, datasets, draw_evolutions, finish,
 def plot_q_over_p(data, ax=None, label=None, **line_kw):
     """Normalised shear stress q/p against eps_q (paper Fig. 3).
 
-    q/p from :func:`grainview.stress.stress_invariants` (wall contacts included, docs/conventions.md §1),
-    eps_q from :func:`grainview.strain.strains` (docs/conventions.md §6). Both dimensionless."""
+    q/p from :func:`grainview.stress.stress_invariants` (wall contacts included,
+    docs/conventions.md §1), eps_q from :func:`grainview.strain.strains`
+    (docs/conventions.md §6). Both dimensionless.
+
+    Parameters
+    ----------
+    data : xarray.Dataset, dict or list
+        One dataset of the contract, or several to compare on the same axes as ``{label: ds}``
+        or ``[(label, ds), ...]``.
+    ax : matplotlib.axes.Axes, optional
+        The axes to draw on (default: new axes on a new figure).
+    label : str, optional
+        Legend label of a single dataset (None: no legend entry), so that successive calls on
+        the same axes build a comparison.
+    **line_kw
+        Keyword arguments of ``matplotlib.axes.Axes.plot`` (``color`` applies when a single
+        sample is drawn).
+
+    Returns
+    -------
+    matplotlib.axes.Axes
+        The axes drawn on.
+
+    References
+    ----------
+    Azéma, Radjai, Peyroux & Saussine, Phys. Rev. E 76, 011301 (2007),
+    Sec. III and Fig. 3; docs/conventions.md §1 and §6.
+    """
     ax = get_axes(ax)
     draw_evolutions(ax, datasets(data, label), stress_invariants, [(None, "q_over_p")], **line_kw)
     set_labels(ax, EPS_Q_LABEL, "$q/p$")
@@ -30,7 +56,36 @@ def plot_q_over_p(data, ax=None, label=None, **line_kw):
 
 
 def plot_volumetric_strain(data, ax=None, label=None, **line_kw):
-    """Cumulative volumetric strain eps_p (dilation positive) against eps_q (paper Fig. 4)."""
+    """Cumulative volumetric strain eps_p (dilation positive) against eps_q (paper Fig. 4).
+
+        eps_p = ln(1 + (V - V0)/V0)
+
+    (:func:`grainview.strain.strains`), both strains dimensionless.
+
+    Parameters
+    ----------
+    data : xarray.Dataset, dict or list
+        One dataset of the contract, or several to compare on the same axes as ``{label: ds}``
+        or ``[(label, ds), ...]``.
+    ax : matplotlib.axes.Axes, optional
+        The axes to draw on (default: new axes on a new figure).
+    label : str, optional
+        Legend label of a single dataset (None: no legend entry), so that successive calls on
+        the same axes build a comparison.
+    **line_kw
+        Keyword arguments of ``matplotlib.axes.Axes.plot`` (``color`` applies when a single
+        sample is drawn).
+
+    Returns
+    -------
+    matplotlib.axes.Axes
+        The axes drawn on.
+
+    References
+    ----------
+    Azéma, Radjai, Peyroux & Saussine, Phys. Rev. E 76, 011301 (2007),
+    Sec. III and Fig. 4; docs/conventions.md §6.
+    """
     ax = get_axes(ax)
     draw_evolutions(ax, datasets(data, label), strains, [(None, "eps_p")], **line_kw)
     set_labels(ax, EPS_Q_LABEL, r"$\varepsilon_p$")
@@ -38,14 +93,42 @@ def plot_volumetric_strain(data, ax=None, label=None, **line_kw):
 
 
 def plot_stress_dilatancy(data, ax=None, label=None, incremental: bool = False, **line_kw):
-    """Stress–dilatancy diagram: dilatancy angle psi against friction angle phi, in rad
-    (paper Fig. 5): sin phi = q/p, sin psi = eps_p/eps_q (cumulative) or, with
-    ``incremental=True``, d eps_p/d eps_q (:func:`grainview.strain.friction_and_dilatancy`).
-    Snapshots where psi is undefined (eps_q = 0) leave a gap.
+    """Stress–dilatancy diagram: dilatancy angle psi against friction angle phi, in rad (paper Fig. 5).
+
+        sin phi = q/p,    sin psi = eps_p/eps_q (cumulative) or d eps_p/d eps_q (incremental)
+
+    (:func:`grainview.strain.friction_and_dilatancy`). Snapshots where psi is undefined
+    (eps_q = 0) leave a gap.
 
     The paper's point is that both shapes follow phi ~ phi_0 + psi (Taylor's stress–dilatancy
     relation, phi_0 the friction angle at zero dilatancy): each sample gets a dashed line of
-    slope 1 with phi_0 the median of phi - psi over its snapshots, given in the legend."""
+    slope 1 with phi_0 the median of phi - psi over its snapshots, given in the legend.
+
+    Parameters
+    ----------
+    data : xarray.Dataset, dict or list
+        One dataset of the contract, or several to compare on the same axes as ``{label: ds}``
+        or ``[(label, ds), ...]``.
+    ax : matplotlib.axes.Axes, optional
+        The axes to draw on (default: new axes on a new figure).
+    label : str, optional
+        Legend label of a single dataset (None: no legend entry), so that successive calls on
+        the same axes build a comparison.
+    incremental : bool, default False
+        Draw the incremental angle, sin psi = d eps_p/d eps_q, instead of the cumulative one.
+    **line_kw
+        Keyword arguments of ``matplotlib.axes.Axes.plot``.
+
+    Returns
+    -------
+    matplotlib.axes.Axes
+        The axes drawn on.
+
+    References
+    ----------
+    Azéma, Radjai, Peyroux & Saussine, Phys. Rev. E 76, 011301 (2007),
+    Sec. III and Fig. 5; docs/conventions.md §6.
+    """
     ax = get_axes(ax)
     name = "psi_incremental" if incremental else "psi"
     for lab, ds in datasets(data, label):
@@ -65,10 +148,42 @@ def plot_stress_dilatancy(data, ax=None, label=None, incremental: bool = False, 
 
 
 def plot_harmonic_prediction(data, ax=None, label=None, bins: int = 36, **line_kw):
-    """q/p (solid), its harmonic prediction (a' + a_n + a_t)/2 (paper Eq. qa, Fig. 12) and the
-    same with the cross term, (a' + a_n + a_t)/(2 + a' a_n), against eps_q
-    (:func:`grainview.forces.harmonic_prediction`, ``bins`` angular sectors). Three lines per
-    sample, in that order."""
+    """q/p and its harmonic predictions against eps_q (paper Eq. qa, Fig. 12).
+
+    Three lines per sample, in this order: q/p (solid), its harmonic prediction
+
+        (a' + a_n + a_t)/2
+
+    and the same with the cross term, (a' + a_n + a_t)/(2 + a' a_n)
+    (:func:`grainview.forces.harmonic_prediction`, ``bins`` angular sectors). All
+    dimensionless.
+
+    Parameters
+    ----------
+    data : xarray.Dataset, dict or list
+        One dataset of the contract, or several to compare on the same axes as ``{label: ds}``
+        or ``[(label, ds), ...]``.
+    ax : matplotlib.axes.Axes, optional
+        The axes to draw on (default: new axes on a new figure).
+    label : str, optional
+        Legend label of a single dataset (None: no legend entry), so that successive calls on
+        the same axes build a comparison.
+    bins : int, default 36
+        Number of angular sectors of [0, pi), centred on theta_k = k pi/bins.
+    **line_kw
+        Keyword arguments of ``matplotlib.axes.Axes.plot`` (``color`` applies when a single
+        sample is drawn).
+
+    Returns
+    -------
+    matplotlib.axes.Axes
+        The axes drawn on.
+
+    References
+    ----------
+    Azéma, Radjai, Peyroux & Saussine, Phys. Rev. E 76, 011301 (2007),
+    Eq. qa (Sec. V.A) and Fig. 12; docs/conventions.md §3.
+    """
     ax = get_axes(ax)
     curves = [("$q/p$", "q_over_p"), ("$(a' + a_n + a_t)/2$", "prediction"),
               ("$(a' + a_n + a_t)/(2 + a' a_n)$", "prediction_cross_term")]
@@ -78,10 +193,36 @@ def plot_harmonic_prediction(data, ax=None, label=None, bins: int = 36, **line_k
 
 
 def plot_partial_q_over_p(data, ax=None, label=None, **line_kw):
-    """q/p of simple contacts (s), double contacts (d) and all contacts (s+d) against eps_q
-    (paper Fig. 18); each partial deviator is divided by the p of the whole sample
+    """q/p of simple (s), double (d) and all (s+d) contacts against eps_q (paper Fig. 18).
+
+    Each partial deviator is divided by the p of the whole sample
     (:func:`grainview.stress.stress_invariants` with ``kind``). Three lines per sample: s, d,
-    s+d."""
+    s+d. Dimensionless.
+
+    Parameters
+    ----------
+    data : xarray.Dataset, dict or list
+        One dataset of the contract, or several to compare on the same axes as ``{label: ds}``
+        or ``[(label, ds), ...]``.
+    ax : matplotlib.axes.Axes, optional
+        The axes to draw on (default: new axes on a new figure).
+    label : str, optional
+        Legend label of a single dataset (None: no legend entry), so that successive calls on
+        the same axes build a comparison.
+    **line_kw
+        Keyword arguments of ``matplotlib.axes.Axes.plot`` (``color`` applies when a single
+        sample is drawn).
+
+    Returns
+    -------
+    matplotlib.axes.Axes
+        The axes drawn on.
+
+    References
+    ----------
+    Azéma, Radjai, Peyroux & Saussine, Phys. Rev. E 76, 011301 (2007),
+    Eq. sigmasd and Fig. 18; docs/conventions.md §1.
+    """
     ax = get_axes(ax)
     curves = [("s", "simple"), ("d", "double"), ("s+d", "all")]
     draw_evolutions(ax, datasets(data, label), _partial_q_over_p, curves, **line_kw)

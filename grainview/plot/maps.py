@@ -34,10 +34,44 @@ KIND_COLOURS = {1: "#0072B2", 2: "#D55E00"}
 
 def plot_particles(data, ax=None, time: int = -1, facecolor=PARTICLE_FACE, edgecolor=PARTICLE_EDGE,
                    linewidth: float = 0.5, values=None, cmap=None, norm=None):
-    """Draw the particles of snapshot ``time``: disks as one EllipseCollection, the polygons of
-    each vertex count as one PolyCollection. With ``values`` (one number per particle) the
+    """Draw the particles of snapshot ``time``: disks and regular polygons.
+
+    Disks as one EllipseCollection, the polygons of each vertex count as one PolyCollection
+    (vertex k of polygon p at position[p] + radius[p] (cos(angle[p] + 2 pi k/n),
+    sin(angle[p] + 2 pi k/n)), docs/schema.md). With ``values`` (one number per particle) the
     faces are coloured by them through ``cmap`` and ``norm`` (a matplotlib Normalize) instead of
-    ``facecolor``. Sets equal aspect, the box as limits, x and y labels in m. Returns the axes."""
+    ``facecolor``. Sets equal aspect, the box as limits, x and y labels in m.
+
+    Parameters
+    ----------
+    data : xarray.Dataset, dict or list
+        One dataset of the contract (a dict or list must hold exactly one): this figure draws
+        one sample.
+    ax : matplotlib.axes.Axes, optional
+        The axes to draw on (default: new axes on a new figure).
+    time : int, default -1
+        Index of the snapshot drawn (negative counts from the end).
+    facecolor, edgecolor : matplotlib colour
+        Face and edge colours of the particles.
+    linewidth : float, default 0.5
+        Edge width, points.
+    values : array_like of float, optional
+        One value per particle, to colour the faces by.
+    cmap : str or matplotlib.colors.Colormap, optional
+        Colour map of ``values``.
+    norm : matplotlib.colors.Normalize, optional
+        Normalisation of ``values``.
+
+    Returns
+    -------
+    matplotlib.axes.Axes
+        The axes drawn on.
+
+    References
+    ----------
+    Azéma, Radjai, Peyroux & Saussine, Phys. Rev. E 76, 011301 (2007),
+    Figs. 13, 17 and 24 (the maps drawn over the particles).
+    """
     _, ds = single_dataset(data)
     ax = get_axes(ax)
     k = snapshot_index(ds, time)
@@ -75,10 +109,47 @@ PARTICLE_FIELDS = {"c": "contacts c", "m_s": "simple contacts m_s", "m_d": "doub
 
 def plot_particle_map(data, field: str = "c", ax=None, time: int = -1, reference: int = 0, walls: bool = True,
                       cmap: str = "cividis"):
-    """Particles of snapshot ``time`` coloured by a per-particle ``field`` (one of
-    :data:`PARTICLE_FIELDS`: contacts, simple/double contacts, strong contacts, rattlers,
-    rotation or displacement since ``reference``), with a colour bar; ``cividis`` is
-    colour-blind safe (integer fields get one colour per value). Returns the axes."""
+    """Particles of snapshot ``time`` coloured by a per-particle ``field``, with a colour bar.
+
+    ``field`` is one of :data:`PARTICLE_FIELDS`: contacts, simple/double contacts, strong
+    contacts, rattlers, rotation or displacement since ``reference``
+    (:func:`grainview.particle_fields.particle_fields`); ``cividis`` is colour-blind safe
+    (integer fields get one colour per value).
+
+    Parameters
+    ----------
+    data : xarray.Dataset, dict or list
+        One dataset of the contract (a dict or list must hold exactly one): this figure draws
+        one sample.
+    field : str, default "c"
+        "c", "m_s", "m_d", "strong", "rattler", "rotation" (rad) or "displacement" (m).
+    ax : matplotlib.axes.Axes, optional
+        The axes to draw on (default: new axes on a new figure).
+    time : int, default -1
+        Index of the snapshot drawn (negative counts from the end).
+    reference : int, default 0
+        Snapshot the rotation and displacement are measured from.
+    walls : bool, default True
+        Include the particle–wall contacts; ``False`` leaves them out.
+    cmap : str, default "cividis"
+        The colour map.
+
+    Returns
+    -------
+    matplotlib.axes.Axes
+        The axes drawn on.
+
+    Raises
+    ------
+    grainview.errors.ParameterError
+        When ``field`` is not one of :data:`PARTICLE_FIELDS`.
+
+    References
+    ----------
+    Azéma, Radjai, Peyroux & Saussine, Phys. Rev. E 76, 011301 (2007),
+    Sec. IV.A (connectivity, rattlers), Sec. V (strong contacts), Sec. VI and Fig. 21
+    (m_s, m_d); docs/analysis.md, "Where in the sample".
+    """
     import matplotlib as mpl
 
     from ..particle_fields import particle_fields
@@ -104,17 +175,86 @@ def plot_particle_map(data, field: str = "c", ax=None, time: int = -1, reference
 
 
 def plot_connectivity_map(data, ax=None, time: int = -1, **options):
-    """:func:`plot_particle_map` of the contacts c of each particle."""
+    """:func:`plot_particle_map` of the contacts c of each particle.
+
+    Parameters
+    ----------
+    data : xarray.Dataset, dict or list
+        One dataset of the contract (a dict or list must hold exactly one): this figure draws
+        one sample.
+    ax : matplotlib.axes.Axes, optional
+        The axes to draw on (default: new axes on a new figure).
+    time : int, default -1
+        Index of the snapshot drawn (negative counts from the end).
+    **options
+        Keyword arguments of :func:`plot_particle_map` (``reference``, ``walls``, ``cmap``).
+
+    Returns
+    -------
+    matplotlib.axes.Axes
+        The axes drawn on.
+
+    References
+    ----------
+    Azéma, Radjai, Peyroux & Saussine, Phys. Rev. E 76, 011301 (2007),
+    Sec. IV.A (connectivity); docs/conventions.md §7.
+    """
     return plot_particle_map(data, "c", ax=ax, time=time, **options)
 
 
 def plot_rattler_map(data, ax=None, time: int = -1, **options):
-    """:func:`plot_particle_map` of the rattlers (particles without force-bearing contacts)."""
+    """:func:`plot_particle_map` of the rattlers (particles without force-bearing contacts).
+
+    Parameters
+    ----------
+    data : xarray.Dataset, dict or list
+        One dataset of the contract (a dict or list must hold exactly one): this figure draws
+        one sample.
+    ax : matplotlib.axes.Axes, optional
+        The axes to draw on (default: new axes on a new figure).
+    time : int, default -1
+        Index of the snapshot drawn (negative counts from the end).
+    **options
+        Keyword arguments of :func:`plot_particle_map` (``reference``, ``walls``, ``cmap``).
+
+    Returns
+    -------
+    matplotlib.axes.Axes
+        The axes drawn on.
+
+    References
+    ----------
+    Azéma, Radjai, Peyroux & Saussine, Phys. Rev. E 76, 011301 (2007),
+    Sec. IV.A (rattlers); docs/conventions.md §7.
+    """
     return plot_particle_map(data, "rattler", ax=ax, time=time, **options)
 
 
 def plot_rotation_map(data, ax=None, time: int = -1, **options):
-    """:func:`plot_particle_map` of each particle's rotation since the ``reference`` snapshot."""
+    """:func:`plot_particle_map` of each particle's rotation (rad) since the ``reference`` snapshot.
+
+    Parameters
+    ----------
+    data : xarray.Dataset, dict or list
+        One dataset of the contract (a dict or list must hold exactly one): this figure draws
+        one sample.
+    ax : matplotlib.axes.Axes, optional
+        The axes to draw on (default: new axes on a new figure).
+    time : int, default -1
+        Index of the snapshot drawn (negative counts from the end).
+    **options
+        Keyword arguments of :func:`plot_particle_map` (``reference``, ``walls``, ``cmap``).
+
+    Returns
+    -------
+    matplotlib.axes.Axes
+        The axes drawn on.
+
+    References
+    ----------
+    Azéma, Radjai, Peyroux & Saussine, Phys. Rev. E 76, 011301 (2007),
+    docs/analysis.md, "Where in the sample".
+    """
     return plot_particle_map(data, "rotation", ax=ax, time=time, **options)
 
 
@@ -129,8 +269,33 @@ def _frame(ax, ds, k):
 
 
 def contact_segments(ds: xr.Dataset, k: int, mask) -> tuple[np.ndarray, np.ndarray]:
-    """(C, 2, 2) segments from the centre of i along the branch vector, and the slot indices
-    of the C contacts of snapshot ``k`` selected by the boolean ``mask`` (contact,), m."""
+    """Segments from the centre of i along the branch vector of the contacts selected by ``mask``.
+
+    (C, 2, 2) segments, m, from the centre of body i to that centre plus the branch vector (the
+    centre of j, or the contact point on a wall), and the slot indices of the C contacts of
+    snapshot ``k`` selected by the boolean ``mask`` (contact,).
+
+    Parameters
+    ----------
+    ds : xarray.Dataset
+        A dataset of the contract.
+    k : int
+        Snapshot index.
+    mask : array_like of bool
+        (contact,): the slots drawn.
+
+    Returns
+    -------
+    segments : numpy.ndarray
+        (C, 2, 2) start and end points, m.
+    slots : numpy.ndarray
+        The C slot indices.
+
+    References
+    ----------
+    Azéma, Radjai, Peyroux & Saussine, Phys. Rev. E 76, 011301 (2007),
+    Fig. 13 (forces drawn along the branch vectors); docs/conventions.md §0.
+    """
     slots = np.flatnonzero(np.asarray(mask, bool))
     snap = ds.isel(time=k, contact=slots)
     i = np.asarray(snap["i"].values, int)
@@ -140,16 +305,54 @@ def contact_segments(ds: xr.Dataset, k: int, mask) -> tuple[np.ndarray, np.ndarr
 
 
 def force_linewidths(fn, max_linewidth: float, force_scale=None) -> np.ndarray:
-    """Line widths proportional to the normal force: max_linewidth * f_n / F (points), F the
-    largest f_n drawn or, for maps that must compare (a movie's frames), ``force_scale`` (N)."""
+    """Line widths proportional to the normal force, in points.
+
+        width = max_linewidth * f_n / F
+
+    F the largest f_n drawn or, for maps that must compare (a movie's frames), ``force_scale``
+    (:func:`width_force`).
+
+    Parameters
+    ----------
+    fn : array_like of float
+        Normal forces, N.
+    max_linewidth : float
+        Width of the force F, points.
+    force_scale : float, optional
+        F in N (default: the largest of ``fn``).
+
+    Returns
+    -------
+    numpy.ndarray
+        Widths, points (zeros when F is 0).
+
+    References
+    ----------
+    Azéma, Radjai, Peyroux & Saussine, Phys. Rev. E 76, 011301 (2007),
+    Fig. 13 (line width proportional to the normal force).
+    """
     fn = np.asarray(fn, float)
     top = width_force(fn, force_scale)
     return max_linewidth * fn / top if top > 0 else np.zeros_like(fn)
 
 
 def width_force(fn, force_scale=None) -> float:
-    """The force F (N) drawn at the largest line width: ``force_scale`` when given, else the
-    largest of ``fn`` (0 for none)."""
+    """The force F (N) drawn at the largest line width.
+
+    ``force_scale`` when given, else the largest of ``fn`` (0 for none).
+
+    Parameters
+    ----------
+    fn : array_like of float
+        Normal forces, N.
+    force_scale : float, optional
+        F in N.
+
+    Returns
+    -------
+    float
+        F, N.
+    """
     fn = np.asarray(fn, float)
     return float(force_scale) if force_scale is not None else (float(fn.max()) if fn.size else 0.0)
 
@@ -175,21 +378,60 @@ def _network(ds, k, mask, colours, ax, max_linewidth, width_by_force, linewidth,
 
 
 def newtons(force: float) -> str:
-    """A force as a legend shows it, to at least 3 significant digits: whole newtons from 100 N
-    to 100 kN, else 3 significant digits."""
+    """A force as a legend shows it, to at least 3 significant digits.
+
+    Whole newtons from 100 N to 100 kN, else 3 significant digits.
+
+    Parameters
+    ----------
+    force : float
+        A force, N.
+
+    Returns
+    -------
+    str
+        The force with its unit, e.g. "1.4 N" or "250 N".
+    """
     return f"{force:.0f} N" if 100.0 <= abs(force) < 1e5 else f"{force:.3g} N"
 
 
 class WidthKey(NamedTuple):
-    """What a map's line widths stand for: ``max_linewidth`` points for ``top_force`` N; the
-    mean force drawn, ``mean_force`` N, is one of the legend's sample widths."""
+    """What a map's line widths stand for: ``max_linewidth`` points for ``top_force`` N.
+
+    The mean force drawn, ``mean_force`` N, is one of the legend's sample widths.
+
+    Attributes
+    ----------
+    top_force : float
+        The force drawn at ``max_linewidth``, N.
+    max_linewidth : float
+        The largest line width, points.
+    mean_force : float
+        The mean force drawn, N.
+    """
     top_force: float
     max_linewidth: float
     mean_force: float
 
 
 def contact_collection(ax) -> LineCollection:
-    """The LineCollection of contacts drawn by a map on ``ax``."""
+    """The LineCollection of contacts drawn by a map on ``ax``.
+
+    Parameters
+    ----------
+    ax : matplotlib.axes.Axes
+        Axes a map was drawn on.
+
+    Returns
+    -------
+    matplotlib.collections.LineCollection
+        The contacts' segments (gid ``"contacts"``).
+
+    Raises
+    ------
+    LookupError
+        When ``ax`` holds no contact map.
+    """
     for coll in ax.collections:
         if isinstance(coll, LineCollection) and coll.get_gid() == "contacts":
             return coll
@@ -198,10 +440,46 @@ def contact_collection(ax) -> LineCollection:
 
 def plot_force_chains(data, ax=None, time: int = -1, walls: bool = False, max_linewidth: float = 3.0,
                       colour="k", particles: bool = True, force_scale=None):
-    """Map of the normal forces of snapshot ``time`` (paper Fig. 13): each force-bearing
-    contact (f_n > 0) a segment along its branch vector, of width proportional to f_n
-    (``max_linewidth`` points for the largest force, or for ``force_scale`` N when given),
-    over the particles. Wall contacts only with ``walls=True``. Returns the axes."""
+    """Map of the normal forces of snapshot ``time`` (paper Fig. 13).
+
+    Each force-bearing contact (f_n > 0) a segment along its branch vector, of width
+    proportional to f_n,
+
+        width = max_linewidth * f_n / F,
+
+    F the largest force (or ``force_scale`` N when given), over the particles. Wall contacts
+    only with ``walls=True``. A legend beside the map gives sample widths in N.
+
+    Parameters
+    ----------
+    data : xarray.Dataset, dict or list
+        One dataset of the contract (a dict or list must hold exactly one): this figure draws
+        one sample.
+    ax : matplotlib.axes.Axes, optional
+        The axes to draw on (default: new axes on a new figure).
+    time : int, default -1
+        Index of the snapshot drawn (negative counts from the end).
+    walls : bool, default False
+        Include the particle–wall contacts (default: particle–particle only).
+    max_linewidth : float, default 3.0
+        Width of the largest force (or of ``force_scale``), points.
+    colour : matplotlib colour, default "k"
+        Colour of the segments.
+    particles : bool, default True
+        Draw the particles under the network.
+    force_scale : float, optional
+        The force F (N) drawn at ``max_linewidth``, to compare maps.
+
+    Returns
+    -------
+    matplotlib.axes.Axes
+        The axes drawn on.
+
+    References
+    ----------
+    Azéma, Radjai, Peyroux & Saussine, Phys. Rev. E 76, 011301 (2007),
+    Fig. 13; docs/conventions.md §0.
+    """
     _, ds = single_dataset(data)
     ax = get_axes(ax)
     k = snapshot_index(ds, time)
@@ -214,10 +492,47 @@ def plot_force_chains(data, ax=None, time: int = -1, walls: bool = False, max_li
 def plot_force_classes(data, ax=None, time: int = -1, walls: bool = False, very_weak: float = 0.1,
                        strong: float = 1.0, width_by_force: bool = False, linewidth: float = 1.0,
                        max_linewidth: float = 3.0, particles: bool = True):
-    """Tricolor map of snapshot ``time`` (paper Fig. 17): very weak contacts
-    (f_n < ``very_weak`` <f_n>) in blue, weak ones in green, strong ones (f_n > ``strong``
-    <f_n>) in red, as classified by :func:`grainview.force_networks.force_class`. Uniform
-    ``linewidth`` unless ``width_by_force``. Returns the axes, with a legend of the classes."""
+    """Tricolor map of the force classes of snapshot ``time`` (paper Fig. 17).
+
+    Very weak contacts (f_n < ``very_weak`` <f_n>) in blue, weak ones in green, strong ones
+    (f_n > ``strong`` <f_n>) in red, as classified by
+    :func:`grainview.force_networks.force_class`. Uniform ``linewidth`` unless
+    ``width_by_force``. A legend of the classes.
+
+    Parameters
+    ----------
+    data : xarray.Dataset, dict or list
+        One dataset of the contract (a dict or list must hold exactly one): this figure draws
+        one sample.
+    ax : matplotlib.axes.Axes, optional
+        The axes to draw on (default: new axes on a new figure).
+    time : int, default -1
+        Index of the snapshot drawn (negative counts from the end).
+    walls : bool, default False
+        Include the particle–wall contacts (default: particle–particle only).
+    very_weak : float, default 0.1
+        Very weak threshold, a multiple of <f_n>.
+    strong : float, default 1.0
+        Strong threshold, a multiple of <f_n>.
+    width_by_force : bool, default False
+        Line width proportional to f_n (``max_linewidth`` for the largest) instead of uniform.
+    linewidth : float, default 1.0
+        Uniform line width, points.
+    max_linewidth : float, default 3.0
+        Width of the largest force with ``width_by_force``, points.
+    particles : bool, default True
+        Draw the particles under the network.
+
+    Returns
+    -------
+    matplotlib.axes.Axes
+        The axes drawn on.
+
+    References
+    ----------
+    Azéma, Radjai, Peyroux & Saussine, Phys. Rev. E 76, 011301 (2007),
+    Secs. V.B and V.C, Fig. 17; docs/conventions.md §4.
+    """
     from ..force_networks import force_class
     _, ds = single_dataset(data)
     ax = get_axes(ax)
@@ -237,8 +552,37 @@ def plot_force_classes(data, ax=None, time: int = -1, walls: bool = False, very_
 
 def plot_contact_kinds(data, ax=None, time: int = -1, walls: bool = False, max_linewidth: float = 3.0,
                        particles: bool = True):
-    """Map of the normal-force network of snapshot ``time`` with simple contacts in blue and
-    double contacts in red, width proportional to f_n (paper Fig. 24). Returns the axes."""
+    """Map of the normal-force network of snapshot ``time`` by contact kind (paper Fig. 24).
+
+    Simple contacts in blue and double contacts in red, width proportional to f_n
+    (``max_linewidth`` points for the largest force).
+
+    Parameters
+    ----------
+    data : xarray.Dataset, dict or list
+        One dataset of the contract (a dict or list must hold exactly one): this figure draws
+        one sample.
+    ax : matplotlib.axes.Axes, optional
+        The axes to draw on (default: new axes on a new figure).
+    time : int, default -1
+        Index of the snapshot drawn (negative counts from the end).
+    walls : bool, default False
+        Include the particle–wall contacts (default: particle–particle only).
+    max_linewidth : float, default 3.0
+        Width of the largest force, points.
+    particles : bool, default True
+        Draw the particles under the network.
+
+    Returns
+    -------
+    matplotlib.axes.Axes
+        The axes drawn on.
+
+    References
+    ----------
+    Azéma, Radjai, Peyroux & Saussine, Phys. Rev. E 76, 011301 (2007),
+    Sec. II.A (simple and double contacts) and Fig. 24.
+    """
     _, ds = single_dataset(data)
     ax = get_axes(ax)
     k = snapshot_index(ds, time)
@@ -266,4 +610,5 @@ def _legend(ax, entries, key=None, key_colour="0.3"):
 
 
 __all__ = ["plot_particles", "plot_force_chains", "plot_force_classes", "plot_contact_kinds",
-           "contact_segments", "force_linewidths", "contact_collection"]
+           "plot_particle_map", "plot_connectivity_map", "plot_rattler_map", "plot_rotation_map",
+           "contact_segments", "force_linewidths", "width_force", "newtons", "WidthKey", "contact_collection"]

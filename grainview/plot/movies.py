@@ -17,6 +17,8 @@ from ..contacts import selection
 from ..errors import ParameterError
 from ._style import single_dataset
 
+__all__ = ["animate"]
+
 KINDS = ("force_chains", "force_classes", "connectivity")
 
 
@@ -40,7 +42,49 @@ def animate(data, path, kind: str = "force_chains", every: int = 1, fps: int = 8
     ``kind``: ``"force_chains"`` (line width proportional to f_n, the largest force of the whole
     movie at ``max_linewidth`` points), ``"force_classes"`` (very weak / weak / strong, paper
     Fig. 17) or ``"connectivity"`` (particles coloured by their contacts, one colour bar for the
-    movie). Returns the path written (atomically: :func:`grainview.export.write_atomically`)."""
+    movie). Each frame is titled with its shear strain eps_q and time. Written atomically
+    (:func:`grainview.export.write_atomically`).
+
+    Parameters
+    ----------
+    data : xarray.Dataset, dict or list
+        One dataset of the contract (a dict or list must hold exactly one): this figure draws
+        one sample.
+    path : str or path-like
+        The movie's file name: ``.gif`` (Pillow) or ``.mp4`` (needs ffmpeg).
+    kind : {"force_chains", "force_classes", "connectivity"}, default "force_chains"
+        The map of each frame.
+    every : int, default 1
+        Draw every ``every``-th snapshot (the last always included).
+    fps : int, default 8
+        Frames per second.
+    walls : bool, default False
+        Include the particle–wall contacts (default: particle–particle only).
+    max_linewidth : float, default 3.0
+        Width of the movie's largest force, points (``"force_chains"``).
+    dpi : int, default 90
+        Resolution of the frames, dots per inch.
+    progress : bool, default True
+        Show a progress bar.
+    overwrite : bool, default False
+        Replace an existing ``path``.
+
+    Returns
+    -------
+    str
+        The path written.
+
+    Raises
+    ------
+    grainview.errors.ParameterError
+        For an unknown ``kind``, an existing ``path`` without ``overwrite``, a name that is
+        neither .gif nor .mp4, or an .mp4 without ffmpeg.
+
+    References
+    ----------
+    Azéma, Radjai, Peyroux & Saussine, Phys. Rev. E 76, 011301 (2007),
+    Figs. 13 and 17 (the maps of the frames).
+    """
     import matplotlib.pyplot as plt
 
     from ..export import snapshot_indices, write_atomically

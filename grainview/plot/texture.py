@@ -19,9 +19,39 @@ from ._style import (EPS_Q_LABEL, axis_label, datasets, draw_evolutions, finish,
 
 
 def plot_coordination(data, ax=None, label=None, walls: bool = False, **line_kw):
-    """Coordination number z of the force-bearing network (rattlers left out, a double contact
-    counted once; docs/conventions.md §7) against eps_q (paper Fig. 6a;
-    :func:`grainview.connectivity.coordination`)."""
+    """Coordination number z of the force-bearing network against eps_q (paper Fig. 6a).
+
+        z = sum_i c_i / N'
+
+    over the N' non-rattler particles (rattlers left out, a double contact counted once;
+    docs/conventions.md §7; :func:`grainview.connectivity.coordination`). Dimensionless.
+
+    Parameters
+    ----------
+    data : xarray.Dataset, dict or list
+        One dataset of the contract, or several to compare on the same axes as ``{label: ds}``
+        or ``[(label, ds), ...]``.
+    ax : matplotlib.axes.Axes, optional
+        The axes to draw on (default: new axes on a new figure).
+    label : str, optional
+        Legend label of a single dataset (None: no legend entry), so that successive calls on
+        the same axes build a comparison.
+    walls : bool, default False
+        Include the particle–wall contacts (default: particle–particle only).
+    **line_kw
+        Keyword arguments of ``matplotlib.axes.Axes.plot`` (``color`` applies when a single
+        sample is drawn).
+
+    Returns
+    -------
+    matplotlib.axes.Axes
+        The axes drawn on.
+
+    References
+    ----------
+    Azéma, Radjai, Peyroux & Saussine, Phys. Rev. E 76, 011301 (2007),
+    Sec. IV.A and Fig. 6a; docs/conventions.md §7.
+    """
     ax = get_axes(ax)
     draw_evolutions(ax, datasets(data, label), lambda ds: coordination(ds, walls=walls), [(None, "z")],
                     **line_kw)
@@ -30,8 +60,39 @@ def plot_coordination(data, ax=None, label=None, walls: bool = False, **line_kw)
 
 
 def plot_persistence(data, ax=None, label=None, reference: int = 0, **line_kw):
-    """Fraction gamma of the contacts of snapshot ``reference`` still present, against eps_q
-    (paper Fig. 6b, docs/conventions.md §8; :func:`grainview.persistence.persistence`)."""
+    """Fraction gamma of the contacts of snapshot ``reference`` still present, against eps_q (paper Fig. 6b).
+
+        gamma(t) = |C(ref) & C(t)| / |C(ref)|
+
+    (docs/conventions.md §8; :func:`grainview.persistence.persistence`, particle–particle
+    force-bearing contacts). Dimensionless; computed.
+
+    Parameters
+    ----------
+    data : xarray.Dataset, dict or list
+        One dataset of the contract, or several to compare on the same axes as ``{label: ds}``
+        or ``[(label, ds), ...]``.
+    ax : matplotlib.axes.Axes, optional
+        The axes to draw on (default: new axes on a new figure).
+    label : str, optional
+        Legend label of a single dataset (None: no legend entry), so that successive calls on
+        the same axes build a comparison.
+    reference : int, default 0
+        The reference snapshot index (negative counts from the end).
+    **line_kw
+        Keyword arguments of ``matplotlib.axes.Axes.plot`` (``color`` applies when a single
+        sample is drawn).
+
+    Returns
+    -------
+    matplotlib.axes.Axes
+        The axes drawn on.
+
+    References
+    ----------
+    Azéma, Radjai, Peyroux & Saussine, Phys. Rev. E 76, 011301 (2007),
+    Sec. IV.A and Fig. 6b; docs/conventions.md §8.
+    """
     from ..persistence import persistence
     ax = get_axes(ax)
     draw_evolutions(ax, datasets(data, label), lambda ds: persistence(ds, reference=reference), [(None, None)],
@@ -42,10 +103,44 @@ def plot_persistence(data, ax=None, label=None, reference: int = 0, **line_kw):
 
 def plot_connectivity_pdf(data, ax=None, label=None, time="residual", max_c: int = 10, walls: bool = False,
                           **line_kw):
-    """P(c), the fraction of (non-rattler) particles with exactly c force-bearing contacts,
-    against c, averaged over the snapshots ``time`` (paper Fig. 7;
-    :func:`grainview.connectivity.connectivity_pdf`). Markers only, c >= 1 (P(c) is discrete,
-    and P(0) = 0 by definition once rattlers are left out); one marker series per sample."""
+    """P(c) against c, averaged over the snapshots ``time`` (paper Fig. 7).
+
+    P(c) is the fraction of (non-rattler) particles with exactly c force-bearing contacts
+    (:func:`grainview.connectivity.connectivity_pdf`). Markers only, c >= 1 (P(c) is discrete,
+    and P(0) = 0 by definition once rattlers are left out); one marker series per sample.
+
+    Parameters
+    ----------
+    data : xarray.Dataset, dict or list
+        One dataset of the contract, or several to compare on the same axes as ``{label: ds}``
+        or ``[(label, ds), ...]``.
+    ax : matplotlib.axes.Axes, optional
+        The axes to draw on (default: new axes on a new figure).
+    label : str, optional
+        Legend label of a single dataset (None: no legend entry), so that successive calls on
+        the same axes build a comparison.
+    time : str, int, slice or sequence of int, default "residual"
+        The snapshots averaged over (:func:`grainview.plot._style.select_snapshots`):
+        ``"residual"`` the residual state, eps_q >= 0.3 (for a run that stops short of it, the
+        last part of the run), ``"all"`` or None every snapshot, a snapshot index, a slice or a
+        sequence of indices.
+    max_c : int, default 10
+        The largest c drawn.
+    walls : bool, default False
+        Include the particle–wall contacts (default: particle–particle only).
+    **line_kw
+        Keyword arguments of ``matplotlib.axes.Axes.plot``.
+
+    Returns
+    -------
+    matplotlib.axes.Axes
+        The axes drawn on.
+
+    References
+    ----------
+    Azéma, Radjai, Peyroux & Saussine, Phys. Rev. E 76, 011301 (2007),
+    Sec. IV.A and Fig. 7; docs/conventions.md §7.
+    """
     ax = get_axes(ax)
     for lab, ds in datasets(data, label):
         pdf = time_mean(connectivity_pdf(select_snapshots(ds, time), max_c=max_c, walls=walls)).sel(c=slice(1, None))
@@ -56,11 +151,47 @@ def plot_connectivity_pdf(data, ax=None, label=None, time="residual", max_c: int
 
 def plot_orientation_pdf(data, ax=None, label=None, time="residual", bins: int = 36, kind="all",
                          walls: bool = False, **line_kw):
-    """Polar plot of the density P(theta) of contact-normal orientations (rad-1), averaged over
-    the snapshots ``time`` (paper Fig. 8; :func:`grainview.fabric.orientation_pdf`).
+    """Polar plot of the density P(theta) of contact-normal orientations (rad-1) (paper Fig. 8).
 
-    P is pi-periodic; the curve is drawn over the full turn (P(theta + pi) = P(theta)) and
-    closed. Needs polar axes (created when ``ax`` is None)."""
+    Averaged over the snapshots ``time`` (:func:`grainview.fabric.orientation_pdf`). P is
+    pi-periodic; the curve is drawn over the full turn (P(theta + pi) = P(theta)) and closed.
+    Needs polar axes (created when ``ax`` is None).
+
+    Parameters
+    ----------
+    data : xarray.Dataset, dict or list
+        One dataset of the contract, or several to compare on the same axes as ``{label: ds}``
+        or ``[(label, ds), ...]``.
+    ax : matplotlib.axes.Axes, optional
+        Polar axes to draw on (default: new polar axes on a new figure).
+    label : str, optional
+        Legend label of a single dataset (None: no legend entry), so that successive calls on
+        the same axes build a comparison.
+    time : str, int, slice or sequence of int, default "residual"
+        The snapshots averaged over (:func:`grainview.plot._style.select_snapshots`):
+        ``"residual"`` the residual state, eps_q >= 0.3 (for a run that stops short of it, the
+        last part of the run), ``"all"`` or None every snapshot, a snapshot index, a slice or a
+        sequence of indices.
+    bins : int, default 36
+        Number of angular sectors of [0, pi), centred on theta_k = k pi/bins.
+    kind : {"all", "simple", "double"}, default "all"
+        The contacts used: all, simple (vertex–edge and disk contacts) or double (edge–edge)
+        ones (also 1, 2, "s", "d"; :func:`grainview.contacts.kind_code`).
+    walls : bool, default False
+        Include the particle–wall contacts (default: particle–particle only).
+    **line_kw
+        Keyword arguments of ``matplotlib.axes.Axes.plot``.
+
+    Returns
+    -------
+    matplotlib.axes.Axes
+        The axes drawn on.
+
+    References
+    ----------
+    Azéma, Radjai, Peyroux & Saussine, Phys. Rev. E 76, 011301 (2007),
+    Sec. IV and Fig. 8; docs/conventions.md §2.
+    """
     ax = get_axes(ax, polar=True)
     for lab, ds in datasets(data, label):
         pdf = time_mean(orientation_pdf(select_snapshots(ds, time), bins=bins, kind=kind, walls=walls))
@@ -71,15 +202,59 @@ def plot_orientation_pdf(data, ax=None, label=None, time="residual", bins: int =
 
 
 def full_turn(theta, r):
-    """A pi-periodic function sampled on [0, pi) extended to [0, 2 pi] and closed."""
+    """A pi-periodic function sampled on [0, pi) extended to [0, 2 pi] and closed.
+
+    Parameters
+    ----------
+    theta : numpy.ndarray
+        Angles in [0, pi), rad.
+    r : numpy.ndarray
+        The values at ``theta``.
+
+    Returns
+    -------
+    theta, r : numpy.ndarray
+        The angles theta, theta + pi and the first angle + 2 pi (rad), and the values repeated
+        to match.
+    """
     theta = np.concatenate([theta, theta + np.pi, theta[:1] + 2 * np.pi])
     r = np.concatenate([r, r, r[:1]])
     return theta, r
 
 
 def plot_fabric_anisotropy(data, ax=None, label=None, walls: bool = False, **line_kw):
-    """Signed fabric anisotropy a' = a cos 2(theta_F - theta_sigma) against eps_q (paper
-    Fig. 9, docs/conventions.md §2; :func:`grainview.fabric.fabric_anisotropy`)."""
+    """Signed fabric anisotropy a' = a cos 2(theta_F - theta_sigma) against eps_q (paper Fig. 9).
+
+        a' = 2 (F_1 - F_2) cos 2(theta_F - theta_sigma)
+
+    (docs/conventions.md §2; :func:`grainview.fabric.fabric_anisotropy`). Dimensionless.
+
+    Parameters
+    ----------
+    data : xarray.Dataset, dict or list
+        One dataset of the contract, or several to compare on the same axes as ``{label: ds}``
+        or ``[(label, ds), ...]``.
+    ax : matplotlib.axes.Axes, optional
+        The axes to draw on (default: new axes on a new figure).
+    label : str, optional
+        Legend label of a single dataset (None: no legend entry), so that successive calls on
+        the same axes build a comparison.
+    walls : bool, default False
+        Include the particle–wall contacts (default: particle–particle only).
+    **line_kw
+        Keyword arguments of ``matplotlib.axes.Axes.plot`` (``color`` applies when a single
+        sample is drawn).
+
+    Returns
+    -------
+    matplotlib.axes.Axes
+        The axes drawn on.
+
+    References
+    ----------
+    Azéma, Radjai, Peyroux & Saussine, Phys. Rev. E 76, 011301 (2007),
+    Eq. a' (Sec. IV.B) and Fig. 9; docs/conventions.md §2.
+    """
     ax = get_axes(ax)
     draw_evolutions(ax, datasets(data, label), lambda ds: fabric_anisotropy(ds, walls=walls),
                     [(None, "a_prime")], **line_kw)
@@ -88,10 +263,38 @@ def plot_fabric_anisotropy(data, ax=None, label=None, walls: bool = False, **lin
 
 
 def plot_partial_fabric_anisotropy(data, ax=None, label=None, walls: bool = False, **line_kw):
-    """Signed anisotropies a'_s and a'_d of the partial fabric tensors of simple and double
-    contacts (F = F_s + F_d, each normalised by the count of all contacts) against eps_q (paper
-    Fig. 22; :func:`grainview.fabric.fabric_anisotropy` with ``kind``). Two lines per sample:
-    s then d."""
+    """Signed anisotropies a'_s and a'_d of the partial fabric tensors against eps_q (paper Fig. 22).
+
+    The partial tensors of simple and double contacts add up, F = F_s + F_d, each normalised by
+    the count of all contacts (:func:`grainview.fabric.fabric_anisotropy` with ``kind``). Two
+    lines per sample: s then d. Dimensionless.
+
+    Parameters
+    ----------
+    data : xarray.Dataset, dict or list
+        One dataset of the contract, or several to compare on the same axes as ``{label: ds}``
+        or ``[(label, ds), ...]``.
+    ax : matplotlib.axes.Axes, optional
+        The axes to draw on (default: new axes on a new figure).
+    label : str, optional
+        Legend label of a single dataset (None: no legend entry), so that successive calls on
+        the same axes build a comparison.
+    walls : bool, default False
+        Include the particle–wall contacts (default: particle–particle only).
+    **line_kw
+        Keyword arguments of ``matplotlib.axes.Axes.plot`` (``color`` applies when a single
+        sample is drawn).
+
+    Returns
+    -------
+    matplotlib.axes.Axes
+        The axes drawn on.
+
+    References
+    ----------
+    Azéma, Radjai, Peyroux & Saussine, Phys. Rev. E 76, 011301 (2007),
+    Eq. fabricsd and Fig. 22; docs/conventions.md §2.
+    """
     ax = get_axes(ax)
 
     def partial(ds):
@@ -104,10 +307,45 @@ def plot_partial_fabric_anisotropy(data, ax=None, label=None, walls: bool = Fals
 
 def plot_joint_connectivity(data, ax=None, label=None, time="residual", max_m: int = 6, walls: bool = False,
                             cmap="Greys", colorbar: bool = True):
-    """Grey-level map of P(m_s, m_d), the fraction of (non-rattler) particles with m_s simple
-    and m_d double force-bearing contacts, averaged over the snapshots ``time`` (paper
-    Fig. 21; :func:`grainview.connectivity.joint_connectivity_pdf`). One sample per axes; the
-    image's array is P with rows m_d and columns m_s."""
+    """Grey-level map of P(m_s, m_d), averaged over the snapshots ``time`` (paper Fig. 21).
+
+    P(m_s, m_d) is the fraction of (non-rattler) particles with m_s simple and m_d double
+    force-bearing contacts (:func:`grainview.connectivity.joint_connectivity_pdf`). One sample
+    per axes; the image's array is P with rows m_d and columns m_s.
+
+    Parameters
+    ----------
+    data : xarray.Dataset, dict or list
+        One dataset of the contract (a dict or list must hold exactly one): this figure draws
+        one sample.
+    ax : matplotlib.axes.Axes, optional
+        The axes to draw on (default: new axes on a new figure).
+    label : str, optional
+        Title of the axes for a single dataset (a dict's or list's label otherwise).
+    time : str, int, slice or sequence of int, default "residual"
+        The snapshots averaged over (:func:`grainview.plot._style.select_snapshots`):
+        ``"residual"`` the residual state, eps_q >= 0.3 (for a run that stops short of it, the
+        last part of the run), ``"all"`` or None every snapshot, a snapshot index, a slice or a
+        sequence of indices.
+    max_m : int, default 6
+        The largest m_s and m_d drawn.
+    walls : bool, default False
+        Include the particle–wall contacts (default: particle–particle only).
+    cmap : str or matplotlib.colors.Colormap, default "Greys"
+        The colour map.
+    colorbar : bool, default True
+        Draw a colour bar.
+
+    Returns
+    -------
+    matplotlib.axes.Axes
+        The axes drawn on.
+
+    References
+    ----------
+    Azéma, Radjai, Peyroux & Saussine, Phys. Rev. E 76, 011301 (2007),
+    Sec. VI and Fig. 21; docs/conventions.md §7.
+    """
     lab, ds = single_dataset(data, label)
     ax = get_axes(ax)
     pdf = time_mean(joint_connectivity_pdf(select_snapshots(ds, time), max_m=max_m, walls=walls))
