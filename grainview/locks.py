@@ -64,12 +64,10 @@ class WriterLock:
     @staticmethod
     def check_free(path) -> None:
         """Raise :class:`FileLockedError` if another process holds ``path``'s lock (e.g. before
-        replacing the file with ``overwrite``); take nothing. A compressed (HDF5) file is a
-        finished run that nothing appends to; the lock HDF5 itself holds on it while a reader
-        has it open is not a writer's."""
-        from .writer import is_compressed
-
-        if fcntl is None or not os.path.exists(path) or is_compressed(path):
+        replacing the file with ``overwrite``); take nothing. Only for files that are appended
+        to (netCDF-3): HDF5 holds a shared lock of its own on a compressed file while a reader
+        has it open, which is not a writer's (:func:`grainview.writer.is_compressed`)."""
+        if fcntl is None or not os.path.exists(path):
             return
         WriterLock(path).release()
 

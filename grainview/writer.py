@@ -173,7 +173,8 @@ class SnapshotWriter:
         folder = os.path.dirname(os.path.abspath(path))
         if not os.path.isdir(folder):  # named here, not by the hidden temporary file's name
             raise FileNotFoundError(f"cannot write {path}: the folder {folder} does not exist")
-        WriterLock.check_free(path)  # never replace a file another run is still writing
+        if os.path.exists(path) and not is_compressed(path):  # a compressed file is a finished run
+            WriterLock.check_free(path)  # never replace a file another run is still writing
         radius = np.asarray(radius, "f8")
         n = radius.shape[0]
         slots = n_contact_slots or contact_slots(n, n_walls)

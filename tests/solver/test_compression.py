@@ -176,3 +176,30 @@ def test_compressed_files_can_be_opened_again_and_again_with_dask_threads(tmp_pa
     done = subprocess.run([sys.executable, "-c", REOPEN, "-", "12", *map(str, paths)], cwd=REPO,
                           capture_output=True, text=True, timeout=300)
     assert done.returncode == 0 and done.stdout.strip() == "ok", (done.returncode, done.stderr[-2000:])
+
+
+HOLD_OPEN = """
+import sys, netCDF4
+nc = netCDF4.Dataset(sys.argv[1])  # HDF5 holds a shared lock while the file is open
+print("open", flush=True)
+sys.stdin.readline()
+"""
+
+
+def test_a_compressed_file_open_in_a_reader_can_be_replaced(run_file, tmp_path):
+    """A notebook that has a finished (compressed) run open does not block --overwrite: HDF5's
+    own reader lock is not taken for a writer's."""
+    path = tmp_path / "run.nc"
+    path.write_bytes(run_file.read_bytes())
+    compress_file(path)
+    reader = subprocess.Popen([sys.executable, "-c", HOLD_OPEN, str(path)], stdin=subprocess.PIPE,
+                              stdout=subprocess.PIPE, text=True)
+    try:
+        assert reader.stdout.readline().strip() == "open"
+        sim = compaction_sample(12, "disk", seed=0)
+        with Recorder(path, sim, overwrite=True, compress=False) as rec:
+            rec.write()
+    finally:
+        reader.communicate("\n", timeout=60)
+    with grainview.open_dataset(path, chunks=None) as ds:
+        assert ds.sizes["particle"] == 12
