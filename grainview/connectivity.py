@@ -51,8 +51,9 @@ def contact_numbers(ds: xr.Dataset, kind="all", walls: bool = False, near=None) 
     Azéma, Radjai, Peyroux & Saussine, Phys. Rev. E 76, 011301 (2007),
     Sec. IV.A; docs/conventions.md §7.
     """
+    which = "force-bearing contacts" if near is None else f"contacts and pairs within {float(near):g} m"
     return with_attrs(counts_of(ds, selection(ds, walls=walls, kind=kind, near=near)), "contact_number", "1",
-                      "number of force-bearing contacts per particle")
+                      f"number of {which} per particle")
 
 
 def counts_of(ds: xr.Dataset, mask: xr.DataArray) -> xr.DataArray:

@@ -12,7 +12,8 @@ ParaView collections (``.pvd``) that put them on the time axis:
   strong, rattler, rotation rad, displacement m);
 * ``contacts_<k>.vtu``: every contact as a line from the centre of i along its branch vector
   (to the centre of j, or to the contact point on a wall); cell fields ``fn``, ``ft`` (N),
-  ``kind`` (1 simple, 2 double) and ``force_class`` (1 very weak, 2 weak, 3 strong; paper Fig. 17).
+  ``kind`` (1 simple, 2 double), ``force_class`` (0 a pair without force, 1 very weak, 2 weak,
+  3 strong; paper Fig. 17) and the bodies ``i``, ``j`` (walls are N, N+1, ...).
 
 CSV: ``contacts.csv``, the tidy contact table of every exported snapshot
 (:func:`grainview.tables.contacts_table`) with its snapshot index and time.

@@ -22,8 +22,8 @@ __all__ = ["force_pdf", "pooled_force_pdf", "strong_force_exponent"]
 
 SCALES = ("log", "linear")
 DEFAULT_RANGE = {"linear": (0.0, 10.0), "log": (1e-4, 10.0)}
-"""Default range of f_n/<f_n> per scale (an exponential tail with alpha = 0.74 leaves about
-0.1 % of the contacts above 10)."""
+"""Default range of f_n/<f_n> per scale: an exponential tail exp(-alpha f/<f>) with
+alpha = 0.74 leaves a fraction of about exp(-7.4), one contact in 1600, above 10."""
 
 
 def _check(bins, scale, value_range):

@@ -66,19 +66,36 @@ def _check_version(ds, source):
 
 
 def open_dataset(path, chunks: int | dict | None = "auto", validate: bool = False) -> xr.Dataset:
-    """Open a grainview netCDF file.
+    """Open a grainview netCDF file, lazily.
+
+    The file is opened read-only and never modified; netCDF-3 (a run still going on or
+    stopped) and compressed files (a finished run, docs/schema.md "Compression") read the
+    same. Trailing snapshots whose ``time`` is missing or whose ``complete`` flag is not set
+    (a writer killed mid-snapshot) are dropped.
 
     Parameters
     ----------
     path : str or path-like
-    chunks : number of snapshots per dask chunk, ``"auto"`` (see :func:`time_chunks`), or
-        ``None`` for eager numpy arrays. Only ``time`` is ever chunked:
-        ``particle`` and ``contact`` stay whole in each chunk, as the analysis kernels need.
-    validate : run :func:`grainview.validation.validate` before returning.
+        A netCDF file of the data contract (docs/schema.md).
+    chunks : int, "auto", dict or None, default "auto"
+        Snapshots per dask chunk, ``"auto"`` (see :func:`time_chunks`), ``{"time": k}``, or
+        ``None`` for eager numpy arrays. Only ``time`` is ever chunked: ``particle`` and
+        ``contact`` stay whole in each chunk, as the analysis kernels need.
+    validate : bool, default False
+        Run :func:`grainview.validation.validate` (every value) before returning.
 
-    The file is opened read-only and never modified. Trailing snapshots whose ``time`` is
-    missing or whose ``complete`` flag is not set (a writer killed mid-snapshot) are dropped;
-    a netCDF-3 file shorter than its header says raises :class:`FileFormatError`.
+    Returns
+    -------
+    xarray.Dataset
+        The file's complete snapshots, with the ``ds.grain`` accessor.
+
+    Raises
+    ------
+    FileFormatError
+        No such file, not a readable netCDF file, a netCDF-3 file shorter than its header
+        says, or an incomplete snapshot before complete ones (a damaged file).
+    SchemaError
+        A schema version newer than this grainview's, or (with ``validate``) any fault.
     """
     source = os.fspath(path)
     if not os.path.exists(source):

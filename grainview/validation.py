@@ -122,7 +122,25 @@ def validate(ds: xr.Dataset, source: str | None = None) -> xr.Dataset:
     positions; ``contact_count`` within the slots; in occupied slots: ids in range and
     ``i < j`` for particle pairs, each pair at most once per snapshot, kind 1 or 2, finite
     forces, points and branches, unit normals; a box of positive size; every variable's
-    ``units`` those of the contract. Returns ``ds`` unchanged so calls can be chained.
+    ``units`` those of the contract. On a dask-backed dataset the value checks are computed
+    in one pass over the chunks.
+
+    Parameters
+    ----------
+    ds : xarray.Dataset
+        A dataset of the contract (docs/schema.md), eager or chunked along ``time``.
+    source : str, optional
+        The file name to put in the error (default: ``ds.encoding["source"]``).
+
+    Returns
+    -------
+    xarray.Dataset
+        ``ds`` unchanged, so that calls can be chained.
+
+    Raises
+    ------
+    SchemaError
+        Every problem found, listed together.
     """
     source = source or (ds.encoding.get("source") if isinstance(ds, xr.Dataset) else None)
     check_structure(ds, source)  # values cannot be checked reliably on a malformed structure

@@ -162,9 +162,50 @@ class SnapshotWriter:
     def create(cls, path, *, radius, n_vertices, mass, inertia, n_walls=0, wall_names=None,
                wall_normal=None, optional=(),
                attrs=None, n_contact_slots=None, overwrite=False, format=APPEND_FORMAT):
-        """Create ``path`` with the static particle data; ``optional`` names the optional
-        per-snapshot variables this file will hold (e.g. ``("velocity", *DIAGNOSTICS)``);
-        the others are not written at all."""
+        """Create ``path`` with the static particle data, ready for :meth:`append`.
+
+        Parameters
+        ----------
+        path : str or path-like
+            The file to create (its folder must exist).
+        radius, mass, inertia : array_like, (N,)
+            Circumscribed radii (m), masses (kg) and moments of inertia (kg m2).
+        n_vertices : array_like, (N,)
+            0 for a disk, n >= 3 for a regular n-gon.
+        n_walls : int, default 0
+            Number of walls (bodies N, N+1, ...).
+        wall_names : sequence of str, optional
+            One name per wall (default: bottom, right, top, left).
+        wall_normal : array_like, (n_walls, 2), optional
+            The walls' inward unit normals, written as ``wall_normal``.
+        optional : sequence of str
+            The optional per-snapshot variables this file will hold (e.g.
+            ``("velocity", *DIAGNOSTICS)``); the others are not written at all.
+        attrs : dict, optional
+            Global attributes added to the contract's.
+        n_contact_slots : int, optional
+            Size of the ``contact`` dimension (default: :func:`grainview.schema.contact_slots`).
+        overwrite : bool, default False
+            Replace an existing ``path`` (refused while another process writes it).
+        format : str, default :data:`APPEND_FORMAT`
+            The netCDF format (netCDF-3, appended in place).
+
+        Returns
+        -------
+        SnapshotWriter
+            Holding the file open and its writer's lock (:mod:`grainview.locks`).
+
+        Raises
+        ------
+        FileExistsError
+            ``path`` exists and ``overwrite`` is False.
+        FileNotFoundError
+            The folder does not exist.
+        grainview.locks.FileLockedError
+            Another process is writing ``path``.
+        ParameterError
+            An unknown optional variable.
+        """
         import netCDF4
 
         path = os.fspath(path)
@@ -276,9 +317,32 @@ class SnapshotWriter:
         return int(complete[-1] + 1) if complete.size else 0
 
     def append(self, **snapshot):
-        """Write one snapshot (:meth:`_append`'s arguments). An I/O failure (a full disk) raises
-        :class:`grainview.errors.OutputError` in one line; the snapshot is not marked complete,
-        so the file keeps the snapshots before it, readable and resumable."""
+        """Write one snapshot and sync it to disk, ``complete`` last.
+
+        Parameters
+        ----------
+        time : float
+            Simulated time, s.
+        position : array_like, (N, 2)
+            Particle centres, m.
+        angle : array_like, (N,)
+            Particle angles, rad.
+        contacts : dict
+            The contact variables (``i, j, kind, normal, fn, ft, point, branch`` and optionally
+            ``gap``), one entry per contact, at most the file's number of slots.
+        box_min, box_max : array_like, (2,)
+            Corners of the sample box, m.
+        **optional
+            Values of the optional variables the file holds (``velocity``, ``wall_force``...).
+
+        Raises
+        ------
+        OutputError
+            An I/O failure (a full disk), in one line; the snapshot is not marked complete,
+            so the file keeps the snapshots before it, readable and resumable.
+        ParameterError
+            More contacts than slots, or an unknown variable.
+        """
         k = self.n_snapshots
         try:
             self._append(**snapshot)
