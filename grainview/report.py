@@ -281,10 +281,15 @@ def write_figures(runs: dict, out: Path, time=-1, residual_strain: float = RESID
                 kwargs["time"] = time
             elif number in DISTRIBUTION_FIGURES:
                 kwargs["time"] = Residual(residual_strain)
+            rule = None
+            if number == "16":
+                kwargs["near"], rule = xi_contacts(data)
             result = func(data if number not in MAP_FIGURES else next(iter(data.values())), **kwargs)
             fig = result if hasattr(result, "savefig") else result.figure
             what = "map" if number in MAP_FIGURES else "distribution" if number in DISTRIBUTION_FIGURES else "evolution"
             lines = [caption(label, ds, what, residual_strain, time) for label, ds in data.items()]
+            if rule is not None:
+                lines.append(rule)
             add_caption(fig, lines)
             if captions is not None:
                 captions[stem] = lines
@@ -294,6 +299,27 @@ def write_figures(runs: dict, out: Path, time=-1, residual_strain: float = RESID
             plt.close(fig)
             written += [out / f"{stem}.png", out / f"{stem}.pdf"]
     return written
+
+
+def xi_contacts(runs: dict):
+    """The contacts of the xi-network's fabric (Fig. 16) and the caption line that says so.
+
+    When every run holds its near pairs, those within :data:`NEAR_FRACTION` of the smallest
+    diameter are counted with the force-bearing contacts, as a code that keeps its alert-distance
+    pairs counts them (docs/fidelity.md, section 5). Counted on their own, the force-bearing
+    contacts include pairs just closing along the compression axis with forces far below the
+    solver's resolution, which lift a'(xi) at the smallest cutoffs (docs/analysis.md).
+    Returns ``(near, line)``: the gap in m (None: force-bearing only) and the caption line."""
+    from .contacts import check_near
+
+    gap = NEAR_FRACTION * 2.0 * min(float(ds["radius"].min()) for ds in runs.values())
+    try:
+        for ds in runs.values():
+            check_near(ds, gap)
+    except ParameterError:
+        return None, "contacts: force-bearing only (f_n > 0; the files hold no near pairs)"
+    return gap, (f"contacts: force-bearing and the pairs within {gap * 1e3:.2g} mm "
+                 f"({NEAR_FRACTION:g} of the smallest diameter), which carry no force")
 
 
 def write_report(runs: dict, out, residual_strain: float = RESIDUAL_STRAIN, overwrite: bool = False,

@@ -735,7 +735,7 @@ def plot_force_pdfs_by_kind(data, label=None, **kw):
 
 # -- Figs. 15, 16: the xi-network --------------------------------------------------------------
 
-def xi_profile(ds: xr.Dataset, xi=None, time="residual") -> xr.Dataset:
+def xi_profile(ds: xr.Dataset, xi=None, time="residual", near=None) -> xr.Dataset:
     """q(xi)/p, a'(xi) and the contact fraction of the xi-network, averaged over the snapshots ``time``.
 
     The xi-network holds the contacts with f_n < xi <f_n> (docs/conventions.md §5;
@@ -752,6 +752,10 @@ def xi_profile(ds: xr.Dataset, xi=None, time="residual") -> xr.Dataset:
         ``"residual"`` the residual state, eps_q >= 0.3 (for a run that stops short of it, the
         last part of the run), ``"all"`` or None every snapshot, a snapshot index, a slice or a
         sequence of indices.
+    near : float, optional
+        None: the force-bearing contacts (f_n > 0); a gap in m: also the pairs within it,
+        which carry no force and so belong to every xi-network (the file must hold them;
+        :func:`grainview.contacts.in_network`).
 
     Returns
     -------
@@ -766,8 +770,8 @@ def xi_profile(ds: xr.Dataset, xi=None, time="residual") -> xr.Dataset:
     """
     from ..xi_network import xi_network
     subset = select_snapshots(ds, time)
-    result = xi_network(subset) if xi is None else xi_network(subset, xi=np.asarray(xi, float))
-    return result.mean("time", keep_attrs=True).compute()
+    cutoffs = {} if xi is None else {"xi": np.asarray(xi, float)}
+    return xi_network(subset, near=near, **cutoffs).mean("time", keep_attrs=True).compute()
 
 
 def plot_xi_stress(data, ax=None, label=None, xi=None, time="residual", min_contacts: float = 10, **line_kw):
@@ -814,7 +818,7 @@ def plot_xi_stress(data, ax=None, label=None, xi=None, time="residual", min_cont
 
 
 def plot_xi_anisotropy(data, ax=None, label=None, xi=None, time="residual", min_contacts: float = 10,
-                       **line_kw):
+                       near=None, inset: bool = True, **line_kw):
     """Partial fabric anisotropy a'(xi) of the contacts f_n < xi <f_n> against the cutoff xi (paper Fig. 16).
 
     a'(xi) is signed against the whole sample's major stress direction (docs/conventions.md §5;
@@ -842,6 +846,12 @@ def plot_xi_anisotropy(data, ax=None, label=None, xi=None, time="residual", min_
         sequence of indices.
     min_contacts : float, default 10
         Cutoffs whose network holds fewer contacts per snapshot on average are not drawn.
+    near : float, optional
+        None: the force-bearing contacts (f_n > 0); a gap in m: also the pairs within it
+        (:func:`xi_profile`). The report counts the near pairs when the files hold them.
+    inset : bool, default True
+        Draw the paper's inset: a'(xi) for 0.01 <= xi <= 1 on a logarithmic axis, where the
+        very weak forces are.
     **line_kw
         Keyword arguments of ``matplotlib.axes.Axes.plot``.
 
@@ -853,15 +863,28 @@ def plot_xi_anisotropy(data, ax=None, label=None, xi=None, time="residual", min_
     References
     ----------
     Azéma, Radjai, Peyroux & Saussine, Phys. Rev. E 76, 011301 (2007),
-    Sec. V.C and Fig. 16; docs/conventions.md §5.
+    Sec. V.C and Fig. 16 (with its inset); docs/conventions.md §5.
     """
-    return _xi(data, ax, label, xi, time, "a_prime", r"$a'(\xi)$", min_contacts, line_kw)
+    ax = _xi(data, ax, label, xi, time, "a_prime", r"$a'(\xi)$", min_contacts, line_kw, near)
+    ax.axhline(0.0, color="0.6", linewidth=0.8, zorder=0)  # a' > 0 along the major stress, < 0 across it
+    if inset:  # the paper's inset: the weakest forces, on a logarithmic xi axis
+        small = ax.inset_axes([0.07, 0.62, 0.3, 0.26])  # upper left: a'(xi) rises from there
+        _xi(data, small, label, np.geomspace(1e-2, 1.0, 13), time, "a_prime", None, min_contacts, {}, near)
+        small.set_xscale("log")
+        small.axhline(0.0, color="0.6", linewidth=0.8, zorder=0)
+        small.tick_params(labelsize="x-small")
+        small.set_xlabel("")
+        if small.get_legend() is not None:
+            small.get_legend().remove()
+        if ax.get_legend() is not None:
+            ax.legend(loc="lower right")
+    return ax
 
 
-def _xi(data, ax, label, xi, time, name, ylabel, min_contacts, line_kw):
+def _xi(data, ax, label, xi, time, name, ylabel, min_contacts, line_kw, near=None):
     ax = get_axes(ax)
     for lab, ds in datasets(data, label):
-        prof = xi_profile(ds, xi, time)
+        prof = xi_profile(ds, xi, time, near)
         keep = values(prof["count"]) >= min_contacts
         ax.plot(np.asarray(prof["xi"].values, float)[keep], values(prof[name])[keep], "o-", markersize=3,
                 color=next_colour(ax), label=lab, **line_kw)

@@ -507,3 +507,49 @@ def test_dask_backed_dataset_draws_the_same_numbers(series):
     np.testing.assert_allclose(ax.lines[1].get_ydata(), harmonic_prediction(series)["prediction"].values)
     ax = gp.plot_force_chains(lazy, particles=False)
     assert len(contact_collection(ax).get_segments()) == int(series["contact_count"][-1])
+
+
+def _with_near_pairs(ds, near_m=1e-3, n_near=40, seed=5):
+    """``ds`` with ``n_near`` of its contacts per snapshot turned into unloaded near pairs
+    (f_n = f_t = 0, gap 0.5 near_m, normals along x) and the others touching (gap 0), and the
+    file's attribute saying pairs within ``near_m`` are written."""
+    rng = np.random.default_rng(seed)
+    ds = ds.copy(deep=True)
+    count = ds["contact_count"].values
+    fn, ft, normal = ds["fn"].values, ds["ft"].values, ds["normal"].values
+    gap = np.where(np.arange(fn.shape[1])[None, :] < count[:, None], 0.0, np.nan)
+    for k in range(fn.shape[0]):
+        pick = rng.choice(count[k], n_near, replace=False)
+        fn[k, pick] = ft[k, pick] = 0.0
+        normal[k, pick] = (1.0, 0.0)
+        gap[k, pick] = 0.5 * near_m
+    ds["fn"].values, ds["ft"].values, ds["normal"].values = fn, ft, normal
+    ds["gap"] = (("time", "contact"), gap, {"units": "m"})
+    ds.attrs["near_contacts_m"] = near_m
+    return ds
+
+
+def test_xi_anisotropy_counts_near_pairs_when_asked_and_draws_the_papers_inset(series):
+    from grainview.xi_network import xi_network
+
+    near = _with_near_pairs(series)
+    xi = np.array([0.1, 0.5, 1.0, 2.0])
+    ax = gp.plot_xi_anisotropy(near, xi=xi, near=1e-3, min_contacts=0)
+    want = xi_network(select_snapshots(near, "residual"), xi=xi, near=1e-3)
+    np.testing.assert_allclose(ax.lines[0].get_ydata(), want["a_prime"].mean("time").values)
+    force_bearing = xi_network(select_snapshots(near, "residual"), xi=xi)["a_prime"].mean("time").values
+    assert not np.allclose(want["a_prime"].mean("time").values, force_bearing)  # the pairs change a'(xi)
+    (inset,) = ax.child_axes
+    assert inset.get_xscale() == "log" and inset.get_xlim()[0] < 0.011 and inset.get_xlim()[1] > 0.9
+    assert not gp.plot_xi_anisotropy(near, xi=xi, inset=False).child_axes
+
+
+def test_the_report_counts_near_pairs_in_fig16_only_when_every_file_holds_them(series):
+    from grainview.report import NEAR_FRACTION, xi_contacts
+
+    near = _with_near_pairs(series, near_m=1.0)
+    gap, line = xi_contacts({"a": near, "b": near})
+    assert gap == pytest.approx(NEAR_FRACTION * 2 * float(series["radius"].min()))
+    assert f"pairs within {gap * 1e3:.2g} mm" in line
+    gap, line = xi_contacts({"a": near, "b": series})  # one file without near pairs: none counted
+    assert gap is None and "force-bearing only" in line
