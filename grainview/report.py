@@ -209,9 +209,11 @@ def write_table(table: pd.DataFrame, out: Path) -> list[Path]:
 
 POLYGON_FIGURES = ("18", "19", "20", "21", "22", "23", "24", "25")
 """Figures about simple versus double contacts (paper Sec. VI): drawn for polygon runs only."""
-MAP_FIGURES = ("13", "17", "21", "24")
+MAP_FIGURES = ("13", "17", "24")
+"""Maps of one snapshot (the report's ``time``, default the last) of one sample."""
+PER_RUN_FIGURES = MAP_FIGURES + ("21",)
 """Figures that draw one sample per call: one file per run."""
-DISTRIBUTION_FIGURES = ("07", "08", "10", "14", "15", "16", "23")
+DISTRIBUTION_FIGURES = ("07", "08", "10", "14", "15", "16", "21", "23")
 """Figures that average distributions over the residual state (their ``time`` argument)."""
 
 FIGURE_NAMES = {
@@ -242,7 +244,8 @@ def caption(label: str, ds: xr.Dataset, what: str, residual_strain: float = RESI
     preparation = ds.attrs.get("preparation_name", "unknown")
     eps_q = strains(ds)["eps_q"]
     if what == "map":
-        shown = f"snapshot {time} (eps_q = {float(eps_q.isel(time=time)):.3f})"
+        index = time % ds.sizes["time"] if isinstance(time, (int, np.integer)) else time
+        shown = f"snapshot {index} of {ds.sizes['time']} (eps_q = {float(eps_q.isel(time=time)):.3f})"
     elif what == "distribution":
         shown = f"averaged over the {residual_snapshots(ds, residual_strain).attrs['window']}"
     else:
@@ -274,7 +277,7 @@ def write_figures(runs: dict, out: Path, time=-1, residual_strain: float = RESID
             continue
         name = f"fig{number}_{FIGURE_NAMES[number]}"
         targets = ([(f"{name}_{_slug(label)}", {label: ds}) for label, ds in chosen.items()]
-                   if number in MAP_FIGURES else [(name, chosen)])
+                   if number in PER_RUN_FIGURES else [(name, chosen)])
         for stem, data in targets:
             kwargs = {}
             if number in MAP_FIGURES:
@@ -284,7 +287,9 @@ def write_figures(runs: dict, out: Path, time=-1, residual_strain: float = RESID
             rule = None
             if number == "16":
                 kwargs["near"], rule = xi_contacts(data)
-            result = func(data if number not in MAP_FIGURES else next(iter(data.values())), **kwargs)
+            if number == "13":  # the maps of every run on one width scale, so that they compare
+                kwargs["force_scale"], rule = common_force_scale(chosen, time)
+            result = func(data if number not in PER_RUN_FIGURES else next(iter(data.values())), **kwargs)
             fig = result if hasattr(result, "savefig") else result.figure
             what = "map" if number in MAP_FIGURES else "distribution" if number in DISTRIBUTION_FIGURES else "evolution"
             lines = [caption(label, ds, what, residual_strain, time) for label, ds in data.items()]
@@ -299,6 +304,22 @@ def write_figures(runs: dict, out: Path, time=-1, residual_strain: float = RESID
             plt.close(fig)
             written += [out / f"{stem}.png", out / f"{stem}.pdf"]
     return written
+
+
+def common_force_scale(runs: dict, time=-1):
+    """The force (N) drawn at the widest line in every run's force-chain map (Fig. 13): the
+    largest particle–particle normal force of snapshot ``time`` over all runs, so that equal
+    widths mean equal forces from one map to the next. Returns ``(force, caption line)``."""
+    from .contacts import selection
+    from .plot.maps import newtons
+
+    largest = 0.0
+    for ds in runs.values():
+        snap = ds.isel(time=time)
+        fn = snap["fn"].where(selection(snap)).max()
+        largest = max(largest, float(fn) if np.isfinite(float(fn)) else 0.0)
+    names = ", ".join(runs)
+    return largest, f"line widths on one scale for {names}: the widest line is {newtons(largest)}"
 
 
 def xi_contacts(runs: dict):

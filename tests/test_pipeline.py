@@ -8,7 +8,7 @@ import pytest
 import grainview
 from grainview.cli import main
 from grainview.plot import FIGURES
-from grainview.report import FIGURE_NAMES, MAP_FIGURES, NOT_REACHED, POLYGON_FIGURES
+from grainview.report import FIGURE_NAMES, NOT_REACHED, PER_RUN_FIGURES, POLYGON_FIGURES
 from grainview.strain import residual_window
 
 WINDOW = 0.003
@@ -28,7 +28,7 @@ def test_every_figure_file_exists(study):
     for number in FIGURES:
         labels = ["pentagons"] if number in POLYGON_FIGURES else ["pentagons", "disks"]
         stems = ([f"fig{number}_{FIGURE_NAMES[number]}_{label}" for label in labels]
-                 if number in MAP_FIGURES else [f"fig{number}_{FIGURE_NAMES[number]}"])
+                 if number in PER_RUN_FIGURES else [f"fig{number}_{FIGURE_NAMES[number]}"])
         for stem in stems:
             for suffix in (".png", ".pdf"):
                 path = figures / (stem + suffix)

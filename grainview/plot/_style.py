@@ -155,6 +155,17 @@ def get_axes(ax=None, polar: bool = False):
     return ax
 
 
+def tidy_polar(ax):
+    """Three radial ticks, in small type, along the 135 degree ray (between the lobes of a
+    distribution elongated along 0 or 90 degrees), so that their labels stay readable."""
+    from matplotlib.ticker import MaxNLocator
+
+    ax.yaxis.set_major_locator(MaxNLocator(3))
+    ax.set_rlabel_position(135)
+    ax.tick_params(axis="y", labelsize="x-small")
+    return ax
+
+
 def new_figure(n_panels: int, polar=False, width: float = 4.5, height: float = 3.6):
     """A figure with ``n_panels`` axes side by side, marked (a), (b), ...; ``polar`` is one
     flag for all panels or one per panel. Returns (figure, list of axes)."""
@@ -284,6 +295,9 @@ def add_caption(fig, lines) -> None:
 # -- evolutions --------------------------------------------------------------------------------
 
 LINESTYLES = ("-", "--", ":", "-.")
+CURVE_MARKERS = ("o", "s", "^", "D")
+"""Markers that tell apart the curves of one sample when several samples share the axes (the
+samples differ by colour): dashes alone are lost where noisy curves cross."""
 
 
 def next_colour(ax) -> str:
@@ -300,19 +314,27 @@ def draw_evolutions(ax, pairs, compute, curves, marker: str = "", **line_kw):
     """One line per (dataset, curve) against eps_q.
 
     ``compute(ds)`` returns a Dataset (or a DataArray) over time; ``curves`` lists
-    ``(curve_label, variable_name)`` of it (a name None takes the DataArray itself). The curves
-    of one sample share its colour and differ by line style; samples differ by colour.
-    Returns the drawn DataArrays (computed), in drawing order.
+    ``(curve_label, variable_name)`` of it (a name None takes the DataArray itself). One sample
+    with several curves: a colour and a line style per curve. Several samples: a colour per
+    sample, and per curve a line style and a marker (:data:`CURVE_MARKERS`, on about a dozen
+    points of each line). Returns the drawn DataArrays (computed), in drawing order.
     """
     drawn = []
     given = line_kw.pop("color", None)
+    several = len(pairs) > 1 and len(curves) > 1
     for label, ds in pairs:
         x = eps_q(ds)
         result = compute(ds).compute()
         colour = given if given is not None and len(pairs) == 1 else next_colour(ax)
         for k, (curve_label, name) in enumerate(curves):
             y = result if name is None else result[name]
-            ax.plot(x, values(y), LINESTYLES[k % len(LINESTYLES)], marker=marker, color=colour,
-                    label=series_label(label, curve_label), **line_kw)
+            style = dict(marker=marker, color=colour)
+            if several:
+                style.update(marker=CURVE_MARKERS[k % len(CURVE_MARKERS)], markersize=3.5,
+                             markevery=max(1, len(x) // 12))
+            elif len(curves) > 1 and k > 0 and given is None:
+                style["color"] = next_colour(ax)
+            ax.plot(x, values(y), LINESTYLES[k % len(LINESTYLES)], label=series_label(label, curve_label),
+                    **style, **line_kw)
             drawn.append(y)
     return drawn

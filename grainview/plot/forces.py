@@ -16,7 +16,8 @@ import xarray as xr
 from ..errors import ParameterError
 from ..forces import angular_force_averages, force_anisotropies
 from ._style import (EPS_Q_LABEL, axis_label, datasets, draw_evolutions, finish, get_axes, new_figure,
-                     next_colour, select_snapshots, series_label, set_labels, time_mean, units_of, values)
+                     next_colour, select_snapshots, series_label, set_labels, tidy_polar, time_mean, units_of,
+                     values)
 from .texture import full_turn
 
 FORCE_RATIO_LABEL = r"$f_n/\langle f_n\rangle$"
@@ -192,6 +193,7 @@ def _polar(data, ax, label, component, symbol, time, bins, kind, walls, normalis
         r = np.abs(r) if component == "ft" else r
         theta, r = full_turn(profile["theta"].values, r)
         ax.plot(theta, r, color=next_colour(ax), label=lab, **line_kw)
+    tidy_polar(ax)
     ax.set_xlabel(axis_label(r"$\theta$", "rad"))
     title = "$" + symbol + (r"/\langle f_n\rangle" if normalise else "") + "$"
     return finish(ax, None, title=axis_label(title, units_of(profile)))
@@ -286,6 +288,8 @@ def plot_angular_forces(data, label=None, **kw):
     fig, (ax_n, ax_t) = new_figure(2, polar=[True, False])
     plot_normal_force_polar(data, ax_n, label, **kw)
     plot_tangential_force(data, ax_t, label, **kw)
+    # the paper draws |<f_t>| in polar axes; a radius cannot carry the sign, these axes do
+    ax_t.set_title(ax_t.get_title() + "\n(Cartesian axes: the sign is kept)", fontsize="small")
     return fig
 
 
@@ -539,13 +543,16 @@ def plot_force_pdf(data, ax=None, label=None, scale: str = "log-linear", time="r
     """
     from ..force_pdf import strong_force_exponent
     ax = get_axes(ax)
+    outside = []
     for lab, ds in datasets(data, label):
         pdf = force_pdf_of(ds, scale, time, bins, range, kind, walls)
         _draw_pdf(ax, pdf, lab, next_colour(ax), line_kw)
+        outside.append((lab, pdf))
         if fit and scale == "log-linear":
             alpha = float(strong_force_exponent(pdf))
             _draw_fit(ax, pdf, alpha, lab, ax.lines[-1].get_color())
     _pdf_axes(ax, scale)
+    _outside_note(ax, outside)
     return finish(ax, None)
 
 
@@ -692,13 +699,27 @@ def plot_force_pdf_by_kind(data, ax=None, label=None, scale: str = "log-linear",
     Sec. V.B and Fig. 23.
     """
     ax = get_axes(ax)
+    outside = []
     for lab, ds in datasets(data, label):
         colour = next_colour(ax)
         for kind, name, style in (("simple", "s", "o-"), ("double", "d", "s--")):
             pdf = force_pdf_of(ds, scale, time, bins, range, kind, walls)
             _draw_pdf(ax, pdf, series_label(lab, name), colour, line_kw, style)
+            outside.append((series_label(lab, name), pdf))
     _pdf_axes(ax, scale)
+    ax.set_ylabel("$P$ (each kind normalised to 1)")
+    _outside_note(ax, outside)
     return finish(ax, None)
+
+
+def _outside_note(ax, pdfs):
+    """Say in the panel which share of the contacts lies outside its force range (a pdf's
+    ``outside_fraction``; e.g. the forces below the log axis's first bin), per curve."""
+    notes = [f"{float(pdf['outside_fraction']):.1%}" + (f" ({lab})" if lab else "")
+             for lab, pdf in pdfs if "outside_fraction" in pdf and float(pdf["outside_fraction"]) > 0]
+    if notes:
+        ax.text(0.02, 0.02, "outside the axis: " + ", ".join(notes), transform=ax.transAxes,
+                fontsize="x-small", va="bottom", ha="left", color="0.3")
 
 
 def plot_force_pdfs_by_kind(data, label=None, **kw):

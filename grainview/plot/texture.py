@@ -14,7 +14,7 @@ import xarray as xr
 from ..connectivity import connectivity_pdf, coordination, joint_connectivity_pdf
 from ..fabric import fabric_anisotropy, orientation_pdf
 from ._style import (EPS_Q_LABEL, axis_label, datasets, draw_evolutions, finish, get_axes,
-                     next_colour, select_snapshots, set_labels, single_dataset, time_mean, units_of,
+                     next_colour, tidy_polar, select_snapshots, set_labels, single_dataset, time_mean, units_of,
                      values)
 
 
@@ -97,7 +97,8 @@ def plot_persistence(data, ax=None, label=None, reference: int = 0, **line_kw):
     ax = get_axes(ax)
     draw_evolutions(ax, datasets(data, label), lambda ds: persistence(ds, reference=reference), [(None, None)],
                     **line_kw)
-    set_labels(ax, EPS_Q_LABEL, r"$\gamma$")
+    which = "the first snapshot's" if reference == 0 else f"snapshot {reference}'s"
+    set_labels(ax, EPS_Q_LABEL, rf"$\gamma$: share of {which} contacts present")
     return finish(ax, None)
 
 
@@ -197,6 +198,7 @@ def plot_orientation_pdf(data, ax=None, label=None, time="residual", bins: int =
         pdf = time_mean(orientation_pdf(select_snapshots(ds, time), bins=bins, kind=kind, walls=walls))
         theta, r = full_turn(pdf["theta"].values, values(pdf))
         ax.plot(theta, r, color=next_colour(ax), label=lab, **line_kw)
+    tidy_polar(ax)
     ax.set_xlabel(axis_label(r"$\theta$", "rad"))
     return finish(ax, None, title=axis_label(r"$P(\theta)$", units_of(pdf)))
 

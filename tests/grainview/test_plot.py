@@ -457,7 +457,7 @@ def test_persistence_and_transitions():
     gamma = persistence.persistence(ds).values
     np.testing.assert_allclose(ax.lines[0].get_ydata(), gamma)
     assert gamma[0] == 1.0 and gamma[-1] < 1.0
-    assert ax.get_ylabel() == r"$\gamma$"
+    assert ax.get_ylabel() == r"$\gamma$: share of the first snapshot's contacts present"
     ax = gp.plot_type_transitions(ds)
     want = persistence.type_transitions(ds)
     np.testing.assert_allclose(ax.lines[0].get_ydata(), want["delta_gamma_s_to_d"].values)
