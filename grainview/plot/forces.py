@@ -715,11 +715,12 @@ def plot_force_pdf_by_kind(data, ax=None, label=None, scale: str = "log-linear",
 def _outside_note(ax, pdfs):
     """Say in the panel which share of the contacts lies outside its force range (a pdf's
     ``outside_fraction``; e.g. the forces below the log axis's first bin), per curve."""
-    notes = [f"{float(pdf['outside_fraction']):.1%}" + (f" ({lab})" if lab else "")
+    notes = [f"{100 * float(pdf['outside_fraction']):.2g}%" + (f" ({lab})" if lab else "")
              for lab, pdf in pdfs if "outside_fraction" in pdf and float(pdf["outside_fraction"]) > 0]
     if notes:
-        ax.text(0.02, 0.02, "outside the axis: " + ", ".join(notes), transform=ax.transAxes,
-                fontsize="x-small", va="bottom", ha="left", color="0.3")
+        edges = pdfs[0][1]["bin_edges"].values
+        ax.text(0.02, 0.02, f"outside {edges[0]:g}-{edges[-1]:g} " + r"$\langle f_n\rangle$: " + ", ".join(notes),
+                transform=ax.transAxes, fontsize="x-small", va="bottom", ha="left", color="0.3")
 
 
 def plot_force_pdfs_by_kind(data, label=None, **kw):

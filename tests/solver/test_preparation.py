@@ -73,6 +73,8 @@ def test_frictionless_compaction_is_denser_and_the_test_gets_its_friction_back()
 
 def test_presets_and_attributes():
     assert PRESETS["paper"] == Preparation()
+    from dataclasses import replace
+    assert PRESETS["fast"] == replace(Preparation(), max_wall_speed=0.2)  # only the walls' speed cap differs
     prep = preparation("frictionless", particles=100, seed=4)
     assert prep.compaction_friction == 0.0 and prep.particles == 100 and prep.seed == 4
     attrs = prep.attrs()
