@@ -910,6 +910,7 @@ def _xi(data, ax, label, xi, time, name, ylabel, min_contacts, line_kw, near=Non
         keep = values(prof["count"]) >= min_contacts
         ax.plot(np.asarray(prof["xi"].values, float)[keep], values(prof[name])[keep], "o-", markersize=3,
                 color=next_colour(ax), label=lab, **line_kw)
+    ax.axvline(1.0, color="0.6", linewidth=0.8, linestyle=":", zorder=0)  # xi = 1: the mean force
     set_labels(ax, XI_LABEL, ylabel)
     return finish(ax, None)
 

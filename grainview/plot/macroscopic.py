@@ -142,6 +142,7 @@ def plot_stress_dilatancy(data, ax=None, label=None, incremental: bool = False, 
             ends = np.array([np.nanmin(phi), np.nanmax(phi)])
             ax.plot(ends, ends - phi_0, "--", color=colour, linewidth=1,
                     label=series_label(lab, rf"$\varphi = \varphi_0 + \psi$, $\varphi_0$ = {phi_0:.2f} rad"))
+    ax.axline((0.0, 0.0), slope=1.0, color="0.6", linewidth=0.8, zorder=0)  # phi = psi, the reference
     set_labels(ax, axis_label(r"$\varphi$", angles["phi"].attrs["units"]),
                axis_label(r"$\psi$", angles[name].attrs["units"]))
     return finish(ax, None)

@@ -146,6 +146,7 @@ def plot_connectivity_pdf(data, ax=None, label=None, time="residual", max_c: int
     for lab, ds in datasets(data, label):
         pdf = time_mean(connectivity_pdf(select_snapshots(ds, time), max_c=max_c, walls=walls)).sel(c=slice(1, None))
         ax.plot(pdf["c"].values, values(pdf), "o", linestyle="none", color=next_colour(ax), label=lab, **line_kw)
+    ax.set_xticks(np.arange(1, max_c + 1))  # c is an integer: every value labelled
     set_labels(ax, "$c$", "$P(c)$")
     return finish(ax, None)
 
