@@ -209,15 +209,16 @@ def write_table(table: pd.DataFrame, out: Path) -> list[Path]:
 
 POLYGON_FIGURES = ("18", "19", "20", "21", "22", "23", "24", "25")
 """Figures about simple versus double contacts (paper Sec. VI): drawn for polygon runs only."""
-MAP_FIGURES = ("13", "17", "24")
-"""Maps of one snapshot (the report's ``time``, default the last) of one sample."""
+MAP_FIGURES = ("02", "13", "17", "24")
+"""Maps of one snapshot of one sample: the report's ``time`` (default the last); Fig. 2, the
+packing at the end of the isotropic compaction, the first snapshot."""
 PER_RUN_FIGURES = MAP_FIGURES + ("21",)
 """Figures that draw one sample per call: one file per run."""
 DISTRIBUTION_FIGURES = ("07", "08", "10", "14", "15", "16", "21", "23")
 """Figures that average distributions over the residual state (their ``time`` argument)."""
 
 FIGURE_NAMES = {
-    "03": "q_over_p", "04": "volumetric_strain", "05": "stress_dilatancy", "06a": "coordination",
+    "02": "packing", "03": "q_over_p", "04": "volumetric_strain", "05": "stress_dilatancy", "06a": "coordination",
     "06b": "persistence", "07": "connectivity", "08": "orientation_pdf", "09": "fabric_anisotropy",
     "10": "angular_forces", "11": "force_anisotropies", "12": "harmonic_prediction", "13": "force_chains",
     "14": "force_pdfs", "15": "xi_stress", "16": "xi_anisotropy", "17": "force_classes",
@@ -280,8 +281,9 @@ def write_figures(runs: dict, out: Path, time=-1, residual_strain: float = RESID
                    if number in PER_RUN_FIGURES else [(name, chosen)])
         for stem, data in targets:
             kwargs = {}
+            shown = 0 if number == "02" else time  # Fig. 2: the compacted sample, before the test
             if number in MAP_FIGURES:
-                kwargs["time"] = time
+                kwargs["time"] = shown
             elif number in DISTRIBUTION_FIGURES:
                 kwargs["time"] = Residual(residual_strain)
             rule = None
@@ -292,7 +294,7 @@ def write_figures(runs: dict, out: Path, time=-1, residual_strain: float = RESID
             result = func(data if number not in PER_RUN_FIGURES else next(iter(data.values())), **kwargs)
             fig = result if hasattr(result, "savefig") else result.figure
             what = "map" if number in MAP_FIGURES else "distribution" if number in DISTRIBUTION_FIGURES else "evolution"
-            lines = [caption(label, ds, what, residual_strain, time) for label, ds in data.items()]
+            lines = [caption(label, ds, what, residual_strain, shown) for label, ds in data.items()]
             if rule is not None:
                 lines.append(rule)
             add_caption(fig, lines)

@@ -61,7 +61,7 @@ from .texture import (plot_connectivity_pdf, plot_coordination, plot_fabric_anis
                       plot_persistence)
 
 FIGURES = {
-    "03": plot_q_over_p, "04": plot_volumetric_strain, "05": plot_stress_dilatancy,
+    "02": plot_particles, "03": plot_q_over_p, "04": plot_volumetric_strain, "05": plot_stress_dilatancy,
     "06a": plot_coordination, "06b": plot_persistence, "07": plot_connectivity_pdf,
     "08": plot_orientation_pdf, "09": plot_fabric_anisotropy, "10": plot_angular_forces,
     "11": plot_force_anisotropies, "12": plot_harmonic_prediction, "13": plot_force_chains,
@@ -70,8 +70,8 @@ FIGURES = {
     "21": plot_joint_connectivity, "22": plot_partial_fabric_anisotropy, "23": plot_force_pdfs_by_kind,
     "24": plot_contact_kinds, "25": plot_strong_weak_proportions,
 }
-"""Paper figure number -> the function drawing it. Maps (13, 17, 24) and the P(m_s, m_d) map
-(21) draw one sample per call; the others accept several."""
+"""Paper figure number -> the function drawing it. The packing (2), the maps (13, 17, 24) and
+the P(m_s, m_d) map (21) draw one sample per call; the others accept several."""
 
 
 def _delegate(func):
