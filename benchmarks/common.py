@@ -79,3 +79,24 @@ def markdown_table(header, rows) -> str:
     lines = ["| " + " | ".join(header) + " |", "|" + "---|" * len(header)]
     lines += ["| " + " | ".join(str(c) for c in row) + " |" for row in rows]
     return "\n".join(lines)
+
+
+def capture_contact_problems(sim, steps: int = 1) -> list:
+    """Step ``sim`` ``steps`` times and return each step's contact problem as the NLGS received
+    it: ``(problem, pn, pt, vx, vy, w, options)`` with copies of the warm-start impulses and the
+    free velocities, and the solver options (tolerances, sweep limit). The steps run as usual."""
+    from unittest import mock
+
+    from solver import nlgs
+
+    seen = []
+    solve = nlgs.solve_problem
+
+    def capture(problem, pn, pt, vx, vy, w, **options):
+        seen.append((problem, pn.copy(), pt.copy(), vx.copy(), vy.copy(), w.copy(), options))
+        return solve(problem, pn, pt, vx, vy, w, **options)
+
+    with mock.patch.object(nlgs, "solve_problem", capture):
+        for _ in range(steps):
+            sim.step()
+    return seen

@@ -27,7 +27,7 @@ HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, HERE)
 sys.path.insert(0, os.path.dirname(HERE))
 
-from common import in_fresh_process, machine_description, markdown_table  # noqa: E402
+from common import capture_contact_problems, in_fresh_process, machine_description, markdown_table  # noqa: E402
 
 RUNS = os.path.join(HERE, "_data", "fidelity", "runs")
 SAMPLES = os.path.join(HERE, "_data", "fidelity", "samples")
@@ -67,8 +67,6 @@ def _one_sweep(path, repeats):
     ``repeats`` times on the same arrays — the cost per sweep without the trajectories parting."""
     import time
     import warnings
-    from unittest import mock
-
     import numba
 
     from solver import load_sample, nlgs, parallel_nlgs
@@ -76,16 +74,7 @@ def _one_sweep(path, repeats):
     warnings.simplefilter("ignore")
     sim = load_sample(path, -1)
     sim.walls.drive_velocity("top", (0.0, -0.032))
-    seen = {}
-    solve = nlgs.solve_problem
-
-    def capture(problem, pn, pt, vx, vy, w, **options):
-        seen.setdefault("args", (problem, pn.copy(), pt.copy(), vx.copy(), vy.copy(), w.copy()))
-        return solve(problem, pn, pt, vx, vy, w, **options)
-
-    with mock.patch.object(nlgs, "solve_problem", capture):
-        sim.step()
-    problem, *state = seen["args"]
+    problem, *state, _ = capture_contact_problems(sim)[0]
     wnn, wnt, wtt = nlgs.delassus(problem.a, problem.b, problem.nx, problem.ny, problem.rax, problem.ray,
                                   problem.rbx, problem.rby, problem.minv_xx, problem.minv_xy, problem.minv_yy,
                                   problem.iinv)

@@ -38,8 +38,7 @@ def _morton(ij):
 
 def measure(n: int, shape: str, repeats: int = 200) -> dict:
     """ns per point-sweep of each order for ``n`` particles of ``shape``."""
-    from unittest import mock
-
+    from common import capture_contact_problems
     from solver import nlgs
     from solver.scenes import compaction_sample
 
@@ -47,16 +46,7 @@ def measure(n: int, shape: str, repeats: int = 200) -> dict:
     sim = compaction_sample(n, shape, seed=0)
     for _ in range(3):
         sim.step()
-    seen = {}
-    solve = nlgs.solve_problem
-
-    def capture(problem, pn, pt, vx, vy, w, **options):
-        seen.setdefault("args", (problem, pn.copy(), pt.copy(), vx.copy(), vy.copy(), w.copy()))
-        return solve(problem, pn, pt, vx, vy, w, **options)
-
-    with mock.patch.object(nlgs, "solve_problem", capture):
-        sim.step()
-    p, pn, pt, vx, vy, w = seen["args"]
+    p, pn, pt, vx, vy, w, _ = capture_contact_problems(sim)[0]
     m = p.a.size
 
     def per_sweep(perm):

@@ -14,7 +14,8 @@ import sys
 import warnings
 import numpy as np
 sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
-from unittest import mock
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from common import capture_contact_problems  # noqa: E402
 from solver import nlgs
 from solver.preparation import preparation, prepare_sample
 
@@ -27,14 +28,7 @@ def main():
     sim.walls.drive_velocity("top", (0.0, -0.01))
     for _ in range(300):
         sim.step()
-    problems = []
-    solve = nlgs.solve_problem
-    def capture(problem, pn, pt, vx, vy, w, **options):
-        problems.append((problem, pn.copy(), pt.copy(), vx.copy(), vy.copy(), w.copy(), options))
-        return solve(problem, pn, pt, vx, vy, w, **options)
-    with mock.patch.object(nlgs, "solve_problem", capture):
-        for _ in range(20):
-            sim.step()
+    problems = capture_contact_problems(sim, 20)
     for P, pn, pt, vx, vy, w, opt in problems[:20:4]:
         m = P.a.size
         wnn, wnt, wtt = nlgs.delassus(P.a, P.b, P.nx, P.ny, P.rax, P.ray, P.rbx, P.rby, P.minv_xx, P.minv_xy, P.minv_yy, P.iinv)
