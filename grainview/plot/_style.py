@@ -316,25 +316,30 @@ def draw_evolutions(ax, pairs, compute, curves, marker: str = "", **line_kw):
     ``compute(ds)`` returns a Dataset (or a DataArray) over time; ``curves`` lists
     ``(curve_label, variable_name)`` of it (a name None takes the DataArray itself). One sample
     with several curves: a colour and a line style per curve. Several samples: a colour per
-    sample, and per curve a line style and a marker (:data:`CURVE_MARKERS`, on about a dozen
-    points of each line). Returns the drawn DataArrays (computed), in drawing order.
+    sample and, with one curve each, a line style per sample (readable in grey print); with
+    several curves, per curve a line style and a marker (:data:`CURVE_MARKERS`, on about a
+    dozen points of each line). Returns the drawn DataArrays (computed), in drawing order.
     """
     drawn = []
     given = line_kw.pop("color", None)
     several = len(pairs) > 1 and len(curves) > 1
-    for label, ds in pairs:
+    for sample, (label, ds) in enumerate(pairs):
         x = eps_q(ds)
         result = compute(ds).compute()
         colour = given if given is not None and len(pairs) == 1 else next_colour(ax)
         for k, (curve_label, name) in enumerate(curves):
             y = result if name is None else result[name]
             style = dict(marker=marker, color=colour)
+            if len(pairs) > 1 and len(curves) == 1:  # samples by line style too: readable in grey print
+                style["linestyle"] = LINESTYLES[sample % len(LINESTYLES)]
             if several:
                 style.update(marker=CURVE_MARKERS[k % len(CURVE_MARKERS)], markersize=3.5,
                              markevery=max(1, len(x) // 12))
             elif len(curves) > 1 and k > 0 and given is None:
                 style["color"] = next_colour(ax)
-            ax.plot(x, values(y), LINESTYLES[k % len(LINESTYLES)], label=series_label(label, curve_label),
-                    **style, **line_kw)
+            style.setdefault("linestyle", LINESTYLES[k % len(LINESTYLES)])
+            if "linestyle" in line_kw or "ls" in line_kw:  # the caller's style wins
+                style.pop("linestyle")
+            ax.plot(x, values(y), label=series_label(label, curve_label), **style, **line_kw)
             drawn.append(y)
     return drawn

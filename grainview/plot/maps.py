@@ -24,10 +24,11 @@ from ._style import axis_label, get_axes, single_dataset, snapshot_index
 
 PARTICLE_FACE = "0.92"
 PARTICLE_EDGE = "0.55"
-CLASS_COLOURS = {1: "#56B4E9", 2: "#009E73", 3: "#D55E00"}
+CLASS_COLOURS = {1: "#0072B2", 2: "#009E73", 3: "#D55E00"}
 """Colours of the tricolor map, the paper's blue / green / red (Fig. 17) taken from the
 Okabe–Ito palette, which stays distinguishable with every common colour-vision deficiency: very
-weak (sky blue), weak (bluish green), strong (vermillion)."""
+weak (blue: the palette's sky blue has too little contrast on the light grey particles), weak
+(bluish green), strong (vermillion)."""
 KIND_COLOURS = {1: "#0072B2", 2: "#D55E00"}
 """Colours of the kind map (paper Fig. 24), Okabe–Ito: simple (blue), double (vermillion)."""
 
