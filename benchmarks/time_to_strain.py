@@ -2,13 +2,16 @@
 counts.
 
     python benchmarks/time_to_strain.py --measure pentagon,disk   # shear 1000 particles (~30 min)
+    python benchmarks/time_to_strain.py --measure pentagon --acceleration anderson   # the same shear,
+                                                                  # Anderson-accelerated sweeps
     python benchmarks/time_to_strain.py                           # the table from what was measured
 
 Measured, per shape, on 1000 particles in one process on one core: the compaction of the
 'paper' preparation (steps, seconds) and a whole biaxial test from that sample to eps_q = 0.4
 (top wall 1 cm/s, sigma0 = 10 kPa, dt = 5e-4 s, default tolerance): steps, NLGS sweeps per
-step (median, 90th percentile), contact points per particle, and microseconds per particle
-per step over the whole shear. Written to benchmarks/_data/time_to_strain/<shape>.json.
+step (median, 90th percentile), contact points per particle, the local-law residual of the
+steps (median, 90th percentile; solver.residuals) and microseconds per particle per step over
+the whole shear. Written to benchmarks/_data/time_to_strain/<shape>.json.
 
 Extrapolated to N = 4000 and 14,400, and to the paper's pair of samples (14,400 pentagons and
 10,000 disks side by side on two cores), with the assumptions the table states:
@@ -49,9 +52,10 @@ class TargetReached(Exception):
     """Raised by the timed step once eps_q reaches the target: ends the test there."""
 
 
-def measure(shape: str) -> dict:
+def measure(shape: str, acceleration: str = "off") -> dict:
     """Compact 1000 particles of ``shape`` ('paper' preparation) and shear them to eps_q = 0.4,
-    timing every step."""
+    timing every step; the shear's NLGS sweeps plain or Anderson-accelerated
+    (``acceleration``), the compaction always plain (the same sample either way)."""
     import solver
     from solver.preparation import prepare_sample, preparation
 
@@ -61,6 +65,8 @@ def measure(shape: str) -> dict:
         warnings.simplefilter("ignore")
         sim = prepare_sample(prep, progress=False)
     compaction_seconds = time.perf_counter() - start
+    sim.parameters.acceleration = acceleration
+    residuals = []
     lo, hi = sim.walls.box_bounds()
     h0, l0 = float(hi[1] - lo[1]), float(hi[0] - lo[0])
     sweeps, points, seconds = [], [], []
@@ -72,6 +78,7 @@ def measure(shape: str) -> dict:
         seconds.append(time.perf_counter() - t)
         sweeps.append(info.iterations)
         points.append(info.n_points)
+        residuals.append(info.local_law_residual)
         lo, hi = sim.walls.box_bounds()
         eps_q = np.log(h0 / float(hi[1] - lo[1])) - np.log(l0 / float(hi[0] - lo[0]))
         if eps_q >= TARGET_EPS_Q:
@@ -79,7 +86,7 @@ def measure(shape: str) -> dict:
         return info
 
     sim.step = timed_step
-    path = os.path.join(OUT, f"{shape}_shear.nc")
+    path = os.path.join(OUT, f"{shape}_{acceleration}_shear.nc")
     try:
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
@@ -90,7 +97,10 @@ def measure(shape: str) -> dict:
     eps_1 = float(np.log(h0 / float(hi[1] - lo[1])))
     os.remove(path)
     sweeps, seconds = np.array(sweeps), np.array(seconds)
-    return {"shape": shape, "particles": MEASURED_N, "compaction_steps": int(sim.compaction_steps),
+    return {"shape": shape, "acceleration": acceleration, "particles": MEASURED_N,
+            "compaction_steps": int(sim.compaction_steps),
+            "local_law_residual_median": float(np.median(residuals)),
+            "local_law_residual_p90": float(np.percentile(residuals, 90)),
             "compaction_seconds": compaction_seconds, "shear_steps": int(len(sweeps)), "eps_1_at_target": eps_1,
             "shear_seconds": float(seconds.sum()), "sweeps_median": float(np.median(sweeps)),
             "sweeps_p90": float(np.percentile(sweeps, 90)), "sweeps_mean": float(sweeps.mean()),
@@ -128,32 +138,38 @@ def table(results: dict) -> str:
 def main(argv=None):
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--measure", default="", help="shapes to measure now, comma-separated")
+    parser.add_argument("--acceleration", default="off", choices=("off", "anderson"),
+                        help="NLGS sweeps of the measured shear (the table extrapolates the plain ones)")
     args = parser.parse_args(argv)
     os.makedirs(OUT, exist_ok=True)
     for shape in filter(None, args.measure.split(",")):
-        result = measure(shape)
-        with open(os.path.join(OUT, f"{shape}.json"), "w") as fh:
+        result = measure(shape, args.acceleration)
+        suffix = "" if args.acceleration == "off" else f"_{args.acceleration}"
+        with open(os.path.join(OUT, f"{shape}{suffix}.json"), "w") as fh:
             json.dump(result, fh, indent=1)
         print(json.dumps(result), flush=True)
-    results = {}
-    for shape in ("pentagon", "disk"):
-        path = os.path.join(OUT, f"{shape}.json")
-        if os.path.exists(path):
-            with open(path) as fh:
-                results[shape] = json.load(fh)
+    measured = []
+    for name in sorted(os.listdir(OUT)):
+        if name.endswith(".json"):
+            with open(os.path.join(OUT, name)) as fh:
+                measured.append(json.load(fh))
+    results = {m["shape"]: m for m in measured if m.get("acceleration", "off") == "off"}
     if not results:
         print("nothing measured yet: run with --measure pentagon,disk")
         return
     from common import machine_description
 
     print(machine_description() + "\n")
-    print("| shape | N | compaction steps, time | shear steps to eps_q = 0.4 (eps_1) | sweeps / step median, p90 | "
-          "contact points / particle | us / particle / step (shear) |")
-    print("|---|---|---|---|---|---|---|")
-    for m in results.values():
-        print(f"| {m['shape']} | {m['particles']} | {m['compaction_steps']:,}, {m['compaction_seconds']:.0f} s | "
-              f"{m['shear_steps']:,} ({m['eps_1_at_target']:.3f}) | {m['sweeps_median']:.0f}, {m['sweeps_p90']:.0f} | "
-              f"{m['points_per_particle']:.2f} | {m['us_per_particle_step']:.1f} |")
+    print("| shape | N | sweeps | compaction steps, time | shear steps to eps_q = 0.4 (eps_1) | sweeps / step median, "
+          "p90 | contact points / particle | local-law residual median, p90 | us / particle / step (shear) |")
+    print("|---|---|---|---|---|---|---|---|---|")
+    for m in measured:
+        law = (f"{m['local_law_residual_median']:.1e}, {m['local_law_residual_p90']:.1e}"
+               if "local_law_residual_median" in m else "-")
+        print(f"| {m['shape']} | {m['particles']} | {m.get('acceleration', 'off')} | {m['compaction_steps']:,}, "
+              f"{m['compaction_seconds']:.0f} s | {m['shear_steps']:,} ({m['eps_1_at_target']:.3f}) | "
+              f"{m['sweeps_median']:.0f}, {m['sweeps_p90']:.0f} | {m['points_per_particle']:.2f} | {law} | "
+              f"{m['us_per_particle_step']:.1f} |")
     print()
     print(table(results))
 
