@@ -273,6 +273,7 @@ def _ensemble(args) -> int:
     print(f"ensemble: {len(specs)} runs on {where}; files in {out} (finished runs are skipped, unfinished "
           "ones resumed)", flush=True)
     results = run_ensemble(specs, out, scheduler=args.scheduler, workers=args.workers, overwrite=args.overwrite,
+                           compress=not args.no_compress,
                            progress=_progress_flag(args), log=lambda line: print(f"ensemble: {line}", flush=True))
     failed = [r for r in results if "error" in r]
     if failed:
@@ -457,6 +458,7 @@ def build_parser() -> argparse.ArgumentParser:
                      "its workers must import grainview and see --out")
     ens.add_argument("--no-report", action="store_true", help="run only; no report")
     ens.add_argument("--overwrite", action="store_true", help="redo every run, replacing its file")
+    no_compress_option(ens)
     ens.add_argument("--progress", choices=["auto", "on", "off"], default="auto", help="a progress bar per run")
     residual_option(ens)
     ens.set_defaults(func=_ensemble)

@@ -173,11 +173,12 @@ def _check_settings(path, spec: RunSpec):
                                   "pass overwrite=True to replace it")
 
 
-def run_one(spec: RunSpec, folder, *, overwrite=False, progress=None) -> dict:
+def run_one(spec: RunSpec, folder, *, overwrite=False, progress=None, compress=True) -> dict:
     """Simulate, resume or skip the run ``spec`` into ``<folder>/<spec.name>.nc`` (see the
     module docstring). Returns a dict: ``name``, ``path``, ``action`` ("ran", "resumed",
     "finished already"), ``steps`` (steps taken now), ``seconds``, ``unconverged`` (steps
-    where NLGS hit its iteration limit). ``progress``: as for :func:`solver.biaxial_test`."""
+    where NLGS hit its iteration limit). ``progress`` and ``compress`` (the finished file kept
+    compressed): as for :func:`solver.biaxial_test`."""
     from .preparation import prepare_sample, record
     from .restart import resume
     from .scenes import biaxial_test
@@ -193,12 +194,12 @@ def run_one(spec: RunSpec, folder, *, overwrite=False, progress=None) -> dict:
             action, steps = "finished already", 0
         elif state == "partial":
             _check_settings(path, spec)
-            action, steps = "resumed", resume(path, progress=progress)
+            action, steps = "resumed", resume(path, progress=progress, compress=compress)
         else:
             sim = prepare_sample(spec.sample(), progress=progress, **dict(spec.solver))
             steps = biaxial_test(sim, path, strain=spec.strain, velocity=spec.velocity, every=int(spec.every),
                                  overwrite=True, attrs={**record(sim), "ensemble_run": spec.name},
-                                 progress=progress, near_contacts=spec.near_contacts)
+                                 progress=progress, near_contacts=spec.near_contacts, compress=compress)
             action = "ran"
     unconverged = sum(issubclass(w.category, ConvergenceWarning) for w in caught)
     others = list(dict.fromkeys(str(w.message).splitlines()[0] for w in caught
@@ -235,10 +236,10 @@ class _EventBar:
                                             "pid": os.getpid()})
 
 
-def _run_on_worker(spec: RunSpec, folder: str) -> dict:
+def _run_on_worker(spec: RunSpec, folder: str, compress: bool = True) -> dict:
     """The task of one run on a dask worker: :func:`run_one` (never overwriting: a retried task
     resumes its file) reporting progress as events."""
-    return run_one(spec, folder, progress=lambda total, desc: _EventBar(spec.name, total, desc))
+    return run_one(spec, folder, progress=lambda total, desc: _EventBar(spec.name, total, desc), compress=compress)
 
 
 class _Display:
@@ -294,7 +295,7 @@ def _client(scheduler, workers):
 
 
 def run_ensemble(specs, folder, *, scheduler=None, workers=None, client=None, overwrite=False, progress=None,
-                 log=None, on_event=None) -> list[dict]:
+                 log=None, on_event=None, compress=True) -> list[dict]:
     """Run every :class:`RunSpec` of ``specs`` into ``folder`` on a dask.distributed cluster.
 
     ``client``: an existing :class:`distributed.Client`; otherwise one to ``scheduler`` (an
@@ -304,7 +305,8 @@ def run_ensemble(specs, folder, *, scheduler=None, workers=None, client=None, ov
     reported and the others go on. ``progress``: one bar per run (None: when stderr is a
     terminal); ``log``: called with one line per finished or failed run; ``on_event``: called
     with each progress event, a dict (``run``, ``stage``, ``n`` steps of ``total``, the worker's
-    ``pid``), in the client's event thread.
+    ``pid``), in the client's event thread. ``compress``: keep each finished file compressed
+    (:func:`solver.biaxial_test`).
 
     Returns one dict per run, in the order of ``specs``: :func:`run_one`'s, or ``name``,
     ``path`` and ``error`` (the exception's one line) for a run that failed. Call it again to
@@ -340,7 +342,7 @@ def run_ensemble(specs, folder, *, scheduler=None, workers=None, client=None, ov
     display = _Display(specs, enabled, on_event)
     try:
         client.subscribe_topic(EVENT_TOPIC, display)
-        futures = {client.submit(_run_on_worker, spec, str(folder.resolve()), pure=False,
+        futures = {client.submit(_run_on_worker, spec, str(folder.resolve()), compress, pure=False,
                                  key=f"grainview-run-{spec.name}-{time.time_ns()}"): spec for spec in specs}
         results = {}
         for future in as_completed(futures):

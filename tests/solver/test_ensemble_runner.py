@@ -15,6 +15,7 @@ import xarray as xr
 import grainview
 from grainview.ensemble import run_dataset
 from grainview.errors import ParameterError
+from grainview.writer import is_compressed
 from solver import ensemble
 from solver.ensemble import RunSpec, grid, run_ensemble, run_one
 
@@ -57,6 +58,13 @@ def test_killed_worker_run_is_resumed_and_exact(killed, tmp_path):
     assert resumed.sizes == alone.sizes
     for name in COMPARED:
         np.testing.assert_array_equal(resumed[name].values, alone[name].values, err_msg=name)
+    # finished runs are kept compressed, the resumed one too; compress=False keeps netCDF-3
+    assert all(is_compressed(r["path"]) for r in results) and is_compressed(reference["path"])
+    (tmp_path / "plain").mkdir()
+    plain = run_one(specs[0], tmp_path / "plain", compress=False)
+    assert not is_compressed(plain["path"])
+    with grainview.open_dataset(plain["path"], chunks=None) as ds:
+        np.testing.assert_array_equal(ds["position"].values, alone["position"].values)
 
 
 def test_open_ensemble_equals_each_file(killed):
