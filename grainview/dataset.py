@@ -198,8 +198,10 @@ def netcdf_encoding(ds: xr.Dataset, zlib: bool = False, complevel: int = 4) -> d
     >>> ds.to_netcdf("run-zlib.nc", format="NETCDF4_CLASSIC",
     ...              encoding=grainview.dataset.netcdf_encoding(ds, zlib=True))  # doctest: +SKIP
     """
-    if zlib and (isinstance(complevel, bool) or not (isinstance(complevel, (int, np.integer)) and 1 <= complevel <= 9)):
-        raise ParameterError(f"complevel={complevel!r}: expected an integer from 1 to 9")
+    if zlib:
+        from .writer import check_complevel
+
+        complevel = check_complevel(complevel)
     enc = {}
     for name in ds.variables:
         if name in VARIABLES:

@@ -18,34 +18,24 @@ import os
 import numpy as np
 
 from .errors import FileFormatError, SchemaError
-from .schema import complete_snapshots, missing_units, particle_area, structure_problems, unit_problems
+from .schema import (complete_snapshots, leading_complete, missing_units, particle_area, structure_problems,
+                     unit_problems)
+from .writer import netcdf3_data_bytes
 
 __all__ = ["read_facts", "describe_file"]
 
 
-def _chars(var) -> list:
-    """The strings of a character variable (e.g. the wall names)."""
-    var.set_auto_chartostring(False)
-    raw = np.asarray(var[:])
-    return ["".join(c.decode() if isinstance(c, bytes) else str(c) for c in row).strip("\x00 ") for row in raw]
-
-
 def _minimum_netcdf3_size(nc) -> int:
-    """Bytes a netCDF-3 file needs at least: its fixed variables and its records (the header,
-    a few KiB, not counted). A file shorter than this was cut short."""
-    fixed = records = 0
+    """Bytes a netCDF-3 file needs at least: its data (:func:`grainview.writer.netcdf3_data_bytes`),
+    the header (a few KiB) not counted. A file shorter than this was cut short."""
+    fixed, record = [], []
     for var in nc.variables.values():
-        size = var.dtype.itemsize * int(np.prod(var.shape[1:] if _is_record(nc, var) else var.shape, dtype=np.int64))
-        if _is_record(nc, var):
-            records += size
-        else:
-            fixed += size
+        is_record = bool(var.dimensions) and nc.dimensions[var.dimensions[0]].isunlimited()
+        shape = var.shape[1:] if is_record else var.shape
+        (record if is_record else fixed).append(var.dtype.itemsize * int(np.prod(shape, dtype=np.int64)))
+    fixed_bytes, record_bytes = netcdf3_data_bytes(fixed, record)
     n_records = len(nc.dimensions["time"]) if "time" in nc.dimensions else 0
-    return fixed + n_records * records
-
-
-def _is_record(nc, var) -> bool:
-    return bool(var.dimensions) and nc.dimensions[var.dimensions[0]].isunlimited()
+    return fixed_bytes + n_records * record_bytes
 
 
 def read_facts(path) -> tuple[dict, dict]:
@@ -77,6 +67,7 @@ def read_facts(path) -> tuple[dict, dict]:
     """
     import netCDF4
 
+    from .arrays.strain import log_strain
     from .arrays.stress import stress_tensor
     from .arrays.tensors import principal
 
@@ -106,7 +97,7 @@ def read_facts(path) -> tuple[dict, dict]:
         facts = {"n_vertices": np.asarray(v["n_vertices"][:]), "n_walls": sizes.get("wall", 0),
                  "n_slots": sizes["contact"], "missing_units": missing_units(units)}
         complete = complete_snapshots(v) if "time" in v and sizes.get("time", 0) else np.zeros(0, bool)
-        snapshots = int(np.argmin(complete)) if not complete.all() else complete.size
+        snapshots = leading_complete(complete)
         facts["snapshots"] = snapshots
         if not snapshots:
             return facts, attrs
@@ -118,8 +109,7 @@ def read_facts(path) -> tuple[dict, dict]:
         solid = float(particle_area(v["radius"][:], facts["n_vertices"]).sum())
         facts["solid_fraction"] = solid / (length * height)
         if snapshots > 1:
-            eps_1 = np.log(1 + (height[0] - height[-1]) / height[0])
-            eps_2 = np.log(1 + (length[0] - length[-1]) / length[0])
+            eps_1, eps_2 = log_strain(height[-1], height[0]), log_strain(length[-1], length[0])
             facts.update(eps_1=float(eps_1), eps_q=float(eps_1 - eps_2))
             occupied = np.arange(sizes["contact"])[None, :] < count[:, None]
             volume = length * height * float(attrs.get("thickness_m", 1.0))

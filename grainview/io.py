@@ -14,7 +14,8 @@ import numpy as np
 import xarray as xr
 
 from .errors import FileFormatError, SchemaError
-from .schema import SCHEMA_VERSION, complete_snapshots
+from .schema import SCHEMA_VERSION, complete_snapshots, leading_complete
+from .writer import netcdf3_data_bytes
 
 
 def _check_netcdf3_length(path: str) -> None:
@@ -36,12 +37,10 @@ def _check_netcdf3_length(path: str) -> None:
                               f"its header describes data beyond its end ({exc})") from exc
     with nc:
         header = nc.fp.tell()
-        fixed = sum((v.data.nbytes + 3) // 4 * 4 for v in nc.variables.values() if not v.isrec)
         records = [v for v in nc.variables.values() if v.isrec]
-        # the classic format's record: each record variable's slice, padded to 4 bytes unless
-        # it is the only record variable
-        slices = [v.itemsize() * int(np.prod(v.shape[1:], dtype=np.int64)) for v in records]
-        record_size = sum(slices) if len(slices) == 1 else sum((s + 3) // 4 * 4 for s in slices)
+        fixed, record_size = netcdf3_data_bytes(
+            [v.data.nbytes for v in nc.variables.values() if not v.isrec],
+            [v.itemsize() * int(np.prod(v.shape[1:], dtype=np.int64)) for v in records])
         n_records = max((v.shape[0] for v in records), default=0)
         expected = header + fixed + n_records * record_size
         for v in nc.variables.values():  # drop the mmap references before closing
@@ -111,7 +110,7 @@ def open_dataset(path, chunks: int | dict | None = "auto", validate: bool = Fals
         raise FileFormatError(f"{source}: not a readable netCDF file ({exc})") from exc
     _check_version(ds, source)
     if complete is not None:
-        n_complete = int(np.argmin(complete)) if not complete.all() else complete.size
+        n_complete = leading_complete(complete)
         if complete[n_complete:].any():
             raise FileFormatError(f"{source}: snapshot {n_complete} is incomplete but later ones are "
                                   "complete; the file is damaged")

@@ -146,16 +146,26 @@ def run_summary(ds: xr.Dataset, residual_strain: float = RESIDUAL_STRAIN) -> dic
     return out
 
 
+def near_gap(runs: dict) -> float | None:
+    """The report's near-pair gap (m): :data:`NEAR_FRACTION` of the smallest diameter over
+    ``runs``, or None when one of them does not hold its near pairs up to that gap."""
+    from .contacts import check_near
+
+    gap = NEAR_FRACTION * 2.0 * min(float(ds["radius"].min()) for ds in runs.values())
+    try:
+        for ds in runs.values():
+            check_near(ds, gap)
+    except ParameterError:
+        return None
+    return gap
+
+
 def _near_rows(res: xr.Dataset) -> dict:
     """The residual z, very weak fraction and fabric a with the near pairs within
     :data:`NEAR_FRACTION` of the smallest diameter counted, when the file holds them ("-"
     otherwise)."""
-    from .contacts import check_near
-
-    gap = NEAR_FRACTION * 2.0 * float(res["radius"].min())
-    try:
-        check_near(res, gap)
-    except ParameterError:
+    gap = near_gap({"run": res})
+    if gap is None:
         return {key: "- (no near pairs in the file)" for key in NEAR_ROWS}
     prop = res.grain.contact_proportions(near=gap).mean("time").compute()
     return {
@@ -279,6 +289,8 @@ def write_figures(runs: dict, out: Path, time=-1, residual_strain: float = RESID
         name = f"fig{number}_{FIGURE_NAMES[number]}"
         targets = ([(f"{name}_{_slug(label)}", {label: ds}) for label, ds in chosen.items()]
                    if number in PER_RUN_FIGURES else [(name, chosen)])
+        if number == "13":  # the maps of every run on one width scale, so that they compare
+            width_scale, width_rule = common_force_scale(chosen, time)
         for stem, data in targets:
             kwargs = {}
             shown = 0 if number == "02" else time  # Fig. 2: the compacted sample, before the test
@@ -289,8 +301,8 @@ def write_figures(runs: dict, out: Path, time=-1, residual_strain: float = RESID
             rule = None
             if number == "16":
                 kwargs["near"], rule = xi_contacts(data)
-            if number == "13":  # the maps of every run on one width scale, so that they compare
-                kwargs["force_scale"], rule = common_force_scale(chosen, time)
+            if number == "13":
+                kwargs["force_scale"], rule = width_scale, width_rule
             result = func(data if number not in PER_RUN_FIGURES else next(iter(data.values())), **kwargs)
             fig = result if hasattr(result, "savefig") else result.figure
             what = "map" if number in MAP_FIGURES else "distribution" if number in DISTRIBUTION_FIGURES else "evolution"
@@ -333,13 +345,8 @@ def xi_contacts(runs: dict):
     contacts include pairs just closing along the compression axis with forces far below the
     solver's resolution, which lift a'(xi) at the smallest cutoffs (docs/analysis.md).
     Returns ``(near, line)``: the gap in m (None: force-bearing only) and the caption line."""
-    from .contacts import check_near
-
-    gap = NEAR_FRACTION * 2.0 * min(float(ds["radius"].min()) for ds in runs.values())
-    try:
-        for ds in runs.values():
-            check_near(ds, gap)
-    except ParameterError:
+    gap = near_gap(runs)
+    if gap is None:
         return None, "contacts: force-bearing only (f_n > 0; the files hold no near pairs)"
     return gap, (f"contacts: force-bearing and the pairs within {gap * 1e3:.2g} mm "
                  f"({NEAR_FRACTION:g} of the smallest diameter), which carry no force")

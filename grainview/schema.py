@@ -170,6 +170,13 @@ def complete_snapshots(variables) -> np.ndarray:
     return ok
 
 
+def leading_complete(complete) -> int:
+    """How many snapshots at the start of a file are complete: the index of the first
+    incomplete one in ``complete`` (:func:`complete_snapshots`), or all of them."""
+    complete = np.asarray(complete, bool)
+    return int(np.argmin(complete)) if not complete.all() else complete.size
+
+
 def variable_attrs(name: str) -> dict:
     """The attributes of contract variable ``name`` (units, long_name, flags)."""
     var = VARIABLES[name]

@@ -12,6 +12,7 @@ import xarray as xr
 
 from . import sample
 from ._lift import with_attrs
+from .arrays.strain import log_strain
 from .errors import ParameterError
 from .stress import stress_invariants
 
@@ -64,8 +65,7 @@ def _ratio(num, den):
 
 
 def _log_strain(size, reference):
-    size0 = size.isel(time=reference)
-    return np.log(1 + (size0 - size) / size0)
+    return log_strain(size, size.isel(time=reference))
 
 
 def strains(ds: xr.Dataset, reference: int = 0) -> xr.Dataset:

@@ -15,7 +15,8 @@ from .locks import WriterLock
 from .schema import (CONTACT_VARIABLES, DEFAULT_WALL_NAMES, OPTIONAL_CONTACT_VARIABLES, REQUIRED, TIME_ATTRS,
                      VARIABLES, complete_snapshots, contact_slots, empty_slots, global_attrs, variable_attrs)
 
-__all__ = ["SnapshotWriter", "compress_file", "decompress_file", "is_compressed", "APPEND_FORMAT",
+__all__ = ["SnapshotWriter", "compress_file", "decompress_file", "is_compressed", "check_complevel",
+           "netcdf3_data_bytes", "APPEND_FORMAT",
            "COMPRESSED_FORMAT", "DEFAULT_COMPLEVEL"]
 
 APPEND_FORMAT = "NETCDF3_64BIT_OFFSET"
@@ -48,6 +49,19 @@ def _move_into_place(temporary: str, path: str, overwrite: bool) -> None:
         os.replace(temporary, path)
         return
     os.remove(temporary)
+
+
+def netcdf3_data_bytes(fixed, record_slices) -> tuple[int, int]:
+    """Bytes of a netCDF-3 file's data, the header aside: ``(fixed part, one record)``.
+
+    ``fixed``: the size in bytes of each fixed-size variable; ``record_slices``: of each record
+    variable's slice (one record's worth). The classic format pads every variable to 4 bytes,
+    except the record slice of a file with a single record variable. A file holds at least
+    header + fixed part + records x record bytes: the check that a netCDF-3 file is whole."""
+    fixed_bytes = sum((int(n) + 3) // 4 * 4 for n in fixed)
+    slices = [int(n) for n in record_slices]
+    record_bytes = sum(slices) if len(slices) == 1 else sum((n + 3) // 4 * 4 for n in slices)
+    return fixed_bytes, record_bytes
 
 
 def is_compressed(path) -> bool:
@@ -107,6 +121,13 @@ def _convert(path, fmt, complevel=None) -> None:
             lock.release()
 
 
+def check_complevel(complevel) -> int:
+    """``complevel`` as an int, or :class:`ParameterError` unless it is a zlib level 1-9."""
+    if isinstance(complevel, bool) or not (isinstance(complevel, (int, np.integer)) and 1 <= complevel <= 9):
+        raise ParameterError(f"complevel={complevel!r}: expected an integer from 1 to 9")
+    return int(complevel)
+
+
 def compress_file(path, complevel: int = DEFAULT_COMPLEVEL) -> None:
     """Rewrite the finished file ``path`` compressed (:data:`COMPRESSED_FORMAT`, zlib at
     ``complevel`` with byte shuffling), in place and atomically; :func:`grainview.open_dataset`
@@ -119,10 +140,9 @@ def compress_file(path, complevel: int = DEFAULT_COMPLEVEL) -> None:
     complevel : int
         zlib level, 1 (fastest) to 9 (smallest).
     """
-    if isinstance(complevel, bool) or not (isinstance(complevel, (int, np.integer)) and 1 <= complevel <= 9):
-        raise ParameterError(f"complevel={complevel!r}: expected an integer from 1 to 9")
+    complevel = check_complevel(complevel)
     if not is_compressed(path):
-        _convert(path, COMPRESSED_FORMAT, int(complevel))
+        _convert(path, COMPRESSED_FORMAT, complevel)
 
 
 def decompress_file(path) -> None:

@@ -1,0 +1,14 @@
+"""Strains of the sample box (docs/conventions.md §6)."""
+
+from __future__ import annotations
+
+import numpy as np
+
+
+def log_strain(size, reference):
+    """Logarithmic strain of a box extent, compression positive: ln(1 + (L0 - L)/L0).
+
+    ``size`` is the extent L (m) of each snapshot, ``reference`` the extent L0 (m) of the
+    reference snapshot; eps_1 for the height, eps_2 for the width (paper Sec. III). Works on
+    numpy arrays and on DataArrays alike (a ufunc expression)."""
+    return np.log(1 + (reference - size) / reference)
