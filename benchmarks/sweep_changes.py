@@ -37,7 +37,7 @@ def main():
         rows = []
         for it in range(1, 2001):
             pn0, pt0 = pn.copy(), pt.copy()
-            s, mx = nlgs.sweep(order, P.a, P.b, P.nx, P.ny, P.rax, P.ray, P.rbx, P.rby, P.bias, P.mu, pn, pt, vx, vy, w,
+            s, mx, _, _ = nlgs.sweep(order, P.a, P.b, P.nx, P.ny, P.rax, P.ray, P.rbx, P.rby, P.bias, P.mu, pn, pt, vx, vy, w,
                                P.minv_xx, P.minv_xy, P.minv_yy, P.iinv, wnn, wnt, wtt)
             q, worst = nlgs.norms(s, mx, pn, pt, wnn, wnt, wtt)
             dpn, dpt = pn - pn0, pt - pt0

@@ -373,7 +373,8 @@ def build_parser() -> argparse.ArgumentParser:
                              "solve time on dense sheared samples (default off; docs/solver.md)")
         physics.add_argument("--domains", type=int, default=None,
                              help="NLGS domains swept at once, one per core (default 1: the serial sweep; "
-                             "deterministic for a given number; on free cores only; docs/solver.md)")
+                             "deterministic for a given number; combines with --acceleration; on free cores only; "
+                             "docs/solver.md)")
         prep = p.add_argument_group("sample preparation (docs/fidelity.md)")
         prep.add_argument("--preparation", choices=preset_names(), default="paper",
                           help="named preparation (default paper: compaction with friction 0.4, walls closing "

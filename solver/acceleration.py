@@ -1,32 +1,44 @@
 """Anderson acceleration of the NLGS: the sweeps as a fixed-point map, extrapolated.
 
-One NLGS sweep maps the impulses x = (p_n, p_t) of all points to new ones, G(x); a solution is
-a fixed point x = G(x). In a dense packing the sweeps converge slowly (long force chains pass a
-correction on by about one contact per sweep), and Anderson acceleration (type II, Walker & Ni,
-SIAM J. Numer. Anal. 49, 2011) combines the last m sweeps instead of keeping the last one only:
+One NLGS sweep maps the impulses x = (p_n, p_t) of all points to new ones; a solution is a
+fixed point. In a dense packing the sweeps converge slowly (long force chains pass a correction
+on by about one contact per sweep), and Anderson acceleration (type II, Walker & Ni, SIAM J.
+Numer. Anal. 49, 2011) combines the last m iterates instead of keeping the last one only. With
+G the map "one sweep",
 
     f_k = G(x_k) - x_k,   gamma = argmin || f_k - dF gamma ||_2,
     x_{k+1} = G(x_k) - dG gamma,
 
 with dF, dG the differences of successive f and G(x) (memory m). The extrapolated impulses are
-projected back onto each point's Coulomb cone (p_n >= 0, |p_t| <= mu p_n) and the body
-velocities rebuilt from them (v = v_free + M^-1 H p). The sweep itself stays the NLGS's exact
-point-by-point solver, so the method is NLGS with an extrapolation between sweeps, and its
-stopping norms are the NLGS's own (:mod:`solver.nlgs`), measured on the change a sweep makes.
+projected back onto each point's Coulomb cone (p_n >= 0, |p_t| <= mu p_n). The sweep itself
+stays the NLGS's exact point-by-point solver, so the method is NLGS with an extrapolation
+between sweeps, and its stopping norms are the NLGS's own (:mod:`solver.nlgs`), measured on the
+change a sweep makes.
 
 Safeguard: the problem is nonsmooth (contacts open, close, stick and slip between sweeps), so
-when a sweep's change |f_k| grows above the previous one the memory is cleared and the plain
-sweep's result kept: the method falls back to NLGS until the sweeps contract again. The
-least-squares problem is solved by its m x m normal equations, updated by one row per sweep,
-so a sweep costs about 2m + 6 passes over the points on top of the NLGS sweep.
+when an iterate's change |f_k| grows above the previous one the history is forgotten and the
+plain sweeps' result kept: the method falls back to NLGS until the sweeps contract again.
+
+Cost. The least-squares problem is solved by its m x m normal equations, one new row per
+iterate. The body velocities stay v = v_free + M^-1 H p without a pass over the points: they
+are linear in the impulses, so the velocity differences dV = M^-1 H dG are kept with dG (one
+row per body, not per point) and v - dV gamma is the velocity of the unprojected extrapolation;
+only the points whose impulse the cone projection moved add their correction to their bodies.
+The history lives in rows of m x P arrays (one contiguous row per iterate).
+
+On several cores (``domains`` > 1) the sweeps are the domain-decomposed ones of
+:mod:`solver.parallel_nlgs`, and the history and extrapolation passes run a block of points (and
+of bodies) per thread. Every sum is a block's own, added in block order, so the result does not
+depend on the number of threads.
 """
 
 from __future__ import annotations
 
 import numpy as np
-from numba import njit
+from numba import njit, prange
 
-from .nlgs import NLGSResult, delassus, norms, sweep, velocities_from_impulses
+from .nlgs import NLGSResult, _apply, delassus, sweep, sweep_norms, velocities_from_impulses
+from .parallel_nlgs import decompose, sweep_domains
 from .residuals import cone_projection
 
 __all__ = ["solve_anderson", "solve_problem_anderson"]
@@ -65,25 +77,195 @@ def _small_solve(matrix, rhs, size):
     return x, True
 
 
+# The passes below work on contiguous views (``v[lo:hi]``) indexed from 0: an index numba can
+# prove non-negative needs no wrap-around check, and the loops vectorise.
+
+
+@njit(cache=True, fastmath={"reassoc"})
+def _dot2(a, b, c, d):
+    """a . b + c . d (a block's share: reassociated, the same for every thread count)."""
+    total = 0.0
+    for k in range(a.size):
+        total += a[k] * b[k] + c[k] * d[k]
+    return total
+
+
 @njit(cache=True)
-def solve_anderson(a, b, nx, ny, rax, ray, rbx, rby, bias, mu, pn, pt, vx, vy, w,
+def _subtract_scaled(target, rows, gamma, count):
+    """target -= sum_j gamma_j rows[j] over the first ``count`` rows (views of one block)."""
+    for j in range(count):
+        g = gamma[j]
+        row = rows[j]
+        for k in range(target.size):
+            target[k] -= g * row[k]
+
+
+@njit(cache=True, fastmath={"reassoc"})
+def _residual(gn, gt, xn, xt, fn, ft):
+    """f = G(x) - x into (fn, ft), then x <- G(x); returns |f|^2."""
+    size = 0.0
+    for k in range(gn.size):
+        a, b = gn[k] - xn[k], gt[k] - xt[k]
+        fn[k], ft[k] = a, b
+        size += a * a + b * b
+        xn[k], xt[k] = gn[k], gt[k]
+    return size
+
+
+@njit(cache=True)
+def _point_history(lo, hi, slot, count, pn, pt, xn, xt, fn, ft, fn_prev, ft_prev, gn_prev, gt_prev, dfn, dft, dgn,
+                   dgt, row, rhs):
+    """The history of points lo..hi - 1 after a sweep has mapped the iterate x to G(x) =
+    (pn, pt): f = G(x) - x; when ``slot`` >= 0 the differences dF, dG with the previous sweep
+    are stored in row ``slot`` of the history, and the block's share of the new Gram row
+    (dF_slot . dF_j) and of the right-hand side (dF_j . f) over the ``count`` rows in use is
+    added to ``row`` and ``rhs``; then previous <- current and x <- G(x). Returns the block's
+    share of |f|^2."""
+    f_n, f_t = fn[lo:hi], ft[lo:hi]
+    size = _residual(pn[lo:hi], pt[lo:hi], xn[lo:hi], xt[lo:hi], f_n, f_t)
+    if slot >= 0:
+        new_fn, new_ft = dfn[slot, lo:hi], dft[slot, lo:hi]
+        new_gn, new_gt = dgn[slot, lo:hi], dgt[slot, lo:hi]
+        old_fn, old_ft, old_gn, old_gt = fn_prev[lo:hi], ft_prev[lo:hi], gn_prev[lo:hi], gt_prev[lo:hi]
+        g_n, g_t = xn[lo:hi], xt[lo:hi]
+        for k in range(f_n.size):
+            new_fn[k] = f_n[k] - old_fn[k]
+            new_ft[k] = f_t[k] - old_ft[k]
+            new_gn[k] = g_n[k] - old_gn[k]
+            new_gt[k] = g_t[k] - old_gt[k]
+        for j in range(count):
+            row[j] += _dot2(new_fn, dfn[j, lo:hi], new_ft, dft[j, lo:hi])
+            rhs[j] += _dot2(f_n, dfn[j, lo:hi], f_t, dft[j, lo:hi])
+    fn_prev[lo:hi] = f_n
+    ft_prev[lo:hi] = f_t
+    gn_prev[lo:hi] = xn[lo:hi]
+    gt_prev[lo:hi] = xt[lo:hi]
+    return size
+
+
+@njit(cache=True)
+def _body_history(lo, hi, slot, vx, vy, w, hvx, hvy, hw, dvx, dvy, dw):
+    """The velocity history of bodies lo..hi - 1: the change since the previous sweep stored
+    in row ``slot`` (when >= 0), then previous <- current. Velocities are linear in the
+    impulses (v = v_free + M^-1 H p), so these are M^-1 H dG."""
+    if slot >= 0:
+        for new, now, old in ((dvx[slot, lo:hi], vx[lo:hi], hvx[lo:hi]), (dvy[slot, lo:hi], vy[lo:hi], hvy[lo:hi]),
+                              (dw[slot, lo:hi], w[lo:hi], hw[lo:hi])):
+            for i in range(new.size):
+                new[i] = now[i] - old[i]
+    hvx[lo:hi] = vx[lo:hi]
+    hvy[lo:hi] = vy[lo:hi]
+    hw[lo:hi] = w[lo:hi]
+
+
+@njit(cache=True)
+def _extrapolate_bodies(lo, hi, gamma, count, dvx, dvy, dw, vx, vy, w):
+    """The velocities of bodies lo..hi - 1 at the extrapolated impulses: v - dV gamma."""
+    _subtract_scaled(vx[lo:hi], dvx[:, lo:hi], gamma, count)
+    _subtract_scaled(vy[lo:hi], dvy[:, lo:hi], gamma, count)
+    _subtract_scaled(w[lo:hi], dw[:, lo:hi], gamma, count)
+
+
+@njit(cache=True)
+def _extrapolate_points(lo, hi, gamma, count, dgn, dgt, a, b, nx, ny, rax, ray, rbx, rby, mu, pn, pt, xn, xt, en, et,
+                        vx, vy, w, minv_xx, minv_xy, minv_yy, iinv):
+    """The impulses of points lo..hi - 1 at the extrapolation G(x) - dG gamma (computed in the
+    scratch ``en, et``), projected onto each point's Coulomb cone; they become the next
+    iterate. Where the projection moved an impulse, its change is added to the velocities of
+    the point's bodies (which :func:`_extrapolate_bodies` set for the unprojected
+    extrapolation)."""
+    e_n, e_t = en[lo:hi], et[lo:hi]
+    e_n[:] = pn[lo:hi]
+    e_t[:] = pt[lo:hi]
+    _subtract_scaled(e_n, dgn[:, lo:hi], gamma, count)
+    _subtract_scaled(e_t, dgt[:, lo:hi], gamma, count)
+    p_n, p_t, x_n, x_t, friction = pn[lo:hi], pt[lo:hi], xn[lo:hi], xt[lo:hi], mu[lo:hi]
+    for q in range(e_n.size):
+        qn, qt = cone_projection(e_n[q], e_t[q], friction[q])
+        if qn != e_n[q] or qt != e_t[q]:
+            _apply(lo + q, qn - e_n[q], qt - e_t[q], a, b, nx, ny, rax, ray, rbx, rby, vx, vy, w, minv_xx, minv_xy,
+                   minv_yy, iinv)
+        p_n[q], p_t[q] = qn, qt
+        x_n[q], x_t[q] = qn, qt
+
+
+@njit(cache=True, parallel=True)
+def _history_blocks(blocks, body_blocks, slot, count, pn, pt, xn, xt, fn, ft, fn_prev, ft_prev, gn_prev, gt_prev,
+                    dfn, dft, dgn, dgt, row, rhs, vx, vy, w, hvx, hvy, hw, dvx, dvy, dw):
+    """:func:`_point_history` over the domains' blocks of points at once (a thread each), then
+    over the interface's, and :func:`_body_history` over the blocks of bodies at once; the
+    blocks' sums are added in block order, so the result does not depend on the threads."""
+    n_blocks = blocks.size - 1
+    domains = n_blocks - 1
+    memory = row.size
+    rows = np.zeros((n_blocks, memory))
+    rhss = np.zeros((n_blocks, memory))
+    sizes = np.zeros(n_blocks)
+    for d in prange(domains):
+        sizes[d] = _point_history(blocks[d], blocks[d + 1], slot, count, pn, pt, xn, xt, fn, ft, fn_prev, ft_prev,
+                                  gn_prev, gt_prev, dfn, dft, dgn, dgt, rows[d], rhss[d])
+    sizes[domains] = _point_history(blocks[domains], blocks[domains + 1], slot, count, pn, pt, xn, xt, fn, ft,
+                                    fn_prev, ft_prev, gn_prev, gt_prev, dfn, dft, dgn, dgt, rows[domains],
+                                    rhss[domains])
+    for d in prange(body_blocks.size - 1):
+        _body_history(body_blocks[d], body_blocks[d + 1], slot, vx, vy, w, hvx, hvy, hw, dvx, dvy, dw)
+    size = 0.0
+    for d in range(n_blocks):
+        size += sizes[d]
+        for j in range(memory):
+            row[j] += rows[d, j]
+            rhs[j] += rhss[d, j]
+    return size
+
+
+@njit(cache=True, parallel=True)
+def _extrapolate_blocks(blocks, body_blocks, gamma, count, dgn, dgt, dvx, dvy, dw, a, b, nx, ny, rax, ray, rbx, rby,
+                        mu, pn, pt, xn, xt, en, et, vx, vy, w, minv_xx, minv_xy, minv_yy, iinv):
+    """:func:`_extrapolate_bodies` over the blocks of bodies at once, then
+    :func:`_extrapolate_points` over the domains at once (each writes its own bodies only) and
+    over the interface (the last block) alone."""
+    for d in prange(body_blocks.size - 1):
+        _extrapolate_bodies(body_blocks[d], body_blocks[d + 1], gamma, count, dvx, dvy, dw, vx, vy, w)
+    domains = blocks.size - 2
+    for d in prange(domains):
+        _extrapolate_points(blocks[d], blocks[d + 1], gamma, count, dgn, dgt, a, b, nx, ny, rax, ray, rbx, rby, mu,
+                            pn, pt, xn, xt, en, et, vx, vy, w, minv_xx, minv_xy, minv_yy, iinv)
+    _extrapolate_points(blocks[domains], blocks[domains + 1], gamma, count, dgn, dgt, a, b, nx, ny, rax, ray, rbx,
+                        rby, mu, pn, pt, xn, xt, en, et, vx, vy, w, minv_xx, minv_xy, minv_yy, iinv)
+
+
+@njit(cache=True)
+def solve_anderson(blocks, a, b, nx, ny, rax, ray, rbx, rby, bias, mu, pn, pt, vx, vy, w,
                    minv_xx, minv_xy, minv_yy, iinv, tol, max_tol, max_iterations, memory):
     """Anderson-accelerated NLGS (module docstring); arguments, in-place updates and result as
-    :func:`solver.nlgs.solve` without the ordering options; ``memory`` is m."""
+    :func:`solver.nlgs.solve` without the ordering options; ``memory`` is m.
+
+    ``blocks`` holds the boundaries of the points' blocks: ``[0, P]`` for the serial sweep over
+    all points in their order, or ``[0, p_1, ..., p_D, P]`` for the domain-decomposed sweep of
+    :mod:`solver.parallel_nlgs` (domain d holds the points ``p_d .. p_{d+1} - 1``, the last
+    block is the interface), the problem being laid out as its :class:`Decomposition` says."""
     m = a.size
-    n2 = 2 * m
+    n_bodies = vx.size
+    parallel = blocks.size > 2
+    domains = blocks.size - 2
+    body_blocks = (np.arange(domains + 1) * n_bodies) // max(domains, 1)
     wnn, wnt, wtt = delassus(a, b, nx, ny, rax, ray, rbx, rby, minv_xx, minv_xy, minv_yy, iinv)
-    free_x, free_y, free_w = vx.copy(), vy.copy(), w.copy()
     velocities_from_impulses(a, b, nx, ny, rax, ray, rbx, rby, pn, pt, vx, vy, w, minv_xx, minv_xy, minv_yy, iinv)
     order = np.arange(m)
-    d_f = np.zeros((memory, n2))
-    d_g = np.zeros((memory, n2))
+    ptr = blocks[:-1].copy()
+    points = np.arange(blocks[-2])
+    interface = np.arange(blocks[-2], m)
+    dfn, dft = np.zeros((memory, m)), np.zeros((memory, m))
+    dgn, dgt = np.zeros((memory, m)), np.zeros((memory, m))
+    dvx, dvy, dw = np.zeros((memory, n_bodies)), np.zeros((memory, n_bodies)), np.zeros((memory, n_bodies))
+    hvx, hvy, hw = vx.copy(), vy.copy(), w.copy()
     gram = np.zeros((memory, memory))
+    row = np.zeros(memory)
     rhs = np.zeros(memory)
-    x = np.empty(n2)
-    f = np.empty(n2)
-    f_prev = np.zeros(n2)
-    g_prev = np.zeros(n2)
+    xn, xt = pn.copy(), pt.copy()
+    fn, ft = np.zeros(m), np.zeros(m)
+    fn_prev, ft_prev = np.zeros(m), np.zeros(m)
+    gn_prev, gt_prev = np.zeros(m), np.zeros(m)
     have_prev = False
     count = 0
     head = 0
@@ -91,71 +273,73 @@ def solve_anderson(a, b, nx, ny, rax, ray, rbx, rby, bias, mu, pn, pt, vx, vy, w
     quad = 0.0
     worst = 0.0
     for it in range(1, max_iterations + 1):
-        x[:m] = pn
-        x[m:] = pt
-        sum_dv2, max_dv2 = sweep(order, a, b, nx, ny, rax, ray, rbx, rby, bias, mu, pn, pt, vx, vy, w,
-                                 minv_xx, minv_xy, minv_yy, iinv, wnn, wnt, wtt)
-        quad, worst = norms(sum_dv2, max_dv2, pn, pt, wnn, wnt, wtt)
+        if parallel:
+            quad, worst = sweep_norms(*sweep_domains(ptr, points, interface, a, b, nx, ny, rax, ray, rbx, rby, bias, mu,
+                                                     pn, pt, vx, vy, w, minv_xx, minv_xy, minv_yy, iinv, wnn, wnt, wtt))
+        else:
+            quad, worst = sweep_norms(*sweep(order, a, b, nx, ny, rax, ray, rbx, rby, bias, mu, pn, pt, vx, vy, w,
+                                             minv_xx, minv_xy, minv_yy, iinv, wnn, wnt, wtt))
         if quad <= tol and worst <= max_tol:
             return it, quad, worst
-        size = 0.0
-        for i in range(m):
-            f[i] = pn[i] - x[i]
-            f[m + i] = pt[i] - x[m + i]
-            size += f[i] * f[i] + f[m + i] * f[m + i]
-        if size > last:  # the sweeps stopped contracting: forget the history
+        # the history, assuming the sweeps still contract; forgotten below if they do not
+        slot = head if have_prev else -1
+        used = min(count + 1, memory) if have_prev else 0
+        row[:] = 0.0
+        rhs[:] = 0.0
+        if parallel:
+            size = _history_blocks(blocks, body_blocks, slot, used, pn, pt, xn, xt, fn, ft, fn_prev, ft_prev, gn_prev,
+                                   gt_prev, dfn, dft, dgn, dgt, row, rhs, vx, vy, w, hvx, hvy, hw, dvx, dvy, dw)
+        else:
+            size = _point_history(0, m, slot, used, pn, pt, xn, xt, fn, ft, fn_prev, ft_prev, gn_prev, gt_prev, dfn,
+                                  dft, dgn, dgt, row, rhs)
+            _body_history(0, n_bodies, slot, vx, vy, w, hvx, hvy, hw, dvx, dvy, dw)
+        have_prev = True
+        if size > last or slot < 0:  # the sweeps stopped contracting, or no history yet: plain sweep
             count = 0
             head = 0
-            have_prev = False
-        last = size
-        if have_prev:
-            slot = head
-            head = (head + 1) % memory
-            count = min(count + 1, memory)
-            for i in range(m):
-                d_f[slot, i] = f[i] - f_prev[i]
-                d_f[slot, m + i] = f[m + i] - f_prev[m + i]
-                d_g[slot, i] = pn[i] - g_prev[i]
-                d_g[slot, m + i] = pt[i] - g_prev[m + i]
-            for j in range(count):
-                gram[slot, j] = gram[j, slot] = np.dot(d_f[slot], d_f[j])
-        for i in range(m):
-            f_prev[i] = f[i]
-            f_prev[m + i] = f[m + i]
-            g_prev[i] = pn[i]
-            g_prev[m + i] = pt[i]
-        have_prev = True
-        if count == 0:
+            last = size
             continue
+        last = size
+        count = used
+        head = (head + 1) % memory
         for j in range(count):
-            rhs[j] = np.dot(d_f[j], f)
+            gram[slot, j] = row[j]
+            gram[j, slot] = row[j]
         gamma, ok = _small_solve(gram, rhs, count)
         if not ok:
             count = 0
             head = 0
             continue
-        for i in range(m):
-            en = pn[i]
-            et = pt[i]
-            for j in range(count):
-                en -= d_g[j, i] * gamma[j]
-                et -= d_g[j, m + i] * gamma[j]
-            pn[i], pt[i] = cone_projection(en, et, mu[i])
-        vx[:] = free_x
-        vy[:] = free_y
-        w[:] = free_w
-        velocities_from_impulses(a, b, nx, ny, rax, ray, rbx, rby, pn, pt, vx, vy, w, minv_xx, minv_xy, minv_yy,
-                                 iinv)
+        if parallel:
+            _extrapolate_blocks(blocks, body_blocks, gamma, count, dgn, dgt, dvx, dvy, dw, a, b, nx, ny, rax, ray, rbx,
+                                rby, mu, pn, pt, xn, xt, fn, ft, vx, vy, w, minv_xx, minv_xy, minv_yy, iinv)
+        else:
+            _extrapolate_bodies(0, n_bodies, gamma, count, dvx, dvy, dw, vx, vy, w)
+            _extrapolate_points(0, m, gamma, count, dgn, dgt, a, b, nx, ny, rax, ray, rbx, rby, mu, pn, pt, xn, xt, fn,
+                                ft, vx, vy, w, minv_xx, minv_xy, minv_yy, iinv)
     return max_iterations, quad, worst
 
 
 def solve_problem_anderson(problem, pn, pt, vx, vy, w, *, tolerance, max_tolerance, max_iterations,
-                           memory=5) -> NLGSResult:
+                           memory=3, domains=1, x=None) -> NLGSResult:
     """Solve ``problem`` (:class:`solver.nlgs.ContactProblem`) by Anderson-accelerated NLGS
     sweeps (module docstring); same arguments, in-place updates and result as
-    :func:`solver.nlgs.solve_problem`. ``memory`` is m, the number of past sweeps combined."""
-    iterations, residual, worst = solve_anderson(
-        problem.a, problem.b, problem.nx, problem.ny, problem.rax, problem.ray, problem.rbx, problem.rby,
-        problem.bias, problem.mu, pn, pt, vx, vy, w, problem.minv_xx, problem.minv_xy, problem.minv_yy,
-        problem.iinv, float(tolerance), float(max_tolerance), int(max_iterations), int(memory))
+    :func:`solver.nlgs.solve_problem`. ``memory`` is m, the number of past sweeps combined.
+    With ``domains`` > 1 the sweeps are the domain-decomposed ones of
+    :mod:`solver.parallel_nlgs`, the particles (the first ``x.size`` bodies, centres'
+    abscissae ``x``, m) cut into that many slabs, and the history passes run a domain per
+    thread too."""
+    options = (float(tolerance), float(max_tolerance), int(max_iterations), int(memory))
+    if domains > 1:
+        dec = decompose(problem, x, domains)
+        geometry, masses, state = dec.gather(problem, pn, pt, vx, vy, w)
+        blocks = np.append(dec.ptr, dec.point_order.size)
+        iterations, residual, worst = solve_anderson(blocks, *geometry, *state, *masses, *options)
+        dec.scatter(state, pn, pt, vx, vy, w)
+    else:
+        blocks = np.array([0, problem.a.size], dtype=np.int64)
+        iterations, residual, worst = solve_anderson(
+            blocks, problem.a, problem.b, problem.nx, problem.ny, problem.rax, problem.ray, problem.rbx, problem.rby,
+            problem.bias, problem.mu, pn, pt, vx, vy, w, problem.minv_xx, problem.minv_xy, problem.minv_yy,
+            problem.iinv, *options)
     return NLGSResult(int(iterations), float(residual), float(worst))

@@ -134,12 +134,19 @@ def local_solve(ufn, uft, bias, wnn, wnt, wtt, mu):
     return pn, 0.0
 
 
+# Point and body indices are read from arrays as unsigned integers in the sweep's helpers: numba
+# then skips the wrap-around test that a possibly negative index costs on every access (the
+# indices are never negative, and the arithmetic is unchanged, bit for bit).
+
+
 @njit(cache=True)
 def _relative_velocity(k, a, b, nx, ny, rax, ray, rbx, rby, vx, vy, w):
-    ubx = vx[b[k]] - w[b[k]] * rby[k]
-    uby = vy[b[k]] + w[b[k]] * rbx[k]
-    uax = vx[a[k]] - w[a[k]] * ray[k]
-    uay = vy[a[k]] + w[a[k]] * rax[k]
+    """Relative velocity (u_n, u_t) of body b with respect to body a at point k (m s-1)."""
+    bb, aa = np.uint64(b[k]), np.uint64(a[k])
+    ubx = vx[bb] - w[bb] * rby[k]
+    uby = vy[bb] + w[bb] * rbx[k]
+    uax = vx[aa] - w[aa] * ray[k]
+    uay = vy[aa] + w[aa] * rax[k]
     dx, dy = ubx - uax, uby - uay
     return dx * nx[k] + dy * ny[k], -dx * ny[k] + dy * nx[k]
 
@@ -151,7 +158,7 @@ def _apply(k, dpn, dpt, a, b, nx, ny, rax, ray, rbx, rby, vx, vy, w, minv_xx, mi
     branch around it compiles into a several times slower sweep."""
     px = dpn * nx[k] - dpt * ny[k]
     py = dpn * ny[k] + dpt * nx[k]
-    bb, aa = b[k], a[k]
+    bb, aa = np.uint64(b[k]), np.uint64(a[k])
     vx[bb] += minv_xx[bb] * px + minv_xy[bb] * py
     vy[bb] += minv_xy[bb] * px + minv_yy[bb] * py
     w[bb] += iinv[bb] * _cross(rbx[k], rby[k], px, py)
@@ -200,9 +207,8 @@ def solve(a, b, nx, ny, rax, ray, rbx, rby, bias, mu, pn, pt, vx, vy, w,
     for it in range(1, max_iterations + 1):
         if shuffle:
             state = _shuffle(order, state)
-        sum_dv2, max_dv2 = sweep(order, a, b, nx, ny, rax, ray, rbx, rby, bias, mu, pn, pt, vx, vy, w,
-                                 minv_xx, minv_xy, minv_yy, iinv, wnn, wnt, wtt)
-        quad, worst = norms(sum_dv2, max_dv2, pn, pt, wnn, wnt, wtt)
+        quad, worst = sweep_norms(*sweep(order, a, b, nx, ny, rax, ray, rbx, rby, bias, mu, pn, pt, vx, vy, w,
+                                         minv_xx, minv_xy, minv_yy, iinv, wnn, wnt, wtt))
         if quad <= tol and worst <= max_tol:
             return it, quad, worst
     return max_iterations, quad, worst
@@ -213,11 +219,15 @@ def sweep(order, a, b, nx, ny, rax, ray, rbx, rby, bias, mu, pn, pt, vx, vy, w,
           minv_xx, minv_xy, minv_yy, iinv, wnn, wnt, wtt):
     """One Gauss–Seidel sweep over the points in ``order``: each solves its local problem with
     the others frozen and applies its impulse change to the bodies at once. Returns the sum and
-    the largest of dV_k^2 = dp_k . W_k dp_k over the sweep (module docstring)."""
+    the largest of dV_k^2 = dp_k . W_k dp_k over the sweep, and the scale S = sum_k p_k . W_k p_k
+    and number of loaded points of the points swept, at their new impulses (module docstring;
+    each point is swept once, so these are the end-of-sweep values)."""
     sum_dv2 = 0.0
     max_dv2 = 0.0
+    scale = 0.0
+    n_active = 0
     for q in range(order.size):
-        k = order[q]
+        k = np.uint64(order[q])
         un, ut = _relative_velocity(k, a, b, nx, ny, rax, ray, rbx, rby, vx, vy, w)
         ufn = un - wnn[k] * pn[k] - wnt[k] * pt[k]
         uft = ut - wnt[k] * pn[k] - wtt[k] * pt[k]
@@ -230,18 +240,29 @@ def sweep(order, a, b, nx, ny, rax, ray, rbx, rby, bias, mu, pn, pt, vx, vy, w,
             if dv2 > max_dv2:
                 max_dv2 = dv2
         pn[k], pt[k] = new_n, new_t
-    return sum_dv2, max_dv2
+        if new_n > 0.0:
+            n_active += 1
+            scale += new_n * (wnn[k] * new_n + wnt[k] * new_t) + new_t * (wnt[k] * new_n + wtt[k] * new_t)
+    return sum_dv2, max_dv2, scale, n_active
 
 
 @njit(cache=True)
 def norms(sum_dv2, max_dv2, pn, pt, wnn, wnt, wtt):
-    """The quadratic and max norms of a sweep (module docstring) from its sum and largest dV^2."""
+    """The quadratic and max norms of a sweep (module docstring) from its sum and largest dV^2,
+    the scale computed from the impulses ``pn, pt``."""
     scale = 0.0
     n_active = 0
     for k in range(pn.size):
         if pn[k] > 0.0:
             n_active += 1
             scale += pn[k] * (wnn[k] * pn[k] + wnt[k] * pt[k]) + pt[k] * (wnt[k] * pn[k] + wtt[k] * pt[k])
+    return sweep_norms(sum_dv2, max_dv2, scale, n_active)
+
+
+@njit(cache=True)
+def sweep_norms(sum_dv2, max_dv2, scale, n_active):
+    """The quadratic and max norms of a sweep (module docstring) from its sum and largest dV^2,
+    the scale S and the number of loaded points, as :func:`sweep` returns them."""
     if scale > 0.0:
         return np.sqrt(sum_dv2 / scale), np.sqrt(max_dv2 / (scale / n_active))
     quad = 0.0 if sum_dv2 == 0.0 else np.inf

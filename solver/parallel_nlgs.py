@@ -39,7 +39,7 @@ from typing import NamedTuple
 import numpy as np
 from numba import njit, prange
 
-from .nlgs import NLGSResult, delassus, norms, sweep, velocities_from_impulses
+from .nlgs import NLGSResult, delassus, sweep, sweep_norms, velocities_from_impulses
 
 FREE = -1
 """Domain of a body that never moves (zero inverse mass and inertia): shared by every domain."""
@@ -102,20 +102,25 @@ def partition_points(a, b, body_domain, domains):
 def sweep_domains(ptr, points, interface, a, b, nx, ny, rax, ray, rbx, rby, bias, mu, pn, pt, vx, vy, w,
                   minv_xx, minv_xy, minv_yy, iinv, wnn, wnt, wtt):
     """One sweep: every domain at once (a thread each), then the interface serially. Returns
-    the sum and the largest dV_k^2 of the sweep, as :func:`solver.nlgs.sweep`."""
+    the sum and the largest dV_k^2 of the sweep, the scale and the number of loaded points, as
+    :func:`solver.nlgs.sweep`."""
     domains = ptr.size - 1
-    partial = np.zeros((domains, 2))
+    partial = np.zeros((domains, 4))
     for d in prange(domains):
-        s, top = sweep(points[ptr[d]:ptr[d + 1]], a, b, nx, ny, rax, ray, rbx, rby, bias, mu, pn, pt, vx, vy, w,
-                       minv_xx, minv_xy, minv_yy, iinv, wnn, wnt, wtt)
+        s, top, scale, active = sweep(points[ptr[d]:ptr[d + 1]], a, b, nx, ny, rax, ray, rbx, rby, bias, mu, pn, pt,
+                                      vx, vy, w, minv_xx, minv_xy, minv_yy, iinv, wnn, wnt, wtt)
         partial[d, 0] = s
         partial[d, 1] = top
-    sum_dv2, max_dv2 = sweep(interface, a, b, nx, ny, rax, ray, rbx, rby, bias, mu, pn, pt, vx, vy, w,
-                             minv_xx, minv_xy, minv_yy, iinv, wnn, wnt, wtt)
-    for d in range(domains):  # in domain order: the same sum whatever the threads did
+        partial[d, 2] = scale
+        partial[d, 3] = active
+    sum_dv2, max_dv2, scale, n_active = sweep(interface, a, b, nx, ny, rax, ray, rbx, rby, bias, mu, pn, pt, vx, vy,
+                                              w, minv_xx, minv_xy, minv_yy, iinv, wnn, wnt, wtt)
+    for d in range(domains):  # in domain order: the same sums whatever the threads did
         sum_dv2 += partial[d, 0]
         max_dv2 = max(max_dv2, partial[d, 1])
-    return sum_dv2, max_dv2
+        scale += partial[d, 2]
+        n_active += np.int64(partial[d, 3])
+    return sum_dv2, max_dv2, scale, n_active
 
 
 @njit(cache=True)
@@ -127,9 +132,8 @@ def solve_domains(ptr, points, interface, a, b, nx, ny, rax, ray, rbx, rby, bias
     quad = 0.0
     worst = 0.0
     for it in range(1, max_iterations + 1):
-        sum_dv2, max_dv2 = sweep_domains(ptr, points, interface, a, b, nx, ny, rax, ray, rbx, rby, bias, mu, pn, pt,
-                                         vx, vy, w, minv_xx, minv_xy, minv_yy, iinv, wnn, wnt, wtt)
-        quad, worst = norms(sum_dv2, max_dv2, pn, pt, wnn, wnt, wtt)
+        quad, worst = sweep_norms(*sweep_domains(ptr, points, interface, a, b, nx, ny, rax, ray, rbx, rby, bias, mu,
+                                                 pn, pt, vx, vy, w, minv_xx, minv_xy, minv_yy, iinv, wnn, wnt, wtt))
         if quad <= tol and worst <= max_tol:
             return it, quad, worst
     return max_iterations, quad, worst

@@ -87,7 +87,7 @@ class Parameters:
     shuffle: bool = False  # random NLGS ordering
     seed: int = 0
     acceleration: str = "off"  # "anderson": Anderson-accelerated sweeps (solver.acceleration); no shuffling then
-    anderson_memory: int = 5  # past sweeps combined by the Anderson extrapolation
+    anderson_memory: int = 3  # past iterates combined by the Anderson extrapolation
     domains: int = 1  # NLGS domains swept at once on several cores (solver.parallel_nlgs); 1: the serial sweep
     overlap_recovery_speed: float = 1e-3  # m s-1, cap of the split-impulse separation of overlaps
     overlap_recovery_rate: float = 0.2  # fraction of an overlap removed per step, below the cap
@@ -110,8 +110,8 @@ class Parameters:
             ("acceleration", self.acceleration in ACCELERATIONS, f"one of {ACCELERATIONS}"),
             ("anderson_memory", 1 <= int(self.anderson_memory) <= 50, "an integer in 1..50"),
             ("domains", isinstance(self.domains, (int, np.integer)) and 1 <= self.domains <= 64, "an integer in 1..64"),
-            ("domains", self.domains == 1 or (self.acceleration == "off" and not self.shuffle),
-             "1 with acceleration or shuffle (the domain-decomposed sweep has its own order)"),
+            ("domains", self.domains == 1 or not self.shuffle,
+             "1 with shuffle (the domain-decomposed sweep has its own order)"),
             ("gravity", len(self.gravity) == 2 and np.all(np.isfinite(self.gravity)), "a finite 2-vector in m s-2"),
             ("overlap_recovery_speed", self.overlap_recovery_speed >= 0, ">= 0 m s-1"),
             ("overlap_recovery_rate", 0 <= self.overlap_recovery_rate <= 1, "in [0, 1]"),
@@ -331,7 +331,8 @@ class Simulation:
         if p.acceleration == "anderson":
             result = acceleration.solve_problem_anderson(problem, pn, pt, vx, vy, om, tolerance=p.tolerance,
                                                          max_tolerance=p.max_tolerance,
-                                                         max_iterations=p.max_iterations, memory=p.anderson_memory)
+                                                         max_iterations=p.max_iterations, memory=p.anderson_memory,
+                                                         domains=p.domains, x=self.position[:self.n_particles, 0])
         elif p.domains > 1:
             result = parallel_nlgs.solve_problem_domains(problem, self.position[:self.n_particles, 0], pn, pt, vx, vy,
                                                          om, domains=p.domains, tolerance=p.tolerance,

@@ -149,3 +149,28 @@ def test_iteration_limit_reports_the_residual_reached():
                                  np.zeros(4), np.zeros(4), pn, pt, *v, inv_mass, np.zeros(4), inv_mass.copy(),
                                  inv_inertia, 1e-14, 1e-14, 1, False, 0)
     assert it == 1 and quad > 1e-14  # stopped by the limit, residual reported
+
+
+@pytest.mark.parametrize("seed", range(3))
+def test_a_sweep_returns_the_scale_of_its_end_impulses(seed):
+    """The sweep accumulates S = sum_k p_k . W_k p_k and the loaded points as it goes; each
+    point is swept once, so they are those of the end-of-sweep impulses (numpy, here) and the
+    norms equal the ones computed after the sweep from the impulses."""
+    rng = np.random.default_rng(seed)
+    a, b, nx, ny, ra, rb, inv_mass, inv_inertia, H, minv, W = _random_frictionless_system(rng)
+    v_free = rng.normal(scale=0.1, size=(4, 3))
+    v_free[3] = 0.0
+    geometry = (a, b, nx, ny, ra[:, 0].copy(), ra[:, 1].copy(), rb[:, 0].copy(), rb[:, 1].copy())
+    masses = (inv_mass, np.zeros(4), inv_mass.copy(), inv_inertia)
+    wnn, wnt, wtt = nlgs.delassus(*geometry, *masses)
+    pn, pt = np.zeros(4), np.zeros(4)
+    vx, vy, w = (v_free[:, k].copy() for k in range(3))
+    for _ in range(3):
+        total, top, scale, active = nlgs.sweep(np.arange(4)[::-1].copy(), *geometry, np.zeros(4), np.full(4, 0.3),
+                                               pn, pt, vx, vy, w, *masses, wnn, wnt, wtt)
+        loaded = pn > 0
+        expected = np.sum((pn * (wnn * pn + wnt * pt) + pt * (wnt * pn + wtt * pt))[loaded])
+        assert active == loaded.sum() and scale == pytest.approx(expected, rel=1e-14)
+        assert nlgs.sweep_norms(total, top, scale, active) == pytest.approx(
+            nlgs.norms(total, top, pn, pt, wnn, wnt, wtt), rel=1e-14)
+    assert active > 0

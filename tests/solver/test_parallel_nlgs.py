@@ -102,6 +102,7 @@ def test_parallel_sweep_is_the_serial_sweep_in_domain_order(problem):
                                         wnn[order], wnt[order], wtt[order])
         # the same updates; the sums differ only by the order of their terms
         assert b[0] == pytest.approx(a[0], rel=1e-12) and b[1] == a[1]
+        assert b[2] == pytest.approx(a[2], rel=1e-12) and b[3] == a[3]
     dec.scatter(parallel, pn, pt, vx, vy, w)
     for x, y in zip(serial, (pn, pt, vx, vy, w)):
         np.testing.assert_array_equal(x, y)
@@ -160,6 +161,7 @@ def test_runs_with_domains_are_deterministic_and_refuse_other_orders():
     from grainview.errors import ParameterError
 
     with pytest.raises(ParameterError, match="domains"):
-        Parameters(domains=2, acceleration="anderson").validate()
+        Parameters(domains=2, shuffle=True).validate()
+    Parameters(domains=2, acceleration="anderson").validate()  # the Anderson form runs on domains too
     with pytest.raises(ParameterError, match="domains"):
         Parameters(domains=0).validate()

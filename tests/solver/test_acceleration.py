@@ -1,0 +1,151 @@
+"""Anderson-accelerated NLGS against a slow numpy version of the same method.
+
+The kernel (solver.acceleration) keeps its history point by point, solves the least-squares
+problem by normal equations updated one row per sweep and updates the body velocities by the
+extrapolation's change. The reference below keeps whole vectors, calls numpy's least squares
+and rebuilds the velocities from the free ones: the two must give the same iterates, serial
+and over the domain-decomposed sweep, and the domain form must not depend on the thread count.
+"""
+
+from __future__ import annotations
+
+import warnings
+
+import numba
+import numpy as np
+import pytest
+
+from grainview.errors import ConvergenceWarning
+from solver import acceleration, compaction_sample, isotropic_compaction, nlgs, parallel_nlgs, residuals
+
+
+@pytest.fixture(scope="module")
+def problem():
+    """The contact problem of a step of 120 pentagons compacted under 10 kPa, warm-started."""
+    sim = compaction_sample(120, "pentagon", seed=5)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", ConvergenceWarning)
+        isotropic_compaction(sim)
+    pts = sim.detect()
+    impulse = sim._matched_impulses(sim._point_keys(pts))
+    v_start, omega_start, v_free, omega_free = sim._free_velocities()
+    prob, _, _ = sim._contact_problem(pts, v_start, omega_start)
+    # half the warm start: the solve has work to do
+    state = [0.5 * impulse[:, 0], 0.5 * impulse[:, 1], v_free[:, 0].copy(), v_free[:, 1].copy(), omega_free.copy()]
+    return sim, prob, state
+
+
+def _copy(state):
+    return [s.copy() for s in state]
+
+
+def reference_anderson(geometry, masses, state, sweep, iterations, memory):
+    """Anderson type II on the fixed-point map 'one sweep', with whole vectors: gamma from
+    numpy's least squares on the last ``memory`` differences, the extrapolation projected on
+    the Coulomb cones, the velocities rebuilt from the free ones; the history is forgotten
+    when |f| grows. Returns the impulses after ``iterations`` sweeps."""
+    a, b, nx, ny, rax, ray, rbx, rby, bias, mu = geometry
+    pn, pt, vx, vy, w = state
+    free = (vx.copy(), vy.copy(), w.copy())
+    wnn, wnt, wtt = nlgs.delassus(a, b, nx, ny, rax, ray, rbx, rby, *masses)
+    nlgs.velocities_from_impulses(a, b, nx, ny, rax, ray, rbx, rby, pn, pt, vx, vy, w, *masses)
+    fs, gs, last = [], [], np.inf
+    for _ in range(iterations):
+        x = np.concatenate([pn, pt])
+        sweep(pn, pt, vx, vy, w, wnn, wnt, wtt)
+        g = np.concatenate([pn, pt])
+        f = g - x
+        if f @ f > last or not fs:
+            fs, gs = [], []
+        last = f @ f
+        fs, gs = (fs + [f])[-(memory + 1):], (gs + [g])[-(memory + 1):]
+        if len(fs) < 2:
+            continue
+        d_f, d_g = np.diff(fs, axis=0).T, np.diff(gs, axis=0).T
+        gamma = np.linalg.lstsq(d_f, f, rcond=None)[0]
+        e = g - d_g @ gamma
+        m = pn.size
+        projected = np.array([residuals.cone_projection(e[k], e[m + k], mu[k]) for k in range(m)])
+        pn[:], pt[:] = projected[:, 0], projected[:, 1]
+        vx[:], vy[:], w[:] = free[0], free[1], free[2]
+        nlgs.velocities_from_impulses(a, b, nx, ny, rax, ray, rbx, rby, pn, pt, vx, vy, w, *masses)
+    return pn, pt
+
+
+def _geometry(prob):
+    return (prob.a, prob.b, prob.nx, prob.ny, prob.rax, prob.ray, prob.rbx, prob.rby, prob.bias, prob.mu)
+
+
+def _masses(prob):
+    return (prob.minv_xx, prob.minv_xy, prob.minv_yy, prob.iinv)
+
+
+ITERATIONS = 15
+
+
+def test_serial_kernel_equals_the_numpy_reference(problem):
+    _, prob, state = problem
+    geometry, masses = _geometry(prob), _masses(prob)
+    order = np.arange(prob.a.size)
+
+    def sweep(pn, pt, vx, vy, w, wnn, wnt, wtt):
+        nlgs.sweep(order, *geometry, pn, pt, vx, vy, w, *masses, wnn, wnt, wtt)
+
+    expected = reference_anderson(geometry, masses, _copy(state), sweep, ITERATIONS, memory=4)
+    got = _copy(state)
+    result = acceleration.solve_problem_anderson(prob, *got, tolerance=0.0, max_tolerance=0.0,
+                                                 max_iterations=ITERATIONS, memory=4)
+    assert result.iterations == ITERATIONS
+    scale = np.abs(expected[0]).max()
+    np.testing.assert_allclose(got[0], expected[0], rtol=0, atol=1e-9 * scale)
+    np.testing.assert_allclose(got[1], expected[1], rtol=0, atol=1e-9 * scale)
+    # the incremental velocity updates stay v = v_free + M^-1 H p
+    rebuilt = _copy(state)[2:]
+    nlgs.velocities_from_impulses(*geometry[:8], got[0], got[1], *rebuilt, *masses)
+    for v, r in zip(got[2:], rebuilt):
+        np.testing.assert_allclose(v, r, rtol=0, atol=1e-12 * np.abs(r).max())
+
+
+def test_domain_kernel_equals_the_numpy_reference_over_the_domain_sweep(problem):
+    sim, prob, state = problem
+    dec = parallel_nlgs.decompose(prob, sim.position[:, 0], 3)
+    geometry, masses, new_state = dec.gather(prob, *_copy(state))
+
+    def sweep(pn, pt, vx, vy, w, wnn, wnt, wtt):
+        parallel_nlgs.sweep_domains(dec.ptr, dec.points, dec.interface, *geometry, pn, pt, vx, vy, w, *masses,
+                                    wnn, wnt, wtt)
+
+    expected = reference_anderson(geometry, masses, [s.copy() for s in new_state], sweep, ITERATIONS, memory=4)
+    got = _copy(state)
+    acceleration.solve_problem_anderson(prob, *got, tolerance=0.0, max_tolerance=0.0, max_iterations=ITERATIONS,
+                                        memory=4, domains=3, x=sim.position[:, 0])
+    scale = np.abs(expected[0]).max()
+    np.testing.assert_allclose(got[0][dec.point_order], expected[0], rtol=0, atol=1e-9 * scale)
+    np.testing.assert_allclose(got[1][dec.point_order], expected[1], rtol=0, atol=1e-9 * scale)
+
+
+def test_domain_form_converges_to_an_admissible_solution_whatever_the_threads(problem):
+    sim, prob, state = problem
+    options = dict(tolerance=1e-5, max_tolerance=1e-3, max_iterations=20000, memory=5, domains=2,
+                   x=sim.position[:, 0])
+    threads = numba.get_num_threads()
+    try:
+        numba.set_num_threads(1)
+        one = _copy(state)
+        r1 = acceleration.solve_problem_anderson(prob, *one, **options)
+        numba.set_num_threads(max(2, threads) if numba.config.NUMBA_NUM_THREADS >= 2 else 1)
+        two = _copy(state)
+        r2 = acceleration.solve_problem_anderson(prob, *two, **options)
+    finally:
+        numba.set_num_threads(threads)
+    assert r1 == r2 and r1.iterations < 20000
+    for x, y in zip(one, two):
+        np.testing.assert_array_equal(x, y)
+    assert residuals.local_law_residual(prob, *one) < 2e-5
+    # fewer sweeps than the plain domain sweep to the same tolerance
+    plain = _copy(state)
+    r0 = parallel_nlgs.solve_problem_domains(prob, sim.position[:, 0], *plain, domains=2, tolerance=1e-5,
+                                             max_tolerance=1e-3, max_iterations=20000)
+    assert r1.iterations < 0.5 * r0.iterations, (r1, r0)
+    # the same confining load on the walls as the plain solution (same statics, other network)
+    assert one[0].sum() == pytest.approx(plain[0].sum(), rel=1e-3)
