@@ -192,44 +192,76 @@ class Decomposition(NamedTuple):
             original[self.source[self.moving]] = solved[self.moving]
 
 
+@njit(cache=True)
+def renumber(a, b, body_domain, ptr, points, interface, domains):
+    """The numbering of :class:`Decomposition`: (point_order, a, b, source, moving) for points
+    ``a, b`` whose bodies lie in ``body_domain`` and whose domains are ``points[ptr[d]:ptr[d +
+    1]]`` and ``interface`` (:func:`partition_points`). Bodies are stored group by group — per
+    domain its moving bodies then its copies of the still walls, then the shared bodies and the
+    interface's still walls — each group in the bodies' own order."""
+    n_bodies = body_domain.size
+    count = np.zeros(domains + 1, dtype=np.int64)  # moving bodies per group; the last: the shared ones
+    free_rank = np.full(n_bodies, -1, dtype=np.int64)
+    n_free = 0
+    for j in range(n_bodies):
+        d = body_domain[j]
+        if d == FREE:
+            free_rank[j] = n_free
+            n_free += 1
+        else:
+            count[domains if d == SHARED else d] += 1
+    start = np.zeros(domains + 1, dtype=np.int64)
+    size = 0
+    for g in range(domains + 1):
+        start[g] = size
+        size += count[g] + n_free
+    source = np.empty(size, dtype=np.int64)
+    new_of = np.full(n_bodies, -1, dtype=np.int64)
+    fill = start.copy()
+    for j in range(n_bodies):
+        d = body_domain[j]
+        if d != FREE:
+            g = domains if d == SHARED else d
+            new_of[j] = fill[g]
+            source[fill[g]] = j
+            fill[g] += 1
+        else:
+            for g in range(domains + 1):
+                source[start[g] + count[g] + free_rank[j]] = j
+    m = a.size
+    point_order = np.empty(m, dtype=np.int64)
+    new_a = np.empty(m, dtype=np.int64)
+    new_b = np.empty(m, dtype=np.int64)
+    n_inner = ptr[domains]
+    point_order[:n_inner] = points
+    point_order[n_inner:] = interface
+    g = 0
+    for q in range(m):
+        while g < domains and q >= ptr[g + 1]:
+            g += 1
+        k = point_order[q]
+        for body, out in ((a[k], new_a), (b[k], new_b)):
+            out[q] = start[g] + count[g] + free_rank[body] if free_rank[body] >= 0 else new_of[body]
+    moving = np.empty(size - (domains + 1) * n_free, dtype=np.int64)
+    n = 0
+    for g in range(domains + 1):
+        for i in range(count[g]):
+            moving[n] = start[g] + i
+            n += 1
+    return point_order, new_a, new_b, source, moving
+
+
 def decompose(problem, x, domains) -> Decomposition:
     """The :class:`Decomposition` of ``problem`` with the particles (centres' abscissae ``x``,
     m) cut into ``domains`` slabs."""
-    n_bodies = problem.minv_xx.size
     domains = int(domains)
-    body_domain = body_domains(np.asarray(x, float), n_bodies, problem.minv_xx, problem.minv_yy, problem.iinv,
-                               domains)
+    body_domain = body_domains(np.asarray(x, float), problem.minv_xx.size, problem.minv_xx, problem.minv_yy,
+                               problem.iinv, domains)
     ptr, points, interface = partition_points(problem.a, problem.b, body_domain, domains)
-    point_order = np.concatenate([points, interface])
-    free = np.flatnonzero(body_domain == FREE)
-    free_rank = np.full(n_bodies, -1, dtype=np.int64)
-    free_rank[free] = np.arange(free.size)
-    # body groups in storage order: per domain its moving bodies and its copies of the still
-    # walls; then the shared bodies and the interface's still walls
-    groups, free_offset, new_of = [], [], np.full(n_bodies, -1, dtype=np.int64)
-    size = 0
-    for d in range(domains):
-        mine = np.flatnonzero(body_domain == d)
-        new_of[mine] = size + np.arange(mine.size)
-        free_offset.append(size + mine.size)
-        groups += [mine, free]
-        size += mine.size + free.size
-    shared = np.flatnonzero(body_domain == SHARED)
-    new_of[shared] = size + np.arange(shared.size)
-    free_offset.append(size + shared.size)
-    groups += [shared, free]
-    source = np.concatenate(groups)
-    owner = np.full(problem.a.size, domains, dtype=np.int64)  # the interface: the last "domain"
-    owner[points] = np.repeat(np.arange(domains), np.diff(ptr))
-    free_offset = np.asarray(free_offset, dtype=np.int64)
-    renumbered = []
-    for bodies in (problem.a, problem.b):
-        bodies = np.asarray(bodies, dtype=np.int64)
-        new = new_of[bodies]
-        still = free_rank[bodies] >= 0
-        new[still] = free_offset[owner[still]] + free_rank[bodies[still]]
-        renumbered.append(np.ascontiguousarray(new[point_order]))
-    return Decomposition(ptr, point_order, renumbered[0], renumbered[1], source, np.sort(new_of[new_of >= 0]))
+    point_order, a, b, source, moving = renumber(np.asarray(problem.a, dtype=np.int64),
+                                                 np.asarray(problem.b, dtype=np.int64), body_domain, ptr, points,
+                                                 interface, domains)
+    return Decomposition(ptr, point_order, a, b, source, moving)
 
 
 def solve_problem_domains(problem, x, pn, pt, vx, vy, w, *, domains, tolerance, max_tolerance,

@@ -10,12 +10,14 @@ One step of length h (the theta-scheme, theta = 1/2 by default), each stage a me
 3. ``_free_velocities``: v_free = v- + h M^-1 F_ext (gravity, wall stresses);
 4. ``_contact_problem``: the points' geometry, Delassus data and Signorini shifts as one
    :class:`solver.nlgs.ContactProblem`;
-5. ``nlgs.solve_problem`` (or its Anderson-accelerated form, :mod:`solver.acceleration`) for
-   the impulses p and the end-of-step velocities v+, then the
-   solution's local-law residual and unbalanced force (:mod:`solver.residuals`) for the report;
+5. ``_solve``: the NLGS (:mod:`solver.nlgs`; Anderson-accelerated, :mod:`solver.acceleration`,
+   and/or on several domains, :mod:`solver.parallel_nlgs`, as the parameters say) for the
+   impulses p and the end-of-step velocities v+, then the solution's local-law residual and
+   unbalanced force (:mod:`solver.residuals`) for the report;
 6. ``_end_velocities``: walls driven as they are (imposed, fixed, capped);
 7. ``_integrate``: x+ = x- + h [(1 - theta) v- + theta v+], likewise angles and wall
-   positions, with the split-impulse removal of remaining overlaps.
+   positions, with the split-impulse removal of remaining overlaps (a second contact problem,
+   solved by the same ``_solve``).
 
 Forces are impulses divided by h. Nothing here loops over particles or contacts in Python:
 each stage is one numba kernel or one vectorised numpy expression.
@@ -328,20 +330,8 @@ class Simulation:
         vx, vy, om = v_free[:, 0].copy(), v_free[:, 1].copy(), omega_free.copy()
         pn, pt = impulse[:, 0].copy(), impulse[:, 1].copy()
         p = self.parameters
-        if p.acceleration == "anderson":
-            result = acceleration.solve_problem_anderson(problem, pn, pt, vx, vy, om, tolerance=p.tolerance,
-                                                         max_tolerance=p.max_tolerance,
-                                                         max_iterations=p.max_iterations, memory=p.anderson_memory,
-                                                         domains=p.domains, x=self.position[:self.n_particles, 0])
-        elif p.domains > 1:
-            result = parallel_nlgs.solve_problem_domains(problem, self.position[:self.n_particles, 0], pn, pt, vx, vy,
-                                                         om, domains=p.domains, tolerance=p.tolerance,
-                                                         max_tolerance=p.max_tolerance,
-                                                         max_iterations=p.max_iterations)
-        else:
-            result = nlgs.solve_problem(problem, pn, pt, vx, vy, om, tolerance=p.tolerance,
-                                        max_tolerance=p.max_tolerance, max_iterations=p.max_iterations,
-                                        shuffle=p.shuffle, seed=p.seed + self.step_index)
+        result = self._solve(problem, pn, pt, vx, vy, om, p.tolerance, p.max_tolerance, p.max_iterations,
+                             shuffle=p.shuffle)
         self.timings["solve"] += time.perf_counter() - solve_start
         update_start = time.perf_counter()
         converged = self._count_solve(result, len(keys))
@@ -489,6 +479,24 @@ class Simulation:
         p = self.parameters
         return np.maximum(g_star, 0.0) / (p.theta * p.time_step)
 
+    def _solve(self, problem, pn, pt, vx, vy, om, tolerance, max_tolerance, max_iterations, shuffle=False):
+        """Solve a contact problem in place with the sweeps the parameters choose: Anderson-
+        accelerated (:mod:`solver.acceleration`), domain-decomposed
+        (:mod:`solver.parallel_nlgs`), or the serial NLGS (:mod:`solver.nlgs`), in a random order
+        when ``shuffle``. Returns the :class:`solver.nlgs.NLGSResult`."""
+        p = self.parameters
+        x = self.position[:self.n_particles, 0]
+        if p.acceleration == "anderson":
+            return acceleration.solve_problem_anderson(problem, pn, pt, vx, vy, om, tolerance=tolerance,
+                                                       max_tolerance=max_tolerance, max_iterations=max_iterations,
+                                                       memory=p.anderson_memory, domains=p.domains, x=x)
+        if p.domains > 1:
+            return parallel_nlgs.solve_problem_domains(problem, x, pn, pt, vx, vy, om, domains=p.domains,
+                                                       tolerance=tolerance, max_tolerance=max_tolerance,
+                                                       max_iterations=max_iterations)
+        return nlgs.solve_problem(problem, pn, pt, vx, vy, om, tolerance=tolerance, max_tolerance=max_tolerance,
+                                  max_iterations=max_iterations, shuffle=shuffle, seed=p.seed + self.step_index)
+
     def _recover_overlaps(self, problem, g_end):
         """Split-impulse removal of overlaps: pseudo-velocities that move the bodies apart at
         most at ``overlap_recovery_speed``, removing ``overlap_recovery_rate`` of each overlap
@@ -502,9 +510,8 @@ class Simulation:
         recovery = problem._replace(bias=np.where(g_end >= 0.0, g_end / h, -recover), mu=np.zeros(m))
         bodies = self.n_particles + self.n_walls
         vx, vy, om = np.zeros(bodies), np.zeros(bodies), np.zeros(bodies)
-        result = nlgs.solve_problem(recovery, np.zeros(m), np.zeros(m), vx, vy, om,
-                                    tolerance=p.overlap_recovery_tolerance, max_tolerance=1.0,
-                                    max_iterations=p.overlap_recovery_iterations)
+        result = self._solve(recovery, np.zeros(m), np.zeros(m), vx, vy, om, p.overlap_recovery_tolerance, 1.0,
+                             p.overlap_recovery_iterations)
         self.counters["recovery_sweeps"] += result.iterations
         return np.stack([vx, vy], -1), om
 
