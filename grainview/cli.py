@@ -369,8 +369,8 @@ def build_parser() -> argparse.ArgumentParser:
                              help="NLGS tolerance, quadratic norm of the velocity changes over a sweep "
                              "(default 1.7e-4; docs/solver.md)")
         physics.add_argument("--acceleration", choices=("off", "anderson"), default=None,
-                             help="'anderson': Anderson-accelerated NLGS sweeps, same accuracy in 1.7-2.6x less "
-                             "solve time on dense sheared samples (default off; docs/solver.md)")
+                             help="'anderson': Anderson-accelerated NLGS sweeps, the same local-law residual in "
+                             "1.6-1.8x less time per step over a whole shear (default off; docs/solver.md)")
         physics.add_argument("--domains", type=int, default=None,
                              help="NLGS domains swept at once, one per core (default 1: the serial sweep; "
                              "deterministic for a given number; combines with --acceleration; on free cores only; "
