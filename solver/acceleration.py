@@ -38,7 +38,7 @@ import numpy as np
 from numba import njit, prange
 
 from .nlgs import NLGSResult, _apply, delassus, sweep, sweep_norms, velocities_from_impulses
-from .parallel_nlgs import decompose, sweep_domains
+from .parallel_nlgs import solve_decomposed, sweep_domains
 from .residuals import cone_projection
 
 __all__ = ["solve_anderson", "solve_problem_anderson"]
@@ -331,15 +331,13 @@ def solve_problem_anderson(problem, pn, pt, vx, vy, w, *, tolerance, max_toleran
     thread too."""
     options = (float(tolerance), float(max_tolerance), int(max_iterations), int(memory))
     if domains > 1:
-        dec = decompose(problem, x, domains)
-        geometry, masses, state = dec.gather(problem, pn, pt, vx, vy, w)
-        blocks = np.append(dec.ptr, dec.point_order.size)
-        iterations, residual, worst = solve_anderson(blocks, *geometry, *state, *masses, *options)
-        dec.scatter(state, pn, pt, vx, vy, w)
-    else:
-        blocks = np.array([0, problem.a.size], dtype=np.int64)
-        iterations, residual, worst = solve_anderson(
-            blocks, problem.a, problem.b, problem.nx, problem.ny, problem.rax, problem.ray, problem.rbx, problem.rby,
-            problem.bias, problem.mu, pn, pt, vx, vy, w, problem.minv_xx, problem.minv_xy, problem.minv_yy,
-            problem.iinv, *options)
+        def kernel(dec, geometry, state, masses):
+            return solve_anderson(dec.blocks, *geometry, *state, *masses, *options)
+
+        return solve_decomposed(problem, x, domains, (pn, pt, vx, vy, w), kernel)
+    blocks = np.array([0, problem.a.size], dtype=np.int64)
+    iterations, residual, worst = solve_anderson(
+        blocks, problem.a, problem.b, problem.nx, problem.ny, problem.rax, problem.ray, problem.rbx, problem.rby,
+        problem.bias, problem.mu, pn, pt, vx, vy, w, problem.minv_xx, problem.minv_xy, problem.minv_yy,
+        problem.iinv, *options)
     return NLGSResult(int(iterations), float(residual), float(worst))

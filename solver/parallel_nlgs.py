@@ -171,6 +171,12 @@ class Decomposition(NamedTuple):
         """The interface points in the new numbering."""
         return np.arange(self.ptr[-1], self.point_order.size)
 
+    @property
+    def blocks(self):
+        """The boundaries of the points' blocks in the new numbering: ``ptr`` then the number of
+        points (the last block is the interface)."""
+        return np.append(self.ptr, self.point_order.size)
+
     def gather(self, problem, pn, pt, vx, vy, w):
         """The problem's arrays in the new numbering: (geometry, masses, state) with geometry =
         (a, b, nx, ny, rax, ray, rbx, rby, bias, mu), masses = (minv_xx, minv_xy, minv_yy, iinv)
@@ -270,9 +276,20 @@ def solve_problem_domains(problem, x, pn, pt, vx, vy, w, *, domains, tolerance, 
     (module docstring) with ``domains`` slabs of the particles whose centres have abscissae
     ``x`` (m, the first ``x.size`` bodies); arguments and result otherwise as
     :func:`solver.nlgs.solve_problem`."""
+    def kernel(dec, geometry, state, masses):
+        return solve_domains(dec.ptr, dec.points, dec.interface, *geometry, *state, *masses, tolerance, max_tolerance,
+                             int(max_iterations))
+
+    return solve_decomposed(problem, x, domains, (pn, pt, vx, vy, w), kernel)
+
+
+def solve_decomposed(problem, x, domains, state, kernel) -> NLGSResult:
+    """Lay ``problem`` out by ``domains`` slabs of the particles (centres' abscissae ``x``, m;
+    :func:`decompose`), run ``kernel(decomposition, geometry, state, masses)`` on the renumbered
+    arrays (:meth:`Decomposition.gather`; it returns sweeps and the two norms) and write the
+    solved impulses and velocities back into ``state`` = (pn, pt, vx, vy, w), in place."""
     dec = decompose(problem, x, domains)
-    geometry, masses, state = dec.gather(problem, pn, pt, vx, vy, w)
-    iterations, residual, worst = solve_domains(dec.ptr, dec.points, dec.interface, *geometry, *state, *masses,
-                                                tolerance, max_tolerance, int(max_iterations))
-    dec.scatter(state, pn, pt, vx, vy, w)
+    geometry, masses, renumbered = dec.gather(problem, *state)
+    iterations, residual, worst = kernel(dec, geometry, renumbered, masses)
+    dec.scatter(renumbered, *state)
     return NLGSResult(int(iterations), float(residual), float(worst))
