@@ -103,7 +103,8 @@ def _solver_parameters(args) -> dict:
     from solver import Parameters
 
     given = {"wall_friction": args.wall_friction, "time_step": args.time_step, "tolerance": args.tolerance,
-             "acceleration": args.acceleration, "domains": getattr(args, "domains", None)}
+             "acceleration": args.acceleration, "domains": getattr(args, "domains", None),
+             "stall_sweeps": getattr(args, "stall_sweeps", None)}
     parameters = {k: v for k, v in given.items() if v is not None}
     Parameters(**parameters).validate()  # one clear line before anything is simulated
     return parameters
@@ -370,7 +371,10 @@ def build_parser() -> argparse.ArgumentParser:
                              "(default 1.7e-4; docs/solver.md)")
         physics.add_argument("--acceleration", choices=("off", "anderson"), default=None,
                              help="'anderson': Anderson-accelerated NLGS sweeps, the same local-law residual in "
-                             "1.6-1.8x less time per step over a whole shear (default off; docs/solver.md)")
+                             "less time per step (default off; docs/solver.md)")
+        physics.add_argument("--stall-sweeps", type=int, default=None,
+                             help="stop a step's NLGS when its quadratic norm has fallen less than 5%% over this many "
+                             "sweeps (a step that would creep to the sweep cap; default 0: never; docs/solver.md)")
         physics.add_argument("--domains", type=int, default=None,
                              help="NLGS domains swept at once, one per core (default 1: the serial sweep; "
                              "deterministic for a given number; combines with --acceleration; on free cores only; "

@@ -15,6 +15,14 @@ stays the NLGS's exact point-by-point solver, so the method is NLGS with an extr
 between sweeps, and its stopping norms are the NLGS's own (:mod:`solver.nlgs`), measured on the
 change a sweep makes.
 
+The map G may be several sweeps (``period`` k: Anderson on G = S^k, S one sweep). The
+extrapolation and its history passes cost about as much as a sweep each time they run; taking
+them after every k-th sweep only divides that cost by k, and the sweeps in between carry the
+extrapolation on. The stopping norms are still checked after every sweep. On the same captured
+problems of sheared dense packings k = 2 needs a few more sweeps than k = 1 and less time;
+over whole steps, where each run follows its own trajectory, the two are not told apart
+(docs/solver.md), and k = 1 stays the default.
+
 Safeguard: the problem is nonsmooth (contacts open, close, stick and slip between sweeps), so
 when an iterate's change |f_k| grows above the previous one the history is forgotten and the
 plain sweeps' result kept: the method falls back to NLGS until the sweeps contract again.
@@ -37,7 +45,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit, prange
 
-from .nlgs import NLGSResult, _apply, delassus, sweep, sweep_norms, velocities_from_impulses
+from .nlgs import NLGSResult, _apply, delassus, stalled, sweep, sweep_norms, velocities_from_impulses
 from .parallel_nlgs import solve_decomposed, sweep_domains
 from .residuals import cone_projection
 
@@ -236,9 +244,12 @@ def _extrapolate_blocks(blocks, body_blocks, gamma, count, dgn, dgt, dvx, dvy, d
 
 @njit(cache=True)
 def solve_anderson(blocks, a, b, nx, ny, rax, ray, rbx, rby, bias, mu, pn, pt, vx, vy, w,
-                   minv_xx, minv_xy, minv_yy, iinv, tol, max_tol, max_iterations, memory):
+                   minv_xx, minv_xy, minv_yy, iinv, tol, max_tol, max_iterations, memory, period=1, stall=0):
     """Anderson-accelerated NLGS (module docstring); arguments, in-place updates and result as
-    :func:`solver.nlgs.solve` without the ordering options; ``memory`` is m.
+    :func:`solver.nlgs.solve` without the ordering options; ``memory`` is m, ``period`` the
+    number of sweeps that make the map G (the history is taken and the iterate extrapolated
+    after every ``period``-th sweep; the stopping norms are checked after every sweep),
+    ``stall`` the sweeps of the stall test (:func:`solver.nlgs.stalled`; 0: none).
 
     ``blocks`` holds the boundaries of the points' blocks: ``[0, P]`` for the serial sweep over
     all points in their order, or ``[0, p_1, ..., p_D, P]`` for the domain-decomposed sweep of
@@ -272,6 +283,7 @@ def solve_anderson(blocks, a, b, nx, ny, rax, ray, rbx, rby, bias, mu, pn, pt, v
     last = np.inf
     quad = 0.0
     worst = 0.0
+    watch = np.full(2, np.inf)
     for it in range(1, max_iterations + 1):
         if parallel:
             quad, worst = sweep_norms(*sweep_domains(ptr, points, interface, a, b, nx, ny, rax, ray, rbx, rby, bias, mu,
@@ -279,8 +291,10 @@ def solve_anderson(blocks, a, b, nx, ny, rax, ray, rbx, rby, bias, mu, pn, pt, v
         else:
             quad, worst = sweep_norms(*sweep(order, a, b, nx, ny, rax, ray, rbx, rby, bias, mu, pn, pt, vx, vy, w,
                                              minv_xx, minv_xy, minv_yy, iinv, wnn, wnt, wtt))
-        if quad <= tol and worst <= max_tol:
+        if (quad <= tol and worst <= max_tol) or stalled(it, quad, watch, stall):
             return it, quad, worst
+        if it % period != 0 or it == max_iterations:  # the last sweep's iterate is the one its norms describe
+            continue
         # the history, assuming the sweeps still contract; forgotten below if they do not
         slot = head if have_prev else -1
         used = min(count + 1, memory) if have_prev else 0
@@ -321,15 +335,16 @@ def solve_anderson(blocks, a, b, nx, ny, rax, ray, rbx, rby, bias, mu, pn, pt, v
 
 
 def solve_problem_anderson(problem, pn, pt, vx, vy, w, *, tolerance, max_tolerance, max_iterations,
-                           memory=3, domains=1, x=None) -> NLGSResult:
+                           memory=3, domains=1, x=None, period=1, stall=0) -> NLGSResult:
     """Solve ``problem`` (:class:`solver.nlgs.ContactProblem`) by Anderson-accelerated NLGS
     sweeps (module docstring); same arguments, in-place updates and result as
     :func:`solver.nlgs.solve_problem`. ``memory`` is m, the number of past sweeps combined.
     With ``domains`` > 1 the sweeps are the domain-decomposed ones of
     :mod:`solver.parallel_nlgs`, the particles (the first ``x.size`` bodies, centres'
     abscissae ``x``, m) cut into that many slabs, and the history passes run a domain per
-    thread too."""
-    options = (float(tolerance), float(max_tolerance), int(max_iterations), int(memory))
+    thread too. ``period``: the sweeps between two extrapolations (Anderson on the map
+    "``period`` sweeps", module docstring); ``stall`` as in :func:`solver.nlgs.solve_problem`."""
+    options = (float(tolerance), float(max_tolerance), int(max_iterations), int(memory), int(period), int(stall))
     if domains > 1:
         def kernel(dec, geometry, state, masses):
             return solve_anderson(dec.blocks, *geometry, *state, *masses, *options)

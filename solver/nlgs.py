@@ -31,6 +31,15 @@ LMGC90's reference criterion (tolerance 1.666e-4), and the max norm keeps a sing
 loaded contact among thousands (whose change is diluted in the quadratic sum) from stopping
 the iterations before its force has built up. With S = 0 (no impulse anywhere) the sweep has
 converged when no impulse changed.
+
+Stall (``stall`` sweeps W > 0). In a step where the packing rearranges, the sweeps can creep
+for thousands of sweeps with the quadratic norm just above its tolerance, or wander around it.
+After every W sweeps the smallest quadratic norm reached so far is compared with the smallest
+at the previous check; when it has not fallen by at least ``STALL_IMPROVEMENT`` (5%), the
+iterations stop there (:func:`stalled`). Such a step has not converged: its norms are returned
+as they are, and the stepper warns as it does for a step stopped by the sweep cap. W = 0 turns
+the test off. The local-law residual (:mod:`solver.residuals`) of the steps stopped this way is
+what the test is judged by (docs/solver.md).
 """
 
 from __future__ import annotations
@@ -67,6 +76,10 @@ class ContactProblem(NamedTuple):
     minv_xy: np.ndarray
     minv_yy: np.ndarray
     iinv: np.ndarray
+
+
+STALL_IMPROVEMENT = 0.05
+"""Least relative fall of the best quadratic norm over ``stall`` sweeps (module docstring)."""
 
 
 class NLGSResult(NamedTuple):
@@ -188,10 +201,26 @@ def _shuffle(order, state):
     return state
 
 
+@njit(cache=True, inline="always")
+def stalled(it, quad, watch, stall):
+    """The stall test after sweep ``it`` of quadratic norm ``quad`` (module docstring):
+    ``watch`` = [best norm so far, best at the previous check] (float64 (2,), updated in place,
+    starting at [inf, inf]); ``stall`` the sweeps between checks (0: never stalled)."""
+    if quad < watch[0]:
+        watch[0] = quad
+    if stall <= 0 or it % stall != 0:
+        return False
+    if watch[0] > (1.0 - STALL_IMPROVEMENT) * watch[1]:
+        return True
+    watch[1] = watch[0]
+    return False
+
+
 @njit(cache=True)
 def solve(a, b, nx, ny, rax, ray, rbx, rby, bias, mu, pn, pt, vx, vy, w,
-          minv_xx, minv_xy, minv_yy, iinv, tol, max_tol, max_iterations, shuffle, seed):
-    """Run NLGS sweeps until convergence; impulses (pn, pt) and velocities are updated in place.
+          minv_xx, minv_xy, minv_yy, iinv, tol, max_tol, max_iterations, shuffle, seed, stall=0):
+    """Run NLGS sweeps until convergence, a stall (``stall`` sweeps, module docstring) or
+    ``max_iterations`` sweeps; impulses (pn, pt) and velocities are updated in place.
 
     On entry ``pn, pt`` hold the warm-start impulses and ``vx, vy, w`` the free velocities;
     they are combined first. Returns (iterations, quadratic residual, max residual).
@@ -204,12 +233,13 @@ def solve(a, b, nx, ny, rax, ray, rbx, rby, bias, mu, pn, pt, vx, vy, w,
     state = np.uint64(seed) * np.uint64(0x9E3779B97F4A7C15) + np.uint64(1)  # never 0
     quad = 0.0
     worst = 0.0
+    watch = np.full(2, np.inf)
     for it in range(1, max_iterations + 1):
         if shuffle:
             state = _shuffle(order, state)
         quad, worst = sweep_norms(*sweep(order, a, b, nx, ny, rax, ray, rbx, rby, bias, mu, pn, pt, vx, vy, w,
                                          minv_xx, minv_xy, minv_yy, iinv, wnn, wnt, wtt))
-        if quad <= tol and worst <= max_tol:
+        if (quad <= tol and worst <= max_tol) or stalled(it, quad, watch, stall):
             return it, quad, worst
     return max_iterations, quad, worst
 
@@ -278,15 +308,16 @@ def velocities_from_impulses(a, b, nx, ny, rax, ray, rbx, rby, pn, pt, vx, vy, w
 
 
 def solve_problem(problem: ContactProblem, pn, pt, vx, vy, w, *, tolerance, max_tolerance, max_iterations,
-                  shuffle=False, seed=0) -> NLGSResult:
-    """Solve ``problem`` by NLGS sweeps until both norms are within their tolerances or
-    ``max_iterations`` sweeps have run. ``pn, pt`` (P,) hold the warm-start impulses (N s) and
-    ``vx, vy, w`` (B,) the free velocities on entry; all five are updated in place to the
-    solution. ``shuffle`` visits the points in a random order seeded by ``seed``."""
+                  shuffle=False, seed=0, stall=0) -> NLGSResult:
+    """Solve ``problem`` by NLGS sweeps until both norms are within their tolerances, the
+    sweeps stall (``stall`` sweeps without a 5% fall of the quadratic norm, module docstring;
+    0: never) or ``max_iterations`` sweeps have run. ``pn, pt`` (P,) hold the warm-start
+    impulses (N s) and ``vx, vy, w`` (B,) the free velocities on entry; all five are updated in
+    place to the solution. ``shuffle`` visits the points in a random order seeded by ``seed``."""
     iterations, residual, worst = solve(
         problem.a, problem.b, problem.nx, problem.ny, problem.rax, problem.ray, problem.rbx, problem.rby,
         problem.bias, problem.mu, pn, pt, vx, vy, w, problem.minv_xx, problem.minv_xy, problem.minv_yy,
-        problem.iinv, tolerance, max_tolerance, int(max_iterations), bool(shuffle), int(seed))
+        problem.iinv, tolerance, max_tolerance, int(max_iterations), bool(shuffle), int(seed), int(stall))
     return NLGSResult(int(iterations), float(residual), float(worst))
 
 

@@ -39,7 +39,7 @@ from typing import NamedTuple
 import numpy as np
 from numba import njit, prange
 
-from .nlgs import NLGSResult, delassus, sweep, sweep_norms, velocities_from_impulses
+from .nlgs import NLGSResult, delassus, stalled, sweep, sweep_norms, velocities_from_impulses
 
 FREE = -1
 """Domain of a body that never moves (zero inverse mass and inertia): shared by every domain."""
@@ -125,16 +125,17 @@ def sweep_domains(ptr, points, interface, a, b, nx, ny, rax, ray, rbx, rby, bias
 
 @njit(cache=True)
 def solve_domains(ptr, points, interface, a, b, nx, ny, rax, ray, rbx, rby, bias, mu, pn, pt, vx, vy, w,
-                  minv_xx, minv_xy, minv_yy, iinv, tol, max_tol, max_iterations):
+                  minv_xx, minv_xy, minv_yy, iinv, tol, max_tol, max_iterations, stall=0):
     """:func:`solver.nlgs.solve` with :func:`sweep_domains` as its sweep."""
     wnn, wnt, wtt = delassus(a, b, nx, ny, rax, ray, rbx, rby, minv_xx, minv_xy, minv_yy, iinv)
     velocities_from_impulses(a, b, nx, ny, rax, ray, rbx, rby, pn, pt, vx, vy, w, minv_xx, minv_xy, minv_yy, iinv)
     quad = 0.0
     worst = 0.0
+    watch = np.full(2, np.inf)
     for it in range(1, max_iterations + 1):
         quad, worst = sweep_norms(*sweep_domains(ptr, points, interface, a, b, nx, ny, rax, ray, rbx, rby, bias, mu,
                                                  pn, pt, vx, vy, w, minv_xx, minv_xy, minv_yy, iinv, wnn, wnt, wtt))
-        if quad <= tol and worst <= max_tol:
+        if (quad <= tol and worst <= max_tol) or stalled(it, quad, watch, stall):
             return it, quad, worst
     return max_iterations, quad, worst
 
@@ -271,14 +272,14 @@ def decompose(problem, x, domains) -> Decomposition:
 
 
 def solve_problem_domains(problem, x, pn, pt, vx, vy, w, *, domains, tolerance, max_tolerance,
-                          max_iterations) -> NLGSResult:
+                          max_iterations, stall=0) -> NLGSResult:
     """Solve ``problem`` (:class:`solver.nlgs.ContactProblem`) by domain-decomposed sweeps
     (module docstring) with ``domains`` slabs of the particles whose centres have abscissae
     ``x`` (m, the first ``x.size`` bodies); arguments and result otherwise as
     :func:`solver.nlgs.solve_problem`."""
     def kernel(dec, geometry, state, masses):
         return solve_domains(dec.ptr, dec.points, dec.interface, *geometry, *state, *masses, tolerance, max_tolerance,
-                             int(max_iterations))
+                             int(max_iterations), int(stall))
 
     return solve_decomposed(problem, x, domains, (pn, pt, vx, vy, w), kernel)
 

@@ -55,7 +55,8 @@ WALL_ATTRIBUTES = ("wall_mode", "wall_stress_Pa", "wall_mass_kg", "wall_max_spee
 BIAXIAL_ATTRIBUTES = ("strain_target", "wall_velocity_m_s", "snapshot_every", "biaxial_steps")
 
 
-LATER_PARAMETERS = {"acceleration": "off", "anderson_memory": 5, "domains": 1}
+LATER_PARAMETERS = {"acceleration": "off", "anderson_memory": 5, "anderson_period": 1, "domains": 1,
+                    "stall_sweeps": 0}
 """Parameters added after files were first written, with the value every older file ran with
 (not the current default, which may change): absent from a file, they take that value."""
 
@@ -77,7 +78,7 @@ def _parameters(attrs, source) -> Parameters:
             value = tuple(float(g) for g in np.atleast_1d(value))
         elif field.name == "shuffle":
             value = bool(value)
-        elif field.name in ("seed", "max_iterations", "anderson_memory", "domains"):
+        elif field.name in ("seed", "max_iterations", "stall_sweeps", "anderson_memory", "anderson_period", "domains"):
             value = int(value)
         else:
             value = float(value)

@@ -84,12 +84,14 @@ class Parameters:
     tolerance: float = 1.7e-4  # NLGS quadratic norm of the velocity changes over a sweep (solver.nlgs)
     max_tolerance: float = 1e-2  # NLGS max norm: largest single change over the RMS (solver.nlgs)
     max_iterations: int = 2000
+    stall_sweeps: int = 0  # > 0: NLGS stops when its quadratic norm falls < 5% over this many sweeps
     alert: float | None = None  # m; default: 2% of the smallest diameter
     skin: float | None = None  # m; default: 10% of the smallest diameter
     shuffle: bool = False  # random NLGS ordering
     seed: int = 0
     acceleration: str = "off"  # "anderson": Anderson-accelerated sweeps (solver.acceleration); no shuffling then
     anderson_memory: int = 3  # past iterates combined by the Anderson extrapolation
+    anderson_period: int = 1  # NLGS sweeps between two Anderson extrapolations
     domains: int = 1  # NLGS domains swept at once on several cores (solver.parallel_nlgs); 1: the serial sweep
     overlap_recovery_speed: float = 1e-3  # m s-1, cap of the split-impulse separation of overlaps
     overlap_recovery_rate: float = 0.2  # fraction of an overlap removed per step, below the cap
@@ -109,8 +111,10 @@ class Parameters:
             ("tolerance", self.tolerance > 0, "> 0"),
             ("max_tolerance", self.max_tolerance > 0, "> 0"),
             ("max_iterations", int(self.max_iterations) >= 1, ">= 1"),
+            ("stall_sweeps", int(self.stall_sweeps) >= 0, "a whole number of sweeps >= 0 (0: no stall test)"),
             ("acceleration", self.acceleration in ACCELERATIONS, f"one of {ACCELERATIONS}"),
             ("anderson_memory", 1 <= int(self.anderson_memory) <= 50, "an integer in 1..50"),
+            ("anderson_period", 1 <= int(self.anderson_period) <= 50, "an integer in 1..50"),
             ("domains", isinstance(self.domains, (int, np.integer)) and 1 <= self.domains <= 64, "an integer in 1..64"),
             ("domains", self.domains == 1 or not self.shuffle,
              "1 with shuffle (the domain-decomposed sweep has its own order)"),
@@ -331,7 +335,7 @@ class Simulation:
         pn, pt = impulse[:, 0].copy(), impulse[:, 1].copy()
         p = self.parameters
         result = self._solve(problem, pn, pt, vx, vy, om, p.tolerance, p.max_tolerance, p.max_iterations,
-                             shuffle=p.shuffle)
+                             shuffle=p.shuffle, stall=p.stall_sweeps)
         self.timings["solve"] += time.perf_counter() - solve_start
         update_start = time.perf_counter()
         converged = self._count_solve(result, len(keys))
@@ -415,18 +419,19 @@ class Simulation:
         return problem, ra, rb
 
     def _count_solve(self, result, n_points):
-        """Count the sweeps; warn (ConvergenceWarning) when the sweep cap stopped the NLGS
-        before both norms were met. Returns whether it converged."""
+        """Count the sweeps; warn (ConvergenceWarning) when the sweep cap or the stall test
+        stopped the NLGS before both norms were met. Returns whether it converged."""
         p = self.parameters
         self.counters["sweeps"] += result.iterations
         self.counters["point_sweeps"] += result.iterations * n_points
-        converged = result.iterations < p.max_iterations or (result.residual <= p.tolerance
-                                                              and result.max_residual <= p.max_tolerance)
+        converged = result.residual <= p.tolerance and result.max_residual <= p.max_tolerance
         if not converged:
-            warnings.warn(f"NLGS did not converge at step {self.step_index} (t = {self.time:.6g} s): "
-                          f"{result.iterations} iterations, quadratic residual {result.residual:.3g} (tolerance "
-                          f"{p.tolerance:g}), max residual {result.max_residual:.3g} (tolerance {p.max_tolerance:g})",
-                          ConvergenceWarning, stacklevel=3)
+            stop = ("the sweep cap" if result.iterations >= p.max_iterations else
+                    f"a stall (the quadratic norm fell < 5% over {p.stall_sweeps} sweeps)")
+            warnings.warn(f"NLGS did not converge at step {self.step_index} (t = {self.time:.6g} s): stopped by "
+                          f"{stop} after {result.iterations} iterations, quadratic residual {result.residual:.3g} "
+                          f"(tolerance {p.tolerance:g}), max residual {result.max_residual:.3g} (tolerance "
+                          f"{p.max_tolerance:g})", ConvergenceWarning, stacklevel=3)
         return converged
 
     def _end_velocities(self, vx, vy, om):
@@ -479,23 +484,22 @@ class Simulation:
         p = self.parameters
         return np.maximum(g_star, 0.0) / (p.theta * p.time_step)
 
-    def _solve(self, problem, pn, pt, vx, vy, om, tolerance, max_tolerance, max_iterations, shuffle=False):
+    def _solve(self, problem, pn, pt, vx, vy, om, tolerance, max_tolerance, max_iterations, shuffle=False, stall=0):
         """Solve a contact problem in place with the sweeps the parameters choose: Anderson-
         accelerated (:mod:`solver.acceleration`), domain-decomposed
         (:mod:`solver.parallel_nlgs`), or the serial NLGS (:mod:`solver.nlgs`), in a random order
-        when ``shuffle``. Returns the :class:`solver.nlgs.NLGSResult`."""
+        when ``shuffle``; ``stall``: sweeps of the stall test (0: none). Returns the
+        :class:`solver.nlgs.NLGSResult`."""
         p = self.parameters
         x = self.position[:self.n_particles, 0]
+        limits = dict(tolerance=tolerance, max_tolerance=max_tolerance, max_iterations=max_iterations, stall=stall)
         if p.acceleration == "anderson":
-            return acceleration.solve_problem_anderson(problem, pn, pt, vx, vy, om, tolerance=tolerance,
-                                                       max_tolerance=max_tolerance, max_iterations=max_iterations,
-                                                       memory=p.anderson_memory, domains=p.domains, x=x)
+            return acceleration.solve_problem_anderson(problem, pn, pt, vx, vy, om, memory=p.anderson_memory,
+                                                       period=p.anderson_period, domains=p.domains, x=x, **limits)
         if p.domains > 1:
-            return parallel_nlgs.solve_problem_domains(problem, x, pn, pt, vx, vy, om, domains=p.domains,
-                                                       tolerance=tolerance, max_tolerance=max_tolerance,
-                                                       max_iterations=max_iterations)
-        return nlgs.solve_problem(problem, pn, pt, vx, vy, om, tolerance=tolerance, max_tolerance=max_tolerance,
-                                  max_iterations=max_iterations, shuffle=shuffle, seed=p.seed + self.step_index)
+            return parallel_nlgs.solve_problem_domains(problem, x, pn, pt, vx, vy, om, domains=p.domains, **limits)
+        return nlgs.solve_problem(problem, pn, pt, vx, vy, om, shuffle=shuffle, seed=p.seed + self.step_index,
+                                  **limits)
 
     def _recover_overlaps(self, problem, g_end):
         """Split-impulse removal of overlaps: pseudo-velocities that move the bodies apart at

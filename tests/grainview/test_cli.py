@@ -59,20 +59,21 @@ def test_harmonic_series_grows_its_anisotropy():
 
 
 def test_physics_options_reach_the_solver_and_act(tmp_path, capsys):
-    """--friction, --wall-friction, --sigma0, --time-step, --tolerance and --acceleration are recorded in the
-    file and obeyed: no contact exceeds its Coulomb cone, some slide on it, and the lateral
-    stress is the requested sigma0."""
+    """--friction, --wall-friction, --sigma0, --time-step, --tolerance, --acceleration and --stall-sweeps are
+    recorded in the file and obeyed: no contact exceeds its Coulomb cone, some slide on it, and
+    the lateral stress is the requested sigma0."""
     path = tmp_path / "run.nc"
     argv = ["run", "--shape", "disk", "--particles", "30", "--strain", "0.01", "--every", "20",
             "--friction", "0.2", "--wall-friction", "0.1", "--sigma0", "5000", "--time-step", "4e-4",
-            "--tolerance", "1e-5", "--acceleration", "anderson", "--out", str(path), "--progress", "off"]
+            "--tolerance", "1e-5", "--acceleration", "anderson", "--stall-sweeps", "300", "--out", str(path),
+            "--progress", "off"]
     assert main(argv) == 0
     with grainview.open_dataset(path, chunks=None) as ds:
         attrs = ds.attrs
         assert attrs["solver_friction"] == 0.2 and attrs["preparation_friction"] == 0.2
         assert attrs["solver_wall_friction"] == 0.1
         assert attrs["solver_time_step"] == 4e-4 and attrs["solver_tolerance"] == 1e-5
-        assert attrs["solver_acceleration"] == "anderson"
+        assert attrs["solver_acceleration"] == "anderson" and attrs["solver_stall_sweeps"] == 300
         assert attrs["sigma0_Pa"] == 5000.0
         used = ds.kind.values > 0
         wall = ds.j.values >= ds.sizes["particle"]
@@ -95,6 +96,10 @@ def test_bad_solver_option_is_one_line_before_simulating(tmp_path, capsys):
     assert main(["run", "--particles", "10", "--time-step", "-1", "--out", str(tmp_path / "x.nc")]) == 2
     err = capsys.readouterr().err.strip()
     assert err.count("\n") == 0 and "time_step=-1.0" in err and "positive number of seconds" in err
+    assert not (tmp_path / "x.nc").exists()
+    assert main(["run", "--particles", "10", "--stall-sweeps", "-5", "--out", str(tmp_path / "x.nc")]) == 2
+    err = capsys.readouterr().err.strip()
+    assert err.count("\n") == 0 and "stall_sweeps=-5" in err and "(0: no stall test)" in err
     assert not (tmp_path / "x.nc").exists()
 
 

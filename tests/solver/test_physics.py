@@ -11,8 +11,10 @@ from solver.shapes import mass_and_inertia
 G = 9.81
 R = 0.0125
 EXACT = dict(tolerance=1e-12, max_tolerance=1e-12, max_iterations=100_000)
-SOLVERS = pytest.mark.parametrize("solver", [{}, {"acceleration": "anderson"}, {"domains": 2}],
-                                  ids=["nlgs", "anderson", "domains2"])  # every solver, same answers
+SOLVERS = pytest.mark.parametrize(
+    "solver", [{}, {"stall_sweeps": 200}, {"acceleration": "anderson"}, {"acceleration": "anderson", "anderson_period": 2},
+               {"domains": 2}],
+    ids=["nlgs", "nlgs-stall", "anderson", "anderson-every-2-sweeps", "domains2"])  # every solver, same answers
 PENTAGON_ON_EDGE = np.radians(-54.0)  # vertices at -54 + 72 k degrees: an edge at the bottom
 
 

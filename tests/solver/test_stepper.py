@@ -133,7 +133,7 @@ def test_pentagon_double_contact_forces_are_equal_with_random_ordering():
 @pytest.mark.parametrize("bad", [dict(theta=0.3), dict(time_step=-1.0), dict(friction=-0.1), dict(friction=1e9),
                                  dict(wall_friction=np.inf), dict(max_iterations=0), dict(gravity=(0.0, np.nan)),
                                  dict(alert=-1.0), dict(acceleration="fast"), dict(anderson_memory=0),
-                                 dict(domains=2, shuffle=True)])
+                                 dict(anderson_period=0), dict(domains=2, shuffle=True)])
 def test_invalid_parameters_are_refused_with_their_name(bad):
     name = next(iter(bad))
     with pytest.raises(ParameterError, match=name):

@@ -1,0 +1,113 @@
+"""The stall test of the NLGS stopping rules (solver.nlgs, module docstring): after every W
+sweeps, stop when the best quadratic norm so far has fallen by less than 5% since the previous
+check. Checked against the rule applied by hand to the norms of plain sweeps, and, for every
+solver, against the same solver stopped by its sweep cap at the same sweep."""
+
+from __future__ import annotations
+
+import copy
+import warnings
+
+import numpy as np
+import pytest
+
+from grainview.errors import ConvergenceWarning
+from solver import acceleration, compaction_sample, isotropic_compaction, nlgs, parallel_nlgs
+
+TIGHT = dict(tolerance=1e-9, max_tolerance=1e-9, max_iterations=20_000)
+WINDOW = 200
+
+
+@pytest.fixture(scope="module")
+def problem():
+    """The contact problem of a step of 120 pentagons compacted under 10 kPa: at a tolerance of
+    1e-9 its sweeps creep for thousands of sweeps, the case the stall test is for."""
+    sim = compaction_sample(120, "pentagon", seed=3)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", ConvergenceWarning)
+        isotropic_compaction(sim)
+    pts = sim.detect()
+    impulse = sim._matched_impulses(sim._point_keys(pts))
+    v_start, omega_start, v_free, omega_free = sim._free_velocities()
+    prob, _, _ = sim._contact_problem(pts, v_start, omega_start)
+    state = [impulse[:, 0].copy(), impulse[:, 1].copy(), v_free[:, 0].copy(), v_free[:, 1].copy(), omega_free.copy()]
+    return sim, prob, state
+
+
+def _copy(state):
+    return [s.copy() for s in state]
+
+
+def expected_stop(norms, window, improvement=nlgs.STALL_IMPROVEMENT):
+    """The sweep (1-based) at which the rule stops a run with these quadratic norms, or None."""
+    best, previous = np.inf, np.inf
+    for it, quad in enumerate(norms, start=1):
+        best = min(best, quad)
+        if it % window == 0:
+            if best > (1 - improvement) * previous:
+                return it
+            previous = best
+    return None
+
+
+def test_plain_sweeps_stop_where_the_rule_says(problem):
+    _, prob, state = problem
+    # the norms of plain sweeps, one by one
+    pn, pt, vx, vy, w = _copy(state)
+    geometry = (prob.a, prob.b, prob.nx, prob.ny, prob.rax, prob.ray, prob.rbx, prob.rby)
+    masses = (prob.minv_xx, prob.minv_xy, prob.minv_yy, prob.iinv)
+    wnn, wnt, wtt = nlgs.delassus(*geometry, *masses)
+    nlgs.velocities_from_impulses(*geometry, pn, pt, vx, vy, w, *masses)
+    order = np.arange(prob.a.size)
+    norms = []
+    for _ in range(6000):
+        sums = nlgs.sweep(order, *geometry, prob.bias, prob.mu, pn, pt, vx, vy, w, *masses, wnn, wnt, wtt)
+        norms.append(nlgs.sweep_norms(*sums)[0])
+    stop = expected_stop(norms, WINDOW)
+    assert stop is not None and 2 * WINDOW <= stop < 6000 and min(norms) > TIGHT["tolerance"]
+    got = _copy(state)
+    result = nlgs.solve_problem(prob, *got, stall=WINDOW, **TIGHT)
+    assert result.iterations == stop
+    assert result.residual == pytest.approx(norms[stop - 1], rel=1e-12)
+    # without the test the same problem runs on, and the stop is that of the cap at that sweep
+    capped = _copy(state)
+    nlgs.solve_problem(prob, *capped, **{**TIGHT, "max_iterations": stop})
+    for x, y in zip(got, capped):
+        np.testing.assert_array_equal(x, y)
+    assert nlgs.solve_problem(prob, *_copy(state), **{**TIGHT, "max_iterations": stop + 1}).iterations == stop + 1
+
+
+@pytest.mark.parametrize("how", ["domains", "anderson", "anderson-domains"])
+def test_every_solver_stalls_like_its_own_sweep_cap(problem, how):
+    sim, prob, state = problem
+    x = sim.position[:, 0]
+
+    def solve(stall, max_iterations):
+        s = _copy(state)
+        limits = {**TIGHT, "max_iterations": max_iterations, "stall": stall}
+        if how == "domains":
+            r = parallel_nlgs.solve_problem_domains(prob, x, *s, domains=2, **limits)
+        else:
+            r = acceleration.solve_problem_anderson(prob, *s, domains=2 if how == "anderson-domains" else 1, x=x,
+                                                    **limits)
+        return r, s
+
+    stalled, s1 = solve(WINDOW, TIGHT["max_iterations"])
+    assert stalled.iterations % WINDOW == 0 and stalled.iterations < TIGHT["max_iterations"]
+    assert stalled.residual > TIGHT["tolerance"]
+    capped, s2 = solve(0, stalled.iterations)
+    assert capped == stalled
+    for a, b in zip(s1, s2):
+        np.testing.assert_array_equal(a, b)
+
+
+def test_a_stalled_step_warns_that_it_stalled(problem):
+    sim = copy.deepcopy(problem[0])
+    for name, value in {**TIGHT, "stall_sweeps": WINDOW}.items():
+        setattr(sim.parameters, name, value)
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        info = sim.step()
+    messages = [str(w.message) for w in caught if issubclass(w.category, ConvergenceWarning)]
+    assert not info.converged and info.iterations % WINDOW == 0 and info.iterations < TIGHT["max_iterations"]
+    assert len(messages) == 1 and "stall" in messages[0] and f"after {info.iterations} iterations" in messages[0]
