@@ -6,6 +6,8 @@ counts.
                                                                   # Anderson-accelerated sweeps
     python benchmarks/time_to_strain.py --measure pentagon --acceleration anderson --domains 2
                                                                   # ... on two domains, one thread each
+    python benchmarks/time_to_strain.py --measure pentagon --acceleration anderson --period 2 \
+        --stall 200 --particles 4000 --until 0.1                  # a check of the extrapolation (~1 h)
     python benchmarks/time_to_strain.py                           # the tables from what was measured
 
 Measured, per shape, on 1000 particles in one process on one core: the compaction of the
@@ -25,6 +27,9 @@ Extrapolated to N = 4000 and 14,400, and to the paper's pair of samples (14,400 
 * compaction steps: measured where a cached dense sample exists (benchmarks/samples.py),
   else grown as sqrt(N) from the measured 1000; compaction time per particle per step as
   measured at 1000.
+
+A measurement at another size (``--particles``) is listed beside the extrapolation from 1000
+to the same size: the check of these assumptions.
 """
 
 from __future__ import annotations
@@ -32,6 +37,7 @@ from __future__ import annotations
 import argparse
 import json
 import os
+import pickle
 import sys
 import time
 import warnings
@@ -54,22 +60,43 @@ class TargetReached(Exception):
     """Raised by the timed step once eps_q reaches the target: ends the test there."""
 
 
-def measure(shape: str, acceleration: str = "off", domains: int = 1) -> dict:
-    """Compact 1000 particles of ``shape`` ('paper' preparation) and shear them to eps_q = 0.4,
-    timing every step; the shear's NLGS sweeps plain or Anderson-accelerated
-    (``acceleration``), serial or on ``domains`` domains (one thread each), the compaction
-    always plain and serial (the same sample either way)."""
-    import solver
+def compacted(shape: str, particles: int):
+    """The 'paper' sample of ``shape`` at ``particles``, compacted with the plain serial NLGS
+    (the same sample whatever the shear's solver), and the compaction's seconds: built once,
+    then read from benchmarks/_data/time_to_strain/sample_<shape>_<N>.pkl."""
     from solver.preparation import prepare_sample, preparation
 
-    prep = preparation("paper", shape=shape, particles=MEASURED_N)
+    path = os.path.join(OUT, f"sample_{shape}_{particles}.pkl")
+    if os.path.exists(path):
+        with open(path, "rb") as fh:
+            return pickle.load(fh)
     start = time.perf_counter()
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
-        sim = prepare_sample(prep, progress=False)
-    compaction_seconds = time.perf_counter() - start
+        sim = prepare_sample(preparation("paper", shape=shape, particles=particles), progress=False,
+                             acceleration="off", domains=1, stall_sweeps=0)
+    found = (sim, time.perf_counter() - start)
+    with open(path + ".part", "wb") as fh:
+        pickle.dump(found, fh)
+    os.replace(path + ".part", path)
+    return found
+
+
+def measure(shape: str, acceleration: str = "off", domains: int = 1, particles: int = MEASURED_N,
+            stall: int = 0, until: float = TARGET_EPS_Q, period: int = 1) -> dict:
+    """Compact ``particles`` particles of ``shape`` ('paper' preparation, :func:`compacted`) and
+    shear them to eps_q = 0.4, timing every step; the shear's NLGS sweeps plain or
+    Anderson-accelerated (``acceleration``, the default memory, an extrapolation every
+    ``period`` sweeps), serial or on ``domains`` domains (one thread each), with the stall
+    test over ``stall`` sweeps (0: none; solver.nlgs); ``until``: the eps_q at which the shear
+    stops (part of a shear, to check the extrapolation at a larger size in less time)."""
+    import solver
+
+    sim, compaction_seconds = compacted(shape, particles)
     sim.parameters.acceleration = acceleration
     sim.parameters.domains = domains
+    sim.parameters.stall_sweeps = stall
+    sim.parameters.anderson_period = period
     residuals = []
     lo, hi = sim.walls.box_bounds()
     h0, l0 = float(hi[1] - lo[1]), float(hi[0] - lo[0])
@@ -85,12 +112,12 @@ def measure(shape: str, acceleration: str = "off", domains: int = 1) -> dict:
         residuals.append(info.local_law_residual)
         lo, hi = sim.walls.box_bounds()
         eps_q = np.log(h0 / float(hi[1] - lo[1])) - np.log(l0 / float(hi[0] - lo[0]))
-        if eps_q >= TARGET_EPS_Q:
+        if eps_q >= until:
             raise TargetReached
         return info
 
     sim.step = timed_step
-    path = os.path.join(OUT, f"{shape}_{acceleration}_{domains}_shear.nc")
+    path = os.path.join(OUT, f"{shape}_{particles}_{acceleration}_{domains}_{stall}_shear.nc")
     try:
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
@@ -101,21 +128,29 @@ def measure(shape: str, acceleration: str = "off", domains: int = 1) -> dict:
     eps_1 = float(np.log(h0 / float(hi[1] - lo[1])))
     os.remove(path)
     sweeps, seconds = np.array(sweeps), np.array(seconds)
-    return {"shape": shape, "acceleration": acceleration, "domains": domains, "particles": MEASURED_N,
+    return {"shape": shape, "acceleration": acceleration, "domains": domains, "particles": particles,
+            "anderson_memory": sim.parameters.anderson_memory, "anderson_period": sim.parameters.anderson_period,
+            "stall_sweeps": stall, "eps_q_target": until,
             "compaction_steps": int(sim.compaction_steps),
             "local_law_residual_median": float(np.median(residuals)),
             "local_law_residual_p90": float(np.percentile(residuals, 90)),
             "compaction_seconds": compaction_seconds, "shear_steps": int(len(sweeps)), "eps_1_at_target": eps_1,
             "shear_seconds": float(seconds.sum()), "sweeps_median": float(np.median(sweeps)),
             "sweeps_p90": float(np.percentile(sweeps, 90)), "sweeps_mean": float(sweeps.mean()),
-            "points_per_particle": float(np.mean(points) / MEASURED_N),
-            "us_per_particle_step": float(1e6 * seconds.sum() / (len(sweeps) * MEASURED_N))}
+            "points_per_particle": float(np.mean(points) / particles),
+            "us_per_particle_step": float(1e6 * seconds.sum() / (len(sweeps) * particles))}
 
 
 def variant(m: dict) -> str:
-    """How a measurement's shear was solved, in words."""
+    """How a measurement's shear was solved, in words (runs from before the Anderson period
+    existed extrapolated after every sweep)."""
     domains = m.get("domains", 1)
-    return m.get("acceleration", "off") + (f", {domains} domains" if domains > 1 else "")
+    how = m.get("acceleration", "off")
+    if how == "anderson":
+        period = m.get("anderson_period", 1)
+        how += ", every sweep" if period == 1 else f", every {period} sweeps"
+    stall = m.get("stall_sweeps", 0)
+    return how + (f", stall {stall}" if stall else "") + (f", {domains} domains" if domains > 1 else "")
 
 
 def table(results: dict) -> str:
@@ -159,12 +194,20 @@ def main(argv=None):
     parser.add_argument("--acceleration", default="off", choices=("off", "anderson"),
                         help="NLGS sweeps of the measured shear (the table extrapolates the plain ones)")
     parser.add_argument("--domains", type=int, default=1, help="NLGS domains of the measured shear (threads)")
+    parser.add_argument("--particles", type=int, default=MEASURED_N,
+                        help="sample size of the measurement (the tables extrapolate from 1000)")
+    parser.add_argument("--stall", type=int, default=0, help="sweeps of the NLGS stall test of the shear (0: none)")
+    parser.add_argument("--period", type=int, default=1, help="NLGS sweeps between Anderson extrapolations")
+    parser.add_argument("--until", type=float, default=TARGET_EPS_Q,
+                        help="eps_q at which the measured shear stops (the tables extrapolate whole shears to 0.4)")
     args = parser.parse_args(argv)
     os.makedirs(OUT, exist_ok=True)
     for shape in filter(None, args.measure.split(",")):
-        result = measure(shape, args.acceleration, args.domains)
-        suffix = ("" if args.acceleration == "off" else f"_{args.acceleration}") + (
-            f"_d{args.domains}" if args.domains > 1 else "")
+        result = measure(shape, args.acceleration, args.domains, args.particles, args.stall, args.until, args.period)
+        suffix = ("" if args.acceleration == "off" else f"_{args.acceleration}_p{result['anderson_period']}") + (
+            f"_stall{args.stall}" if args.stall else "") + (f"_d{args.domains}" if args.domains > 1 else "") + (
+            f"_n{args.particles}" if args.particles != MEASURED_N else "") + (
+            f"_to{args.until:g}" if args.until != TARGET_EPS_Q else "")
         with open(os.path.join(OUT, f"{shape}{suffix}.json"), "w") as fh:
             json.dump(result, fh, indent=1)
         print(json.dumps(result), flush=True)
@@ -175,7 +218,8 @@ def main(argv=None):
                 measured.append(json.load(fh))
     variants = {}
     for m in measured:
-        variants.setdefault(variant(m), {})[m["shape"]] = m
+        if m["particles"] == MEASURED_N and m.get("eps_q_target", TARGET_EPS_Q) == TARGET_EPS_Q:
+            variants.setdefault(variant(m), {})[m["shape"]] = m
     results = variants.get("off", {})
     if not results:
         print("nothing measured yet: run with --measure pentagon,disk")
@@ -197,7 +241,25 @@ def main(argv=None):
         if set(found) == set(PAPER):
             print(f"\n**Sweeps: {name}** (time per particle and step as measured with them)\n")
             print(table(found))
+    def same(m, base):
+        return (base["particles"] == MEASURED_N and base["shape"] == m["shape"] and variant(base) == variant(m)
+                and base.get("eps_q_target", TARGET_EPS_Q) == m.get("eps_q_target", TARGET_EPS_Q))
 
+    checks = [(m, base) for m in measured if m["particles"] != MEASURED_N for base in measured if same(m, base)]
+    if checks:
+        print("\n**The extrapolation checked**: a shear measured at another size, against the "
+              f"extrapolation from {MEASURED_N:,} particles solved the same way to the same eps_q\n")
+        print("| shape | N | sweeps | to eps_q | shear steps: measured, extrapolated | sweeps / step median, mean: "
+              f"measured, at {MEASURED_N:,} | us / particle / step: measured, at {MEASURED_N:,} | shear time: "
+              "measured, extrapolated |")
+        print("|---|---|---|---|---|---|---|---|")
+        for m, base in checks:
+            steps = int(base["shear_steps"] * (m["particles"] / base["particles"]) ** 0.5)
+            guess = base["shear_seconds"] / (base["shear_steps"] * base["particles"]) * m["particles"] * steps
+            print(f"| {m['shape']} | {m['particles']:,} | {variant(m)} | {m.get('eps_q_target', TARGET_EPS_Q):g} | "
+                  f"{m['shear_steps']:,}, {steps:,} | {m['sweeps_median']:.0f}, {m['sweeps_mean']:.0f}; "
+                  f"{base['sweeps_median']:.0f}, {base['sweeps_mean']:.0f} | {m['us_per_particle_step']:.1f}, "
+                  f"{base['us_per_particle_step']:.1f} | {m['shear_seconds'] / 3600:.2f} h, {guess / 3600:.2f} h |")
 
 if __name__ == "__main__":
     main()
