@@ -153,7 +153,7 @@ def _simulate(prep, path, *, strain, every, velocity, near_contacts, overwrite, 
                          progress=progress, attrs=attrs, near_contacts=near_contacts, compress=compress)
     unconverged = sum(issubclass(w.category, ConvergenceWarning) for w in caught)
     if unconverged:
-        print(f"{name}: warning: NLGS reached its iteration limit in {unconverged} step(s)", file=sys.stderr)
+        print(f"{name}: warning: NLGS did not converge (sweep cap or stall test) in {unconverged} step(s)", file=sys.stderr)
     print(f"{name}: wrote {path}", flush=True)
     return path
 

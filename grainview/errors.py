@@ -43,4 +43,5 @@ class ParameterError(GrainviewError, ValueError):
 
 
 class ConvergenceWarning(UserWarning):
-    """The contact solver stopped at its iteration limit before reaching its tolerance."""
+    """The contact solver stopped before reaching its tolerance: at its sweep cap, or because
+    its sweeps stalled (``stall_sweeps``)."""

@@ -291,7 +291,7 @@ def solve_anderson(blocks, a, b, nx, ny, rax, ray, rbx, rby, bias, mu, pn, pt, v
         else:
             quad, worst = sweep_norms(*sweep(order, a, b, nx, ny, rax, ray, rbx, rby, bias, mu, pn, pt, vx, vy, w,
                                              minv_xx, minv_xy, minv_yy, iinv, wnn, wnt, wtt))
-        if (quad <= tol and worst <= max_tol) or stalled(it, quad, watch, stall):
+        if (quad <= tol and worst <= max_tol) or stalled(it, quad, tol, watch, stall):
             return it, quad, worst
         if it % period != 0 or it == max_iterations:  # the last sweep's iterate is the one its norms describe
             continue
@@ -344,6 +344,8 @@ def solve_problem_anderson(problem, pn, pt, vx, vy, w, *, tolerance, max_toleran
     abscissae ``x``, m) cut into that many slabs, and the history passes run a domain per
     thread too. ``period``: the sweeps between two extrapolations (Anderson on the map
     "``period`` sweeps", module docstring); ``stall`` as in :func:`solver.nlgs.solve_problem`."""
+    if int(period) < 1 or int(memory) < 1:
+        raise ValueError(f"memory={memory!r}, period={period!r}: expected whole numbers >= 1")
     options = (float(tolerance), float(max_tolerance), int(max_iterations), int(memory), int(period), int(stall))
     if domains > 1:
         def kernel(dec, geometry, state, masses):

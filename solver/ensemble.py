@@ -177,7 +177,7 @@ def run_one(spec: RunSpec, folder, *, overwrite=False, progress=None, compress=T
     """Simulate, resume or skip the run ``spec`` into ``<folder>/<spec.name>.nc`` (see the
     module docstring). Returns a dict: ``name``, ``path``, ``action`` ("ran", "resumed",
     "finished already"), ``steps`` (steps taken now), ``seconds``, ``unconverged`` (steps
-    where NLGS hit its iteration limit). ``progress`` and ``compress`` (the finished file kept
+    where NLGS stopped unconverged: sweep cap or stall test). ``progress`` and ``compress`` (the finished file kept
     compressed): as for :func:`solver.biaxial_test`."""
     from .preparation import prepare_sample, record
     from .restart import resume
@@ -369,7 +369,7 @@ def describe_result(result: dict) -> str:
     """One line saying what happened to a run."""
     if "error" in result:
         return f"{result['name']}: FAILED ({result['error']})"
-    extra = f", NLGS iteration limit in {result['unconverged']} step(s)" if result.get("unconverged") else ""
+    extra = f", NLGS unconverged in {result['unconverged']} step(s)" if result.get("unconverged") else ""
     warned = result.get("warnings") or []
     if warned:
         extra += f"; {len(warned)} warning(s), the first: {warned[0]}"

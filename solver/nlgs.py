@@ -36,7 +36,8 @@ Stall (``stall`` sweeps W > 0). In a step where the packing rearranges, the swee
 for thousands of sweeps with the quadratic norm just above its tolerance, or wander around it.
 After every W sweeps the smallest quadratic norm reached so far is compared with the smallest
 at the previous check; when it has not fallen by at least ``STALL_IMPROVEMENT`` (5%), the
-iterations stop there (:func:`stalled`). Such a step has not converged: its norms are returned
+iterations stop there (:func:`stalled`), unless the quadratic norm already meets its
+tolerance (then only the max norm is left, which the quadratic norm need not follow). Such a step has not converged: its norms are returned
 as they are, and the stepper warns as it does for a step stopped by the sweep cap. W = 0 turns
 the test off. The local-law residual (:mod:`solver.residuals`) of the steps stopped this way is
 what the test is judged by (docs/solver.md).
@@ -202,13 +203,15 @@ def _shuffle(order, state):
 
 
 @njit(cache=True, inline="always")
-def stalled(it, quad, watch, stall):
+def stalled(it, quad, tol, watch, stall):
     """The stall test after sweep ``it`` of quadratic norm ``quad`` (module docstring):
     ``watch`` = [best norm so far, best at the previous check] (float64 (2,), updated in place,
-    starting at [inf, inf]); ``stall`` the sweeps between checks (0: never stalled)."""
+    starting at [inf, inf]); ``stall`` the sweeps between checks (0: never stalled). A sweep
+    whose quadratic norm already meets ``tol`` never stalls: only the max norm is left to meet,
+    and the quadratic norm need not fall for it."""
     if quad < watch[0]:
         watch[0] = quad
-    if stall <= 0 or it % stall != 0:
+    if stall <= 0 or it % stall != 0 or quad <= tol:
         return False
     if watch[0] > (1.0 - STALL_IMPROVEMENT) * watch[1]:
         return True
@@ -239,7 +242,7 @@ def solve(a, b, nx, ny, rax, ray, rbx, rby, bias, mu, pn, pt, vx, vy, w,
             state = _shuffle(order, state)
         quad, worst = sweep_norms(*sweep(order, a, b, nx, ny, rax, ray, rbx, rby, bias, mu, pn, pt, vx, vy, w,
                                          minv_xx, minv_xy, minv_yy, iinv, wnn, wnt, wtt))
-        if (quad <= tol and worst <= max_tol) or stalled(it, quad, watch, stall):
+        if (quad <= tol and worst <= max_tol) or stalled(it, quad, tol, watch, stall):
             return it, quad, worst
     return max_iterations, quad, worst
 

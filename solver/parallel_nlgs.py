@@ -135,7 +135,7 @@ def solve_domains(ptr, points, interface, a, b, nx, ny, rax, ray, rbx, rby, bias
     for it in range(1, max_iterations + 1):
         quad, worst = sweep_norms(*sweep_domains(ptr, points, interface, a, b, nx, ny, rax, ray, rbx, rby, bias, mu,
                                                  pn, pt, vx, vy, w, minv_xx, minv_xy, minv_yy, iinv, wnn, wnt, wtt))
-        if (quad <= tol and worst <= max_tol) or stalled(it, quad, watch, stall):
+        if (quad <= tol and worst <= max_tol) or stalled(it, quad, tol, watch, stall):
             return it, quad, worst
     return max_iterations, quad, worst
 

@@ -236,7 +236,7 @@ def main(argv=None) -> int:
             warnings.showwarning(w.message, w.category, w.filename, w.lineno)
     unconverged = sum(issubclass(w.category, ConvergenceWarning) for w in caught)
     if unconverged:
-        print(f"warning: NLGS reached its iteration limit in {unconverged} step(s)", file=sys.stderr)
+        print(f"warning: NLGS did not converge (sweep cap or stall test) in {unconverged} step(s)", file=sys.stderr)
     print(f"{args.path}: {'already complete' if steps == 0 else f'resumed for {steps} steps, complete'}")
     return 0
 

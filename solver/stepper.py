@@ -84,7 +84,7 @@ class Parameters:
     tolerance: float = 1.7e-4  # NLGS quadratic norm of the velocity changes over a sweep (solver.nlgs)
     max_tolerance: float = 1e-2  # NLGS max norm: largest single change over the RMS (solver.nlgs)
     max_iterations: int = 2000
-    stall_sweeps: int = 0  # > 0: NLGS stops when its quadratic norm falls < 5% over this many sweeps
+    stall_sweeps: int = 0  # > 0: checks every this many sweeps; NLGS stops if its best norm fell < 5% since the last
     alert: float | None = None  # m; default: 2% of the smallest diameter
     skin: float | None = None  # m; default: 10% of the smallest diameter
     shuffle: bool = False  # random NLGS ordering
@@ -427,7 +427,8 @@ class Simulation:
         converged = result.residual <= p.tolerance and result.max_residual <= p.max_tolerance
         if not converged:
             stop = ("the sweep cap" if result.iterations >= p.max_iterations else
-                    f"a stall (the quadratic norm fell < 5% over {p.stall_sweeps} sweeps)")
+                    f"a stall (the best quadratic norm fell < {100 * nlgs.STALL_IMPROVEMENT:g}% over "
+                    f"{p.stall_sweeps} sweeps)")
             warnings.warn(f"NLGS did not converge at step {self.step_index} (t = {self.time:.6g} s): stopped by "
                           f"{stop} after {result.iterations} iterations, quadratic residual {result.residual:.3g} "
                           f"(tolerance {p.tolerance:g}), max residual {result.max_residual:.3g} (tolerance "

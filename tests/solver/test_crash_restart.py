@@ -313,7 +313,8 @@ def test_a_run_killed_while_creating_its_file_leaves_no_partial_file(tmp_path):
 def test_the_sweep_method_is_recorded_and_older_files_load_with_plain_sweeps(tmp_path, method):
     from solver import load_sample
 
-    sim = compaction_sample(20, "disk", seed=1, acceleration=method, anderson_memory=4, anderson_period=3)
+    sim = compaction_sample(20, "disk", seed=1, acceleration=method, anderson_memory=4, anderson_period=3,
+                            stall_sweeps=300)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         for _ in range(5):
@@ -323,14 +324,15 @@ def test_the_sweep_method_is_recorded_and_older_files_load_with_plain_sweeps(tmp
         rec.write()
     loaded = load_sample(path)
     assert loaded.parameters.acceleration == method and loaded.parameters.anderson_memory == 4
-    assert loaded.parameters.anderson_period == 3
+    assert loaded.parameters.anderson_period == 3 and loaded.parameters.stall_sweeps == 300
     with netCDF4.Dataset(path, "a") as nc:  # a file written before the parameters existed
         nc.delncattr("solver_acceleration")
         nc.delncattr("solver_anderson_memory")
         nc.delncattr("solver_anderson_period")
+        nc.delncattr("solver_stall_sweeps")
     older = load_sample(path)
     assert older.parameters.acceleration == "off" and older.parameters.anderson_memory == 5
-    assert older.parameters.anderson_period == 1
+    assert older.parameters.anderson_period == 1 and older.parameters.stall_sweeps == 0
 
 
 def test_the_resume_command_runs_without_warnings(tmp_path):

@@ -38,12 +38,12 @@ def _copy(state):
     return [s.copy() for s in state]
 
 
-def expected_stop(norms, window, improvement=nlgs.STALL_IMPROVEMENT):
+def expected_stop(norms, window, tolerance, improvement=nlgs.STALL_IMPROVEMENT):
     """The sweep (1-based) at which the rule stops a run with these quadratic norms, or None."""
     best, previous = np.inf, np.inf
     for it, quad in enumerate(norms, start=1):
         best = min(best, quad)
-        if it % window == 0:
+        if it % window == 0 and quad > tolerance:
             if best > (1 - improvement) * previous:
                 return it
             previous = best
@@ -63,7 +63,7 @@ def test_plain_sweeps_stop_where_the_rule_says(problem):
     for _ in range(6000):
         sums = nlgs.sweep(order, *geometry, prob.bias, prob.mu, pn, pt, vx, vy, w, *masses, wnn, wnt, wtt)
         norms.append(nlgs.sweep_norms(*sums)[0])
-    stop = expected_stop(norms, WINDOW)
+    stop = expected_stop(norms, WINDOW, TIGHT["tolerance"])
     assert stop is not None and 2 * WINDOW <= stop < 6000 and min(norms) > TIGHT["tolerance"]
     got = _copy(state)
     result = nlgs.solve_problem(prob, *got, stall=WINDOW, **TIGHT)
@@ -75,6 +75,18 @@ def test_plain_sweeps_stop_where_the_rule_says(problem):
     for x, y in zip(got, capped):
         np.testing.assert_array_equal(x, y)
     assert nlgs.solve_problem(prob, *_copy(state), **{**TIGHT, "max_iterations": stop + 1}).iterations == stop + 1
+
+
+def test_a_met_quadratic_norm_never_stalls(problem):
+    """With the quadratic norm within its tolerance only the max norm is left to meet: the
+    stall test must not stop the sweeps then, whatever the quadratic norm does."""
+    _, prob, state = problem
+    loose = dict(tolerance=1.0, max_tolerance=1e-9, max_iterations=1000)  # the quadratic norm is met at once
+    with_test, without = _copy(state), _copy(state)
+    r1 = nlgs.solve_problem(prob, *with_test, stall=WINDOW, **loose)
+    r0 = nlgs.solve_problem(prob, *without, **loose)
+    assert r1 == r0 and r0.residual <= 1.0
+    assert expected_stop([0.5] * 1000, WINDOW, 1.0) is None and expected_stop([0.5] * 1000, WINDOW, 0.1) == 2 * WINDOW
 
 
 @pytest.mark.parametrize("how", ["domains", "anderson", "anderson-domains"])
