@@ -100,3 +100,24 @@ def capture_contact_problems(sim, steps: int = 1) -> list:
         for _ in range(steps):
             sim.step()
     return seen
+
+
+def sheared_sample(shape: str, particles: int, strain: float, folder: str):
+    """A sample of ``shape`` at ``particles`` compacted with the 'fast' preparation (plain
+    serial NLGS, no stall test) and sheared to eps_1 = ``strain`` (top wall 1 cm/s, sigma0 =
+    10 kPa, dt = 5e-4 s), warnings silenced: the start of the benchmarks that compare ways of
+    solving. The shear's file is written in ``folder`` and removed."""
+    import warnings
+
+    import solver
+    from solver.preparation import prepare_sample, preparation
+
+    os.makedirs(folder, exist_ok=True)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        sim = prepare_sample(preparation("fast", shape=shape, particles=particles), progress=False,
+                             acceleration="off", stall_sweeps=0)
+        path = os.path.join(folder, f"{shape}_{particles}_shear.nc")
+        solver.biaxial_test(sim, path, strain=strain, velocity=0.01, every=10**9, overwrite=True, progress=False)
+    os.remove(path)
+    return sim

@@ -33,7 +33,7 @@ import numpy as np
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, os.path.dirname(HERE))
-from common import capture_contact_problems, machine_description, markdown_table  # noqa: E402
+from common import capture_contact_problems, machine_description, markdown_table, sheared_sample  # noqa: E402
 
 OUT = os.path.join(HERE, "_data", "solve_variants")
 RESULTS = os.path.join(HERE, "RESULTS-solve-variants.md")
@@ -60,17 +60,10 @@ def cache_path(shape, particles):
 
 def build(shape, particles):
     """Capture the problems of ``shape`` at ``particles`` (module docstring) into the cache."""
-    import solver
-    from solver.preparation import prepare_sample, preparation
-
-    os.makedirs(OUT, exist_ok=True)
+    sim = sheared_sample(shape, particles, SHEAR, OUT)
+    captured = []
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
-        sim = prepare_sample(preparation("fast", shape=shape, particles=particles), progress=False)
-        path = os.path.join(OUT, f"{shape}_{particles}_shear.nc")
-        solver.biaxial_test(sim, path, strain=SHEAR, velocity=0.01, every=10**9, overwrite=True, progress=False)
-        os.remove(path)
-        captured = []
         for _ in range(STEPS):
             x = sim.position[:sim.n_particles, 0].copy()
             seen = capture_contact_problems(sim, 1)

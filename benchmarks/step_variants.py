@@ -32,7 +32,7 @@ import numpy as np
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, os.path.dirname(HERE))
-from common import machine_description, markdown_table  # noqa: E402
+from common import machine_description, markdown_table, sheared_sample  # noqa: E402
 
 OUT = os.path.join(HERE, "_data", "step_variants")
 RESULTS = os.path.join(HERE, "RESULTS-step-variants.md")
@@ -58,17 +58,7 @@ def cache_path(shape, particles):
 
 def build(shape, particles):
     """Compact and shear the sample of ``shape`` at ``particles`` (module docstring); cache it."""
-    import solver
-    from solver.preparation import prepare_sample, preparation
-
-    os.makedirs(OUT, exist_ok=True)
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore")
-        sim = prepare_sample(preparation("fast", shape=shape, particles=particles), progress=False,
-                             acceleration="off", stall_sweeps=0)
-        path = os.path.join(OUT, f"{shape}_{particles}_shear.nc")
-        solver.biaxial_test(sim, path, strain=SHEAR, velocity=0.01, every=10**9, overwrite=True, progress=False)
-        os.remove(path)
+    sim = sheared_sample(shape, particles, SHEAR, OUT)
     with open(cache_path(shape, particles), "wb") as f:
         pickle.dump(sim, f)
     print(f"{shape}, {particles}: sheared to eps_1 = {SHEAR}", flush=True)

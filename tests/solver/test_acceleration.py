@@ -9,31 +9,22 @@ and over the domain-decomposed sweep, and the domain form must not depend on the
 
 from __future__ import annotations
 
-import warnings
-
 import numba
 import numpy as np
 import pytest
 
-from grainview.errors import ConvergenceWarning
-from solver import acceleration, compaction_sample, isotropic_compaction, nlgs, parallel_nlgs, residuals
+from solver import acceleration, nlgs, parallel_nlgs, residuals
+
+from .conftest import compacted_problem
 
 
 @pytest.fixture(scope="module")
 def problem():
     """The contact problem of a step of 120 pentagons compacted under 10 kPa, warm-started."""
-    sim = compaction_sample(120, "pentagon", seed=5)
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore", ConvergenceWarning)
-        isotropic_compaction(sim)
-    pts = sim.detect()
-    impulse = sim._matched_impulses(sim._point_keys(pts))
-    v_start, omega_start, v_free, omega_free = sim._free_velocities()
-    prob, _, _ = sim._contact_problem(pts, v_start, omega_start)
+    sim, prob, impulse, v_free, omega_free = compacted_problem(5)
     # half the warm start: the solve has work to do
     state = [0.5 * impulse[:, 0], 0.5 * impulse[:, 1], v_free[:, 0].copy(), v_free[:, 1].copy(), omega_free.copy()]
     return sim, prob, state
-
 
 def _copy(state):
     return [s.copy() for s in state]

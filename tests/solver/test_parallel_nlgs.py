@@ -15,7 +15,9 @@ import numpy as np
 import pytest
 
 from grainview.errors import ConvergenceWarning
-from solver import Parameters, compaction_sample, isotropic_compaction, nlgs, parallel_nlgs
+from solver import Parameters, compaction_sample, nlgs, parallel_nlgs
+
+from .conftest import compacted_problem
 from solver.parallel_nlgs import FREE, SHARED
 
 
@@ -23,17 +25,7 @@ from solver.parallel_nlgs import FREE, SHARED
 def problem():
     """The contact problem of a step of 120 pentagons compacted under 10 kPa (a stress-driven
     right wall)."""
-    sim = compaction_sample(120, "pentagon", seed=3)
-    with warnings.catch_warnings():  # a few compaction steps hit the sweep cap: not what is tested
-        warnings.simplefilter("ignore", ConvergenceWarning)
-        isotropic_compaction(sim)
-    pts = sim.detect()
-    keys = sim._point_keys(pts)
-    impulse = sim._matched_impulses(keys)
-    v_start, omega_start, v_free, omega_free = sim._free_velocities()
-    prob, _, _ = sim._contact_problem(pts, v_start, omega_start)
-    return sim, prob, impulse, v_free, omega_free
-
+    return compacted_problem(3)
 
 def _state(impulse, v_free, omega_free):
     return [impulse[:, 0].copy(), impulse[:, 1].copy(), v_free[:, 0].copy(), v_free[:, 1].copy(), omega_free.copy()]

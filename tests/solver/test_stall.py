@@ -12,7 +12,9 @@ import numpy as np
 import pytest
 
 from grainview.errors import ConvergenceWarning
-from solver import acceleration, compaction_sample, isotropic_compaction, nlgs, parallel_nlgs
+from solver import acceleration, nlgs, parallel_nlgs
+
+from .conftest import compacted_problem
 
 TIGHT = dict(tolerance=1e-9, max_tolerance=1e-9, max_iterations=20_000)
 WINDOW = 200
@@ -22,17 +24,9 @@ WINDOW = 200
 def problem():
     """The contact problem of a step of 120 pentagons compacted under 10 kPa: at a tolerance of
     1e-9 its sweeps creep for thousands of sweeps, the case the stall test is for."""
-    sim = compaction_sample(120, "pentagon", seed=3)
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore", ConvergenceWarning)
-        isotropic_compaction(sim)
-    pts = sim.detect()
-    impulse = sim._matched_impulses(sim._point_keys(pts))
-    v_start, omega_start, v_free, omega_free = sim._free_velocities()
-    prob, _, _ = sim._contact_problem(pts, v_start, omega_start)
+    sim, prob, impulse, v_free, omega_free = compacted_problem(3)
     state = [impulse[:, 0].copy(), impulse[:, 1].copy(), v_free[:, 0].copy(), v_free[:, 1].copy(), omega_free.copy()]
     return sim, prob, state
-
 
 def _copy(state):
     return [s.copy() for s in state]
