@@ -370,8 +370,8 @@ def build_parser() -> argparse.ArgumentParser:
                              help="NLGS tolerance, quadratic norm of the velocity changes over a sweep "
                              "(default 1.7e-4; docs/solver.md)")
         physics.add_argument("--acceleration", choices=("off", "anderson"), default=None,
-                             help="'anderson': Anderson-accelerated NLGS sweeps, the same local-law residual in "
-                             "less time per step (default off; docs/solver.md)")
+                             help="'anderson' (the default): Anderson-accelerated NLGS sweeps, the same "
+                             "local-law residual in less time per step than 'off', plain sweeps (docs/solver.md)")
         physics.add_argument("--stall-sweeps", type=int, default=None,
                              help="stop a step's NLGS when its quadratic norm has fallen less than 5%% over this many "
                              "sweeps (a step that would creep to the sweep cap; default 0: never; docs/solver.md)")

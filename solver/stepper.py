@@ -87,9 +87,9 @@ class Parameters:
     stall_sweeps: int = 0  # > 0: checks every this many sweeps; NLGS stops if its best norm fell < 5% since the last
     alert: float | None = None  # m; default: 2% of the smallest diameter
     skin: float | None = None  # m; default: 10% of the smallest diameter
-    shuffle: bool = False  # random NLGS ordering
+    shuffle: bool = False  # random NLGS ordering (plain sweeps only: acceleration "off")
     seed: int = 0
-    acceleration: str = "off"  # "anderson": Anderson-accelerated sweeps (solver.acceleration); no shuffling then
+    acceleration: str = "anderson"  # Anderson-accelerated sweeps (solver.acceleration; no shuffling); "off": plain
     anderson_memory: int = 3  # past iterates combined by the Anderson extrapolation
     anderson_period: int = 1  # NLGS sweeps between two Anderson extrapolations
     domains: int = 1  # NLGS domains swept at once on several cores (solver.parallel_nlgs); 1: the serial sweep
@@ -118,6 +118,9 @@ class Parameters:
             ("domains", isinstance(self.domains, (int, np.integer)) and 1 <= self.domains <= 64, "an integer in 1..64"),
             ("domains", self.domains == 1 or not self.shuffle,
              "1 with shuffle (the domain-decomposed sweep has its own order)"),
+            ("shuffle", not self.shuffle or self.acceleration == "off",
+             "False with acceleration='anderson' (the random order is an option of the plain sweeps: "
+             "pass acceleration='off' with it)"),
             ("gravity", len(self.gravity) == 2 and np.all(np.isfinite(self.gravity)), "a finite 2-vector in m s-2"),
             ("overlap_recovery_speed", self.overlap_recovery_speed >= 0, ">= 0 m s-1"),
             ("overlap_recovery_rate", 0 <= self.overlap_recovery_rate <= 1, "in [0, 1]"),

@@ -24,8 +24,8 @@ from .config import HERE, Config
 from .helpers import dense_sample, fmt, reset_meters, run_steps, start_biaxial
 
 CANDIDATES = (
-    ("NLGS (default)", {}),
-    ("NLGS, random order each sweep", dict(shuffle=True)),
+    ("NLGS", dict(acceleration="off")),
+    ("NLGS, random order each sweep", dict(acceleration="off", shuffle=True)),
     ("Anderson, m = 3", dict(acceleration="anderson", anderson_memory=3)),
     ("Anderson, m = 5", dict(acceleration="anderson", anderson_memory=5)),
     ("Anderson, m = 8", dict(acceleration="anderson", anderson_memory=8)),

@@ -15,12 +15,13 @@ EXACT = dict(tolerance=1e-12, max_tolerance=1e-12, max_iterations=100_000)
 
 def compacted_problem(seed):
     """The contact problem of the next step of 120 pentagons compacted under 10 kPa (seed
-    ``seed``; a stress-driven right wall): (sim, problem, warm-start impulses (P, 2), free
-    velocities (B, 2), free angular velocities (B,)). A few compaction steps hit the sweep cap:
-    not what the tests using it check."""
+    ``seed``; a stress-driven right wall) with plain NLGS sweeps, so that the problem is fixed
+    whatever the solver's default: (sim, problem, warm-start impulses (P, 2), free velocities
+    (B, 2), free angular velocities (B,)). A few compaction steps hit the sweep cap: not what
+    the tests using it check."""
     from solver import compaction_sample, isotropic_compaction
 
-    sim = compaction_sample(120, "pentagon", seed=seed)
+    sim = compaction_sample(120, "pentagon", seed=seed, acceleration="off")
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", ConvergenceWarning)
         isotropic_compaction(sim)

@@ -95,10 +95,11 @@ def test_every_admissible_split_of_a_hyperstatic_load_has_zero_residual():
 
 
 def compacting(n, seed, steps):
-    """A compaction sample of ``n`` pentagons after ``steps`` steps (warnings of the collapse ignored)."""
+    """A compaction sample of ``n`` pentagons after ``steps`` steps with plain NLGS sweeps (a
+    fixed state whatever the solver's default; warnings of the collapse ignored)."""
     from solver import compaction_sample
 
-    sim = compaction_sample(n, "pentagon", seed=seed)
+    sim = compaction_sample(n, "pentagon", seed=seed, acceleration="off")
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         for _ in range(steps):
@@ -124,19 +125,21 @@ def test_step_reports_the_measures_and_momentum_balances():
 
 
 def test_a_tighter_tolerance_gives_a_smaller_local_law_residual():
-    """One dense state, solved cold (no warm start) at two NLGS tolerances."""
+    """One dense state, solved cold (no warm start) at two NLGS tolerances, with plain and with
+    Anderson sweeps."""
     import copy
     from dataclasses import replace
 
     sim = compacting(60, seed=5, steps=600)
-    found = []
-    for tolerance in (1e-2, 1e-7):
-        trial = copy.deepcopy(sim)
-        trial.parameters = replace(trial.parameters, tolerance=tolerance, max_tolerance=tolerance * 10,
-                                   max_iterations=100000).validate()
-        trial.scale_warm_start(0.0)
-        found.append(trial.step().local_law_residual)
-    assert sim.last.n_points > 30 and found[1] < 0.01 * found[0], found
+    for acceleration in ("off", "anderson"):
+        found = []
+        for tolerance in (1e-2, 1e-7):
+            trial = copy.deepcopy(sim)
+            trial.parameters = replace(trial.parameters, tolerance=tolerance, max_tolerance=tolerance * 10,
+                                       max_iterations=100000, acceleration=acceleration).validate()
+            trial.scale_warm_start(0.0)
+            found.append(trial.step().local_law_residual)
+        assert sim.last.n_points > 30 and found[1] < 0.01 * found[0], (acceleration, found)
 
 
 def test_anderson_acceleration_reaches_the_same_solution_in_fewer_sweeps():

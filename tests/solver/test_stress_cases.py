@@ -39,13 +39,21 @@ def test_tall_column_of_50_pentagons():
     x = rng.uniform(-0.1, 0.1, n) * R
     sim = gravity_scene(np.stack([x, y], -1), rng.uniform(0, 2 * np.pi, n), np.full(n, R), np.full(n, 5),
                         sides=(-1.3 * R, 1.3 * R))
-    overlap, energy, caught = _run(sim, 2000)
+    overlap, energy, caught = _run(sim, 1800)
+    floor = []
+    for _ in range(200):
+        sim.step()
+        floor.append(-sim.wall_forces()[0, 1])
     # stated bounds: 5% of the diameter while the column lands (grains hit at ~1 m/s), and
     # 1e-3 once settled (the split-impulse recovery has removed the landing overlaps)
     assert overlap < 5e-2 * 2 * R
     assert sim.last.max_interpenetration < 1e-3 * 2 * R
-    # a chain of 50 contacts at the default NLGS tolerance: the floor force is right to ~2%
-    assert -sim.wall_forces()[0, 1] == pytest.approx(sim.mass.sum() * G, rel=3e-2)
+    # a chain of 50 rigid contacts at the default NLGS tolerance chatters: the floor force of
+    # one step is within about 15% of the weight, their mean over 200 steps (momentum balance
+    # over time) within 1%
+    weight = sim.mass.sum() * G
+    assert np.mean(floor) == pytest.approx(weight, rel=1e-2)
+    assert np.all(np.abs(np.array(floor) / weight - 1) < 0.2)
     assert energy[-1] < 1e-3 * energy.max()  # it came to rest
 
 
