@@ -3,6 +3,8 @@ the state it reaches, for routes that differ in how fast the walls close.
 
     python benchmarks/compaction.py --shape pentagon --particles 1000 --seeds 0,1,2 \
         --routes paper,approach,fast [--out benchmarks/_data/compaction.jsonl]
+    python benchmarks/compaction.py --particles 4000 --routes paper --acceleration anderson \
+        --stall 200                                    # the same route, solved another way
 
 Every route deposits the sample of the 'paper' preparation (friction 0.4, sigma0 = 10 kPa on
 the right and top walls) and compacts it until the equilibrium test of
@@ -15,10 +17,16 @@ solver.scenes.isotropic_compaction holds; they differ only in the closing walls'
 * ``loose``: as ``paper``, with the NLGS tolerance 10x looser until the test first holds, then
   the default tolerance until it holds again.
 
+The solver is the default one unless asked otherwise: ``--acceleration anderson`` (with
+``--period``: an extrapolation every k sweeps) and ``--stall W`` (the stall test over W sweeps;
+solver.nlgs) solve the same route's steps another way; each row says how.
+
 The state reached: solid fraction, coordination z of the force-bearing contacts over the
 particles with at least two (rattlers left out; a double contact counts once), the number of
 rattlers, and the fabric anisotropy a = 2 (F_1 - F_2) of the particle-particle contact
-normals. One JSON line per (route, seed) is appended to ``--out`` and printed; ``--table``
+normals. Time: wall-clock seconds and the process's CPU seconds (nearer the time on an idle
+core when other processes share the machine). One JSON line per (route, seed) is appended to
+``--out`` and printed; ``--table``
 prints the Markdown table of a JSON-lines file.
 """
 
@@ -44,8 +52,13 @@ ROUTES = {
 }
 
 
-def compact(shape: str, particles: int, seed: int, route: str) -> dict:
-    """Compact one sample along ``route``; the numbers of the module docstring."""
+def compact(shape: str, particles: int, seed: int, route: str, acceleration: str = "off", period: int = 1,
+            stall: int = 0) -> dict:
+    """Compact one sample along ``route`` with NLGS sweeps plain or Anderson-accelerated
+    (``acceleration``, an extrapolation every ``period`` sweeps) and the stall test over
+    ``stall`` sweeps (0: none); the numbers of the module docstring, and the sweeps per step
+    (median, 90th percentile) and the number of steps that met their tolerance late or never
+    (stopped by the sweep cap or the stall test)."""
     from solver.output import pair_contacts
     from solver.preparation import preparation
     from solver.scenes import compaction_sample, isotropic_compaction
@@ -54,7 +67,8 @@ def compact(shape: str, particles: int, seed: int, route: str) -> dict:
     r = ROUTES[route]
     prep = preparation("paper", shape=shape, particles=particles, seed=seed)
     sim = compaction_sample(prep.particles, prep.shape, sigma0=prep.sigma0, friction=prep.friction, seed=seed,
-                            aspect=prep.aspect, max_wall_speed=r["speed"])
+                            aspect=prep.aspect, max_wall_speed=r["speed"], acceleration=acceleration,
+                            anderson_period=period, stall_sweeps=stall)
     driven = np.flatnonzero(sim.walls.mode == STRESS)
     solid = float((sim.mass / (sim.parameters.density * sim.parameters.thickness)).sum())
     default_tolerance = sim.parameters.tolerance
@@ -62,13 +76,14 @@ def compact(shape: str, particles: int, seed: int, route: str) -> dict:
     approaching = r["approach_speed"] is not None
     if approaching:
         sim.walls.max_speed[driven] = r["approach_speed"]
-    counts = {"sweeps": 0, "switch_step": None}
+    counts = {"sweeps": [], "unconverged": 0, "switch_step": None}
     step = sim.step
 
     def counted_step():
         nonlocal approaching
         info = step()
-        counts["sweeps"] += info.iterations
+        counts["sweeps"].append(info.iterations)
+        counts["unconverged"] += not info.converged
         if approaching:
             lo, hi = sim.walls.box_bounds()
             if solid / float(np.prod(hi - lo)) >= r["until_solid_fraction"]:
@@ -78,7 +93,7 @@ def compact(shape: str, particles: int, seed: int, route: str) -> dict:
         return info
 
     sim.step = counted_step
-    start = time.perf_counter()
+    start, cpu = time.perf_counter(), time.process_time()
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         steps = isotropic_compaction(sim, max_steps=prep.max_steps, progress=False)
@@ -86,7 +101,7 @@ def compact(shape: str, particles: int, seed: int, route: str) -> dict:
             sim.parameters.tolerance = default_tolerance
             sim.walls.max_speed[driven] = r["speed"]
             steps += isotropic_compaction(sim, max_steps=prep.max_steps, progress=False)
-    seconds = time.perf_counter() - start
+    seconds, cpu = time.perf_counter() - start, time.process_time() - cpu
     lo, hi = sim.walls.box_bounds()
     contacts = pair_contacts(sim, None, 10**6)
     i, j, normal = (np.asarray(contacts[k]) for k in ("i", "j", "normal"))
@@ -95,31 +110,50 @@ def compact(shape: str, particles: int, seed: int, route: str) -> dict:
     nx, ny = normal[pp, 0], normal[pp, 1]
     fabric = np.array([[np.mean(nx * nx), np.mean(nx * ny)], [np.mean(nx * ny), np.mean(ny * ny)]])
     low, high = np.linalg.eigvalsh(fabric)
-    return {"shape": shape, "particles": particles, "seed": seed, "route": route, "steps": int(steps),
-            "switch_step": counts["switch_step"], "sweeps": int(counts["sweeps"]), "seconds": round(seconds, 1),
+    sweeps = np.array(counts["sweeps"])
+    return {"shape": shape, "particles": particles, "seed": seed, "route": route, "acceleration": acceleration,
+            "anderson_period": period, "stall_sweeps": stall, "steps": int(steps),
+            "switch_step": counts["switch_step"], "sweeps": int(sweeps.sum()),
+            "sweeps_median": float(np.median(sweeps)), "sweeps_p90": float(np.percentile(sweeps, 90)),
+            "unconverged_steps": int(counts["unconverged"]), "seconds": round(seconds, 1),
+            "cpu_seconds": round(cpu, 1),
             "settled": bool(sim.settled), "solid_fraction": round(solid / float(np.prod(hi - lo)), 4),
             "z": round(float(per_particle[per_particle >= 2].mean()), 3),
             "rattlers": int((per_particle < 2).sum()), "fabric_a": round(float(2 * (high - low)), 4)}
 
 
+def solved(r: dict) -> str:
+    """How a row's steps were solved, in words (rows from before these options: plain NLGS)."""
+    how = r.get("acceleration", "off")
+    if how == "anderson":
+        period = r.get("anderson_period", 1)
+        how += ", every sweep" if period == 1 else f", every {period} sweeps"
+    stall = r.get("stall_sweeps", 0)
+    return how + (f", stall {stall}" if stall else "")
+
+
 def table(path) -> str:
-    """The Markdown table of a JSON-lines file written by this script: one row per route with
-    the mean and the spread (min-max) over seeds."""
+    """The Markdown table of a JSON-lines file written by this script: one row per route and
+    way of solving, with the mean and the spread (min-max) over seeds."""
     rows = [json.loads(line) for line in open(path) if line.strip()]
-    out = ["| sample | route | seeds | steps | NLGS sweeps (M) | time (s) | solid fraction | z | rattlers | a |",
-           "|---|---|---|---|---|---|---|---|---|---|"]
-    keys = sorted({(r["shape"], r["particles"], r["route"]) for r in rows},
-                  key=lambda k: (k[0], k[1], list(ROUTES).index(k[2])))
-    for shape, n, route in keys:
-        rs = [r for r in rows if (r["shape"], r["particles"], r["route"]) == (shape, n, route)]
+    out = ["| sample | route | sweeps | seeds | steps | NLGS sweeps (M) | sweeps / step median, p90 | "
+           "unconverged steps | time (s) | CPU time (s) | solid fraction | z | rattlers | a |",
+           "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
+    keys = sorted({(r["shape"], r["particles"], r["route"], solved(r)) for r in rows},
+                  key=lambda k: (k[0], k[1], list(ROUTES).index(k[2]), k[3] != "off", k[3]))
+    for shape, n, route, how in keys:
+        rs = [r for r in rows if (r["shape"], r["particles"], r["route"], solved(r)) == (shape, n, route, how)]
 
         def span(name, fmt="{:.0f}", scale=1.0):
+            if any(name not in r for r in rs):
+                return "-"
             v = np.array([r[name] for r in rs], float) * scale
             return (fmt.format(v.mean()) + (f" ({fmt.format(v.min())}-{fmt.format(v.max())})" if len(v) > 1 else ""))
 
-        out.append(f"| {n} {shape}s | {route} | {len(rs)} | {span('steps')} | {span('sweeps', '{:.2f}', 1e-6)} | "
-                   f"{span('seconds')} | {span('solid_fraction', '{:.4f}')} | {span('z', '{:.3f}')} | "
-                   f"{span('rattlers')} | {span('fabric_a', '{:.3f}')} |")
+        out.append(f"| {n} {shape}s | {route} | {how} | {len(rs)} | {span('steps')} | "
+                   f"{span('sweeps', '{:.2f}', 1e-6)} | {span('sweeps_median')}, {span('sweeps_p90')} | "
+                   f"{span('unconverged_steps')} | {span('seconds')} | {span('cpu_seconds')} | {span('solid_fraction', '{:.4f}')} | "
+                   f"{span('z', '{:.3f}')} | {span('rattlers')} | {span('fabric_a', '{:.3f}')} |")
     return "\n".join(out)
 
 
@@ -129,6 +163,9 @@ def main(argv=None):
     parser.add_argument("--particles", type=int, default=1000)
     parser.add_argument("--seeds", default="0")
     parser.add_argument("--routes", default="paper,fast")
+    parser.add_argument("--acceleration", choices=("off", "anderson"), default="off")
+    parser.add_argument("--period", type=int, default=1, help="Anderson: sweeps between extrapolations")
+    parser.add_argument("--stall", type=int, default=0, help="the stall test over this many sweeps (0: none)")
     parser.add_argument("--out", default=os.path.join(HERE, "_data", "compaction.jsonl"))
     parser.add_argument("--table", action="store_true", help="print the table of --out and stop")
     args = parser.parse_args(argv)
@@ -138,7 +175,7 @@ def main(argv=None):
     os.makedirs(os.path.dirname(os.path.abspath(args.out)), exist_ok=True)
     for seed in map(int, args.seeds.split(",")):
         for route in args.routes.split(","):
-            result = compact(args.shape, args.particles, seed, route)
+            result = compact(args.shape, args.particles, seed, route, args.acceleration, args.period, args.stall)
             with open(args.out, "a") as fh:
                 fh.write(json.dumps(result) + "\n")
             print(json.dumps(result), flush=True)

@@ -24,9 +24,14 @@ Extrapolated to N = 4000 and 14,400, and to the paper's pair of samples (14,400 
   fixed speed; the eps_1 at which eps_q reaches 0.4 is the measured one);
 * the time per particle per step stays the measured one (sweeps per step in the quasi-static
   shear do not grow with N: docs/solver.md; ns per point-sweep stays 16-20 up to 14,400);
-* compaction steps: measured where a cached dense sample exists (benchmarks/samples.py),
-  else grown as sqrt(N) from the measured 1000; compaction time per particle per step as
-  measured at 1000.
+* compaction steps: measured where a compaction of that size was run (here or by
+  benchmarks/compaction.py) or a cached dense sample exists (benchmarks/samples.py), else grown
+  as sqrt(N) from the measured 1000;
+* compaction time per particle per step: it grows with N (the jamming phase's steps need more
+  sweeps in a larger packing), so it is taken from the compactions measured at each size, solved
+  as the shear is (Anderson or plain sweeps: benchmarks/_data/compaction_solvers.jsonl written by
+  benchmarks/compaction.py, and the compactions of this script's cached samples, which are
+  plain), and, at a size not measured, a power of N through the two sizes measured nearest to it.
 
 A measurement at another size (``--particles``) is listed beside the extrapolation from 1000
 to the same size: the check of these assumptions.
@@ -54,6 +59,11 @@ PAPER = {"pentagon": 14_400, "disk": 10_000}
 COMPACTION_STEPS = {("pentagon", 4000): 11_671, ("disk", 4000): 961, ("disk", 14_400): 2_001}
 """Compaction steps of the dense samples built by benchmarks/samples.py (paper preparation,
 seed 0; docs/benchmarks.md)."""
+
+
+COMPACTIONS = os.path.join(HERE, "_data", "compaction_solvers.jsonl")
+"""The 'paper' compactions measured by benchmarks/compaction.py, solved plain or with Anderson
+sweeps (docs/benchmarks.md)."""
 
 
 class TargetReached(Exception):
@@ -153,24 +163,66 @@ def variant(m: dict) -> str:
     return how + (f", stall {stall}" if stall else "") + (f", {domains} domains" if domains > 1 else "")
 
 
-def table(results: dict) -> str:
-    """The extrapolated table for one way of solving (``results``: a measurement per shape)."""
+def compaction_rates(shape: str, acceleration: str, measured: list) -> dict:
+    """Measured 'paper' compactions of ``shape`` solved with ``acceleration``: {N: (mean steps,
+    mean seconds per particle per step)}, from benchmarks/compaction.py's rows (their CPU time,
+    where recorded: the machine is shared) and, for plain sweeps, the compactions of this
+    script's cached samples (``measured``)."""
+    runs = {}
+    if os.path.exists(COMPACTIONS):
+        for line in open(COMPACTIONS):
+            r = json.loads(line) if line.strip() else None
+            if r and r["shape"] == shape and r["route"] == "paper" and r.get("acceleration", "off") == acceleration \
+                    and not r.get("stall_sweeps", 0):
+                runs.setdefault(r["particles"], []).append((r["steps"], r.get("cpu_seconds", r["seconds"])))
+    if acceleration == "off":
+        cached = {(m["particles"], m["compaction_steps"], m["compaction_seconds"]) for m in measured
+                  if m["shape"] == shape}
+        for n, steps, seconds in cached:
+            runs.setdefault(n, []).append((steps, seconds))
+    return {n: (float(np.mean([s for s, _ in r])), float(np.mean([t / (s * n) for s, t in r])))
+            for n, r in runs.items()}
+
+
+def compaction_at(n: int, rates: dict):
+    """Steps (None: not measured) and seconds per particle per step of a compaction of ``n``
+    particles from ``rates`` (:func:`compaction_rates`): measured at ``n``, else a power of N
+    through the two nearest sizes measured (the one size there is, when only one is)."""
+    if n in rates:
+        return rates[n]
+    sizes = sorted(rates, key=lambda k: (abs(np.log(k / n)), k))[:2]
+    if len(sizes) == 1:
+        return None, rates[sizes[0]][1]
+    (n1, (_, r1)), (n2, (_, r2)) = sorted((k, rates[k]) for k in sizes)
+    power = np.log(r2 / r1) / np.log(n2 / n1)
+    return None, r1 * (n / n1) ** power
+
+
+def table(results: dict, measured: list) -> str:
+    """The extrapolated table for one way of solving (``results``: a measurement per shape;
+    ``measured``: every measurement, for the compactions of other sizes)."""
     rows = ["| shape | N | compaction steps | compaction time | shear steps to eps_q = 0.4 | shear time | "
             "total | basis |", "|---|---|---|---|---|---|---|---|"]
     totals = {}
     for shape, m in results.items():
-        per_compaction = m["compaction_seconds"] / (m["compaction_steps"] * m["particles"])
+        rates = compaction_rates(shape, m.get("acceleration", "off"), measured)
+        # no compaction measured with these sweeps at this size: the cached sample's (plain)
+        rates.setdefault(m["particles"], (m["compaction_steps"],
+                                          m["compaction_seconds"] / (m["compaction_steps"] * m["particles"])))
         per_shear = m["shear_seconds"] / (m["shear_steps"] * m["particles"])
         for n in sorted(set(SIZES) | {PAPER[shape]}):
             grow = (n / m["particles"]) ** 0.5
-            c_steps = m["compaction_steps"] if n == m["particles"] else COMPACTION_STEPS.get(
-                (shape, n), int(m["compaction_steps"] * grow))
+            steps, per_compaction = compaction_at(n, rates)
+            c_steps = int(steps) if steps is not None else COMPACTION_STEPS.get((shape, n),
+                                                                               int(m["compaction_steps"] * grow))
             s_steps = int(m["shear_steps"] * grow)
             c_time = per_compaction * n * c_steps
             s_time = per_shear * n * s_steps
             totals[(shape, n)] = c_time + s_time
-            basis = ("measured" if n == m["particles"] else
-                     ("compaction steps measured, " if (shape, n) in COMPACTION_STEPS else "") + "extrapolated")
+            basis = ("shear measured" if n == m["particles"] else "shear extrapolated") + (
+                "; compaction measured" if n in rates else
+                "; compaction steps measured, time per step extrapolated" if (shape, n) in COMPACTION_STEPS else
+                "; compaction extrapolated")
             rows.append(f"| {shape} | {n:,} | {c_steps:,} | {c_time / 3600:.2f} h | {s_steps:,} | "
                         f"{s_time / 3600:.2f} h | {(c_time + s_time) / 3600:.2f} h | {basis} |")
     lines = ["\n".join(rows)]
@@ -240,7 +292,7 @@ def main(argv=None):
     for name, found in variants.items():
         if set(found) == set(PAPER):
             print(f"\n**Sweeps: {name}** (time per particle and step as measured with them)\n")
-            print(table(found))
+            print(table(found, measured))
     def same(m, base):
         return (base["particles"] == MEASURED_N and base["shape"] == m["shape"] and variant(base) == variant(m)
                 and base.get("eps_q_target", TARGET_EPS_Q) == m.get("eps_q_target", TARGET_EPS_Q))
