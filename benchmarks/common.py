@@ -1,5 +1,6 @@
 """Shared helpers of the benchmarks: machine description, medians of repeated timings, peak
-memory of a measurement run in a fresh process, Markdown tables."""
+memory of a measurement run in a fresh process, Markdown tables and results files, how a row
+was solved in words."""
 
 from __future__ import annotations
 
@@ -121,3 +122,27 @@ def sheared_sample(shape: str, particles: int, strain: float, folder: str):
         solver.biaxial_test(sim, path, strain=strain, velocity=0.01, every=10**9, overwrite=True, progress=False)
     os.remove(path)
     return sim
+
+
+def way_of_solving(row: dict) -> str:
+    """How a benchmark row's NLGS was run, in words, from its ``acceleration``,
+    ``anderson_period``, ``stall_sweeps`` and ``domains`` (rows from before an option existed:
+    plain sweeps, an extrapolation after every sweep, no stall test, one domain)."""
+    how = row.get("acceleration", "off")
+    if how == "anderson":
+        period = row.get("anderson_period", 1)
+        how += ", every sweep" if period == 1 else f", every {period} sweeps"
+    stall = row.get("stall_sweeps", 0)
+    domains = row.get("domains", 1)
+    return how + (f", stall {stall}" if stall else "") + (f", {domains} domains" if domains > 1 else "")
+
+
+def write_results(path: str, title: str, intro: str, sections: list) -> str:
+    """Write a RESULTS-*.md file: the ``title``, the ``intro`` paragraph, the machine
+    description and the ``sections``, each followed by a blank line; print it and return it."""
+    text = "\n".join([f"# {title}", "", intro, "", machine_description(), ""] + [line for section in sections
+                                                                               for line in (section, "")])
+    with open(path, "w") as f:
+        f.write(text)
+    print(text)
+    return text

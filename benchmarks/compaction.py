@@ -43,6 +43,7 @@ import numpy as np
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, os.path.dirname(HERE))
+from common import way_of_solving  # noqa: E402
 
 ROUTES = {
     "paper": {"approach_speed": None, "until_solid_fraction": None, "loosen": 1.0, "speed": 0.05},
@@ -122,16 +123,6 @@ def compact(shape: str, particles: int, seed: int, route: str, acceleration: str
             "rattlers": int((per_particle < 2).sum()), "fabric_a": round(float(2 * (high - low)), 4)}
 
 
-def solved(r: dict) -> str:
-    """How a row's steps were solved, in words (rows from before these options: plain NLGS)."""
-    how = r.get("acceleration", "off")
-    if how == "anderson":
-        period = r.get("anderson_period", 1)
-        how += ", every sweep" if period == 1 else f", every {period} sweeps"
-    stall = r.get("stall_sweeps", 0)
-    return how + (f", stall {stall}" if stall else "")
-
-
 def table(path) -> str:
     """The Markdown table of a JSON-lines file written by this script: one row per route and
     way of solving, with the mean and the spread (min-max) over seeds."""
@@ -139,10 +130,10 @@ def table(path) -> str:
     out = ["| sample | route | sweeps | seeds | steps | NLGS sweeps (M) | sweeps / step median, p90 | "
            "unconverged steps | time (s) | CPU time (s) | solid fraction | z | rattlers | a |",
            "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
-    keys = sorted({(r["shape"], r["particles"], r["route"], solved(r)) for r in rows},
+    keys = sorted({(r["shape"], r["particles"], r["route"], way_of_solving(r)) for r in rows},
                   key=lambda k: (k[0], k[1], list(ROUTES).index(k[2]), k[3] != "off", k[3]))
     for shape, n, route, how in keys:
-        rs = [r for r in rows if (r["shape"], r["particles"], r["route"], solved(r)) == (shape, n, route, how)]
+        rs = [r for r in rows if (r["shape"], r["particles"], r["route"], way_of_solving(r)) == (shape, n, route, how)]
 
         def span(name, fmt="{:.0f}", scale=1.0):
             if any(name not in r for r in rs):

@@ -100,10 +100,10 @@ def compactions(seed: int, shape: str) -> list:
     from solver.stepper import Parameters
 
     defaults = Parameters()
+    prep = preparation("paper", particles=PARTICLES, shape=shape, seed=seed)
     rows = []
     for acceleration in ("off", "anderson"):
         for tighter in (1, 10):
-            prep = preparation("paper", particles=PARTICLES, shape=shape, seed=seed)
             start = time.perf_counter()
             with warnings.catch_warnings():
                 warnings.simplefilter("ignore")

@@ -33,7 +33,7 @@ import numpy as np
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, os.path.dirname(HERE))
-from common import capture_contact_problems, machine_description, markdown_table, sheared_sample  # noqa: E402
+from common import capture_contact_problems, markdown_table, sheared_sample, write_results  # noqa: E402
 
 OUT = os.path.join(HERE, "_data", "solve_variants")
 RESULTS = os.path.join(HERE, "RESULTS-solve-variants.md")
@@ -137,20 +137,12 @@ def main(argv=None):
     if args.build:
         for shape, particles in sets:
             build(shape, particles)
-    machine = machine_description()
     sections = [measure(shape, particles, candidates) for shape, particles in sets
                 if os.path.exists(cache_path(shape, particles))]
-    text = ["# The same contact problems, every solver candidate", "",
-            "Written by `python benchmarks/solve_variants.py` (its docstring gives the method). The speed-up is "
-            "the plain NLGS's total solve time over the candidate's, from one run with the candidates "
-            "interleaved problem by problem; equal local-law residuals mean equal accuracy.", "",
-            machine, ""]
-    for section in sections:
-        text += [section, ""]
-    with open(RESULTS, "w") as f:
-        f.write("\n".join(text))
-    print("\n".join(text))
-
+    write_results(RESULTS, "The same contact problems, every solver candidate",
+                  "Written by `python benchmarks/solve_variants.py` (its docstring gives the method). The speed-up is "
+                  "the plain NLGS's total solve time over the candidate's, from one run with the candidates "
+                  "interleaved problem by problem; equal local-law residuals mean equal accuracy.", sections)
 
 if __name__ == "__main__":
     main()

@@ -32,7 +32,7 @@ import numpy as np
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, os.path.dirname(HERE))
-from common import machine_description, markdown_table, sheared_sample  # noqa: E402
+from common import markdown_table, sheared_sample, write_results  # noqa: E402
 
 OUT = os.path.join(HERE, "_data", "step_variants")
 RESULTS = os.path.join(HERE, "RESULTS-step-variants.md")
@@ -125,20 +125,13 @@ def main(argv=None):
     if args.build:
         for shape, particles in sets:
             build(shape, particles)
-    machine = machine_description()
     sections = [measure(shape, particles, args.steps, args.chunk, candidates) for shape, particles in sets
                 if os.path.exists(cache_path(shape, particles))]
-    text = ["# Whole steps, every way of solving", "",
-            "Written by `python benchmarks/step_variants.py` (its docstring gives the method). Each candidate "
-            "follows its own trajectory from the same sheared sample; the candidates take turns, so the "
-            "speed-up (the plain NLGS's total time over the candidate's) is from one run under the same drift.",
-            "", machine, ""]
-    for section in sections:
-        text += [section, ""]
-    with open(RESULTS, "w") as f:
-        f.write("\n".join(text))
-    print("\n".join(text))
-
+    write_results(RESULTS, "Whole steps, every way of solving",
+                  "Written by `python benchmarks/step_variants.py` (its docstring gives the method). Each candidate "
+                  "follows its own trajectory from the same sheared sample; the candidates take turns, so the "
+                  "speed-up (the plain NLGS's total time over the candidate's) is from one run under the same drift.",
+                  sections)
 
 if __name__ == "__main__":
     main()

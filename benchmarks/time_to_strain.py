@@ -51,6 +51,7 @@ import numpy as np
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, os.path.dirname(HERE))
+from common import way_of_solving  # noqa: E402
 OUT = os.path.join(HERE, "_data", "time_to_strain")
 TARGET_EPS_Q = 0.4
 MEASURED_N = 1000
@@ -149,18 +150,6 @@ def measure(shape: str, acceleration: str = "off", domains: int = 1, particles: 
             "sweeps_p90": float(np.percentile(sweeps, 90)), "sweeps_mean": float(sweeps.mean()),
             "points_per_particle": float(np.mean(points) / particles),
             "us_per_particle_step": float(1e6 * seconds.sum() / (len(sweeps) * particles))}
-
-
-def variant(m: dict) -> str:
-    """How a measurement's shear was solved, in words (runs from before the Anderson period
-    existed extrapolated after every sweep)."""
-    domains = m.get("domains", 1)
-    how = m.get("acceleration", "off")
-    if how == "anderson":
-        period = m.get("anderson_period", 1)
-        how += ", every sweep" if period == 1 else f", every {period} sweeps"
-    stall = m.get("stall_sweeps", 0)
-    return how + (f", stall {stall}" if stall else "") + (f", {domains} domains" if domains > 1 else "")
 
 
 def compaction_rates(shape: str, acceleration: str, measured: list) -> dict:
@@ -271,7 +260,7 @@ def main(argv=None):
     variants = {}
     for m in measured:
         if m["particles"] == MEASURED_N and m.get("eps_q_target", TARGET_EPS_Q) == TARGET_EPS_Q:
-            variants.setdefault(variant(m), {})[m["shape"]] = m
+            variants.setdefault(way_of_solving(m), {})[m["shape"]] = m
     results = variants.get("off", {})
     if not results:
         print("nothing measured yet: run with --measure pentagon,disk")
@@ -285,7 +274,7 @@ def main(argv=None):
     for m in measured:
         law = (f"{m['local_law_residual_median']:.1e}, {m['local_law_residual_p90']:.1e}"
                if "local_law_residual_median" in m else "-")
-        print(f"| {m['shape']} | {m['particles']} | {variant(m)} | {m['compaction_steps']:,}, "
+        print(f"| {m['shape']} | {m['particles']} | {way_of_solving(m)} | {m['compaction_steps']:,}, "
               f"{m['compaction_seconds']:.0f} s | {m['shear_steps']:,} ({m['eps_1_at_target']:.3f}) | "
               f"{m['sweeps_median']:.0f}, {m['sweeps_p90']:.0f} | {m['points_per_particle']:.2f} | {law} | "
               f"{m['us_per_particle_step']:.1f} |")
@@ -294,7 +283,7 @@ def main(argv=None):
             print(f"\n**Sweeps: {name}** (time per particle and step as measured with them)\n")
             print(table(found, measured))
     def same(m, base):
-        return (base["particles"] == MEASURED_N and base["shape"] == m["shape"] and variant(base) == variant(m)
+        return (base["particles"] == MEASURED_N and base["shape"] == m["shape"] and way_of_solving(base) == way_of_solving(m)
                 and base.get("eps_q_target", TARGET_EPS_Q) == m.get("eps_q_target", TARGET_EPS_Q))
 
     checks = [(m, base) for m in measured if m["particles"] != MEASURED_N for base in measured if same(m, base)]
@@ -308,7 +297,7 @@ def main(argv=None):
         for m, base in checks:
             steps = int(base["shear_steps"] * (m["particles"] / base["particles"]) ** 0.5)
             guess = base["shear_seconds"] / (base["shear_steps"] * base["particles"]) * m["particles"] * steps
-            print(f"| {m['shape']} | {m['particles']:,} | {variant(m)} | {m.get('eps_q_target', TARGET_EPS_Q):g} | "
+            print(f"| {m['shape']} | {m['particles']:,} | {way_of_solving(m)} | {m.get('eps_q_target', TARGET_EPS_Q):g} | "
                   f"{m['shear_steps']:,}, {steps:,} | {m['sweeps_median']:.0f}, {m['sweeps_mean']:.0f}; "
                   f"{base['sweeps_median']:.0f}, {base['sweeps_mean']:.0f} | {m['us_per_particle_step']:.1f}, "
                   f"{base['us_per_particle_step']:.1f} | {m['shear_seconds'] / 3600:.2f} h, {guess / 3600:.2f} h |")
