@@ -5,6 +5,8 @@ the state it reaches, for routes that differ in how fast the walls close.
         --routes paper,approach,fast [--out benchmarks/_data/compaction.jsonl]
     python benchmarks/compaction.py --particles 4000 --routes paper --acceleration anderson \
         --stall 200                                    # the same route, solved another way
+    python benchmarks/compaction.py --particles 14400 --routes fast --acceleration anderson \
+        --domains 2 --report-every 250 --save sample.pkl  # on both cores; keep the sample
 
 Every route deposits the sample of the 'paper' preparation (friction 0.4, sigma0 = 10 kPa on
 the right and top walls) and compacts it until the equilibrium test of
@@ -17,9 +19,12 @@ solver.scenes.isotropic_compaction holds; they differ only in the closing walls'
 * ``loose``: as ``paper``, with the NLGS tolerance 10x looser until the test first holds, then
   the default tolerance until it holds again.
 
-The solver is the default one unless asked otherwise: ``--acceleration anderson`` (with
-``--period``: an extrapolation every k sweeps) and ``--stall W`` (the stall test over W sweeps;
-solver.nlgs) solve the same route's steps another way; each row says how.
+The solver is the serial plain NLGS unless asked otherwise: ``--acceleration anderson`` (with
+``--period``: an extrapolation every k sweeps), ``--stall W`` (the stall test over W sweeps;
+solver.nlgs) and ``--domains D`` (D domains swept at once, a thread each; solver.parallel_nlgs)
+solve the same route's steps another way; each row says how. ``--save`` pickles the compacted
+simulation with its compaction's seconds, the form benchmarks/time_to_strain.py ``--sample``
+shears.
 
 The state reached: solid fraction, coordination z of the force-bearing contacts over the
 particles with at least two (rattlers left out; a double contact counts once), the number of
@@ -35,6 +40,7 @@ from __future__ import annotations
 import argparse
 import json
 import os
+import pickle
 import sys
 import time
 import warnings
@@ -54,12 +60,14 @@ ROUTES = {
 
 
 def compact(shape: str, particles: int, seed: int, route: str, acceleration: str = "off", period: int = 1,
-            stall: int = 0) -> dict:
+            stall: int = 0, domains: int = 1, save: str | None = None, report_every: int = 0) -> dict:
     """Compact one sample along ``route`` with NLGS sweeps plain or Anderson-accelerated
-    (``acceleration``, an extrapolation every ``period`` sweeps) and the stall test over
-    ``stall`` sweeps (0: none); the numbers of the module docstring, and the sweeps per step
-    (median, 90th percentile) and the number of steps that met their tolerance late or never
-    (stopped by the sweep cap or the stall test)."""
+    (``acceleration``, an extrapolation every ``period`` sweeps), serial or on ``domains``
+    domains (a thread each), and the stall test over ``stall`` sweeps (0: none); the numbers of
+    the module docstring, and the sweeps per step (median, 90th percentile) and the number of
+    steps that met their tolerance late or never (stopped by the sweep cap or the stall test).
+    ``save``: a pickle file for the compacted simulation (written whole or not at all);
+    ``report_every``: a progress line on stderr every so many steps (0: none)."""
     from solver.output import pair_contacts
     from solver.preparation import preparation
     from solver.scenes import compaction_sample, isotropic_compaction
@@ -69,7 +77,7 @@ def compact(shape: str, particles: int, seed: int, route: str, acceleration: str
     prep = preparation("paper", shape=shape, particles=particles, seed=seed)
     sim = compaction_sample(prep.particles, prep.shape, sigma0=prep.sigma0, friction=prep.friction, seed=seed,
                             aspect=prep.aspect, max_wall_speed=r["speed"], acceleration=acceleration,
-                            anderson_period=period, stall_sweeps=stall)
+                            anderson_period=period, stall_sweeps=stall, domains=domains)
     driven = np.flatnonzero(sim.walls.mode == STRESS)
     solid = float((sim.mass / (sim.parameters.density * sim.parameters.thickness)).sum())
     default_tolerance = sim.parameters.tolerance
@@ -85,6 +93,11 @@ def compact(shape: str, particles: int, seed: int, route: str, acceleration: str
         info = step()
         counts["sweeps"].append(info.iterations)
         counts["unconverged"] += not info.converged
+        if report_every and sim.step_index % report_every == 0:
+            lo, hi = sim.walls.box_bounds()
+            print(f"step {sim.step_index}: solid fraction {solid / float(np.prod(hi - lo)):.4f}, "
+                  f"{np.median(counts['sweeps'][-report_every:]):.0f} sweeps (median), "
+                  f"{time.perf_counter() - start:.0f} s", file=sys.stderr, flush=True)
         if approaching:
             lo, hi = sim.walls.box_bounds()
             if solid / float(np.prod(hi - lo)) >= r["until_solid_fraction"]:
@@ -103,6 +116,12 @@ def compact(shape: str, particles: int, seed: int, route: str, acceleration: str
             sim.walls.max_speed[driven] = r["speed"]
             steps += isotropic_compaction(sim, max_steps=prep.max_steps, progress=False)
     seconds, cpu = time.perf_counter() - start, time.process_time() - cpu
+    del sim.step  # the class's step again: the counting wrapper is not part of the sample
+    sim.compaction_steps = int(steps)
+    if save:
+        with open(save + ".part", "wb") as fh:
+            pickle.dump((sim, seconds), fh)
+        os.replace(save + ".part", save)
     lo, hi = sim.walls.box_bounds()
     contacts = pair_contacts(sim, None, 10**6)
     i, j, normal = (np.asarray(contacts[k]) for k in ("i", "j", "normal"))
@@ -113,7 +132,7 @@ def compact(shape: str, particles: int, seed: int, route: str, acceleration: str
     low, high = np.linalg.eigvalsh(fabric)
     sweeps = np.array(counts["sweeps"])
     return {"shape": shape, "particles": particles, "seed": seed, "route": route, "acceleration": acceleration,
-            "anderson_period": period, "stall_sweeps": stall, "steps": int(steps),
+            "anderson_period": period, "stall_sweeps": stall, "domains": domains, "steps": int(steps),
             "switch_step": counts["switch_step"], "sweeps": int(sweeps.sum()),
             "sweeps_median": float(np.median(sweeps)), "sweeps_p90": float(np.percentile(sweeps, 90)),
             "unconverged_steps": int(counts["unconverged"]), "seconds": round(seconds, 1),
@@ -157,6 +176,9 @@ def main(argv=None):
     parser.add_argument("--acceleration", choices=("off", "anderson"), default="off")
     parser.add_argument("--period", type=int, default=1, help="Anderson: sweeps between extrapolations")
     parser.add_argument("--stall", type=int, default=0, help="the stall test over this many sweeps (0: none)")
+    parser.add_argument("--domains", type=int, default=1, help="NLGS domains swept at once (threads)")
+    parser.add_argument("--save", default="", help="pickle the compacted simulation here (one seed and route only)")
+    parser.add_argument("--report-every", type=int, default=0, help="a progress line every so many steps")
     parser.add_argument("--out", default=os.path.join(HERE, "_data", "compaction.jsonl"))
     parser.add_argument("--table", action="store_true", help="print the table of --out and stop")
     args = parser.parse_args(argv)
@@ -164,9 +186,12 @@ def main(argv=None):
         print(table(args.out))
         return
     os.makedirs(os.path.dirname(os.path.abspath(args.out)), exist_ok=True)
+    if args.save and ("," in args.seeds or "," in args.routes):
+        parser.error("--save keeps one sample: give one seed and one route")
     for seed in map(int, args.seeds.split(",")):
         for route in args.routes.split(","):
-            result = compact(args.shape, args.particles, seed, route, args.acceleration, args.period, args.stall)
+            result = compact(args.shape, args.particles, seed, route, args.acceleration, args.period, args.stall,
+                             args.domains, args.save or None, args.report_every)
             with open(args.out, "a") as fh:
                 fh.write(json.dumps(result) + "\n")
             print(json.dumps(result), flush=True)

@@ -15,7 +15,8 @@ Measured, per shape, on 1000 particles in one process on one core: the compactio
 (top wall 1 cm/s, sigma0 = 10 kPa, dt = 5e-4 s, default tolerance): steps, NLGS sweeps per
 step (median, 90th percentile), contact points per particle, the local-law residual of the
 steps (median, 90th percentile; solver.residuals) and microseconds per particle per step over
-the whole shear. Written to benchmarks/_data/time_to_strain/<shape>.json.
+the whole shear. Written to benchmarks/_data/time_to_strain/<shape>.json, and every step's
+eps_q, sweeps and seconds to <shape>_steps.npz beside it.
 
 Extrapolated to N = 4000 and 14,400, and to the paper's pair of samples (14,400 pentagons and
 10,000 disks side by side on two cores), with the assumptions the table states:
@@ -94,16 +95,26 @@ def compacted(shape: str, particles: int):
 
 
 def measure(shape: str, acceleration: str = "off", domains: int = 1, particles: int = MEASURED_N,
-            stall: int = 0, until: float = TARGET_EPS_Q, period: int = 1) -> dict:
+            stall: int = 0, until: float = TARGET_EPS_Q, period: int = 1, sample: str | None = None) -> dict:
     """Compact ``particles`` particles of ``shape`` ('paper' preparation, :func:`compacted`) and
     shear them to eps_q = 0.4, timing every step; the shear's NLGS sweeps plain or
     Anderson-accelerated (``acceleration``, the default memory, an extrapolation every
     ``period`` sweeps), serial or on ``domains`` domains (one thread each), with the stall
     test over ``stall`` sweeps (0: none; solver.nlgs); ``until``: the eps_q at which the shear
-    stops (part of a shear, to check the extrapolation at a larger size in less time)."""
+    stops (part of a shear, to check the extrapolation at a larger size in less time);
+    ``sample``: a pickled compacted simulation and its compaction's seconds to shear instead
+    (``benchmarks/compaction.py --save``, e.g. a sample of the 'fast' route)."""
     import solver
 
-    sim, compaction_seconds = compacted(shape, particles)
+    if sample:
+        with open(sample, "rb") as fh:
+            sim, compaction_seconds = pickle.load(fh)
+        from solver.shapes import n_vertices_of
+
+        if sim.n_particles != particles or np.any(sim.n_vertices != n_vertices_of(shape)):
+            raise SystemExit(f"--sample {sample}: holds {sim.n_particles} particles, expected {particles} {shape}s")
+    else:
+        sim, compaction_seconds = compacted(shape, particles)
     sim.parameters.acceleration = acceleration
     sim.parameters.domains = domains
     sim.parameters.stall_sweeps = stall
@@ -111,7 +122,7 @@ def measure(shape: str, acceleration: str = "off", domains: int = 1, particles: 
     residuals = []
     lo, hi = sim.walls.box_bounds()
     h0, l0 = float(hi[1] - lo[1]), float(hi[0] - lo[0])
-    sweeps, points, seconds = [], [], []
+    sweeps, points, seconds, strains = [], [], [], []
     step = sim.step
 
     def timed_step():
@@ -123,6 +134,7 @@ def measure(shape: str, acceleration: str = "off", domains: int = 1, particles: 
         residuals.append(info.local_law_residual)
         lo, hi = sim.walls.box_bounds()
         eps_q = np.log(h0 / float(hi[1] - lo[1])) - np.log(l0 / float(hi[0] - lo[0]))
+        strains.append(eps_q)
         if eps_q >= until:
             raise TargetReached
         return info
@@ -141,7 +153,7 @@ def measure(shape: str, acceleration: str = "off", domains: int = 1, particles: 
     sweeps, seconds = np.array(sweeps), np.array(seconds)
     return {"shape": shape, "acceleration": acceleration, "domains": domains, "particles": particles,
             "anderson_memory": sim.parameters.anderson_memory, "anderson_period": sim.parameters.anderson_period,
-            "stall_sweeps": stall, "eps_q_target": until,
+            "stall_sweeps": stall, "eps_q_target": until, "sample": os.path.basename(sample) if sample else "paper",
             "compaction_steps": int(sim.compaction_steps),
             "local_law_residual_median": float(np.median(residuals)),
             "local_law_residual_p90": float(np.percentile(residuals, 90)),
@@ -149,14 +161,16 @@ def measure(shape: str, acceleration: str = "off", domains: int = 1, particles: 
             "shear_seconds": float(seconds.sum()), "sweeps_median": float(np.median(sweeps)),
             "sweeps_p90": float(np.percentile(sweeps, 90)), "sweeps_mean": float(sweeps.mean()),
             "points_per_particle": float(np.mean(points) / particles),
-            "us_per_particle_step": float(1e6 * seconds.sum() / (len(sweeps) * particles))}
+            "us_per_particle_step": float(1e6 * seconds.sum() / (len(sweeps) * particles)),
+            "per_step": {"eps_q": np.array(strains), "sweeps": sweeps, "seconds": seconds}}
 
 
 def compaction_rates(shape: str, acceleration: str, measured: list) -> dict:
     """Measured 'paper' compactions of ``shape`` solved with ``acceleration``: {N: (mean steps,
     mean seconds per particle per step)}, from benchmarks/compaction.py's rows (their CPU time,
     where recorded: the machine is shared) and, for plain sweeps, the compactions of this
-    script's cached samples (``measured``)."""
+    script's cached 'paper' samples (``measured``; a sample given with ``--sample`` was compacted
+    another way)."""
     runs = {}
     if os.path.exists(COMPACTIONS):
         for line in open(COMPACTIONS):
@@ -166,7 +180,7 @@ def compaction_rates(shape: str, acceleration: str, measured: list) -> dict:
                 runs.setdefault(r["particles"], []).append((r["steps"], r.get("cpu_seconds", r["seconds"])))
     if acceleration == "off":
         cached = {(m["particles"], m["compaction_steps"], m["compaction_seconds"]) for m in measured
-                  if m["shape"] == shape}
+                  if m["shape"] == shape and m.get("sample", "paper") == "paper"}
         for n, steps, seconds in cached:
             runs.setdefault(n, []).append((steps, seconds))
     return {n: (float(np.mean([s for s, _ in r])), float(np.mean([t / (s * n) for s, t in r])))
@@ -239,16 +253,22 @@ def main(argv=None):
                         help="sample size of the measurement (the tables extrapolate from 1000)")
     parser.add_argument("--stall", type=int, default=0, help="sweeps of the NLGS stall test of the shear (0: none)")
     parser.add_argument("--period", type=int, default=1, help="NLGS sweeps between Anderson extrapolations")
+    parser.add_argument("--sample", default="",
+                        help="a pickled compacted sample to shear (benchmarks/compaction.py --save); default: the "
+                             "cached 'paper' sample, compacted first if missing")
     parser.add_argument("--until", type=float, default=TARGET_EPS_Q,
                         help="eps_q at which the measured shear stops (the tables extrapolate whole shears to 0.4)")
     args = parser.parse_args(argv)
     os.makedirs(OUT, exist_ok=True)
     for shape in filter(None, args.measure.split(",")):
-        result = measure(shape, args.acceleration, args.domains, args.particles, args.stall, args.until, args.period)
+        result = measure(shape, args.acceleration, args.domains, args.particles, args.stall, args.until, args.period,
+                         args.sample or None)
         suffix = ("" if args.acceleration == "off" else f"_{args.acceleration}_p{result['anderson_period']}") + (
             f"_stall{args.stall}" if args.stall else "") + (f"_d{args.domains}" if args.domains > 1 else "") + (
             f"_n{args.particles}" if args.particles != MEASURED_N else "") + (
-            f"_to{args.until:g}" if args.until != TARGET_EPS_Q else "")
+            f"_to{args.until:g}" if args.until != TARGET_EPS_Q else "") + (
+            "_" + os.path.splitext(os.path.basename(args.sample))[0] if args.sample else "")
+        np.savez(os.path.join(OUT, f"{shape}{suffix}_steps.npz"), **result.pop("per_step"))
         with open(os.path.join(OUT, f"{shape}{suffix}.json"), "w") as fh:
             json.dump(result, fh, indent=1)
         print(json.dumps(result), flush=True)
@@ -268,13 +288,14 @@ def main(argv=None):
     from common import machine_description
 
     print(machine_description() + "\n")
-    print("| shape | N | sweeps | compaction steps, time | shear steps to eps_q = 0.4 (eps_1) | sweeps / step median, "
+    print("| shape | N | sample | sweeps | compaction steps, time | shear steps to eps_q = 0.4 (eps_1) | sweeps / step median, "
           "p90 | contact points / particle | local-law residual median, p90 | us / particle / step (shear) |")
-    print("|---|---|---|---|---|---|---|---|---|")
+    print("|---|---|---|---|---|---|---|---|---|---|")
     for m in measured:
         law = (f"{m['local_law_residual_median']:.1e}, {m['local_law_residual_p90']:.1e}"
                if "local_law_residual_median" in m else "-")
-        print(f"| {m['shape']} | {m['particles']} | {way_of_solving(m)} | {m['compaction_steps']:,}, "
+        print(f"| {m['shape']} | {m['particles']} | {m.get('sample', 'paper')} | {way_of_solving(m)} | "
+              f"{m['compaction_steps']:,}, "
               f"{m['compaction_seconds']:.0f} s | {m['shear_steps']:,} ({m['eps_1_at_target']:.3f}) | "
               f"{m['sweeps_median']:.0f}, {m['sweeps_p90']:.0f} | {m['points_per_particle']:.2f} | {law} | "
               f"{m['us_per_particle_step']:.1f} |")

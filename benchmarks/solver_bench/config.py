@@ -35,7 +35,8 @@ class Config:
     peer_particles: int = 1000
     peer_settle_steps: int = 3000
     peer_steps: int = 200
-    peer_budgets: tuple = (10, 50)
+    peer_budgets: tuple = (10, 25, 50)
+    peer_tolerances: tuple = (1e-5, 1e-6)  # besides the default: what a smaller floor-force error costs
     # skipping
     skip_particles: int = 1000
     skip_steps: int = 40
@@ -62,6 +63,7 @@ class Config:
             self.peer_settle_steps = 100
             self.peer_steps = 20
             self.peer_budgets = (10,)
+            self.peer_tolerances = ()
             self.skip_particles = 200
             self.acc_particles = 80
             self.acc_steps = 20

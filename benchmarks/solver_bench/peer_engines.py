@@ -36,14 +36,21 @@ def settle_pile(n, shape, steps, seed=0):
                 dt=p.time_step, friction=p.friction, kinetic_energy=sim.kinetic_energy())
 
 
-def _ours_on_pile(path, steps, iterations, default_tolerance):
-    from solver import gravity_scene
+def _ours_on_pile(path, steps, iterations, tolerance):
+    """This solver on the pile: ``iterations`` sweeps every step (``tolerance`` None), or until
+    ``tolerance`` (the quadratic norm; the max norm in the defaults' ratio; "default": the
+    defaults) with at most 2000 sweeps."""
+    from solver import Parameters, gravity_scene
 
     pile = dict(np.load(path))
     x0, _, x1, _ = pile["box"]
-    kwargs = dict(max_iterations=iterations, tolerance=1e-30, max_tolerance=1e-30)
-    if default_tolerance:
+    defaults = Parameters()
+    if tolerance is None:
+        kwargs = dict(max_iterations=iterations, tolerance=1e-30, max_tolerance=1e-30)
+    elif tolerance == "default":
         kwargs = {}
+    else:
+        kwargs = dict(tolerance=tolerance, max_tolerance=tolerance * defaults.max_tolerance / defaults.tolerance)
     sim = gravity_scene(pile["position"], pile["angle"], pile["radius"], pile["n_vertices"], sides=(x0, x1),
                         gravity=float(-pile["gravity"][1]), time_step=float(pile["dt"]), **kwargs)
     run_steps(sim, 2)  # numba caches loaded
@@ -79,17 +86,19 @@ def section_peers(cfg: Config, log=print):
         walls = Walls.floor(sides=(x0, x1))
         log(f"pile {shape}: N = {n}, kinetic energy after settling {pile['kinetic_energy']:.3g} J")
         settled_note.append(f"{shape} pile: E_kin {pile['kinetic_energy']:.2g} J after settling")
-        cases = [("this solver", b, False) for b in cfg.peer_budgets] + [("this solver (default tol.)", None, True)]
+        cases = [("this solver", b, None) for b in cfg.peer_budgets] + [("this solver (default tol.)", None, "default")]
+        cases += [("this solver", None, t) for t in cfg.peer_tolerances]
         cases += [(e, b, None) for e in ("pymunk", "box2d") for b in cfg.peer_budgets]
-        for engine, budget, default in cases:
+        for engine, budget, tolerance in cases:
             try:
                 if engine.startswith("this solver"):
-                    r, _ = in_fresh_process(_ours_on_pile, path, cfg.peer_steps, budget or 2000, default)
+                    r, _ = in_fresh_process(_ours_on_pile, path, cfg.peer_steps, budget or 2000, tolerance)
                     q = r["parts"]
                     extra = (f"{r['sweeps']:.0f} sweeps/step, {r['ns']:.0f} ns/point/sweep, "
                              f"{r['points']} points / {r['pairs']} pairs; ms/step: NLGS {q['solve']:.2f}, "
                              f"overlap recovery {q['update']:.2f} ({r['recovery_sweeps']:.0f} sweeps), detection {q['broad_phase'] + q['narrow_phase']:.2f}")
-                    budget_text = "tol. 1.7e-4 (<= 2000)" if default else f"{budget} sweeps"
+                    budget_text = (f"{budget} sweeps" if tolerance is None else "tol. 1.7e-4 (<= 2000)"
+                                   if tolerance == "default" else f"tol. {tolerance:g} (<= 2000)")
                 else:
                     if not have_peers:
                         rows.append([shape, engine, f"{budget}", "-", "-", "-", "-", "peer venv missing"])
@@ -121,7 +130,9 @@ def section_peers(cfg: Config, log=print):
             f"This solver at a fixed budget: tolerance 1e-30 so it always spends max_iterations sweeps; its "
             f"overlap-recovery pass keeps its own settings (tolerance 1e-2, at most 50 sweeps, run only where an "
             f"overlap exceeds 1e-4 d); where a settled pile keeps overlaps of ~1% d (pentagons), which recovery "
-            f"removes at <= 1 mm/s, it runs every step (its ms/step and sweeps in the notes). Box2D "
+            f"removes at <= 1 mm/s, it runs every step (its ms/step and sweeps in the notes). This solver to a "
+            f"tolerance: the default one, and tighter ones with the max norm in the defaults' ratio (at most 2000 "
+            f"sweeps), the NLGS sweeps as the defaults say (Anderson-accelerated). Box2D "
             f"runs in units of 2.5 cm; pymunk collision_slop 1e-5 m (benchmarks/peers.py).\n\n")
     if not have_peers:
         text += (f"**Peer engines not run**: {PEER_PYTHON} not found; create it with `python3 -m venv /tmp/peervenv && "
