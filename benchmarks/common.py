@@ -124,6 +124,25 @@ def sheared_sample(shape: str, particles: int, strain: float, folder: str):
     return sim
 
 
+def save_sample(path: str, sim, seconds: float) -> None:
+    """Pickle a compacted simulation and its compaction's seconds to ``path``, whole or not at
+    all (written beside it, then renamed): the sample files of compaction.py ``--save`` and
+    time_to_strain.py's cache."""
+    import pickle
+
+    with open(path + ".part", "wb") as fh:
+        pickle.dump((sim, seconds), fh)
+    os.replace(path + ".part", path)
+
+
+def load_sample(path: str):
+    """The compacted simulation and its compaction's seconds from a file of :func:`save_sample`."""
+    import pickle
+
+    with open(path, "rb") as fh:
+        return pickle.load(fh)
+
+
 def way_of_solving(row: dict) -> str:
     """How a benchmark row's NLGS was run, in words, from its ``acceleration``,
     ``anderson_period``, ``stall_sweeps`` and ``domains`` (rows from before an option existed:

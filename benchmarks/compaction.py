@@ -40,7 +40,6 @@ from __future__ import annotations
 import argparse
 import json
 import os
-import pickle
 import sys
 import time
 import warnings
@@ -49,7 +48,7 @@ import numpy as np
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, os.path.dirname(HERE))
-from common import way_of_solving  # noqa: E402
+from common import save_sample, way_of_solving  # noqa: E402
 
 ROUTES = {
     "paper": {"approach_speed": None, "until_solid_fraction": None, "loosen": 1.0, "speed": 0.05},
@@ -80,6 +79,11 @@ def compact(shape: str, particles: int, seed: int, route: str, acceleration: str
                             anderson_period=period, stall_sweeps=stall, domains=domains)
     driven = np.flatnonzero(sim.walls.mode == STRESS)
     solid = float((sim.mass / (sim.parameters.density * sim.parameters.thickness)).sum())
+
+    def solid_fraction():
+        lo, hi = sim.walls.box_bounds()
+        return solid / float(np.prod(hi - lo))
+
     default_tolerance = sim.parameters.tolerance
     sim.parameters.tolerance = default_tolerance * r["loosen"]
     approaching = r["approach_speed"] is not None
@@ -94,16 +98,13 @@ def compact(shape: str, particles: int, seed: int, route: str, acceleration: str
         counts["sweeps"].append(info.iterations)
         counts["unconverged"] += not info.converged
         if report_every and sim.step_index % report_every == 0:
-            lo, hi = sim.walls.box_bounds()
-            print(f"step {sim.step_index}: solid fraction {solid / float(np.prod(hi - lo)):.4f}, "
+            print(f"step {sim.step_index}: solid fraction {solid_fraction():.4f}, "
                   f"{np.median(counts['sweeps'][-report_every:]):.0f} sweeps (median), "
                   f"{time.perf_counter() - start:.0f} s", file=sys.stderr, flush=True)
-        if approaching:
-            lo, hi = sim.walls.box_bounds()
-            if solid / float(np.prod(hi - lo)) >= r["until_solid_fraction"]:
-                approaching = False
-                counts["switch_step"] = sim.step_index
-                sim.walls.max_speed[driven] = r["speed"]
+        if approaching and solid_fraction() >= r["until_solid_fraction"]:
+            approaching = False
+            counts["switch_step"] = sim.step_index
+            sim.walls.max_speed[driven] = r["speed"]
         return info
 
     sim.step = counted_step
@@ -119,10 +120,7 @@ def compact(shape: str, particles: int, seed: int, route: str, acceleration: str
     del sim.step  # the class's step again: the counting wrapper is not part of the sample
     sim.compaction_steps = int(steps)
     if save:
-        with open(save + ".part", "wb") as fh:
-            pickle.dump((sim, seconds), fh)
-        os.replace(save + ".part", save)
-    lo, hi = sim.walls.box_bounds()
+        save_sample(save, sim, seconds)
     contacts = pair_contacts(sim, None, 10**6)
     i, j, normal = (np.asarray(contacts[k]) for k in ("i", "j", "normal"))
     pp = j < particles
@@ -137,7 +135,7 @@ def compact(shape: str, particles: int, seed: int, route: str, acceleration: str
             "sweeps_median": float(np.median(sweeps)), "sweeps_p90": float(np.percentile(sweeps, 90)),
             "unconverged_steps": int(counts["unconverged"]), "seconds": round(seconds, 1),
             "cpu_seconds": round(cpu, 1),
-            "settled": bool(sim.settled), "solid_fraction": round(solid / float(np.prod(hi - lo)), 4),
+            "settled": bool(sim.settled), "solid_fraction": round(solid_fraction(), 4),
             "z": round(float(per_particle[per_particle >= 2].mean()), 3),
             "rattlers": int((per_particle < 2).sum()), "fabric_a": round(float(2 * (high - low)), 4)}
 

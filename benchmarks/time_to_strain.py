@@ -43,7 +43,6 @@ from __future__ import annotations
 import argparse
 import json
 import os
-import pickle
 import sys
 import time
 import warnings
@@ -52,7 +51,7 @@ import numpy as np
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, os.path.dirname(HERE))
-from common import way_of_solving  # noqa: E402
+from common import load_sample, save_sample, way_of_solving  # noqa: E402
 OUT = os.path.join(HERE, "_data", "time_to_strain")
 TARGET_EPS_Q = 0.4
 MEASURED_N = 1000
@@ -80,18 +79,15 @@ def compacted(shape: str, particles: int):
 
     path = os.path.join(OUT, f"sample_{shape}_{particles}.pkl")
     if os.path.exists(path):
-        with open(path, "rb") as fh:
-            return pickle.load(fh)
+        return load_sample(path)
     start = time.perf_counter()
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         sim = prepare_sample(preparation("paper", shape=shape, particles=particles), progress=False,
                              acceleration="off", domains=1, stall_sweeps=0)
-    found = (sim, time.perf_counter() - start)
-    with open(path + ".part", "wb") as fh:
-        pickle.dump(found, fh)
-    os.replace(path + ".part", path)
-    return found
+    seconds = time.perf_counter() - start
+    save_sample(path, sim, seconds)
+    return sim, seconds
 
 
 def measure(shape: str, acceleration: str = "off", domains: int = 1, particles: int = MEASURED_N,
@@ -107,8 +103,7 @@ def measure(shape: str, acceleration: str = "off", domains: int = 1, particles: 
     import solver
 
     if sample:
-        with open(sample, "rb") as fh:
-            sim, compaction_seconds = pickle.load(fh)
+        sim, compaction_seconds = load_sample(sample)
         from solver.shapes import n_vertices_of
 
         if sim.n_particles != particles or np.any(sim.n_vertices != n_vertices_of(shape)):
@@ -267,7 +262,7 @@ def main(argv=None):
             f"_stall{args.stall}" if args.stall else "") + (f"_d{args.domains}" if args.domains > 1 else "") + (
             f"_n{args.particles}" if args.particles != MEASURED_N else "") + (
             f"_to{args.until:g}" if args.until != TARGET_EPS_Q else "") + (
-            "_" + os.path.splitext(os.path.basename(args.sample))[0] if args.sample else "")
+            "_" + os.path.splitext(result["sample"])[0] if args.sample else "")
         np.savez(os.path.join(OUT, f"{shape}{suffix}_steps.npz"), **result.pop("per_step"))
         with open(os.path.join(OUT, f"{shape}{suffix}.json"), "w") as fh:
             json.dump(result, fh, indent=1)
