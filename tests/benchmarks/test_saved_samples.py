@@ -3,26 +3,13 @@ benchmarks/time_to_strain.py ``--sample`` shears: the pickle holds the compacted
 whole (its steps, its particles, its state), the shear starts from it, and a sample of another
 size or shape is refused with one line."""
 
-import importlib.util
 import os
 import pickle
-import sys
 
 import numpy as np
 import pytest
 
-BENCHMARKS = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "benchmarks")
-
-
-def load(name):
-    sys.path.insert(0, BENCHMARKS)
-    try:
-        spec = importlib.util.spec_from_file_location(f"bench_{name}", os.path.join(BENCHMARKS, f"{name}.py"))
-        module = importlib.util.module_from_spec(spec)
-        spec.loader.exec_module(module)
-    finally:
-        sys.path.remove(BENCHMARKS)
-    return module
+from .conftest import load_benchmark as load
 
 
 @pytest.fixture(scope="module")

@@ -1,0 +1,266 @@
+"""Why a large sheared packing needs more sweeps per step: the anatomy of its slow steps.
+
+    python benchmarks/sweep_bursts.py --sample benchmarks/_data/time_to_strain/sample_pentagon_14400_fast.pkl
+
+A 14,400-pentagon shear needs three times the sweeps per step of a 4000-pentagon one, in bursts
+of consecutive steps that end at the stall test (docs/solver.md, "At 14,400 pentagons"). This
+script shears a saved sample (``benchmarks/compaction.py --save``) as time_to_strain.py does
+(Anderson sweeps extrapolated every 2 sweeps, stall test over 200 sweeps, one domain), captures
+the contact problem of shear steps ``--steps A B`` with its warm start, and asks of each
+*burst* step (at least ``--burst`` sweeps) and of the quiet steps:
+
+1. **Where** its impulse changes are: the contact points binned in a 24 x 24 grid over the
+   box, the share of cells that carry 90% of the sum of dV_k^2 = dp_k . W_k dp_k (the NLGS's
+   own measure of a change, :mod:`solver.nlgs`) over sweeps 21 to the last. A local
+   rearrangement would put it in a few cells.
+2. **Cycling or drifting**: over plain sweeps 101-400, the net change of each point's impulse
+   over the sum of its per-sweep changes (both in the point's W_k norm, so the ratio is <= 1 by
+   the triangle inequality): near 0 for points that cycle (e.g. the two points of a double
+   contact trading their load), 1 for a steady drift.
+3. **Does the drift move the bodies**: the RMS change of the points' relative velocities over
+   those sweeps against the RMS of W_k dp_k, the velocity change each point's impulse change
+   would make alone. A small ratio means the impulses redistribute among the contacts (a
+   self-stress-like change) without changing the motion.
+4. The local-law residual (:mod:`solver.residuals`) after 20, 100 and 400 plain sweeps.
+5. **Two remedies, re-solved offline** on the captured problems: Anderson memories 3, 8 and
+   12, and the warm start extrapolated from the last two steps' impulses,
+   p_k + f (p_k - p_(k-1)) projected onto the Coulomb cone, for f = 0, 0.5, 1 (each step
+   re-solved from the captured trajectory; a real run's own trajectory responds to it, and
+   docs/solver.md reports what that did).
+
+Writes benchmarks/RESULTS-sweep-bursts-<N>.md.
+"""
+import argparse
+import os
+import sys
+import time
+import warnings
+
+import numpy as np
+
+sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from common import load_sample, markdown_table, write_results  # noqa: E402
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+GRID = 24
+"""Cells per side of the grid over the box in which the changes are binned."""
+
+
+class _Done(Exception):
+    pass
+
+
+def capture(sim, first: int, last: int) -> list:
+    """Shear ``sim`` (top wall at 1 cm/s, ``solver.biaxial_test``) until shear step ``last``
+    with Anderson sweeps every 2 sweeps and the stall test over 200, one domain, and return the
+    main contact problem of steps ``first``..``last`` as dicts: step, problem, warm-start
+    impulses pn, pt, free velocities vx, vy, w, the solver options, the particles' positions
+    and the sweeps the step took."""
+    import solver
+    from solver import acceleration
+
+    p = sim.parameters
+    p.acceleration, p.anderson_period, p.stall_sweeps, p.domains = "anderson", 2, 200, 1
+    caught, done = [], [0]
+    solve = acceleration.solve_problem_anderson
+
+    def capturing(problem, pn, pt, vx, vy, w, **options):
+        main = options["tolerance"] == p.tolerance and first <= done[0] <= last
+        if main:
+            caught.append(dict(step=done[0], problem=problem, pn=pn.copy(), pt=pt.copy(), vx=vx.copy(),
+                               vy=vy.copy(), w=w.copy(), options=dict(options),
+                               position=sim.position[:sim.n_particles].copy()))
+        result = solve(problem, pn, pt, vx, vy, w, **options)
+        if main:
+            caught[-1]["sweeps"] = result.iterations
+        return result
+
+    step = sim.step
+
+    def counted_step():
+        info = step()
+        done[0] += 1
+        if done[0] > last:
+            raise _Done
+        return info
+
+    sim.step = counted_step
+    acceleration.solve_problem_anderson = capturing
+    path = os.path.join(HERE, "_data", "sweep_bursts_shear.nc")
+    os.makedirs(os.path.dirname(path), exist_ok=True)
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            solver.biaxial_test(sim, path, strain=0.5, velocity=0.01, every=10**9, overwrite=True, progress=False)
+    except _Done:
+        pass
+    finally:
+        acceleration.solve_problem_anderson = solve
+        del sim.step  # the class's method again
+        if os.path.exists(path):
+            os.remove(path)
+    return caught
+
+
+def _w_norm(dpn, dpt, wnn, wnt, wtt):
+    return np.sqrt(np.maximum(dpn * (wnn * dpn + wnt * dpt) + dpt * (wnt * dpn + wtt * dpt), 0.0))
+
+
+def _relative_velocity(problem, vx, vy, w):
+    """Normal and tangential relative velocity (b minus a) at every point, m s-1."""
+    P = problem
+    ua_x, ua_y = vx[P.a] - w[P.a] * P.ray, vy[P.a] + w[P.a] * P.rax
+    ub_x, ub_y = vx[P.b] - w[P.b] * P.rby, vy[P.b] + w[P.b] * P.rbx
+    dx, dy = ub_x - ua_x, ub_y - ua_y
+    return dx * P.nx + dy * P.ny, -dx * P.ny + dy * P.nx
+
+
+def anatomy(case: dict, bounds, n_particles: int, sweeps: int = 400, drift_from: int = 100) -> dict:
+    """Plain NLGS sweeps on one captured step (``case`` from :func:`capture`), from its warm
+    start: the share of grid cells carrying 90% of the change over sweeps 21..``sweeps``, the
+    net-over-gross ratio and the velocity ratio over sweeps ``drift_from``+1..``sweeps``
+    (module docstring, items 1-3), and the quadratic norm and local-law residual after sweeps
+    20, ``drift_from`` and ``sweeps``."""
+    from solver import nlgs, residuals
+
+    P = case["problem"]
+    m = P.a.size
+    pn, pt = case["pn"].copy(), case["pt"].copy()
+    vx, vy, w = case["vx"].copy(), case["vy"].copy(), case["w"].copy()
+    wnn, wnt, wtt = nlgs.delassus(P.a, P.b, P.nx, P.ny, P.rax, P.ray, P.rbx, P.rby, P.minv_xx, P.minv_xy,
+                                  P.minv_yy, P.iinv)
+    nlgs.velocities_from_impulses(P.a, P.b, P.nx, P.ny, P.rax, P.ray, P.rbx, P.rby, pn, pt, vx, vy, w,
+                                  P.minv_xx, P.minv_xy, P.minv_yy, P.iinv)
+    lo, hi = bounds
+    pos = case["position"]
+    on_a = P.a < n_particles
+    body = np.where(on_a, P.a, P.b)
+    arm = np.where(on_a[:, None], np.stack([P.rax, P.ray], -1), np.stack([P.rbx, P.rby], -1))
+    where = pos[np.minimum(body, n_particles - 1)] + arm
+    cx = np.clip(((where[:, 0] - lo[0]) / (hi[0] - lo[0]) * GRID).astype(int), 0, GRID - 1)
+    cy = np.clip(((where[:, 1] - lo[1]) / (hi[1] - lo[1]) * GRID).astype(int), 0, GRID - 1)
+    cell = cx * GRID + cy
+    order = np.arange(m)
+    change = np.zeros(m)
+    gross = np.zeros(m)
+    checkpoints = {}
+    for it in range(1, sweeps + 1):
+        pn0, pt0 = pn.copy(), pt.copy()
+        total, largest, _, _ = nlgs.sweep(order, P.a, P.b, P.nx, P.ny, P.rax, P.ray, P.rbx, P.rby, P.bias, P.mu, pn,
+                                          pt, vx, vy, w, P.minv_xx, P.minv_xy, P.minv_yy, P.iinv, wnn, wnt, wtt)
+        dv = _w_norm(pn - pn0, pt - pt0, wnn, wnt, wtt)
+        if it > 20:
+            change += dv ** 2
+        if it > drift_from:
+            gross += dv
+        if it == drift_from:
+            start = (pn.copy(), pt.copy(), *_relative_velocity(P, vx, vy, w))
+        if it in (20, drift_from, sweeps):
+            quad, _ = nlgs.norms(total, largest, pn, pt, wnn, wnt, wtt)
+            checkpoints[it] = (float(quad), residuals.local_law_residual(P, pn, pt, vx, vy, w))
+    per_cell = np.sort(np.bincount(cell, change, GRID * GRID))[::-1]
+    cells90 = (np.searchsorted(np.cumsum(per_cell) / per_cell.sum(), 0.9) + 1) / GRID ** 2
+    dpn, dpt = pn - start[0], pt - start[1]
+    net = _w_norm(dpn, dpt, wnn, wnt, wtt)
+    un, ut = _relative_velocity(P, vx, vy, w)
+    own = np.hypot(wnn * dpn + wnt * dpt, wnt * dpn + wtt * dpt)
+    moved = np.sqrt(np.mean((un - start[2]) ** 2 + (ut - start[3]) ** 2))
+    return dict(cells90=float(cells90), net_over_gross=float(net.sum() / gross.sum()),
+                velocity_ratio=float(moved / np.sqrt(np.mean(own ** 2))), checkpoints=checkpoints)
+
+
+def point_keys_of(problem) -> np.ndarray:
+    """A key per point, the same for the same point in two steps: the body pair and the point's
+    rank in it (the stepper's :func:`solver.contact_points.point_keys`, from the problem's
+    arrays, whose points of a pair are consecutive)."""
+    pair = problem.a * (1 << 31) + problem.b
+    rank = np.r_[0, (pair[1:] == pair[:-1]).astype(np.int64)]
+    return pair * 2 + rank
+
+
+def extrapolated(previous: dict, case: dict, factor: float):
+    """The warm start p_k + f (p_k - p_(k-1)) of ``case`` from its own warm start p_k and the
+    previous captured step's, p_(k-1), at the points of both, projected onto the Coulomb cone."""
+    keys, old_keys = point_keys_of(case["problem"]), point_keys_of(previous["problem"])
+    order = np.argsort(old_keys)
+    where = np.minimum(np.searchsorted(old_keys[order], keys), len(old_keys) - 1)
+    hit = old_keys[order][where] == keys
+    pn, pt = case["pn"].copy(), case["pt"].copy()
+    pn[hit] += factor * (pn[hit] - previous["pn"][order[where[hit]]])
+    pt[hit] += factor * (pt[hit] - previous["pt"][order[where[hit]]])
+    pn = np.maximum(pn, 0.0)
+    mu = case["problem"].mu
+    return pn, np.clip(pt, -mu * pn, mu * pn)
+
+
+def resolve(caught: list, memory: int = 3, factor: float = 0.0) -> np.ndarray:
+    """Re-solve the captured steps (all but the first) with Anderson memory ``memory`` from a
+    warm start extrapolated by ``factor``: rows (sweeps, seconds, local-law residual)."""
+    from solver import acceleration, residuals
+
+    rows = []
+    for previous, case in zip(caught[:-1], caught[1:]):
+        pn, pt = extrapolated(previous, case, factor) if factor else (case["pn"].copy(), case["pt"].copy())
+        vx, vy, w = case["vx"].copy(), case["vy"].copy(), case["w"].copy()
+        o = case["options"]
+        start = time.perf_counter()
+        result = acceleration.solve_problem_anderson(
+            case["problem"], pn, pt, vx, vy, w, tolerance=o["tolerance"], max_tolerance=o["max_tolerance"],
+            max_iterations=o["max_iterations"], memory=memory, period=2, stall=200, domains=1)
+        seconds = time.perf_counter() - start
+        rows.append((result.iterations, seconds, residuals.local_law_residual(case["problem"], pn, pt, vx, vy, w)))
+    return np.array(rows)
+
+
+def main(argv=None):
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--sample", required=True, help="a pickled compacted sample (compaction.py --save)")
+    parser.add_argument("--steps", type=int, nargs=2, default=(10, 60), metavar=("A", "B"),
+                        help="the shear steps captured (default 10 60)")
+    parser.add_argument("--burst", type=int, default=200, help="sweeps that make a step a burst step (default 200)")
+    parser.add_argument("--sweeps", type=int, default=400, help="plain sweeps of the anatomy (default 400)")
+    parser.add_argument("--out", help="the results file (default benchmarks/RESULTS-sweep-bursts-<N>.md)")
+    args = parser.parse_args(argv)
+    sim, _ = load_sample(args.sample)
+    n = sim.n_particles
+    out = args.out or os.path.join(HERE, f"RESULTS-sweep-bursts-{n}.md")
+    bounds = sim.walls.box_bounds()
+    caught = capture(sim, *args.steps)
+    sweeps = [c["sweeps"] for c in caught]
+    print(f"captured steps {args.steps[0]}-{args.steps[1]}: sweeps {sweeps}", flush=True)
+    burst = [c for c in caught if c["sweeps"] >= args.burst]
+    quiet = [c for c in caught if c["sweeps"] < min(60, args.burst)]
+    rows = []
+    for kind, cases in (("burst", burst[:6]), ("quiet", quiet[:3])):
+        for case in cases:
+            a = anatomy(case, bounds, n, sweeps=args.sweeps)
+            c = a["checkpoints"]
+            rows.append([case["step"], kind, case["sweeps"], case["problem"].a.size, f"{a['cells90']:.2f}",
+                         f"{a['net_over_gross']:.3f}", f"{a['velocity_ratio']:.4f}",
+                         *(f"{c[k][0]:.2e} / {c[k][1]:.2e}" for k in sorted(c))])
+            print(rows[-1], flush=True)
+    anatomy_table = markdown_table(
+        ["step", "kind", "sweeps (Anderson)", "points", "cells with 90% of the change", "net / gross change",
+         "relative-velocity change / W dp", "quad / law after 20", "after 100", f"after {args.sweeps}"], rows)
+    remedies = []
+    for label, memory, factor in (("Anderson memory 3 (default)", 3, 0.0), ("memory 8", 8, 0.0),
+                                  ("memory 12", 12, 0.0), ("warm start extrapolated, f = 0.5", 3, 0.5),
+                                  ("warm start extrapolated, f = 1", 3, 1.0)):
+        r = resolve(caught, memory, factor)
+        remedies.append([label, f"{np.median(r[:, 0]):.0f}", f"{r[:, 0].mean():.0f}", f"{np.percentile(r[:, 0], 90):.0f}",
+                         f"{r[:, 1].sum():.1f}", f"{np.median(r[:, 2]):.2e}", f"{np.percentile(r[:, 2], 90):.2e}"])
+        print(remedies[-1], flush=True)
+    remedy_table = markdown_table(["re-solved with", "sweeps median", "mean", "p90", "seconds", "local-law residual median",
+                                   "p90"], remedies)
+    intro = (f"Written by `python benchmarks/sweep_bursts.py --sample {os.path.relpath(args.sample, os.path.dirname(HERE))} "
+             f"--steps {args.steps[0]} {args.steps[1]}`: {n} particles, shear steps {args.steps[0]}-{args.steps[1]} "
+             f"(sweeps per step: {sweeps}). The script's docstring defines each column; docs/solver.md "
+             "(\"At 14,400 pentagons\") reads them.")
+    write_results(out, "The anatomy of slow shear steps", intro,
+                  ["## Where the changes are, and what they are (plain NLGS sweeps from the step's warm start)",
+                   anatomy_table, "## Remedies, re-solved on the captured steps (one domain)", remedy_table])
+
+
+if __name__ == "__main__":
+    main()

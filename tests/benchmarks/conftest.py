@@ -1,0 +1,20 @@
+"""Loading a script of benchmarks/ as a module, as the benchmarks themselves import each other
+(their folder on sys.path while the script loads)."""
+
+import importlib.util
+import os
+import sys
+
+BENCHMARKS = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "benchmarks")
+
+
+def load_benchmark(name):
+    """The module of ``benchmarks/<name>.py``."""
+    sys.path.insert(0, BENCHMARKS)
+    try:
+        spec = importlib.util.spec_from_file_location(f"bench_{name}", os.path.join(BENCHMARKS, f"{name}.py"))
+        module = importlib.util.module_from_spec(spec)
+        spec.loader.exec_module(module)
+    finally:
+        sys.path.remove(BENCHMARKS)
+    return module

@@ -1,0 +1,87 @@
+"""benchmarks/sweep_bursts.py: its point keys match the stepper's, its extrapolated warm start
+follows the rule by hand, and its anatomy of a captured step obeys the triangle inequality and
+agrees with the solver's own residuals."""
+
+import numpy as np
+import pytest
+
+from .conftest import load_benchmark
+
+
+@pytest.fixture(scope="module")
+def bursts():
+    return load_benchmark("sweep_bursts")
+
+
+@pytest.fixture(scope="module")
+def captured(bursts, tmp_path_factory):
+    compaction = load_benchmark("compaction")
+    path = str(tmp_path_factory.mktemp("samples") / "pentagons.pkl")
+    compaction.compact("pentagon", 60, 0, "fast", acceleration="anderson", save=path)
+    sim, _ = load_benchmark("common").load_sample(path)
+    bounds = sim.walls.box_bounds()
+    return sim, bounds, bursts.capture(sim, 2, 6)
+
+
+def test_capture_keeps_the_steps_asked_for(captured):
+    sim, _, caught = captured
+    assert [c["step"] for c in caught] == [2, 3, 4, 5, 6]
+    assert all(c["sweeps"] >= 1 and c["pn"].size == c["problem"].a.size for c in caught)
+    assert "step" not in vars(sim)  # the counting wrapper is removed
+
+
+def test_point_keys_match_the_stepper_keys(bursts, captured):
+    """Two steps' points matched by the script's keys pair up exactly as by the stepper's
+    (solver.contact_points.point_keys), whose matching gives the warm start: the captured warm
+    start of step 6 is step 5's solution at the same points."""
+    sim, _, caught = captured
+    from solver import acceleration
+
+    five, six = caught[3], caught[4]
+    pn, pt = five["pn"].copy(), five["pt"].copy()
+    o = five["options"]
+    acceleration.solve_problem_anderson(five["problem"], pn, pt, five["vx"].copy(), five["vy"].copy(),
+                                        five["w"].copy(), tolerance=o["tolerance"], max_tolerance=o["max_tolerance"],
+                                        max_iterations=o["max_iterations"], memory=3, period=2, stall=200)
+    keys5, keys6 = bursts.point_keys_of(five["problem"]), bursts.point_keys_of(six["problem"])
+    assert len(np.unique(keys6)) == keys6.size
+    order = np.argsort(keys5)
+    where = np.minimum(np.searchsorted(keys5[order], keys6), keys5.size - 1)
+    hit = keys5[order][where] == keys6
+    np.testing.assert_allclose(six["pn"][hit], pn[order[where[hit]]], rtol=1e-12, atol=0)
+    assert np.all(six["pn"][~hit] == 0.0)  # new points start from nothing
+    assert hit.mean() > 0.9
+
+
+def test_extrapolated_warm_start_by_hand(bursts, captured):
+    _, _, caught = captured
+    previous, case = caught[0], caught[1]
+    keys, old = bursts.point_keys_of(case["problem"]), bursts.point_keys_of(previous["problem"])
+    pn, pt = bursts.extrapolated(previous, case, 0.5)
+    mu = case["problem"].mu
+    for k in range(keys.size):
+        match = np.flatnonzero(old == keys[k])
+        n, t = case["pn"][k], case["pt"][k]
+        if match.size:
+            n, t = n + 0.5 * (n - previous["pn"][match[0]]), t + 0.5 * (t - previous["pt"][match[0]])
+        n = max(n, 0.0)
+        assert pn[k] == pytest.approx(n, rel=1e-12, abs=1e-300)
+        assert pt[k] == pytest.approx(min(max(t, -mu[k] * n), mu[k] * n), rel=1e-12, abs=1e-300)
+
+
+def test_anatomy_obeys_the_triangle_inequality_and_the_solvers_residuals(bursts, captured):
+    from solver import nlgs
+
+    sim, bounds, caught = captured
+    case = caught[0]
+    a = bursts.anatomy(case, bounds, sim.n_particles, sweeps=30, drift_from=10)
+    assert 0.0 < a["net_over_gross"] <= 1.0 + 1e-12  # |sum of changes| <= sum of |changes| in the W_k seminorm
+    assert 1 / bursts.GRID ** 2 <= a["cells90"] <= 1.0
+    assert a["velocity_ratio"] >= 0.0
+    assert sorted(a["checkpoints"]) == [10, 20, 30]
+    # the quadratic norm after 30 plain sweeps is the NLGS's own after 30 sweeps
+    P = case["problem"]
+    pn, pt, vx, vy, w = (case[k].copy() for k in ("pn", "pt", "vx", "vy", "w"))
+    result = nlgs.solve_problem(P, pn, pt, vx, vy, w, tolerance=0.0, max_tolerance=0.0, max_iterations=30)
+    assert result.iterations == 30
+    assert a["checkpoints"][30][0] == pytest.approx(result.residual, rel=1e-9)
