@@ -27,6 +27,9 @@ the contact problem of shear steps ``--steps A B`` with its warm start, and asks
    p_k + f (p_k - p_(k-1)) projected onto the Coulomb cone, for f = 0, 0.5, 1 (each step
    re-solved from the captured trajectory; a real run's own trajectory responds to it, and
    docs/solver.md reports what that did).
+6. **A lead**: on the steps of items 1-4, the iterations a Jacobi-scaled accelerated projected
+   gradient (:func:`apgd_probe`, numpy) needs to reach the local-law residual that the default
+   NLGS reached on the same step.
 
 Writes benchmarks/RESULTS-sweep-bursts-<N>.md.
 """
@@ -170,6 +173,103 @@ def anatomy(case: dict, bounds, n_particles: int, sweeps: int = 400, drift_from:
                 velocity_ratio=float(moved / np.sqrt(np.mean(own ** 2))), checkpoints=checkpoints)
 
 
+def _velocities(problem, free, pn, pt):
+    """Body velocities (vx, vy, w) = free + M^-1 H p (the NLGS's own kernel)."""
+    from solver import nlgs
+
+    P = problem
+    vx, vy, w = (v.copy() for v in free)
+    nlgs.velocities_from_impulses(P.a, P.b, P.nx, P.ny, P.rax, P.ray, P.rbx, P.rby, pn, pt, vx, vy, w, P.minv_xx,
+                                  P.minv_xy, P.minv_yy, P.iinv)
+    return vx, vy, w
+
+
+def _cone_projections(zn, zt, mu):
+    """Projection of every (zn, zt) onto its Coulomb cone {|t| <= mu n} (as
+    solver.residuals.cone_projection, point by point)."""
+    at = np.abs(zt)
+    inside = (zn >= 0.0) & (at <= mu * zn)
+    polar = mu * at <= -zn
+    edge = (zn + mu * at) / (1.0 + mu * mu)
+    return (np.where(inside, zn, np.where(polar, 0.0, edge)),
+            np.where(inside, zt, np.where(polar, 0.0, np.sign(zt) * mu * edge)))
+
+
+def apgd_probe(case: dict, target: float, iterations: int = 400, check_every: int = 10, seed: int = 0,
+               stop: bool = False):
+    """Accelerated projected gradient on one captured step, from its warm start: the first
+    iteration (a multiple of ``check_every``) at which the local-law residual is <= ``target``
+    (None if none within ``iterations``), and the lowest residual met with its impulses
+    (``stop``: return at that first iteration).
+
+    The iteration (Nesterov's method with the gradient-restart test, as APGD in Project Chrono)
+    on impulses p in the cones K_k = {|p_t| <= mu_k p_n}:
+    g = u(y) + (b_k + mu_k |u_t(y)|, 0), the relative velocities u(y) of the bodies moved by the
+    free velocities and the impulses y, shifted by the Signorini term and De Saxcé's mu |u_t|
+    (so that a fixed point satisfies the Coulomb law, not its associated relaxation);
+    p+ = proj_K(y - t D g), D = diag(1 / W_nn,k) (a Jacobi scaling), t = 1 / (1.05 L) with L the
+    largest eigenvalue of D^(1/2) W D^(1/2) by 20 power iterations; y+ = p+ + beta (p+ - p),
+    beta from theta_(k+1)^2 = (1 - theta_(k+1)) theta_k^2, reset to y+ = p+ when g . (p+ - p) > 0.
+    A probe in numpy, not a solver: the De Saxcé shift taken at the current iterate makes the
+    map non-monotone, and the residual can rise again after its minimum."""
+    from solver import nlgs, residuals
+
+    P = case["problem"]
+    free = (case["vx"], case["vy"], case["w"])
+    wnn, _, _ = nlgs.delassus(P.a, P.b, P.nx, P.ny, P.rax, P.ray, P.rbx, P.rby, P.minv_xx, P.minv_xy, P.minv_yy,
+                              P.iinv)
+    scale = 1.0 / wnn
+    root = np.sqrt(scale)
+    rest = tuple(np.zeros_like(v) for v in free)
+    xn, xt = np.random.default_rng(seed).standard_normal((2, P.a.size))
+    for _ in range(20):
+        un, ut = _relative_velocity(P, *_velocities(P, rest, root * xn, root * xt))
+        yn, yt = root * un, root * ut
+        norm = np.sqrt(np.sum(yn ** 2 + yt ** 2))
+        largest = norm / np.sqrt(np.sum(xn ** 2 + xt ** 2))
+        xn, xt = yn / norm, yt / norm
+    t = 1.0 / (1.05 * largest)
+    pn, pt = case["pn"].copy(), case["pt"].copy()
+    yn, yt = pn.copy(), pt.copy()
+    theta = 1.0
+    best = (residuals.local_law_residual(P, pn, pt, *_velocities(P, free, pn, pt)), pn.copy(), pt.copy())
+    reached = None
+    for it in range(1, iterations + 1):
+        un, ut = _relative_velocity(P, *_velocities(P, free, yn, yt))
+        gn, gt = un + P.bias + P.mu * np.abs(ut), ut
+        new_n, new_t = _cone_projections(yn - t * scale * gn, yt - t * scale * gt, P.mu)
+        next_theta = 0.5 * (-theta ** 2 + theta * np.sqrt(theta ** 2 + 4.0))
+        if np.sum(gn * (new_n - pn) + gt * (new_t - pt)) > 0.0:
+            yn, yt, next_theta = new_n.copy(), new_t.copy(), 1.0
+        else:
+            beta = theta * (1.0 - theta) / (theta ** 2 + next_theta)
+            yn, yt = new_n + beta * (new_n - pn), new_t + beta * (new_t - pt)
+        pn, pt, theta = new_n, new_t, next_theta
+        if it % check_every == 0:
+            law = residuals.local_law_residual(P, pn, pt, *_velocities(P, free, pn, pt))
+            if law < best[0]:
+                best = (law, pn.copy(), pt.copy())
+            if reached is None and law <= target:
+                reached = it
+                if stop:
+                    break
+    return reached, best
+
+
+def default_solve(case: dict):
+    """The step solved as the shear solved it (Anderson every 2 sweeps, stall 200, one domain):
+    (sweeps, local-law residual)."""
+    from solver import acceleration, residuals
+
+    pn, pt = case["pn"].copy(), case["pt"].copy()
+    vx, vy, w = case["vx"].copy(), case["vy"].copy(), case["w"].copy()
+    o = case["options"]
+    result = acceleration.solve_problem_anderson(
+        case["problem"], pn, pt, vx, vy, w, tolerance=o["tolerance"], max_tolerance=o["max_tolerance"],
+        max_iterations=o["max_iterations"], memory=3, period=2, stall=200, domains=1)
+    return result.iterations, residuals.local_law_residual(case["problem"], pn, pt, vx, vy, w)
+
+
 def point_keys_of(problem) -> np.ndarray:
     """A key per point, the same for the same point in two steps: the body pair and the point's
     rank in it (the stepper's :func:`solver.contact_points.point_keys`, from the problem's
@@ -231,7 +331,7 @@ def main(argv=None):
     print(f"captured steps {args.steps[0]}-{args.steps[1]}: sweeps {sweeps}", flush=True)
     burst = [c for c in caught if c["sweeps"] >= args.burst]
     quiet = [c for c in caught if c["sweeps"] < min(60, args.burst)]
-    rows = []
+    rows, leads = [], []
     for kind, cases in (("burst", burst[:6]), ("quiet", quiet[:3])):
         for case in cases:
             a = anatomy(case, bounds, n, sweeps=args.sweeps)
@@ -239,10 +339,16 @@ def main(argv=None):
             rows.append([case["step"], kind, case["sweeps"], case["problem"].a.size, f"{a['cells90']:.2f}",
                          f"{a['net_over_gross']:.3f}", f"{a['velocity_ratio']:.4f}",
                          *(f"{c[k][0]:.2e} / {c[k][1]:.2e}" for k in sorted(c))])
-            print(rows[-1], flush=True)
+            sweeps_default, law = default_solve(case)
+            reached, best = apgd_probe(case, law)
+            leads.append([case["step"], kind, sweeps_default, f"{law:.2e}", reached or "not within 400",
+                          f"{best[0]:.2e}"])
+            print(rows[-1], leads[-1], flush=True)
     anatomy_table = markdown_table(
         ["step", "kind", "sweeps (Anderson)", "points", "cells with 90% of the change", "net / gross change",
          "relative-velocity change / W dp", "quad / law after 20", "after 100", f"after {args.sweeps}"], rows)
+    lead_table = markdown_table(["step", "kind", "default: sweeps", "its local-law residual",
+                                 "APGD iterations to the same residual", "lowest APGD residual in 400"], leads)
     remedies = []
     for label, memory, factor in (("Anderson memory 3 (default)", 3, 0.0), ("memory 8", 8, 0.0),
                                   ("memory 12", 12, 0.0), ("warm start extrapolated, f = 0.5", 3, 0.5),
@@ -259,7 +365,8 @@ def main(argv=None):
              "(\"At 14,400 pentagons\") reads them.")
     write_results(out, "The anatomy of slow shear steps", intro,
                   ["## Where the changes are, and what they are (plain NLGS sweeps from the step's warm start)",
-                   anatomy_table, "## Remedies, re-solved on the captured steps (one domain)", remedy_table])
+                   anatomy_table, "## Remedies, re-solved on the captured steps (one domain)", remedy_table,
+                   "## A lead: an accelerated projected gradient (numpy probe, `apgd_probe`)", lead_table])
 
 
 if __name__ == "__main__":

@@ -85,3 +85,30 @@ def test_anatomy_obeys_the_triangle_inequality_and_the_solvers_residuals(bursts,
     result = nlgs.solve_problem(P, pn, pt, vx, vy, w, tolerance=0.0, max_tolerance=0.0, max_iterations=30)
     assert result.iterations == 30
     assert a["checkpoints"][30][0] == pytest.approx(result.residual, rel=1e-9)
+
+
+def test_apgd_probe_finds_the_weight_of_a_disk_on_the_floor(bursts):
+    """One disk at rest on the floor under gravity: the one solution is p_n = m g h, p_t = 0."""
+    from solver import gravity_scene
+    from solver.nlgs import ContactProblem
+
+    sim = gravity_scene([[0.0, 0.0125]], [0.0], [0.0125], [0], acceleration="off")
+    caught = []
+    import solver.nlgs as nlgs
+    solve = nlgs.solve_problem
+
+    def capture(problem, pn, pt, vx, vy, w, **options):
+        caught.append(dict(problem=problem, pn=pn.copy(), pt=pt.copy(), vx=vx.copy(), vy=vy.copy(), w=w.copy()))
+        return solve(problem, pn, pt, vx, vy, w, **options)
+
+    nlgs.solve_problem = capture
+    try:
+        sim.step()
+    finally:
+        nlgs.solve_problem = solve
+    case = caught[0]
+    assert isinstance(case["problem"], ContactProblem) and case["problem"].a.size == 1
+    reached, (law, pn, pt) = bursts.apgd_probe(case, 1e-12, iterations=50, check_every=1)
+    assert reached is not None and law <= 1e-12
+    assert pn[0] == pytest.approx(sim.mass[0] * 9.81 * 5e-4, rel=1e-10)
+    assert abs(pt[0]) <= 1e-12 * pn[0]
