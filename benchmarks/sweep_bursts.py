@@ -29,7 +29,9 @@ the contact problem of shear steps ``--steps A B`` with its warm start, and asks
    docs/solver.md reports what that did).
 6. **A lead**: on the steps of items 1-4, the iterations a Jacobi-scaled accelerated projected
    gradient (:func:`apgd_probe`, numpy) needs to reach the local-law residual that the default
-   NLGS reached on the same step.
+   NLGS reached on the same step. ``--apgd-shear EPS_Q`` then shears the sample to that eps_q
+   twice, with the default solve and with the probe as the step's solve (:func:`shear`), and
+   adds a table of the two runs.
 
 Writes benchmarks/RESULTS-sweep-bursts-<N>.md.
 """
@@ -270,6 +272,69 @@ def default_solve(case: dict):
     return result.iterations, residuals.local_law_residual(case["problem"], pn, pt, vx, vy, w)
 
 
+def shear(sim, until: float, apgd_target: float = 0.0, apgd_iterations: int = 300) -> dict:
+    """Shear ``sim`` to eps_q = ``until`` as :func:`capture` does; with ``apgd_target`` > 0 each
+    step's main solve is :func:`apgd_probe` stopping at that local-law residual, finished by the
+    default NLGS from its best iterate when it does not get there within ``apgd_iterations``.
+    Returns the per-step work (APGD iterations plus sweeps), local-law residual and unbalanced
+    force, the fallbacks and the wall-clock seconds."""
+    import solver
+    from solver import acceleration
+    from solver.nlgs import NLGSResult
+
+    p = sim.parameters
+    p.acceleration, p.anderson_period, p.stall_sweeps, p.domains = "anderson", 2, 200, 1
+    lo, hi = sim.walls.box_bounds()
+    h0, l0 = float(hi[1] - lo[1]), float(hi[0] - lo[0])
+    record = {"work": [], "law": [], "unbalanced": [], "fallbacks": 0}
+    solve = acceleration.solve_problem_anderson
+
+    def probed(problem, pn, pt, vx, vy, w, **options):
+        if options["tolerance"] != p.tolerance:  # the overlap recovery keeps its sweeps
+            return solve(problem, pn, pt, vx, vy, w, **options)
+        free = (vx.copy(), vy.copy(), w.copy())
+        case = dict(problem=problem, pn=pn, pt=pt, vx=free[0], vy=free[1], w=free[2])
+        reached, (_, best_n, best_t) = apgd_probe(case, apgd_target, iterations=apgd_iterations, stop=True)
+        pn[:], pt[:] = best_n, best_t
+        if reached is not None:
+            vx[:], vy[:], w[:] = _velocities(problem, free, best_n, best_t)
+            return NLGSResult(reached, 0.0, 0.0)
+        record["fallbacks"] += 1
+        result = solve(problem, pn, pt, vx, vy, w, **options)
+        return NLGSResult(apgd_iterations + result.iterations, result.residual, result.max_residual)
+
+    step = sim.step
+
+    def recorded_step():
+        info = step()
+        record["work"].append(info.iterations)
+        record["law"].append(info.local_law_residual)
+        record["unbalanced"].append(info.unbalanced_force)
+        lo, hi = sim.walls.box_bounds()
+        if np.log(h0 / float(hi[1] - lo[1])) - np.log(l0 / float(hi[0] - lo[0])) >= until:
+            raise _Done
+        return info
+
+    sim.step = recorded_step
+    if apgd_target > 0:
+        acceleration.solve_problem_anderson = probed
+    path = os.path.join(HERE, "_data", "sweep_bursts_shear.nc")
+    start = time.perf_counter()
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            solver.biaxial_test(sim, path, strain=0.5, velocity=0.01, every=10**9, overwrite=True, progress=False)
+    except _Done:
+        pass
+    finally:
+        acceleration.solve_problem_anderson = solve
+        del sim.step
+        if os.path.exists(path):
+            os.remove(path)
+    record["seconds"] = time.perf_counter() - start
+    return {k: (np.array(v) if isinstance(v, list) else v) for k, v in record.items()}
+
+
 def point_keys_of(problem) -> np.ndarray:
     """A key per point, the same for the same point in two steps: the body pair and the point's
     rank in it (the stepper's :func:`solver.contact_points.point_keys`, from the problem's
@@ -320,6 +385,10 @@ def main(argv=None):
                         help="the shear steps captured (default 10 60)")
     parser.add_argument("--burst", type=int, default=200, help="sweeps that make a step a burst step (default 200)")
     parser.add_argument("--sweeps", type=int, default=400, help="plain sweeps of the anatomy (default 400)")
+    parser.add_argument("--apgd-shear", type=float, default=0.0, metavar="EPS_Q",
+                        help="also shear to this eps_q with the default solve and with the APGD probe (item 6)")
+    parser.add_argument("--apgd-target", type=float, default=1.3e-4,
+                        help="the local-law residual at which the probe stops in --apgd-shear (default 1.3e-4)")
     parser.add_argument("--out", help="the results file (default benchmarks/RESULTS-sweep-bursts-<N>.md)")
     args = parser.parse_args(argv)
     sim, _ = load_sample(args.sample)
@@ -359,14 +428,31 @@ def main(argv=None):
         print(remedies[-1], flush=True)
     remedy_table = markdown_table(["re-solved with", "sweeps median", "mean", "p90", "seconds", "local-law residual median",
                                    "p90"], remedies)
+    shears = []
+    if args.apgd_shear > 0:
+        for label, target in (("default (Anderson every 2 sweeps, stall 200)", 0.0),
+                              (f"APGD probe to a local-law residual of {args.apgd_target:g}, else the default", args.apgd_target)):
+            run = shear(load_sample(args.sample)[0], args.apgd_shear, target)
+            w = run["work"]
+            shears.append([label, len(w), f"{np.median(w):.0f}", f"{w.mean():.0f}", f"{np.percentile(w, 90):.0f}",
+                           run["fallbacks"] if target else "-", f"{np.median(run['law']):.2e}",
+                           f"{np.median(run['unbalanced']):.3f}", f"{run['seconds']:.0f}"])
+            print(shears[-1], flush=True)
+    sections = []
+    if shears:
+        sections = [f"## A real shear to eps_q = {args.apgd_shear:g}, default against the probe (one core each, one after the other)",
+                    markdown_table(["solve", "steps", "work per step (APGD iterations + sweeps): median", "mean", "p90",
+                                    "fallbacks to the NLGS", "local-law residual median", "unbalanced force median",
+                                    "seconds (the probe is numpy)"], shears)]
     intro = (f"Written by `python benchmarks/sweep_bursts.py --sample {os.path.relpath(args.sample, os.path.dirname(HERE))} "
-             f"--steps {args.steps[0]} {args.steps[1]}`: {n} particles, shear steps {args.steps[0]}-{args.steps[1]} "
+             f"--steps {args.steps[0]} {args.steps[1]}"
+             + (f" --apgd-shear {args.apgd_shear:g}" if args.apgd_shear else "") + f"`: {n} particles, shear steps {args.steps[0]}-{args.steps[1]} "
              f"(sweeps per step: {sweeps}). The script's docstring defines each column; docs/solver.md "
              "(\"At 14,400 pentagons\") reads them.")
     write_results(out, "The anatomy of slow shear steps", intro,
                   ["## Where the changes are, and what they are (plain NLGS sweeps from the step's warm start)",
                    anatomy_table, "## Remedies, re-solved on the captured steps (one domain)", remedy_table,
-                   "## A lead: an accelerated projected gradient (numpy probe, `apgd_probe`)", lead_table])
+                   "## A lead: an accelerated projected gradient (numpy probe, `apgd_probe`)", lead_table] + sections)
 
 
 if __name__ == "__main__":

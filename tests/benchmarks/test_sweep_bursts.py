@@ -112,3 +112,24 @@ def test_apgd_probe_finds_the_weight_of_a_disk_on_the_floor(bursts):
     assert reached is not None and law <= 1e-12
     assert pn[0] == pytest.approx(sim.mass[0] * 9.81 * 5e-4, rel=1e-10)
     assert abs(pt[0]) <= 1e-12 * pn[0]
+
+
+def test_shear_with_the_probe_restores_the_solver(bursts, tmp_path_factory):
+    """A shear with the probe as the step's solve: every step is recorded, a step that the
+    probe finished has no NLGS sweeps in its work only if it stopped at the target, and the
+    solver's own solve is back afterwards."""
+    from solver import acceleration
+
+    compaction = load_benchmark("compaction")
+    path = str(tmp_path_factory.mktemp("probe") / "pentagons.pkl")
+    compaction.compact("pentagon", 60, 1, "fast", acceleration="anderson", save=path)
+    load_sample = load_benchmark("common").load_sample
+    solve = acceleration.solve_problem_anderson
+    default = bursts.shear(load_sample(path)[0], 0.002)
+    probed = bursts.shear(load_sample(path)[0], 0.002, apgd_target=1e-3, apgd_iterations=50)
+    assert acceleration.solve_problem_anderson is solve
+    assert default["fallbacks"] == 0 and len(default["work"]) > 5
+    assert len(probed["work"]) > 5 and 0 <= probed["fallbacks"] <= len(probed["work"])
+    finished = probed["work"] <= 50
+    assert np.all(probed["work"][finished] % 10 == 0)  # stopped at a check, every 10 iterations
+    assert np.all(probed["law"][finished] <= 1e-3)  # ... at the target, by the solver's own measure
