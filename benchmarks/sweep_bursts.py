@@ -56,22 +56,56 @@ class _Done(Exception):
     pass
 
 
-def capture(sim, first: int, last: int) -> list:
-    """Shear ``sim`` (top wall at 1 cm/s, ``solver.biaxial_test``) until shear step ``last``
-    with Anderson sweeps every 2 sweeps and the stall test over 200, one domain, and return the
-    main contact problem of steps ``first``..``last`` as dicts: step, problem, warm-start
-    impulses pn, pt, free velocities vx, vy, w, the solver options, the particles' positions
-    and the sweeps the step took."""
+def _shear(sim, after_step, solve=None) -> float:
+    """Run ``solver.biaxial_test`` on ``sim`` (top wall at 1 cm/s, no snapshots but the first,
+    warnings silenced) with Anderson sweeps every 2 sweeps and the stall test over 200 on one
+    domain, calling ``after_step(info)`` after every step (it raises :class:`_Done` to stop),
+    with ``solve`` (if given) in place of ``solver.acceleration.solve_problem_anderson``; the
+    simulation's and the module's own functions are back afterwards. Returns the seconds."""
     import solver
     from solver import acceleration
 
     p = sim.parameters
     p.acceleration, p.anderson_period, p.stall_sweeps, p.domains = "anderson", 2, 200, 1
+    original_solve, step = acceleration.solve_problem_anderson, sim.step
+
+    def stepped():
+        info = step()
+        after_step(info)
+        return info
+
+    sim.step = stepped
+    acceleration.solve_problem_anderson = solve or original_solve
+    path = os.path.join(HERE, "_data", "sweep_bursts_shear.nc")
+    os.makedirs(os.path.dirname(path), exist_ok=True)
+    start = time.perf_counter()
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            solver.biaxial_test(sim, path, strain=0.5, velocity=0.01, every=10**9, overwrite=True, progress=False)
+    except _Done:
+        pass
+    finally:
+        acceleration.solve_problem_anderson = original_solve
+        del sim.step  # the class's method again
+        if os.path.exists(path):
+            os.remove(path)
+    return time.perf_counter() - start
+
+
+def capture(sim, first: int, last: int) -> list:
+    """Shear ``sim`` as :func:`_shear` does until shear step ``last`` and return the main contact
+    problem of steps ``first``..``last`` as dicts: step, problem, warm-start impulses pn, pt,
+    free velocities vx, vy, w, the solver options, the particles' positions and the sweeps the
+    step took."""
+    from solver import acceleration
+
+    tolerance = sim.parameters.tolerance
     caught, done = [], [0]
     solve = acceleration.solve_problem_anderson
 
     def capturing(problem, pn, pt, vx, vy, w, **options):
-        main = options["tolerance"] == p.tolerance and first <= done[0] <= last
+        main = options["tolerance"] == tolerance and first <= done[0] <= last
         if main:
             caught.append(dict(step=done[0], problem=problem, pn=pn.copy(), pt=pt.copy(), vx=vx.copy(),
                                vy=vy.copy(), w=w.copy(), options=dict(options),
@@ -81,30 +115,12 @@ def capture(sim, first: int, last: int) -> list:
             caught[-1]["sweeps"] = result.iterations
         return result
 
-    step = sim.step
-
-    def counted_step():
-        info = step()
+    def count(info):
         done[0] += 1
         if done[0] > last:
             raise _Done
-        return info
 
-    sim.step = counted_step
-    acceleration.solve_problem_anderson = capturing
-    path = os.path.join(HERE, "_data", "sweep_bursts_shear.nc")
-    os.makedirs(os.path.dirname(path), exist_ok=True)
-    try:
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore")
-            solver.biaxial_test(sim, path, strain=0.5, velocity=0.01, every=10**9, overwrite=True, progress=False)
-    except _Done:
-        pass
-    finally:
-        acceleration.solve_problem_anderson = solve
-        del sim.step  # the class's method again
-        if os.path.exists(path):
-            os.remove(path)
+    _shear(sim, count, capturing)
     return caught
 
 
@@ -273,24 +289,22 @@ def default_solve(case: dict):
 
 
 def shear(sim, until: float, apgd_target: float = 0.0, apgd_iterations: int = 300) -> dict:
-    """Shear ``sim`` to eps_q = ``until`` as :func:`capture` does; with ``apgd_target`` > 0 each
+    """Shear ``sim`` to eps_q = ``until`` as :func:`_shear` does; with ``apgd_target`` > 0 each
     step's main solve is :func:`apgd_probe` stopping at that local-law residual, finished by the
     default NLGS from its best iterate when it does not get there within ``apgd_iterations``.
     Returns the per-step work (APGD iterations plus sweeps), local-law residual and unbalanced
     force, the fallbacks and the wall-clock seconds."""
-    import solver
     from solver import acceleration
     from solver.nlgs import NLGSResult
 
-    p = sim.parameters
-    p.acceleration, p.anderson_period, p.stall_sweeps, p.domains = "anderson", 2, 200, 1
+    tolerance = sim.parameters.tolerance
     lo, hi = sim.walls.box_bounds()
     h0, l0 = float(hi[1] - lo[1]), float(hi[0] - lo[0])
     record = {"work": [], "law": [], "unbalanced": [], "fallbacks": 0}
     solve = acceleration.solve_problem_anderson
 
     def probed(problem, pn, pt, vx, vy, w, **options):
-        if options["tolerance"] != p.tolerance:  # the overlap recovery keeps its sweeps
+        if options["tolerance"] != tolerance:  # the overlap recovery keeps its sweeps
             return solve(problem, pn, pt, vx, vy, w, **options)
         free = (vx.copy(), vy.copy(), w.copy())
         case = dict(problem=problem, pn=pn, pt=pt, vx=free[0], vy=free[1], w=free[2])
@@ -299,39 +313,19 @@ def shear(sim, until: float, apgd_target: float = 0.0, apgd_iterations: int = 30
         if reached is not None:
             vx[:], vy[:], w[:] = _velocities(problem, free, best_n, best_t)
             return NLGSResult(reached, 0.0, 0.0)
-        record["fallbacks"] += 1
+        record["fallbacks"] += 1  # vx, vy, w still hold the free velocities the NLGS starts from
         result = solve(problem, pn, pt, vx, vy, w, **options)
         return NLGSResult(apgd_iterations + result.iterations, result.residual, result.max_residual)
 
-    step = sim.step
-
-    def recorded_step():
-        info = step()
+    def record_step(info):
         record["work"].append(info.iterations)
         record["law"].append(info.local_law_residual)
         record["unbalanced"].append(info.unbalanced_force)
         lo, hi = sim.walls.box_bounds()
         if np.log(h0 / float(hi[1] - lo[1])) - np.log(l0 / float(hi[0] - lo[0])) >= until:
             raise _Done
-        return info
 
-    sim.step = recorded_step
-    if apgd_target > 0:
-        acceleration.solve_problem_anderson = probed
-    path = os.path.join(HERE, "_data", "sweep_bursts_shear.nc")
-    start = time.perf_counter()
-    try:
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore")
-            solver.biaxial_test(sim, path, strain=0.5, velocity=0.01, every=10**9, overwrite=True, progress=False)
-    except _Done:
-        pass
-    finally:
-        acceleration.solve_problem_anderson = solve
-        del sim.step
-        if os.path.exists(path):
-            os.remove(path)
-    record["seconds"] = time.perf_counter() - start
+    record["seconds"] = _shear(sim, record_step, probed if apgd_target > 0 else None)
     return {k: (np.array(v) if isinstance(v, list) else v) for k, v in record.items()}
 
 
