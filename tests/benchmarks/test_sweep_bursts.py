@@ -133,3 +133,19 @@ def test_shear_with_the_probe_restores_the_solver(bursts, tmp_path_factory):
     finished = probed["work"] <= 50
     assert np.all(probed["work"][finished] % 10 == 0)  # stopped at a check, every 10 iterations
     assert np.all(probed["law"][finished] <= 1e-3)  # ... at the target, by the solver's own measure
+
+
+def test_shear_records_the_top_walls_q_over_p_from_its_stress(bursts, tmp_path_factory):
+    """q/p of the shear's record against the wall stress the file's analysis would read: at the
+    last step, (sigma_top - sigma_0) / (sigma_top + sigma_0) from the impulses on the top wall."""
+    compaction = load_benchmark("compaction")
+    path = str(tmp_path_factory.mktemp("qp") / "pentagons.pkl")
+    compaction.compact("pentagon", 60, 2, "fast", acceleration="anderson", save=path)
+    sim = load_benchmark("common").load_sample(path)[0]
+    run = bursts.shear(sim, 0.002)
+    top = sim.n_particles + sim.walls.index("top")
+    on_top = (sim.points.body_i == top) | (sim.points.body_j == top)
+    lo, hi = sim.walls.box_bounds()
+    sigma = sim.impulse[on_top, 0].sum() / sim.parameters.time_step / ((hi[0] - lo[0]) * sim.parameters.thickness)
+    assert run["q_over_p"][-1] == pytest.approx((sigma - sim.sigma0) / (sigma + sim.sigma0), rel=1e-9)
+    assert len(run["q_over_p"]) == len(run["work"])
