@@ -81,7 +81,7 @@ import math
 from typing import NamedTuple
 
 import numpy as np
-from numba import njit
+from numba import njit, prange
 
 from grainview.errors import ParameterError
 from grainview.schema import KIND_DOUBLE, KIND_SIMPLE
@@ -168,18 +168,9 @@ def _disk_wall(x, y, r, px, py, wnx, wny, c, normal, point, gap):
 
 
 @njit(cache=True)
-def _polygon_geometry(pos, angle, nvert, first_vertex, vertex_radius, vertex_angle, normal_angle):
-    """World vertices (N, maxn, 2) and outward unit edge normals (N, maxn, 2) of every polygon
-    from the shape table (:class:`solver.shapes.Shapes`): vertex k at the polar angle
-    angle + vertex_angle[k] and distance vertex_radius[k], the normal of edge k (vertex k -> k+1)
-    at angle + normal_angle[k]."""
-    n = pos.shape[0]
-    maxn = 1
-    for p in range(n):
-        maxn = max(maxn, nvert[p])
-    verts = np.zeros((n, maxn, 2))
-    norms = np.zeros((n, maxn, 2))
-    for p in range(n):
+def _polygon_block(lo, hi, pos, angle, nvert, first_vertex, vertex_radius, vertex_angle, normal_angle, verts, norms):
+    """The world vertices and edge normals of particles lo..hi-1 (:func:`_polygon_geometry`)."""
+    for p in range(lo, hi):
         s = first_vertex[p]
         for k in range(nvert[p]):
             phi = angle[p] + vertex_angle[s + k]
@@ -188,6 +179,36 @@ def _polygon_geometry(pos, angle, nvert, first_vertex, vertex_radius, vertex_ang
             psi = angle[p] + normal_angle[s + k]
             norms[p, k, 0] = math.cos(psi)
             norms[p, k, 1] = math.sin(psi)
+
+
+@njit(cache=True, parallel=True)
+def _polygon_blocks(chunks, pos, angle, nvert, first_vertex, vertex_radius, vertex_angle, normal_angle, verts, norms):
+    """:func:`_polygon_block` over ``chunks`` consecutive blocks of particles at once (a thread each)."""
+    n = pos.shape[0]
+    for d in prange(chunks):
+        _polygon_block(n * d // chunks, n * (d + 1) // chunks, pos, angle, nvert, first_vertex, vertex_radius,
+                       vertex_angle, normal_angle, verts, norms)
+
+
+@njit(cache=True)
+def _polygon_geometry(pos, angle, nvert, first_vertex, vertex_radius, vertex_angle, normal_angle, chunks=1):
+    """World vertices (N, maxn, 2) and outward unit edge normals (N, maxn, 2) of every polygon
+    from the shape table (:class:`solver.shapes.Shapes`): vertex k at the polar angle
+    angle + vertex_angle[k] and distance vertex_radius[k], the normal of edge k (vertex k -> k+1)
+    at angle + normal_angle[k]. With ``chunks`` > 1 the particles are split into that many
+    consecutive blocks computed at once (a thread each; each particle's entries are its own);
+    with 1 no second thread is woken."""
+    n = pos.shape[0]
+    maxn = 1
+    for p in range(n):
+        maxn = max(maxn, nvert[p])
+    verts = np.zeros((n, maxn, 2))
+    norms = np.zeros((n, maxn, 2))
+    if chunks == 1:
+        _polygon_block(0, n, pos, angle, nvert, first_vertex, vertex_radius, vertex_angle, normal_angle, verts, norms)
+    else:
+        _polygon_blocks(chunks, pos, angle, nvert, first_vertex, vertex_radius, vertex_angle, normal_angle, verts,
+                        norms)
     return verts, norms
 
 
@@ -439,21 +460,12 @@ def _pair_points(a, b, pos, radius, nvert, verts, norms, double_alert, c, normal
 
 
 @njit(cache=True)
-def _detect_kernel(pos, angle, radius, nvert, first_vertex, vertex_radius, vertex_angle, normal_angle,
-                   wall_point, wall_normal, alert, double_alert, pi, pj, wp, ww):
-    """Pass 1: up to two points per candidate into fixed slots (each candidate writes only its
-    own slot); pass 2: compaction of the kept ones at prefix-sum offsets."""
-    n_particles = pos.shape[0]
-    m_pairs = pi.shape[0]
-    m = m_pairs + wp.shape[0]
-    count = np.zeros(m, np.int64)
-    normal = np.empty((m, 2))
-    point = np.empty((m, 2, 2))
-    gap = np.empty((m, 2))
-    kind = np.empty(m, np.int8)
-    verts, norms = _polygon_geometry(pos, angle, nvert, first_vertex, vertex_radius, vertex_angle, normal_angle)
-    # pass 1: geometry of every candidate into its own slot
-    for c in range(m):
+def _candidate_block(lo, hi, m_pairs, pos, radius, nvert, verts, norms, wall_point, wall_normal, alert,
+                     double_alert, pi, pj, wp, ww, count, normal, point, gap, kind):
+    """Pass 1 for candidates lo..hi-1: up to two points of candidate c into its own slot
+    (normal[c], point[c], gap[c], kind[c]) and count[c] = their number if the nearest is
+    within ``alert``, else 0."""
+    for c in range(lo, hi):
         if c < m_pairs:
             i = pi[c]
             j = pj[c]
@@ -478,21 +490,13 @@ def _detect_kernel(pos, angle, radius, nvert, first_vertex, vertex_radius, verte
         if cnt == 2 and gap[c, 1] < gmin:
             gmin = gap[c, 1]
         count[c] = cnt if (cnt > 0 and gmin <= alert) else 0
-    # pass 2: compact
-    offsets = np.zeros(m + 1, np.int64)
-    pair_offsets = np.zeros(m + 1, np.int64)
-    for c in range(m):
-        offsets[c + 1] = offsets[c] + count[c]
-        pair_offsets[c + 1] = pair_offsets[c] + (1 if count[c] > 0 else 0)
-    total = offsets[m]
-    o_i = np.empty(total, np.int32)
-    o_j = np.empty(total, np.int32)
-    o_normal = np.empty((total, 2))
-    o_point = np.empty((total, 2))
-    o_gap = np.empty(total)
-    o_kind = np.empty(total, np.int8)
-    o_pair = np.empty(total, np.int32)
-    for c in range(m):
+
+
+@njit(cache=True)
+def _compact_block(lo, hi, m_pairs, n_particles, pi, pj, wp, ww, count, offsets, pair_offsets, normal, point, gap,
+                   kind, o_i, o_j, o_normal, o_point, o_gap, o_kind, o_pair):
+    """Pass 2 for candidates lo..hi-1: the kept points of candidate c to rows offsets[c]...."""
+    for c in range(lo, hi):
         if c < m_pairs:
             bi = pi[c]
             bj = pj[c]
@@ -510,6 +514,73 @@ def _detect_kernel(pos, angle, radius, nvert, first_vertex, vertex_radius, verte
             o_gap[q] = gap[c, k]
             o_kind[q] = kind[c]
             o_pair[q] = pair_offsets[c]
+
+
+@njit(cache=True, parallel=True)
+def _candidate_blocks(chunks, m_pairs, pos, radius, nvert, verts, norms, wall_point, wall_normal, alert, double_alert,
+                      pi, pj, wp, ww, count, normal, point, gap, kind):
+    """:func:`_candidate_block` over ``chunks`` consecutive blocks of candidates at once (a thread each)."""
+    m = count.size
+    for d in prange(chunks):
+        _candidate_block(m * d // chunks, m * (d + 1) // chunks, m_pairs, pos, radius, nvert, verts, norms,
+                         wall_point, wall_normal, alert, double_alert, pi, pj, wp, ww, count, normal, point, gap,
+                         kind)
+
+
+@njit(cache=True, parallel=True)
+def _compact_blocks(chunks, m_pairs, n_particles, pi, pj, wp, ww, count, offsets, pair_offsets, normal, point, gap,
+                    kind, o_i, o_j, o_normal, o_point, o_gap, o_kind, o_pair):
+    """:func:`_compact_block` over ``chunks`` consecutive blocks of candidates at once (a thread each)."""
+    m = count.size
+    for d in prange(chunks):
+        _compact_block(m * d // chunks, m * (d + 1) // chunks, m_pairs, n_particles, pi, pj, wp, ww, count, offsets,
+                       pair_offsets, normal, point, gap, kind, o_i, o_j, o_normal, o_point, o_gap, o_kind, o_pair)
+
+
+@njit(cache=True)
+def _detect_kernel(pos, angle, radius, nvert, first_vertex, vertex_radius, vertex_angle, normal_angle,
+                   wall_point, wall_normal, alert, double_alert, pi, pj, wp, ww, chunks):
+    """Pass 1: up to two points per candidate into fixed slots (each candidate writes only its
+    own slot); pass 2: compaction of the kept ones at prefix-sum offsets. With ``chunks`` > 1
+    both passes split the candidates into that many consecutive blocks done at once (a thread
+    each); as no slot is shared, the result does not depend on ``chunks``. With 1 no second
+    thread is woken (a woken thread waits for a busy core), and the allocations stay out of
+    the parallel functions (numba would make each one a parallel region)."""
+    n_particles = pos.shape[0]
+    m_pairs = pi.shape[0]
+    m = m_pairs + wp.shape[0]
+    count = np.zeros(m, np.int64)
+    normal = np.empty((m, 2))
+    point = np.empty((m, 2, 2))
+    gap = np.empty((m, 2))
+    kind = np.empty(m, np.int8)
+    verts, norms = _polygon_geometry(pos, angle, nvert, first_vertex, vertex_radius, vertex_angle, normal_angle,
+                                     chunks)
+    if chunks == 1:
+        _candidate_block(0, m, m_pairs, pos, radius, nvert, verts, norms, wall_point, wall_normal, alert, double_alert,
+                         pi, pj, wp, ww, count, normal, point, gap, kind)
+    else:
+        _candidate_blocks(chunks, m_pairs, pos, radius, nvert, verts, norms, wall_point, wall_normal, alert,
+                          double_alert, pi, pj, wp, ww, count, normal, point, gap, kind)
+    offsets = np.zeros(m + 1, np.int64)
+    pair_offsets = np.zeros(m + 1, np.int64)
+    for c in range(m):
+        offsets[c + 1] = offsets[c] + count[c]
+        pair_offsets[c + 1] = pair_offsets[c] + (1 if count[c] > 0 else 0)
+    total = offsets[m]
+    o_i = np.empty(total, np.int32)
+    o_j = np.empty(total, np.int32)
+    o_normal = np.empty((total, 2))
+    o_point = np.empty((total, 2))
+    o_gap = np.empty(total)
+    o_kind = np.empty(total, np.int8)
+    o_pair = np.empty(total, np.int32)
+    if chunks == 1:
+        _compact_block(0, m, m_pairs, n_particles, pi, pj, wp, ww, count, offsets, pair_offsets, normal, point, gap,
+                       kind, o_i, o_j, o_normal, o_point, o_gap, o_kind, o_pair)
+    else:
+        _compact_blocks(chunks, m_pairs, n_particles, pi, pj, wp, ww, count, offsets, pair_offsets, normal, point,
+                        gap, kind, o_i, o_j, o_normal, o_point, o_gap, o_kind, o_pair)
     return o_i, o_j, o_normal, o_point, o_gap, o_kind, o_pair, pair_offsets[m]
 
 
@@ -523,7 +594,7 @@ def _index_array(name, value, upper):
     return arr
 
 
-def detect(pos, angle, shapes, wall_point, wall_normal, alert, pi, pj, wp, ww, double_alert=None):
+def detect(pos, angle, shapes, wall_point, wall_normal, alert, pi, pj, wp, ww, double_alert=None, threads=1):
     """Contact points of the candidate particle pairs (pi, pj) and particle-wall candidates
     (wp, ww) (from :mod:`solver.broadphase`), keeping the contacts with gap <= alert.
 
@@ -538,6 +609,8 @@ def detect(pos, angle, shapes, wall_point, wall_normal, alert, pi, pj, wp, ww, d
     double_alert : m, >= 0, the tolerance of the double-contact criterion (module doc);
     default ``alert``. The stepper widens ``alert`` for fast steps but keeps this one fixed,
     so that a fast approach does not turn edges far from parallel into double contacts.
+    threads : int >= 1, the candidates are split into this many blocks computed at once (a
+    thread each, as the NLGS's domains); the result is the same for any number.
 
     Returns
     -------
@@ -571,7 +644,9 @@ def detect(pos, angle, shapes, wall_point, wall_normal, alert, pi, pj, wp, ww, d
     ww = _index_array("ww", ww, wall_point.shape[0])
     if wp.shape != ww.shape:
         raise ParameterError(f"wp and ww must have the same length, got {wp.size} and {ww.size}")
+    if not isinstance(threads, (int, np.integer)) or threads < 1:
+        raise ParameterError(f"threads={threads!r}: expected an integer >= 1")
     out = _detect_kernel(pos, angle, shapes.radius, shapes.n_vertices, shapes.first_vertex, shapes.vertex_radius,
                          shapes.vertex_angle, shapes.normal_angle, wall_point, wall_normal, alert, double_alert,
-                         pi, pj, wp, ww)
+                         pi, pj, wp, ww, int(threads))
     return ContactPoints(*out[:7], int(out[7]))

@@ -92,7 +92,8 @@ class Parameters:
     acceleration: str = "anderson"  # Anderson-accelerated sweeps (solver.acceleration; no shuffling); "off": plain
     anderson_memory: int = 3  # past iterates combined by the Anderson extrapolation
     anderson_period: int = 1  # NLGS sweeps between two Anderson extrapolations
-    domains: int = 1  # NLGS domains swept at once on several cores (solver.parallel_nlgs); 1: the serial sweep
+    domains: int = 1  # NLGS domains swept at once on several cores (solver.parallel_nlgs), and as many blocks
+    # of the narrow phase (solver.narrowphase); 1: the serial sweep and detection
     overlap_recovery_speed: float = 1e-3  # m s-1, cap of the split-impulse separation of overlaps
     overlap_recovery_rate: float = 0.2  # fraction of an overlap removed per step, below the cap
     overlap_recovery_threshold: float = 1e-4  # fraction of the smallest diameter: smaller overlaps are left
@@ -257,7 +258,8 @@ class Simulation:
         middle = time.perf_counter()
         pi, pj, wp, ww = self._candidates
         points = narrowphase.detect(self.position, self.angle, self.shapes, self.walls.point,
-                                    self.walls.normal, alert, pi, pj, wp, ww, double_alert=self.alert)
+                                    self.walls.normal, alert, pi, pj, wp, ww, double_alert=self.alert,
+                                    threads=self.parameters.domains)
         self.timings["broad_phase"] += middle - start
         self.timings["narrow_phase"] += time.perf_counter() - middle
         return points
