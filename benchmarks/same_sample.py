@@ -2,6 +2,8 @@
 
     python benchmarks/same_sample.py --seeds 0,1,2            # shears (~25 min per seed, 2 cores)
     python benchmarks/same_sample.py --compaction --seeds 0,1,2,3,4 --shapes disk
+    python benchmarks/same_sample.py --tighter 4 --seeds 0,1,2,3 --shapes pentagon
+    python benchmarks/same_sample.py --static --seeds 0 --shapes pentagon
     python benchmarks/same_sample.py --table                  # RESULTS-same-sample.md's tables
 
 Shears. Per seed and shape (400 particles, the 'paper' preparation, the study's defaults:
@@ -22,6 +24,22 @@ the compacted state's coordination z (force-bearing contacts, rattlers out;
 ``ds.grain.coordination``) and solid fraction are written to
 benchmarks/_data/same_sample/compaction.jsonl.
 
+Tolerance (``--tighter K``). Does the default tolerance bias the physics? Per seed and shape,
+sample B (compacted with Anderson sweeps at the default tolerance) is sheared twice with
+Anderson sweeps, at the default tolerance (B-and, as above) and at a K times smaller one with a
+K times higher sweep cap (B-tight); besides the residual-state summaries, each run's per-step
+sweeps, local-law residual and unbalanced-force ratio (:mod:`solver.residuals`) are summarised.
+Written to benchmarks/_data/same_sample/tolerance_<shape>_<seed>_<K>.json.
+
+Static part (``--static``). Is a tolerance's effect that of the forces solved on the same
+geometry, or of the path the grains take? Sample B is sheared with Anderson sweeps (as
+``sweep_bursts.capture`` shears: an extrapolation every 2 sweeps, the stall test over 200) to
+shear step 30,000 (eps_q about 0.45 for 400 pentagons: the residual state), and every 20th
+step's contact problem up to step 30,400 is re-solved from its warm start at the default
+tolerance and 4, 10 and 100 times tighter (sweep cap 2000, else 22,000). The q/p of each
+solution's stress tensor (grainview.arrays.stress, the particle-wall contacts included) is
+compared on the same geometry. Written to benchmarks/_data/same_sample/static_<shape>_<seed>.json.
+
 Runs two processes at a time (one per core); timings are in the files but the point is the
 physics: steps, sweeps and states are exact and reproducible.
 """
@@ -41,6 +59,7 @@ import numpy as np
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, os.path.dirname(HERE))
+sys.path.insert(0, HERE)
 OUT = os.path.join(HERE, "_data", "same_sample")
 PARTICLES = 400
 SHEARS = {"A-off": ("A", "off"), "A-and": ("A", "anderson"), "B-and": ("B", "anderson")}
@@ -55,9 +74,6 @@ QUANTITIES = ["q/p (residual)", "a (residual)", "a_n (residual)", "a_t (residual
 def shears(seed: int, shape: str) -> dict:
     """The three shears of one seed and shape (module docstring); writes and returns their
     residual-state summaries, seconds and the compactions' steps and seconds."""
-    import grainview
-    import solver
-    from grainview.report import run_summary
     from solver.preparation import preparation, prepare_sample, record
 
     out = {"seed": seed, "shape": shape, "particles": PARTICLES}
@@ -75,21 +91,136 @@ def shears(seed: int, shape: str) -> dict:
         sim, attrs = samples[name]
         sim = copy.deepcopy(sim)
         sim.parameters.acceleration = acceleration
-        path = os.path.join(OUT, f"{shape}_{seed}_{run}.nc")
-        start = time.perf_counter()
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore")
-            solver.biaxial_test(sim, path, strain=0.2, velocity=0.01, every=200, overwrite=True, progress=False,
-                                attrs=attrs, near_contacts=True)
-        seconds = time.perf_counter() - start
-        with grainview.open_dataset(path) as ds:
-            summary = run_summary(ds, 0.3)
-        out[run] = {k: (float(v) if isinstance(v, (int, float)) else str(v)) for k, v in summary.items()}
-        out[run]["seconds"] = seconds
-        os.remove(path)
+        out[run] = _shear_summary(sim, attrs, os.path.join(OUT, f"{shape}_{seed}_{run}.nc"))
     with open(os.path.join(OUT, f"{shape}_{seed}.json"), "w") as fh:
         json.dump(out, fh, indent=1)
     return out
+
+
+def _shear_summary(sim, attrs: dict, path: str) -> dict:
+    """Shear ``sim`` (eps_1 = 0.2 at 1 cm/s, a snapshot every 200 steps, near contacts written,
+    to the temporary file ``path``): the residual-state summary (eps_q >= 0.3;
+    grainview.report.run_summary), the seconds, and the median and 90th percentile of the
+    steps' sweeps, local-law residual and unbalanced-force ratio."""
+    import grainview
+    import solver
+    from grainview.report import run_summary
+
+    steps = []
+    step = sim.step
+
+    def recorded():
+        info = step()
+        steps.append((info.iterations, info.local_law_residual, info.unbalanced_force))
+        return info
+
+    sim.step = recorded
+    start = time.perf_counter()
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        solver.biaxial_test(sim, path, strain=0.2, velocity=0.01, every=200, overwrite=True, progress=False,
+                            attrs=attrs, near_contacts=True)
+    seconds = time.perf_counter() - start
+    del sim.step
+    with grainview.open_dataset(path) as ds:
+        summary = run_summary(ds, 0.3)
+    os.remove(path)
+    out = {k: (float(v) if isinstance(v, (int, float)) else str(v)) for k, v in summary.items()}
+    steps = np.array(steps, dtype=float)
+    out.update(seconds=seconds, steps=len(steps))
+    for column, name in enumerate(("sweeps", "local-law residual", "unbalanced force")):
+        out[f"{name} median"] = float(np.nanmedian(steps[:, column]))
+        out[f"{name} p90"] = float(np.nanpercentile(steps[:, column], 90))
+    return out
+
+
+def tolerance(seed: int, shape: str, tighter: int) -> dict:
+    """The tolerance study of one seed and shape (module docstring); writes and returns it."""
+    from solver.preparation import preparation, prepare_sample, record
+
+    prep = preparation("paper", particles=PARTICLES, shape=shape, seed=seed)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        sample = prepare_sample(prep, acceleration="anderson")
+    out = {"seed": seed, "shape": shape, "particles": PARTICLES, "tighter": tighter}
+    for run, factor in (("B-and", 1), ("B-tight", tighter)):
+        sim = copy.deepcopy(sample)
+        sim.parameters.acceleration = "anderson"
+        sim.parameters.tolerance /= factor
+        sim.parameters.max_iterations *= factor
+        out[run] = _shear_summary(sim, record(sample), os.path.join(OUT, f"tolerance_{shape}_{seed}_{run}.nc"))
+    with open(os.path.join(OUT, f"tolerance_{shape}_{seed}_{tighter}.json"), "w") as fh:
+        json.dump(out, fh, indent=1)
+    return out
+
+
+STATIC_STEPS = (30_000, 30_400, 20)
+"""Shear steps first, last and every of the ``--static`` re-solves."""
+STATIC_FACTORS = (1, 4, 10, 100)
+
+
+def _q_over_p(problem, pn, pt) -> float:
+    """q/p of the stress tensor of one contact problem's impulses (the branch vector of a point
+    is r_a - r_b: centre of a to centre of b, or to the contact point for a wall)."""
+    from grainview.arrays.stress import stress_tensor
+    from grainview.arrays.tensors import principal
+
+    normal = np.stack([problem.nx, problem.ny], -1)
+    branch = np.stack([problem.rax - problem.rbx, problem.ray - problem.rby], -1)
+    s1, s2, _ = principal(stress_tensor(pn, pt, normal, branch, np.ones(pn.size, bool), 1.0))
+    return float((s1 - s2) / (s1 + s2))
+
+
+def static(seed: int, shape: str) -> dict:
+    """The static part of the tolerance effect for one seed and shape (module docstring)."""
+    from solver import acceleration, residuals
+    from solver.preparation import preparation, prepare_sample
+    from sweep_bursts import capture
+
+    prep = preparation("paper", particles=PARTICLES, shape=shape, seed=seed)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        sim = prepare_sample(prep, acceleration="anderson")
+    first, last, every = STATIC_STEPS
+    rows = []
+    for case in capture(sim, first, last)[::every]:
+        problem, o = case["problem"], case["options"]
+        row = {"step": case["step"]}
+        for factor in STATIC_FACTORS:
+            pn, pt = case["pn"].copy(), case["pt"].copy()
+            vx, vy, w = case["vx"].copy(), case["vy"].copy(), case["w"].copy()
+            result = acceleration.solve_problem_anderson(
+                problem, pn, pt, vx, vy, w, tolerance=o["tolerance"] / factor, max_tolerance=o["max_tolerance"],
+                max_iterations=2000 if factor == 1 else 22_000, memory=3, period=1, stall=0, domains=1)
+            row[factor] = {"q/p": _q_over_p(problem, pn, pt), "sweeps": int(result.iterations),
+                           "local-law residual": residuals.local_law_residual(problem, pn, pt, vx, vy, w)}
+        rows.append(row)
+    out = {"seed": seed, "shape": shape, "particles": PARTICLES, "rows": rows}
+    with open(os.path.join(OUT, f"static_{shape}_{seed}.json"), "w") as fh:
+        json.dump(out, fh, indent=1)
+    return out
+
+
+def static_table(shape: str) -> str:
+    """Markdown: per tolerance factor, the re-solved steps' mean q/p, its paired difference from
+    the default's (mean, standard error), and the median sweeps and local-law residual."""
+    runs = [json.load(open(f)) for f in sorted(glob.glob(os.path.join(OUT, f"static_{shape}_*.json")))]
+    if not runs:
+        return f"(no {shape} static re-solves)"
+    rows = [r for run in runs for r in run["rows"]]
+    base = np.array([r["1"]["q/p"] for r in rows])
+    lines = [f"**{PARTICLES} {shape}s, seeds {', '.join(str(r['seed']) for r in runs)}: {len(rows)} residual-state "
+             "steps re-solved on the same geometry**", "",
+             "| tolerance | q/p: mean | minus the default's, paired: mean | standard error | sweeps median | "
+             "local-law residual median |", "|---|---|---|---|---|---|"]
+    for factor in STATIC_FACTORS:
+        q = np.array([r[str(factor)]["q/p"] for r in rows])
+        d = q - base
+        lines.append(f"| {'default' if factor == 1 else f'{factor}x tighter'} | {q.mean():.4f} | {d.mean():+.4f} | "
+                     f"{d.std(ddof=1) / np.sqrt(d.size):.4f} | "
+                     f"{np.median([r[str(factor)]['sweeps'] for r in rows]):.0f} | "
+                     f"{np.median([r[str(factor)]['local-law residual'] for r in rows]):.2e} |")
+    return "\n".join(lines)
 
 
 def compactions(seed: int, shape: str) -> list:
@@ -153,6 +284,50 @@ def shear_table(shape: str) -> str:
     return "\n".join(lines)
 
 
+def tolerance_table(shape: str) -> str:
+    """Markdown, per tightening factor K run: the tolerance study's B-and and B-tight, seed mean
+    (sd), and their paired differences, mean and standard error, per quantity; then how each
+    was solved."""
+    files = sorted(glob.glob(os.path.join(OUT, f"tolerance_{shape}_*.json")))
+    if not files:
+        return f"(no {shape} tolerance runs)"
+    by_factor = {}
+    for f in files:
+        run = json.load(open(f))
+        by_factor.setdefault(run["tighter"], []).append(run)
+    return "\n\n".join(_tolerance_table(runs, factor) for factor, runs in sorted(by_factor.items()))
+
+
+def _tolerance_table(runs: list, tighter: int) -> str:
+    n = len(runs)
+
+    def sd(v):
+        return f"{v.std(ddof=1):.3f}" if n > 1 else "-"
+
+    lines = [f"**{PARTICLES} {runs[0]['shape']}s, seeds {', '.join(str(r['seed']) for r in runs)}: the default "
+             f"tolerance (B-and) and {tighter}x tighter (B-tight)**", "",
+             "| quantity | B-and: mean (sd over seeds) | B-tight: mean (sd) | B-tight - B-and: mean | standard error |",
+             "|---|---|---|---|---|"]
+    for key in QUANTITIES:
+        default = np.array([r["B-and"][key] for r in runs])
+        tight = np.array([r["B-tight"][key] for r in runs])
+        d = tight - default
+        se = f"{d.std(ddof=1) / np.sqrt(n):.3f}" if n > 1 else "-"
+        lines.append(f"| {key} | {default.mean():.3f} ({sd(default)}) | {tight.mean():.3f} ({sd(tight)}) | "
+                     f"{d.mean():+.3f} | {se} |")
+    lines += ["", "| run | steps | sweeps per step: median, p90 | local-law residual: median, p90 | "
+              "unbalanced force: median, p90 | seconds |", "|---|---|---|---|---|---|"]
+    for run in ("B-and", "B-tight"):
+        def mean(key):
+            return np.mean([r[run][key] for r in runs])
+        lines.append(f"| {run} | {mean('steps'):.0f} | {mean('sweeps median'):.0f}, {mean('sweeps p90'):.0f} | "
+                     f"{mean('local-law residual median'):.2e}, {mean('local-law residual p90'):.2e} | "
+                     f"{mean('unbalanced force median'):.3f}, {mean('unbalanced force p90'):.3f} | "
+                     f"{mean('seconds'):.0f} |")
+    lines += ["", "(the second table: means over the seeds; two runs at a time on the 2 cores)"]
+    return "\n".join(lines)
+
+
 def compaction_table() -> str:
     """Markdown: z and solid fraction of the compacted samples, mean (sd) over seeds, per shape,
     acceleration and tolerance, and the paired differences that matter."""
@@ -192,17 +367,27 @@ def main(argv=None):
     parser.add_argument("--seeds", default="0")
     parser.add_argument("--shapes", default="pentagon,disk")
     parser.add_argument("--compaction", action="store_true", help="the compactions instead of the shears")
+    parser.add_argument("--tighter", type=int, default=0, metavar="K",
+                        help="the tolerance study: shear at the default tolerance and K times tighter")
+    parser.add_argument("--static", action="store_true",
+                        help="the static part: residual-state steps re-solved at tighter tolerances")
     parser.add_argument("--table", action="store_true", help="print the tables of what was run and stop")
     args = parser.parse_args(argv)
     if args.table:
         for shape in ("pentagon", "disk"):
             print(shear_table(shape) + "\n")
+        for shape in ("pentagon", "disk"):
+            print(tolerance_table(shape) + "\n")
+            print(static_table(shape) + "\n")
         print(compaction_table())
         return
     os.makedirs(OUT, exist_ok=True)
     jobs = [(int(seed), shape) for seed in args.seeds.split(",") for shape in args.shapes.split(",")]
     with ProcessPoolExecutor(2) as pool:
-        for result in pool.map(compactions if args.compaction else shears, *zip(*jobs)):
+        if args.tighter:
+            jobs = [job + (args.tighter,) for job in jobs]
+        work = compactions if args.compaction else tolerance if args.tighter else static if args.static else shears
+        for result in pool.map(work, *zip(*jobs)):
             if args.compaction:
                 with open(os.path.join(OUT, "compaction.jsonl"), "a") as fh:
                     fh.writelines(json.dumps(r) + "\n" for r in result)
