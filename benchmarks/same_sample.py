@@ -36,7 +36,7 @@ geometry, or of the path the grains take? Sample B is sheared with Anderson swee
 ``sweep_bursts.capture`` shears: an extrapolation every 2 sweeps, the stall test over 200) to
 shear step 30,000 (eps_q about 0.45 for 400 pentagons: the residual state), and every 20th
 step's contact problem up to step 30,400 is re-solved from its warm start at the default
-tolerance and 4, 10 and 100 times tighter (sweep cap 2000, else 22,000). The q/p of each
+tolerance and 4, 10 and 100 times tighter (the shear's sweep cap, else 22,000). The q/p of each
 solution's stress tensor (grainview.arrays.stress, the particle-wall contacts included) is
 compared on the same geometry. Written to benchmarks/_data/same_sample/static_<shape>_<seed>.json.
 
@@ -116,12 +116,14 @@ def _shear_summary(sim, attrs: dict, path: str) -> dict:
 
     sim.step = recorded
     start = time.perf_counter()
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore")
-        solver.biaxial_test(sim, path, strain=0.2, velocity=0.01, every=200, overwrite=True, progress=False,
-                            attrs=attrs, near_contacts=True)
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            solver.biaxial_test(sim, path, strain=0.2, velocity=0.01, every=200, overwrite=True, progress=False,
+                                attrs=attrs, near_contacts=True)
+    finally:
+        del sim.step
     seconds = time.perf_counter() - start
-    del sim.step
     with grainview.open_dataset(path) as ds:
         summary = run_summary(ds, 0.3)
     os.remove(path)
@@ -157,6 +159,20 @@ def tolerance(seed: int, shape: str, tighter: int) -> dict:
 STATIC_STEPS = (30_000, 30_400, 20)
 """Shear steps first, last and every of the ``--static`` re-solves."""
 STATIC_FACTORS = (1, 4, 10, 100)
+"""Tolerances of the ``--static`` re-solves: the default divided by these."""
+STATIC_CAP = 22_000
+"""Sweep cap of the tighter ``--static`` re-solves (the default's is the shear's own)."""
+
+
+def _standard_error(d) -> float:
+    """Standard error of the mean of the paired differences ``d`` (sample sd / sqrt(n))."""
+    d = np.asarray(d, dtype=float)
+    return float(d.std(ddof=1) / np.sqrt(d.size))
+
+
+def _sd(v) -> str:
+    """The seeds' sample standard deviation, or '-' for one seed."""
+    return f"{np.std(v, ddof=1):.3f}" if len(v) > 1 else "-"
 
 
 def _q_over_p(problem, pn, pt) -> float:
@@ -183,7 +199,9 @@ def static(seed: int, shape: str) -> dict:
         sim = prepare_sample(prep, acceleration="anderson")
     first, last, every = STATIC_STEPS
     rows = []
-    for case in capture(sim, first, last)[::every]:
+    for case in capture(sim, first, last):
+        if (case["step"] - first) % every:
+            continue
         problem, o = case["problem"], case["options"]
         row = {"step": case["step"]}
         for factor in STATIC_FACTORS:
@@ -191,7 +209,8 @@ def static(seed: int, shape: str) -> dict:
             vx, vy, w = case["vx"].copy(), case["vy"].copy(), case["w"].copy()
             result = acceleration.solve_problem_anderson(
                 problem, pn, pt, vx, vy, w, tolerance=o["tolerance"] / factor, max_tolerance=o["max_tolerance"],
-                max_iterations=2000 if factor == 1 else 22_000, memory=3, period=1, stall=0, domains=1)
+                max_iterations=o["max_iterations"] if factor == 1 else STATIC_CAP, memory=3, period=1, stall=0,
+                domains=1)
             row[factor] = {"q/p": _q_over_p(problem, pn, pt), "sweeps": int(result.iterations),
                            "local-law residual": residuals.local_law_residual(problem, pn, pt, vx, vy, w)}
         rows.append(row)
@@ -202,22 +221,26 @@ def static(seed: int, shape: str) -> dict:
 
 
 def static_table(shape: str) -> str:
-    """Markdown: per tolerance factor, the re-solved steps' mean q/p, its paired difference from
-    the default's (mean, standard error), and the median sweeps and local-law residual."""
+    """Markdown: per tolerance factor, the re-solved steps' mean q/p, its difference from the
+    default's on the same step averaged per seed (the steps of one shear are 20 steps apart,
+    so not independent: the seed is the unit), the mean of those over the seeds and their
+    standard error, and the median sweeps and local-law residual."""
     runs = [json.load(open(f)) for f in sorted(glob.glob(os.path.join(OUT, f"static_{shape}_*.json")))]
     if not runs:
         return f"(no {shape} static re-solves)"
     rows = [r for run in runs for r in run["rows"]]
-    base = np.array([r["1"]["q/p"] for r in rows])
-    lines = [f"**{PARTICLES} {shape}s, seeds {', '.join(str(r['seed']) for r in runs)}: {len(rows)} residual-state "
-             "steps re-solved on the same geometry**", "",
-             "| tolerance | q/p: mean | minus the default's, paired: mean | standard error | sweeps median | "
-             "local-law residual median |", "|---|---|---|---|---|---|"]
+    seeds = ", ".join(str(r["seed"]) for r in runs)
+    lines = [f"**{PARTICLES} {shape}s, seeds {seeds}: {len(rows)} residual-state steps re-solved on the same "
+             "geometry**", "",
+             f"| tolerance | q/p: mean | minus the default's, paired by step: mean per seed ({seeds}) | "
+             "mean over seeds | standard error over seeds | sweeps median | local-law residual median |",
+             "|---|---|---|---|---|---|---|"]
     for factor in STATIC_FACTORS:
         q = np.array([r[str(factor)]["q/p"] for r in rows])
-        d = q - base
-        lines.append(f"| {'default' if factor == 1 else f'{factor}x tighter'} | {q.mean():.4f} | {d.mean():+.4f} | "
-                     f"{d.std(ddof=1) / np.sqrt(d.size):.4f} | "
+        per_seed = np.array([np.mean([r[str(factor)]["q/p"] - r["1"]["q/p"] for r in run["rows"]]) for run in runs])
+        se = f"{_standard_error(per_seed):.4f}" if len(runs) > 1 else "-"
+        lines.append(f"| {'default' if factor == 1 else f'{factor}x tighter'} | {q.mean():.4f} | "
+                     f"{', '.join(f'{d:+.4f}' for d in per_seed)} | {per_seed.mean():+.4f} | {se} | "
                      f"{np.median([r[str(factor)]['sweeps'] for r in rows]):.0f} | "
                      f"{np.median([r[str(factor)]['local-law residual'] for r in rows]):.2e} |")
     return "\n".join(lines)
@@ -260,10 +283,6 @@ def shear_table(shape: str) -> str:
     runs = [json.load(open(f)) for f in sorted(glob.glob(os.path.join(OUT, f"{shape}_*.json")))]
     if not runs:
         return f"(no {shape} runs)"
-
-    def sd(v):
-        return f"{v.std(ddof=1):.3f}" if len(v) > 1 else "-"
-
     lines = [f"**{PARTICLES} {shape}s, seeds {', '.join(str(r['seed']) for r in runs)}**", "",
              "| quantity | A-off: mean (sd over seeds) | B-and: mean (sd over seeds) | A-and - A-off: mean (sd) | "
              "B-and - A-off: mean (sd) |",
@@ -271,10 +290,10 @@ def shear_table(shape: str) -> str:
     for key in QUANTITIES:
         off = np.array([r["A-off"][key] for r in runs])
         both = np.array([r["B-and"][key] for r in runs])
-        cells = [f"{off.mean():.3f} ({sd(off)})", f"{both.mean():.3f} ({sd(both)})"]
+        cells = [f"{off.mean():.3f} ({_sd(off)})", f"{both.mean():.3f} ({_sd(both)})"]
         for run in ("A-and", "B-and"):
             d = np.array([r[run][key] for r in runs]) - off
-            cells.append(f"{d.mean():+.3f} ({sd(d)})")
+            cells.append(f"{d.mean():+.3f} ({_sd(d)})")
         lines.append(f"| {key} | " + " | ".join(cells) + " |")
     seconds = {run: np.mean([r[run]["seconds"] for r in runs]) for run in SHEARS}
     compacting = {name: np.mean([r[f"compact_{name}"]["seconds"] for r in runs]) for name in COMPACTIONS}
@@ -300,10 +319,6 @@ def tolerance_table(shape: str) -> str:
 
 def _tolerance_table(runs: list, tighter: int) -> str:
     n = len(runs)
-
-    def sd(v):
-        return f"{v.std(ddof=1):.3f}" if n > 1 else "-"
-
     lines = [f"**{PARTICLES} {runs[0]['shape']}s, seeds {', '.join(str(r['seed']) for r in runs)}: the default "
              f"tolerance (B-and) and {tighter}x tighter (B-tight)**", "",
              "| quantity | B-and: mean (sd over seeds) | B-tight: mean (sd) | B-tight - B-and: mean | standard error |",
@@ -312,8 +327,8 @@ def _tolerance_table(runs: list, tighter: int) -> str:
         default = np.array([r["B-and"][key] for r in runs])
         tight = np.array([r["B-tight"][key] for r in runs])
         d = tight - default
-        se = f"{d.std(ddof=1) / np.sqrt(n):.3f}" if n > 1 else "-"
-        lines.append(f"| {key} | {default.mean():.3f} ({sd(default)}) | {tight.mean():.3f} ({sd(tight)}) | "
+        se = f"{_standard_error(d):.3f}" if n > 1 else "-"
+        lines.append(f"| {key} | {default.mean():.3f} ({_sd(default)}) | {tight.mean():.3f} ({_sd(tight)}) | "
                      f"{d.mean():+.3f} | {se} |")
     lines += ["", "| run | steps | sweeps per step: median, p90 | local-law residual: median, p90 | "
               "unbalanced force: median, p90 | seconds |", "|---|---|---|---|---|---|"]
@@ -356,7 +371,7 @@ def compaction_table() -> str:
             if len(seeds) < 2:
                 continue
             d = np.array([ra[s]["z"] - rb[s]["z"] for s in seeds])
-            lines.append(f"| {shape} | {name} | {d.mean():+.3f} | {d.std(ddof=1) / np.sqrt(len(d)):.3f} |")
+            lines.append(f"| {shape} | {name} | {d.mean():+.3f} | {_standard_error(d):.3f} |")
     return "\n".join(lines)
 
 
@@ -366,12 +381,13 @@ def main(argv=None):
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--seeds", default="0")
     parser.add_argument("--shapes", default="pentagon,disk")
-    parser.add_argument("--compaction", action="store_true", help="the compactions instead of the shears")
-    parser.add_argument("--tighter", type=int, default=0, metavar="K",
-                        help="the tolerance study: shear at the default tolerance and K times tighter")
-    parser.add_argument("--static", action="store_true",
-                        help="the static part: residual-state steps re-solved at tighter tolerances")
-    parser.add_argument("--table", action="store_true", help="print the tables of what was run and stop")
+    what = parser.add_mutually_exclusive_group()
+    what.add_argument("--compaction", action="store_true", help="the compactions instead of the shears")
+    what.add_argument("--tighter", type=int, default=0, metavar="K",
+                      help="the tolerance study: shear at the default tolerance and K times tighter")
+    what.add_argument("--static", action="store_true",
+                      help="the static part: residual-state steps re-solved at tighter tolerances")
+    what.add_argument("--table", action="store_true", help="print the tables of what was run and stop")
     args = parser.parse_args(argv)
     if args.table:
         for shape in ("pentagon", "disk"):

@@ -35,10 +35,11 @@ def test_tolerance_table_pairs_by_seed(same_sample, tmp_path):
     table = same_sample.tolerance_table("pentagon")
     row = next(line for line in table.splitlines() if line.startswith("| q/p (residual)"))
     cells = [c.strip() for c in row.strip("|").split("|")]
-    d = np.array([-0.05, -0.02, -0.06])
-    assert cells[1] == f"{np.mean([0.50, 0.60, 0.55]):.3f} ({np.std([0.50, 0.60, 0.55], ddof=1):.3f})"
-    assert cells[3] == f"{d.mean():+.3f}"
-    assert cells[4] == f"{d.std(ddof=1) / np.sqrt(3):.3f}"
+    # by hand: B-and 0.50, 0.60, 0.55 -> mean 0.55, sd 0.05; differences -0.05, -0.02, -0.06 ->
+    # mean -0.0433, sd sqrt(8.667e-4 / 2) = 0.0208, standard error 0.0208 / sqrt(3) = 0.0120
+    assert cells[1] == "0.550 (0.050)"
+    assert cells[3] == "-0.043"
+    assert cells[4] == "0.012"
     assert "seeds 0, 1, 2" in table and "4x tighter" in table
 
 
@@ -69,14 +70,31 @@ def test_q_over_p_of_two_contacts_by_hand(same_sample):
     assert same_sample._q_over_p(problem, np.array([1.0, 0.5]), np.array([0.2, 0.0])) == pytest.approx(q / 0.75, rel=1e-12)
 
 
-def test_static_table_pairs_each_step_with_its_default(same_sample, tmp_path):
-    rows = [{"step": k, **{str(f): {"q/p": 0.5 + 0.01 * k + (0.002 * f if f > 1 else 0.0), "sweeps": 10 * f,
-                                    "local-law residual": 1e-4 / f} for f in same_sample.STATIC_FACTORS}}
-            for k in range(4)]
-    with open(tmp_path / "static_pentagon_0.json", "w") as fh:
-        json.dump({"seed": 0, "shape": "pentagon", "rows": rows}, fh)
+def test_static_table_averages_per_seed_then_over_seeds(same_sample, tmp_path):
+    """Seed 0: steps whose 10x tighter q/p sits 0.01 and 0.03 above the default's (mean 0.02);
+    seed 1: 0.00 and 0.02 (mean 0.01). Over the seeds: mean 0.015, sd 0.00707, standard error
+    0.00707 / sqrt(2) = 0.0050. The other factors sit 0.001 f above."""
+    for seed, shifts in ((0, (0.01, 0.03)), (1, (0.00, 0.02))):
+        rows = []
+        for k, shift in enumerate(shifts):
+            base = 0.5 + 0.1 * k + 0.05 * seed
+            rows.append({"step": 30_000 + 20 * k, **{
+                str(f): {"q/p": base + (shift if f == 10 else 0.001 * f if f > 1 else 0.0), "sweeps": 10 * f + k,
+                         "local-law residual": 1e-4 / f} for f in same_sample.STATIC_FACTORS}})
+        with open(tmp_path / f"static_pentagon_{seed}.json", "w") as fh:
+            json.dump({"seed": seed, "shape": "pentagon", "rows": rows}, fh)
     table = same_sample.static_table("pentagon")
+    assert "seeds 0, 1: 4 residual-state steps" in table
     line = next(x for x in table.splitlines() if x.startswith("| 10x tighter"))
     cells = [c.strip() for c in line.strip("|").split("|")]
-    assert cells[1] == f"{0.515 + 0.02:.4f}" and cells[2] == "+0.0200" and cells[3] == "0.0000"
-    assert cells[4] == "100" and cells[5] == "1.00e-05"
+    # q/p mean: defaults 0.5, 0.6, 0.55, 0.65 (mean 0.575) plus the shifts' mean 0.015
+    assert cells[1] == "0.5900"
+    assert cells[2] == "+0.0200, +0.0100" and cells[3] == "+0.0150" and cells[4] == "0.0050"
+    assert cells[5] == "100" and cells[6] == "1.00e-05"
+    default = next(x for x in table.splitlines() if x.startswith("| default"))
+    assert "+0.0000, +0.0000" in default
+
+
+def test_the_runs_are_exclusive(same_sample):
+    with pytest.raises(SystemExit):
+        same_sample.main(["--tighter", "4", "--static"])

@@ -39,7 +39,8 @@ def test_one_sticking_disk_is_solved_exactly(subspace):
     frozen at the warm start's sliding velocity, mu |v|: on the face, u_n + mu |v| = 0 and u_t = 0
     give p_n = m (g dt - mu |v|) and p_t = v / W_tt (the tangent t = (-n_y, n_x) points along -x, so
     u_t = -v before the impulse and the force -p_t along x opposes the sliding), W_tt = 1/m + R^2/I = 3/m, which the
-    block-preconditioned CG reaches in one iteration."""
+    block-preconditioned CG reaches in one iteration: at the first checkpoint the reduced gradient
+    is zero."""
     from solver import nlgs
 
     m, radius, g_dt, v, mu = 2.0, 0.1, 0.01, 0.005, 0.5

@@ -417,7 +417,8 @@ def test_random_scene_against_numpy_oracle(seed):
 @pytest.mark.parametrize("threads", [2, 3, 7])
 def test_threads_give_the_same_points_bit_for_bit(threads):
     """The candidates split into blocks done at once (pairs and wall candidates, disks and
-    polygons; more blocks than candidates too) give exactly the serial kernel's points."""
+    polygons; more blocks than candidates, and no candidate at all) give exactly the serial
+    kernel's points."""
     pos, angle, radius, nvert = random_scene(5, n=80)
     shapes = Shapes.regular(radius, nvert)
     walls = box_walls(1.0, 1.0)
@@ -425,7 +426,7 @@ def test_threads_give_the_same_points_bit_for_bit(threads):
     wp, ww = np.repeat(np.arange(80), 4), np.tile(np.arange(4), 80)
     serial = detect(pos, angle, shapes, *walls, 0.02, pi, pj, wp, ww)
     assert serial.n_pairs > 20 and np.sum(serial.body_j >= 80) > 5
-    for pairs, (a, b) in ((slice(None), (wp, ww)), (slice(0, 3), ([], []))):
+    for pairs, (a, b) in ((slice(None), (wp, ww)), (slice(0, 3), ([], [])), (slice(0, 0), ([], []))):
         one = detect(pos, angle, shapes, *walls, 0.02, pi[pairs], pj[pairs], a, b)
         many = detect(pos, angle, shapes, *walls, 0.02, pi[pairs], pj[pairs], a, b, threads=threads)
         for field in one._fields:
