@@ -113,6 +113,9 @@ class Parameters:
             ("max_tolerance", self.max_tolerance > 0, "> 0"),
             ("max_iterations", int(self.max_iterations) >= 1, ">= 1"),
             ("stall_sweeps", int(self.stall_sweeps) >= 0, "a whole number of sweeps >= 0 (0: no stall test)"),
+            ("stall_sweeps", 2 * int(self.stall_sweeps) <= int(self.max_iterations),
+             f"at most max_iterations/2 = {int(self.max_iterations) // 2} (the first check only records the best "
+             "norm, so a stall can show at the second; 0: no stall test)"),
             ("acceleration", self.acceleration in ACCELERATIONS, f"one of {ACCELERATIONS}"),
             ("anderson_memory", 1 <= int(self.anderson_memory) <= 50, "an integer in 1..50"),
             ("anderson_period", 1 <= int(self.anderson_period) <= 50, "an integer in 1..50"),

@@ -135,7 +135,7 @@ def test_pentagon_double_contact_forces_are_equal_with_random_ordering():
                                  dict(wall_friction=np.inf), dict(max_iterations=0), dict(gravity=(0.0, np.nan)),
                                  dict(alert=-1.0), dict(acceleration="fast"), dict(anderson_memory=0),
                                  dict(anderson_period=0), dict(domains=2, shuffle=True, acceleration="off"),
-                                 dict(shuffle=True)])
+                                 dict(shuffle=True), dict(stall_sweeps=600, max_iterations=1000)])
 def test_invalid_parameters_are_refused_with_their_name(bad):
     name = next(iter(bad))
     with pytest.raises(ParameterError, match=name):
