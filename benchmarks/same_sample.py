@@ -41,7 +41,8 @@ solution's stress tensor (grainview.arrays.stress, the particle-wall contacts in
 compared on the same geometry. Written to benchmarks/_data/same_sample/static_<shape>_<seed>.json.
 
 Runs two processes at a time (one per core); timings are in the files but the point is the
-physics: steps, sweeps and states are exact and reproducible.
+physics: steps, sweeps and states are exact and reproducible on one machine (on another, the
+round-off of its arithmetic starts another trajectory: docs/fidelity.md, section 6).
 """
 
 from __future__ import annotations
