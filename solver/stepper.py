@@ -375,7 +375,9 @@ class Simulation:
         :meth:`_point_keys`), 0 for new points."""
         impulse = np.zeros((len(keys), 2))
         if len(self._keys) and len(keys):
-            order = np.argsort(self._keys)
+            # detection gives the points nearly in key order, which a stable (merge) sort takes in
+            # one pass; the keys are unique, so any sort gives this order
+            order = np.argsort(self._keys, kind="stable")
             sorted_keys = self._keys[order]
             where = np.searchsorted(sorted_keys, keys)
             where = np.minimum(where, len(sorted_keys) - 1)

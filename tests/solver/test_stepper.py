@@ -180,3 +180,22 @@ def test_shuffled_sweeps_are_random_permutations_and_leave_numbas_generator_alon
                         np.zeros(4), shuffle=True, acceleration="off", seed=3, **EXACT)
     sim.step()
     assert next_draw() == expected
+
+
+def test_matched_impulses_are_those_of_the_same_keys():
+    """The warm start against a dictionary from key to last impulse: points kept (in a new
+    order), points new (0) and points gone, keys nearly sorted as detection gives them."""
+    from types import SimpleNamespace
+
+    rng = np.random.default_rng(5)
+    last_keys = np.sort(rng.choice(10**6, 400, replace=False)).astype(np.int64)
+    last_keys[[10, 11]] = last_keys[[11, 10]]  # nearly sorted
+    last = rng.normal(size=(400, 2))
+    keys = np.concatenate([last_keys[50:300], rng.choice(np.arange(10**6, 2 * 10**6), 30, replace=False)])
+    rng.shuffle(keys)
+    state = SimpleNamespace(_keys=last_keys, _impulse=last)
+    got = Simulation._matched_impulses(state, keys)
+    reference = dict(zip(last_keys.tolist(), map(tuple, last)))
+    expected = np.array([reference.get(k, (0.0, 0.0)) for k in keys.tolist()])
+    np.testing.assert_array_equal(got, expected)
+    assert np.count_nonzero(got[:, 0]) == 250
