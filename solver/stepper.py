@@ -33,7 +33,7 @@ import numpy as np
 
 from grainview.errors import ConvergenceWarning, ParameterError
 
-from . import acceleration, broadphase, narrowphase, nlgs, parallel_nlgs, residuals
+from . import acceleration, broadphase, narrowphase, nlgs, parallel_nlgs, problem_assembly, residuals
 from .contact_points import PairIndex, force_vectors, point_keys
 from .shapes import Shapes
 from .walls import FIXED, STRESS, VELOCITY, Walls
@@ -407,24 +407,16 @@ class Simulation:
 
     def _contact_problem(self, pts, v_start, omega_start):
         """The step's :class:`solver.nlgs.ContactProblem` from the detected points, and the
-        lever arms ra, rb (P, 2) m. The Signorini shift comes from the gaps predicted to
-        mid-step with the start velocities (:meth:`contact_bias`)."""
+        lever arms ra, rb (P, 2) m (:func:`solver.problem_assembly.assemble`: the Signorini
+        shift comes from the gaps predicted to mid-step with the start velocities)."""
         p = self.parameters
-        h, theta, n = p.time_step, p.theta, self.n_particles
         centre = np.concatenate([self.position, self.walls.point])
-        a, b = pts.body_i.astype(np.int64), pts.body_j.astype(np.int64)
-        ra = pts.point - centre[a]
-        rb = pts.point - centre[b]
-        rb[b >= n] = 0.0
-        nx, ny = pts.normal[:, 0].copy(), pts.normal[:, 1].copy()
-        u0 = (v_start[b] + omega_start[b, None] * np.stack([-rb[:, 1], rb[:, 0]], -1)
-              - v_start[a] - omega_start[a, None] * np.stack([-ra[:, 1], ra[:, 0]], -1))
-        un0 = u0[:, 0] * nx + u0[:, 1] * ny
-        g_star = pts.gap + h * (1 - theta) * un0
+        a, b, ra, rb, nx, ny, bias, mu = problem_assembly.assemble(
+            pts.point, pts.normal, pts.gap, pts.body_i, pts.body_j, centre, v_start, omega_start, self.n_particles,
+            float(p.time_step), float(p.theta), float(p.friction), float(p.wall_friction))
         minv, iinv = self._mobility()
         problem = nlgs.ContactProblem(
-            a, b, nx, ny, ra[:, 0].copy(), ra[:, 1].copy(), rb[:, 0].copy(), rb[:, 1].copy(),
-            self.contact_bias(g_star), np.where(b >= n, p.wall_friction, p.friction),
+            a, b, nx, ny, ra[:, 0].copy(), ra[:, 1].copy(), rb[:, 0].copy(), rb[:, 1].copy(), bias, mu,
             minv[:, 0].copy(), minv[:, 1].copy(), minv[:, 2].copy(), iinv)
         return problem, ra, rb
 
@@ -487,13 +479,6 @@ class Simulation:
         self.walls.velocity[stress_walls] = v_end[n + stress_walls]
         self.velocity = v_end
         self.angular_velocity = om
-
-    def contact_bias(self, g_star):
-        """The shift b of Signorini's condition u_n + b >= 0 for gaps g* predicted to mid-step:
-        b = max(0, g*)/(theta h). An open gap may close within the step; an existing overlap
-        is not pushed out by the velocities (LMGC90's IQS law)."""
-        p = self.parameters
-        return np.maximum(g_star, 0.0) / (p.theta * p.time_step)
 
     def _solve(self, problem, pn, pt, vx, vy, om, tolerance, max_tolerance, max_iterations, shuffle=False, stall=0):
         """Solve a contact problem in place with the sweeps the parameters choose: Anderson-

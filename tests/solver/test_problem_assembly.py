@@ -1,0 +1,58 @@
+"""solver.problem_assembly: the one-pass kernel against the whole-array numpy reference, bit for
+bit, and one point's lever arms, shift and friction by hand."""
+
+import numpy as np
+import pytest
+
+from solver.problem_assembly import assemble, assemble_reference
+
+
+def _random_points(seed, n=30, walls=4, m=200):
+    rng = np.random.default_rng(seed)
+    bodies = n + walls
+    body_i = rng.integers(0, n, m).astype(np.int32)
+    body_j = rng.integers(0, bodies, m).astype(np.int32)
+    angle = rng.uniform(0, 2 * np.pi, m)
+    normal = np.stack([np.cos(angle), np.sin(angle)], -1)
+    return dict(point=rng.uniform(0, 1, (m, 2)), normal=normal, gap=rng.normal(0, 1e-4, m), body_i=body_i,
+                body_j=body_j, centre=rng.uniform(0, 1, (bodies, 2)), v_start=rng.normal(0, 0.01, (bodies, 2)),
+                omega_start=rng.normal(0, 0.1, bodies), n_particles=n)
+
+
+@pytest.mark.parametrize("seed", [0, 1, 2])
+@pytest.mark.parametrize("theta", [0.5, 1.0])
+def test_the_kernel_is_the_reference_bit_for_bit(seed, theta):
+    points = _random_points(seed)
+    args = (*points.values(), 5e-4, theta, 0.4, 0.1)
+    got, expected = assemble(*args), assemble_reference(*args)
+    for name, x, y in zip(("a", "b", "ra", "rb", "nx", "ny", "bias", "mu"), got, expected):
+        np.testing.assert_array_equal(x, y, err_msg=name)
+    walls = points["body_j"] >= points["n_particles"]
+    assert walls.any() and np.all(got[3][walls] == 0.0) and np.all(got[7][walls] == 0.1)
+    assert np.any(got[6] == 0.0) and np.any(got[6] > 0.0)  # closed and open points both met
+
+
+def test_no_points():
+    points = _random_points(0, m=0)
+    out = assemble(*points.values(), 5e-4, 0.5, 0.4, 0.1)
+    assert all(x.shape[0] == 0 for x in out)
+
+
+def test_one_point_by_hand():
+    """Particle 0 at (0, 0), rotating at w = 2 rad/s and moving at (0.1, 0); particle 1 at
+    (1, 0) at rest; the point at (0.5, 0.1), normal (1, 0), gap 1e-3 m. r_a = (0.5, 0.1),
+    r_b = (-0.5, 0.1); u_0 = -(v_a + w (-r_a,y, r_a,x)) = -(0.1 - 0.2, 1.0) = (0.1, -1.0),
+    u_n0 = 0.1; g* = 1e-3 + h (1 - theta) 0.1 = 1e-3 + 2.5e-5; bias = g* / (theta h)."""
+    h, theta = 5e-4, 0.5
+    a, b, ra, rb, nx, ny, bias, mu = assemble(
+        np.array([[0.5, 0.1]]), np.array([[1.0, 0.0]]), np.array([1e-3]), np.array([0], np.int32),
+        np.array([1], np.int32), np.array([[0.0, 0.0], [1.0, 0.0]]), np.array([[0.1, 0.0], [0.0, 0.0]]),
+        np.array([2.0, 0.0]), 2, h, theta, 0.4, 0.1)
+    np.testing.assert_allclose(ra, [[0.5, 0.1]], rtol=1e-15)
+    np.testing.assert_allclose(rb, [[-0.5, 0.1]], rtol=1e-15)
+    assert bias[0] == pytest.approx((1e-3 + 2.5e-5) / (theta * h), rel=1e-12) and mu[0] == 0.4
+    # an overlap that the start velocities do not open: no shift (the IQS law)
+    *_, bias, _ = assemble(np.array([[0.5, 0.1]]), np.array([[1.0, 0.0]]), np.array([-1e-3]), np.array([0], np.int32),
+                           np.array([1], np.int32), np.array([[0.0, 0.0], [1.0, 0.0]]),
+                           np.array([[0.1, 0.0], [0.0, 0.0]]), np.array([2.0, 0.0]), 2, h, theta, 0.4, 0.1)
+    assert bias[0] == 0.0
