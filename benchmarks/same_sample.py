@@ -72,19 +72,27 @@ QUANTITIES = ["q/p (residual)", "a (residual)", "a_n (residual)", "a_t (residual
               "z (initial)"]
 
 
+def _compacted(seed: int, shape: str, acceleration: str, **options):
+    """The seed's 'paper' deposit of PARTICLES ``shape``s compacted with ``acceleration``
+    sweeps (``options``: other solver parameters), its warnings silenced."""
+    from solver.preparation import preparation, prepare_sample
+
+    prep = preparation("paper", particles=PARTICLES, shape=shape, seed=seed)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        return prepare_sample(prep, acceleration=acceleration, **options)
+
+
 def shears(seed: int, shape: str) -> dict:
     """The three shears of one seed and shape (module docstring); writes and returns their
     residual-state summaries, seconds and the compactions' steps and seconds."""
-    from solver.preparation import preparation, prepare_sample, record
+    from solver.preparation import record
 
     out = {"seed": seed, "shape": shape, "particles": PARTICLES}
-    prep = preparation("paper", particles=PARTICLES, shape=shape, seed=seed)
     samples = {}
     for name, acceleration in COMPACTIONS.items():
         start = time.perf_counter()
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore")
-            sim = prepare_sample(prep, acceleration=acceleration)
+        sim = _compacted(seed, shape, acceleration)
         out[f"compact_{name}"] = {"steps": int(sim.compaction_steps), "seconds": time.perf_counter() - start,
                                   "settled": bool(sim.settled)}
         samples[name] = (sim, record(sim))
@@ -139,12 +147,9 @@ def _shear_summary(sim, attrs: dict, path: str) -> dict:
 
 def tolerance(seed: int, shape: str, tighter: int) -> dict:
     """The tolerance study of one seed and shape (module docstring); writes and returns it."""
-    from solver.preparation import preparation, prepare_sample, record
+    from solver.preparation import record
 
-    prep = preparation("paper", particles=PARTICLES, shape=shape, seed=seed)
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore")
-        sample = prepare_sample(prep, acceleration="anderson")
+    sample = _compacted(seed, shape, "anderson")
     out = {"seed": seed, "shape": shape, "particles": PARTICLES, "tighter": tighter}
     for run, factor in (("B-and", 1), ("B-tight", tighter)):
         sim = copy.deepcopy(sample)
@@ -191,13 +196,9 @@ def _q_over_p(problem, pn, pt) -> float:
 def static(seed: int, shape: str) -> dict:
     """The static part of the tolerance effect for one seed and shape (module docstring)."""
     from solver import acceleration, residuals
-    from solver.preparation import preparation, prepare_sample
     from sweep_bursts import capture
 
-    prep = preparation("paper", particles=PARTICLES, shape=shape, seed=seed)
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore")
-        sim = prepare_sample(prep, acceleration="anderson")
+    sim = _compacted(seed, shape, "anderson")
     first, last, every = STATIC_STEPS
     rows = []
     for case in capture(sim, first, last):
@@ -251,19 +252,16 @@ def compactions(seed: int, shape: str) -> list:
     """The four compactions of one seed and shape (module docstring); returns their rows."""
     import grainview
     from solver.output import Recorder
-    from solver.preparation import preparation, prepare_sample, record
+    from solver.preparation import record
     from solver.stepper import Parameters
 
     defaults = Parameters()
-    prep = preparation("paper", particles=PARTICLES, shape=shape, seed=seed)
     rows = []
     for acceleration in ("off", "anderson"):
         for tighter in (1, 10):
             start = time.perf_counter()
-            with warnings.catch_warnings():
-                warnings.simplefilter("ignore")
-                sim = prepare_sample(prep, acceleration=acceleration, tolerance=defaults.tolerance / tighter,
-                                     max_iterations=defaults.max_iterations * tighter)
+            sim = _compacted(seed, shape, acceleration, tolerance=defaults.tolerance / tighter,
+                             max_iterations=defaults.max_iterations * tighter)
             seconds = time.perf_counter() - start
             path = os.path.join(OUT, f"compacted_{shape}_{seed}_{acceleration}_{tighter}.nc")
             with Recorder(path, sim, attrs={"scene": "isotropic", **record(sim)}, overwrite=True,

@@ -28,7 +28,6 @@ speed-ups they bound the whole step's (Amdahl). Writes benchmarks/RESULTS-step-p
 from __future__ import annotations
 
 import argparse
-import copy
 import os
 import sys
 import time
