@@ -335,7 +335,7 @@ def solve_anderson(blocks, a, b, nx, ny, rax, ray, rbx, rby, bias, mu, pn, pt, v
 
 
 def solve_problem_anderson(problem, pn, pt, vx, vy, w, *, tolerance, max_tolerance, max_iterations,
-                           memory=3, domains=1, x=None, period=1, stall=0) -> NLGSResult:
+                           memory=3, domains=1, x=None, period=1, stall=0, decomposition=None) -> NLGSResult:
     """Solve ``problem`` (:class:`solver.nlgs.ContactProblem`) by Anderson-accelerated NLGS
     sweeps (module docstring); same arguments, in-place updates and result as
     :func:`solver.nlgs.solve_problem`. ``memory`` is m, the number of past sweeps combined.
@@ -343,7 +343,8 @@ def solve_problem_anderson(problem, pn, pt, vx, vy, w, *, tolerance, max_toleran
     :mod:`solver.parallel_nlgs`, the particles (the first ``x.size`` bodies, centres'
     abscissae ``x``, m) cut into that many slabs, and the history passes run a domain per
     thread too. ``period``: the sweeps between two extrapolations (Anderson on the map
-    "``period`` sweeps", module docstring); ``stall`` as in :func:`solver.nlgs.solve_problem`."""
+    "``period`` sweeps", module docstring); ``stall`` as in :func:`solver.nlgs.solve_problem`;
+    ``decomposition`` as in :func:`solver.parallel_nlgs.solve_decomposed`."""
     if int(period) < 1 or int(memory) < 1:
         raise ValueError(f"memory={memory!r}, period={period!r}: expected whole numbers >= 1")
     options = (float(tolerance), float(max_tolerance), int(max_iterations), int(memory), int(period), int(stall))
@@ -351,7 +352,7 @@ def solve_problem_anderson(problem, pn, pt, vx, vy, w, *, tolerance, max_toleran
         def kernel(dec, geometry, state, masses):
             return solve_anderson(dec.blocks, *geometry, *state, *masses, *options)
 
-        return solve_decomposed(problem, x, domains, (pn, pt, vx, vy, w), kernel)
+        return solve_decomposed(problem, x, domains, (pn, pt, vx, vy, w), kernel, decomposition)
     blocks = np.array([0, problem.a.size], dtype=np.int64)
     iterations, residual, worst = solve_anderson(
         blocks, problem.a, problem.b, problem.nx, problem.ny, problem.rax, problem.ray, problem.rbx, problem.rby,

@@ -96,30 +96,37 @@ def _cross(rx, ry, ex, ey):
     return rx * ey - ry * ex
 
 
-@njit(cache=True)
-def delassus(a, b, nx, ny, rax, ray, rbx, rby, minv_xx, minv_xy, minv_yy, iinv):
-    """Local 2x2 Delassus blocks (W_nn, W_nt, W_tt) of every point (s kg-1 with impulses).
+@njit(cache=True, inline="always")
+def delassus_block(k, a, b, nx, ny, rax, ray, rbx, rby, minv_xx, minv_xy, minv_yy, iinv):
+    """The local 2x2 Delassus block (W_nn, W_nt, W_tt) of point k (s kg-1 with impulses).
 
     For each body: W += e_a^T M^-1 e_b + I^-1 (r x e_a)(r x e_b), e in {n, t}, t = (-n_y, n_x).
     """
+    tx, ty = -ny[k], nx[k]
+    nn = nt = tt = 0.0
+    for side in range(2):
+        body = a[k] if side == 0 else b[k]
+        rx = rax[k] if side == 0 else rbx[k]
+        ry = ray[k] if side == 0 else rby[k]
+        mxx, mxy, myy = minv_xx[body], minv_xy[body], minv_yy[body]
+        rn = _cross(rx, ry, nx[k], ny[k])
+        rt = _cross(rx, ry, tx, ty)
+        nn += nx[k] * (mxx * nx[k] + mxy * ny[k]) + ny[k] * (mxy * nx[k] + myy * ny[k]) + iinv[body] * rn * rn
+        nt += nx[k] * (mxx * tx + mxy * ty) + ny[k] * (mxy * tx + myy * ty) + iinv[body] * rn * rt
+        tt += tx * (mxx * tx + mxy * ty) + ty * (mxy * tx + myy * ty) + iinv[body] * rt * rt
+    return nn, nt, tt
+
+
+@njit(cache=True)
+def delassus(a, b, nx, ny, rax, ray, rbx, rby, minv_xx, minv_xy, minv_yy, iinv):
+    """Local 2x2 Delassus blocks (W_nn, W_nt, W_tt) of every point (:func:`delassus_block`)."""
     m = a.size
     w_nn = np.empty(m)
     w_nt = np.empty(m)
     w_tt = np.empty(m)
     for k in range(m):
-        tx, ty = -ny[k], nx[k]
-        nn = nt = tt = 0.0
-        for side in range(2):
-            body = a[k] if side == 0 else b[k]
-            rx = rax[k] if side == 0 else rbx[k]
-            ry = ray[k] if side == 0 else rby[k]
-            mxx, mxy, myy = minv_xx[body], minv_xy[body], minv_yy[body]
-            rn = _cross(rx, ry, nx[k], ny[k])
-            rt = _cross(rx, ry, tx, ty)
-            nn += nx[k] * (mxx * nx[k] + mxy * ny[k]) + ny[k] * (mxy * nx[k] + myy * ny[k]) + iinv[body] * rn * rn
-            nt += nx[k] * (mxx * tx + mxy * ty) + ny[k] * (mxy * tx + myy * ty) + iinv[body] * rn * rt
-            tt += tx * (mxx * tx + mxy * ty) + ty * (mxy * tx + myy * ty) + iinv[body] * rt * rt
-        w_nn[k], w_nt[k], w_tt[k] = nn, nt, tt
+        w_nn[k], w_nt[k], w_tt[k] = delassus_block(k, a, b, nx, ny, rax, ray, rbx, rby, minv_xx, minv_xy, minv_yy,
+                                                   iinv)
     return w_nn, w_nt, w_tt
 
 

@@ -181,22 +181,55 @@ class Decomposition(NamedTuple):
     def gather(self, problem, pn, pt, vx, vy, w):
         """The problem's arrays in the new numbering: (geometry, masses, state) with geometry =
         (a, b, nx, ny, rax, ray, rbx, rby, bias, mu), masses = (minv_xx, minv_xy, minv_yy, iinv)
-        and state = (pn, pt, vx, vy, w) (copies)."""
-        k, j = self.point_order, self.source
-        geometry = (self.a, self.b, *(np.ascontiguousarray(v[k]) for v in (
-            problem.nx, problem.ny, problem.rax, problem.ray, problem.rbx, problem.rby, problem.bias, problem.mu)))
-        masses = tuple(np.ascontiguousarray(m[j]) for m in (problem.minv_xx, problem.minv_xy, problem.minv_yy,
-                                                           problem.iinv))
-        return geometry, masses, (pn[k], pt[k], vx[j], vy[j], w[j])
+        and state = (pn, pt, vx, vy, w) (copies; :func:`gather`)."""
+        arrays = gather(self.point_order, self.source, problem.nx, problem.ny, problem.rax, problem.ray, problem.rbx,
+                        problem.rby, problem.bias, problem.mu, pn, pt, problem.minv_xx, problem.minv_xy,
+                        problem.minv_yy, problem.iinv, vx, vy, w)
+        return (self.a, self.b, *arrays[:8]), arrays[10:14], (*arrays[8:10], *arrays[14:])
 
     def scatter(self, state, pn, pt, vx, vy, w):
         """Write a solved ``state`` (new numbering) back into the original arrays, in place:
         every impulse, and the velocities of the bodies that can move (a still wall's
-        velocity is imposed and stays as it was)."""
-        spn, spt, svx, svy, sw = state
-        pn[self.point_order], pt[self.point_order] = spn, spt
-        for original, solved in ((vx, svx), (vy, svy), (w, sw)):
-            original[self.source[self.moving]] = solved[self.moving]
+        velocity is imposed and stays as it was; :func:`scatter`)."""
+        scatter(self.point_order, self.source, self.moving, *state, pn, pt, vx, vy, w)
+
+
+@njit(cache=True)
+def gather(point_order, source, nx, ny, rax, ray, rbx, rby, bias, mu, pn, pt, minv_xx, minv_xy, minv_yy, iinv,
+           vx, vy, w):
+    """Copies in the new numbering of :class:`Decomposition`: the ten point arrays (nx .. pt)
+    taken at ``point_order``, then the seven body arrays (minv_xx .. w) at ``source``, in the
+    order of the arguments."""
+    m = point_order.size
+    points = np.empty((10, m))
+    for q in range(m):
+        k = point_order[q]
+        points[0, q], points[1, q], points[2, q], points[3, q], points[4, q] = nx[k], ny[k], rax[k], ray[k], rbx[k]
+        points[5, q], points[6, q], points[7, q], points[8, q], points[9, q] = rby[k], bias[k], mu[k], pn[k], pt[k]
+    n = source.size
+    bodies = np.empty((7, n))
+    for q in range(n):
+        j = source[q]
+        bodies[0, q], bodies[1, q], bodies[2, q], bodies[3, q] = minv_xx[j], minv_xy[j], minv_yy[j], iinv[j]
+        bodies[4, q], bodies[5, q], bodies[6, q] = vx[j], vy[j], w[j]
+    return (points[0], points[1], points[2], points[3], points[4], points[5], points[6], points[7], points[8],
+            points[9], bodies[0], bodies[1], bodies[2], bodies[3], bodies[4], bodies[5], bodies[6])
+
+
+@njit(cache=True)
+def scatter(point_order, source, moving, spn, spt, svx, svy, sw, pn, pt, vx, vy, w):
+    """:meth:`Decomposition.scatter`: impulses back to their points, the moving bodies'
+    velocities back to their bodies, in place."""
+    for q in range(point_order.size):
+        k = point_order[q]
+        pn[k] = spn[q]
+        pt[k] = spt[q]
+    for i in range(moving.size):
+        q = moving[i]
+        j = source[q]
+        vx[j] = svx[q]
+        vy[j] = svy[q]
+        w[j] = sw[q]
 
 
 @njit(cache=True)
@@ -272,24 +305,29 @@ def decompose(problem, x, domains) -> Decomposition:
 
 
 def solve_problem_domains(problem, x, pn, pt, vx, vy, w, *, domains, tolerance, max_tolerance,
-                          max_iterations, stall=0) -> NLGSResult:
+                          max_iterations, stall=0, decomposition=None) -> NLGSResult:
     """Solve ``problem`` (:class:`solver.nlgs.ContactProblem`) by domain-decomposed sweeps
     (module docstring) with ``domains`` slabs of the particles whose centres have abscissae
     ``x`` (m, the first ``x.size`` bodies); arguments and result otherwise as
-    :func:`solver.nlgs.solve_problem`."""
+    :func:`solver.nlgs.solve_problem`. ``decomposition``: the problem's :func:`decompose`, when
+    the caller already has it (:func:`solve_decomposed`)."""
     def kernel(dec, geometry, state, masses):
         return solve_domains(dec.ptr, dec.points, dec.interface, *geometry, *state, *masses, tolerance, max_tolerance,
                              int(max_iterations), int(stall))
 
-    return solve_decomposed(problem, x, domains, (pn, pt, vx, vy, w), kernel)
+    return solve_decomposed(problem, x, domains, (pn, pt, vx, vy, w), kernel, decomposition)
 
 
-def solve_decomposed(problem, x, domains, state, kernel) -> NLGSResult:
+def solve_decomposed(problem, x, domains, state, kernel, decomposition=None) -> NLGSResult:
     """Lay ``problem`` out by ``domains`` slabs of the particles (centres' abscissae ``x``, m;
     :func:`decompose`), run ``kernel(decomposition, geometry, state, masses)`` on the renumbered
     arrays (:meth:`Decomposition.gather`; it returns sweeps and the two norms) and write the
-    solved impulses and velocities back into ``state`` = (pn, pt, vx, vy, w), in place."""
-    dec = decompose(problem, x, domains)
+    solved impulses and velocities back into ``state`` = (pn, pt, vx, vy, w), in place.
+
+    ``decomposition``: the :func:`decompose` of a problem with the same points, bodies and
+    masses (another right-hand side or friction, as the overlap recovery's), made from the
+    same ``x``; made here when None."""
+    dec = decompose(problem, x, domains) if decomposition is None else decomposition
     geometry, masses, renumbered = dec.gather(problem, *state)
     iterations, residual, worst = kernel(dec, geometry, renumbered, masses)
     dec.scatter(renumbered, *state)

@@ -34,7 +34,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from .nlgs import _relative_velocity, delassus
+from .nlgs import _relative_velocity, delassus_block
 
 __all__ = ["cone_projection", "natural_map", "natural_maps", "local_law_residuals", "particle_imbalance",
            "local_law_residual", "unbalanced_ratios"]
@@ -105,20 +105,52 @@ def particle_imbalance(a, b, nx, ny, rax, ray, rbx, rby, pn, pt, n_particles):
     return fx, fy, torque
 
 
+@njit(cache=True)
+def _law_sums(a, b, nx, ny, rax, ray, rbx, rby, bias, mu, pn, pt, vx, vy, w, minv_xx, minv_xy, minv_yy, iinv):
+    """(sum of |F_k|^2, sum of |r_k|^2) over the points: :func:`local_law_residuals` and the
+    impulses' squared norm in one pass, each point's W_nn from :func:`solver.nlgs.delassus_block`."""
+    violation = 0.0
+    scale = 0.0
+    for k in range(a.size):
+        wnn = delassus_block(k, a, b, nx, ny, rax, ray, rbx, rby, minv_xx, minv_xy, minv_yy, iinv)[0]
+        un, ut = _relative_velocity(k, a, b, nx, ny, rax, ray, rbx, rby, vx, vy, w)
+        fn, ft = natural_map(pn[k], pt[k], un + bias[k], ut, mu[k], 1.0 / wnn)
+        violation += fn * fn + ft * ft
+        scale += pn[k] * pn[k] + pt[k] * pt[k]
+    return violation, scale
+
+
 def local_law_residual(problem, pn, pt, vx, vy, w) -> float:
     """The step's local-law residual |F| / |r| (module docstring) for a
     :class:`solver.nlgs.ContactProblem` and its impulses and end velocities; 0 for no points."""
     if problem.a.size == 0:
         return 0.0
-    wnn = delassus(problem.a, problem.b, problem.nx, problem.ny, problem.rax, problem.ray, problem.rbx,
-                   problem.rby, problem.minv_xx, problem.minv_xy, problem.minv_yy, problem.iinv)[0]
-    fn, ft = local_law_residuals(problem.a, problem.b, problem.nx, problem.ny, problem.rax, problem.ray,
-                                 problem.rbx, problem.rby, problem.bias, problem.mu, pn, pt, vx, vy, w, wnn)
-    violation = float(np.sqrt(np.sum(fn * fn + ft * ft)))
-    scale = float(np.sqrt(np.sum(pn * pn + pt * pt)))
+    violation, scale = _law_sums(problem.a, problem.b, problem.nx, problem.ny, problem.rax, problem.ray, problem.rbx,
+                                 problem.rby, problem.bias, problem.mu, pn, pt, vx, vy, w, problem.minv_xx,
+                                 problem.minv_xy, problem.minv_yy, problem.iinv)
     if scale > 0.0:
-        return violation / scale
+        return float(np.sqrt(violation) / np.sqrt(scale))
     return 0.0 if violation == 0.0 else float("inf")
+
+
+@njit(cache=True)
+def _unbalanced(a, b, nx, ny, rax, ray, rbx, rby, pn, pt, external_impulse, radius):
+    """(largest |sum of impulses|, largest |sum of moments| / R, mean |r| of the loaded
+    points, loaded points) of :func:`unbalanced_ratios`, in one pass over the points and one
+    over the particles."""
+    fx, fy, torque = particle_imbalance(a, b, nx, ny, rax, ray, rbx, rby, pn, pt, radius.size)
+    total = 0.0
+    loaded = 0
+    for k in range(pn.size):
+        if pn[k] > 0.0:
+            total += np.hypot(pn[k], pt[k])
+            loaded += 1
+    force = 0.0
+    moment = 0.0
+    for i in range(radius.size):
+        force = max(force, np.hypot(fx[i] + external_impulse[i, 0], fy[i] + external_impulse[i, 1]))
+        moment = max(moment, abs(torque[i]) / radius[i])
+    return force, moment, total / max(loaded, 1), loaded
 
 
 def unbalanced_ratios(problem, pn, pt, external_impulse, radius) -> tuple[float, float]:
@@ -126,12 +158,10 @@ def unbalanced_ratios(problem, pn, pt, external_impulse, radius) -> tuple[float,
     + external impulse| over the particles (``external_impulse`` (N, 2) N s, e.g. h m g) and the
     largest |sum of contact moments| / R_i, both over the mean |r| of the loaded points. (0, 0)
     when no point is loaded."""
-    n = len(radius)
-    loaded = pn > 0.0
-    if not loaded.any():
+    force, moment, mean, loaded = _unbalanced(problem.a, problem.b, problem.nx, problem.ny, problem.rax, problem.ray,
+                                              problem.rbx, problem.rby, np.asarray(pn, float), np.asarray(pt, float),
+                                              np.ascontiguousarray(external_impulse, dtype=float),
+                                              np.asarray(radius, float))
+    if loaded == 0:
         return 0.0, 0.0
-    mean = float(np.mean(np.hypot(pn[loaded], pt[loaded])))
-    fx, fy, torque = particle_imbalance(problem.a, problem.b, problem.nx, problem.ny, problem.rax, problem.ray,
-                                        problem.rbx, problem.rby, pn, pt, n)
-    force = np.hypot(fx + external_impulse[:, 0], fy + external_impulse[:, 1])
-    return float(force.max() / mean), float(np.max(np.abs(torque) / radius) / mean)
+    return float(force / mean), float(moment / mean)

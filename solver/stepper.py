@@ -33,15 +33,10 @@ import numpy as np
 
 from grainview.errors import ConvergenceWarning, ParameterError
 
-from . import acceleration, broadphase, narrowphase, nlgs, parallel_nlgs, problem_assembly, residuals
+from . import acceleration, broadphase, narrowphase, nlgs, parallel_nlgs, problem_assembly, residuals, warm_start
 from .contact_points import PairIndex, force_vectors, point_keys
 from .shapes import Shapes
 from .walls import FIXED, STRESS, VELOCITY, Walls
-
-
-def _cross2(r, normal):
-    """(omega x r) . n per unit omega: r_x n_y - r_y n_x, row by row."""
-    return r[:, 0] * normal[:, 1] - r[:, 1] * normal[:, 0]
 
 
 MAX_FRICTION = 10.0
@@ -342,15 +337,16 @@ class Simulation:
         vx, vy, om = v_free[:, 0].copy(), v_free[:, 1].copy(), omega_free.copy()
         pn, pt = impulse[:, 0].copy(), impulse[:, 1].copy()
         p = self.parameters
+        decomposition = self._decomposition(problem)
         result = self._solve(problem, pn, pt, vx, vy, om, p.tolerance, p.max_tolerance, p.max_iterations,
-                             shuffle=p.shuffle, stall=p.stall_sweeps)
+                             shuffle=p.shuffle, stall=p.stall_sweeps, decomposition=decomposition)
         self.timings["solve"] += time.perf_counter() - solve_start
         update_start = time.perf_counter()
         converged = self._count_solve(result, len(keys))
         law = residuals.local_law_residual(problem, pn, pt, vx, vy, om)
         force, torque = self._unbalanced(problem, pn, pt)
         v_end, om = self._end_velocities(vx, vy, om)
-        self._integrate(pts, problem, ra, rb, v_start, omega_start, v_end, om)
+        self._integrate(pts, problem, ra, rb, v_start, omega_start, v_end, om, decomposition)
         self.points = pts
         self.impulse = np.stack([pn, pt], -1)
         self._keys, self._impulse = keys, self.impulse
@@ -372,18 +368,8 @@ class Simulation:
 
     def _matched_impulses(self, keys):
         """Warm start: the last step's impulses (P, 2) of the same contact points (keys of
-        :meth:`_point_keys`), 0 for new points."""
-        impulse = np.zeros((len(keys), 2))
-        if len(self._keys) and len(keys):
-            # detection gives the points nearly in key order, which a stable (merge) sort takes in
-            # one pass; the keys are unique, so any sort gives this order
-            order = np.argsort(self._keys, kind="stable")
-            sorted_keys = self._keys[order]
-            where = np.searchsorted(sorted_keys, keys)
-            where = np.minimum(where, len(sorted_keys) - 1)
-            hit = sorted_keys[where] == keys
-            impulse[hit] = self._impulse[order[where[hit]]]
-        return impulse
+        :meth:`_point_keys`), 0 for new points (:func:`solver.warm_start.match_impulses`)."""
+        return warm_start.match_impulses(self._keys, self._impulse, keys)
 
     def _free_velocities(self):
         """Start-of-step velocities (bodies, 2) and (bodies,) with the imposed wall velocities,
@@ -455,20 +441,20 @@ class Simulation:
         om[n:] = 0.0
         return v_end, om
 
-    def _integrate(self, pts, problem, ra, rb, v_start, omega_start, v_end, om):
+    def _integrate(self, pts, problem, ra, rb, v_start, omega_start, v_end, om, decomposition=None):
         """theta-scheme update of positions, angles and walls, with the split-impulse removal of
-        remaining overlaps (:meth:`_recover_overlaps`); stores the end velocities."""
+        remaining overlaps (:meth:`_recover_overlaps`, on the step's ``decomposition``); stores
+        the end velocities."""
         p = self.parameters
         h, theta, n = p.time_step, p.theta, self.n_particles
         a, b = problem.a, problem.b
         step_v = (1 - theta) * v_start + theta * v_end
         step_om = (1 - theta) * omega_start + theta * om
-        g_end = pts.gap + h * ((step_v[b] - step_v[a]) * pts.normal).sum(1) if len(a) else pts.gap
         if p.overlap_recovery_speed > 0 and len(a):
             # the end-of-step gaps (first order) tell which overlaps remain
-            g_end = g_end + h * (step_om[b] * _cross2(rb, pts.normal) - step_om[a] * _cross2(ra, pts.normal))
+            g_end = problem_assembly.end_gaps(pts.gap, pts.normal, a, b, ra, rb, step_v, step_om, h)
             if g_end.min() < -p.overlap_recovery_threshold * 2 * float(self.radius.min()):
-                pseudo_v, pseudo_om = self._recover_overlaps(problem, g_end)
+                pseudo_v, pseudo_om = self._recover_overlaps(problem, g_end, decomposition)
                 pseudo_v[n + np.flatnonzero(self.walls.mode != STRESS)] = 0.0
                 step_v = step_v + pseudo_v
                 step_om = step_om + pseudo_om
@@ -480,29 +466,41 @@ class Simulation:
         self.velocity = v_end
         self.angular_velocity = om
 
-    def _solve(self, problem, pn, pt, vx, vy, om, tolerance, max_tolerance, max_iterations, shuffle=False, stall=0):
+    def _decomposition(self, problem):
+        """The step's :func:`solver.parallel_nlgs.decompose` of ``problem`` on the parameters'
+        domains (None on one domain): made once, for the main solve and the overlap recovery's
+        (same points, bodies and particle positions)."""
+        if self.parameters.domains <= 1:
+            return None
+        return parallel_nlgs.decompose(problem, self.position[:self.n_particles, 0], self.parameters.domains)
+
+    def _solve(self, problem, pn, pt, vx, vy, om, tolerance, max_tolerance, max_iterations, shuffle=False, stall=0,
+               decomposition=None):
         """Solve a contact problem in place with the sweeps the parameters choose: Anderson-
         accelerated (:mod:`solver.acceleration`), domain-decomposed
-        (:mod:`solver.parallel_nlgs`), or the serial NLGS (:mod:`solver.nlgs`), in a random order
-        when ``shuffle``; ``stall``: sweeps of the stall test (0: none). Returns the
-        :class:`solver.nlgs.NLGSResult`."""
+        (:mod:`solver.parallel_nlgs`, on ``decomposition`` when given), or the serial NLGS
+        (:mod:`solver.nlgs`), in a random order when ``shuffle``; ``stall``: sweeps of the stall
+        test (0: none). Returns the :class:`solver.nlgs.NLGSResult`."""
         p = self.parameters
         x = self.position[:self.n_particles, 0]
         limits = dict(tolerance=tolerance, max_tolerance=max_tolerance, max_iterations=max_iterations, stall=stall)
         if p.acceleration == "anderson":
             return acceleration.solve_problem_anderson(problem, pn, pt, vx, vy, om, memory=p.anderson_memory,
-                                                       period=p.anderson_period, domains=p.domains, x=x, **limits)
+                                                       period=p.anderson_period, domains=p.domains, x=x,
+                                                       decomposition=decomposition, **limits)
         if p.domains > 1:
-            return parallel_nlgs.solve_problem_domains(problem, x, pn, pt, vx, vy, om, domains=p.domains, **limits)
+            return parallel_nlgs.solve_problem_domains(problem, x, pn, pt, vx, vy, om, domains=p.domains,
+                                                       decomposition=decomposition, **limits)
         return nlgs.solve_problem(problem, pn, pt, vx, vy, om, shuffle=shuffle, seed=p.seed + self.step_index,
                                   **limits)
 
-    def _recover_overlaps(self, problem, g_end):
+    def _recover_overlaps(self, problem, g_end, decomposition=None):
         """Split-impulse removal of overlaps: pseudo-velocities that move the bodies apart at
         most at ``overlap_recovery_speed``, removing ``overlap_recovery_rate`` of each overlap
         per step, frictionless, added to the positions only. The real velocities (momentum,
         kinetic energy) are untouched, so existing overlaps are removed gently and never
-        pushed out explosively. Returns the pseudo-velocities (bodies, 2) and (bodies,)."""
+        pushed out explosively. ``decomposition``: the step's (:meth:`_decomposition`). Returns
+        the pseudo-velocities (bodies, 2) and (bodies,)."""
         p = self.parameters
         h = p.time_step
         recover = np.minimum(p.overlap_recovery_rate * np.maximum(-g_end, 0.0) / h, p.overlap_recovery_speed)
@@ -511,7 +509,7 @@ class Simulation:
         bodies = self.n_particles + self.n_walls
         vx, vy, om = np.zeros(bodies), np.zeros(bodies), np.zeros(bodies)
         result = self._solve(recovery, np.zeros(m), np.zeros(m), vx, vy, om, p.overlap_recovery_tolerance, 1.0,
-                             p.overlap_recovery_iterations)
+                             p.overlap_recovery_iterations, decomposition=decomposition)
         self.counters["recovery_sweeps"] += result.iterations
         return np.stack([vx, vy], -1), om
 

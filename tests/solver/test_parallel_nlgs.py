@@ -157,3 +157,63 @@ def test_runs_with_domains_are_deterministic_and_refuse_other_orders():
     Parameters(domains=2, acceleration="anderson").validate()  # the Anderson form runs on domains too
     with pytest.raises(ParameterError, match="domains"):
         Parameters(domains=0).validate()
+
+
+def test_gather_and_scatter_are_numpy_indexing(problem):
+    """The renumbering kernels against numpy's fancy indexing: the arrays taken at the new
+    numbering, and written back (the moving bodies' velocities only)."""
+    sim, prob, impulse, v_free, omega_free = problem
+    dec = parallel_nlgs.decompose(prob, sim.position[:, 0], 3)
+    state = _state(impulse, v_free, omega_free)
+    geometry, masses, renumbered = dec.gather(prob, *state)
+    k, j = dec.point_order, dec.source
+    for got, original in zip(geometry[2:], (prob.nx, prob.ny, prob.rax, prob.ray, prob.rbx, prob.rby, prob.bias,
+                                            prob.mu)):
+        np.testing.assert_array_equal(got, original[k])
+    for got, original in zip(masses, (prob.minv_xx, prob.minv_xy, prob.minv_yy, prob.iinv)):
+        np.testing.assert_array_equal(got, original[j])
+    for got, original, index in zip(renumbered, state, (k, k, j, j, j)):
+        np.testing.assert_array_equal(got, original[index])
+    rng = np.random.default_rng(0)
+    solved = tuple(rng.normal(size=x.size) for x in renumbered)
+    back = [x.copy() for x in state]
+    dec.scatter(solved, *back)
+    expected = [x.copy() for x in state]
+    expected[0][k], expected[1][k] = solved[0], solved[1]
+    for original, new in zip(expected[2:], solved[2:]):
+        original[j[dec.moving]] = new[dec.moving]
+    for got, want in zip(back, expected):
+        np.testing.assert_array_equal(got, want)
+
+
+def test_one_decomposition_per_step_serves_the_main_solve_and_the_recovery():
+    """A step decomposes its problem once and the overlap recovery's solve reuses it: the run is
+    bit for bit the one in which every solve decomposes its own problem."""
+    def run(share):
+        sim = compaction_sample(80, "pentagon", seed=1)
+        sim.parameters = dataclasses.replace(sim.parameters, domains=2)
+        if not share:
+            sim._decomposition = lambda problem: None  # each solve then decomposes on its own
+        made = []
+        decompose = parallel_nlgs.decompose
+
+        def counted(*args):
+            made.append(1)
+            return decompose(*args)
+
+        parallel_nlgs.decompose = counted
+        try:
+            with warnings.catch_warnings():
+                warnings.simplefilter("ignore", ConvergenceWarning)
+                for _ in range(120):
+                    sim.step()
+        finally:
+            parallel_nlgs.decompose = decompose
+        return sim, len(made)
+
+    shared, shared_made = run(True)
+    own, own_made = run(False)
+    assert shared.counters["recovery_sweeps"] > 0  # the recovery ran
+    assert shared_made == 120 and own_made > 120  # once per step, against once per solve
+    for name in ("position", "angle", "velocity", "impulse"):
+        np.testing.assert_array_equal(getattr(shared, name), getattr(own, name))

@@ -4,7 +4,7 @@ bit, and one point's lever arms, shift and friction by hand."""
 import numpy as np
 import pytest
 
-from solver.problem_assembly import assemble, assemble_reference
+from solver.problem_assembly import assemble, assemble_reference, end_gaps
 
 
 def _random_points(seed, n=30, walls=4, m=200):
@@ -56,3 +56,29 @@ def test_one_point_by_hand():
                            np.array([1], np.int32), np.array([[0.0, 0.0], [1.0, 0.0]]),
                            np.array([[0.1, 0.0], [0.0, 0.0]]), np.array([2.0, 0.0]), 2, h, theta, 0.4, 0.1)
     assert bias[0] == 0.0
+
+
+@pytest.mark.parametrize("seed", [0, 1])
+def test_end_gaps_are_the_whole_array_expression_bit_for_bit(seed):
+    """The first-order end-of-step gaps against the numpy expression they replace in the stepper."""
+    points = _random_points(seed)
+    h = 5e-4
+    a, b, ra, rb, *_ = assemble(*points.values(), h, 0.5, 0.4, 0.1)
+    rng = np.random.default_rng(seed + 10)
+    velocity, omega = rng.normal(0, 0.01, (34, 2)), rng.normal(0, 0.1, 34)
+    normal, gap = points["normal"], points["gap"]
+    expected = gap + h * ((velocity[b] - velocity[a]) * normal).sum(1)
+    cross_b = rb[:, 0] * normal[:, 1] - rb[:, 1] * normal[:, 0]
+    cross_a = ra[:, 0] * normal[:, 1] - ra[:, 1] * normal[:, 0]
+    expected = expected + h * (omega[b] * cross_b - omega[a] * cross_a)
+    np.testing.assert_array_equal(end_gaps(gap, normal, a, b, ra, rb, velocity, omega, h), expected)
+
+
+def test_end_gap_of_one_point_by_hand():
+    """Particle 0 at rest, particle 1 moving at (-0.2, 0) m/s and turning at w = 3 rad/s, the
+    point at r_b = (-0.5, 0.1) from its centre, normal (1, 0) from 0 to 1, gap 1e-3 m: u_n =
+    -0.2 + 3 (r_b x n) = -0.2 + 3 (-0.5 * 0 - 0.1 * 1) = -0.5 m/s; g_end = 1e-3 - h 0.5."""
+    h = 1e-3
+    g = end_gaps(np.array([1e-3]), np.array([[1.0, 0.0]]), np.array([0]), np.array([1]), np.array([[0.5, 0.1]]),
+                 np.array([[-0.5, 0.1]]), np.array([[0.0, 0.0], [-0.2, 0.0]]), np.array([0.0, 3.0]), h)
+    assert g[0] == pytest.approx(1e-3 - h * 0.5, rel=1e-13)

@@ -162,3 +162,30 @@ def test_anderson_acceleration_reaches_the_same_solution_in_fewer_sweeps():
         assert info.local_law_residual < 1e-8
         found[method] = info.iterations
     assert found["anderson"] < 0.5 * found["off"], found
+
+
+def test_one_pass_measures_are_the_plain_whole_array_ones():
+    """On a compacted sample's problem, solved loosely (violations everywhere): the one-pass
+    local-law residual and unbalanced ratios against the same formulas written with whole-array
+    numpy operations (the Delassus diagonal, the per-point natural maps, masks and sums)."""
+    from .conftest import compacted_problem
+
+    sim, problem, impulse, v_free, omega_free = compacted_problem(3)
+    pn, pt = impulse[:, 0].copy(), impulse[:, 1].copy()
+    vx, vy, w = v_free[:, 0].copy(), v_free[:, 1].copy(), omega_free.copy()
+    nlgs.solve_problem(problem, pn, pt, vx, vy, w, tolerance=1e-2, max_tolerance=1.0, max_iterations=3)
+    P = problem
+    geometry = (P.a, P.b, P.nx, P.ny, P.rax, P.ray, P.rbx, P.rby)
+    wnn = nlgs.delassus(*geometry, P.minv_xx, P.minv_xy, P.minv_yy, P.iinv)[0]
+    fn, ft = residuals.local_law_residuals(*geometry, P.bias, P.mu, pn, pt, vx, vy, w, wnn)
+    expected = np.sqrt(np.sum(fn * fn + ft * ft)) / np.sqrt(np.sum(pn * pn + pt * pt))
+    got = residuals.local_law_residual(problem, pn, pt, vx, vy, w)
+    assert got == pytest.approx(expected, rel=1e-12) and got > 1e-4
+    external = 1e-4 * sim.mass[:, None] * np.array([0.0, -9.81])
+    loaded = pn > 0
+    mean = np.mean(np.hypot(pn[loaded], pt[loaded]))
+    fx, fy, torque = residuals.particle_imbalance(*geometry, pn, pt, sim.n_particles)
+    force = np.hypot(fx + external[:, 0], fy + external[:, 1]).max() / mean
+    moment = np.max(np.abs(torque) / sim.radius) / mean
+    assert residuals.unbalanced_ratios(problem, pn, pt, external, sim.radius) == pytest.approx((force, moment),
+                                                                                              rel=1e-12)
