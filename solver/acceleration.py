@@ -45,7 +45,8 @@ from __future__ import annotations
 import numpy as np
 from numba import njit, prange
 
-from .nlgs import NLGSResult, _apply, delassus, stalled, sweep, sweep_norms, velocities_from_impulses
+from . import scratch
+from .nlgs import NLGSResult, _apply, delassus_into, stalled, sweep, sweep_norms, velocities_from_impulses
 from .parallel_nlgs import solve_decomposed, sweep_domains
 from .residuals import cone_projection
 
@@ -243,8 +244,15 @@ def _extrapolate_blocks(blocks, body_blocks, gamma, count, dgn, dgt, dvx, dvy, d
 
 
 @njit(cache=True)
+def scratch_size(points, bodies, memory):
+    """The floats of working memory :func:`solve_anderson` takes from its ``work`` array for a
+    problem of ``points`` points and ``bodies`` bodies with history ``memory``."""
+    return (4 * memory + 11) * points + (3 * memory + 3) * bodies
+
+
+@njit(cache=True)
 def solve_anderson(blocks, a, b, nx, ny, rax, ray, rbx, rby, bias, mu, pn, pt, vx, vy, w,
-                   minv_xx, minv_xy, minv_yy, iinv, tol, max_tol, max_iterations, memory, period=1, stall=0):
+                   minv_xx, minv_xy, minv_yy, iinv, tol, max_tol, max_iterations, memory, period, stall, work):
     """Anderson-accelerated NLGS (module docstring); arguments, in-place updates and result as
     :func:`solver.nlgs.solve` without the ordering options; ``memory`` is m, ``period`` the
     number of sweeps that make the map G (the history is taken and the iterate extrapolated
@@ -254,29 +262,49 @@ def solve_anderson(blocks, a, b, nx, ny, rax, ray, rbx, rby, bias, mu, pn, pt, v
     ``blocks`` holds the boundaries of the points' blocks: ``[0, P]`` for the serial sweep over
     all points in their order, or ``[0, p_1, ..., p_D, P]`` for the domain-decomposed sweep of
     :mod:`solver.parallel_nlgs` (domain d holds the points ``p_d .. p_{d+1} - 1``, the last
-    block is the interface), the problem being laid out as its :class:`Decomposition` says."""
+    block is the interface), the problem being laid out as its :class:`Decomposition` says.
+
+    ``work``: a float array of at least :func:`scratch_size` entries, the working memory (its
+    contents on entry do not matter: every entry is written before it is read)."""
     m = a.size
     n_bodies = vx.size
     parallel = blocks.size > 2
     domains = blocks.size - 2
     body_blocks = (np.arange(domains + 1) * n_bodies) // max(domains, 1)
-    wnn, wnt, wtt = delassus(a, b, nx, ny, rax, ray, rbx, rby, minv_xx, minv_xy, minv_yy, iinv)
+    # the working arrays, cut from ``work``: history rows (memory x points, memory x bodies),
+    # then single arrays of points and of bodies
+    history, bodies = memory * m, memory * n_bodies
+    dfn = work[0:history].reshape((memory, m))
+    dft = work[history:2 * history].reshape((memory, m))
+    dgn = work[2 * history:3 * history].reshape((memory, m))
+    dgt = work[3 * history:4 * history].reshape((memory, m))
+    start = 4 * history
+    dvx = work[start:start + bodies].reshape((memory, n_bodies))
+    dvy = work[start + bodies:start + 2 * bodies].reshape((memory, n_bodies))
+    dw = work[start + 2 * bodies:start + 3 * bodies].reshape((memory, n_bodies))
+    start += 3 * bodies
+    singles = work[start:start + 11 * m + 3 * n_bodies]
+    wnn, wnt, wtt = singles[0:m], singles[m:2 * m], singles[2 * m:3 * m]
+    xn, xt, fn, ft = singles[3 * m:4 * m], singles[4 * m:5 * m], singles[5 * m:6 * m], singles[6 * m:7 * m]
+    fn_prev, ft_prev = singles[7 * m:8 * m], singles[8 * m:9 * m]
+    gn_prev, gt_prev = singles[9 * m:10 * m], singles[10 * m:11 * m]
+    hvx = singles[11 * m:11 * m + n_bodies]
+    hvy = singles[11 * m + n_bodies:11 * m + 2 * n_bodies]
+    hw = singles[11 * m + 2 * n_bodies:11 * m + 3 * n_bodies]
+    delassus_into(a, b, nx, ny, rax, ray, rbx, rby, minv_xx, minv_xy, minv_yy, iinv, wnn, wnt, wtt)
     velocities_from_impulses(a, b, nx, ny, rax, ray, rbx, rby, pn, pt, vx, vy, w, minv_xx, minv_xy, minv_yy, iinv)
     order = np.arange(m)
     ptr = blocks[:-1].copy()
-    points = np.arange(blocks[-2])
-    interface = np.arange(blocks[-2], m)
-    dfn, dft = np.zeros((memory, m)), np.zeros((memory, m))
-    dgn, dgt = np.zeros((memory, m)), np.zeros((memory, m))
-    dvx, dvy, dw = np.zeros((memory, n_bodies)), np.zeros((memory, n_bodies)), np.zeros((memory, n_bodies))
-    hvx, hvy, hw = vx.copy(), vy.copy(), w.copy()
+    points = order[:blocks[-2]]
+    interface = order[blocks[-2]:]
+    hvx[:] = vx
+    hvy[:] = vy
+    hw[:] = w
     gram = np.zeros((memory, memory))
     row = np.zeros(memory)
     rhs = np.zeros(memory)
-    xn, xt = pn.copy(), pt.copy()
-    fn, ft = np.zeros(m), np.zeros(m)
-    fn_prev, ft_prev = np.zeros(m), np.zeros(m)
-    gn_prev, gt_prev = np.zeros(m), np.zeros(m)
+    xn[:] = pn
+    xt[:] = pt
     have_prev = False
     count = 0
     head = 0
@@ -350,12 +378,14 @@ def solve_problem_anderson(problem, pn, pt, vx, vy, w, *, tolerance, max_toleran
     options = (float(tolerance), float(max_tolerance), int(max_iterations), int(memory), int(period), int(stall))
     if domains > 1:
         def kernel(dec, geometry, state, masses):
-            return solve_anderson(dec.blocks, *geometry, *state, *masses, *options)
+            work = scratch.buffer("anderson", scratch_size(dec.a.size, dec.source.size, int(memory)))
+            return solve_anderson(dec.blocks, *geometry, *state, *masses, *options, work)
 
         return solve_decomposed(problem, x, domains, (pn, pt, vx, vy, w), kernel, decomposition)
+    work = scratch.buffer("anderson", scratch_size(problem.a.size, problem.minv_xx.size, int(memory)))
     blocks = np.array([0, problem.a.size], dtype=np.int64)
     iterations, residual, worst = solve_anderson(
         blocks, problem.a, problem.b, problem.nx, problem.ny, problem.rax, problem.ray, problem.rbx, problem.rby,
         problem.bias, problem.mu, pn, pt, vx, vy, w, problem.minv_xx, problem.minv_xy, problem.minv_yy,
-        problem.iinv, *options)
+        problem.iinv, *options, work)
     return NLGSResult(int(iterations), float(residual), float(worst))

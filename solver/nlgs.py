@@ -118,15 +118,21 @@ def delassus_block(k, a, b, nx, ny, rax, ray, rbx, rby, minv_xx, minv_xy, minv_y
 
 
 @njit(cache=True)
+def delassus_into(a, b, nx, ny, rax, ray, rbx, rby, minv_xx, minv_xy, minv_yy, iinv, w_nn, w_nt, w_tt):
+    """:func:`delassus` written into the given arrays (P,) each."""
+    for k in range(a.size):
+        w_nn[k], w_nt[k], w_tt[k] = delassus_block(k, a, b, nx, ny, rax, ray, rbx, rby, minv_xx, minv_xy, minv_yy,
+                                                   iinv)
+
+
+@njit(cache=True)
 def delassus(a, b, nx, ny, rax, ray, rbx, rby, minv_xx, minv_xy, minv_yy, iinv):
     """Local 2x2 Delassus blocks (W_nn, W_nt, W_tt) of every point (:func:`delassus_block`)."""
     m = a.size
     w_nn = np.empty(m)
     w_nt = np.empty(m)
     w_tt = np.empty(m)
-    for k in range(m):
-        w_nn[k], w_nt[k], w_tt[k] = delassus_block(k, a, b, nx, ny, rax, ray, rbx, rby, minv_xx, minv_xy, minv_yy,
-                                                   iinv)
+    delassus_into(a, b, nx, ny, rax, ray, rbx, rby, minv_xx, minv_xy, minv_yy, iinv, w_nn, w_nt, w_tt)
     return w_nn, w_nt, w_tt
 
 

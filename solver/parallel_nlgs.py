@@ -39,6 +39,7 @@ from typing import NamedTuple
 import numpy as np
 from numba import njit, prange
 
+from . import scratch
 from .nlgs import NLGSResult, delassus, stalled, sweep, sweep_norms, velocities_from_impulses
 
 FREE = -1
@@ -178,13 +179,16 @@ class Decomposition(NamedTuple):
         points (the last block is the interface)."""
         return np.append(self.ptr, self.point_order.size)
 
-    def gather(self, problem, pn, pt, vx, vy, w):
+    def gather(self, problem, pn, pt, vx, vy, w, out=None):
         """The problem's arrays in the new numbering: (geometry, masses, state) with geometry =
         (a, b, nx, ny, rax, ray, rbx, rby, bias, mu), masses = (minv_xx, minv_xy, minv_yy, iinv)
-        and state = (pn, pt, vx, vy, w) (copies; :func:`gather`)."""
+        and state = (pn, pt, vx, vy, w) (copies; :func:`gather`), in ``out`` (a float array of
+        at least 10 P + 7 B entries, P points and B bodies in the new numbering) or in new
+        memory."""
+        size = 10 * self.point_order.size + 7 * self.source.size
         arrays = gather(self.point_order, self.source, problem.nx, problem.ny, problem.rax, problem.ray, problem.rbx,
                         problem.rby, problem.bias, problem.mu, pn, pt, problem.minv_xx, problem.minv_xy,
-                        problem.minv_yy, problem.iinv, vx, vy, w)
+                        problem.minv_yy, problem.iinv, vx, vy, w, np.empty(size) if out is None else out)
         return (self.a, self.b, *arrays[:8]), arrays[10:14], (*arrays[8:10], *arrays[14:])
 
     def scatter(self, state, pn, pt, vx, vy, w):
@@ -196,18 +200,18 @@ class Decomposition(NamedTuple):
 
 @njit(cache=True)
 def gather(point_order, source, nx, ny, rax, ray, rbx, rby, bias, mu, pn, pt, minv_xx, minv_xy, minv_yy, iinv,
-           vx, vy, w):
+           vx, vy, w, out):
     """Copies in the new numbering of :class:`Decomposition`: the ten point arrays (nx .. pt)
     taken at ``point_order``, then the seven body arrays (minv_xx .. w) at ``source``, in the
-    order of the arguments."""
+    order of the arguments, written into ``out`` (10 P + 7 B floats or more)."""
     m = point_order.size
-    points = np.empty((10, m))
+    points = out[:10 * m].reshape((10, m))
     for q in range(m):
         k = point_order[q]
         points[0, q], points[1, q], points[2, q], points[3, q], points[4, q] = nx[k], ny[k], rax[k], ray[k], rbx[k]
         points[5, q], points[6, q], points[7, q], points[8, q], points[9, q] = rby[k], bias[k], mu[k], pn[k], pt[k]
     n = source.size
-    bodies = np.empty((7, n))
+    bodies = out[10 * m:10 * m + 7 * n].reshape((7, n))
     for q in range(n):
         j = source[q]
         bodies[0, q], bodies[1, q], bodies[2, q], bodies[3, q] = minv_xx[j], minv_xy[j], minv_yy[j], iinv[j]
@@ -328,7 +332,8 @@ def solve_decomposed(problem, x, domains, state, kernel, decomposition=None) -> 
     masses (another right-hand side or friction, as the overlap recovery's), made from the
     same ``x``; made here when None."""
     dec = decompose(problem, x, domains) if decomposition is None else decomposition
-    geometry, masses, renumbered = dec.gather(problem, *state)
+    out = scratch.buffer("renumbered", 10 * dec.point_order.size + 7 * dec.source.size)
+    geometry, masses, renumbered = dec.gather(problem, *state, out=out)
     iterations, residual, worst = kernel(dec, geometry, renumbered, masses)
     dec.scatter(renumbered, *state)
     return NLGSResult(int(iterations), float(residual), float(worst))

@@ -148,3 +148,55 @@ def test_domain_form_converges_to_an_admissible_solution_whatever_the_threads(pr
     assert r1.iterations < 0.5 * r0.iterations, (r1, r0)
     # the same confining load on the walls as the plain solution (same statics, other network)
     assert one[0].sum() == pytest.approx(plain[0].sum(), rel=1e-3)
+
+
+@pytest.mark.parametrize("domains", [1, 3])
+def test_scratch_memory_left_dirty_changes_nothing(problem, domains):
+    """The solver's working memory is reused from solve to solve (solver.scratch): a solve on
+    buffers filled with NaN, with a smaller problem's leftovers and fresh ones gives the same
+    impulses and velocities bit for bit, so no entry is read before it is written."""
+    import threading
+
+    from solver import scratch
+
+    sim, prob, state = problem
+    options = dict(tolerance=1e-4, max_tolerance=1e-2, max_iterations=3000, memory=4, period=2, domains=domains,
+                   x=sim.position[:, 0])
+    runs = []
+    for dirty in ("fresh", "nan", "leftovers"):
+        def run():
+            if dirty == "nan":
+                for name in ("anderson", "renumbered"):
+                    scratch.buffer(name, 10**6)[:] = np.nan
+            elif dirty == "leftovers":  # a few sweeps of another problem first
+                acceleration.solve_problem_anderson(prob, *_copy(state), **dict(options, max_iterations=5))
+            got = _copy(state)
+            result = acceleration.solve_problem_anderson(prob, *got, **options)
+            runs.append((result, got))
+
+        thread = threading.Thread(target=run)  # a thread of its own: its own, fresh buffers
+        thread.start()
+        thread.join()
+    (first, expected), *others = runs
+    assert 5 < first.iterations < 3000
+    for result, got in others:
+        assert result == first
+        for x, y in zip(got, expected):
+            np.testing.assert_array_equal(x, y)
+
+
+def test_scratch_buffers_are_kept_grown_and_the_threads_own():
+    import threading
+
+    from solver import scratch
+
+    small = scratch.buffer("test-buffer", 100)
+    assert small.size >= 100 and scratch.buffer("test-buffer", 50) is small  # kept
+    assert scratch.buffer("another-buffer", 100) is not small  # one per name
+    large = scratch.buffer("test-buffer", 10_000)
+    assert large.size >= 10_000 and large is not small and scratch.buffer("test-buffer", 100) is large
+    theirs = []
+    thread = threading.Thread(target=lambda: theirs.append(scratch.buffer("test-buffer", 100)))
+    thread.start()
+    thread.join()
+    assert theirs[0] is not large  # another thread's
