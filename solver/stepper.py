@@ -6,12 +6,14 @@ One step of length h (the theta-scheme, theta = 1/2 by default), each stage a me
 1. ``detect``: the cell-list broad phase is reused while no particle has moved more than half
    the ``skin`` since it ran; the narrow phase runs every step;
 2. ``_matched_impulses``: the warm start, the previous step's impulses of the same contact
-   points (matched by body pair and point rank, :meth:`Simulation._point_keys`);
+   points (matched by body pair and point rank, :meth:`Simulation._point_keys`;
+   :mod:`solver.warm_start`);
 3. ``_free_velocities``: v_free = v- + h M^-1 F_ext (gravity, wall stresses);
 4. ``_contact_problem``: the points' geometry, Delassus data and Signorini shifts as one
    :class:`solver.nlgs.ContactProblem`;
 5. ``_solve``: the NLGS (:mod:`solver.nlgs`; Anderson-accelerated, :mod:`solver.acceleration`,
-   and/or on several domains, :mod:`solver.parallel_nlgs`, as the parameters say) for the
+   and/or on several domains, :mod:`solver.parallel_nlgs`, decomposed once per step for this
+   solve and the overlap recovery's, as the parameters say) for the
    impulses p and the end-of-step velocities v+, then the solution's local-law residual and
    unbalanced force (:mod:`solver.residuals`) for the report;
 6. ``_end_velocities``: walls driven as they are (imposed, fixed, capped);
