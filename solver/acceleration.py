@@ -246,7 +246,9 @@ def _extrapolate_blocks(blocks, body_blocks, gamma, count, dgn, dgt, dvx, dvy, d
 @njit(cache=True)
 def scratch_size(points, bodies, memory):
     """The floats of working memory :func:`solve_anderson` takes from its ``work`` array for a
-    problem of ``points`` points and ``bodies`` bodies with history ``memory``."""
+    problem of P = ``points`` points and B = ``bodies`` bodies with history m = ``memory``:
+    (4 m + 11) P + (3 m + 3) B (the history rows dF, dG of the points and dV of the bodies,
+    the Delassus blocks, the iterate and its residuals, the bodies' last velocities)."""
     return (4 * memory + 11) * points + (3 * memory + 3) * bodies
 
 
@@ -268,6 +270,8 @@ def solve_anderson(blocks, a, b, nx, ny, rax, ray, rbx, rby, bias, mu, pn, pt, v
     contents on entry do not matter: every entry is written before it is read)."""
     m = a.size
     n_bodies = vx.size
+    if work.size < scratch_size(m, n_bodies, memory):
+        raise ValueError("solve_anderson: the work array is shorter than scratch_size(points, bodies, memory)")
     parallel = blocks.size > 2
     domains = blocks.size - 2
     body_blocks = (np.arange(domains + 1) * n_bodies) // max(domains, 1)
@@ -372,7 +376,8 @@ def solve_problem_anderson(problem, pn, pt, vx, vy, w, *, tolerance, max_toleran
     abscissae ``x``, m) cut into that many slabs, and the history passes run a domain per
     thread too. ``period``: the sweeps between two extrapolations (Anderson on the map
     "``period`` sweeps", module docstring); ``stall`` as in :func:`solver.nlgs.solve_problem`;
-    ``decomposition`` as in :func:`solver.parallel_nlgs.solve_decomposed`."""
+    ``decomposition`` as in :func:`solver.parallel_nlgs.solve_decomposed` (with ``domains`` > 1
+    only)."""
     if int(period) < 1 or int(memory) < 1:
         raise ValueError(f"memory={memory!r}, period={period!r}: expected whole numbers >= 1")
     options = (float(tolerance), float(max_tolerance), int(max_iterations), int(memory), int(period), int(stall))

@@ -182,11 +182,11 @@ class Decomposition(NamedTuple):
     def gather(self, problem, pn, pt, vx, vy, w, out=None):
         """The problem's arrays in the new numbering: (geometry, masses, state) with geometry =
         (a, b, nx, ny, rax, ray, rbx, rby, bias, mu), masses = (minv_xx, minv_xy, minv_yy, iinv)
-        and state = (pn, pt, vx, vy, w) (copies; :func:`gather`), in ``out`` (a float array of
+        and state = (pn, pt, vx, vy, w) (copies; :func:`gather_into`), in ``out`` (a float array of
         at least 10 P + 7 B entries, P points and B bodies in the new numbering) or in new
         memory."""
         size = 10 * self.point_order.size + 7 * self.source.size
-        arrays = gather(self.point_order, self.source, problem.nx, problem.ny, problem.rax, problem.ray, problem.rbx,
+        arrays = gather_into(self.point_order, self.source, problem.nx, problem.ny, problem.rax, problem.ray, problem.rbx,
                         problem.rby, problem.bias, problem.mu, pn, pt, problem.minv_xx, problem.minv_xy,
                         problem.minv_yy, problem.iinv, vx, vy, w, np.empty(size) if out is None else out)
         return (self.a, self.b, *arrays[:8]), arrays[10:14], (*arrays[8:10], *arrays[14:])
@@ -194,13 +194,13 @@ class Decomposition(NamedTuple):
     def scatter(self, state, pn, pt, vx, vy, w):
         """Write a solved ``state`` (new numbering) back into the original arrays, in place:
         every impulse, and the velocities of the bodies that can move (a still wall's
-        velocity is imposed and stays as it was; :func:`scatter`)."""
-        scatter(self.point_order, self.source, self.moving, *state, pn, pt, vx, vy, w)
+        velocity is imposed and stays as it was; :func:`scatter_from`)."""
+        scatter_from(self.point_order, self.source, self.moving, *state, pn, pt, vx, vy, w)
 
 
 @njit(cache=True)
-def gather(point_order, source, nx, ny, rax, ray, rbx, rby, bias, mu, pn, pt, minv_xx, minv_xy, minv_yy, iinv,
-           vx, vy, w, out):
+def gather_into(point_order, source, nx, ny, rax, ray, rbx, rby, bias, mu, pn, pt, minv_xx, minv_xy, minv_yy, iinv,
+                vx, vy, w, out):
     """Copies in the new numbering of :class:`Decomposition`: the ten point arrays (nx .. pt)
     taken at ``point_order``, then the seven body arrays (minv_xx .. w) at ``source``, in the
     order of the arguments, written into ``out`` (10 P + 7 B floats or more)."""
@@ -221,7 +221,7 @@ def gather(point_order, source, nx, ny, rax, ray, rbx, rby, bias, mu, pn, pt, mi
 
 
 @njit(cache=True)
-def scatter(point_order, source, moving, spn, spt, svx, svy, sw, pn, pt, vx, vy, w):
+def scatter_from(point_order, source, moving, spn, spt, svx, svy, sw, pn, pt, vx, vy, w):
     """:meth:`Decomposition.scatter`: impulses back to their points, the moving bodies'
     velocities back to their bodies, in place."""
     for q in range(point_order.size):
@@ -330,8 +330,11 @@ def solve_decomposed(problem, x, domains, state, kernel, decomposition=None) -> 
 
     ``decomposition``: the :func:`decompose` of a problem with the same points, bodies and
     masses (another right-hand side or friction, as the overlap recovery's), made from the
-    same ``x``; made here when None."""
+    same ``x`` on ``domains`` domains (``x`` is then not read again); made here when None."""
     dec = decompose(problem, x, domains) if decomposition is None else decomposition
+    if dec.point_order.size != problem.a.size or dec.ptr.size != int(domains) + 1:
+        raise ValueError(f"the decomposition is of {dec.point_order.size} points on {dec.ptr.size - 1} domains, the "
+                         f"problem has {problem.a.size} points on {int(domains)} domains: expected the same")
     out = scratch.buffer("renumbered", 10 * dec.point_order.size + 7 * dec.source.size)
     geometry, masses, renumbered = dec.gather(problem, *state, out=out)
     iterations, residual, worst = kernel(dec, geometry, renumbered, masses)

@@ -147,9 +147,13 @@ def _unbalanced(a, b, nx, ny, rax, ray, rbx, rby, pn, pt, external_impulse, radi
             loaded += 1
     force = 0.0
     moment = 0.0
-    for i in range(radius.size):
-        force = max(force, np.hypot(fx[i] + external_impulse[i, 0], fy[i] + external_impulse[i, 1]))
-        moment = max(moment, abs(torque[i]) / radius[i])
+    for i in range(radius.size):  # a NaN is kept, as numpy's max keeps it
+        f = np.hypot(fx[i] + external_impulse[i, 0], fy[i] + external_impulse[i, 1])
+        if not f <= force:
+            force = f
+        t = abs(torque[i]) / radius[i]
+        if not t <= moment:
+            moment = t
     return force, moment, total / max(loaded, 1), loaded
 
 
@@ -158,10 +162,13 @@ def unbalanced_ratios(problem, pn, pt, external_impulse, radius) -> tuple[float,
     + external impulse| over the particles (``external_impulse`` (N, 2) N s, e.g. h m g) and the
     largest |sum of contact moments| / R_i, both over the mean |r| of the loaded points. (0, 0)
     when no point is loaded."""
+    external_impulse = np.ascontiguousarray(external_impulse, dtype=float)
+    if external_impulse.shape != (len(radius), 2):
+        raise ValueError(f"external_impulse has shape {external_impulse.shape}: expected ({len(radius)}, 2), one row "
+                         "per particle")
     force, moment, mean, loaded = _unbalanced(problem.a, problem.b, problem.nx, problem.ny, problem.rax, problem.ray,
                                               problem.rbx, problem.rby, np.asarray(pn, float), np.asarray(pt, float),
-                                              np.ascontiguousarray(external_impulse, dtype=float),
-                                              np.asarray(radius, float))
+                                              external_impulse, np.asarray(radius, float))
     if loaded == 0:
         return 0.0, 0.0
     return float(force / mean), float(moment / mean)

@@ -10,8 +10,9 @@ solution, so the sweeps start near it.
 
 The match walks the new keys along last step's keys, sorted once. Detection gives the points
 nearly in key order, so a stable (merge) sort sorts last step's keys in about one pass, and the
-walk moves forward from one match to the next, with a binary search only where a new key is
-smaller than the one before it. The keys are unique, so any sort gives the same order and the
+walk moves forward from one match to the next (searching the rest by halves when the next match
+is far), with a binary search below the last match where a new key is smaller than the one
+before it. The keys are unique, so any sort gives the same order and the
 same match.
 """
 
@@ -22,10 +23,9 @@ from numba import njit
 
 
 @njit(cache=True)
-def _first_not_below(sorted_keys, key):
-    """The first position of ``sorted_keys`` whose key is >= ``key`` (binary search)."""
-    lo = 0
-    hi = sorted_keys.size
+def _first_not_below(sorted_keys, key, lo, hi):
+    """The first position in ``lo .. hi`` of ``sorted_keys`` whose key is >= ``key`` (``hi``
+    when none; binary search)."""
     while lo < hi:
         mid = (lo + hi) >> 1
         if sorted_keys[mid] < key:
@@ -35,12 +35,17 @@ def _first_not_below(sorted_keys, key):
     return lo
 
 
+WALK = 8
+"""Steps the forward walk takes one by one before it searches the rest of the keys."""
+
+
 @njit(cache=True)
 def _match_sorted(last_keys, order, last_impulse, keys):
     """For each of ``keys``: the row of ``last_impulse`` (P_last, 2) whose key in ``last_keys``
-    is the same (``order`` sorts ``last_keys``), or (0, 0). The keys come nearly in order, so
-    the search walks forward from the last match and searches from scratch only where a key is
-    smaller than the one before it."""
+    is the same (``order`` sorts ``last_keys``), or (0, 0). The position is the first sorted
+    key not below the key. The keys come nearly in order, so it is found by walking forward from
+    the last key's position, a binary search taking over after :data:`WALK` steps, and by a
+    binary search below the last position where a key is smaller than the one before it."""
     m = keys.size
     last = order.size
     sorted_keys = np.empty(last, dtype=np.int64)
@@ -51,10 +56,14 @@ def _match_sorted(last_keys, order, last_impulse, keys):
     for k in range(m):
         key = keys[k]
         if k > 0 and key < keys[k - 1]:
-            position = _first_not_below(sorted_keys, key)
+            position = _first_not_below(sorted_keys, key, 0, position)
         else:
-            while position < last and sorted_keys[position] < key:
+            steps = 0
+            while position < last and sorted_keys[position] < key and steps < WALK:
                 position += 1
+                steps += 1
+            if steps == WALK:
+                position = _first_not_below(sorted_keys, key, position, last)
         if position < last and sorted_keys[position] == key:
             j = order[position]
             out[k, 0] = last_impulse[j, 0]

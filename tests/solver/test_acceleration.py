@@ -153,13 +153,16 @@ def test_domain_form_converges_to_an_admissible_solution_whatever_the_threads(pr
 @pytest.mark.parametrize("domains", [1, 3])
 def test_scratch_memory_left_dirty_changes_nothing(problem, domains):
     """The solver's working memory is reused from solve to solve (solver.scratch): a solve on
-    buffers filled with NaN, with a smaller problem's leftovers and fresh ones gives the same
-    impulses and velocities bit for bit, so no entry is read before it is written."""
+    buffers filled with NaN, on the leftovers of another sample's problem and on fresh ones
+    gives the same impulses and velocities bit for bit, so no entry is read before it is
+    written."""
     import threading
 
     from solver import scratch
 
     sim, prob, state = problem
+    other_sim, other, impulse, v_free, omega_free = compacted_problem(6)
+    other_state = [impulse[:, 0], impulse[:, 1], v_free[:, 0], v_free[:, 1], omega_free]
     options = dict(tolerance=1e-4, max_tolerance=1e-2, max_iterations=3000, memory=4, period=2, domains=domains,
                    x=sim.position[:, 0])
     runs = []
@@ -168,8 +171,9 @@ def test_scratch_memory_left_dirty_changes_nothing(problem, domains):
             if dirty == "nan":
                 for name in ("anderson", "renumbered"):
                     scratch.buffer(name, 10**6)[:] = np.nan
-            elif dirty == "leftovers":  # a few sweeps of another problem first
-                acceleration.solve_problem_anderson(prob, *_copy(state), **dict(options, max_iterations=5))
+            elif dirty == "leftovers":  # a few sweeps of another sample's problem first
+                acceleration.solve_problem_anderson(other, *_copy(other_state), **dict(
+                    options, max_iterations=5, x=other_sim.position[:, 0]))
             got = _copy(state)
             result = acceleration.solve_problem_anderson(prob, *got, **options)
             runs.append((result, got))
@@ -200,3 +204,12 @@ def test_scratch_buffers_are_kept_grown_and_the_threads_own():
     thread.start()
     thread.join()
     assert theirs[0] is not large  # another thread's
+
+
+def test_a_short_work_array_is_refused(problem):
+    _, prob, state = problem
+    m, n = prob.a.size, prob.minv_xx.size
+    work = np.empty(acceleration.scratch_size(m, n, 3) - 1)
+    with pytest.raises(ValueError, match="work array"):
+        acceleration.solve_anderson(np.array([0, m]), *_geometry(prob), *_copy(state), *_masses(prob), 1e-4, 1e-2, 5,
+                                    3, 2, 0, work)

@@ -186,12 +186,15 @@ def test_gather_and_scatter_are_numpy_indexing(problem):
         np.testing.assert_array_equal(got, want)
 
 
-def test_one_decomposition_per_step_serves_the_main_solve_and_the_recovery():
+@pytest.mark.parametrize("acceleration", ["anderson", "off"])
+def test_one_decomposition_per_step_serves_the_main_solve_and_the_recovery(acceleration):
     """A step decomposes its problem once and the overlap recovery's solve reuses it: the run is
-    bit for bit the one in which every solve decomposes its own problem."""
+    bit for bit the one in which every solve decomposes its own problem, with Anderson sweeps
+    and with plain ones; a decomposition of another problem is refused."""
+
     def run(share):
         sim = compaction_sample(80, "pentagon", seed=1)
-        sim.parameters = dataclasses.replace(sim.parameters, domains=2)
+        sim.parameters = dataclasses.replace(sim.parameters, domains=2, acceleration=acceleration)
         if not share:
             sim._decomposition = lambda problem: None  # each solve then decomposes on its own
         made = []
@@ -217,3 +220,10 @@ def test_one_decomposition_per_step_serves_the_main_solve_and_the_recovery():
     assert shared_made == 120 and own_made > 120  # once per step, against once per solve
     for name in ("position", "angle", "velocity", "impulse"):
         np.testing.assert_array_equal(getattr(shared, name), getattr(own, name))
+    problem = shared._contact_problem(shared.detect(), shared.velocity, shared.angular_velocity)[0]
+    other = parallel_nlgs.decompose(problem, shared.position[:shared.n_particles, 0], 3)
+    state = [np.zeros(problem.a.size) for _ in range(2)] + [np.zeros(problem.minv_xx.size) for _ in range(3)]
+    with pytest.raises(ValueError, match="decomposition"):
+        parallel_nlgs.solve_problem_domains(problem, shared.position[:shared.n_particles, 0], *state, domains=2,
+                                            tolerance=1e-4, max_tolerance=1e-2, max_iterations=5,
+                                            decomposition=other)

@@ -39,3 +39,17 @@ def test_no_last_points_and_no_new_points():
     assert match_impulses(last_keys, impulse, np.empty(0, np.int64)).shape == (0, 2)
     one = match_impulses(np.array([5]), np.array([[1.5, -0.5]]), np.array([4, 5, 6]))
     assert one.tolist() == [[0.0, 0.0], [1.5, -0.5], [0.0, 0.0]]
+
+
+@pytest.mark.parametrize("seed", [0, 1])
+def test_repeated_keys_far_jumps_and_two_sorted_runs(seed):
+    """Keys that repeat, that jump far ahead (past the walk's steps, to the binary search) and
+    that come in two sorted runs (as blocks of points detected apart would)."""
+    last_keys, impulse, keys = _keys(seed, last=2000, kept=1500, new=100, shuffle=False)
+    by_key = dict(zip(last_keys.tolist(), map(tuple, impulse)))
+    cases = {"repeated": np.repeat(keys, 2), "far jumps": keys[::37].copy(),
+             "two runs": np.concatenate([np.sort(keys[1::2]), np.sort(keys[::2])])}
+    for name, case in cases.items():
+        got = match_impulses(last_keys, impulse, case)
+        np.testing.assert_array_equal(got, match_impulses_reference(last_keys, impulse, case), err_msg=name)
+        np.testing.assert_array_equal(got, [by_key.get(k, (0.0, 0.0)) for k in case.tolist()], err_msg=name)
