@@ -298,8 +298,10 @@ def run_ensemble(specs, folder, *, scheduler=None, workers=None, client=None, ov
                  log=None, on_event=None, compress=True) -> list[dict]:
     """Run every :class:`RunSpec` of ``specs`` into ``folder`` on a dask.distributed cluster.
 
-    ``client``: an existing :class:`distributed.Client`; otherwise one to ``scheduler`` (an
-    address) or to a new local cluster of ``workers`` processes (default one per core), closed
+    ``client``: an existing :class:`distributed.Client`, whose workers have one thread each
+    (the netCDF/HDF5 library cannot write two files from two threads of a process at once: a
+    worker with more threads is refused); otherwise one to ``scheduler`` (an address) or to a
+    new local cluster of ``workers`` single-threaded processes (default one per core), closed
     at the end. A run whose worker dies is given to another worker by the scheduler and
     resumes its file (up to the scheduler's ``allowed-failures``); a run that raises is
     reported and the others go on. ``progress``: one bar per run (None: when stderr is a
@@ -341,6 +343,11 @@ def run_ensemble(specs, folder, *, scheduler=None, workers=None, client=None, ov
     enabled = sys.stderr.isatty() if progress is None else bool(progress)
     display = _Display(specs, enabled, on_event)
     try:
+        threaded = {worker: n for worker, n in client.nthreads().items() if n > 1}
+        if threaded:
+            raise ParameterError(f"workers with {max(threaded.values())} threads ({', '.join(sorted(threaded))}): "
+                                 "expected one thread per worker, since two runs in one process would write "
+                                 "their netCDF (HDF5) files at once, which the library does not support")
         client.subscribe_topic(EVENT_TOPIC, display)
         futures = {client.submit(_run_on_worker, spec, str(folder.resolve()), compress, pure=False,
                                  key=f"grainview-run-{spec.name}-{time.time_ns()}"): spec for spec in specs}

@@ -94,7 +94,9 @@ def test_rerun_skips_finished_and_refuses_changed_settings(killed):
 
 def test_failed_run_reported_others_finish(tmp_path, monkeypatch):
     """A run that raises is reported in one line; the other finishes; a second call runs only
-    the failed one (threads in this process, so that the failure can be injected)."""
+    the failed one (a thread in this process, so that the failure can be injected; one thread:
+    two would write netCDF files at once, which HDF5 does not support and which crashed this
+    test once, and such a worker is refused)."""
     specs = grid(seeds=2, **{**TINY, "strain": 0.01})
     real = ensemble.run_one
 
@@ -105,6 +107,10 @@ def test_failed_run_reported_others_finish(tmp_path, monkeypatch):
 
     monkeypatch.setattr(ensemble, "run_one", flaky)
     with distributed.LocalCluster(n_workers=1, threads_per_worker=2, processes=False, dashboard_address=None) as cl, \
+            distributed.Client(cl) as client:
+        with pytest.raises(ParameterError, match="one thread per worker"):
+            run_ensemble(specs, tmp_path, client=client, progress=False)
+    with distributed.LocalCluster(n_workers=1, threads_per_worker=1, processes=False, dashboard_address=None) as cl, \
             distributed.Client(cl) as client:
         lines = []
         first = run_ensemble(specs, tmp_path, client=client, progress=False, log=lines.append)
