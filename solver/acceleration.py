@@ -301,9 +301,6 @@ def solve_anderson(blocks, a, b, nx, ny, rax, ray, rbx, rby, bias, mu, pn, pt, v
     ptr = blocks[:-1].copy()
     points = order[:blocks[-2]]
     interface = order[blocks[-2]:]
-    hvx[:] = vx
-    hvy[:] = vy
-    hw[:] = w
     gram = np.zeros((memory, memory))
     row = np.zeros(memory)
     rhs = np.zeros(memory)

@@ -174,6 +174,11 @@ class Decomposition(NamedTuple):
         return np.arange(self.ptr[-1], self.point_order.size)
 
     @property
+    def gathered_size(self):
+        """Floats that :meth:`gather` writes: 10 per point and 7 per body, new numbering."""
+        return 10 * self.point_order.size + 7 * self.source.size
+
+    @property
     def blocks(self):
         """The boundaries of the points' blocks in the new numbering: ``ptr`` then the number of
         points (the last block is the interface)."""
@@ -183,12 +188,11 @@ class Decomposition(NamedTuple):
         """The problem's arrays in the new numbering: (geometry, masses, state) with geometry =
         (a, b, nx, ny, rax, ray, rbx, rby, bias, mu), masses = (minv_xx, minv_xy, minv_yy, iinv)
         and state = (pn, pt, vx, vy, w) (copies; :func:`gather_into`), in ``out`` (a float array of
-        at least 10 P + 7 B entries, P points and B bodies in the new numbering) or in new
-        memory."""
-        size = 10 * self.point_order.size + 7 * self.source.size
-        arrays = gather_into(self.point_order, self.source, problem.nx, problem.ny, problem.rax, problem.ray, problem.rbx,
-                        problem.rby, problem.bias, problem.mu, pn, pt, problem.minv_xx, problem.minv_xy,
-                        problem.minv_yy, problem.iinv, vx, vy, w, np.empty(size) if out is None else out)
+        at least :attr:`gathered_size` entries) or in new memory."""
+        arrays = gather_into(self.point_order, self.source, problem.nx, problem.ny, problem.rax, problem.ray,
+                             problem.rbx, problem.rby, problem.bias, problem.mu, pn, pt, problem.minv_xx,
+                             problem.minv_xy, problem.minv_yy, problem.iinv, vx, vy, w,
+                             np.empty(self.gathered_size) if out is None else out)
         return (self.a, self.b, *arrays[:8]), arrays[10:14], (*arrays[8:10], *arrays[14:])
 
     def scatter(self, state, pn, pt, vx, vy, w):
@@ -335,7 +339,7 @@ def solve_decomposed(problem, x, domains, state, kernel, decomposition=None) -> 
     if dec.point_order.size != problem.a.size or dec.ptr.size != int(domains) + 1:
         raise ValueError(f"the decomposition is of {dec.point_order.size} points on {dec.ptr.size - 1} domains, the "
                          f"problem has {problem.a.size} points on {int(domains)} domains: expected the same")
-    out = scratch.buffer("renumbered", 10 * dec.point_order.size + 7 * dec.source.size)
+    out = scratch.buffer("renumbered", dec.gathered_size)
     geometry, masses, renumbered = dec.gather(problem, *state, out=out)
     iterations, residual, worst = kernel(dec, geometry, renumbered, masses)
     dec.scatter(renumbered, *state)

@@ -72,6 +72,14 @@ def natural_maps(pn, pt, un, ut, mu, rho):
     return fn, ft
 
 
+@njit(cache=True, inline="always")
+def _point_natural_map(k, a, b, nx, ny, rax, ray, rbx, rby, bias, mu, pn, pt, vx, vy, w, wnn_k):
+    """:func:`natural_map` of point k, its velocity from the bodies' (Signorini shift added)
+    and rho = 1 / W_nn."""
+    un, ut = _relative_velocity(k, a, b, nx, ny, rax, ray, rbx, rby, vx, vy, w)
+    return natural_map(pn[k], pt[k], un + bias[k], ut, mu[k], 1.0 / wnn_k)
+
+
 @njit(cache=True)
 def local_law_residuals(a, b, nx, ny, rax, ray, rbx, rby, bias, mu, pn, pt, vx, vy, w, wnn):
     """Natural-map residual (F_n, F_t) (N s) of every point (module docstring), from the
@@ -80,8 +88,7 @@ def local_law_residuals(a, b, nx, ny, rax, ray, rbx, rby, bias, mu, pn, pt, vx, 
     fn = np.empty(m)
     ft = np.empty(m)
     for k in range(m):
-        un, ut = _relative_velocity(k, a, b, nx, ny, rax, ray, rbx, rby, vx, vy, w)
-        fn[k], ft[k] = natural_map(pn[k], pt[k], un + bias[k], ut, mu[k], 1.0 / wnn[k])
+        fn[k], ft[k] = _point_natural_map(k, a, b, nx, ny, rax, ray, rbx, rby, bias, mu, pn, pt, vx, vy, w, wnn[k])
     return fn, ft
 
 
@@ -113,8 +120,7 @@ def _law_sums(a, b, nx, ny, rax, ray, rbx, rby, bias, mu, pn, pt, vx, vy, w, min
     scale = 0.0
     for k in range(a.size):
         wnn = delassus_block(k, a, b, nx, ny, rax, ray, rbx, rby, minv_xx, minv_xy, minv_yy, iinv)[0]
-        un, ut = _relative_velocity(k, a, b, nx, ny, rax, ray, rbx, rby, vx, vy, w)
-        fn, ft = natural_map(pn[k], pt[k], un + bias[k], ut, mu[k], 1.0 / wnn)
+        fn, ft = _point_natural_map(k, a, b, nx, ny, rax, ray, rbx, rby, bias, mu, pn, pt, vx, vy, w, wnn)
         violation += fn * fn + ft * ft
         scale += pn[k] * pn[k] + pt[k] * pt[k]
     return violation, scale
