@@ -7,7 +7,7 @@
 A full run writes benchmarks/RESULTS.md; --quick and --only write benchmarks/_data/RESULTS-*.md
 (not committed) unless --output says otherwise.
 
-Sections: scaling (solver speed vs the issue-3 targets), work-precision, peers (pymunk, Box2D;
+Sections: scaling (solver speed on dense samples, serial and on 2 domains), work-precision, peers (pymunk, Box2D;
 needs the venv of benchmarks/requirements-peers.txt at /tmp/peervenv or $PEER_PYTHON),
 analysis throughput (benchmarks/analysis.py), skipping what a scene does not need, stress
 tests. RESULTS.md is rewritten after every section, so an interrupted run keeps what it did.
@@ -32,7 +32,8 @@ from common import machine_description  # noqa: E402
 
 SECTIONS = ["scaling", "work_precision", "acceleration", "peers", "analysis", "skipping", "stress", "ensemble"]
 TITLES = {
-    "scaling": "a. Scaling: time per step, per particle, per contact point per NLGS sweep, memory",
+    "scaling": "a. Scaling on dense samples, serial and on 2 domains: time per step, per particle, per contact point "
+               "per NLGS sweep, memory",
     "work_precision": "b. Work-precision: run time against error",
     "acceleration": "b2. Fewer sweeps at equal accuracy: candidates against the NLGS",
     "peers": "c. Peers: pymunk and Box2D on the same settled piles",

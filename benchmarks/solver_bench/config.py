@@ -20,10 +20,16 @@ TARGET_DETECTION_SHARE = 0.20
 class Config:
     quick: bool = False
     plot_dir: str = HERE  # where plots go: next to the RESULTS file that links them
-    # scaling
-    sizes: tuple = (500, 1000, 4000, 14400, 57600)
-    compaction_steps: dict = None  # per (shape, N): a fixed count, so that every run measures the same state
-    timed_steps: dict = None
+    # scaling: dense samples sheared (dense_skip steps left out, dense_timed timed) on each domain count
+    dense_sizes: tuple = (1000, 4000, 14400)
+    domain_counts: tuple = (1, 2)
+    dense_turns: int = 3  # runs of each case, the domain counts in turns
+    dense_skip: dict = None
+    dense_timed: dict = None
+    # ... and loose samples, compacted for a fixed number of steps (the same in every run)
+    loose_sizes: tuple = (57600,)
+    compaction_steps: dict = None  # per (shape, N)
+    loose_timed_steps: int = 3
     # work-precision
     wp_particles: int = 250
     wp_compaction_steps: int = 8000  # a fixed count, so that every run starts from the same state
@@ -36,7 +42,7 @@ class Config:
     peer_settle_steps: int = 3000
     peer_steps: int = 200
     peer_budgets: tuple = (10, 25, 50)
-    peer_tolerances: tuple = (1e-5, 1e-6)  # besides the default: what a smaller floor-force error costs
+    peer_tolerances: tuple = (3e-5, 1e-5, 1e-6)  # besides the default: what a smaller floor-force error costs
     # skipping
     skip_particles: int = 1000
     skip_steps: int = 40
@@ -50,9 +56,11 @@ class Config:
 
     def __post_init__(self):
         if self.quick:
-            self.sizes = (300, 1000)
-            self.compaction_steps = {(shape, n): 200 for shape in ("disk", "pentagon") for n in self.sizes}
-            self.timed_steps = {300: 10, 1000: 5}
+            self.dense_sizes = (200,)
+            self.dense_skip = {200: 5}
+            self.dense_timed = {200: 10}
+            self.dense_turns = 1
+            self.loose_sizes = ()
             self.wp_particles = 80
             self.wp_compaction_steps = 500
             self.wp_duration = 0.004
@@ -70,13 +78,10 @@ class Config:
             self.skip_steps = 10
             self.stress_scale = 0
         else:
-            # ~25-150 s of compaction each on the 2-core VM of RESULTS.md; the samples of 4000 and
-            # more stay loose (contact points / particle in the table)
-            self.compaction_steps = self.compaction_steps or {
-                ("disk", 500): 30_000, ("disk", 1000): 19_000, ("disk", 4000): 350, ("disk", 14400): 135,
-                ("disk", 57600): 60, ("pentagon", 500): 12_000, ("pentagon", 1000): 3400,
-                ("pentagon", 4000): 1200, ("pentagon", 14400): 1200, ("pentagon", 57600): 1000}
-            self.timed_steps = self.timed_steps or {500: 40, 1000: 30, 4000: 20, 14400: 6, 57600: 3}
+            self.dense_skip = self.dense_skip or {1000: 100, 4000: 100, 14400: 100}
+            self.dense_timed = self.dense_timed or {1000: 400, 4000: 300, 14400: 200}
+            # ~1-3 min of compaction each on the 2-core VM of RESULTS.md: the samples stay loose
+            self.compaction_steps = self.compaction_steps or {("disk", 57600): 60, ("pentagon", 57600): 1000}
 
 
 # --------------------------------------------------------------------------------------------

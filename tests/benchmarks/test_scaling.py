@@ -1,0 +1,63 @@
+"""benchmarks/solver_bench/scaling.py (section a of RESULTS.md): the timed window is the shear
+itself, step for step, and its counts add up."""
+
+import os
+import sys
+
+import numpy as np
+import pytest
+
+from .conftest import BENCHMARKS, load_benchmark as load
+
+
+@pytest.fixture(scope="module")
+def scaling():
+    sys.path.insert(0, BENCHMARKS)
+    try:
+        from solver_bench import scaling
+    finally:
+        sys.path.remove(BENCHMARKS)
+    return scaling
+
+
+@pytest.fixture(scope="module")
+def sample(tmp_path_factory):
+    compaction = load("compaction")
+    path = str(tmp_path_factory.mktemp("samples") / "pentagons.pkl")
+    compaction.compact("pentagon", 60, 0, "fast", acceleration="anderson", save=path)
+    return path
+
+
+@pytest.mark.parametrize("domains", [1, 2])
+def test_the_window_counts_add_up(scaling, sample, domains):
+    r = scaling.dense_case(sample, domains, 5, 12)
+    assert r["n"] == 60 and r["domains"] == domains
+    assert len(r["seconds"]) == len(r["sweeps"]) == len(r["points"]) == 12
+    # the simulation's meters cover the timed window only
+    assert r["counters"]["steps"] == 12
+    assert r["counters"]["sweeps"] == r["sweeps"].sum()
+    assert np.all(r["seconds"] > 0) and r["timings"]["solve"] < r["seconds"].sum()
+    assert np.all(r["law"] >= 0) and r["converged"].dtype == bool
+
+
+def test_the_timed_window_is_the_shear(scaling, sample):
+    """Steps 6-17 of the measured serial shear take the sweeps of the same steps of an
+    unmeasured shear from the same sample (the measure times the steps, it does not change them)."""
+    sweep_bursts = load("sweep_bursts")
+    sim, _ = load("common").load_sample(sample)
+    sweeps = []
+
+    def count(info):
+        sweeps.append(info.iterations)
+        if len(sweeps) == 17:
+            raise sweep_bursts._Done
+
+    sweep_bursts._shear(sim, count)
+    r = scaling.dense_case(sample, 1, 5, 12)
+    np.testing.assert_array_equal(r["sweeps"], sweeps[5:])
+
+
+def test_sample_path_names_shape_and_size(scaling):
+    path = scaling.sample_path("disk", 14400)
+    assert os.path.basename(path) == "disk_14400_fast.pkl"
+    assert os.path.basename(os.path.dirname(path)) == "samples"
