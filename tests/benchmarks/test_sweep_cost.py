@@ -1,0 +1,41 @@
+"""benchmarks/sweep_cost.py: the captured problems are laid out whole for one domain and
+renumbered, all points kept, for several; the measured costs are positive."""
+
+import numpy as np
+import pytest
+
+from .conftest import load_benchmark as load
+
+
+@pytest.fixture(scope="module")
+def problems(tmp_path_factory):
+    compaction = load("compaction")
+    common = load("common")
+    sweep_bursts = load("sweep_bursts")
+    path = str(tmp_path_factory.mktemp("samples") / "pentagons.pkl")
+    compaction.compact("pentagon", 60, 0, "fast", acceleration="anderson", save=path)
+    sim, _ = common.load_sample(path)
+    return sweep_bursts.capture(sim, 3, 4)
+
+
+def test_layouts_keep_every_point(problems):
+    sweep_cost = load("sweep_cost")
+    c = problems[0]
+    problem = c["problem"]
+    geometry, masses, state, blocks, dec = sweep_cost._layout(c, 1)
+    assert dec is None and list(blocks) == [0, problem.a.size]
+    np.testing.assert_array_equal(geometry[8], problem.bias)
+    np.testing.assert_array_equal(state[0], c["pn"])
+    geometry, masses, state, blocks, dec = sweep_cost._layout(c, 2)
+    assert blocks[-1] == problem.a.size and len(blocks) == 4
+    # the same points, renumbered: the same multiset of Signorini shifts and warm-start impulses
+    np.testing.assert_array_equal(np.sort(geometry[8]), np.sort(problem.bias))
+    np.testing.assert_array_equal(np.sort(state[0]), np.sort(c["pn"]))
+    assert masses[0].size >= problem.minv_xx.size  # every body, walls copied into each domain that touches them
+
+
+def test_costs_are_measured_for_every_kind_and_domain_count(problems):
+    sweep_cost = load("sweep_cost")
+    out = sweep_cost.measure(problems, [1, 2], sweeps=4, repeats=1)
+    assert set(out) == {(k, d) for k in sweep_cost.KINDS for d in (1, 2)}
+    assert all(np.isfinite(v) for v in out.values())
