@@ -34,6 +34,8 @@ walls, a fraction ~ D / sqrt(N) of the points.
 
 from __future__ import annotations
 
+import os
+import warnings
 from typing import NamedTuple
 
 import numpy as np
@@ -46,6 +48,22 @@ FREE = -1
 """Domain of a body that never moves (zero inverse mass and inertia): shared by every domain."""
 SHARED = -2
 """Domain of a moving body that is not a particle (a wall pushed by a stress)."""
+
+
+def warn_if_threads_sleep(domains, environ=None) -> bool:
+    """Warn (RuntimeWarning) when ``domains`` > 1 and ``OMP_WAIT_POLICY`` is ``passive``:
+    numba's OpenMP threads then sleep between the parallel regions of every sweep and must be
+    woken each time, which made a domain-decomposed sweep slower than the serial one
+    (docs/solver.md, "Both cores"). ``environ``: the environment read (default ``os.environ``;
+    the thread pool reads it when it starts). Returns whether it warned."""
+    policy = (os.environ if environ is None else environ).get("OMP_WAIT_POLICY", "")
+    if domains > 1 and policy.strip().lower() == "passive":
+        warnings.warn(f"domains={domains} with OMP_WAIT_POLICY={policy}: the sweeps' threads sleep between "
+                      "parallel regions, and a domain-decomposed sweep measured slower than the serial one; "
+                      "expected OMP_WAIT_POLICY unset or 'active' (set before Python starts)", RuntimeWarning,
+                      stacklevel=3)
+        return True
+    return False
 
 
 def body_domains(x, n_bodies, minv_xx, minv_yy, iinv, domains):

@@ -133,6 +133,7 @@ class Parameters:
                 bad.append(f"{name}={value!r}: expected a positive length in m")
         if bad:
             raise ParameterError("invalid solver parameters: " + "; ".join(bad))
+        parallel_nlgs.warn_if_threads_sleep(self.domains)
         return self
 
 

@@ -227,3 +227,23 @@ def test_one_decomposition_per_step_serves_the_main_solve_and_the_recovery(accel
         parallel_nlgs.solve_problem_domains(problem, shared.position[:shared.n_particles, 0], *state, domains=2,
                                             tolerance=1e-4, max_tolerance=1e-2, max_iterations=5,
                                             decomposition=other)
+
+
+def test_sleeping_thread_pool_is_named_once_domains_are_asked_for(monkeypatch):
+    """OMP_WAIT_POLICY=passive made domain-decomposed sweeps slower than serial ones: asking for
+    domains with it set warns, naming the variable; one domain, or the policy unset or active,
+    does not."""
+    warn_if_threads_sleep = parallel_nlgs.warn_if_threads_sleep
+    with pytest.warns(RuntimeWarning, match="OMP_WAIT_POLICY=PASSIVE"):
+        assert warn_if_threads_sleep(2, {"OMP_WAIT_POLICY": "PASSIVE"})
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        assert not warn_if_threads_sleep(1, {"OMP_WAIT_POLICY": "passive"})
+        assert not warn_if_threads_sleep(2, {"OMP_WAIT_POLICY": "active"})
+        assert not warn_if_threads_sleep(2, {})
+    monkeypatch.setenv("OMP_WAIT_POLICY", "passive")
+    with pytest.warns(RuntimeWarning, match="domains=2"):
+        Parameters(domains=2).validate()
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        Parameters(domains=1).validate()
