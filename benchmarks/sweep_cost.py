@@ -16,6 +16,16 @@ problems of the median over ``--repeats`` repeats.
 With one thread and several domains the sweeps visit the points in the decomposition's order
 (domain after domain, then their interface) on one core: the test of whether the order, rather
 than the second core, makes a domain-decomposed sweep cheaper per point.
+
+``--stages``: the serial Anderson solve taken apart instead. The same iteration as
+:func:`solver.acceleration.solve_anderson` (no stopping test), driven from Python, calls the
+solver's own kernels one by one and times each: the sweep, the points' and the bodies' history
+passes, the small least-squares solve, the extrapolation of the bodies' velocities and of the
+points' impulses (with its projection onto the Coulomb cones); ns per point, per sweep or per
+extrapolation, and the share of points the projection moved. Each kernel is called once on the
+first problem before the timing (loading compiled code); each timed call includes its dispatch
+from Python, a few microseconds that the solver's own loop does not pay (most of the least
+squares' time).
 """
 
 from __future__ import annotations
@@ -80,6 +90,92 @@ def sweep_seconds(caught: dict, domains: int, kind: str, sweeps: int, repeats: i
     return float(np.median([(run(sweeps + 2) - run(2)) / sweeps for _ in range(repeats)]))
 
 
+STAGES = ("sweep", "point history", "body history", "least squares", "extrapolation, bodies",
+          "extrapolation, points")
+
+
+def stage_seconds(caught: dict, sweeps: int) -> tuple:
+    """Seconds spent in each of :data:`STAGES` by a serial Anderson solve (memory 3, an
+    extrapolation every 2 sweeps) of ``sweeps`` sweeps of a captured problem, the number of
+    extrapolations, the points moved by their projection onto the Coulomb cones, and the final
+    impulses (p_n, p_t): those of :func:`solver.acceleration.solve_anderson` run for as many
+    sweeps without a tolerance."""
+    from solver import acceleration as anderson, nlgs
+    from solver.residuals import cone_projection
+
+    geometry, masses, state, _, _ = _layout(caught, 1)
+    a, b, nx, ny, rax, ray, rbx, rby, bias, mu = geometry
+    pn, pt, vx, vy, w = (v.copy() for v in state)
+    m, n_bodies = a.size, vx.size
+    dfn, dft, dgn, dgt = (np.zeros((MEMORY, m)) for _ in range(4))
+    dvx, dvy, dw = (np.zeros((MEMORY, n_bodies)) for _ in range(3))
+    wnn, wnt, wtt, xn, xt, fn, ft, fn_prev, ft_prev, gn_prev, gt_prev = (np.zeros(m) for _ in range(11))
+    hvx, hvy, hw = (np.zeros(n_bodies) for _ in range(3))
+    nlgs.delassus_into(a, b, nx, ny, rax, ray, rbx, rby, *masses, wnn, wnt, wtt)
+    nlgs.velocities_from_impulses(a, b, nx, ny, rax, ray, rbx, rby, pn, pt, vx, vy, w, *masses)
+    order = np.arange(m)
+    gram, row, rhs = np.zeros((MEMORY, MEMORY)), np.zeros(MEMORY), np.zeros(MEMORY)
+    xn[:], xt[:] = pn, pt
+    seconds = dict.fromkeys(STAGES, 0.0)
+    have_prev, count, head, last, extrapolations, moved = False, 0, 0, np.inf, 0, 0
+
+    def timed(stage, function, *args):
+        start = time.perf_counter()
+        out = function(*args)
+        seconds[stage] += time.perf_counter() - start
+        return out
+
+    for it in range(1, sweeps + 1):
+        timed("sweep", nlgs.sweep, order, a, b, nx, ny, rax, ray, rbx, rby, bias, mu, pn, pt, vx, vy, w, *masses,
+              wnn, wnt, wtt)
+        if it % PERIOD or it == sweeps:  # as solve_anderson: the last sweep's iterate is kept
+            continue
+        slot = head if have_prev else -1
+        used = min(count + 1, MEMORY) if have_prev else 0
+        row[:], rhs[:] = 0.0, 0.0
+        size = timed("point history", anderson._point_history, 0, m, slot, used, pn, pt, xn, xt, fn, ft, fn_prev,
+                     ft_prev, gn_prev, gt_prev, dfn, dft, dgn, dgt, row, rhs)
+        timed("body history", anderson._body_history, 0, n_bodies, slot, vx, vy, w, hvx, hvy, hw, dvx, dvy, dw)
+        have_prev = True
+        if size > last or slot < 0:
+            count, head, last = 0, 0, size
+            continue
+        last, count, head = size, used, (head + 1) % MEMORY
+        gram[slot, :count] = row[:count]
+        gram[:count, slot] = row[:count]
+        gamma, ok = timed("least squares", anderson._small_solve, gram, rhs, count)
+        if not ok:
+            count, head = 0, 0
+            continue
+        before_n, before_t = pn - gamma[:count] @ dgn[:count], pt - gamma[:count] @ dgt[:count]
+        timed("extrapolation, bodies", anderson._extrapolate_bodies, 0, n_bodies, gamma, count, dvx, dvy, dw, vx, vy, w)
+        timed("extrapolation, points", anderson._extrapolate_points, 0, m, gamma, count, dgn, dgt, a, b, nx, ny, rax,
+              ray, rbx, rby, mu, pn, pt, xn, xt, fn, ft, vx, vy, w, *masses)
+        extrapolations += 1
+        moved += int(np.count_nonzero([cone_projection(en, et, f) != (en, et)
+                                       for en, et, f in zip(before_n, before_t, mu)]))
+    return seconds, extrapolations, moved, (pn, pt)
+
+
+def stages_table(problems: list, sweeps: int) -> str:
+    """Markdown: ns per point of each stage of :func:`stage_seconds`, summed over the problems
+    after a first untimed solve of the first one."""
+    stage_seconds(problems[0], 2 * PERIOD + 2)  # compiled code loaded
+    total, extrapolations, moved, points = dict.fromkeys(STAGES, 0.0), 0, 0, 0
+    for c in problems:
+        seconds, e, mv, _ = stage_seconds(c, sweeps)
+        for k in STAGES:
+            total[k] += seconds[k] * 1e9 / c["problem"].a.size
+        extrapolations += e
+        moved += mv
+        points += c["problem"].a.size * e
+    n_sweeps = sweeps * len(problems)
+    rows = [[k, f"{total[k] / (n_sweeps if k == 'sweep' else extrapolations):.2f}",
+             "per sweep" if k == "sweep" else "per extrapolation"] for k in STAGES]
+    rows.append(["points moved by the projection", f"{100 * moved / max(points, 1):.1f}%", "per extrapolation"])
+    return markdown_table(["stage", "ns per point", "counted"], rows)
+
+
 def measure(problems: list, strips: list, sweeps: int, repeats: int) -> dict:
     """ns per point and sweep, {(kind, domains): median over problems}."""
     out = {}
@@ -100,6 +196,7 @@ def main(argv=None):
     parser.add_argument("--repeats", type=int, default=3, help="repeats per problem (default 3)")
     parser.add_argument("--strips", default="1,2", help="domain counts (default 1,2)")
     parser.add_argument("--threads", type=int, default=2, help="numba threads (default 2)")
+    parser.add_argument("--stages", action="store_true", help="the serial Anderson solve's stages instead")
     parser.add_argument("--out", help="the results file (default: printed only)")
     args = parser.parse_args(argv)
     if not os.path.exists(args.sample):
@@ -112,6 +209,17 @@ def main(argv=None):
     sim, _ = load_sample(args.sample)
     n = sim.n_particles
     problems = capture(sim, args.first, args.first + args.count - 1)
+    if args.stages:
+        numba.set_num_threads(1)
+        table = stages_table(problems, args.sweeps)
+        intro = (f"`python benchmarks/sweep_cost.py --sample {os.path.basename(args.sample)} --first {args.first} "
+                 f"--count {args.count} --sweeps {args.sweeps} --stages`: {n} particles, the serial Anderson solve "
+                 "(memory 3, an extrapolation every 2 sweeps) taken apart.")
+        if args.out:
+            write_results(args.out, f"Stages of an Anderson solve: {n} particles", intro, [table])
+        else:
+            print(intro + "\n\n" + table)
+        return
     strips = [int(d) for d in args.strips.split(",")]
     result = measure(problems, strips, args.sweeps, args.repeats)
     points = int(np.median([c["problem"].a.size for c in problems]))

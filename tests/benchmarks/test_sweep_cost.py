@@ -39,3 +39,22 @@ def test_costs_are_measured_for_every_kind_and_domain_count(problems):
     out = sweep_cost.measure(problems, [1, 2], sweeps=4, repeats=1)
     assert set(out) == {(k, d) for k in sweep_cost.KINDS for d in (1, 2)}
     assert all(np.isfinite(v) for v in out.values())
+
+
+def test_the_stages_are_the_anderson_solve_taken_apart(problems):
+    """Driven kernel by kernel from Python, the solve ends on the impulses of solve_anderson
+    run for as many sweeps without a tolerance, bit for bit: the stages timed are the solver's."""
+    from solver import acceleration
+
+    sweep_cost = load("sweep_cost")
+    c = problems[1]
+    seconds, extrapolations, moved, (pn, pt) = sweep_cost.stage_seconds(c, 12)
+    assert set(seconds) == set(sweep_cost.STAGES) and min(seconds.values()) >= 0.0
+    assert 1 <= extrapolations <= 5 and 0 <= moved <= extrapolations * c["problem"].a.size
+    geometry, masses, state, blocks, _ = sweep_cost._layout(c, 1)
+    s = tuple(v.copy() for v in state)
+    work = np.empty(acceleration.scratch_size(geometry[0].size, s[2].size, sweep_cost.MEMORY))
+    acceleration.solve_anderson(blocks, *geometry, *s, *masses, 0.0, 0.0, 12, sweep_cost.MEMORY, sweep_cost.PERIOD, 0,
+                                work)
+    np.testing.assert_array_equal(pn, s[0])
+    np.testing.assert_array_equal(pt, s[1])
