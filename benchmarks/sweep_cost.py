@@ -90,18 +90,38 @@ def sweep_seconds(caught: dict, domains: int, kind: str, sweeps: int, repeats: i
     return float(np.median([(run(sweeps + 2) - run(2)) / sweeps for _ in range(repeats)]))
 
 
+MIN_STAGE_SWEEPS = 2 * PERIOD + 1
+"""The fewest sweeps for which a --stages solve can extrapolate (the first history pass has no
+predecessor)."""
 STAGES = ("sweep", "point history", "body history", "least squares", "extrapolation, bodies",
           "extrapolation, points")
 
 
 def stage_seconds(caught: dict, sweeps: int) -> tuple:
-    """Seconds spent in each of :data:`STAGES` by a serial Anderson solve (memory 3, an
-    extrapolation every 2 sweeps) of ``sweeps`` sweeps of a captured problem, the number of
-    extrapolations, the points moved by their projection onto the Coulomb cones, and the final
-    impulses (p_n, p_t): those of :func:`solver.acceleration.solve_anderson` run for as many
-    sweeps without a tolerance."""
+    """A serial Anderson solve (memory 3, an extrapolation every 2 sweeps) of a captured
+    problem, driven kernel by kernel and timed.
+
+    Parameters
+    ----------
+    caught : dict
+        A problem of ``sweep_bursts.capture``.
+    sweeps : int
+        Sweeps of the solve (no tolerance).
+
+    Returns
+    -------
+    seconds : dict
+        Seconds in each of :data:`STAGES`.
+    passes : tuple of int
+        (history passes, extrapolations).
+    moved : int
+        Points whose extrapolated impulse the projection onto the Coulomb cone changed, summed
+        over the extrapolations.
+    impulses : tuple of ndarray
+        The final (p_n, p_t): those of :func:`solver.acceleration.solve_anderson` run for as
+        many sweeps without a tolerance.
+    """
     from solver import acceleration as anderson, nlgs
-    from solver.residuals import cone_projection
 
     geometry, masses, state, _, _ = _layout(caught, 1)
     a, b, nx, ny, rax, ray, rbx, rby, bias, mu = geometry
@@ -117,7 +137,7 @@ def stage_seconds(caught: dict, sweeps: int) -> tuple:
     gram, row, rhs = np.zeros((MEMORY, MEMORY)), np.zeros(MEMORY), np.zeros(MEMORY)
     xn[:], xt[:] = pn, pt
     seconds = dict.fromkeys(STAGES, 0.0)
-    have_prev, count, head, last, extrapolations, moved = False, 0, 0, np.inf, 0, 0
+    have_prev, count, head, last, histories, extrapolations, moved = False, 0, 0, np.inf, 0, 0, 0
 
     def timed(stage, function, *args):
         start = time.perf_counter()
@@ -136,6 +156,7 @@ def stage_seconds(caught: dict, sweeps: int) -> tuple:
         size = timed("point history", anderson._point_history, 0, m, slot, used, pn, pt, xn, xt, fn, ft, fn_prev,
                      ft_prev, gn_prev, gt_prev, dfn, dft, dgn, dgt, row, rhs)
         timed("body history", anderson._body_history, 0, n_bodies, slot, vx, vy, w, hvx, hvy, hw, dvx, dvy, dw)
+        histories += 1
         have_prev = True
         if size > last or slot < 0:
             count, head, last = 0, 0, size
@@ -147,33 +168,34 @@ def stage_seconds(caught: dict, sweeps: int) -> tuple:
         if not ok:
             count, head = 0, 0
             continue
-        before_n, before_t = pn - gamma[:count] @ dgn[:count], pt - gamma[:count] @ dgt[:count]
         timed("extrapolation, bodies", anderson._extrapolate_bodies, 0, n_bodies, gamma, count, dvx, dvy, dw, vx, vy, w)
         timed("extrapolation, points", anderson._extrapolate_points, 0, m, gamma, count, dgn, dgt, a, b, nx, ny, rax,
               ray, rbx, rby, mu, pn, pt, xn, xt, fn, ft, vx, vy, w, *masses)
         extrapolations += 1
-        moved += int(np.count_nonzero([cone_projection(en, et, f) != (en, et)
-                                       for en, et, f in zip(before_n, before_t, mu)]))
-    return seconds, extrapolations, moved, (pn, pt)
+        moved += int(np.count_nonzero((fn != pn) | (ft != pt)))  # fn, ft: the extrapolation before its projection
+    return seconds, (histories, extrapolations), moved, (pn, pt)
 
 
 def stages_table(problems: list, sweeps: int) -> str:
     """Markdown: ns per point of each stage of :func:`stage_seconds`, summed over the problems
     after a first untimed solve of the first one."""
-    stage_seconds(problems[0], 2 * PERIOD + 2)  # compiled code loaded
-    total, extrapolations, moved, points = dict.fromkeys(STAGES, 0.0), 0, 0, 0
+    stage_seconds(problems[0], sweeps)  # compiled code loaded
+    total, counts, moved, points = dict.fromkeys(STAGES, 0.0), dict(sweep=0, history=0, extrapolation=0), 0, 0
     for c in problems:
-        seconds, e, mv, _ = stage_seconds(c, sweeps)
+        seconds, (h, e), mv, _ = stage_seconds(c, sweeps)
         for k in STAGES:
             total[k] += seconds[k] * 1e9 / c["problem"].a.size
-        extrapolations += e
+        counts["sweep"] += sweeps
+        counts["history"] += h
+        counts["extrapolation"] += e
         moved += mv
         points += c["problem"].a.size * e
-    n_sweeps = sweeps * len(problems)
-    rows = [[k, f"{total[k] / (n_sweeps if k == 'sweep' else extrapolations):.2f}",
-             "per sweep" if k == "sweep" else "per extrapolation"] for k in STAGES]
-    rows.append(["points moved by the projection", f"{100 * moved / max(points, 1):.1f}%", "per extrapolation"])
-    return markdown_table(["stage", "ns per point", "counted"], rows)
+    per = {k: ("sweep" if k == "sweep" else "history" if "history" in k else "extrapolation") for k in STAGES}
+    rows = [[k, f"{total[k] / counts[per[k]]:.2f}" if counts[per[k]] else "-", f"per {per[k]} ({counts[per[k]]})"]
+            for k in STAGES]
+    rows.append(["points moved by the projection", f"{100 * moved / points:.1f}%" if points else "-",
+                 "per extrapolation"])
+    return markdown_table(["stage", "ns per point", "per (how many)"], rows)
 
 
 def measure(problems: list, strips: list, sweeps: int, repeats: int) -> dict:
@@ -199,10 +221,23 @@ def main(argv=None):
     parser.add_argument("--stages", action="store_true", help="the serial Anderson solve's stages instead")
     parser.add_argument("--out", help="the results file (default: printed only)")
     args = parser.parse_args(argv)
-    if not os.path.exists(args.sample):
-        raise SystemExit(f"sweep_cost.py: no sample at {args.sample}: make one with compaction.py --save")
     import numba
 
+    try:
+        strips = [int(d) for d in args.strips.split(",")]
+    except ValueError:
+        parser.error(f"--strips {args.strips!r}: expected domain counts separated by commas, e.g. 1,2")
+    if min(strips) < 1:
+        parser.error(f"--strips {args.strips!r}: expected domain counts >= 1")
+    if args.count < 1 or args.repeats < 1:
+        parser.error(f"--count {args.count}, --repeats {args.repeats}: expected at least 1 each")
+    if args.sweeps < (MIN_STAGE_SWEEPS if args.stages else 1):
+        parser.error(f"--sweeps {args.sweeps}: expected at least {MIN_STAGE_SWEEPS if args.stages else 1}"
+                     f"{' with --stages (the first extrapolation comes after the second history pass)' if args.stages else ''}")
+    if not 1 <= args.threads <= numba.config.NUMBA_NUM_THREADS:
+        parser.error(f"--threads {args.threads}: expected 1 to {numba.config.NUMBA_NUM_THREADS} (numba's threads)")
+    if not os.path.exists(args.sample):
+        raise SystemExit(f"sweep_cost.py: no sample at {args.sample}: make one with compaction.py --save")
     from sweep_bursts import capture
 
     numba.set_num_threads(args.threads)
@@ -220,7 +255,6 @@ def main(argv=None):
         else:
             print(intro + "\n\n" + table)
         return
-    strips = [int(d) for d in args.strips.split(",")]
     result = measure(problems, strips, args.sweeps, args.repeats)
     points = int(np.median([c["problem"].a.size for c in problems]))
     rows = []

@@ -51,11 +51,24 @@ SHARED = -2
 
 
 def warn_if_threads_sleep(domains, environ=None) -> bool:
-    """Warn (RuntimeWarning) when ``domains`` > 1 and ``OMP_WAIT_POLICY`` is ``passive``:
-    numba's OpenMP threads then sleep between the parallel regions of every sweep and must be
-    woken each time, which made a domain-decomposed sweep slower than the serial one
-    (docs/solver.md, "Both cores"). ``environ``: the environment read (default ``os.environ``;
-    the thread pool reads it when it starts). Returns whether it warned."""
+    """Warn when domains are asked for while the OpenMP threads are told to sleep.
+
+    With ``OMP_WAIT_POLICY=passive`` numba's OpenMP threads sleep between the parallel regions
+    of every sweep and must be woken each time, which made a domain-decomposed sweep slower
+    than the serial one (docs/solver.md, "Both cores").
+
+    Parameters
+    ----------
+    domains : int
+        The NLGS domains asked for; one domain never warns.
+    environ : mapping, optional
+        The environment read (default ``os.environ``; the thread pool reads it when it starts).
+
+    Returns
+    -------
+    bool
+        Whether it warned (a ``RuntimeWarning`` naming the variable and what is expected).
+    """
     policy = (os.environ if environ is None else environ).get("OMP_WAIT_POLICY", "")
     if domains > 1 and policy.strip().lower() == "passive":
         warnings.warn(f"domains={domains} with OMP_WAIT_POLICY={policy}: the sweeps' threads sleep between "

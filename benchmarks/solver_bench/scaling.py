@@ -86,6 +86,8 @@ def dense_case(path: str, domains: int, skip: int, steps: int) -> dict:
 
 
 def _loose_case(n, shape, compaction, steps, domains):
+    """A loose sample (``compaction`` steps of :func:`solver.compaction_sample`), then ``steps``
+    timed biaxial steps on ``domains`` domains: the timings and counters of those steps."""
     sim, compaction_steps = dense_sample(n, shape, np.inf, max_steps=compaction)
     start_biaxial(sim)
     sim.parameters.domains = domains
@@ -102,7 +104,10 @@ def _median_turn(turns):
     return sorted(turns, key=lambda r: float(r["seconds"].sum()))[len(turns) // 2]
 
 
-def _dense_row(shape, turns, serial):
+def _dense_row(shape, turns, serial, planned):
+    """The table's row of one case: its median turn (:func:`_median_turn`) with the turns'
+    range, and the speed-ups over the ``serial`` case's median turn (None: no speed-up).
+    ``planned``: the turns asked for; a row from fewer (some failed) says so."""
     r = _median_turn(turns)
     t, c = r["timings"], r["counters"]
     steps = len(r["seconds"])
@@ -111,7 +116,8 @@ def _dense_row(shape, turns, serial):
     spread = [1e3 * float(x["seconds"].sum()) / steps for x in turns]
     solve_per_sweep = t["solve"] / max(c["sweeps"], 1)
     row = [shape, f"{n:,}", r["domains"], f"{r['points'].mean() / n:.2f}", steps, f"{1e3 * per_step:.2f}",
-           f"{min(spread):.2f}-{max(spread):.2f}", f"{1e6 * per_step / n:.2f}",
+           f"{min(spread):.2f}-{max(spread):.2f}" + ("" if len(turns) == planned else f" ({len(turns)}/{planned} turns)"),
+           f"{1e6 * per_step / n:.2f}",
            f"{np.median(r['sweeps']):.0f} ({np.percentile(r['sweeps'], 90):.0f})",
            f"{c['recovery_sweeps'] / steps:.1f}", f"{1e9 * t['solve'] / max(c['point_sweeps'], 1):.1f}",
            f"{100 * (t['broad_phase'] + t['narrow_phase']) / r['seconds'].sum():.0f}%",
@@ -135,7 +141,12 @@ def section_scaling(cfg: Config, log=print):
             path = sample_path(shape, n)
             if not os.path.exists(path):
                 log(f"building the dense sample {os.path.basename(path)} (benchmarks/compaction.py, fast route)")
-                in_fresh_process(build_sample, shape, n)
+                try:
+                    in_fresh_process(build_sample, shape, n)
+                except RuntimeError as exc:
+                    rows += [[shape, f"{n:,}", d, "sample not built: " + str(exc)[:80]] + [""] * 14
+                             for d in cfg.domain_counts]
+                    continue
             turns = {d: [] for d in cfg.domain_counts}
             failed = {}
             for turn in range(cfg.dense_turns):  # the order reversed every other turn: drift falls on each alike
@@ -153,8 +164,8 @@ def section_scaling(cfg: Config, log=print):
                 if not turns[domains]:
                     rows.append([shape, f"{n:,}", domains, "failed: " + failed.get(domains, "")] + [""] * 14)
                     continue
-                serial = turns[cfg.domain_counts[0]] if domains != cfg.domain_counts[0] else None
-                rows.append(_dense_row(shape, turns[domains], serial or None))
+                serial = turns.get(1) if domains != 1 else None
+                rows.append(_dense_row(shape, turns[domains], serial or None, cfg.dense_turns))
                 results.extend(turns[domains])
                 log(rows[-1])
     header = ["shape", "N", "domains", "contact points / particle", "timed steps", "ms / step",
@@ -183,6 +194,7 @@ def section_scaling(cfg: Config, log=print):
 
 
 def _loose_section(cfg: Config, log=print):
+    """The loose rows (module docstring): Markdown text and the runs' results."""
     rows, results = [], []
     for shape in ("pentagon", "disk"):
         for n in cfg.loose_sizes:

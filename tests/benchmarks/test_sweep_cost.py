@@ -48,9 +48,9 @@ def test_the_stages_are_the_anderson_solve_taken_apart(problems):
 
     sweep_cost = load("sweep_cost")
     c = problems[1]
-    seconds, extrapolations, moved, (pn, pt) = sweep_cost.stage_seconds(c, 12)
+    seconds, (histories, extrapolations), moved, (pn, pt) = sweep_cost.stage_seconds(c, 12)
     assert set(seconds) == set(sweep_cost.STAGES) and min(seconds.values()) >= 0.0
-    assert 1 <= extrapolations <= 5 and 0 <= moved <= extrapolations * c["problem"].a.size
+    assert histories == 5 and 1 <= extrapolations <= 5 and 0 <= moved <= extrapolations * c["problem"].a.size
     geometry, masses, state, blocks, _ = sweep_cost._layout(c, 1)
     s = tuple(v.copy() for v in state)
     work = np.empty(acceleration.scratch_size(geometry[0].size, s[2].size, sweep_cost.MEMORY))
@@ -58,3 +58,19 @@ def test_the_stages_are_the_anderson_solve_taken_apart(problems):
                                 work)
     np.testing.assert_array_equal(pn, s[0])
     np.testing.assert_array_equal(pt, s[1])
+
+
+@pytest.mark.parametrize("argv, words", [
+    (["--sweeps", "4", "--stages"], "--sweeps 4: expected at least 5"),
+    (["--sweeps", "0"], "--sweeps 0: expected at least 1"),
+    (["--strips", "1,x"], "--strips '1,x': expected domain counts"),
+    (["--strips", "0,2"], "expected domain counts >= 1"),
+    (["--count", "0"], "--count 0"),
+    (["--threads", "999"], "--threads 999: expected 1 to"),
+])
+def test_bad_arguments_get_one_line(argv, words, capsys):
+    sweep_cost = load("sweep_cost")
+    with pytest.raises(SystemExit):
+        sweep_cost.main(["--sample", "no-such-file.pkl"] + argv)
+    err = capsys.readouterr().err.strip().splitlines()
+    assert words in err[-1]
