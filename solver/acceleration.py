@@ -100,11 +100,13 @@ def _dot2(a, b, c, d):
 
 
 @njit(cache=True)
-def _subtract_scaled(target, rows, gamma, count):
-    """target -= sum_j gamma_j rows[j] over the first ``count`` rows (views of one block)."""
+def _subtract_scaled(target, rows, lo, hi, gamma, count):
+    """target -= sum_j gamma_j rows[j, lo:hi] over the first ``count`` rows (``target`` is the
+    block lo..hi - 1 of its array). Each row is taken as ``rows[j, lo:hi]``, a contiguous view
+    the loop vectorises (a 2-D view ``rows[:, lo:hi]`` is not known to be contiguous)."""
     for j in range(count):
         g = gamma[j]
-        row = rows[j]
+        row = rows[j, lo:hi]
         for k in range(target.size):
             target[k] -= g * row[k]
 
@@ -170,9 +172,9 @@ def _body_history(lo, hi, slot, vx, vy, w, hvx, hvy, hw, dvx, dvy, dw):
 @njit(cache=True)
 def _extrapolate_bodies(lo, hi, gamma, count, dvx, dvy, dw, vx, vy, w):
     """The velocities of bodies lo..hi - 1 at the extrapolated impulses: v - dV gamma."""
-    _subtract_scaled(vx[lo:hi], dvx[:, lo:hi], gamma, count)
-    _subtract_scaled(vy[lo:hi], dvy[:, lo:hi], gamma, count)
-    _subtract_scaled(w[lo:hi], dw[:, lo:hi], gamma, count)
+    _subtract_scaled(vx[lo:hi], dvx, lo, hi, gamma, count)
+    _subtract_scaled(vy[lo:hi], dvy, lo, hi, gamma, count)
+    _subtract_scaled(w[lo:hi], dw, lo, hi, gamma, count)
 
 
 @njit(cache=True)
@@ -186,8 +188,8 @@ def _extrapolate_points(lo, hi, gamma, count, dgn, dgt, a, b, nx, ny, rax, ray, 
     e_n, e_t = en[lo:hi], et[lo:hi]
     e_n[:] = pn[lo:hi]
     e_t[:] = pt[lo:hi]
-    _subtract_scaled(e_n, dgn[:, lo:hi], gamma, count)
-    _subtract_scaled(e_t, dgt[:, lo:hi], gamma, count)
+    _subtract_scaled(e_n, dgn, lo, hi, gamma, count)
+    _subtract_scaled(e_t, dgt, lo, hi, gamma, count)
     p_n, p_t, x_n, x_t, friction = pn[lo:hi], pt[lo:hi], xn[lo:hi], xt[lo:hi], mu[lo:hi]
     for q in range(e_n.size):
         qn, qt = cone_projection(e_n[q], e_t[q], friction[q])
