@@ -134,23 +134,28 @@ def _point_history(lo, hi, slot, count, pn, pt, xn, xt, fn, ft, fn_prev, ft_prev
     share of |f|^2."""
     f_n, f_t = fn[lo:hi], ft[lo:hi]
     size = _residual(pn[lo:hi], pt[lo:hi], xn[lo:hi], xt[lo:hi], f_n, f_t)
+    old_fn, old_ft, old_gn, old_gt = fn_prev[lo:hi], ft_prev[lo:hi], gn_prev[lo:hi], gt_prev[lo:hi]
+    g_n, g_t = xn[lo:hi], xt[lo:hi]
     if slot >= 0:
         new_fn, new_ft = dfn[slot, lo:hi], dft[slot, lo:hi]
         new_gn, new_gt = dgn[slot, lo:hi], dgt[slot, lo:hi]
-        old_fn, old_ft, old_gn, old_gt = fn_prev[lo:hi], ft_prev[lo:hi], gn_prev[lo:hi], gt_prev[lo:hi]
-        g_n, g_t = xn[lo:hi], xt[lo:hi]
-        for k in range(f_n.size):
+        for k in range(f_n.size):  # the differences, and previous <- current in the same pass
             new_fn[k] = f_n[k] - old_fn[k]
             new_ft[k] = f_t[k] - old_ft[k]
             new_gn[k] = g_n[k] - old_gn[k]
             new_gt[k] = g_t[k] - old_gt[k]
+            old_fn[k] = f_n[k]
+            old_ft[k] = f_t[k]
+            old_gn[k] = g_n[k]
+            old_gt[k] = g_t[k]
         for j in range(count):
             row[j] += _dot2(new_fn, dfn[j, lo:hi], new_ft, dft[j, lo:hi])
             rhs[j] += _dot2(f_n, dfn[j, lo:hi], f_t, dft[j, lo:hi])
-    fn_prev[lo:hi] = f_n
-    ft_prev[lo:hi] = f_t
-    gn_prev[lo:hi] = xn[lo:hi]
-    gt_prev[lo:hi] = xt[lo:hi]
+    else:
+        old_fn[:] = f_n
+        old_ft[:] = f_t
+        old_gn[:] = g_n
+        old_gt[:] = g_t
     return size
 
 
