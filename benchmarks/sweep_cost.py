@@ -209,6 +209,14 @@ def measure(problems: list, strips: list, sweeps: int, repeats: int) -> dict:
     return out
 
 
+def _report(out, title, intro, table):
+    """Write the results file ``out`` (:func:`common.write_results`), or print when none."""
+    if out:
+        write_results(out, title, intro, [table])
+    else:
+        print(intro + "\n\n" + table)
+
+
 def main(argv=None):
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--sample", required=True, help="a pickled compacted sample (compaction.py --save)")
@@ -250,10 +258,7 @@ def main(argv=None):
         intro = (f"`python benchmarks/sweep_cost.py --sample {os.path.basename(args.sample)} --first {args.first} "
                  f"--count {args.count} --sweeps {args.sweeps} --stages`: {n} particles, the serial Anderson solve "
                  "(memory 3, an extrapolation every 2 sweeps) taken apart.")
-        if args.out:
-            write_results(args.out, f"Stages of an Anderson solve: {n} particles", intro, [table])
-        else:
-            print(intro + "\n\n" + table)
+        _report(args.out, f"Stages of an Anderson solve: {n} particles", intro, table)
         return
     result = measure(problems, strips, args.sweeps, args.repeats)
     points = int(np.median([c["problem"].a.size for c in problems]))
@@ -271,10 +276,7 @@ def main(argv=None):
              f"--threads {args.threads}`: "
              f"{n} particles, {len(problems)} problems of about {points} points, {args.threads} thread(s); "
              "the speed-up is over the first domain count.")
-    if args.out:
-        write_results(args.out, f"Cost of an NLGS sweep per contact point: {n} particles", intro, [table])
-    else:
-        print(intro + "\n\n" + table)
+    _report(args.out, f"Cost of an NLGS sweep per contact point: {n} particles", intro, table)
 
 
 if __name__ == "__main__":

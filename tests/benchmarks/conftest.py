@@ -5,6 +5,8 @@ import importlib.util
 import os
 import sys
 
+import pytest
+
 BENCHMARKS = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "benchmarks")
 
 
@@ -18,3 +20,13 @@ def load_benchmark(name):
     finally:
         sys.path.remove(BENCHMARKS)
     return module
+
+
+@pytest.fixture(scope="session")
+def pentagon_sample(tmp_path_factory):
+    """The path of a compacted sample of 60 pentagons ('fast' route, Anderson sweeps, seed 0),
+    saved once by ``benchmarks/compaction.py`` for every test that shears one; each test loads
+    its own copy from the file."""
+    path = str(tmp_path_factory.mktemp("samples") / "pentagons.pkl")
+    load_benchmark("compaction").compact("pentagon", 60, 0, "fast", acceleration="anderson", save=path)
+    return path

@@ -20,17 +20,9 @@ def scaling():
     return scaling
 
 
-@pytest.fixture(scope="module")
-def sample(tmp_path_factory):
-    compaction = load("compaction")
-    path = str(tmp_path_factory.mktemp("samples") / "pentagons.pkl")
-    compaction.compact("pentagon", 60, 0, "fast", acceleration="anderson", save=path)
-    return path
-
-
 @pytest.mark.parametrize("domains", [1, 2])
-def test_the_window_counts_add_up(scaling, sample, domains):
-    r = scaling.dense_case(sample, domains, 5, 12)
+def test_the_window_counts_add_up(scaling, pentagon_sample, domains):
+    r = scaling.dense_case(pentagon_sample, domains, 5, 12)
     assert r["n"] == 60 and r["domains"] == domains
     assert len(r["seconds"]) == len(r["sweeps"]) == len(r["points"]) == 12
     # the simulation's meters cover the timed window only
@@ -40,11 +32,11 @@ def test_the_window_counts_add_up(scaling, sample, domains):
     assert np.all(r["law"] >= 0) and r["converged"].dtype == bool
 
 
-def test_the_timed_window_is_the_shear(scaling, sample):
+def test_the_timed_window_is_the_shear(scaling, pentagon_sample):
     """Steps 6-17 of the measured serial shear take the sweeps of the same steps of an
     unmeasured shear from the same sample (the measure times the steps, it does not change them)."""
     sweep_bursts = load("sweep_bursts")
-    sim, _ = load("common").load_sample(sample)
+    sim, _ = load("common").load_sample(pentagon_sample)
     sweeps = []
 
     def count(info):
@@ -53,7 +45,7 @@ def test_the_timed_window_is_the_shear(scaling, sample):
             raise sweep_bursts._Done
 
     sweep_bursts._shear(sim, count)
-    r = scaling.dense_case(sample, 1, 5, 12)
+    r = scaling.dense_case(pentagon_sample, 1, 5, 12)
     np.testing.assert_array_equal(r["sweeps"], sweeps[5:])
 
 

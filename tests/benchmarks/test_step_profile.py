@@ -10,20 +10,12 @@ import pytest
 from .conftest import load_benchmark as load
 
 
-@pytest.fixture(scope="module")
-def sample(tmp_path_factory):
-    compaction = load("compaction")
-    path = str(tmp_path_factory.mktemp("samples") / "pentagons.pkl")
-    compaction.compact("pentagon", 60, 0, "fast", acceleration="anderson", save=path)
-    return path
-
-
 @pytest.mark.parametrize("domains", [1, 2])
-def test_each_piece_once_per_step_and_the_stages_add_up(sample, domains):
+def test_each_piece_once_per_step_and_the_stages_add_up(pentagon_sample, domains):
     from solver import residuals
 
     step_profile = load("step_profile")
-    sim, _ = step_profile.load_sample(sample)
+    sim, _ = step_profile.load_sample(pentagon_sample)
     law = residuals.local_law_residual
     out = step_profile.profile(sim, 5, 12, domains)
     calls = out["calls"]
@@ -39,12 +31,12 @@ def test_each_piece_once_per_step_and_the_stages_add_up(sample, domains):
     assert residuals.local_law_residual is law
 
 
-def test_the_profiled_shear_is_the_shear(sample):
+def test_the_profiled_shear_is_the_shear(pentagon_sample):
     """The same 12 steps after 5, sheared once profiled and once with only a counter: the
     same sweeps per step (profiling times the pieces, it does not change them)."""
     step_profile = load("step_profile")
     sweep_bursts = load("sweep_bursts")
-    sim, _ = step_profile.load_sample(sample)
+    sim, _ = step_profile.load_sample(pentagon_sample)
     plain = copy.deepcopy(sim)
     out = step_profile.profile(sim, 5, 12)
     sweeps = []
@@ -59,7 +51,7 @@ def test_the_profiled_shear_is_the_shear(sample):
     np.testing.assert_array_equal(sim.position, plain.position)
 
 
-def test_the_table_takes_the_median_of_the_turns(sample):
+def test_the_table_takes_the_median_of_the_turns(pentagon_sample):
     step_profile = load("step_profile")
     stages = step_profile.STAGES
 

@@ -61,11 +61,8 @@ def test_one_sticking_disk_is_solved_exactly(subspace):
 
 
 @pytest.fixture(scope="module")
-def probed(subspace, tmp_path_factory):
-    compaction = load_benchmark("compaction")
-    path = str(tmp_path_factory.mktemp("samples") / "pentagons.pkl")
-    compaction.compact("pentagon", 60, 0, "fast", acceleration="anderson", save=path)
-    sim, _ = load_benchmark("common").load_sample(path)
+def probed(subspace, pentagon_sample):
+    sim, _ = load_benchmark("common").load_sample(pentagon_sample)
     case = subspace.capture(sim, 3, 3)[0]
     return case, sim.n_particles, subspace.probe(case, sim.n_particles, sweeps=5, checkpoints=(2, 4))
 

@@ -14,11 +14,8 @@ def bursts():
 
 
 @pytest.fixture(scope="module")
-def captured(bursts, tmp_path_factory):
-    compaction = load_benchmark("compaction")
-    path = str(tmp_path_factory.mktemp("samples") / "pentagons.pkl")
-    compaction.compact("pentagon", 60, 0, "fast", acceleration="anderson", save=path)
-    sim, _ = load_benchmark("common").load_sample(path)
+def captured(bursts, pentagon_sample):
+    sim, _ = load_benchmark("common").load_sample(pentagon_sample)
     bounds = sim.walls.box_bounds()
     return sim, bounds, bursts.capture(sim, 2, 6)
 

@@ -8,13 +8,9 @@ from .conftest import load_benchmark as load
 
 
 @pytest.fixture(scope="module")
-def problems(tmp_path_factory):
-    compaction = load("compaction")
-    common = load("common")
+def problems(pentagon_sample):
     sweep_bursts = load("sweep_bursts")
-    path = str(tmp_path_factory.mktemp("samples") / "pentagons.pkl")
-    compaction.compact("pentagon", 60, 0, "fast", acceleration="anderson", save=path)
-    sim, _ = common.load_sample(path)
+    sim, _ = load("common").load_sample(pentagon_sample)
     return sweep_bursts.capture(sim, 3, 4)
 
 
