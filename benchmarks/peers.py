@@ -11,8 +11,9 @@ density, box (x0, y0, x1, y1), gravity, dt, friction) is settled once and saved 
 ``benchmarks/solver_bench/peer_engines.py``; every engine is timed on the same reloaded pile, as
 ``../shared/PEERS.md`` recommends. The engine steps ``--steps`` times with a fixed iteration
 budget and writes the final positions and angles (the caller measures the overlaps with this
-project's narrow phase, one metric for all engines), the wall time per step, and the mean
-force on the floor over the last half of the steps (to compare with the weight).
+project's narrow phase, one metric for all engines), the wall time per step, and the force on
+the floor in each of ``--measured`` further steps, not timed (to compare with the weight: in a
+pile at rest every step's floor force is the weight).
 
 Fairness notes (PEERS.md): pymunk combines friction by product, Box2D by geometric mean: both
 get per-shape coefficients that give mu = 0.4 between grains and 0 with walls. Box2D runs in
@@ -35,7 +36,7 @@ def local_vertices(pile, p):
     return pile["local_vertices"][first[p]:first[p + 1]]
 
 
-def run_pymunk(pile, steps, iterations):
+def run_pymunk(pile, steps, iterations, measured):
     import pymunk
 
     space = pymunk.Space()
@@ -89,15 +90,15 @@ def run_pymunk(pile, steps, iterations):
     for k in range(steps):
         space.step(dt)
     elapsed = time.perf_counter() - start
-    for k in range(max(steps // 10, 1)):  # force measurement, not timed
+    for k in range(measured):  # force measurement, not timed
         space.step(dt)
         floor_force.append(floor_impulse() / dt)
     pos = np.array([b.position for b in bodies])
     ang = np.array([b.angle for b in bodies])
-    return pos, ang, elapsed / steps, float(np.mean(floor_force))
+    return pos, ang, elapsed / steps, np.array(floor_force)
 
 
-def run_box2d(pile, steps, iterations):
+def run_box2d(pile, steps, iterations, measured):
     import Box2D as b2
 
     unit = 0.025  # length unit of the simulation, m
@@ -140,16 +141,16 @@ def run_box2d(pile, steps, iterations):
     elapsed = time.perf_counter() - start
     listener = FloorListener()
     world.contactListener = listener
-    measured = max(steps // 10, 1)
-    for k in range(measured):
-        world.Step(dt, int(iterations), int(iterations))
     # impulses are in (density-1 mass units) x unit/s: convert to the weight ratio directly
-    total_mass_b2 = sum(b.mass for b in bodies)
-    weight_b2 = total_mass_b2 * abs(g[1])
-    floor_ratio = listener.impulse / dt / measured / weight_b2
+    weight_b2 = sum(b.mass for b in bodies) * abs(g[1])
+    floor_ratio = []
+    for k in range(measured):
+        listener.impulse = 0.0
+        world.Step(dt, int(iterations), int(iterations))
+        floor_ratio.append(listener.impulse / dt / weight_b2)
     pos = np.array([b.position for b in bodies]) * unit
     ang = np.array([b.angle for b in bodies])
-    return pos, ang, elapsed / steps, floor_ratio
+    return pos, ang, elapsed / steps, np.array(floor_ratio)
 
 
 def main():
@@ -159,14 +160,18 @@ def main():
     parser.add_argument("--engine", choices=["pymunk", "box2d"], required=True)
     parser.add_argument("--steps", type=int, default=200)
     parser.add_argument("--iterations", type=int, default=50)
+    parser.add_argument("--measured", type=int, default=100, help="untimed steps whose floor force is recorded")
     args = parser.parse_args()
+    if args.steps < 1 or args.iterations < 1 or args.measured < 1:
+        parser.error(f"--steps {args.steps}, --iterations {args.iterations}, --measured {args.measured}: expected "
+                     "whole numbers >= 1")
     pile = dict(np.load(args.pile))
     if args.engine == "pymunk":
-        pos, ang, per_step, floor = run_pymunk(pile, args.steps, args.iterations)
+        pos, ang, per_step, floor = run_pymunk(pile, args.steps, args.iterations, args.measured)
         mass = float(pile["density"]) * _areas(pile).sum()
         floor_ratio = floor / (mass * abs(pile["gravity"][1]))
     else:
-        pos, ang, per_step, floor_ratio = run_box2d(pile, args.steps, args.iterations)
+        pos, ang, per_step, floor_ratio = run_box2d(pile, args.steps, args.iterations, args.measured)
     np.savez(args.out, position=pos, angle=ang, time_per_step=per_step, floor_over_weight=floor_ratio)
 
 

@@ -39,8 +39,9 @@ class Config:
     peer_particles: int = 1000
     peer_settle_steps: int = 3000
     peer_steps: int = 200
+    peer_measured_steps: int = 100  # untimed steps whose floor force is recorded, one value per step
     peer_budgets: tuple = (10, 25, 50)
-    peer_tolerances: tuple = (3e-5, 1e-5, 1e-6)  # besides the default: what a smaller floor-force error costs
+    peer_tolerances: tuple = (3e-5, 2e-5, 1.5e-5, 1e-5, 1e-6)  # besides the default: what a smaller floor-force error costs
     # skipping
     skip_particles: int = 1000
     skip_steps: int = 40
@@ -68,6 +69,7 @@ class Config:
             self.peer_particles = 60
             self.peer_settle_steps = 100
             self.peer_steps = 20
+            self.peer_measured_steps = 10
             self.peer_budgets = (10,)
             self.peer_tolerances = ()
             self.skip_particles = 200

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import os
 import subprocess
+import warnings
 
 import numpy as np
 
@@ -36,10 +37,11 @@ def settle_pile(n, shape, steps, seed=0):
                 dt=p.time_step, friction=p.friction, kinetic_energy=sim.kinetic_energy())
 
 
-def _ours_on_pile(path, steps, iterations, tolerance):
+def _ours_on_pile(path, steps, iterations, tolerance, measured):
     """This solver on the pile: ``iterations`` sweeps every step (``tolerance`` None), or until
     ``tolerance`` (the quadratic norm; the max norm in the defaults' ratio; "default": the
-    defaults) with at most 2000 sweeps."""
+    defaults) with at most 2000 sweeps; then ``measured`` untimed steps whose floor force over
+    the weight is recorded, one value per step."""
     from solver import Parameters, gravity_scene
 
     pile = dict(np.load(path))
@@ -60,14 +62,25 @@ def _ours_on_pile(path, steps, iterations, tolerance):
     recovery_sweeps = sim.counters["recovery_sweeps"] / steps
     point_sweeps = sim.counters["point_sweeps"]
     floor = []
-    for _ in range(max(steps // 10, 1)):
-        sim.step()
-        floor.append(-sim.wall_forces()[0, 1])
-    ratio = float(np.mean(floor)) / (sim.mass.sum() * abs(pile["gravity"][1]))
+    with warnings.catch_warnings():  # a fixed budget stops every step at its cap, by design
+        warnings.simplefilter("ignore")
+        for _ in range(measured):
+            sim.step()
+            floor.append(-sim.wall_forces()[0, 1])
+    ratio = np.array(floor) / (sim.mass.sum() * abs(pile["gravity"][1]))
     parts = {k: 1e3 * v / steps for k, v in sim.timings.items()}
     return dict(position=sim.position, angle=sim.angle, per_step=elapsed / steps, floor=ratio, sweeps=sweeps, parts=parts,
                 recovery_sweeps=recovery_sweeps, ns=1e9 * sim.timings["solve"] / max(point_sweeps, 1), points=sim.last.n_points,
                 pairs=sim.points.n_pairs)
+
+
+def floor_errors(ratio):
+    """(|mean - 1|, per-step RMS of ratio - 1) of the floor force over the weight, one ``ratio``
+    per step. In a pile at rest the floor carries the weight in every step; over many steps the
+    mean tends to the weight whatever the solver does (the pile's momentum stays near zero), so
+    the per-step RMS is the measure of how well each step's forces balance the weight."""
+    error = np.asarray(ratio, dtype=float) - 1.0
+    return abs(float(error.mean())), float(np.sqrt(np.mean(error ** 2)))
 
 
 def section_peers(cfg: Config, log=print):
@@ -92,7 +105,8 @@ def section_peers(cfg: Config, log=print):
         for engine, budget, tolerance in cases:
             try:
                 if engine.startswith("this solver"):
-                    r, _ = in_fresh_process(_ours_on_pile, path, cfg.peer_steps, budget or 2000, tolerance)
+                    r, _ = in_fresh_process(_ours_on_pile, path, cfg.peer_steps, budget or 2000, tolerance,
+                                            cfg.peer_measured_steps)
                     q = r["parts"]
                     extra = (f"{r['sweeps']:.0f} sweeps/step, {r['ns']:.0f} ns/point/sweep, "
                              f"{r['points']} points / {r['pairs']} pairs; ms/step: NLGS {q['solve']:.2f}, "
@@ -101,31 +115,37 @@ def section_peers(cfg: Config, log=print):
                                    if tolerance == "default" else f"tol. {tolerance:g} (<= 2000)")
                 else:
                     if not have_peers:
-                        rows.append([shape, engine, f"{budget}", "-", "-", "-", "-", "peer venv missing"])
+                        rows.append([shape, engine, f"{budget}", "-", "-", "-", "-", "-", "peer venv missing"])
                         continue
                     out = os.path.join(DATA, f"peer_{engine}_{shape}_{budget}.npz")
                     subprocess.run([PEER_PYTHON, os.path.join(HERE, "peers.py"), path, out, "--engine", engine,
-                                    "--steps", str(cfg.peer_steps), "--iterations", str(budget)], check=True,
+                                    "--steps", str(cfg.peer_steps), "--iterations", str(budget),
+                                    "--measured", str(cfg.peer_measured_steps)], check=True,
                                    capture_output=True, text=True, timeout=900)
                     res = dict(np.load(out))
                     r = dict(position=res["position"], angle=res["angle"], per_step=float(res["time_per_step"]),
-                             floor=float(res["floor_over_weight"]))
+                             floor=res["floor_over_weight"])
                     extra = ("velocity = position iterations" if engine == "box2d" else "") + "; fixed budget"
                     budget_text = f"{budget} iterations"
                 overlap = largest_overlap(r["position"], r["angle"], pile["radius"], pile["n_vertices"], walls.point,
                                           walls.normal)
                 rows.append([shape, engine, budget_text, f"{1e3 * r['per_step']:.2f}", f"{1e6 * r['per_step'] / n:.1f}",
-                             fmt(abs(r["floor"] - 1)), fmt(overlap / diameter), extra])
+                             *(fmt(e) for e in floor_errors(r["floor"])), fmt(overlap / diameter), extra])
             except Exception as exc:  # a peer failing must not stop the run
-                rows.append([shape, engine, f"{budget}", "-", "-", "-", "-", f"failed: {str(exc)[:100]}"])
+                rows.append([shape, engine, f"{budget}", "-", "-", "-", "-", "-", f"failed: {str(exc)[:100]}"])
             log(rows[-1])
-    header = ["pile", "engine", "budget", "ms / step", "us / step / particle", "|floor force / weight - 1|",
+    header = ["pile", "engine", "budget", "ms / step", "us / step / particle",
+              f"|floor force / weight - 1|, mean of {cfg.peer_measured_steps} steps",
+              "floor force / weight - 1, per-step RMS",
               "largest overlap / mean d", "notes"]
     text = (f"Piles of {cfg.peer_particles} particles (paper size mix, box width for h/l ~ 1, side walls, friction "
             f"0.4 between grains, 0 with walls) deposited geometrically and settled by this solver for "
             f"up to {cfg.peer_settle_steps} steps (until E_kin < 1e-6 m g d; {'; '.join(settled_note)}), saved to .npz and reloaded into every engine in a fresh process "
             f"(PEERS.md). Each engine then runs {cfg.peer_steps} timed steps at dt = 5e-4 s with the stated "
-            f"budget; floor force averaged over {max(cfg.peer_steps // 10, 1)} further steps (not timed); overlap "
+            f"budget; then the floor force is recorded in each of {cfg.peer_measured_steps} further steps (not "
+            f"timed), and its error against the weight given as the mean's and per step (RMS): over many steps "
+            f"the mean tends to the weight whatever the solver does (the pile's momentum stays near zero), so the "
+            f"per-step RMS is the accuracy measure; overlap "
             f"measured on each engine's final positions with this project's narrow phase (same metric for all). "
             f"This solver at a fixed budget: tolerance 1e-30 so it always spends max_iterations sweeps; its "
             f"overlap-recovery pass keeps its own settings (tolerance 1e-2, at most 50 sweeps, run only where an "
