@@ -31,8 +31,12 @@ def test_floor_errors_by_hand(peer_engines):
 
 def test_a_settled_pile_carries_its_weight_step_by_step(peer_engines, tmp_path):
     pile = peer_engines.settle_pile(40, "disk", 1500)
+    # settled: at rest, and no overlap left for the recovery pass
+    assert pile["settle_steps"] < 1500
+    assert pile["largest_overlap"] < 1e-4 * 2 * pile["radius"].min()
     path = str(tmp_path / "pile.npz")
-    np.savez(path, **{k: v for k, v in pile.items() if k != "kinetic_energy"})
+    peer_engines.save_pile(pile, path)
+    assert "settle_steps" not in np.load(path)
     r = peer_engines._ours_on_pile(path, 20, 2000, 1e-6, 15)
     assert r["floor"].shape == (15,)
     mean, rms = peer_engines.floor_errors(r["floor"])
