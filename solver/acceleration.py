@@ -162,16 +162,18 @@ def _point_history(lo, hi, slot, count, pn, pt, xn, xt, fn, ft, fn_prev, ft_prev
 @njit(cache=True)
 def _body_history(lo, hi, slot, vx, vy, w, hvx, hvy, hw, dvx, dvy, dw):
     """The velocity history of bodies lo..hi - 1: the change since the previous sweep stored
-    in row ``slot`` (when >= 0), then previous <- current. Velocities are linear in the
-    impulses (v = v_free + M^-1 H p), so these are M^-1 H dG."""
+    in row ``slot`` (when >= 0), and previous <- current in the same pass. Velocities are
+    linear in the impulses (v = v_free + M^-1 H p), so these are M^-1 H dG."""
     if slot >= 0:
         for new, now, old in ((dvx[slot, lo:hi], vx[lo:hi], hvx[lo:hi]), (dvy[slot, lo:hi], vy[lo:hi], hvy[lo:hi]),
                               (dw[slot, lo:hi], w[lo:hi], hw[lo:hi])):
             for i in range(new.size):
                 new[i] = now[i] - old[i]
-    hvx[lo:hi] = vx[lo:hi]
-    hvy[lo:hi] = vy[lo:hi]
-    hw[lo:hi] = w[lo:hi]
+                old[i] = now[i]
+    else:
+        hvx[lo:hi] = vx[lo:hi]
+        hvy[lo:hi] = vy[lo:hi]
+        hw[lo:hi] = w[lo:hi]
 
 
 @njit(cache=True)
