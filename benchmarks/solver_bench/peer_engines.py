@@ -18,45 +18,64 @@ from .helpers import fmt, largest_overlap, reset_meters, run_steps
 def settle_pile(n, shape, steps, seed=0):
     """Deposit ``n`` particles (paper size mix) between side walls and settle them under
     gravity with this solver, 50 steps at a time for at most ``steps`` steps, until the pile is
-    at rest (kinetic energy below 10^-6 m g d) and its overlaps are gone (none above the
-    overlap recovery's threshold over the last 50 steps: a pile still being pushed apart at the
-    recovery's speed cap is not settled, and every engine would spend its timed steps on that);
-    returns the pile as a dict in the format benchmarks/peers.py reads, with ``kinetic_energy``,
-    ``largest_overlap`` (m, over the last 50 steps) and ``settle_steps``."""
+    at rest (kinetic energy below 10^-6 m g d) and free of overlaps: the overlap recovery did
+    not run in the last 50 steps (no end-of-step overlap above its threshold). A pile still
+    being pushed apart at the recovery's speed cap is not settled, and every engine would spend
+    its timed steps on that.
+
+    Returns
+    -------
+    dict
+        The pile in the format benchmarks/peers.py reads, and the settling's record:
+        ``kinetic_energy`` (J), ``largest_overlap`` (over the last 50 steps, in smallest
+        diameters), ``settle_steps`` and ``settled`` (False when ``steps`` ran out first).
+    """
     from solver import gravity_scene
     from solver.packing import box_width_for, deposit
     from solver.shapes import n_vertices_of
 
+    if steps < 50:
+        raise ValueError(f"settle_pile: steps={steps}: expected at least 50 (the pile is checked every 50 steps)")
     width = box_width_for(n, aspect_ratio=1.0)
     pos, ang, rad, nv, height = deposit(n, nvert=n_vertices_of(shape), width=width, seed=seed)
     sim = gravity_scene(pos, ang, rad, nv, sides=(0.0, width))
     weight_scale = float(sim.mass.sum()) * 9.81 * 2 * float(rad.mean())  # J
     p = sim.parameters
-    threshold = p.overlap_recovery_threshold * 2 * float(rad.min())  # m, as the stepper's
-    settled = 0
-    while settled < steps:
+    done, settled = 0, False
+    while done < steps and not settled:
+        recovery_sweeps = sim.counters["recovery_sweeps"]
         _, _, overlap, _ = run_steps(sim, 50)
-        settled += 50
-        if sim.kinetic_energy() < 1e-6 * weight_scale and overlap < threshold:
-            break
+        done += 50
+        settled = (sim.kinetic_energy() < 1e-6 * weight_scale
+                   and sim.counters["recovery_sweeps"] == recovery_sweeps)
     return dict(position=sim.position.copy(), angle=sim.angle.copy(), radius=rad, n_vertices=nv.astype(np.int64),
                 first_vertex=sim.shapes.first_vertex, local_vertices=sim.shapes.local_vertices(),
                 density=p.density, box=np.array([0.0, 0.0, width, height]), gravity=np.array(p.gravity),
-                dt=p.time_step, friction=p.friction, kinetic_energy=sim.kinetic_energy(), largest_overlap=overlap,
-                settle_steps=settled)
+                dt=p.time_step, friction=p.friction, kinetic_energy=sim.kinetic_energy(),
+                largest_overlap=overlap / (2 * float(rad.min())), settle_steps=done, settled=settled)
 
 
 def save_pile(pile, path):
     """Write a :func:`settle_pile` pile to ``path`` (.npz) in the format benchmarks/peers.py
     reads (without the settling's own record)."""
-    np.savez(path, **{k: v for k, v in pile.items() if k not in ("kinetic_energy", "largest_overlap", "settle_steps")})
+    np.savez(path, **{k: v for k, v in pile.items() if k not in ("kinetic_energy", "largest_overlap", "settle_steps", "settled")})
 
 
 def _ours_on_pile(path, steps, iterations, tolerance, measured):
     """This solver on the pile: ``iterations`` sweeps every step (``tolerance`` None), or until
     ``tolerance`` (the quadratic norm; the max norm in the defaults' ratio; "default": the
     defaults) with at most 2000 sweeps; then ``measured`` untimed steps whose floor force over
-    the weight is recorded, one value per step."""
+    the weight is recorded, one value per step.
+
+    Returns
+    -------
+    dict
+        ``per_step`` (s, timed steps), ``floor`` (array of the measured steps' floor force over
+        the weight), ``sweeps`` and ``recovery_sweeps`` per timed step, ``parts`` (ms per timed
+        step of each stage), ``ns`` (solve time per point-sweep), ``points``, ``pairs``,
+        ``unconverged`` (steps, timed and measured, that did not reach the tolerance; 0 at a
+        fixed budget), and the final ``position`` and ``angle``.
+    """
     from solver import Parameters, gravity_scene
 
     pile = dict(np.load(path))
@@ -114,7 +133,8 @@ def section_peers(cfg: Config, log=print):
         x0, _, x1, _ = pile["box"]
         walls = Walls.floor(sides=(x0, x1))
         note = (f"{shape} pile: {pile['settle_steps']} steps, E_kin {pile['kinetic_energy']:.2g} J, largest overlap "
-                f"{pile['largest_overlap'] / diameter:.1e} d over its last 50 steps")
+                f"{pile['largest_overlap']:.1e} of the smallest diameter over its last 50 steps"
+                + ("" if pile["settled"] else f", NOT settled within {cfg.peer_settle_steps} steps"))
         log(note)
         settled_note.append(note)
         cases = [("this solver", b, None) for b in cfg.peer_budgets] + [("this solver (default tol.)", None, "default")]
@@ -128,7 +148,7 @@ def section_peers(cfg: Config, log=print):
                     q = r["parts"]
                     extra = (f"{r['sweeps']:.0f} sweeps/step, {r['ns']:.0f} ns/point/sweep, "
                              f"{r['points']} points / {r['pairs']} pairs; ms/step: NLGS {q['solve']:.2f}, "
-                             f"update with overlap recovery {q['update']:.2f} ({r['recovery_sweeps']:.0f} recovery sweeps), detection {q['broad_phase'] + q['narrow_phase']:.2f}"
+                             f"update with overlap recovery {q['update']:.2f} ({r['recovery_sweeps']:.2f} recovery sweeps), detection {q['broad_phase'] + q['narrow_phase']:.2f}"
                              + (f"; {r['unconverged']} of {cfg.peer_steps + cfg.peer_measured_steps} steps stopped by the "
                                 "2000-sweep cap" if r["unconverged"] else ""))
                     budget_text = (f"{budget} sweeps" if tolerance is None else "tol. 1.7e-4 (<= 2000)"
@@ -160,8 +180,9 @@ def section_peers(cfg: Config, log=print):
               "largest overlap / mean d", "notes"]
     text = (f"Piles of {cfg.peer_particles} particles (paper size mix, box width for h/l ~ 1, side walls, friction "
             f"0.4 between grains, 0 with walls) deposited geometrically and settled by this solver for "
-            f"up to {cfg.peer_settle_steps} steps (until E_kin < 1e-6 m g d and no overlap above the overlap recovery's "
-            f"threshold, 1e-4 of the smallest diameter; {'; '.join(settled_note)}), saved to .npz and reloaded into every engine in a fresh process "
+            f"up to {cfg.peer_settle_steps} steps (until E_kin < 1e-6 m g d and the overlap recovery, which runs when "
+            f"an end-of-step overlap exceeds 1e-4 of the smallest diameter, ran in none of the last 50 steps; "
+            f"{'; '.join(settled_note)}), saved to .npz and reloaded into every engine in a fresh process "
             f"(PEERS.md). Each engine then runs {cfg.peer_steps} timed steps at dt = 5e-4 s with the stated "
             f"budget; then the floor force is recorded in each of {cfg.peer_measured_steps} further steps (not "
             f"timed), and its error against the weight given as the mean's and per step (RMS): over many steps "

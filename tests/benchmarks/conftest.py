@@ -22,6 +22,16 @@ def load_benchmark(name):
     return module
 
 
+def load_solver_bench(name):
+    """The module ``solver_bench.<name>`` of benchmarks/ (the package the sections of
+    RESULTS.md live in), imported with benchmarks/ on sys.path as ``benchmarks/run.py`` has it."""
+    sys.path.insert(0, BENCHMARKS)
+    try:
+        return importlib.import_module(f"solver_bench.{name}")
+    finally:
+        sys.path.remove(BENCHMARKS)
+
+
 @pytest.fixture(scope="session")
 def pentagon_sample(tmp_path_factory):
     """The path of a compacted sample of 60 pentagons ('fast' route, Anderson sweeps, seed 0),

@@ -1,22 +1,15 @@
 """benchmarks/solver_bench/peer_engines.py (section c of RESULTS.md): the floor-force errors, by
 hand and on a small pile at rest."""
 
-import sys
-
 import numpy as np
 import pytest
 
-from .conftest import BENCHMARKS
+from .conftest import load_solver_bench
 
 
 @pytest.fixture(scope="module")
 def peer_engines():
-    sys.path.insert(0, BENCHMARKS)
-    try:
-        from solver_bench import peer_engines
-    finally:
-        sys.path.remove(BENCHMARKS)
-    return peer_engines
+    return load_solver_bench("peer_engines")
 
 
 def test_floor_errors_by_hand(peer_engines):
@@ -32,8 +25,8 @@ def test_floor_errors_by_hand(peer_engines):
 def test_a_settled_pile_carries_its_weight_step_by_step(peer_engines, tmp_path):
     pile = peer_engines.settle_pile(40, "disk", 1500)
     # settled: at rest, and no overlap left for the recovery pass
-    assert pile["settle_steps"] < 1500
-    assert pile["largest_overlap"] < 1e-4 * 2 * pile["radius"].min()
+    assert pile["settled"] and pile["settle_steps"] <= 1500
+    assert pile["largest_overlap"] < 1e-4
     path = str(tmp_path / "pile.npz")
     peer_engines.save_pile(pile, path)
     assert "settle_steps" not in np.load(path)
@@ -42,7 +35,6 @@ def test_a_settled_pile_carries_its_weight_step_by_step(peer_engines, tmp_path):
     mean, rms = peer_engines.floor_errors(r["floor"])
     # at rest and solved tightly, every step's floor force is the weight (to the solver's tolerance)
     assert rms < 1e-4
-    assert mean <= rms
     # three sweeps a step leave each step's forces far from balancing the weight
     loose = peer_engines._ours_on_pile(path, 20, 3, None, 15)
     assert peer_engines.floor_errors(loose["floor"])[1] > 100 * rms

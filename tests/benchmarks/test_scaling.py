@@ -2,22 +2,16 @@
 itself, step for step, and its counts add up."""
 
 import os
-import sys
 
 import numpy as np
 import pytest
 
-from .conftest import BENCHMARKS, load_benchmark as load
+from .conftest import load_benchmark as load, load_solver_bench
 
 
 @pytest.fixture(scope="module")
 def scaling():
-    sys.path.insert(0, BENCHMARKS)
-    try:
-        from solver_bench import scaling
-    finally:
-        sys.path.remove(BENCHMARKS)
-    return scaling
+    return load_solver_bench("scaling")
 
 
 @pytest.mark.parametrize("domains", [1, 2])
