@@ -79,15 +79,33 @@ def warn_if_threads_sleep(domains, environ=None) -> bool:
     return False
 
 
-def body_domains(x, n_bodies, minv_xx, minv_yy, iinv, domains):
-    """Domain of every body: particles (the first ``x.size`` bodies, centres at ``x``, m) in
-    ``domains`` slabs of equal counts by x; bodies that never move :data:`FREE`; other moving
-    bodies (walls under a stress) :data:`SHARED`."""
+def slab_of_particles(x, domains):
+    """Slab of each particle (centres' abscissae ``x``, m) among ``domains`` slabs of equal
+    counts by x: rank(x) * domains // n, with ties ranked by index (a stable sort's ranks).
+
+    The slab boundaries are order statistics, so they are found by selection (``np.partition``,
+    O(n)) instead of a full sort: with distinct abscissae a particle lies in slab d exactly when
+    x reaches the boundary values of slabs 1 .. d. Where a boundary value is shared by several
+    particles the ranks decide among them, and the stable sort is used."""
     n = x.size
-    out = np.full(n_bodies, SHARED, dtype=np.int64)
+    if n == 0 or domains <= 1:
+        return np.zeros(n, dtype=np.int64)
+    first = -(-np.arange(1, domains) * n // domains)  # the smallest rank of each slab 1 .. D - 1
+    first = first[first < n]
+    bounds = np.partition(x, first)[first]
+    if all(np.count_nonzero(x == value) == 1 for value in np.unique(bounds)):
+        return np.searchsorted(bounds, x, side="right").astype(np.int64)
     rank = np.empty(n, dtype=np.int64)
     rank[np.argsort(x, kind="stable")] = np.arange(n)
-    out[:n] = rank * domains // max(n, 1)
+    return rank * domains // n
+
+
+def body_domains(x, n_bodies, minv_xx, minv_yy, iinv, domains):
+    """Domain of every body: particles (the first ``x.size`` bodies, centres at ``x``, m) in
+    ``domains`` slabs of equal counts by x (:func:`slab_of_particles`); bodies that never move
+    :data:`FREE`; other moving bodies (walls under a stress) :data:`SHARED`."""
+    out = np.full(n_bodies, SHARED, dtype=np.int64)
+    out[:x.size] = slab_of_particles(x, domains)
     still = (minv_xx == 0.0) & (minv_yy == 0.0) & (iinv == 0.0)
     out[still] = FREE
     return out

@@ -31,6 +31,27 @@ def _state(impulse, v_free, omega_free):
     return [impulse[:, 0].copy(), impulse[:, 1].copy(), v_free[:, 0].copy(), v_free[:, 1].copy(), omega_free.copy()]
 
 
+def _stable_ranks_slab(x, domains):
+    """The slabs by the definition: rank in a stable sort of x, times domains // n."""
+    rank = np.empty(x.size, dtype=np.int64)
+    rank[np.argsort(x, kind="stable")] = np.arange(x.size)
+    return rank * domains // max(x.size, 1)
+
+
+@pytest.mark.parametrize("ties", [False, True])
+def test_slabs_by_selection_are_the_stable_sorts_slabs(ties):
+    # distinct abscissae take the O(n) selection path; lattice-like repeated abscissae (a
+    # boundary value shared by several particles) the stable sort's: both equal the definition
+    rng = np.random.default_rng(3)
+    for _ in range(500):
+        n, domains = int(rng.integers(1, 80)), int(rng.integers(1, 9))
+        x = rng.integers(0, 6, n).astype(float) if ties else rng.random(n)
+        np.testing.assert_array_equal(parallel_nlgs.slab_of_particles(x, domains), _stable_ranks_slab(x, domains))
+    # equal counts: 10 particles in 3 slabs hold 4, 3 and 3 (ranks 0-3, 4-6, 7-9)
+    slabs = parallel_nlgs.slab_of_particles(np.linspace(1.0, 0.0, 10), 3)
+    np.testing.assert_array_equal(slabs, [2, 2, 2, 1, 1, 1, 0, 0, 0, 0])
+
+
 def test_decomposition_respects_bodies(problem):
     sim, prob, *_ = problem
     n = sim.n_particles
