@@ -47,7 +47,7 @@ from numba import njit, prange
 
 from . import scratch
 from .nlgs import NLGSResult, _apply, delassus_into, stalled, sweep, sweep_norms, velocities_from_impulses
-from .parallel_nlgs import solve_decomposed, sweep_domains
+from .parallel_nlgs import solve_decomposed, start_domains, sweep_domains
 from .residuals import cone_projection
 
 __all__ = ["solve_anderson", "solve_problem_anderson"]
@@ -304,8 +304,13 @@ def solve_anderson(blocks, a, b, nx, ny, rax, ray, rbx, rby, bias, mu, pn, pt, v
     hvx = singles[11 * m:11 * m + n_bodies]
     hvy = singles[11 * m + n_bodies:11 * m + 2 * n_bodies]
     hw = singles[11 * m + 2 * n_bodies:11 * m + 3 * n_bodies]
-    delassus_into(a, b, nx, ny, rax, ray, rbx, rby, minv_xx, minv_xy, minv_yy, iinv, wnn, wnt, wtt)
-    velocities_from_impulses(a, b, nx, ny, rax, ray, rbx, rby, pn, pt, vx, vy, w, minv_xx, minv_xy, minv_yy, iinv)
+    if parallel:
+        start_domains(blocks, a, b, nx, ny, rax, ray, rbx, rby, pn, pt, vx, vy, w, minv_xx, minv_xy, minv_yy, iinv,
+                      wnn, wnt, wtt)
+    else:
+        delassus_into(a, b, nx, ny, rax, ray, rbx, rby, minv_xx, minv_xy, minv_yy, iinv, wnn, wnt, wtt)
+        velocities_from_impulses(a, b, nx, ny, rax, ray, rbx, rby, pn, pt, vx, vy, w, minv_xx, minv_xy, minv_yy,
+                                 iinv)
     order = np.arange(m)
     ptr = blocks[:-1].copy()
     points = order[:blocks[-2]]

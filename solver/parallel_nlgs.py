@@ -42,7 +42,7 @@ import numpy as np
 from numba import njit, prange
 
 from . import scratch
-from .nlgs import NLGSResult, delassus, stalled, sweep, sweep_norms, velocities_from_impulses
+from .nlgs import NLGSResult, delassus_into, stalled, sweep, sweep_norms, velocities_from_impulses
 
 FREE = -1
 """Domain of a body that never moves (zero inverse mass and inertia): shared by every domain."""
@@ -173,12 +173,43 @@ def sweep_domains(ptr, points, interface, a, b, nx, ny, rax, ray, rbx, rby, bias
     return sum_dv2, max_dv2, scale, n_active
 
 
+@njit(cache=True, parallel=True)
+def start_domains(blocks, a, b, nx, ny, rax, ray, rbx, rby, pn, pt, vx, vy, w, minv_xx, minv_xy, minv_yy, iinv,
+                  wnn, wnt, wtt):
+    """The start of a domain-decomposed solve, a block of points per thread: each point's
+    Delassus block into ``wnn, wnt, wtt`` (:func:`solver.nlgs.delassus_into`), then the
+    impulses added to the velocities (:func:`solver.nlgs.velocities_from_impulses`), the
+    domains at once (each writes its own bodies only) and the interface (the last block) after
+    them. ``blocks``: ``[0, p_1, ..., p_D, P]`` of the renumbered problem
+    (:attr:`Decomposition.blocks`). Every body receives its points' impulses in the order the
+    serial pass over all points would add them, so the velocities are the serial ones bit for
+    bit."""
+    domains = blocks.size - 2
+    for d in prange(domains):  # a loop of D iterations gives each of D threads one domain
+        lo, hi = blocks[d], blocks[d + 1]
+        delassus_into(a[lo:hi], b[lo:hi], nx[lo:hi], ny[lo:hi], rax[lo:hi], ray[lo:hi], rbx[lo:hi], rby[lo:hi],
+                      minv_xx, minv_xy, minv_yy, iinv, wnn[lo:hi], wnt[lo:hi], wtt[lo:hi])
+        velocities_from_impulses(a[lo:hi], b[lo:hi], nx[lo:hi], ny[lo:hi], rax[lo:hi], ray[lo:hi], rbx[lo:hi],
+                                 rby[lo:hi], pn[lo:hi], pt[lo:hi], vx, vy, w, minv_xx, minv_xy, minv_yy, iinv)
+    lo, hi = blocks[domains], blocks[domains + 1]
+    delassus_into(a[lo:hi], b[lo:hi], nx[lo:hi], ny[lo:hi], rax[lo:hi], ray[lo:hi], rbx[lo:hi], rby[lo:hi],
+                  minv_xx, minv_xy, minv_yy, iinv, wnn[lo:hi], wnt[lo:hi], wtt[lo:hi])
+    velocities_from_impulses(a[lo:hi], b[lo:hi], nx[lo:hi], ny[lo:hi], rax[lo:hi], ray[lo:hi], rbx[lo:hi], rby[lo:hi],
+                             pn[lo:hi], pt[lo:hi], vx, vy, w, minv_xx, minv_xy, minv_yy, iinv)
+
+
 @njit(cache=True)
 def solve_domains(ptr, points, interface, a, b, nx, ny, rax, ray, rbx, rby, bias, mu, pn, pt, vx, vy, w,
                   minv_xx, minv_xy, minv_yy, iinv, tol, max_tol, max_iterations, stall=0):
-    """:func:`solver.nlgs.solve` with :func:`sweep_domains` as its sweep."""
-    wnn, wnt, wtt = delassus(a, b, nx, ny, rax, ray, rbx, rby, minv_xx, minv_xy, minv_yy, iinv)
-    velocities_from_impulses(a, b, nx, ny, rax, ray, rbx, rby, pn, pt, vx, vy, w, minv_xx, minv_xy, minv_yy, iinv)
+    """:func:`solver.nlgs.solve` with :func:`sweep_domains` as its sweep (the problem laid out
+    as its :class:`Decomposition` says: ``points`` and ``interface`` contiguous, in order)."""
+    m = a.size
+    wnn, wnt, wtt = np.empty(m), np.empty(m), np.empty(m)
+    blocks = np.empty(ptr.size + 1, dtype=np.int64)
+    blocks[:ptr.size] = ptr
+    blocks[ptr.size] = m
+    start_domains(blocks, a, b, nx, ny, rax, ray, rbx, rby, pn, pt, vx, vy, w, minv_xx, minv_xy, minv_yy, iinv,
+                  wnn, wnt, wtt)
     quad = 0.0
     worst = 0.0
     watch = np.full(2, np.inf)
@@ -251,21 +282,22 @@ class Decomposition(NamedTuple):
         scatter_from(self.point_order, self.source, self.moving, *state, pn, pt, vx, vy, w)
 
 
-@njit(cache=True)
+@njit(cache=True, parallel=True)
 def gather_into(point_order, source, nx, ny, rax, ray, rbx, rby, bias, mu, pn, pt, minv_xx, minv_xy, minv_yy, iinv,
                 vx, vy, w, out):
     """Copies in the new numbering of :class:`Decomposition`: the ten point arrays (nx .. pt)
     taken at ``point_order``, then the seven body arrays (minv_xx .. w) at ``source``, in the
-    order of the arguments, written into ``out`` (10 P + 7 B floats or more)."""
+    order of the arguments, written into ``out`` (10 P + 7 B floats or more). Plain copies,
+    shared among the threads."""
     m = point_order.size
     points = out[:10 * m].reshape((10, m))
-    for q in range(m):
+    for q in prange(m):
         k = point_order[q]
         points[0, q], points[1, q], points[2, q], points[3, q], points[4, q] = nx[k], ny[k], rax[k], ray[k], rbx[k]
         points[5, q], points[6, q], points[7, q], points[8, q], points[9, q] = rby[k], bias[k], mu[k], pn[k], pt[k]
     n = source.size
     bodies = out[10 * m:10 * m + 7 * n].reshape((7, n))
-    for q in range(n):
+    for q in prange(n):
         j = source[q]
         bodies[0, q], bodies[1, q], bodies[2, q], bodies[3, q] = minv_xx[j], minv_xy[j], minv_yy[j], iinv[j]
         bodies[4, q], bodies[5, q], bodies[6, q] = vx[j], vy[j], w[j]

@@ -207,6 +207,39 @@ def test_gather_and_scatter_are_numpy_indexing(problem):
         np.testing.assert_array_equal(got, want)
 
 
+@pytest.mark.parametrize("domains", [2, 3])
+def test_start_of_a_domain_solve_is_the_serial_start_bit_for_bit(problem, domains):
+    """The threads' Delassus blocks and start velocities against the serial kernels on the same
+    renumbered problem, and the velocities against numpy: v = v_free + M^-1 H p summed point by
+    point with np.add.at (a different order of the sums: equal to round-off)."""
+    sim, prob, impulse, v_free, omega_free = problem
+    dec = parallel_nlgs.decompose(prob, sim.position[:, 0], domains)
+    geometry, masses, renumbered = dec.gather(prob, *_state(impulse, v_free, omega_free))
+    m = dec.a.size
+    blocks = np.append(dec.ptr, m)
+    threads = [x.copy() for x in renumbered]
+    w_threads = [np.empty(m) for _ in range(3)]
+    parallel_nlgs.start_domains(blocks, *geometry[:8], *threads, *masses, *w_threads)
+    serial = [x.copy() for x in renumbered]
+    w_serial = [np.empty(m) for _ in range(3)]
+    nlgs.delassus_into(*geometry[:8], *masses, *w_serial)
+    nlgs.velocities_from_impulses(*geometry[:8], *serial, *masses)
+    for got, want in zip(w_threads + threads, w_serial + serial):
+        np.testing.assert_array_equal(got, want)
+    # the velocities by numpy: each point's impulse p_n n + p_t t applied at its lever arms
+    a, b, nx, ny, rax, ray, rbx, rby = geometry[:8]
+    minv_xx, minv_xy, minv_yy, iinv = masses
+    pn, pt, vx, vy, w = [x.copy() for x in renumbered]
+    fx, fy = pn * nx - pt * ny, pn * ny + pt * nx
+    for body, sign, rx, ry in ((a, -1.0, rax, ray), (b, 1.0, rbx, rby)):
+        gx, gy = sign * fx, sign * fy
+        np.add.at(vx, body, minv_xx[body] * gx + minv_xy[body] * gy)
+        np.add.at(vy, body, minv_xy[body] * gx + minv_yy[body] * gy)
+        np.add.at(w, body, iinv[body] * (rx * gy - ry * gx))
+    for got, want in zip(threads[2:], (vx, vy, w)):
+        np.testing.assert_allclose(got, want, rtol=1e-12, atol=1e-12 * np.abs(want).max())
+
+
 @pytest.mark.parametrize("acceleration", ["anderson", "off"])
 def test_one_decomposition_per_step_serves_the_main_solve_and_the_recovery(acceleration):
     """A step decomposes its problem once and the overlap recovery's solve reuses it: the run is
