@@ -44,7 +44,7 @@ def test_slabs_by_selection_are_the_stable_sorts_slabs(ties):
     # boundary value shared by several particles) the stable sort's: both equal the definition
     rng = np.random.default_rng(3)
     for _ in range(500):
-        n, domains = int(rng.integers(1, 80)), int(rng.integers(1, 9))
+        n, domains = int(rng.integers(0, 80)), int(rng.integers(1, 17))
         x = rng.integers(0, 6, n).astype(float) if ties else rng.random(n)
         np.testing.assert_array_equal(parallel_nlgs.slab_of_particles(x, domains), _stable_ranks_slab(x, domains))
     # equal counts: 10 particles in 3 slabs hold 4, 3 and 3 (ranks 0-3, 4-6, 7-9)
