@@ -173,6 +173,17 @@ def sweep_domains(ptr, points, interface, a, b, nx, ny, rax, ray, rbx, rby, bias
     return sum_dv2, max_dv2, scale, n_active
 
 
+@njit(cache=True)
+def _start_block(lo, hi, a, b, nx, ny, rax, ray, rbx, rby, pn, pt, vx, vy, w, minv_xx, minv_xy, minv_yy, iinv, wnn,
+                 wnt, wtt):
+    """The Delassus blocks of points lo..hi - 1 (:func:`solver.nlgs.delassus_into`), then their
+    impulses added to their bodies' velocities (:func:`solver.nlgs.velocities_from_impulses`)."""
+    delassus_into(a[lo:hi], b[lo:hi], nx[lo:hi], ny[lo:hi], rax[lo:hi], ray[lo:hi], rbx[lo:hi], rby[lo:hi],
+                  minv_xx, minv_xy, minv_yy, iinv, wnn[lo:hi], wnt[lo:hi], wtt[lo:hi])
+    velocities_from_impulses(a[lo:hi], b[lo:hi], nx[lo:hi], ny[lo:hi], rax[lo:hi], ray[lo:hi], rbx[lo:hi], rby[lo:hi],
+                             pn[lo:hi], pt[lo:hi], vx, vy, w, minv_xx, minv_xy, minv_yy, iinv)
+
+
 @njit(cache=True, parallel=True)
 def start_domains(blocks, a, b, nx, ny, rax, ray, rbx, rby, pn, pt, vx, vy, w, minv_xx, minv_xy, minv_yy, iinv,
                   wnn, wnt, wtt):
@@ -186,16 +197,10 @@ def start_domains(blocks, a, b, nx, ny, rax, ray, rbx, rby, pn, pt, vx, vy, w, m
     bit."""
     domains = blocks.size - 2
     for d in prange(domains):  # a loop of D iterations gives each of D threads one domain
-        lo, hi = blocks[d], blocks[d + 1]
-        delassus_into(a[lo:hi], b[lo:hi], nx[lo:hi], ny[lo:hi], rax[lo:hi], ray[lo:hi], rbx[lo:hi], rby[lo:hi],
-                      minv_xx, minv_xy, minv_yy, iinv, wnn[lo:hi], wnt[lo:hi], wtt[lo:hi])
-        velocities_from_impulses(a[lo:hi], b[lo:hi], nx[lo:hi], ny[lo:hi], rax[lo:hi], ray[lo:hi], rbx[lo:hi],
-                                 rby[lo:hi], pn[lo:hi], pt[lo:hi], vx, vy, w, minv_xx, minv_xy, minv_yy, iinv)
-    lo, hi = blocks[domains], blocks[domains + 1]
-    delassus_into(a[lo:hi], b[lo:hi], nx[lo:hi], ny[lo:hi], rax[lo:hi], ray[lo:hi], rbx[lo:hi], rby[lo:hi],
-                  minv_xx, minv_xy, minv_yy, iinv, wnn[lo:hi], wnt[lo:hi], wtt[lo:hi])
-    velocities_from_impulses(a[lo:hi], b[lo:hi], nx[lo:hi], ny[lo:hi], rax[lo:hi], ray[lo:hi], rbx[lo:hi], rby[lo:hi],
-                             pn[lo:hi], pt[lo:hi], vx, vy, w, minv_xx, minv_xy, minv_yy, iinv)
+        _start_block(blocks[d], blocks[d + 1], a, b, nx, ny, rax, ray, rbx, rby, pn, pt, vx, vy, w, minv_xx, minv_xy,
+                     minv_yy, iinv, wnn, wnt, wtt)
+    _start_block(blocks[domains], blocks[domains + 1], a, b, nx, ny, rax, ray, rbx, rby, pn, pt, vx, vy, w, minv_xx,
+                 minv_xy, minv_yy, iinv, wnn, wnt, wtt)
 
 
 @njit(cache=True)
