@@ -32,6 +32,22 @@ def load_solver_bench(name):
         sys.path.remove(BENCHMARKS)
 
 
+def shear_sweeps(sim, steps):
+    """The NLGS sweeps of each of the first ``steps`` steps of ``sim``'s shear as the shear
+    benchmarks run it (``sweep_bursts._shear``), with nothing timed or profiled: the reference
+    that a measured run of the same steps must repeat."""
+    sweep_bursts = load_benchmark("sweep_bursts")
+    sweeps = []
+
+    def count(info):
+        sweeps.append(info.iterations)
+        if len(sweeps) == steps:
+            raise sweep_bursts._Done
+
+    sweep_bursts._shear(sim, count)
+    return sweeps
+
+
 @pytest.fixture(scope="session")
 def pentagon_sample(tmp_path_factory):
     """The path of a compacted sample of 60 pentagons ('fast' route, Anderson sweeps, seed 0),

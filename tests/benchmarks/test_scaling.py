@@ -6,7 +6,7 @@ import os
 import numpy as np
 import pytest
 
-from .conftest import load_benchmark as load, load_solver_bench
+from .conftest import load_benchmark as load, load_solver_bench, shear_sweeps
 
 
 @pytest.fixture(scope="module")
@@ -29,16 +29,8 @@ def test_the_window_counts_add_up(scaling, pentagon_sample, domains):
 def test_the_timed_window_is_the_shear(scaling, pentagon_sample):
     """Steps 6-17 of the measured serial shear take the sweeps of the same steps of an
     unmeasured shear from the same sample (the measure times the steps, it does not change them)."""
-    sweep_bursts = load("sweep_bursts")
     sim, _ = load("common").load_sample(pentagon_sample)
-    sweeps = []
-
-    def count(info):
-        sweeps.append(info.iterations)
-        if len(sweeps) == 17:
-            raise sweep_bursts._Done
-
-    sweep_bursts._shear(sim, count)
+    sweeps = shear_sweeps(sim, 17)
     r = scaling.dense_case(pentagon_sample, 1, 5, 12)
     np.testing.assert_array_equal(r["sweeps"], sweeps[5:])
 

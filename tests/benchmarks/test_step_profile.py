@@ -7,7 +7,7 @@ import copy
 import numpy as np
 import pytest
 
-from .conftest import load_benchmark as load
+from .conftest import load_benchmark as load, shear_sweeps
 
 
 @pytest.mark.parametrize("domains", [1, 2])
@@ -35,18 +35,10 @@ def test_the_profiled_shear_is_the_shear(pentagon_sample):
     """The same 12 steps after 5, sheared once profiled and once with only a counter: the
     same sweeps per step (profiling times the pieces, it does not change them)."""
     step_profile = load("step_profile")
-    sweep_bursts = load("sweep_bursts")
     sim, _ = step_profile.load_sample(pentagon_sample)
     plain = copy.deepcopy(sim)
     out = step_profile.profile(sim, 5, 12)
-    sweeps = []
-
-    def count(info):
-        sweeps.append(info.iterations)
-        if len(sweeps) == 17:
-            raise sweep_bursts._Done
-
-    sweep_bursts._shear(plain, count)
+    sweeps = shear_sweeps(plain, 17)
     assert out["sweeps"] == pytest.approx(np.mean(sweeps[5:]), rel=1e-12)
     np.testing.assert_array_equal(sim.position, plain.position)
 
