@@ -57,3 +57,15 @@ def test_every_pair_the_file_holds_needs_no_gap():
 def test_bad_near_arguments_say_what_is_wrong(near, held, gap, match):
     with pytest.raises(ParameterError, match=match):
         selection(chain(held=held, gap=gap), near=near)
+
+
+def test_a_pair_whose_gap_equals_near_counts():
+    """The rule is gap <= near: an unloaded pair exactly at the threshold is in the network, and
+    one a float's width beyond it is not."""
+    ds = chain()
+    gaps = ds["gap"].values[0]
+    for pair, expected in ((2, 3), (3, 4)):  # threshold at the gap of pair (2,3), then of (3,4)
+        near = float(gaps[pair])
+        assert int(selection(ds, near=near).sum()) == expected
+        assert int(selection(ds, near=float(np.nextafter(near, 0.0))).sum()) == expected - 1
+    assert float(ds.grain.coordination(near=float(gaps[2]))["z"].values[0]) == pytest.approx(6 / 4, abs=1e-12)
