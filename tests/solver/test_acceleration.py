@@ -30,12 +30,13 @@ def _copy(state):
     return [s.copy() for s in state]
 
 
-def reference_anderson(geometry, masses, state, sweep, iterations, memory, period=1):
+def reference_anderson(geometry, masses, state, sweep, iterations, memory, period=1, resets=None):
     """Anderson type II on the fixed-point map '``period`` sweeps', with whole vectors: gamma
     from numpy's least squares on the last ``memory`` differences, the extrapolation projected
     on the Coulomb cones, the velocities rebuilt from the free ones; the history is forgotten
     when |f| grows; the last sweep is not extrapolated (its iterate is the one its norms
-    describe). Returns the impulses after ``iterations`` sweeps."""
+    describe). Returns the impulses after ``iterations`` sweeps; ``resets``, a list, receives
+    the index of each map after which a history was forgotten because |f| grew."""
     a, b, nx, ny, rax, ray, rbx, rby, bias, mu = geometry
     pn, pt, vx, vy, w = state
     free = (vx.copy(), vy.copy(), w.copy())
@@ -51,6 +52,8 @@ def reference_anderson(geometry, masses, state, sweep, iterations, memory, perio
             break
         g = np.concatenate([pn, pt])
         f = g - x
+        if f @ f > last and fs and resets is not None:
+            resets.append(k)
         if f @ f > last or not fs:
             fs, gs = [], []
         last = f @ f
@@ -101,6 +104,29 @@ def test_serial_kernel_equals_the_numpy_reference(problem, period):
     nlgs.velocities_from_impulses(*geometry[:8], got[0], got[1], *rebuilt, *masses)
     for v, r in zip(got[2:], rebuilt):
         np.testing.assert_allclose(v, r, rtol=0, atol=1e-12 * np.abs(r).max())
+
+
+@pytest.mark.parametrize("period", [1, 2])
+def test_serial_kernel_equals_the_reference_through_the_safeguard(problem, period):
+    """Over 40 sweeps the iterate's change |f| grows a few times: each time the history must
+    be forgotten and plain sweeps kept, in the kernel as in the reference (without the
+    safeguard the kernel's iterates leave the reference's)."""
+    _, prob, state = problem
+    geometry, masses = _geometry(prob), _masses(prob)
+    order = np.arange(prob.a.size)
+
+    def sweep(pn, pt, vx, vy, w, wnn, wnt, wtt):
+        nlgs.sweep(order, *geometry, pn, pt, vx, vy, w, *masses, wnn, wnt, wtt)
+
+    resets = []
+    expected = reference_anderson(geometry, masses, _copy(state), sweep, 40, memory=4, period=period, resets=resets)
+    assert len(resets) >= 1  # the case this test is for
+    got = _copy(state)
+    acceleration.solve_problem_anderson(prob, *got, tolerance=0.0, max_tolerance=0.0, max_iterations=40, memory=4,
+                                        period=period)
+    scale = np.abs(expected[0]).max()
+    np.testing.assert_allclose(got[0], expected[0], rtol=0, atol=1e-9 * scale)
+    np.testing.assert_allclose(got[1], expected[1], rtol=0, atol=1e-9 * scale)
 
 
 @pytest.mark.parametrize("period", [1, 2])
