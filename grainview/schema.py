@@ -116,6 +116,13 @@ VARIABLES: dict[str, Var] = {
                               "zero for every solution of the Signorini-Coulomb laws", False),
     "unbalanced_force": Var(("time",), "f8", "1", "largest net force on a particle over the mean force of a "
                             "loaded contact point, last step", False),
+    "nlgs_unconverged_steps": Var(("time",), "i4", "1", "steps since the previous snapshot (this one's included) "
+                                  "whose NLGS stopped at its sweep cap or stall test before its stopping norms "
+                                  "met their tolerances", False),
+    "nlgs_unconverged_residual": Var(("time",), "f8", "1", "largest final NLGS quadratic norm (the stopping norm, "
+                                     "against solver_tolerance) of those steps; 0 when there are none", False),
+    "nlgs_unconverged_local_law_residual": Var(("time",), "f8", "1", "largest natural-map residual |F|/|r| of "
+                                               "those steps' impulses; 0 when there are none", False),
     "max_interpenetration": Var(("time",), "f8", "m", "largest interpenetration between bodies", False),
     "kinetic_energy": Var(("time",), "f8", "J", "total kinetic energy", False),
     # written last in each snapshot by SnapshotWriter (the last bytes of a netCDF-3 record)
@@ -127,7 +134,11 @@ CONTACT_VARIABLES = ("i", "j", "kind", "normal", "fn", "ft", "point", "branch")
 OPTIONAL_CONTACT_VARIABLES = ("gap",)
 """Optional variables given per contact, like the required ones, in a snapshot's ``contacts``."""
 DIAGNOSTICS = ("step", "nlgs_iterations", "nlgs_residual", "local_law_residual", "unbalanced_force",
+               "nlgs_unconverged_steps", "nlgs_unconverged_residual", "nlgs_unconverged_local_law_residual",
                "max_interpenetration", "kinetic_energy")
+"""The solver's per-snapshot diagnostics (optional variables along ``time``); the
+``nlgs_unconverged_*`` ones count the steps since the previous snapshot, the others describe
+the snapshot's own last step."""
 
 
 def particle_area(radius, n_vertices):

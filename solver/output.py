@@ -162,6 +162,11 @@ class Recorder:
     ``near_contacts=True`` also writes the pairs within the alert distance that carry no force
     (:func:`written_pairs` with ``near = sim.alert``; attribute ``near_contacts_m``).
 
+    Each snapshot also records the steps since the previous snapshot (since the recorder was
+    made, for the first) whose NLGS did not converge, from :meth:`solver.Simulation.take_unconverged`:
+    ``nlgs_unconverged_steps``, ``nlgs_unconverged_residual`` and
+    ``nlgs_unconverged_local_law_residual`` (:class:`solver.stepper.Unconverged`).
+
     While the run goes on the file is netCDF-3, appended snapshot by snapshot (a killed run
     keeps every completed snapshot). When the ``with`` block ends without an exception, the
     finished file is rewritten compressed (:func:`grainview.writer.compress_file`, zlib at
@@ -180,6 +185,7 @@ class Recorder:
         self.near = float(sim.alert) if near_contacts else None
         params["near_contacts_m"] = "none" if self.near is None else self.near
         self.sim = sim
+        sim.take_unconverged()  # each snapshot counts the unconverged steps since the one before it
         self.writer = SnapshotWriter.create(
             path, radius=sim.radius, n_vertices=sim.n_vertices, mass=sim.mass, inertia=sim.inertia,
             n_walls=sim.n_walls, wall_names=sim.walls.names, wall_normal=sim.walls.normal,
@@ -193,6 +199,7 @@ class Recorder:
         recorder = cls.__new__(cls)
         recorder.compress = compress_level(compress)
         recorder.sim = sim
+        sim.take_unconverged()
         recorder.writer = SnapshotWriter.open_append(path)
         near = recorder.writer.attribute("near_contacts_m", "none")
         recorder.near = None if isinstance(near, str) else float(near)
@@ -205,6 +212,7 @@ class Recorder:
         info = sim.last
         slots = self.writer.n_slots
         normal_impulse, tangential_impulse = point_impulses(sim, slots, self.near)
+        unconverged = sim.take_unconverged()
         self.writer.append(
             time=sim.time, position=sim.position, angle=sim.angle, contacts=pair_contacts(sim, self.near, slots),
             box_min=lo, box_max=hi,
@@ -213,7 +221,9 @@ class Recorder:
             wall_force=sim.wall_forces(), step=sim.step_index,
             nlgs_iterations=info.iterations if info else 0, nlgs_residual=info.residual if info else 0.0,
             local_law_residual=info.local_law_residual if info else 0.0,
-            unbalanced_force=info.unbalanced_force if info else 0.0,
+            unbalanced_force=info.unbalanced_force if info else 0.0, nlgs_unconverged_steps=unconverged.steps,
+            nlgs_unconverged_residual=unconverged.residual,
+            nlgs_unconverged_local_law_residual=unconverged.local_law_residual,
             max_interpenetration=info.max_interpenetration if info else 0.0, kinetic_energy=sim.kinetic_energy())
 
     def close(self):

@@ -129,9 +129,13 @@ def record(sim) -> dict:
     prep = sim.preparation
     if prep is None:
         return {}
-    return {**prep.attrs(), "preparation_name": preset_name(prep), "sigma0_Pa": prep.sigma0,
-            "compaction_steps": sim.compaction_steps, "compaction_settled": int(bool(sim.settled)),
-            "compaction_inertia_number": sim.compaction_inertia_number}
+    out = {**prep.attrs(), "preparation_name": preset_name(prep), "sigma0_Pa": prep.sigma0,
+           "compaction_steps": sim.compaction_steps, "compaction_settled": int(bool(sim.settled)),
+           "compaction_inertia_number": sim.compaction_inertia_number}
+    if sim.compaction_unconverged is not None:  # steps whose NLGS stopped before its tolerances
+        out.update(compaction_unconverged_steps=sim.compaction_unconverged.steps,
+                   compaction_unconverged_local_law_residual=sim.compaction_unconverged.local_law_residual)
+    return out
 
 
 def preset_names():
@@ -161,7 +165,9 @@ def preparation(name_or_prep="paper", **changes) -> Preparation:
 def prepare_sample(prep: Preparation, progress=None, **parameters):
     """Deposit and compact a sample as ``prep`` says; returns the compacted :class:`Simulation`
     with the test's friction set, and the compaction's outcome in ``sim.settled``,
-    ``sim.compaction_stress``, ``sim.compaction_inertia_number`` and ``sim.compaction_steps``.
+    ``sim.compaction_stress``, ``sim.compaction_inertia_number``, ``sim.compaction_steps`` and
+    ``sim.compaction_unconverged`` (its steps whose NLGS did not converge,
+    :class:`solver.stepper.Unconverged`).
     ``parameters`` go to :class:`solver.Parameters` (time step, tolerances...)."""
     prep = prep.validate()
     compaction_friction = prep.friction if prep.compaction_friction is None else prep.compaction_friction
@@ -175,6 +181,7 @@ def prepare_sample(prep: Preparation, progress=None, **parameters):
                     "a closing wall of the compaction")
     sim.compaction_steps = isotropic_compaction(sim, max_steps=prep.max_steps, max_inertia_number=prep.max_inertia_number,
                                                 pressure_ramp=prep.pressure_ramp, progress=progress)
+    sim.compaction_unconverged = sim.take_unconverged()
     sim.parameters.friction = prep.friction
     sim.preparation = prep
     sim.preparation_attrs = record(sim)

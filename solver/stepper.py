@@ -156,6 +156,28 @@ class StepInfo:
     unbalanced_torque: float = 0.0
 
 
+@dataclass
+class Unconverged:
+    """The steps whose NLGS stopped before both its norms met their tolerances (the sweep cap
+    ``max_iterations`` or the stall test of :mod:`solver.nlgs` ended it; :class:`StepInfo`
+    ``converged`` False), over a span of steps: how many, and the largest of their final
+    quadratic norms (the stopping norm, against ``Parameters.tolerance``) and of their local-law
+    residuals |F|/|r| (:mod:`solver.residuals`; zero for every solution of the contact laws).
+    Both largest values are 0 when no step is counted, and a NaN is kept."""
+
+    steps: int = 0
+    residual: float = 0.0
+    local_law_residual: float = 0.0
+
+    def add(self, info: StepInfo):
+        """Count the step ``info`` (an unconverged one)."""
+        self.steps += 1
+        if not info.residual <= self.residual:
+            self.residual = float(info.residual)
+        if not info.local_law_residual <= self.local_law_residual:
+            self.local_law_residual = float(info.local_law_residual)
+
+
 class Simulation:
     """State of a packing (particles and walls) and its time stepping.
 
@@ -216,10 +238,13 @@ class Simulation:
         self.compaction_steps = None  # steps the compaction took
         self.compaction_stress = None  # Pa, mean stress on each stress-driven wall at its end
         self.compaction_inertia_number = None  # the largest inertia number of the closing walls
+        self.compaction_unconverged = None  # the compaction's unconverged steps (Unconverged)
         self.preparation = None  # the solver.preparation.Preparation that made the sample
         self.preparation_attrs = {}  # the same and the compaction's outcome, as file attributes
         self.timings = {"broad_phase": 0.0, "narrow_phase": 0.0, "solve": 0.0, "update": 0.0}
-        self.counters = {"steps": 0, "broad_phase_runs": 0, "sweeps": 0, "point_sweeps": 0, "recovery_sweeps": 0}
+        self.counters = {"steps": 0, "broad_phase_runs": 0, "sweeps": 0, "point_sweeps": 0, "recovery_sweeps": 0,
+                         "unconverged_steps": 0}
+        self.unconverged = Unconverged()  # the unconverged steps since the last take_unconverged()
 
     # -- mobility ---------------------------------------------------------------------------
     def _mobility(self):
@@ -360,7 +385,17 @@ class Simulation:
         overlap = float(max(0.0, -pts.gap.min())) if len(pts.gap) else 0.0
         self.last = StepInfo(result.iterations, result.residual, result.max_residual, converged, len(keys), overlap,
                              law, force, torque)
+        if not converged:
+            self.counters["unconverged_steps"] += 1
+            self.unconverged.add(self.last)
         return self.last
+
+    def take_unconverged(self) -> Unconverged:
+        """The :class:`Unconverged` steps since the previous call (or since the simulation was
+        made), and a new count from here: what a snapshot records of the steps since the one
+        before it (:class:`solver.output.Recorder`)."""
+        taken, self.unconverged = self.unconverged, Unconverged()
+        return taken
 
     def _unbalanced(self, problem, pn, pt):
         """(force, torque) ratios of :func:`solver.residuals.unbalanced_ratios`, gravity the
