@@ -16,7 +16,12 @@ ParaView collections (``.pvd``) that put them on the time axis:
   3 strong; paper Fig. 17) and the bodies ``i``, ``j`` (walls are N, N+1, ...).
 
 CSV: ``contacts.csv``, the tidy contact table of every exported snapshot
-(:func:`grainview.tables.contacts_table`) with its snapshot index and time.
+(:func:`grainview.tables.contacts_table`), one row per occupied contact slot, its columns
+named with their units (:data:`CSV_COLUMNS`, docs/analysis.md "Exports"): ``snapshot``,
+``time_s``, ``i``, ``j``, ``kind`` ("simple" or "double"), ``wall``, ``loaded`` (f_n > 0:
+the force-bearing contacts; False for the pairs without force, such as the near pairs of a
+file written with them), ``fn_N``, ``ft_N``, ``normal_x``, ``normal_y``, ``point_x_m``,
+``point_y_m``, ``branch_x_m``, ``branch_y_m`` and ``gap_m`` (when the file has gaps).
 
 Files are written to a temporary name and moved into place, so that an interrupted export
 never leaves a half-written file under the final name; existing files are not overwritten
@@ -34,7 +39,29 @@ import xarray as xr
 from .errors import ParameterError
 from .schema import polygon_vertices
 
-__all__ = ["write_vtk", "write_csv", "snapshot_indices", "write_atomically"]
+__all__ = ["write_vtk", "write_csv", "snapshot_indices", "write_atomically", "CSV_COLUMNS"]
+
+CSV_COLUMNS = {
+    "snapshot": "index of the snapshot along time",
+    "time_s": "time of the snapshot (s)",
+    "i": "first body (particle index)",
+    "j": "second body (particle index, or N + wall index for a wall)",
+    "kind": "simple (one contact point) or double (two points: an edge facing an edge)",
+    "wall": "True when j is a wall",
+    "loaded": "True when f_n > 0 (the force-bearing network); False for a pair without force, e.g. a near pair",
+    "fn_N": "normal force exerted by i on j, compression > 0 (N)",
+    "ft_N": "tangential force exerted by i on j along t = (-n_y, n_x) (N)",
+    "normal_x": "unit contact normal from i to j, x component",
+    "normal_y": "unit contact normal from i to j, y component",
+    "point_x_m": "application point of the contact force, x (m)",
+    "point_y_m": "application point of the contact force, y (m)",
+    "branch_x_m": "branch vector, centre of i to centre of j (to the contact point for walls), x (m)",
+    "branch_y_m": "branch vector, y (m)",
+    "gap_m": "smallest separation of the contact's points along the normal, negative: overlap (m; files with gaps)",
+}
+"""The columns of ``contacts.csv``, in order, and what each holds (units in the names)."""
+KIND_NAMES = {1: "simple", 2: "double"}
+"""The contract's contact kinds as the CSV writes them."""
 
 
 def snapshot_indices(ds: xr.Dataset, every: int = 1) -> np.ndarray:
@@ -88,7 +115,7 @@ def write_atomically(path, overwrite, write):
         When ``path`` exists and ``overwrite`` is False.
     """
     if os.path.exists(path) and not overwrite:
-        raise ParameterError(f"{path} exists; pass overwrite=True (--overwrite) to replace it")
+        raise ParameterError(f"{path} exists; pass overwrite=True to replace it")
     root, ext = os.path.splitext(path)
     temporary = f"{root}.part{ext}"
     write(temporary)
@@ -202,7 +229,7 @@ def write_vtk(ds: xr.Dataset, out_dir, every: int = 1, overwrite: bool = False, 
     existing = [t for t in targets if os.path.exists(t)]
     if existing and not overwrite:  # before anything is written
         raise ParameterError(f"{existing[0]} exists ({len(existing)} of the {len(targets)} files to write); "
-                             "pass overwrite=True (--overwrite) to replace them")
+                             "pass overwrite=True to replace them")
     os.makedirs(out_dir, exist_ok=True)
     fields = particle_fields(ds, walls=True)
     classes = force_class(ds, walls=True)
@@ -230,11 +257,17 @@ def write_vtk(ds: xr.Dataset, out_dir, every: int = 1, overwrite: bool = False, 
     return written
 
 
+_CSV_NAMES = {"time": "time_s", "fn": "fn_N", "ft": "ft_N", "point_x": "point_x_m", "point_y": "point_y_m",
+              "branch_x": "branch_x_m", "branch_y": "branch_y_m", "gap": "gap_m"}
+
+
 def write_csv(ds: xr.Dataset, out_dir, every: int = 1, overwrite: bool = False) -> str:
     """Write ``contacts.csv``: the tidy contact table of every ``every``-th snapshot.
 
     The table is :func:`grainview.tables.contacts_table`'s, with columns ``snapshot`` and
-    ``time`` (s) first.
+    ``time_s`` first, the units in the column names, ``kind`` as "simple" or "double" and a
+    column ``loaded`` (f_n > 0) that tells the force-bearing contacts from the pairs without
+    force (:data:`CSV_COLUMNS`).
 
     Parameters
     ----------
@@ -273,8 +306,11 @@ def write_csv(ds: xr.Dataset, out_dir, every: int = 1, overwrite: bool = False) 
         table = contacts_table(ds, time=int(k))
         table.insert(0, "time", table.attrs["time"])
         table.insert(0, "snapshot", int(k))
-        frames.append(table)
+        table.insert(table.columns.get_loc("fn"), "loaded", table["fn"] > 0)
+        table["kind"] = table["kind"].map(lambda code: KIND_NAMES.get(int(code), str(int(code))))
+        frames.append(table.rename(columns=_CSV_NAMES))
     path = os.path.join(out_dir, "contacts.csv")
-    out = pd.concat(frames, ignore_index=True) if frames else pd.DataFrame()
+    out = pd.concat(frames, ignore_index=True) if frames else pd.DataFrame(columns=[
+        c for c in CSV_COLUMNS if c != "gap_m" or "gap" in ds])
     write_atomically(path, overwrite, lambda temporary: out.to_csv(temporary, index=False))
     return path

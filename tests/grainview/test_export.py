@@ -79,8 +79,8 @@ def test_csv_is_the_tidy_table_of_every_snapshot(tmp_path):
     table = pd.read_csv(path)
     assert len(table) == sum(len(s) for s in SERIES)
     at = table[table.snapshot == 2]
-    assert sorted(zip(at.i, at.j, at.fn)) == sorted((i, j, fn) for i, j, _, fn in SERIES[2])
-    assert (at.time == 2.0).all()
+    assert sorted(zip(at.i, at.j, at.fn_N)) == sorted((i, j, fn) for i, j, _, fn in SERIES[2])
+    assert (at.time_s == 2.0).all()
 
 
 def test_export_command(tmp_path, capsys):
