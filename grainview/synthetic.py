@@ -14,6 +14,9 @@ import numpy as np
 from .dataset import make_dataset
 
 PAIR_LENGTH_M = 0.02
+SOLID_FRACTION = 0.1
+"""Area fraction of the particles in the first snapshot's box (the pairs are scattered, not
+packed); the box grows with the number of contacts to keep it."""
 
 
 def harmonic_contacts(n, a, a_n, a_t, theta_0=0.0, mean_force=1.0, rng=None, double_fraction=0.3,
@@ -44,14 +47,22 @@ def harmonic_series(n_snapshots=10, n_contacts=1000, anisotropy=(0.3, 0.4, 0.25)
 
     Particle 2k touches particle 2k+1 at distance 0.02 m along the drawn normal, so every
     contact is its own pair; the anisotropies grow linearly from 0 to ``anisotropy`` (a, a_n,
-    a_t) over the series and the box shrinks in height and widens, like a biaxial test.
+    a_t) over the series and the box shrinks in height and widens, like a biaxial test. The
+    box, l x 2l, holds the particles at a solid fraction of :data:`SOLID_FRACTION` at the
+    start (l at least 8 pair lengths), and every pair lies inside it, carried by the box's
+    affine deformation.
     """
     rng = np.random.default_rng(seed)
     n_part = 2 * n_contacts
     i = np.arange(0, n_part, 2, dtype="i4")
+    radius = PAIR_LENGTH_M / 2
+    width = max(np.sqrt(n_part * np.pi * radius ** 2 / SOLID_FRACTION / 2), 8 * PAIR_LENGTH_M)
+    strain = np.linspace(0, 0.1, n_snapshots)
+    box_max = np.stack([width * (1 + 0.5 * strain), 2 * width * (1 - strain)], -1)
+    margin = PAIR_LENGTH_M + radius  # the partner, one pair length away in any direction, stays inside
+    where = rng.uniform(0, 1, (n_contacts, 2))
     pos = np.zeros((n_snapshots, n_part, 2))
-    pos[:, i, 0] = rng.uniform(-0.5, 0.5, n_contacts)
-    pos[:, i, 1] = rng.uniform(-0.5, 0.5, n_contacts)
+    pos[:, i] = margin + where[None] * (box_max[:, None, :] - 2 * margin)
     contacts = []
     for k in range(n_snapshots):
         s = k / max(n_snapshots - 1, 1)
@@ -60,9 +71,7 @@ def harmonic_series(n_snapshots=10, n_contacts=1000, anisotropy=(0.3, 0.4, 0.25)
                                                  spread=spread, double_fraction=double_fraction)
         pos[k, i + 1] = pos[k, i] + PAIR_LENGTH_M * normal
         contacts.append(dict(i=i, j=i + 1, kind=kind, normal=normal, fn=fn, ft=ft))
-    strain = np.linspace(0, 0.1, n_snapshots)
-    box_max = np.stack([1.0 * (1 + 0.5 * strain), 2.0 * (1 - strain)], -1)
-    return make_dataset(radius=np.full(n_part, PAIR_LENGTH_M / 2), position=pos, contacts=contacts,
+    return make_dataset(radius=np.full(n_part, radius), position=pos, contacts=contacts,
                         box_min=np.zeros((n_snapshots, 2)), box_max=box_max,
                         time=np.arange(n_snapshots, dtype=float), n_contact_slots=n_contacts,
                         attrs={"source": "grainview.synthetic.harmonic_series", "seed": seed})
