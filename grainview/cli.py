@@ -1,5 +1,5 @@
-"""The ``grainview`` command line: ``study``, ``run``, ``ensemble``, ``report``, ``info``, ``export`` and
-``demo``.
+"""The ``grainview`` command line: ``study``, ``run``, ``ensemble``, ``report``, ``info``, ``export``,
+``demo`` and ``warmup``.
 
 Errors a user can cause are printed as one line (``grainview: error: ...``) with exit code 2,
 never as a traceback.
@@ -16,6 +16,10 @@ from .errors import ConvergenceWarning, GrainviewError
 RESIDUAL_STRAIN = 0.3
 """Default start of the residual window (eps_q); the same as grainview.strain.RESIDUAL_STRAIN,
 repeated here so that ``--help`` does not import xarray."""
+S1S2_HELP = ("s1s2: the paper's two initial states, each shape compacted its own way: pentagons with "
+             "friction 0.4 as 'paper' (the paper's S1, solid fraction 0.80), disks compacted frictionless (S2, the "
+             "denser 0.82); both tested with friction 0.4; docs/fidelity.md")
+"""What ``--preparation s1s2`` means, in the help of every command that takes it."""
 DEFAULT_STRAIN = 0.2
 """Default vertical strain eps_1 of a biaxial test: eps_q reaches ~0.55-0.65, well into the
 residual state (eps_q >= 0.3)."""
@@ -61,30 +65,24 @@ def _export(args) -> int:
     return 0
 
 
-def _demo(args) -> int:
-    from . import open_dataset
-    from .dataset import netcdf_options
-    from .synthetic import harmonic_series
+def _warmup(args) -> int:
+    import os
 
-    if args.snapshots < 2 or args.contacts < 1:
-        raise GrainviewError(f"--snapshots {args.snapshots} --contacts {args.contacts}: expected at least 2 "
-                             "snapshots and 1 contact")
-    out = Path(args.out)
-    out.mkdir(parents=True, exist_ok=True)
-    path = out / "synthetic.nc"
-    if path.exists() and not args.overwrite:
-        raise GrainviewError(f"{path} exists; pass --overwrite to replace it")
-    ds = harmonic_series(n_snapshots=args.snapshots, n_contacts=args.contacts, seed=args.seed)
-    tmp = path.with_suffix(".nc.part")
-    ds.to_netcdf(tmp, **netcdf_options(ds, compress=not args.no_compress))
-    tmp.replace(path)
-    lazy = open_dataset(path, chunks=5, validate=True)
-    table = lazy.grain.harmonic_prediction().compute()
-    table["a"] = lazy.grain.fabric_anisotropy()["a"].compute()
-    frame = table.to_dataframe()[["q_over_p", "prediction", "a_prime", "a_n", "a_t"]]
-    print(f"wrote {path}; q/p against the harmonic prediction (a' + a_n + a_t)/2:")
-    print(frame.round(4).to_string())
-    frame.to_csv(out / "harmonic_prediction.csv")
+    from .warmup import cache_location, warm_up
+
+    folder = os.environ.get("NUMBA_CACHE_DIR")
+    if folder:
+        try:
+            os.makedirs(folder, exist_ok=True)
+        except OSError as exc:
+            raise GrainviewError(f"NUMBA_CACHE_DIR={folder}: cannot create the folder ({exc.strerror})") from None
+        if not os.access(folder, os.W_OK):
+            raise GrainviewError(f"NUMBA_CACHE_DIR={folder}: the folder is not writable; expected a writable folder")
+    print(f"warmup: compiling, or loading from the cache, every numba kernel of the solver and the analysis; "
+          f"cache: {cache_location()}", flush=True)
+    result = warm_up(log=lambda line: print(f"warmup: {line}", flush=True))
+    print(f"warmup: done: {result['kernels']} kernels ready in {result['cache']}; runs that use this cache "
+          "start without compiling", flush=True)
     return 0
 
 
@@ -226,9 +224,17 @@ def _report(args) -> int:
             print(f"report: movie of {label} ...", flush=True)
             files.append(animate(ds, path, kind="force_chains", every=args.movie_every, overwrite=args.overwrite,
                                  progress=False))
-    print(result["table"].to_string())
+    print(_terminal_table(result["table"]))
     print(f"wrote {len(files)} files in {args.out}")
     return 0
+
+
+def _terminal_table(table) -> str:
+    """A report's table fitted to the terminal's width, rounded as the Markdown
+    (grainview.report.terminal_table)."""
+    from .report import terminal_table
+
+    return terminal_table(table)
 
 
 def _ensemble_report(args) -> int:
@@ -238,7 +244,7 @@ def _ensemble_report(args) -> int:
     ens = open_ensemble(args.files, validate=True)
     result = write_ensemble_report(ens, args.out, residual_strain=args.residual_strain, overwrite=args.overwrite,
                                    log=lambda line: print(f"report: {line}", flush=True))
-    print(result["table"].to_string())
+    print(_terminal_table(result["table"]))
     print(f"wrote {len(result['files'])} files in {args.out}")
     return 0
 
@@ -270,6 +276,10 @@ def _ensemble(args) -> int:
                  preparation=args.preparation, strain=args.strain, velocity=args.velocity, every=args.every,
                  solver=tuple(sorted(_solver_parameters(args).items())))
     out = Path(args.out)
+    report = out / "report"
+    if not args.no_report and (report / "headline.csv").exists() and not (args.overwrite or args.overwrite_report):
+        raise GrainviewError(f"{report} already holds a report; pass --overwrite-report to replace it (finished runs "
+                             "are kept), or --no-report to run only")
     where = args.scheduler or f"a local cluster of {args.workers or 'one worker per core'}"
     print(f"ensemble: {len(specs)} runs on {where}; files in {out} (finished runs are skipped, unfinished "
           "ones resumed)", flush=True)
@@ -284,8 +294,8 @@ def _ensemble(args) -> int:
     if args.no_report:
         return 0
     args.files = [r["path"] for r in results]
-    args.out = str(out / "report")
-    args.overwrite = True  # the report of these runs is regenerated with them
+    args.out = str(report)
+    args.overwrite = True  # checked above, before the runs: an existing report is replaced only when asked
     return _ensemble_report(args)
 
 
@@ -381,13 +391,13 @@ def build_parser() -> argparse.ArgumentParser:
                              "docs/solver.md)")
         prep = p.add_argument_group("sample preparation (docs/fidelity.md)")
         prep.add_argument("--preparation", choices=preset_names(), default="paper",
-                          help="named preparation (default paper: compaction with friction 0.4, walls closing "
-                          "at up to 5 cm/s; s1s2: pentagons so, disks frictionless, the paper's initial "
-                          "states); the options below change it")
+                          help=f"named preparation (default paper: compaction with friction 0.4, walls closing "
+                          f"at up to 5 cm/s; {S1S2_HELP}); the options below change it")
         prep.add_argument("--compaction-friction", type=float, default=None,
                           help="grain friction during compaction (default: the test's 0.4)")
         prep.add_argument("--max-inertia-number", type=float, default=None,
-                          help="cap of the inertia number I = (v/L) d sqrt(rho/sigma0) of the closing walls")
+                          help="cap of the inertia number I = (v/L) d sqrt(rho/sigma0) of the closing walls "
+                          "(default: none, the walls close at up to 5 cm/s)")
         prep.add_argument("--aspect", type=float, default=None, help="h/l of the sample box (default 2)")
         prep.add_argument("--pressure-ramp", type=float, default=None,
                           help="time in s over which sigma0 rises from 0 (default 0: applied at once)")
@@ -452,19 +462,23 @@ def build_parser() -> argparse.ArgumentParser:
     ens.add_argument("--strain", type=float, default=DEFAULT_STRAIN, help=f"vertical strain eps_1 (default {DEFAULT_STRAIN})")
     ens.add_argument("--velocity", type=float, default=0.01, help="speed of the top wall in m/s (default 0.01)")
     ens.add_argument("--every", type=int, default=200, help="steps between snapshots (default 200)")
-    ens.add_argument("--preparation", default="paper", help="named preparation (default paper)")
+    ens.add_argument("--preparation", default="paper", help=f"named preparation (default paper; {S1S2_HELP})")
     ens.add_argument("--wall-friction", type=float, default=None, help="grain-wall friction (default 0)")
     ens.add_argument("--time-step", type=float, default=None, help="time step in s (default 5e-4)")
     ens.add_argument("--tolerance", type=float, default=None, help="NLGS tolerance (default 1.7e-4)")
-    ens.add_argument("--acceleration", choices=("off", "anderson"), default=None, help="NLGS acceleration")
+    ens.add_argument("--acceleration", choices=("off", "anderson"), default=None, help="NLGS acceleration: 'anderson' (default) or "
+                     "'off', plain sweeps (docs/solver.md)")
     ens.add_argument("--workers", type=int, default=None, help="worker processes of the local cluster "
                      "(default: one per core; each single-threaded)")
     ens.add_argument("--scheduler", default=None, help="address of an existing dask scheduler (tcp://host:8786); "
-                     "its workers must import grainview and see --out")
+                     "its workers must import grainview and see --out (default: none, a local cluster)")
     ens.add_argument("--no-report", action="store_true", help="run only; no report")
-    ens.add_argument("--overwrite", action="store_true", help="redo every run, replacing its file")
+    ens.add_argument("--overwrite", action="store_true", help="redo every run, replacing its file (and the report)")
+    ens.add_argument("--overwrite-report", action="store_true", help="replace an existing report in OUT/report; "
+                     "finished runs are kept")
     no_compress_option(ens)
-    ens.add_argument("--progress", choices=["auto", "on", "off"], default="auto", help="a progress bar per run")
+    ens.add_argument("--progress", choices=["auto", "on", "off"], default="auto", help="a progress bar per run (default auto: on "
+                     "in a terminal)")
     residual_option(ens)
     ens.set_defaults(func=_ensemble)
     info = sub.add_parser("info", help="validate a grainview netCDF file and print its summary",
@@ -501,6 +515,13 @@ def build_parser() -> argparse.ArgumentParser:
     demo.add_argument("--overwrite", action="store_true", help="replace existing output files")
     no_compress_option(demo)
     demo.set_defaults(func=_demo)
+    warmup = sub.add_parser("warmup", help="compile every numba kernel into the cache, so that runs start at once",
+                            description="Compile (or load) every numba kernel of the solver and the analysis into "
+                            "numba's cache (NUMBA_CACHE_DIR when set, else __pycache__ beside the modules) with a "
+                            "tiny workload (seconds once warm, about a minute cold). A run on a cold cache spends "
+                            "its first step compiling, and acts on SIGTERM only after that step: warm the cache "
+                            "once per installation, e.g. before submitting batch jobs (docs/solver.md).")
+    warmup.set_defaults(func=_warmup)
     return parser
 
 

@@ -20,30 +20,38 @@ import pandas as pd
 
 from .ensemble import run_dataset, seed_statistics
 from .errors import ParameterError
-from .report import PAPER, paper_key
+from .report import INITIAL_ROWS, NOT_REACHED, PAPER, paper_key
 from .strain import RESIDUAL_STRAIN
 
 DESCRIPTION = ("particles", "seed", "preparation", "residual window", "double-contact criterion")
 """Rows of a run's summary that describe it rather than measure it (left out of the statistics)."""
 STATISTICS = ("mean", "std", "sem", "n")
 """Columns of each group in :func:`ensemble_table`'s numbers."""
+REACHED = "residual window reached"
+"""Column of :func:`run_table`: whether the run reaches the residual window."""
 
 
 def run_table(ens, residual_strain: float = RESIDUAL_STRAIN, log=None) -> pd.DataFrame:
     """The headline numbers of every run (rows: runs named as ``run``; columns: the rows of
-    :data:`grainview.report.PAPER`, NaN where a run has no number) with the run's ``group``."""
+    :data:`grainview.report.PAPER`, NaN where a run has no number) with the run's ``group`` and
+    whether it reaches the residual window (:data:`REACHED`). The residual rows are kept when
+    a run does not reach the window, so that the report can say so; other rows without any
+    number are left out."""
     from .report import run_summary
 
-    rows = {}
+    rows, reached = {}, {}
     for k, name in enumerate(str(n) for n in ens["run"].values):
         if log is not None:
             log(f"run {k + 1}/{ens.sizes['run']}: {name}")
         summary = run_summary(run_dataset(ens, k), residual_strain)
+        reached[name] = not str(summary["residual window"]).startswith(NOT_REACHED)
         rows[name] = {key: value for key, value in summary.items() if key in PAPER["pentagons"] and key not in DESCRIPTION}
     table = pd.DataFrame.from_dict(rows, orient="index")
     numbers = table.apply(pd.to_numeric, errors="coerce")
-    numbers = numbers.loc[:, numbers.notna().any()]
+    missed = table.eq(NOT_REACHED).any()
+    numbers = numbers.loc[:, numbers.notna().any() | missed]
     numbers.insert(0, "group", [str(g) for g in ens["group"].values])
+    numbers.insert(1, REACHED, [reached[name] for name in numbers.index])
     return numbers
 
 
@@ -53,7 +61,7 @@ def ensemble_table(ens, residual_strain: float = RESIDUAL_STRAIN, log=None) -> t
     if "run" not in ens.dims:
         raise ParameterError("not an ensemble: expected open_ensemble's Dataset (a 'run' dimension)")
     runs = run_table(ens, residual_strain, log)
-    values = runs.drop(columns="group")
+    values = runs.drop(columns=["group", REACHED])
     grouped = values.groupby(runs["group"], sort=False)
     n = grouped.count()
     std = grouped.std(ddof=1).where(n > 1)
@@ -64,18 +72,33 @@ def ensemble_table(ens, residual_strain: float = RESIDUAL_STRAIN, log=None) -> t
     return table, runs
 
 
-def format_table(stats: pd.DataFrame) -> pd.DataFrame:
+def format_table(stats: pd.DataFrame, runs: pd.DataFrame | None = None,
+                 residual_strain: float = RESIDUAL_STRAIN) -> pd.DataFrame:
     """The statistics as text, "mean +- std (n seeds)" per group, with the paper's column
-    beside every group whose label names a shape of the paper."""
+    beside every group whose label names a shape of the paper.
+
+    With ``runs`` (:func:`run_table`), a residual row of a group whose runs do not all reach
+    the residual window (eps_q >= ``residual_strain``) says so, as the report of single runs
+    does: "not reached (0 of 3 seeds reach eps_q >= 0.3)" when none does, "... (2 seeds; 1 not
+    reached)" when some do."""
     columns = {}
     for group in dict.fromkeys(stats.columns.get_level_values(0)):
         s = stats[group]
+        if runs is not None:
+            members = runs[runs["group"] == group]
+            total, short = len(members), int((~members[REACHED].astype(bool)).sum())
+        else:
+            total = short = 0
 
         def cell(row):
+            residual = row.name not in INITIAL_ROWS
             if not np.isfinite(row["mean"]):
+                if residual and short and short == total:
+                    return f"{NOT_REACHED} (0 of {total} seeds reach eps_q >= {residual_strain:g})"
                 return "-"
             spread = f" ± {row['std']:.3f}" if np.isfinite(row["std"]) else ""
-            return f"{row['mean']:.3f}{spread} ({int(row['n'])} seed{'s' if row['n'] != 1 else ''})"
+            missed = f"; {short} {NOT_REACHED}" if residual and short else ""
+            return f"{row['mean']:.3f}{spread} ({int(row['n'])} seed{'s' if row['n'] != 1 else ''}{missed})"
 
         columns[f"{group} (mean ± std)"] = s.apply(cell, axis=1)
         paper = PAPER.get(paper_key(group))
@@ -95,13 +118,14 @@ def write_ensemble_report(ens, out, residual_strain: float = RESIDUAL_STRAIN, ov
     import matplotlib.pyplot as plt
 
     from .plot._style import save_figure
+    from .report import file_link
     from .plot.ensemble import seed_bands
 
     out = Path(out)
     if not overwrite and (out / "headline.csv").exists():
         raise FileExistsError(f"{out} already holds a report; pass overwrite=True to replace it")
     stats, runs = ensemble_table(ens, residual_strain, log)
-    text = format_table(stats)
+    text = format_table(stats, runs, residual_strain)
     out.mkdir(parents=True, exist_ok=True)
     files = [out / "headline.csv", out / "runs.csv", out / "headline.md"]
     stats.to_csv(files[0])
@@ -131,7 +155,7 @@ def write_ensemble_report(ens, out, residual_strain: float = RESIDUAL_STRAIN, ov
              "- q/p against eps_q: [fig_ensemble_q_over_p.png](fig_ensemble_q_over_p.png)",
              "- fabric anisotropy a against eps_q: [fig_ensemble_fabric_anisotropy.png]"
              "(fig_ensemble_fabric_anisotropy.png)", "", "## Runs", ""]
-    index += [f"- `{name}`: group {g}, file `{src}`" for name, g, src in
+    index += [f"- `{name}`: group {g}, file {file_link(src, out)}" for name, g, src in
               zip(ens["run"].values, ens["group"].values, ens["source"].values)]
     (out / "index.md").write_text("\n".join(index) + "\n")
     files.append(out / "index.md")

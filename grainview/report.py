@@ -176,17 +176,67 @@ def _near_rows(res: xr.Dataset) -> dict:
 
 
 def headline_table(runs: dict, residual_strain: float = RESIDUAL_STRAIN) -> pd.DataFrame:
-    """One row per headline quantity; for each run a column of its value and, where the run's
-    label names a shape of the paper ("pentagons", "disks"), a column of the paper's value."""
+    """One row per headline quantity; for each run a column of its value and, where the run is
+    one of the paper's samples, a column of the paper's value: "<label> (paper)" when its label
+    names the sample ("pentagons", "disks", :func:`paper_key`), else "<label> (paper: <sample>)"
+    when its particles do (:func:`paper_sample`).
+
+    ``table.attrs["csv"]`` holds the rows that describe the runs as numbers, for
+    :func:`write_table`'s CSV: ``{column: {row: number}}`` (:func:`description_numbers`)."""
     if not runs:
         raise ParameterError("runs is empty: expected {label: dataset}")
-    columns = {}
+    columns, numbers = {}, {}
     for label, ds in runs.items():
         columns[f"{label} (this run)"] = run_summary(ds, residual_strain)
-        paper = PAPER.get(paper_key(label))
-        if paper is not None:
-            columns[f"{label} (paper)"] = paper
-    return pd.DataFrame(columns)
+        numbers[f"{label} (this run)"] = description_numbers(ds, residual_strain)
+        key = paper_key(label)
+        name = f"{label} (paper)"
+        if key is None:
+            key = paper_sample(ds)
+            name = f"{label} (paper: {key})"
+        if key is not None:
+            columns[name] = PAPER[key]
+            numbers[name] = PAPER_NUMBERS[key]
+    table = pd.DataFrame(columns)
+    table.attrs["csv"] = numbers
+    return table
+
+
+PAPER_NUMBERS = {"pentagons": {"particles": 14400, "residual window from eps_q": 0.3},
+                 "disks": {"particles": 10000, "residual window from eps_q": 0.3}}
+"""The description rows of the paper's samples as numbers (:func:`description_numbers`)."""
+CSV_DESCRIPTION = {"particles": ("particles",), "seed": ("seed",),
+                   "residual window": ("residual window from eps_q", "residual window to eps_q",
+                                       "residual window snapshots")}
+"""The CSV's numeric rows in place of each description row of the table."""
+
+
+def description_numbers(ds: xr.Dataset, residual_strain: float = RESIDUAL_STRAIN) -> dict:
+    """The rows that describe a run, as numbers: its particle count, its seed (None when the
+    file records none) and its residual window: first and last eps_q of the snapshots with
+    eps_q >= ``residual_strain`` (None when none reaches it) and how many they are."""
+    from .strain import strains
+
+    window = np.asarray(residual_window(ds, residual_strain).values, bool)
+    inside = np.asarray(strains(ds)["eps_q"].values, float)[window]
+    seed = ds.attrs.get("preparation_seed", ds.attrs.get("solver_seed"))
+    try:
+        seed = int(seed) if seed is not None and float(seed) == int(seed) else None
+    except (TypeError, ValueError):
+        seed = None
+    return {"particles": int(ds.sizes["particle"]), "seed": seed,
+            "residual window from eps_q": float(inside.min()) if inside.size else None,
+            "residual window to eps_q": float(inside.max()) if inside.size else None,
+            "residual window snapshots": int(inside.size)}
+
+
+def paper_sample(ds: xr.Dataset) -> str | None:
+    """The paper's sample whose particles a run has: "disks" (every particle a disk),
+    "pentagons" (every particle a pentagon) or None."""
+    n_vertices = np.asarray(ds["n_vertices"].values)
+    if not n_vertices.any():
+        return "disks"
+    return "pentagons" if (n_vertices == 5).all() else None
 
 
 def paper_key(label: str) -> str | None:
@@ -199,20 +249,104 @@ def paper_key(label: str) -> str | None:
     return None
 
 
+def _number(value):
+    """``value`` as an int or a finite float, or None when it is no number (text, NaN)."""
+    if isinstance(value, (bool, np.bool_)):
+        return None
+    if isinstance(value, (int, np.integer)):
+        return int(value)
+    if isinstance(value, (float, np.floating)):
+        return float(value) if np.isfinite(value) else None
+    return None
+
+
+def csv_table(table: pd.DataFrame) -> pd.DataFrame:
+    """The numbers of ``table``, as :func:`write_table` writes them to CSV: ints stay ints,
+    a cell that is not a number is None (empty), and the rows that describe the runs
+    (particles, seed, residual window) are the numbers of ``table.attrs["csv"]``
+    (:data:`CSV_DESCRIPTION`)."""
+    numbers = table.attrs.get("csv", {})
+    rows = {}
+    for idx, row in table.iterrows():
+        if idx in CSV_DESCRIPTION and numbers:
+            for name in CSV_DESCRIPTION[idx]:
+                rows[name] = {column: _number(numbers.get(column, {}).get(name)) for column in table.columns}
+        else:
+            rows[idx] = {column: _number(value) for column, value in row.items()}
+    values = np.empty((len(rows), len(table.columns)), dtype=object)  # ints stay ints, None stays empty
+    values[:] = [[row[column] for column in table.columns] for row in rows.values()]
+    return pd.DataFrame(values, index=list(rows), columns=table.columns)
+
+
+def format_cell(value) -> str:
+    """A table cell as the Markdown and the terminal show it: finite floats to 3 decimals,
+    anything else as text."""
+    return f"{value:.3f}" if isinstance(value, (float, np.floating)) and np.isfinite(value) else str(value)
+
+
+def terminal_table(table: pd.DataFrame, width: int | None = None, column_width: int = 24) -> str:
+    """``table`` as text that fits a terminal ``width`` characters wide (default: the
+    terminal's, :func:`shutil.get_terminal_size`), cells rounded as in the Markdown
+    (:func:`format_cell`).
+
+    Text longer than ``column_width`` wraps within its cell (headers too), and the columns
+    that do not fit beside the row names go to further blocks below, each repeating the row
+    names. Returns the text, lines joined by newlines."""
+    import shutil
+    import textwrap
+
+    width = max(int(width or shutil.get_terminal_size().columns), 30)
+    gap = "  "
+    names = [str(idx) for idx in table.index]
+    name_width = min(max([len(n) for n in names] + [1]), max(12, width // 3))
+    room = width - name_width - len(gap)
+    cells = {column: [format_cell(v) for v in table[column]] for column in table.columns}
+    widths = {column: max(1, min(max([len(str(column))] + [len(c) for c in cells[column]]), column_width, room))
+              for column in table.columns}
+
+    def wrap(text, size):
+        return textwrap.wrap(text, size, break_long_words=True, break_on_hyphens=False) or [""]
+
+    blocks, block, used = [], [], 0
+    for column in table.columns:
+        needed = widths[column] + (len(gap) if block else 0)
+        if block and used + needed > room:
+            blocks.append(block)
+            block, used, needed = [], 0, widths[column]
+        block.append(column)
+        used += needed
+    if block:
+        blocks.append(block)
+
+    lines = []
+    for b, columns in enumerate(blocks):
+        if b:
+            lines.append("")
+        rows = [(" " * name_width, [wrap(str(c), widths[c]) for c in columns])]
+        rows += [(names[r], [wrap(cells[c][r], widths[c]) for c in columns]) for r in range(len(names))]
+        for name, parts in rows:
+            name_lines = wrap(name, name_width) if name.strip() else [""]
+            height = max([len(name_lines)] + [len(p) for p in parts])
+            for k in range(height):
+                left = name_lines[k] if k < len(name_lines) else ""
+                line = left.ljust(name_width) + gap + gap.join(
+                    (p[k] if k < len(p) else "").ljust(widths[c]) for p, c in zip(parts, columns))
+                lines.append(line.rstrip())
+    return "\n".join(lines)
+
+
 def write_table(table: pd.DataFrame, out: Path) -> list[Path]:
-    """Write ``table`` as ``headline.md`` (everything, prose included) and ``headline.csv``
-    (numbers only: a cell that is not a number — "not reached", a qualitative statement of the
-    paper, a description of the run — is empty there, so the file loads as floats)."""
+    """Write ``table`` as ``headline.md`` (everything, prose included) and ``headline.csv`` (numbers only, :func:`csv_table`: a cell that is
+    not a number — "not reached", a qualitative statement of the paper — is empty there, so
+    the file loads as floats; integers are written as integers, and the particles, the seed
+    and the residual window are rows of numbers)."""
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
     csv, md = out / "headline.csv", out / "headline.md"
-    table.apply(pd.to_numeric, errors="coerce").to_csv(csv)
-
-    def fmt(v):
-        return f"{v:.3f}" if isinstance(v, (float, np.floating)) and np.isfinite(v) else str(v)
+    csv_table(table).to_csv(csv)
 
     lines = ["| quantity | " + " | ".join(table.columns) + " |", "|---" * (len(table.columns) + 1) + "|"]
-    lines += ["| " + " | ".join([str(idx), *(fmt(v) for v in row)]) + " |" for idx, row in table.iterrows()]
+    lines += ["| " + " | ".join([str(idx), *(format_cell(v) for v in row)]) + " |" for idx, row in table.iterrows()]
     md.write_text("\n".join(lines) + "\n")
     return [csv, md]
 
@@ -374,6 +508,19 @@ def write_report(runs: dict, out, residual_strain: float = RESIDUAL_STRAIN, over
     return {"table": table, "files": files}
 
 
+def file_link(source, folder) -> str:
+    """A Markdown link to file ``source`` from a page in ``folder``: the path relative to
+    ``folder``, so that it resolves wherever the two are moved together; "(in memory)" for
+    no file."""
+    import os
+    from urllib.parse import quote
+
+    if not source:
+        return "(in memory)"
+    relative = Path(os.path.relpath(os.path.abspath(source), os.path.abspath(folder))).as_posix()
+    return f"[{relative}]({quote(relative)})"
+
+
 def write_index(runs: dict, out: Path, captions: dict, residual_strain: float = RESIDUAL_STRAIN) -> Path:
     """``out/index.md``: the runs (their settings, :func:`grainview.summary.describe`), the
     headline table, and every figure file with its caption, in the paper's order."""
@@ -383,8 +530,7 @@ def write_index(runs: dict, out: Path, captions: dict, residual_strain: float = 
     lines = ["# Report", "", "Force transmission in the runs below, next to Azema, Radjai, Peyroux & Saussine, "
              "Phys. Rev. E 76, 011301 (2007). Residual state: eps_q >= " + f"{residual_strain:g}.", "", "## Runs", ""]
     for label, ds in runs.items():
-        source = ds.encoding.get("source", "(in memory)")
-        lines += [f"### {label}", "", f"File: `{source}`", ""] + [f"- {line}" for line in describe(ds)] + [""]
+        lines += [f"### {label}", "", f"File: {file_link(ds.encoding.get('source'), out)}", ""] + [f"- {line}" for line in describe(ds)] + [""]
     lines += ["## Headline table", "", "[headline.md](headline.md) (numbers only: [headline.csv](headline.csv))", "",
               "## Figures", ""]
     for stem, caption_lines in captions.items():

@@ -63,7 +63,9 @@ def test_table_equals_the_accessors(study):
     # the CSV holds numbers only; the prose is in the Markdown table
     assert all(dtype.kind == "f" for dtype in table.dtypes)
     assert table.loc["q/p (residual)", "pentagons (paper)"] == 0.35
-    assert np.isnan(table.loc["particles", "pentagons (this run)"])
+    assert table.loc["particles", "pentagons (this run)"] == 30  # the description rows as numbers
+    assert table.loc["particles", "pentagons (paper)"] == 14400
+    assert table.loc["residual window snapshots", "disks (this run)"] == late.size
     md = (study / "report" / "headline.md").read_text()
     assert "| particles | 30 5-gons | 14400 | 30 disks | 10000 |" in md
     assert "| preparation | paper |" in md
