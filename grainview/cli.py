@@ -65,6 +65,24 @@ def _export(args) -> int:
     return 0
 
 
+def _convert(args) -> int:
+    from .formats.lammps import convert_lammps
+
+    columns = None
+    if args.columns:
+        try:
+            columns = dict(item.split("=", 1) for item in args.columns.split(","))
+        except ValueError:
+            raise GrainviewError(f"--columns {args.columns}: expected QUANTITY=COLUMN,... (e.g. "
+                                 "patom1=c_pairs[1],patom2=c_pairs[2])") from None
+    count = convert_lammps(args.out, args.particles, args.contacts, args.walls, log=args.log,
+                           time_step=args.time_step, columns=columns, inertia=args.inertia,
+                           overwrite=args.overwrite, compress=not args.no_compress,
+                           progress=args.progress != "off")
+    print(f"wrote {args.out}: {count} snapshots from LAMMPS (check it: grainview info {args.out} --check)")
+    return 0
+
+
 def _warmup(args) -> int:
     import os
 
@@ -522,6 +540,34 @@ def build_parser() -> argparse.ArgumentParser:
                             "its first step compiling, and acts on SIGTERM only after that step: warm the cache "
                             "once per installation, e.g. before submitting batch jobs (docs/solver.md).")
     warmup.set_defaults(func=_warmup)
+    convert = sub.add_parser("convert", help="turn another code's output into a file of the contract",
+                             description="Read another code's output and write a validated, compressed file of "
+                             "the grainview contract (docs/formats.md); an existing file is kept unless "
+                             "--overwrite.")
+    formats = convert.add_subparsers(dest="format", metavar="FORMAT", required=True)
+    lammps = formats.add_parser("lammps", help="a LAMMPS 2D granular run (dump custom + dump local)",
+                                description="A LAMMPS 2D granular run: the particles' dump custom (id radius mass "
+                                "x y, optionally vx vy omegaz), the pairs' dump local (compute property/local "
+                                "patom1 patom2; compute pair/local fx fy fz p1 p2 p3), optionally the walls' dump "
+                                "custom of fix wall/gran ... contacts arrays, and the log (time step and the "
+                                "computes' definitions). Contacts: touching pairs with a compressive normal force "
+                                "(docs/formats.md).")
+    lammps.add_argument("--particles", required=True, help="the particles' dump custom")
+    lammps.add_argument("--contacts", required=True, help="the pairs' dump local")
+    lammps.add_argument("--walls", help="the walls' dump custom (id and f_ID[1..8] of fix wall/gran ... contacts)")
+    lammps.add_argument("--log", help="the run's log.lammps or input script: time step and compute definitions")
+    lammps.add_argument("--time-step", type=float, help="the time step in s (default: the log's)")
+    lammps.add_argument("--columns", help="which dump local column holds each quantity, e.g. "
+                        "patom1=c_pairs[1],patom2=c_pairs[2],fx=c_forces[2],fy=c_forces[3],p1=c_forces[5],"
+                        "p2=c_forces[6] (default: from the log or the columns' own names)")
+    lammps.add_argument("--inertia", choices=("auto", "disc", "sphere"), default="auto",
+                        help="moments of inertia m r^2/2 (disc) or 2 m r^2/5 (sphere); auto: as the log's "
+                        "fix nve/sphere says, disc without a log (default: auto)")
+    lammps.add_argument("--out", required=True, help="the netCDF file to write")
+    lammps.add_argument("--overwrite", action="store_true", help="replace an existing --out")
+    lammps.add_argument("--progress", choices=("on", "off"), default="on", help="progress bar (default: on)")
+    no_compress_option(lammps)
+    lammps.set_defaults(func=_convert)
     return parser
 
 

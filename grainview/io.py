@@ -64,8 +64,9 @@ def _check_version(ds, source):
             f"({SCHEMA_VERSION}); upgrade grainview", source)
 
 
-def open_dataset(path, chunks: int | dict | None = "auto", validate: bool = False) -> xr.Dataset:
-    """Open a grainview netCDF file, lazily.
+def open_dataset(path, chunks: int | dict | None = "auto", validate: bool = False, format: str = "grainview",
+                 **reader_options) -> xr.Dataset:
+    """Open a grainview netCDF file, lazily; or another code's output, with ``format``.
 
     The file is opened read-only and never modified; netCDF-3 (a run still going on or
     stopped) and compressed files (a finished run, docs/schema.md "Compression") read the
@@ -82,6 +83,14 @@ def open_dataset(path, chunks: int | dict | None = "auto", validate: bool = Fals
         ``contact`` stay whole in each chunk, as the analysis kernels need.
     validate : bool, default False
         Run :func:`grainview.validation.validate` (every value) before returning.
+    format : str, default "grainview"
+        ``"grainview"``: a netCDF file of the contract. Another code's output
+        (:data:`grainview.formats.READERS`, docs/formats.md), read into memory and chunked as
+        asked: ``"lammps"``, with ``path`` the particles' dump and ``contacts=``, ``walls=``,
+        ``log=``, ``time_step=``... in ``reader_options``
+        (:func:`grainview.formats.lammps.open_lammps`).
+    **reader_options
+        Passed on to the reader of ``format``.
 
     Returns
     -------
@@ -96,6 +105,17 @@ def open_dataset(path, chunks: int | dict | None = "auto", validate: bool = Fals
     SchemaError
         A schema version newer than this grainview's, or (with ``validate``) any fault.
     """
+    if format != "grainview" or reader_options:
+        from .formats import open_format
+
+        ds = open_format(format, path, **reader_options)
+        if chunks is not None:
+            ds = ds.chunk(time_chunks(ds, chunks))
+        if validate:
+            from .validation import validate as check
+
+            check(ds, source=os.fspath(path))
+        return ds
     source = os.fspath(path)
     if not os.path.exists(source):
         raise FileFormatError(f"{source}: no such file")

@@ -1,0 +1,26 @@
+"""Other codes' files, read into datasets of the grainview contract (docs/formats.md).
+
+Each reader is usable three ways: as a function (``open_lammps``), through
+``grainview.open_dataset(path, format="lammps", ...)`` and ``xr.open_dataset(path,
+engine="lammps", ...)``, and on the command line (``grainview convert lammps ...``).
+"""
+
+from __future__ import annotations
+
+import importlib
+
+from ..errors import ParameterError
+
+__all__ = ["READERS", "open_format"]
+
+READERS = {"lammps": "grainview.formats.lammps:open_lammps"}
+"""Format name -> the reader that opens it as an in-memory dataset of the contract."""
+
+
+def open_format(format: str, path, **options):
+    """Open ``path`` with the reader of ``format`` (:data:`READERS`); one line for an unknown
+    format."""
+    if format not in READERS:
+        raise ParameterError(f"format={format!r}: expected 'grainview' or one of {', '.join(sorted(READERS))}")
+    module, name = READERS[format].split(":")
+    return getattr(importlib.import_module(module), name)(path, **options)

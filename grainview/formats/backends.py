@@ -1,0 +1,41 @@
+"""The readers as xarray backends: ``xr.open_dataset(path, engine="lammps", ...)``.
+
+Registered through the ``xarray.backends`` entry point (pyproject.toml), so xarray finds them
+once grainview is installed. A backend opens a run only when asked by name (``engine=``):
+other codes' text dumps carry no signature that would let xarray guess them safely.
+"""
+
+from __future__ import annotations
+
+from xarray.backends import BackendEntrypoint
+
+__all__ = ["LammpsBackend"]
+
+
+class LammpsBackend(BackendEntrypoint):
+    """LAMMPS 2D granular runs (:func:`grainview.formats.lammps.open_lammps`).
+
+    ``xr.open_dataset("dump.particles", engine="lammps", contacts="dump.contacts",
+    walls="dump.walls", log="log.lammps")``: the particles' ``dump custom`` is the path;
+    ``contacts`` (required), ``walls``, ``log``, ``time_step``, ``columns`` and ``inertia`` are
+    passed on to :func:`~grainview.formats.lammps.open_lammps`.
+    """
+
+    description = "LAMMPS 2D granular dumps (particles, pairs, walls) as a grainview dataset"
+    url = "https://github.com/lammps/lammps"
+    open_dataset_parameters = ("filename_or_obj", "drop_variables", "contacts", "walls", "log", "time_step",
+                               "columns", "inertia")
+
+    def open_dataset(self, filename_or_obj, *, drop_variables=None, contacts=None, walls=None, log=None,
+                     time_step=None, columns=None, inertia="auto"):
+        from ..errors import ParameterError
+        from .lammps import open_lammps
+
+        if contacts is None:
+            raise ParameterError("engine='lammps' needs contacts=<the pairs' dump local> besides the particles' dump")
+        ds = open_lammps(filename_or_obj, contacts, walls, log=log, time_step=time_step, columns=columns,
+                         inertia=inertia)
+        return ds.drop_vars(list(drop_variables or []), errors="ignore")
+
+    def guess_can_open(self, filename_or_obj) -> bool:
+        return False

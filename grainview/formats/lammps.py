@@ -1,0 +1,548 @@
+"""LAMMPS 2D granular runs as datasets of the grainview contract.
+
+A 2D granular LAMMPS run (``dimension 2``, ``atom_style sphere``, a granular pair style) gives
+its particles and its contacts in two text dumps, and optionally its wall contacts in a third:
+
+* **particles**: a ``dump custom`` with columns (found by name) ``id``, ``radius``, ``mass``,
+  ``x``, ``y``, and optionally ``vx``, ``vy``, ``omegaz``;
+* **contacts**: a ``dump local`` of ``compute property/local patom1 patom2`` and
+  ``compute pair/local fx fy fz p1 p2 p3``: one row per neighbour pair, with the force on
+  ``patom1`` from ``patom2``. For the granular pair styles ``fx, fy, fz`` is only the central
+  (normal) part of that force, and ``p1, p2, p3`` its tangential part (the pair styles'
+  ``single()`` puts the tangential force there), so the force is ``(fx + p1, fy + p2)``.
+  LAMMPS names these columns ``c_ID[k]``; which is which is read from the run's log (the compute
+  definitions), from names given by ``dump_modify colname`` (``patom1``, ``patom2``, ``fx``,
+  ``fy``, ``p1``, ``p2``), or from an explicit mapping;
+* **walls** (optional): a ``dump custom`` of the per-atom arrays of ``fix wall/gran ...
+  contacts`` (columns ``f_ID[1]`` to ``f_ID[8]``: touching flag, force on the particle, contact
+  point, radius), for plane walls (``xplane``, ``yplane``).
+
+How the contract's quantities are made (docs/formats.md states the same for users):
+
+* Particles are numbered by increasing LAMMPS id; the same particles must be in every snapshot.
+* A pair is a contact when its disks overlap (``r_i + r_j > |x_j - x_i|``) and its normal
+  force is compressive (``fn > 0``); the neighbour list's other pairs are dropped, and so are
+  touching pairs pulled together by viscous damping as they separate (counted in the
+  ``tensile`` entry of each snapshot, reported by :func:`open_lammps` and the converter). Bodies ``i < j``; ``normal`` is the unit
+  vector from the centre of i to the centre of j; the force exerted by i on j is minus the force
+  on ``patom1`` when ``patom1`` is i (Newton's third law), the force itself otherwise;
+  ``fn = f . n``, ``ft = f . t`` with ``t = (-n_y, n_x)``; ``branch = x_j - x_i``; ``point`` is
+  the middle of the overlap, ``x_i + (r_i - delta/2) n``; ``gap = -delta``.
+* A wall contact joins particle i to wall body ``N + w`` (walls ``bottom, right, top, left``,
+  told apart by the direction from the particle to the contact point); ``normal`` points from
+  the particle to the wall, ``branch`` is from the centre to the contact point, and the force
+  exerted by the particle on the wall is minus the force the fix reports on the particle.
+* ``time = step x time step``; the box is each snapshot's ``BOX BOUNDS`` (x and y);
+  ``inertia = m r^2 / 2`` for disks (``fix nve/sphere ... disc``; ``2 m r^2 / 5`` when the log
+  shows ``nve/sphere`` without ``disc``).
+* LAMMPS's 2D forces are taken as forces per unit thickness: ``thickness_m = 1``, so stresses
+  come out in N/m = Pa over a 1 m slab.
+
+Every function checks its input first and refuses bad input in one line
+(:class:`grainview.errors.FileFormatError` or :class:`~grainview.errors.ParameterError`).
+"""
+
+from __future__ import annotations
+
+import os
+import re
+import warnings
+
+import numpy as np
+
+from ..errors import FileFormatError, ParameterError
+from .lammps_dump import LammpsLog, iter_dump, read_log
+
+__all__ = ["lammps_snapshots", "open_lammps", "convert_lammps", "WALL_NAMES", "PARTICLE_COLUMNS", "PAIR_COLUMNS"]
+
+WALL_NAMES = ("bottom", "right", "top", "left")
+"""The walls a wall contact can belong to, in the contract's order (bodies N .. N+3)."""
+_WALL_DIRECTIONS = np.array([[0.0, -1.0], [1.0, 0.0], [0.0, 1.0], [-1.0, 0.0]])
+"""Direction from a particle to each wall of :data:`WALL_NAMES`."""
+
+PARTICLE_COLUMNS = {"required": ("id", "radius", "mass", "x", "y"), "optional": ("vx", "vy", "omegaz")}
+"""Columns of the particles' ``dump custom``, by LAMMPS's own names."""
+PAIR_COLUMNS = ("patom1", "patom2", "fx", "fy", "p1", "p2")
+"""Quantities the reader needs from the pairs' ``dump local``: the atom ids, and the force on
+``patom1`` from ``patom2`` as LAMMPS's granular pair styles give it, a central part ``fx, fy``
+and a tangential part ``p1, p2``."""
+_PAIR_KEYWORDS = {"property/local": ("patom1", "patom2"), "pair/local": ("fx", "fy", "p1", "p2")}
+_WALL_ARRAY = 8  # flag, fx, fy, fz, x, y, z, radius: fix wall/gran's per-atom contacts array
+_INDEXED = re.compile(r"^c_([^\[\]]+)(?:\[(\d+)\])?$")
+
+
+def pair_columns(columns, log: LammpsLog | None = None, mapping: dict | None = None, source="contacts") -> dict:
+    """Which column of a pairs' ``dump local`` holds each of :data:`PAIR_COLUMNS`.
+
+    In order: the explicit ``mapping`` (quantity -> column name); a column named after the
+    quantity itself (``dump_modify colname``); a column ``c_ID[k]`` (or ``c_ID``) whose compute
+    ``ID`` the log defines as ``property/local`` or ``pair/local`` with that quantity as its
+    k-th keyword.
+
+    Returns
+    -------
+    dict
+        quantity -> column index.
+
+    Raises
+    ------
+    ParameterError
+        A mapped column that the dump does not have, or a quantity found nowhere (naming it,
+        with the dump's columns and what would resolve it).
+    """
+    columns = tuple(columns)
+    mapping = dict(mapping or {})
+    unknown = set(mapping) - set(PAIR_COLUMNS)
+    if unknown:
+        raise ParameterError(f"columns: unknown quantity {sorted(unknown)[0]!r}; expected some of "
+                             f"{', '.join(PAIR_COLUMNS)}")
+    found = {}
+    for quantity, name in mapping.items():
+        if name not in columns:
+            raise ParameterError(f"{source}: column {name!r} (given for {quantity}) is not in the dump's columns "
+                                 f"{' '.join(columns)}")
+        found[quantity] = columns.index(name)
+    for quantity in PAIR_COLUMNS:
+        if quantity not in found and quantity in columns:
+            found[quantity] = columns.index(quantity)
+    if log is not None:
+        for index, name in enumerate(columns):
+            match = _INDEXED.match(name)
+            if match is None or match.group(1) not in log.computes:
+                continue
+            style, keywords = log.computes[match.group(1)]
+            k = int(match.group(2) or 1) - 1
+            if style in _PAIR_KEYWORDS and k < len(keywords) and keywords[k] in _PAIR_KEYWORDS[style]:
+                found.setdefault(keywords[k], index)
+    missing = [q for q in PAIR_COLUMNS if q not in found]
+    if missing:
+        hint = ("dump them (compute property/local patom1 patom2; compute pair/local fx fy fz p1 p2 p3, p1 p2 "
+                "being the tangential force of granular pair styles) or map them (columns={'patom1': 'c_ID[1]', "
+                "...}; --columns patom1=c_ID[1],...)" if log is not None
+                else "give the run's LAMMPS log (log=..., --log), which defines the computes, or map them")
+        raise ParameterError(f"{source}: cannot tell which column holds {', '.join(missing)} among "
+                             f"{' '.join(columns)}: {hint}")
+    return found
+
+
+def _check_particle_columns(snap, source):
+    missing = [c for c in PARTICLE_COLUMNS["required"] if c not in snap.columns]
+    if missing:
+        raise FileFormatError(f"{source}: step {snap.timestep}: no column {', '.join(missing)} (has "
+                              f"{' '.join(snap.columns)}); dump custom needs id radius mass x y")
+
+
+def _wall_fixes(columns, source):
+    """Fix ID -> the indices of its 8 columns ``f_ID[1..8]`` in a walls dump."""
+    fixes = {}
+    for index, name in enumerate(columns):
+        match = re.match(r"^f_([^\[\]]+)\[(\d+)\]$", name)
+        if match:
+            fixes.setdefault(match.group(1), {})[int(match.group(2))] = index
+    if "id" not in columns or not fixes:
+        raise FileFormatError(f"{source}: expected columns id and f_ID[1] .. f_ID[8] of fix wall/gran ... contacts, "
+                              f"found {' '.join(columns)}")
+    out = {}
+    for fix, found in fixes.items():
+        if sorted(found) != list(range(1, _WALL_ARRAY + 1)):
+            raise FileFormatError(f"{source}: fix {fix}: expected its {_WALL_ARRAY} columns f_{fix}[1] .. "
+                                  f"f_{fix}[{_WALL_ARRAY}] (fix wall/gran ... contacts), found "
+                                  f"{len(found)}")
+        out[fix] = [found[k] for k in range(1, _WALL_ARRAY + 1)]
+    return out
+
+
+def _inertia_factor(inertia, log):
+    """The factor k of I = k m r^2."""
+    if inertia == "disc":
+        return 0.5, "disc: m r^2 / 2"
+    if inertia == "sphere":
+        return 0.4, "sphere: 2 m r^2 / 5"
+    if inertia != "auto":
+        raise ParameterError(f"inertia={inertia!r}: expected 'auto', 'disc' or 'sphere'")
+    if log is not None:
+        for style, args in log.fixes.values():
+            if style.startswith("nve/sphere"):
+                return (0.5, "disc: m r^2 / 2 (fix nve/sphere ... disc)") if "disc" in args else \
+                    (0.4, "sphere: 2 m r^2 / 5 (fix nve/sphere without disc)")
+    return 0.5, "disc: m r^2 / 2 (assumed: no fix nve/sphere in a log)"
+
+
+class _Particles:
+    """The static data of the particles, from the first snapshot, and their index by id."""
+
+    def __init__(self, snap, source, inertia_factor):
+        _check_particle_columns(snap, source)
+        ids = snap.column("id").astype(np.int64)
+        self.order = np.argsort(ids, kind="stable")
+        self.ids = ids[self.order]
+        if np.any(np.diff(self.ids) == 0):
+            raise FileFormatError(f"{source}: step {snap.timestep}: an atom id appears twice")
+        self.radius = snap.column("radius")[self.order].copy()
+        self.mass = snap.column("mass")[self.order].copy()
+        if not (np.all(self.radius > 0) and np.all(self.mass > 0)):
+            raise FileFormatError(f"{source}: step {snap.timestep}: radii and masses must be > 0 "
+                                  "(atom_style sphere, dump custom ... radius mass)")
+        self.inertia = inertia_factor * self.mass * self.radius**2
+        self.source = source
+
+    def index(self, ids, where):
+        """Particle indices of LAMMPS atom ids; one line naming an unknown id."""
+        ids = np.asarray(ids).astype(np.int64)
+        k = np.searchsorted(self.ids, ids)
+        bad = (k >= self.ids.size) | (self.ids[np.minimum(k, self.ids.size - 1)] != ids)
+        if bad.any():
+            raise FileFormatError(f"{where}: atom id {ids[bad][0]} is not among the particles of {self.source}")
+        return k
+
+    def state(self, snap):
+        """Positions (N, 2) and the optional velocities of a snapshot, in particle order."""
+        _check_particle_columns(snap, self.source)
+        ids = snap.column("id").astype(np.int64)
+        order = np.argsort(ids, kind="stable")
+        if ids.size != self.ids.size or np.any(ids[order] != self.ids):
+            raise FileFormatError(f"{self.source}: step {snap.timestep}: the atoms differ from the first snapshot's "
+                                  f"({ids.size} against {self.ids.size}); the contract needs the same particles "
+                                  "throughout")
+        radius = snap.column("radius")[order]
+        if not np.allclose(radius, self.radius, rtol=1e-12, atol=0):
+            raise FileFormatError(f"{self.source}: step {snap.timestep}: radii changed during the run; the "
+                                  "contract holds one radius per particle")
+        position = np.stack([snap.column("x")[order], snap.column("y")[order]], axis=1)
+        extra = {}
+        if "vx" in snap.columns and "vy" in snap.columns:
+            extra["velocity"] = np.stack([snap.column("vx")[order], snap.column("vy")[order]], axis=1)
+        if "omegaz" in snap.columns:
+            extra["angular_velocity"] = snap.column("omegaz")[order].copy()
+        return position, extra
+
+
+def _pair_contacts(particles, position, snap, columns, where):
+    """Contract contacts (dict of arrays) of the touching, compressed pairs of one pairs
+    snapshot, and the number of touching pairs left out for a tensile normal force."""
+    a = particles.index(snap.data[:, columns["patom1"]], where)
+    b = particles.index(snap.data[:, columns["patom2"]], where)
+    force = np.stack([snap.data[:, columns["fx"]] + snap.data[:, columns["p1"]],
+                      snap.data[:, columns["fy"]] + snap.data[:, columns["p2"]]], axis=1)  # on a, from b
+    radius = particles.radius
+    d = position[b] - position[a]
+    overlap = radius[a] + radius[b] - np.hypot(d[:, 0], d[:, 1])
+    touching = (overlap > 0) & (a != b)
+    a, b, force, overlap = a[touching], b[touching], force[touching], overlap[touching]
+    i, j = np.minimum(a, b), np.maximum(a, b)
+    on_j = np.where((a == i)[:, None], -force, force)  # exerted by i on j
+    # a pair listed twice (newton off across processors) is one contact
+    key = i * np.int64(particles.ids.size) + j
+    unique, first = np.unique(key, return_index=True)
+    if unique.size != key.size:
+        same = np.isclose(on_j, on_j[first[np.searchsorted(unique, key)]], rtol=1e-9, atol=0).all(axis=1)
+        if not same.all():
+            k = np.flatnonzero(~same)[0]
+            raise FileFormatError(f"{where}: pair {particles.ids[i[k]]}-{particles.ids[j[k]]} is listed twice "
+                                  "with different forces")
+        i, j, on_j, overlap = i[first], j[first], on_j[first], overlap[first]
+    branch = position[j] - position[i]
+    n = branch / np.hypot(branch[:, 0], branch[:, 1])[:, None]
+    fn = np.einsum("ij,ij->i", on_j, n)
+    loaded = fn > 0
+    i, j, on_j, overlap, branch, n, fn = (x[loaded] for x in (i, j, on_j, overlap, branch, n, fn))
+    t = np.stack([-n[:, 1], n[:, 0]], axis=1)
+    point = position[i] + n * (radius[i] - overlap / 2)[:, None]
+    contacts = dict(i=i, j=j, kind=np.ones(i.size, "i1"), normal=n, fn=fn, ft=np.einsum("ij,ij->i", on_j, t),
+                    point=point, branch=branch, gap=-overlap)
+    return contacts, int((~loaded).sum())
+
+
+def _wall_contacts(particles, position, snap, fixes, where):
+    """Contract contacts of one walls snapshot (fix wall/gran ... contacts arrays)."""
+    n_particles = particles.ids.size
+    index = particles.index(snap.column("id"), where)
+    out = {k: [] for k in ("i", "j", "normal", "fn", "ft", "point", "branch", "gap")}
+    tensile = 0
+    for fix, cols in fixes.items():
+        values = snap.data[:, cols]
+        touching = values[:, 0] != 0
+        if not touching.any():
+            continue
+        p = index[touching]
+        on_particle = values[touching][:, 1:3]
+        point = values[touching][:, 4:6]
+        arm = point - position[p]
+        length = np.hypot(arm[:, 0], arm[:, 1])
+        if np.any(length == 0):
+            raise FileFormatError(f"{where}: fix {fix}: a wall contact point at a particle centre")
+        n = arm / length[:, None]
+        wall = np.argmax(n @ _WALL_DIRECTIONS.T, axis=1)
+        if not np.allclose(n, _WALL_DIRECTIONS[wall], atol=1e-6):
+            raise FileFormatError(f"{where}: fix {fix}: a wall that is not an x or y plane (only fix wall/gran "
+                                  "xplane and yplane walls can be read)")
+        n = _WALL_DIRECTIONS[wall]
+        on_wall = -on_particle
+        loaded = np.einsum("ij,ij->i", on_wall, n) > 0
+        tensile += int((~loaded).sum())
+        p, n, on_wall, point, arm, length = (x[loaded] for x in (p, n, on_wall, point, arm, length))
+        t = np.stack([-n[:, 1], n[:, 0]], axis=1)
+        out["i"].append(p)
+        out["j"].append(n_particles + wall)
+        out["normal"].append(n)
+        out["fn"].append(np.einsum("ij,ij->i", on_wall, n))
+        out["ft"].append(np.einsum("ij,ij->i", on_wall, t))
+        out["point"].append(point)
+        out["branch"].append(arm)
+        out["gap"].append(length - particles.radius[p])
+    if not out["i"]:
+        return None, tensile
+    joined = {k: np.concatenate(v) for k, v in out.items()}
+    joined["kind"] = np.ones(joined["i"].size, "i1")
+    return joined, tensile
+
+
+def _join(pairs, walls):
+    if walls is None:
+        return pairs
+    return {k: np.concatenate([pairs[k], walls[k]]) for k in pairs}
+
+
+def _zip_dumps(particles_path, contacts_path, walls_path):
+    """The three dumps' snapshots side by side, matched by step (one line on a mismatch)."""
+    streams = [iter_dump(particles_path), iter_dump(contacts_path)]
+    if walls_path is not None:
+        streams.append(iter_dump(walls_path))
+    names = [os.fspath(p) for p in (particles_path, contacts_path, walls_path) if p is not None]
+    while True:
+        snaps = [next(s, None) for s in streams]
+        if all(s is None for s in snaps):
+            return
+        if any(s is None for s in snaps):
+            longer = [n for n, s in zip(names, snaps) if s is not None]
+            step = next(s.timestep for s in snaps if s is not None)
+            shorter = [n for n, s in zip(names, snaps) if s is None]
+            raise FileFormatError(f"{longer[0]} has a snapshot at step {step} that {shorter[0]} does not have "
+                                  "(the dumps must hold the same steps)")
+        steps = [s.timestep for s in snaps]
+        if len(set(steps)) > 1:
+            raise FileFormatError(f"mismatched steps: {names[0]} at step {steps[0]}, "
+                                  + ", ".join(f"{n} at step {s}" for n, s in zip(names[1:], steps[1:]))
+                                  + " (the dumps must hold the same steps, e.g. the same dump interval)")
+        yield snaps
+
+
+def lammps_snapshots(particles, contacts, walls=None, *, log=None, time_step=None, columns=None,
+                     inertia="auto"):
+    """Read a LAMMPS run snapshot by snapshot, as the contract's per-snapshot arrays.
+
+    Parameters
+    ----------
+    particles : str or path-like
+        The particles' ``dump custom`` (columns ``id radius mass x y`` and optionally
+        ``vx vy omegaz``).
+    contacts : str or path-like
+        The pairs' ``dump local`` (``compute property/local patom1 patom2`` and
+        ``compute pair/local fx fy fz p1 p2 p3``).
+    walls : str or path-like, optional
+        A ``dump custom`` of ``id`` and the arrays ``f_ID[1..8]`` of ``fix wall/gran ...
+        contacts`` (plane walls).
+    log : str or path-like, optional
+        The run's ``log.lammps`` (or input script): the time step and the computes' definitions.
+    time_step : float, optional
+        The time step, s (overrides the log's).
+    columns : dict, optional
+        quantity -> column name for the pairs' dump (:func:`pair_columns`).
+    inertia : {"auto", "disc", "sphere"}
+        Moments of inertia: ``m r^2 / 2``, ``2 m r^2 / 5``, or what the log's
+        ``fix nve/sphere`` says (``disc`` when there is no log).
+
+    Returns
+    -------
+    (static, iterator)
+        ``static``: a dict of the particles' ``radius``, ``mass``, ``inertia`` (arrays, (N,)),
+        ``n_walls``, ``wall_names`` and ``attrs`` (the conversion's provenance); the iterator
+        yields one dict per snapshot with ``time`` (s), ``position`` (N, 2), ``angle`` (N,),
+        ``contacts`` (dict of contract contact arrays), ``box_min``, ``box_max`` (2,) and,
+        when the dump has them, ``velocity`` and ``angular_velocity``. The static part is read
+        from the first snapshot at once; the iterator reads the rest one snapshot at a time.
+
+    Raises
+    ------
+    FileFormatError, ParameterError
+        One line naming what is wrong: a file that is not a LAMMPS dump, a truncated dump, a
+        missing column, steps that differ between the dumps, unknown atom ids, a time step
+        known from neither ``time_step`` nor the log.
+    """
+    log_info = read_log(log) if log is not None else None
+    if log_info is not None and log_info.units not in (None, "si"):
+        raise ParameterError(f"{os.fspath(log)}: the run is in LAMMPS units {log_info.units!r}; only runs in SI units "
+                             "(units si) can be read")
+    if time_step is None and log_info is not None:
+        time_step = log_info.time_step
+    if time_step is None:
+        raise ParameterError("the time step is unknown: give it (time_step=..., --time-step) or the run's LAMMPS "
+                             "log (log=..., --log)")
+    if isinstance(time_step, bool) or not np.isfinite(float(time_step)) or float(time_step) <= 0:
+        raise ParameterError(f"time_step={time_step!r}: expected a time step > 0 in s")
+    time_step = float(time_step)
+    factor, inertia_rule = _inertia_factor(inertia, log_info)
+    stream = _zip_dumps(particles, contacts, walls)
+    first = next(stream, None)
+    if first is None:
+        raise FileFormatError(f"{os.fspath(particles)}: no snapshot (an empty dump)")
+    source = os.fspath(particles)
+    static_particles = _Particles(first[0], source, factor)
+    pair_index = pair_columns(first[1].columns, log_info, columns, source=os.fspath(contacts))
+    fixes = _wall_fixes(first[2].columns, os.fspath(walls)) if walls is not None else None
+    if any(flag.startswith("p") for flag in first[0].boundary[:2]):
+        raise FileFormatError(f"{source}: periodic in x or y (boundary {' '.join(first[0].boundary)}); the contract "
+                              "holds bounded samples only")
+    attrs = {"source": "LAMMPS", "lammps_particles": os.path.basename(os.fspath(particles)),
+             "lammps_contacts": os.path.basename(os.fspath(contacts)), "lammps_time_step_s": time_step,
+             "lammps_inertia": inertia_rule, "thickness_m": 1.0,
+             "lammps_contact_rule": "pairs that overlap with a compressive normal force"}
+    if walls is not None:
+        attrs["lammps_walls"] = os.path.basename(os.fspath(walls))
+    if log_info is not None and log_info.version:
+        attrs["lammps_version"] = log_info.version
+    static = dict(radius=static_particles.radius, mass=static_particles.mass, inertia=static_particles.inertia,
+                  n_walls=len(WALL_NAMES) if walls is not None else 0,
+                  wall_names=list(WALL_NAMES) if walls is not None else None, attrs=attrs)
+
+    def snapshots():
+        for snaps in _chain_first(first, stream):
+            part, pairs = snaps[0], snaps[1]
+            where = f"{os.fspath(contacts)}: step {part.timestep}"
+            position, extra = static_particles.state(part)
+            contacts_now, tensile = _pair_contacts(static_particles, position, pairs, pair_index, where)
+            if fixes is not None:
+                on_walls, tensile_walls = _wall_contacts(static_particles, position, snaps[2], fixes,
+                                                         f"{os.fspath(walls)}: step {part.timestep}")
+                contacts_now, tensile = _join(contacts_now, on_walls), tensile + tensile_walls
+            yield dict(time=part.timestep * time_step, step=part.timestep, tensile=tensile, position=position,
+                       angle=np.zeros(position.shape[0]), contacts=contacts_now,
+                       box_min=part.bounds[:2, 0].copy(), box_max=part.bounds[:2, 1].copy(), **extra)
+
+    return static, snapshots()
+
+
+def _chain_first(first, stream):
+    yield first
+    yield from stream
+
+
+def open_lammps(particles, contacts, walls=None, *, log=None, time_step=None, columns=None, inertia="auto",
+                progress=False):
+    """A LAMMPS 2D granular run as an in-memory dataset of the contract.
+
+    Arguments as :func:`lammps_snapshots`; ``progress`` shows a progress bar over the
+    snapshots. For a run too large for memory, :func:`convert_lammps` writes a file snapshot by
+    snapshot instead.
+
+    Returns
+    -------
+    xarray.Dataset
+        A dataset of the contract (docs/schema.md; the conversion's rules: docs/formats.md),
+        with ``velocity`` and ``angular_velocity`` when the particles' dump has them, and
+        ``step``.
+    """
+    from ..dataset import make_dataset
+
+    static, stream = lammps_snapshots(particles, contacts, walls, log=log, time_step=time_step, columns=columns,
+                                      inertia=inertia)
+    if progress:
+        from tqdm.auto import tqdm
+
+        stream = tqdm(stream, desc="lammps", unit=" snapshots")
+    snaps = list(stream)
+    _warn_tensile(sum(s["tensile"] for s in snaps), len(snaps))
+    optional = {"step": np.array([s["step"] for s in snaps], "i4")}
+    for name in ("velocity", "angular_velocity"):
+        if all(name in s for s in snaps):
+            optional[name] = np.stack([s[name] for s in snaps])
+    n = static["radius"].size
+    slots = max([3 * (n + static["n_walls"]) - 6] + [len(s["contacts"]["i"]) for s in snaps])
+    return make_dataset(radius=static["radius"], mass=static["mass"], inertia=static["inertia"],
+                        position=np.stack([s["position"] for s in snaps]), contacts=[s["contacts"] for s in snaps],
+                        box_min=np.stack([s["box_min"] for s in snaps]), box_max=np.stack([s["box_max"] for s in snaps]),
+                        time=np.array([s["time"] for s in snaps]), n_walls=static["n_walls"],
+                        wall_names=static["wall_names"], attrs=static["attrs"], n_contact_slots=slots, **optional)
+
+
+def _warn_tensile(count, snapshots):
+    if count:
+        warnings.warn(f"{count} touching pair(s) over {snapshots} snapshot(s) had a tensile normal force (viscous "
+                      "damping as they separate) and were left out of the contacts", UserWarning, stacklevel=3)
+
+
+def convert_lammps(out, particles, contacts, walls=None, *, log=None, time_step=None, columns=None, inertia="auto",
+                   overwrite=False, compress=True, progress=False):
+    """Convert a LAMMPS 2D granular run into a file of the contract, snapshot by snapshot.
+
+    The dumps are read one snapshot at a time and each snapshot is appended to the file as it
+    is read (:class:`grainview.writer.SnapshotWriter`), so a run of any length converts in the
+    memory of one snapshot. The file is written under a hidden temporary name, validated,
+    compressed (unless ``compress=False``) and only then moved to ``out``: bad input anywhere
+    in the dumps leaves nothing behind.
+
+    Parameters
+    ----------
+    out : str or path-like
+        The netCDF file to write; an existing one is refused unless ``overwrite``.
+    particles, contacts, walls, log, time_step, columns, inertia
+        As :func:`lammps_snapshots`.
+    overwrite : bool, default False
+        Replace an existing ``out``.
+    compress : bool, default True
+        Write the finished file compressed (docs/schema.md, "Compression").
+    progress : bool, default False
+        Show a progress bar over the snapshots.
+
+    Returns
+    -------
+    int
+        The number of snapshots written.
+
+    Raises
+    ------
+    FileExistsError
+        ``out`` exists and ``overwrite`` is False (checked before any work).
+    FileFormatError, ParameterError, SchemaError
+        Bad input (one line); nothing is written.
+    """
+    from ..io import open_dataset
+    from ..writer import SnapshotWriter, _move_into_place, compress_file
+
+    out = os.fspath(out)
+    if os.path.exists(out) and not overwrite:
+        raise FileExistsError(f"{out} exists; pass overwrite=True to replace it")
+    folder = os.path.dirname(os.path.abspath(out))
+    if not os.path.isdir(folder):
+        raise FileFormatError(f"{out}: the folder {folder} does not exist")
+    static, stream = lammps_snapshots(particles, contacts, walls, log=log, time_step=time_step, columns=columns,
+                                      inertia=inertia)
+    temporary = os.path.join(folder, f".{os.path.basename(out)}.{os.getpid()}.lammps")
+    first = next(stream)
+    optional = ("step", "gap") + tuple(name for name in ("velocity", "angular_velocity") if name in first)
+    if progress:
+        from tqdm.auto import tqdm
+
+        stream = tqdm(stream, desc=f"lammps -> {os.path.basename(out)}", unit=" snapshots", initial=1)
+    count = tensile = 0
+    n = static["radius"].size
+    try:
+        with SnapshotWriter.create(temporary, radius=static["radius"], n_vertices=np.zeros(n, "i4"),
+                                   mass=static["mass"], inertia=static["inertia"], n_walls=static["n_walls"],
+                                   wall_names=static["wall_names"], optional=optional,
+                                   attrs=static["attrs"]) as writer:
+            for snap in _chain_first(first, stream):
+                tensile += snap.pop("tensile")
+                writer.append(**snap)
+                count += 1
+        open_dataset(temporary, chunks=None, validate=True).close()
+        if compress:
+            compress_file(temporary)
+        _move_into_place(temporary, out, overwrite)
+    finally:
+        if progress:
+            stream.close()
+        if os.path.exists(temporary):
+            os.remove(temporary)
+    _warn_tensile(tensile, count)
+    return count

@@ -1,0 +1,216 @@
+"""LAMMPS text dumps and logs, parsed into arrays: the file layer of the LAMMPS reader.
+
+A LAMMPS text dump (``dump custom`` or ``dump local``, written by LAMMPS's ``dump_custom.cpp``
+and ``dump_local.cpp``) is a series of snapshots, each::
+
+    ITEM: TIMESTEP
+    <step>
+    ITEM: NUMBER OF ATOMS            (dump custom; ``NUMBER OF ENTRIES`` for dump local)
+    <n>
+    ITEM: BOX BOUNDS ff ff pp        (boundary flags of x, y, z)
+    <xlo> <xhi>
+    <ylo> <yhi>
+    <zlo> <zhi>
+    ITEM: ATOMS id type x y ...      (``ITEM: ENTRIES c_ID[1] ...`` for dump local)
+    <n rows of numbers>
+
+:func:`iter_dump` reads one snapshot at a time, so a dump of any length is read in the memory
+of one snapshot. :func:`read_log` takes from a LAMMPS log (or input script) what a dump does not
+say: the time step, and the definitions of the computes and fixes whose columns a dump names
+only ``c_ID[k]`` and ``f_ID[k]``.
+"""
+
+from __future__ import annotations
+
+import os
+import re
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..errors import FileFormatError
+
+__all__ = ["DumpSnapshot", "LammpsLog", "iter_dump", "read_log"]
+
+
+@dataclass(frozen=True)
+class DumpSnapshot:
+    """One snapshot of a LAMMPS text dump.
+
+    Attributes
+    ----------
+    timestep : int
+        The step index (``ITEM: TIMESTEP``).
+    bounds : numpy.ndarray, (3, 2)
+        ``[[xlo, xhi], [ylo, yhi], [zlo, zhi]]`` of the box, in the run's distance units.
+    boundary : tuple of str
+        The boundary flags of x, y, z (``ff``, ``pp``, ``fs``, ...).
+    columns : tuple of str
+        The column names of the ``ITEM: ATOMS`` or ``ITEM: ENTRIES`` line.
+    data : numpy.ndarray, (n, len(columns))
+        The rows, as floats (ids are exact up to 2**53).
+    """
+
+    timestep: int
+    bounds: np.ndarray
+    boundary: tuple
+    columns: tuple
+    data: np.ndarray
+
+    def column(self, name: str) -> np.ndarray:
+        """The values of column ``name``."""
+        return self.data[:, self.columns.index(name)]
+
+
+def _read_item(fh, path, expect, where):
+    line = fh.readline()
+    if not line.startswith("ITEM: " + expect):
+        found = line.strip()[:60] or "the end of the file"
+        raise FileFormatError(f"{path}: {where}: expected 'ITEM: {expect}', found {found!r} "
+                              "(not a LAMMPS text dump, or a truncated one)")
+    return line
+
+
+def _read_numbers(fh, path, count, where):
+    line = fh.readline()
+    try:
+        values = [float(v) for v in line.split()]
+    except ValueError:
+        values = []
+    if len(values) < count:
+        raise FileFormatError(f"{path}: {where}: expected {count} number(s), found {line.strip()[:60]!r}")
+    return values
+
+
+def iter_dump(path):
+    """Iterate over the snapshots of a LAMMPS text dump, one :class:`DumpSnapshot` at a time.
+
+    Parameters
+    ----------
+    path : str or path-like
+        A ``dump custom`` or ``dump local`` file in LAMMPS's text format (not binary, not
+        gzipped).
+
+    Yields
+    ------
+    DumpSnapshot
+
+    Raises
+    ------
+    FileFormatError
+        A missing or unreadable file, a header that is not LAMMPS's, a triclinic box, or a
+        snapshot with fewer rows than announced or a row of the wrong length (a truncated or
+        damaged dump), naming the file and the snapshot.
+    """
+    path = os.fspath(path)
+    try:
+        fh = open(path, encoding="ascii", errors="replace")
+    except OSError as exc:
+        raise FileFormatError(f"{path}: cannot be read ({exc.strerror or exc})") from None
+    with fh:
+        index = 0
+        while True:
+            line = fh.readline()
+            if not line:
+                return
+            if not line.strip():
+                continue
+            where = f"snapshot {index}"
+            if not line.startswith("ITEM: TIMESTEP"):
+                raise FileFormatError(f"{path}: {where}: expected 'ITEM: TIMESTEP', found {line.strip()[:60]!r} "
+                                      "(not a LAMMPS text dump)")
+            timestep = int(_read_numbers(fh, path, 1, where)[0])
+            where = f"snapshot {index} (step {timestep})"
+            _read_item(fh, path, "NUMBER OF", where)
+            rows = int(_read_numbers(fh, path, 1, where)[0])
+            header = _read_item(fh, path, "BOX BOUNDS", where)
+            flags = header.split()[3:]
+            if any(flag in ("xy", "xz", "yz") for flag in flags):
+                raise FileFormatError(f"{path}: {where}: a triclinic box; only orthogonal boxes can be read")
+            bounds = np.array([_read_numbers(fh, path, 2, where)[:2] for _ in range(3)])
+            header = fh.readline()
+            if not (header.startswith("ITEM: ATOMS") or header.startswith("ITEM: ENTRIES")):
+                raise FileFormatError(f"{path}: {where}: expected 'ITEM: ATOMS' or 'ITEM: ENTRIES', found "
+                                      f"{header.strip()[:60]!r}")
+            columns = tuple(header.split()[2:])
+            lines = [fh.readline() for _ in range(rows)]
+            if rows and not lines[-1]:  # the file ended first
+                lines = [line for line in lines if line]
+                raise FileFormatError(f"{path}: {where}: {rows} rows announced, {len(lines)} found "
+                                      "(a truncated dump)")
+            try:
+                values = np.array(" ".join(lines).split(), dtype=np.float64)
+            except ValueError:
+                raise FileFormatError(f"{path}: {where}: a row holds something other than numbers") from None
+            if values.size != rows * len(columns):
+                raise FileFormatError(f"{path}: {where}: {values.size} values in {rows} rows of "
+                                      f"{len(columns)} columns (a damaged dump)")
+            yield DumpSnapshot(timestep, bounds, tuple(flags), columns, values.reshape(rows, len(columns)))
+            index += 1
+
+
+@dataclass
+class LammpsLog:
+    """What a LAMMPS log or input script says about a run's output.
+
+    Attributes
+    ----------
+    time_step : float or None
+        The last ``timestep`` command's value, in the run's time units.
+    computes : dict
+        compute ID -> (style, keywords), e.g. ``"forces" -> ("pair/local", ["dist", "fx", ...])``.
+    fixes : dict
+        fix ID -> (style, arguments).
+    version : str or None
+        The LAMMPS version line (``LAMMPS (22 Jul 2025 - Update 4)``).
+    units : str or None
+        The ``units`` command's style (``si``, ``lj``, ...).
+    """
+
+    time_step: float | None = None
+    units: str | None = None
+    computes: dict = field(default_factory=dict)
+    fixes: dict = field(default_factory=dict)
+    version: str | None = None
+
+
+_COMMAND = re.compile(r"^\s*(compute|fix|timestep|units)\s+(.*)$")
+
+
+def read_log(path) -> LammpsLog:
+    """The time step and the compute and fix definitions of a LAMMPS log or input script.
+
+    Lines still holding a variable (``${name}``, ``$x``) are skipped: LAMMPS echoes each such
+    command a second time with the variable substituted, and that line is the one read. A
+    command given twice (a compute redefined, a second ``timestep``) keeps its last form.
+
+    Raises
+    ------
+    FileFormatError
+        The file cannot be read.
+    """
+    path = os.fspath(path)
+    log = LammpsLog()
+    try:
+        fh = open(path, encoding="utf-8", errors="replace")
+    except OSError as exc:
+        raise FileFormatError(f"{path}: cannot be read ({exc.strerror or exc})") from None
+    with fh:
+        for line in fh:
+            if log.version is None and line.startswith("LAMMPS ("):
+                log.version = line.strip()
+            match = _COMMAND.match(line.split("#", 1)[0])
+            if match is None or "$" in line:
+                continue
+            command, words = match.group(1), match.group(2).split()
+            if command == "units" and words:
+                log.units = words[0]
+            elif command == "timestep":
+                try:
+                    log.time_step = float(words[0])
+                except (ValueError, IndexError):
+                    pass
+            elif len(words) >= 3:  # ID group style args...
+                target = log.computes if command == "compute" else log.fixes
+                target[words[0]] = (words[2], words[3:])
+    return log
