@@ -581,8 +581,10 @@ def build_parser() -> argparse.ArgumentParser:
                                 "(docs/formats.md).")
     lammps.add_argument("--particles", required=True, help="the particles' dump custom")
     lammps.add_argument("--contacts", required=True, help="the pairs' dump local")
-    lammps.add_argument("--walls", help="the walls' dump custom (id and f_ID[1..8] of fix wall/gran ... contacts)")
-    lammps.add_argument("--log", help="the run's log.lammps or input script: time step and compute definitions")
+    lammps.add_argument("--walls", help="the walls' dump custom (id and f_ID[1..8] of fix wall/gran ... contacts; "
+                        "default: none, no wall contacts)")
+    lammps.add_argument("--log", help="the run's log.lammps or input script: time step and compute definitions "
+                        "(default: none; then --time-step is needed)")
     lammps.add_argument("--time-step", type=float, help="the time step in s (default: the log's)")
     lammps.add_argument("--columns", help="which dump local column holds each quantity, e.g. "
                         "patom1=c_pairs[1],patom2=c_pairs[2],fx=c_forces[2],fy=c_forces[3],p1=c_forces[5],"
