@@ -478,10 +478,12 @@ def build_parser() -> argparse.ArgumentParser:
     report = sub.add_parser("report", help="analyse runs: headline table vs the paper and all figures",
                             description="Analyse one or more files of the data contract: the headline table "
                             "(residual state next to the paper's values), the paper's figures, a CSV of the "
-                            "table. Runs labelled with 'pent' or 'disk' are compared with S1 or S2.")
+                            "table. Runs labelled with 'pent' or 'disk', or else whose particles are all pentagons or all "
+                            "disks, are compared with the paper's S1 or S2.")
     report.add_argument("files", nargs="+", help="netCDF files of the grainview contract")
     report.add_argument("--labels", default=None, help="comma-separated labels (default: file names); "
-                        "labels containing 'pent' or 'disk' are compared with the paper's S1/S2 values")
+                        "labels containing 'pent' or 'disk' are compared with the paper's S1/S2 values; other runs by their "
+                        "particles' shape")
     report.add_argument("--out", default="report", help="output folder (default: report)")
     report.add_argument("--overwrite", action="store_true", help="replace an existing report in --out")
     report.add_argument("--movie", action="store_true", help="also a force-chain movie of each run "
