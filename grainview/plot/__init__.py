@@ -27,7 +27,7 @@ paper figure  function                                   module
 12            plot_harmonic_prediction                   macroscopic
 13            plot_force_chains                          maps
 14            plot_force_pdfs (plot_force_pdf)           forces
-15, 16        plot_xi_stress, plot_xi_anisotropy         forces
+15, 16        plot_xi_stress, plot_xi_anisotropies       forces
 17            plot_force_classes                         maps
 18            plot_partial_q_over_p                      macroscopic
 19            plot_contact_proportions                   forces
@@ -49,8 +49,10 @@ import xarray as xr
 from ._style import save_figure
 from .forces import (plot_angular_forces, plot_contact_proportions, plot_force_anisotropies,
                      plot_force_anisotropy, plot_force_pdf, plot_force_pdf_by_kind, plot_force_pdfs,
-                     plot_force_pdfs_by_kind, plot_normal_force_polar, plot_strong_weak_proportions,
-                     plot_tangential_force, plot_tangential_force_polar, plot_type_transitions, plot_xi_anisotropy, plot_xi_stress)
+                     plot_force_pdfs_by_kind, plot_normal_force, plot_normal_force_polar,
+                     plot_strong_weak_proportion, plot_strong_weak_proportions, plot_tangential_force,
+                     plot_tangential_force_polar, plot_type_transitions, plot_xi_anisotropies, plot_xi_anisotropy,
+                     plot_xi_stress)
 from .macroscopic import (plot_harmonic_prediction, plot_partial_q_over_p, plot_q_over_p,
                           plot_stress_dilatancy, plot_volumetric_strain)
 from .movies import animate
@@ -65,7 +67,7 @@ FIGURES = {
     "06a": plot_coordination, "06b": plot_persistence, "07": plot_connectivity_pdf,
     "08": plot_orientation_pdf, "09": plot_fabric_anisotropy, "10": plot_angular_forces,
     "11": plot_force_anisotropies, "12": plot_harmonic_prediction, "13": plot_force_chains,
-    "14": plot_force_pdfs, "15": plot_xi_stress, "16": plot_xi_anisotropy, "17": plot_force_classes,
+    "14": plot_force_pdfs, "15": plot_xi_stress, "16": plot_xi_anisotropies, "17": plot_force_classes,
     "18": plot_partial_q_over_p, "19": plot_contact_proportions, "20": plot_type_transitions,
     "21": plot_joint_connectivity, "22": plot_partial_fabric_anisotropy, "23": plot_force_pdfs_by_kind,
     "24": plot_contact_kinds, "25": plot_strong_weak_proportions,
@@ -116,6 +118,7 @@ class PlotAccessor:
     joint_connectivity = _delegate(plot_joint_connectivity)
     partial_fabric_anisotropy = _delegate(plot_partial_fabric_anisotropy)
     # forces (Figs. 10, 11, 14, 15, 16, 19, 20, 23, 25)
+    normal_force = _delegate(plot_normal_force)
     normal_force_polar = _delegate(plot_normal_force_polar)
     tangential_force_polar = _delegate(plot_tangential_force_polar)
     tangential_force = _delegate(plot_tangential_force)
@@ -128,8 +131,10 @@ class PlotAccessor:
     force_pdfs_by_kind = _delegate(plot_force_pdfs_by_kind)
     xi_stress = _delegate(plot_xi_stress)
     xi_anisotropy = _delegate(plot_xi_anisotropy)
+    xi_anisotropies = _delegate(plot_xi_anisotropies)
     contact_proportions = _delegate(plot_contact_proportions)
     type_transitions = _delegate(plot_type_transitions)
+    strong_weak_proportion = _delegate(plot_strong_weak_proportion)
     strong_weak_proportions = _delegate(plot_strong_weak_proportions)
     # maps (Figs. 13, 17, 24)
     particles = _delegate(plot_particles)
@@ -148,5 +153,5 @@ class PlotAccessor:
 __all__ = ["PlotAccessor", "save_figure", "FIGURES", "animate", *(f.__name__ for f in FIGURES.values()),
            "plot_particles", "plot_particle_map", "plot_connectivity_map", "plot_rattler_map", "plot_rotation_map",
            "plot_normal_force_polar", "plot_tangential_force_polar", "plot_tangential_force",
-           "plot_force_anisotropy",
+           "plot_force_anisotropy", "plot_normal_force", "plot_xi_anisotropy", "plot_strong_weak_proportion",
            "plot_force_pdf", "plot_force_pdf_by_kind"]

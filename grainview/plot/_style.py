@@ -284,15 +284,135 @@ def save_figure(fig, path, dpi: int = 150) -> list[Path]:
     return out
 
 
+CAPTION_FONTSIZE = 8
+"""Size of the caption text under a figure, points."""
+
+
 def add_caption(fig, lines) -> None:
-    """Write ``lines`` (what the figure shows: samples, N, strain window, preparation, seed)
-    in small type under the figure; :func:`save_figure` keeps it in the saved file."""
+    """Write ``lines`` (what the figure plots, then its samples: N, strain window, preparation,
+    seed) in :data:`CAPTION_FONTSIZE` type under the figure, each line wrapped to the figure's
+    width; :func:`save_figure` keeps it in the saved file.
+
+    The caption starts at the left edge of what the figure draws (axes, labels, legends) and
+    just under its lowest part, not at the figure's edges: a figure narrower than its canvas
+    (a tall map) is saved without a blank margin on its left, and a legend under the panels
+    stays above the caption."""
+    import textwrap
+
     figure = getattr(fig, "figure", fig) if not hasattr(fig, "savefig") else fig
-    figure.text(0.0, -0.01, "\n".join(lines), ha="left", va="top", fontsize=6, color="0.3",
-                transform=figure.transFigure)
+    figure.canvas.draw()  # lays the figure out: its drawn extent is known from here
+    box = figure.get_tightbbox(figure.canvas.get_renderer())  # inches: axes, labels, legends
+    width, height = figure.get_figwidth(), figure.get_figheight()
+    chars = max(60, int(box.width * 72 / (0.5 * CAPTION_FONTSIZE)))  # about half an em per character
+    wrapped = [part for line in lines for part in textwrap.wrap(str(line), chars) or [""]]
+    figure.text(box.x0 / width, box.y0 / height - 0.1 / height, "\n".join(wrapped), ha="left", va="top",
+                fontsize=CAPTION_FONTSIZE, color="0.25", transform=figure.transFigure)
+
+
+def legend_in_first(axes, loc: str = "upper right") -> None:
+    """One legend for all ``axes`` of a figure, inside the first of them at ``loc`` (the
+    entries of the first axes that has any), instead of a legend beside one panel, which would
+    make that panel narrower than the others; the other panels' legends are removed."""
+    handles, labels = [], []
+    for ax in axes:
+        handles, labels = ax.get_legend_handles_labels()
+        if labels:
+            break
+    for ax in axes:
+        if ax.get_legend() is not None:
+            ax.get_legend().remove()
+    if labels:
+        axes[0].legend(handles, labels, loc=loc, fontsize="small")
 
 
 # -- evolutions --------------------------------------------------------------------------------
+
+PALETTE = {
+    "pentagons": "#0072B2",
+    "disks": "#E69F00",
+    "simple": "#009E73",
+    "double": "#CC79A7",
+    "all": "0.15",
+}
+"""One meaning per colour in every figure (Okabe–Ito colours, told apart with the common
+colour-vision deficiencies): a sample of pentagons is blue and one of disks orange wherever
+samples are compared (the study's figures and the ensemble figures alike); simple contacts are
+bluish green, double ones reddish purple and all contacts together near-black, in the curves of
+Figs. 18, 19, 22, 23, 25 and the map of Fig. 24."""
+
+OTHER_COLOURS = ("#56B4E9", "#D55E00", "0.45", "#F0E442", "0.15")
+"""Colours of samples of other shapes, or a second sample of the same shape, in this order:
+none of them is a colour of :data:`PALETTE`'s samples or contact kinds (near-black last)."""
+
+NEUTRAL_COLOURS = ("0.15", "0.5", "#56B4E9", "#D55E00")
+"""Colours of the curves of one sample that are neither samples nor contact kinds (Fig. 20's
+s->d and d->s), in this order."""
+
+
+def shape_key(label=None, ds: xr.Dataset | None = None) -> str | None:
+    """The shape a sample is coloured by: "pentagons", "disks" or None (another shape).
+
+    The dataset decides when given (no vertices: disks; five: pentagons); otherwise the label
+    does ("pent" or "5-gon": pentagons; "disk" or "disc": disks), as for an ensemble's groups.
+
+    Parameters
+    ----------
+    label : str, optional
+        The sample's label.
+    ds : xarray.Dataset, optional
+        The sample's dataset.
+
+    Returns
+    -------
+    str or None
+        A sample key of :data:`PALETTE`, or None.
+    """
+    if ds is not None and "n_vertices" in ds:
+        n_vertices = np.asarray(ds["n_vertices"].values)
+        if not n_vertices.any():
+            return "disks"
+        return "pentagons" if int(n_vertices.max()) == 5 and int(n_vertices.min()) == 5 else None
+    low = str(label or "").lower()
+    if "pent" in low or "5-gon" in low:
+        return "pentagons"
+    if "disk" in low or "disc" in low:
+        return "disks"
+    return None
+
+
+def _used_colours(ax) -> set:
+    from matplotlib.colors import to_hex
+    return {to_hex(line.get_color()) for line in ax.lines}
+
+
+def sample_colour(ax, label=None, ds: xr.Dataset | None = None) -> str:
+    """The colour of a sample drawn on ``ax``: its shape's colour in :data:`PALETTE` unless a
+    line of ``ax`` already has it (a second sample of that shape), else the first of
+    :data:`OTHER_COLOURS` not yet on ``ax``.
+
+    Parameters
+    ----------
+    ax : matplotlib.axes.Axes
+        The axes the sample is drawn on.
+    label : str, optional
+        The sample's label (:func:`shape_key`).
+    ds : xarray.Dataset, optional
+        The sample's dataset (:func:`shape_key`).
+
+    Returns
+    -------
+    str
+        A matplotlib colour.
+    """
+    from matplotlib.colors import to_hex
+    used = _used_colours(ax)
+    shape = shape_key(label, ds)
+    choices = ([PALETTE[shape]] if shape else []) + list(OTHER_COLOURS)
+    for colour in choices:
+        if to_hex(colour) not in used:
+            return colour
+    return choices[len(used) % len(choices)]
+
 
 LINESTYLES = ("-", "--", ":", "-.")
 CURVE_MARKERS = ("o", "s", "^", "D")
@@ -300,25 +420,19 @@ CURVE_MARKERS = ("o", "s", "^", "D")
 samples differ by colour): dashes alone are lost where noisy curves cross."""
 
 
-def next_colour(ax) -> str:
-    """The first colour of the default cycle not yet used by a line of ``ax``, so that
-    samples drawn by successive calls on the same axes get different colours."""
-    used = {line.get_color() for line in ax.lines}
-    for k in range(10):
-        if f"C{k}" not in used:
-            return f"C{k}"
-    return f"C{len(used) % 10}"
-
-
-def draw_evolutions(ax, pairs, compute, curves, marker: str = "", **line_kw):
+def draw_evolutions(ax, pairs, compute, curves, marker: str = "", curve_colours=None, curve_styles=None,
+                    **line_kw):
     """One line per (dataset, curve) against eps_q.
 
     ``compute(ds)`` returns a Dataset (or a DataArray) over time; ``curves`` lists
     ``(curve_label, variable_name)`` of it (a name None takes the DataArray itself). One sample
-    with several curves: a colour and a line style per curve. Several samples: a colour per
-    sample and, with one curve each, a line style per sample (readable in grey print); with
-    several curves, per curve a line style and a marker (:data:`CURVE_MARKERS`, on about a
-    dozen points of each line). Returns the drawn DataArrays (computed), in drawing order.
+    with several curves: a colour and a line style per curve, the colours ``curve_colours`` (one
+    per curve, e.g. :data:`PALETTE`'s contact kinds) or else the sample's colour for the first
+    curve and :data:`NEUTRAL_COLOURS` for the others, and the line styles ``curve_styles`` (one
+    per curve) or else :data:`LINESTYLES` in turn. Several samples: a colour per sample
+    (:func:`sample_colour`) and, with one curve each, a line style per sample (readable in grey
+    print); with several curves, per curve a line style and a marker (:data:`CURVE_MARKERS`, on
+    about a dozen points of each line). Returns the drawn DataArrays (computed), in drawing order.
     """
     drawn = []
     given = line_kw.pop("color", None)
@@ -326,7 +440,8 @@ def draw_evolutions(ax, pairs, compute, curves, marker: str = "", **line_kw):
     for sample, (label, ds) in enumerate(pairs):
         x = eps_q(ds)
         result = compute(ds).compute()
-        colour = given if given is not None and len(pairs) == 1 else next_colour(ax)
+        colour = given if given is not None and len(pairs) == 1 else sample_colour(ax, label, ds)
+        neutral = iter(NEUTRAL_COLOURS)
         for k, (curve_label, name) in enumerate(curves):
             y = result if name is None else result[name]
             style = dict(marker=marker, color=colour)
@@ -335,9 +450,13 @@ def draw_evolutions(ax, pairs, compute, curves, marker: str = "", **line_kw):
             if several:
                 style.update(marker=CURVE_MARKERS[k % len(CURVE_MARKERS)], markersize=3.5,
                              markevery=max(1, len(x) // 12))
-            elif len(curves) > 1 and k > 0 and given is None:
-                style["color"] = next_colour(ax)
-            style.setdefault("linestyle", LINESTYLES[k % len(LINESTYLES)])
+            elif len(curves) > 1 and given is None:
+                if curve_colours is not None:
+                    style["color"] = curve_colours[k]
+                elif k > 0:
+                    style["color"] = next(neutral, colour)
+            style.setdefault("linestyle", curve_styles[k] if curve_styles is not None
+                             else LINESTYLES[k % len(LINESTYLES)])
             if "linestyle" in line_kw or "ls" in line_kw:  # the caller's style wins
                 style.pop("linestyle")
             ax.plot(x, values(y), label=series_label(label, curve_label), **style, **line_kw)

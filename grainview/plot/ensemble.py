@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ._style import EPS_Q_LABEL
+from ._style import EPS_Q_LABEL, sample_colour
 
 __all__ = ["seed_bands"]
 
@@ -13,7 +13,9 @@ def seed_bands(stats, ax=None, label: str = "", units: str = "1"):
     """Draw :func:`grainview.ensemble.seed_statistics` binned on eps_q: mean and spread per group.
 
     Per group the mean as a line and mean +- one standard deviation as a band (none where a
-    bin has a single seed), the number of seeds in the legend.
+    bin has a single seed), the number of seeds in the legend. A group named after a shape
+    ("pentagon", "disk") has that shape's colour in every figure
+    (:func:`grainview.plot._style.sample_colour`), whatever order the groups come in.
 
     Parameters
     ----------
@@ -41,7 +43,8 @@ def seed_bands(stats, ax=None, label: str = "", units: str = "1"):
         s = stats.sel(group=group)
         mean, std, n = s["mean"].values, s["std"].values, s["n"].values
         seeds = int(n.max()) if n.size else 0
-        (line,) = ax.plot(x, mean, marker="o", ms=3, label=f"{group} ({seeds} seeds)")
+        (line,) = ax.plot(x, mean, marker="o", ms=3, color=sample_colour(ax, str(group)),
+                          label=f"{group} ({seeds} seeds)")
         ax.fill_between(x, mean - std, mean + std, color=line.get_color(), alpha=0.25,
                         lw=0)
     ax.set_xlabel(EPS_Q_LABEL)

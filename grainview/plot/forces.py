@@ -15,9 +15,9 @@ import xarray as xr
 
 from ..errors import ParameterError
 from ..forces import angular_force_averages, force_anisotropies
-from ._style import (EPS_Q_LABEL, axis_label, datasets, draw_evolutions, finish, get_axes, new_figure,
-                     next_colour, select_snapshots, series_label, set_labels, tidy_polar, time_mean, units_of,
-                     values)
+from ._style import (EPS_Q_LABEL, PALETTE, PI_TICK_LABELS, axis_label, datasets, draw_evolutions, finish, get_axes,
+                     legend_in_first, new_figure, sample_colour, select_snapshots, series_label, set_labels, tidy_polar,
+                     time_mean, units_of, values)
 from .texture import full_turn
 
 FORCE_RATIO_LABEL = r"$f_n/\langle f_n\rangle$"
@@ -192,7 +192,7 @@ def _polar(data, ax, label, component, symbol, time, bins, kind, walls, normalis
         r = values(profile)
         r = np.abs(r) if component == "ft" else r
         theta, r = full_turn(profile["theta"].values, r)
-        ax.plot(theta, r, color=next_colour(ax), label=lab, **line_kw)
+        ax.plot(theta, r, color=sample_colour(ax, lab, ds), label=lab, **line_kw)
     tidy_polar(ax)
     ax.set_xlabel(axis_label(r"$\theta$", "rad"))
     title = "$" + symbol + (r"/\langle f_n\rangle" if normalise else "") + "$"
@@ -248,21 +248,92 @@ def plot_tangential_force(data, ax=None, label=None, time="residual", bins: int 
     Azéma, Radjai, Peyroux & Saussine, Phys. Rev. E 76, 011301 (2007),
     Eq. fnft (Sec. V.A) and Fig. 10b; docs/conventions.md §3.
     """
+    return _cartesian_profile(data, ax, label, "ft", time, bins, kind, walls, normalise, line_kw)
+
+
+def plot_normal_force(data, ax=None, label=None, time="residual", bins: int = 36, kind="all",
+                      walls: bool = False, normalise: bool = True, **line_kw):
+    """The angle-averaged normal force <f_n>(theta) against theta on Cartesian axes (paper Fig. 10a).
+
+    theta in [0, pi). Harmonic form (docs/conventions.md §3):
+
+        <f_n>(theta) = <f> (1 + a_n cos 2(theta - theta_n))
+
+    Divided by <f_n> unless ``normalise=False`` (then N) (:func:`angular_profile`); a grey line
+    marks the mean (1, or nothing when not normalised). The paper draws it in polar axes
+    (:func:`plot_normal_force_polar`); these axes share theta and the scale with
+    :func:`plot_tangential_force`, so that a_n and a_t compare by eye (Fig. 10 of the report).
+
+    Parameters
+    ----------
+    data : xarray.Dataset, dict or list
+        One dataset of the contract, or several to compare on the same axes as ``{label: ds}``
+        or ``[(label, ds), ...]``.
+    ax : matplotlib.axes.Axes, optional
+        The axes to draw on (default: new axes on a new figure).
+    label : str, optional
+        Legend label of a single dataset (None: no legend entry), so that successive calls on
+        the same axes build a comparison.
+    time : str, int, slice or sequence of int, default "residual"
+        The snapshots averaged over (:func:`grainview.plot._style.select_snapshots`):
+        ``"residual"`` the residual state, eps_q >= 0.3 (for a run that stops short of it, the
+        last part of the run), ``"all"`` or None every snapshot, a snapshot index, a slice or a
+        sequence of indices.
+    bins : int, default 36
+        Number of angular sectors of [0, pi), centred on theta_k = k pi/bins.
+    kind : {"all", "simple", "double"}, default "all"
+        The contacts used: all, simple (vertex–edge and disk contacts) or double (edge–edge)
+        ones (also 1, 2, "s", "d"; :func:`grainview.contacts.kind_code`).
+    walls : bool, default False
+        Include the particle–wall contacts (default: particle–particle only).
+    normalise : bool, default True
+        Divide each snapshot's profile by its mean normal force <f_n> over the same contacts
+        (dimensionless); otherwise in N.
+    **line_kw
+        Keyword arguments of ``matplotlib.axes.Axes.plot``.
+
+    Returns
+    -------
+    matplotlib.axes.Axes
+        The axes drawn on.
+
+    References
+    ----------
+    Azéma, Radjai, Peyroux & Saussine, Phys. Rev. E 76, 011301 (2007),
+    Eq. fnft (Sec. V.A) and Fig. 10a; docs/conventions.md §3.
+    """
+    return _cartesian_profile(data, ax, label, "fn", time, bins, kind, walls, normalise, line_kw)
+
+
+HALF_TURN_TICKS = np.arange(5) * np.pi / 4
+"""Ticks of a theta axis over [0, pi], labelled as the polar figures' (multiples of pi/4)."""
+
+
+def _cartesian_profile(data, ax, label, component, time, bins, kind, walls, normalise, line_kw):
+    """<f_n>(theta) or <f_t>(theta) against theta in [0, pi] with pi/4 ticks; a grey line at
+    the mean (<f_n>: 1 when normalised) or at zero (<f_t>)."""
     ax = get_axes(ax)
     for lab, ds in datasets(data, label):
-        profile = angular_profile(ds, "ft", time, bins, kind, walls, normalise)
-        ax.plot(profile["theta"].values, values(profile), "o-", color=next_colour(ax), label=lab, **line_kw)
-    ax.axhline(0.0, color="0.6", linewidth=0.8)
+        profile = angular_profile(ds, component, time, bins, kind, walls, normalise)
+        ax.plot(profile["theta"].values, values(profile), "o-", markersize=3, color=sample_colour(ax, lab, ds),
+                label=lab, **line_kw)
+    if component == "ft" or normalise:
+        ax.axhline(0.0 if component == "ft" else 1.0, color="0.6", linewidth=0.8, zorder=0)
     ax.set_xlim(0.0, np.pi)
-    symbol = r"$\langle f_t\rangle(\theta)" + (r"/\langle f_n\rangle$" if normalise else "$")
+    ax.set_xticks(HALF_TURN_TICKS, PI_TICK_LABELS[:5])
+    name = "f_t" if component == "ft" else "f_n"
+    symbol = rf"$\langle {name}\rangle(\theta)" + (r"/\langle f_n\rangle$" if normalise else "$")
     set_labels(ax, axis_label(r"$\theta$", "rad"), axis_label(symbol, units_of(profile)))
     return finish(ax, None)
 
 
 def plot_angular_forces(data, label=None, **kw):
-    """Figure of paper Fig. 10: (a) <f_n>(theta) in polar axes, (b) <f_t>(theta) with its sign.
+    """Figure of paper Fig. 10: (a) <f_n>(theta) and (b) <f_t>(theta) with its sign, against theta.
 
-    Panels drawn by :func:`plot_normal_force_polar` and :func:`plot_tangential_force`.
+    Panels drawn by :func:`plot_normal_force` and :func:`plot_tangential_force`, on Cartesian
+    axes with the same theta ticks (multiples of pi/4) and y ranges of one length, so that the
+    two panels read on one scale (the paper draws polar plots: a polar radius cannot carry the
+    sign of <f_t>, and its radial labels sit on the curves). One legend, in (a).
 
     Parameters
     ----------
@@ -285,12 +356,23 @@ def plot_angular_forces(data, label=None, **kw):
     Azéma, Radjai, Peyroux & Saussine, Phys. Rev. E 76, 011301 (2007),
     Eq. fnft (Sec. V.A) and Fig. 10; docs/conventions.md §3.
     """
-    fig, (ax_n, ax_t) = new_figure(2, polar=[True, False])
-    plot_normal_force_polar(data, ax_n, label, **kw)
+    fig, (ax_n, ax_t) = new_figure(2)
+    plot_normal_force(data, ax_n, label, **kw)
     plot_tangential_force(data, ax_t, label, **kw)
-    # the paper draws |<f_t>| in polar axes; a radius cannot carry the sign, these axes do
-    ax_t.set_title(ax_t.get_title() + "\n(Cartesian axes: the sign is kept)", fontsize="small")
+    same_scale(ax_n, ax_t)
+    if ax_t.get_legend() is not None:  # one legend, in (a)
+        ax_t.get_legend().remove()
     return fig
+
+
+def same_scale(*axes) -> None:
+    """Give ``axes`` y ranges of one length, each centred on its own data, so that equal
+    heights mean equal values from one panel to the next (a_n against a_t in Fig. 10)."""
+    limits = [ax.get_ylim() for ax in axes]
+    span = max(hi - lo for lo, hi in limits)
+    for ax, (lo, hi) in zip(axes, limits):
+        middle = 0.5 * (lo + hi)
+        ax.set_ylim(middle - span / 2, middle + span / 2)
 
 
 # -- Fig. 11: force anisotropies ---------------------------------------------------------------
@@ -546,7 +628,7 @@ def plot_force_pdf(data, ax=None, label=None, scale: str = "log-linear", time="r
     outside = []
     for lab, ds in datasets(data, label):
         pdf = force_pdf_of(ds, scale, time, bins, range, kind, walls)
-        _draw_pdf(ax, pdf, lab, next_colour(ax), line_kw)
+        _draw_pdf(ax, pdf, lab, sample_colour(ax, lab, ds), line_kw)
         outside.append((lab, pdf))
         if fit and scale == "log-linear":
             alpha = float(strong_force_exponent(pdf))
@@ -650,6 +732,7 @@ def plot_force_pdfs(data, label=None, **kw):
     fig, (ax_lin, ax_log) = new_figure(2)
     plot_force_pdf(data, ax_lin, label, scale="log-linear", **kw)
     plot_force_pdf(data, ax_log, label, scale="log-log", **kw)
+    legend_in_first([ax_lin, ax_log])  # inside (a), where the pdf falls away: both panels as wide
     return fig
 
 
@@ -658,7 +741,8 @@ def plot_force_pdf_by_kind(data, ax=None, label=None, scale: str = "log-linear",
     """Pdfs of f_n/<f_n> for simple (s, solid) and double (d, dashed) contacts (paper Fig. 23).
 
     Each pdf is normalised over its own contacts (:func:`grainview.force_pdf.pooled_force_pdf`
-    with ``kind``). Two lines per sample: s then d.
+    with ``kind``). Two lines per sample: s then d; with one sample in the contact kinds'
+    colours (:data:`grainview.plot._style.PALETTE`), with several in the sample's colour.
 
     Parameters
     ----------
@@ -700,11 +784,14 @@ def plot_force_pdf_by_kind(data, ax=None, label=None, scale: str = "log-linear",
     """
     ax = get_axes(ax)
     outside = []
-    for lab, ds in datasets(data, label):
-        colour = next_colour(ax)
+    pairs = datasets(data, label)
+    for lab, ds in pairs:
+        colour = sample_colour(ax, lab, ds)
         for kind, name, style in (("simple", "s", "o-"), ("double", "d", "s--")):
             pdf = force_pdf_of(ds, scale, time, bins, range, kind, walls)
-            _draw_pdf(ax, pdf, series_label(lab, name), colour, line_kw, style)
+            # one sample: the contact kinds' colours; several: the sample's, the kind by style
+            _draw_pdf(ax, pdf, series_label(lab, name), PALETTE[kind] if len(pairs) == 1 else colour, line_kw,
+                      style)
             outside.append((series_label(lab, name), pdf))
     _pdf_axes(ax, scale)
     ax.set_ylabel("$P$ (each kind normalised to 1)")
@@ -717,9 +804,9 @@ def _outside_note(ax, pdfs):
     ``outside_fraction``; e.g. the forces below the log axis's first bin), per curve."""
     notes = [f"{100 * float(pdf['outside_fraction']):.2g}%" + (f" ({lab})" if lab else "")
              for lab, pdf in pdfs if "outside_fraction" in pdf and float(pdf["outside_fraction"]) > 0]
-    if notes:
+    if notes:  # one line per curve, so that the note stays inside the frame
         edges = pdfs[0][1]["bin_edges"].values
-        ax.text(0.02, 0.02, f"outside {edges[0]:g}-{edges[-1]:g} " + r"$\langle f_n\rangle$: " + ", ".join(notes),
+        ax.text(0.03, 0.03, "\n".join([f"outside {edges[0]:g}-{edges[-1]:g} " + r"$\langle f_n\rangle$:", *notes]),
                 transform=ax.transAxes, fontsize="x-small", va="bottom", ha="left", color="0.3")
 
 
@@ -752,6 +839,7 @@ def plot_force_pdfs_by_kind(data, label=None, **kw):
     fig, (ax_lin, ax_log) = new_figure(2)
     plot_force_pdf_by_kind(data, ax_lin, label, scale="log-linear", **kw)
     plot_force_pdf_by_kind(data, ax_log, label, scale="log-log", **kw)
+    legend_in_first([ax_lin, ax_log])
     return fig
 
 
@@ -840,7 +928,7 @@ def plot_xi_stress(data, ax=None, label=None, xi=None, time="residual", min_cont
 
 
 def plot_xi_anisotropy(data, ax=None, label=None, xi=None, time="residual", min_contacts: float = 10,
-                       near=None, inset: bool = True, **line_kw):
+                       near=None, log: bool = False, **line_kw):
     """Partial fabric anisotropy a'(xi) of the contacts f_n < xi <f_n> against the cutoff xi (paper Fig. 16).
 
     a'(xi) is signed against the whole sample's major stress direction (docs/conventions.md §5;
@@ -871,9 +959,8 @@ def plot_xi_anisotropy(data, ax=None, label=None, xi=None, time="residual", min_
     near : float, optional
         None: the force-bearing contacts (f_n > 0); a gap in m: also the pairs within it
         (:func:`xi_profile`). The report counts the near pairs when the files hold them.
-    inset : bool, default True
-        Draw the paper's inset: a'(xi) for 0.01 <= xi <= 1 on a logarithmic axis, where the
-        very weak forces are.
+    log : bool, default False
+        A logarithmic xi axis (the paper's inset: the very weak forces).
     **line_kw
         Keyword arguments of ``matplotlib.axes.Axes.plot``.
 
@@ -885,22 +972,57 @@ def plot_xi_anisotropy(data, ax=None, label=None, xi=None, time="residual", min_
     References
     ----------
     Azéma, Radjai, Peyroux & Saussine, Phys. Rev. E 76, 011301 (2007),
-    Sec. V.C and Fig. 16 (with its inset); docs/conventions.md §5.
+    Sec. V.C and Fig. 16; docs/conventions.md §5.
     """
     ax = _xi(data, ax, label, xi, time, "a_prime", r"$a'(\xi)$", min_contacts, line_kw, near)
     ax.axhline(0.0, color="0.6", linewidth=0.8, zorder=0)  # a' > 0 along the major stress, < 0 across it
-    if inset:  # the paper's inset: the weakest forces, on a logarithmic xi axis
-        small = ax.inset_axes([0.07, 0.62, 0.3, 0.26])  # upper left: a'(xi) rises from there
-        _xi(data, small, label, np.geomspace(1e-2, 1.0, 13), time, "a_prime", None, min_contacts, {}, near)
-        small.set_xscale("log")
-        small.axhline(0.0, color="0.6", linewidth=0.8, zorder=0)
-        small.tick_params(labelsize="x-small")
-        small.set_xlabel("")
-        if small.get_legend() is not None:
-            small.get_legend().remove()
-        if ax.get_legend() is not None:
-            ax.legend(loc="lower right")
+    if log:
+        ax.set_xscale("log")
     return ax
+
+
+WEAK_XI = np.geomspace(1e-2, 1.0, 13)
+"""The cutoffs of the paper's inset of Fig. 16, the very weak and weak forces, 0.01 to 1."""
+
+
+def plot_xi_anisotropies(data, label=None, near=None, **kw):
+    """Figure of paper Fig. 16: a'(xi) over the whole range (a) and, on a logarithmic axis,
+    for the weak forces, 0.01 <= xi <= 1 (b, the paper's inset).
+
+    Panels drawn by :func:`plot_xi_anisotropy`; (b) is a panel of its own rather than an
+    inset, so that it hides no part of (a) and carries its own axis labels.
+
+    Parameters
+    ----------
+    data : xarray.Dataset, dict or list
+        One dataset of the contract, or several to compare on the same axes as ``{label: ds}``
+        or ``[(label, ds), ...]``.
+    label : str, optional
+        Legend label of a single dataset (None: no legend entry).
+    near : float, optional
+        None: the force-bearing contacts (f_n > 0); a gap in m: also the pairs within it
+        (:func:`xi_profile`).
+    **kw
+        Keyword arguments of :func:`plot_xi_anisotropy` (``time``, ``min_contacts``, line
+        keywords), passed to both panels; ``xi`` applies to (a) only.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        The figure with panels (a) and (b).
+
+    References
+    ----------
+    Azéma, Radjai, Peyroux & Saussine, Phys. Rev. E 76, 011301 (2007),
+    Sec. V.C and Fig. 16 (with its inset); docs/conventions.md §5.
+    """
+    fig, (ax_all, ax_weak) = new_figure(2)
+    plot_xi_anisotropy(data, ax_all, label, near=near, **kw)
+    kw.pop("xi", None)
+    plot_xi_anisotropy(data, ax_weak, label, xi=WEAK_XI, near=near, log=True, **kw)
+    if ax_weak.get_legend() is not None:  # one legend, in (a)
+        ax_weak.get_legend().remove()
+    return fig
 
 
 def _xi(data, ax, label, xi, time, name, ylabel, min_contacts, line_kw, near=None):
@@ -909,7 +1031,7 @@ def _xi(data, ax, label, xi, time, name, ylabel, min_contacts, line_kw, near=Non
         prof = xi_profile(ds, xi, time, near)
         keep = values(prof["count"]) >= min_contacts
         ax.plot(np.asarray(prof["xi"].values, float)[keep], values(prof[name])[keep], "o-", markersize=3,
-                color=next_colour(ax), label=lab, **line_kw)
+                color=sample_colour(ax, lab, ds), label=lab, **line_kw)
     ax.axvline(1.0, color="0.6", linewidth=0.8, linestyle=":", zorder=0)  # xi = 1: the mean force
     set_labels(ax, XI_LABEL, ylabel)
     return finish(ax, None)
@@ -923,7 +1045,8 @@ def plot_contact_proportions(data, ax=None, label=None, **line_kw):
         k_s = N_s/N_c,   k_d = N_d/N_c,   f_s = k_s <f_n>_s/<f_n>,   f_d = k_d <f_n>_d/<f_n>
 
     (docs/conventions.md §4; :func:`grainview.force_networks.contact_proportions`). Four lines
-    per sample: k_s, k_d, f_s, f_d. Dimensionless.
+    per sample: k_s, k_d (solid), f_s, f_d (dashed); with one sample, simple and double in the
+    contact kinds' colours (:data:`grainview.plot._style.PALETTE`). Dimensionless.
 
     Parameters
     ----------
@@ -952,7 +1075,9 @@ def plot_contact_proportions(data, ax=None, label=None, **line_kw):
     from ..force_networks import contact_proportions
     ax = get_axes(ax)
     curves = [("$k_s$", "k_s"), ("$k_d$", "k_d"), ("$f_s$", "f_s"), ("$f_d$", "f_d")]
-    draw_evolutions(ax, datasets(data, label), contact_proportions, curves, **line_kw)
+    kinds = [PALETTE["simple"], PALETTE["double"]] * 2
+    draw_evolutions(ax, datasets(data, label), contact_proportions, curves, curve_colours=kinds,
+                    curve_styles=["-", "-", "--", "--"], **line_kw)
     set_labels(ax, EPS_Q_LABEL, "$k$: share of contacts, $f$: share of normal force")
     return finish(ax, None)
 
@@ -996,13 +1121,15 @@ def plot_type_transitions(data, ax=None, label=None, **line_kw):
     return finish(ax, None)
 
 
-def plot_strong_weak_proportions(data, ax=None, label=None, **line_kw):
-    """Fractions k_s^S, k_s^W, k_d^S, k_d^W of strong and weak contacts against eps_q (paper Fig. 25).
+def plot_strong_weak_proportion(data, ax=None, label=None, network: str = "strong", **line_kw):
+    """Fractions k_s and k_d of the strong or of the weak contacts against eps_q (a panel of paper Fig. 25).
 
-    Fractions of all contacts that are simple and strong (k_s^S), simple and weak (k_s^W),
-    double and strong (k_d^S), double and weak (k_d^W), strong meaning f_n > <f_n>
-    (docs/conventions.md §4; :func:`grainview.force_networks.contact_proportions`). Four lines
-    per sample in that order. Dimensionless.
+    ``network="strong"``: k_s^S and k_d^S, the fractions of all contacts that are simple and
+    strong, double and strong; ``"weak"``: k_s^W and k_d^W. Strong means f_n > <f_n>, weak
+    f_n <= <f_n>
+    (docs/conventions.md §4; :func:`grainview.force_networks.contact_proportions`). Two lines
+    per sample, s then d; with one sample in the contact kinds' colours
+    (:data:`grainview.plot._style.PALETTE`). Dimensionless.
 
     Parameters
     ----------
@@ -1014,6 +1141,8 @@ def plot_strong_weak_proportions(data, ax=None, label=None, **line_kw):
     label : str, optional
         Legend label of a single dataset (None: no legend entry), so that successive calls on
         the same axes build a comparison.
+    network : {"strong", "weak"}, default "strong"
+        Which network's fractions are drawn.
     **line_kw
         Keyword arguments of ``matplotlib.axes.Axes.plot`` (``color`` applies when a single
         sample is drawn).
@@ -1023,22 +1152,66 @@ def plot_strong_weak_proportions(data, ax=None, label=None, **line_kw):
     matplotlib.axes.Axes
         The axes drawn on.
 
+    Raises
+    ------
+    grainview.errors.ParameterError
+        When ``network`` is neither "strong" nor "weak".
+
     References
     ----------
     Azéma, Radjai, Peyroux & Saussine, Phys. Rev. E 76, 011301 (2007),
     Sec. VI and Fig. 25; docs/conventions.md §4.
     """
     from ..force_networks import contact_proportions
+    if network not in ("strong", "weak"):
+        raise ParameterError(f"network={network!r}: expected 'strong' or 'weak'")
     ax = get_axes(ax)
-    curves = [("$k_s^S$", "k_s_strong"), ("$k_s^W$", "k_s_weak"), ("$k_d^S$", "k_d_strong"),
-              ("$k_d^W$", "k_d_weak")]
-    draw_evolutions(ax, datasets(data, label), contact_proportions, curves, **line_kw)
-    set_labels(ax, EPS_Q_LABEL, "proportion")
+    mark = "S" if network == "strong" else "W"
+    curves = [(f"$k_s^{mark}$", f"k_s_{network}"), (f"$k_d^{mark}$", f"k_d_{network}")]
+    draw_evolutions(ax, datasets(data, label), contact_proportions, curves,
+                    curve_colours=[PALETTE["simple"], PALETTE["double"]], curve_styles=["-", "--"], **line_kw)
+    relation = ">" if network == "strong" else r"\leq"
+    set_labels(ax, EPS_Q_LABEL, f"share of contacts, {network} ($f_n {relation} " + r"\langle f_n\rangle$)")
     return finish(ax, None)
+
+
+def plot_strong_weak_proportions(data, label=None, **kw):
+    """Figure of paper Fig. 25: (a) k_s^S and k_d^S, (b) k_s^W and k_d^W against eps_q.
+
+    Panels drawn by :func:`plot_strong_weak_proportion`. The paper compares simple with double
+    contacts within each network (k_s^S with k_d^S, k_s^W with k_d^W); one panel per network
+    keeps each comparison apart from the curves of the other, which cross it.
+
+    Parameters
+    ----------
+    data : xarray.Dataset, dict or list
+        One dataset of the contract, or several to compare on the same axes as ``{label: ds}``
+        or ``[(label, ds), ...]``.
+    label : str, optional
+        Legend label of a single dataset (None: no legend entry).
+    **kw
+        Keyword arguments of the panel function, passed to both panels.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        The figure with panels (a) and (b).
+
+    References
+    ----------
+    Azéma, Radjai, Peyroux & Saussine, Phys. Rev. E 76, 011301 (2007),
+    Sec. VI and Fig. 25; docs/conventions.md §4.
+    """
+    fig, (ax_strong, ax_weak) = new_figure(2)
+    for ax, network in ((ax_strong, "strong"), (ax_weak, "weak")):
+        plot_strong_weak_proportion(data, ax, label, network, **kw)
+        legend_in_first([ax], loc="best")  # inside each panel: both panels as wide
+    return fig
 
 
 __all__ = ["plot_normal_force_polar", "plot_tangential_force_polar", "plot_tangential_force", "plot_angular_forces",
            "plot_force_anisotropy", "plot_force_anisotropies", "plot_force_pdf", "plot_force_pdfs",
            "plot_force_pdf_by_kind", "plot_force_pdfs_by_kind", "plot_xi_stress", "plot_xi_anisotropy",
+           "plot_xi_anisotropies", "plot_normal_force", "plot_strong_weak_proportion", "same_scale",
            "plot_contact_proportions", "plot_type_transitions", "plot_strong_weak_proportions",
            "angular_profile", "force_pdf_of", "exponential_fit", "counting_error", "xi_profile"]

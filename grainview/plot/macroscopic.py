@@ -11,11 +11,11 @@ from __future__ import annotations
 import numpy as np
 import xarray as xr
 
-from ..strain import friction_and_dilatancy, strains
+from ..strain import RESIDUAL_STRAIN, friction_and_dilatancy, residual_window, strains
 from ..stress import stress_invariants
 from ..forces import harmonic_prediction
-from ._style import (EPS_Q_LABEL, axis_label, datasets, draw_evolutions, finish, get_axes, next_colour,
-                     series_label, set_labels, values)
+from ._style import (EPS_Q_LABEL, PALETTE, axis_label, datasets, draw_evolutions, eps_q, finish, get_axes,
+                     sample_colour, series_label, set_labels, values)
 
 
 def plot_q_over_p(data, ax=None, label=None, **line_kw):
@@ -92,17 +92,70 @@ def plot_volumetric_strain(data, ax=None, label=None, **line_kw):
     return finish(ax, None)
 
 
-def plot_stress_dilatancy(data, ax=None, label=None, incremental: bool = False, **line_kw):
+EARLY_STRAIN = 0.02
+"""Snapshots below this shear strain are left out of the stress–dilatancy diagram: there
+psi = arcsin(eps_p/eps_q) divides two strains that both start from zero, so it swings through
+large values that say nothing about dilatancy (and would set the figure's range)."""
+
+
+def friction_offset(ds: xr.Dataset, min_strain: float = EARLY_STRAIN, incremental: bool = False) -> float:
+    """phi_0 of the stress–dilatancy relation phi ~ phi_0 + psi, in rad: the median of phi - psi.
+
+        phi_0 = median over the snapshots with eps_q >= min_strain of (phi - psi),
+
+    sin phi = q/p, sin psi = eps_p/eps_q (or d eps_p/d eps_q with ``incremental``;
+    :func:`grainview.strain.friction_and_dilatancy`). It is the friction angle at zero
+    dilatancy of Taylor's relation, which the paper's Fig. 5 shows both shapes follow. A median,
+    not a fit: the slope is 1 by assumption.
+
+    Parameters
+    ----------
+    ds : xarray.Dataset
+        A dataset of the contract.
+    min_strain : float, default 0.02
+        Snapshots with a smaller eps_q are left out (:data:`EARLY_STRAIN`).
+    incremental : bool, default False
+        Use the incremental dilatancy angle.
+
+    Returns
+    -------
+    float
+        phi_0, rad (NaN when no snapshot has both angles).
+
+    References
+    ----------
+    Azéma, Radjai, Peyroux & Saussine, Phys. Rev. E 76, 011301 (2007),
+    Sec. III and Fig. 5; docs/conventions.md §6.
+    """
+    phi, psi = _angles(ds, min_strain, incremental)
+    both = np.isfinite(phi) & np.isfinite(psi)
+    return float(np.median(phi[both] - psi[both])) if both.any() else float("nan")
+
+
+def _angles(ds, min_strain, incremental):
+    """phi and psi of every snapshot (rad), NaN below ``min_strain``."""
+    angles = friction_and_dilatancy(ds).compute()
+    early = eps_q(ds) < min_strain
+    phi = np.where(early, np.nan, values(angles["phi"]))
+    psi = np.where(early, np.nan, values(angles["psi_incremental" if incremental else "psi"]))
+    return phi, psi
+
+
+def plot_stress_dilatancy(data, ax=None, label=None, incremental: bool = False, min_strain: float = EARLY_STRAIN,
+                          **line_kw):
     """Stress–dilatancy diagram: dilatancy angle psi against friction angle phi, in rad (paper Fig. 5).
 
         sin phi = q/p,    sin psi = eps_p/eps_q (cumulative) or d eps_p/d eps_q (incremental)
 
     (:func:`grainview.strain.friction_and_dilatancy`). Snapshots where psi is undefined
-    (eps_q = 0) leave a gap.
+    (eps_q = 0) or ill-conditioned (eps_q < ``min_strain``) are not drawn (their line points are
+    NaN), and the panel says so.
 
     The paper's point is that both shapes follow phi ~ phi_0 + psi (Taylor's stress–dilatancy
-    relation, phi_0 the friction angle at zero dilatancy): each sample gets a dashed line of
-    slope 1 with phi_0 the median of phi - psi over its snapshots, given in the legend.
+    relation, phi_0 the friction angle at zero dilatancy): each sample gets a dotted guide of
+    slope 1 through phi_0, the median of phi - psi (:func:`friction_offset`), labelled as a
+    guide and not a fit, with phi_0 in the legend. Its slope is parallel to phi = psi, which
+    passes through the origin, away from both paths, and is not drawn.
 
     Parameters
     ----------
@@ -116,6 +169,8 @@ def plot_stress_dilatancy(data, ax=None, label=None, incremental: bool = False, 
         the same axes build a comparison.
     incremental : bool, default False
         Draw the incremental angle, sin psi = d eps_p/d eps_q, instead of the cumulative one.
+    min_strain : float, default 0.02
+        Snapshots with a smaller eps_q are not drawn (:data:`EARLY_STRAIN`); 0 draws them all.
     **line_kw
         Keyword arguments of ``matplotlib.axes.Axes.plot``.
 
@@ -130,34 +185,37 @@ def plot_stress_dilatancy(data, ax=None, label=None, incremental: bool = False, 
     Sec. III and Fig. 5; docs/conventions.md §6.
     """
     ax = get_axes(ax)
-    name = "psi_incremental" if incremental else "psi"
     for lab, ds in datasets(data, label):
-        angles = friction_and_dilatancy(ds).compute()
-        phi, psi = values(angles["phi"]), values(angles[name])
-        colour = next_colour(ax)
+        phi, psi = _angles(ds, min_strain, incremental)
+        colour = sample_colour(ax, lab, ds)
         ax.plot(phi, psi, "o-", markersize=3, color=colour, label=lab, **line_kw)
-        both = np.isfinite(phi) & np.isfinite(psi)
-        if both.any():
-            phi_0 = float(np.median(phi[both] - psi[both]))
+        phi_0 = friction_offset(ds, min_strain, incremental)
+        if np.isfinite(phi_0):
             ends = np.array([np.nanmin(phi), np.nanmax(phi)])
-            ax.plot(ends, ends - phi_0, "--", color=colour, linewidth=1,
-                    label=series_label(lab, rf"$\varphi = \varphi_0 + \psi$, $\varphi_0$ = {phi_0:.2f} rad"))
-    ax.axline((0.0, 0.0), slope=1.0, color="0.6", linewidth=0.8, zorder=0)  # phi = psi, the reference
-    set_labels(ax, axis_label(r"$\varphi$", angles["phi"].attrs["units"]),
-               axis_label(r"$\psi$", angles[name].attrs["units"]))
+            ax.plot(ends, ends - phi_0, ":", color=colour, linewidth=1.2,
+                    label=series_label(lab, rf"guide of slope 1, not a fit: $\varphi_0$ = {phi_0:.2f} rad"))
+    if min_strain > 0:
+        ax.text(0.98, 0.02, rf"$\varepsilon_q < {min_strain:g}$ not drawn ($\psi$ ill-conditioned)",
+                transform=ax.transAxes, ha="right", va="bottom", fontsize="x-small", color="0.3")
+    symbol = r"$\psi$" + (r" (incremental)" if incremental else "")
+    set_labels(ax, axis_label(r"$\varphi$", "rad"), axis_label(symbol, "rad"))
     return finish(ax, None)
 
 
 def plot_harmonic_prediction(data, ax=None, label=None, bins: int = 36, **line_kw):
     """q/p and its harmonic predictions against eps_q (paper Eq. qa, Fig. 12).
 
-    Three lines per sample, in this order: q/p (solid), its harmonic prediction
+    Three lines per sample, in this order: q/p, its harmonic prediction
 
         (a' + a_n + a_t)/2
 
     and the same with the cross term, (a' + a_n + a_t)/(2 + a' a_n)
     (:func:`grainview.forces.harmonic_prediction`, ``bins`` angular sectors). All
-    dimensionless.
+    dimensionless. Where the three agree (the disks) they overlap within the snapshots' noise,
+    so they are drawn to stay apart even then: q/p as a wide pale band, the predictions as thin
+    dashed and thin solid lines over it, all in the sample's colour; each legend entry gives
+    the curve's mean over the residual state (eps_q >= 0.3), so that the agreement is read as
+    numbers too.
 
     Parameters
     ----------
@@ -186,11 +244,30 @@ def plot_harmonic_prediction(data, ax=None, label=None, bins: int = 36, **line_k
     Eq. qa (Sec. V.A) and Fig. 12; docs/conventions.md §3.
     """
     ax = get_axes(ax)
-    curves = [("$q/p$", "q_over_p"), ("$(a' + a_n + a_t)/2$", "prediction"),
-              ("$(a' + a_n + a_t)/(2 + a' a_n)$", "prediction_cross_term")]
-    draw_evolutions(ax, datasets(data, label), lambda ds: harmonic_prediction(ds, bins), curves, **line_kw)
-    set_labels(ax, EPS_Q_LABEL, "$q/p$")
-    return finish(ax, None)
+    given = line_kw.pop("color", None)
+    pairs = datasets(data, label)
+    for lab, ds in pairs:
+        result = harmonic_prediction(ds, bins).compute()
+        x = eps_q(ds)
+        window = np.asarray(residual_window(ds).values, bool)
+        colour = given if given is not None and len(pairs) == 1 else sample_colour(ax, lab, ds)
+        for (curve, name), style in zip(HARMONIC_CURVES, HARMONIC_STYLES):
+            y = values(result[name])
+            text = curve + (f": {np.nanmean(y[window]):.2f}" if window.any() else "")
+            ax.plot(x, y, color=colour, label=series_label(lab, text), **{**style, **line_kw})
+    set_labels(ax, EPS_Q_LABEL, "$q/p$ and its predictions")
+    finish(ax, None)
+    if ax.get_legend() is not None:
+        ax.get_legend().set_title(rf"mean over $\varepsilon_q \geq {RESIDUAL_STRAIN:g}$", prop={"size": "small"})
+    return ax
+
+
+HARMONIC_CURVES = [("$q/p$", "q_over_p"), ("$(a' + a_n + a_t)/2$", "prediction"),
+                   ("$(a' + a_n + a_t)/(2 + a' a_n)$", "prediction_cross_term")]
+"""Fig. 12's curves: legend text and variable of :func:`grainview.forces.harmonic_prediction`."""
+HARMONIC_STYLES = [dict(linewidth=4.0, alpha=0.35, solid_capstyle="butt"), dict(linewidth=1.0, linestyle="--"),
+                   dict(linewidth=0.9, linestyle="-")]
+"""Fig. 12's line styles: q/p a wide pale band, the two predictions thin lines over it."""
 
 
 def plot_partial_q_over_p(data, ax=None, label=None, **line_kw):
@@ -198,7 +275,8 @@ def plot_partial_q_over_p(data, ax=None, label=None, **line_kw):
 
     Each partial deviator is divided by the p of the whole sample
     (:func:`grainview.stress.stress_invariants` with ``kind``). Three lines per sample: s, d,
-    s+d. Dimensionless.
+    s+d; with one sample in the contact kinds' colours (:data:`grainview.plot._style.PALETTE`).
+    Dimensionless.
 
     Parameters
     ----------
@@ -226,8 +304,9 @@ def plot_partial_q_over_p(data, ax=None, label=None, **line_kw):
     """
     ax = get_axes(ax)
     curves = [("s", "simple"), ("d", "double"), ("s+d", "all")]
-    draw_evolutions(ax, datasets(data, label), _partial_q_over_p, curves, **line_kw)
-    set_labels(ax, EPS_Q_LABEL, "$q/p$")
+    draw_evolutions(ax, datasets(data, label), _partial_q_over_p, curves,
+                    curve_colours=[PALETTE[kind] for kind in ("simple", "double", "all")], **line_kw)
+    set_labels(ax, EPS_Q_LABEL, "$q_s/p$, $q_d/p$, $q/p$")
     return finish(ax, None)
 
 
@@ -235,5 +314,5 @@ def _partial_q_over_p(ds):
     return xr.Dataset({kind: stress_invariants(ds, kind)["q_over_p"] for kind in ("simple", "double", "all")})
 
 
-__all__ = ["plot_q_over_p", "plot_volumetric_strain", "plot_stress_dilatancy",
+__all__ = ["plot_q_over_p", "plot_volumetric_strain", "plot_stress_dilatancy", "friction_offset",
            "plot_harmonic_prediction", "plot_partial_q_over_p"]

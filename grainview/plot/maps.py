@@ -20,7 +20,7 @@ from matplotlib.collections import EllipseCollection, LineCollection, PolyCollec
 from ..contacts import selection
 from ..errors import ParameterError
 from ..schema import polygon_vertices
-from ._style import axis_label, get_axes, single_dataset, snapshot_index
+from ._style import PALETTE, axis_label, get_axes, single_dataset, snapshot_index
 
 PARTICLE_FACE = "0.92"
 PARTICLE_EDGE = "0.55"
@@ -29,8 +29,10 @@ CLASS_COLOURS = {1: "#0072B2", 2: "#009E73", 3: "#D55E00"}
 Okabe–Ito palette, which stays distinguishable with every common colour-vision deficiency: very
 weak (blue: the palette's sky blue has too little contrast on the light grey particles), weak
 (bluish green), strong (vermillion)."""
-KIND_COLOURS = {1: "#0072B2", 2: "#D55E00"}
-"""Colours of the kind map (paper Fig. 24), Okabe–Ito: simple (blue), double (vermillion)."""
+KIND_COLOURS = {1: PALETTE["simple"], 2: PALETTE["double"]}
+"""Colours of the kind map (paper Fig. 24): simple and double contacts in the colours they have
+in every figure (:data:`grainview.plot._style.PALETTE`), not the paper's blue and red: blue marks
+the pentagon sample wherever samples are compared."""
 
 
 def plot_particles(data, ax=None, time: int = -1, facecolor=PARTICLE_FACE, edgecolor=PARTICLE_EDGE,
@@ -74,8 +76,8 @@ def plot_particles(data, ax=None, time: int = -1, facecolor=PARTICLE_FACE, edgec
     Figs. 13, 17 and 24 (the maps drawn over the particles).
     """
     _, ds = single_dataset(data)
-    ax = get_axes(ax)
     k = snapshot_index(ds, time)
+    ax = map_axes(ax, ds, k)
     position = np.asarray(ds["position"].isel(time=k).values, float)
     angle = np.asarray(ds["angle"].isel(time=k).values, float)
     radius = np.asarray(ds["radius"].values, float)
@@ -158,8 +160,8 @@ def plot_particle_map(data, field: str = "c", ax=None, time: int = -1, reference
     if field not in PARTICLE_FIELDS:
         raise ParameterError(f"field={field!r}: expected one of {sorted(PARTICLE_FIELDS)}")
     _, ds = single_dataset(data)
-    ax = get_axes(ax)
     k = snapshot_index(ds, time)
+    ax = map_axes(ax, ds, k)
     values = np.asarray(particle_fields(ds, reference=reference, walls=walls)[field].isel(time=k).values, float)
     if field in ("rotation", "displacement"):
         norm = mpl.colors.Normalize(vmin=np.nanmin(values), vmax=max(np.nanmax(values), np.nanmin(values) + 1e-12))
@@ -257,6 +259,42 @@ def plot_rotation_map(data, ax=None, time: int = -1, **options):
     docs/analysis.md, "Where in the sample".
     """
     return plot_particle_map(data, "rotation", ax=ax, time=time, **options)
+
+
+MAP_HEIGHT = 5.0
+"""Height of a new map's figure, inches; its width follows the box's aspect."""
+
+
+def map_axes(ax, ds: xr.Dataset, k: int):
+    """``ax`` itself, or new axes on a figure shaped like the box of snapshot ``k``.
+
+    The figure is :data:`MAP_HEIGHT` inches high and as wide as the box drawn at that height
+    plus room for the axis labels, so that a tall sample does not sit in the middle of a
+    landscape figure with blank space on both sides.
+
+    Parameters
+    ----------
+    ax : matplotlib.axes.Axes or None
+        Axes to draw on.
+    ds : xarray.Dataset
+        A dataset of the contract.
+    k : int
+        The snapshot drawn.
+
+    Returns
+    -------
+    matplotlib.axes.Axes
+        ``ax``, or the new axes.
+    """
+    if ax is not None:
+        return get_axes(ax)
+    import matplotlib.pyplot as plt
+
+    size = np.asarray(ds["box_max"].isel(time=k).values, float) - np.asarray(ds["box_min"].isel(time=k).values, float)
+    aspect = size[0] / size[1] if size[1] > 0 and size[0] > 0 else 1.0
+    width = float(np.clip(MAP_HEIGHT * aspect + 1.0, 2.5, 14.0))
+    _, ax = plt.subplots(figsize=(width, MAP_HEIGHT))
+    return ax
 
 
 def _frame(ax, ds, k):
@@ -370,7 +408,8 @@ def _network(ds, k, mask, colours, ax, max_linewidth, width_by_force, linewidth,
               else np.full(slots.size, linewidth))
     key = None
     if width_by_force and fn.size:
-        key = WidthKey(width_force(fn, force_scale), max_linewidth, float(fn.mean()))
+        key = WidthKey(width_force(fn, force_scale), max_linewidth, float(fn.mean()),
+                       float(ds.attrs.get("thickness_m", 1.0)))
     colours = colours(slots) if callable(colours) else colours
     lines = LineCollection(segments, linewidths=widths, colors=colours, capstyle="round", zorder=zorder)
     lines.set_gid("contacts")
@@ -399,7 +438,9 @@ def newtons(force: float) -> str:
 class WidthKey(NamedTuple):
     """What a map's line widths stand for: ``max_linewidth`` points for ``top_force`` N.
 
-    The mean force drawn, ``mean_force`` N, is one of the legend's sample widths.
+    The mean force drawn, ``mean_force`` N, is one of the legend's sample widths. Forces are
+    those on the slab of thickness ``thickness`` m that the 2D sample stands for
+    (docs/schema.md), i.e. N per metre of thickness for the default 1 m.
 
     Attributes
     ----------
@@ -409,10 +450,13 @@ class WidthKey(NamedTuple):
         The largest line width, points.
     mean_force : float
         The mean force drawn, N.
+    thickness : float
+        The slab's thickness, m (the file's ``thickness_m``).
     """
     top_force: float
     max_linewidth: float
     mean_force: float
+    thickness: float = 1.0
 
 
 def contact_collection(ax) -> LineCollection:
@@ -482,8 +526,8 @@ def plot_force_chains(data, ax=None, time: int = -1, walls: bool = False, max_li
     Fig. 13; docs/conventions.md §0.
     """
     _, ds = single_dataset(data)
-    ax = get_axes(ax)
     k = snapshot_index(ds, time)
+    ax = map_axes(ax, ds, k)
     mask = selection(ds.isel(time=k), walls=walls).values
     _, key = _network(ds, k, mask, colour, ax, max_linewidth, True, None, particles, force_scale=force_scale)
     _legend(ax, {}, key, colour)
@@ -536,8 +580,8 @@ def plot_force_classes(data, ax=None, time: int = -1, walls: bool = False, very_
     """
     from ..force_networks import force_class
     _, ds = single_dataset(data)
-    ax = get_axes(ax)
     k = snapshot_index(ds, time)
+    ax = map_axes(ax, ds, k)
     snap = ds.isel(time=[k])
     classes = np.asarray(force_class(snap, very_weak=very_weak, strong=strong, walls=walls).isel(time=0).values, int)
     mask = selection(snap.isel(time=0), walls=walls).values & (classes > 0)
@@ -585,8 +629,8 @@ def plot_contact_kinds(data, ax=None, time: int = -1, walls: bool = False, max_l
     Sec. II.A (simple and double contacts) and Fig. 24.
     """
     _, ds = single_dataset(data)
-    ax = get_axes(ax)
     k = snapshot_index(ds, time)
+    ax = map_axes(ax, ds, k)
     mask = selection(ds.isel(time=k), walls=walls).values
     kind = np.asarray(ds["kind"].isel(time=k).values, int)
     _, key = _network(ds, k, mask, lambda slots: [KIND_COLOURS.get(c, "k") for c in kind[slots]], ax,
@@ -598,16 +642,39 @@ def plot_contact_kinds(data, ax=None, time: int = -1, walls: bool = False, max_l
 def _legend(ax, entries, key=None, key_colour="0.3"):
     """A legend beside the map (never over the packing): one line per colour of ``entries``
     ({label: colour}) and, when the widths stand for forces (``key``, a :class:`WidthKey`), three
-    sample widths labelled in N: the mean force, half the largest and the largest."""
+    sample widths labelled in N, each saying which force it is (the mean force, half the widest
+    line's, the widest line's), under a title giving the slab thickness the forces act on
+    (:func:`force_unit`)."""
     from matplotlib.lines import Line2D
     handles = [Line2D([], [], color=c, label=name) for name, c in entries.items()]
+    title = None
     if key is not None and key.top_force > 0:
-        for force in sorted({key.mean_force, key.top_force / 2, key.top_force}):
+        names = {key.mean_force: r"mean $\langle f_n\rangle$", key.top_force / 2: "half the widest",
+                 key.top_force: "widest line"}
+        for force in sorted(names):
             handles.append(Line2D([], [], color=key_colour, linewidth=key.max_linewidth * force / key.top_force,
-                                  label=f"$f_n$ = {newtons(force)}"))
+                                  label=f"{newtons(force)}: {names[force]}"))
+        title = f"line width $\\propto f_n$\n(forces {force_unit(key.thickness)})"
     if handles:
         ax.legend(handles=handles, fontsize="small", loc="upper left", bbox_to_anchor=(1.02, 1.0),
-                  borderaxespad=0.0)
+                  borderaxespad=0.0, title=title, title_fontsize="small")
+
+
+def force_unit(thickness: float = 1.0) -> str:
+    """What a force in N of a 2D sample means: the force on a slab ``thickness`` m thick,
+    "per m of thickness" for the default 1 m (docs/schema.md).
+
+    Parameters
+    ----------
+    thickness : float, default 1.0
+        The slab's thickness, m (a file's ``thickness_m``).
+
+    Returns
+    -------
+    str
+        "per m of thickness", or "on a slab 0.1 m thick".
+    """
+    return "per m of thickness" if thickness == 1.0 else f"on a slab {thickness:g} m thick"
 
 
 __all__ = ["plot_particles", "plot_force_chains", "plot_force_classes", "plot_contact_kinds",

@@ -13,8 +13,8 @@ import xarray as xr
 
 from ..connectivity import connectivity_pdf, coordination, joint_connectivity_pdf
 from ..fabric import fabric_anisotropy, orientation_pdf
-from ._style import (EPS_Q_LABEL, axis_label, datasets, draw_evolutions, finish, get_axes,
-                     next_colour, tidy_polar, select_snapshots, set_labels, single_dataset, time_mean, units_of,
+from ._style import (EPS_Q_LABEL, PALETTE, axis_label, datasets, draw_evolutions, finish, get_axes,
+                     sample_colour, tidy_polar, select_snapshots, set_labels, single_dataset, time_mean, units_of,
                      values)
 
 
@@ -145,7 +145,8 @@ def plot_connectivity_pdf(data, ax=None, label=None, time="residual", max_c: int
     ax = get_axes(ax)
     for lab, ds in datasets(data, label):
         pdf = time_mean(connectivity_pdf(select_snapshots(ds, time), max_c=max_c, walls=walls)).sel(c=slice(1, None))
-        ax.plot(pdf["c"].values, values(pdf), "o", linestyle="none", color=next_colour(ax), label=lab, **line_kw)
+        ax.plot(pdf["c"].values, values(pdf), "o", linestyle="none", color=sample_colour(ax, lab, ds), label=lab,
+                **line_kw)
     ax.set_xticks(np.arange(1, max_c + 1))  # c is an integer: every value labelled
     set_labels(ax, "$c$", "$P(c)$")
     return finish(ax, None)
@@ -198,7 +199,7 @@ def plot_orientation_pdf(data, ax=None, label=None, time="residual", bins: int =
     for lab, ds in datasets(data, label):
         pdf = time_mean(orientation_pdf(select_snapshots(ds, time), bins=bins, kind=kind, walls=walls))
         theta, r = full_turn(pdf["theta"].values, values(pdf))
-        ax.plot(theta, r, color=next_colour(ax), label=lab, **line_kw)
+        ax.plot(theta, r, color=sample_colour(ax, lab, ds), label=lab, **line_kw)
     tidy_polar(ax)
     ax.set_xlabel(axis_label(r"$\theta$", "rad"))
     return finish(ax, None, title=axis_label(r"$P(\theta)$", units_of(pdf)))
@@ -270,7 +271,8 @@ def plot_partial_fabric_anisotropy(data, ax=None, label=None, walls: bool = Fals
 
     The partial tensors of simple and double contacts add up, F = F_s + F_d, each normalised by
     the count of all contacts (:func:`grainview.fabric.fabric_anisotropy` with ``kind``). Two
-    lines per sample: s then d. Dimensionless.
+    lines per sample: s then d; with one sample in the contact kinds' colours
+    (:data:`grainview.plot._style.PALETTE`). Dimensionless.
 
     Parameters
     ----------
@@ -303,8 +305,9 @@ def plot_partial_fabric_anisotropy(data, ax=None, label=None, walls: bool = Fals
     def partial(ds):
         return xr.Dataset({kind: fabric_anisotropy(ds, kind, walls)["a_prime"] for kind in ("simple", "double")})
 
-    draw_evolutions(ax, datasets(data, label), partial, [("s", "simple"), ("d", "double")], **line_kw)
-    set_labels(ax, EPS_Q_LABEL, "$a'$")
+    draw_evolutions(ax, datasets(data, label), partial, [("s", "simple"), ("d", "double")],
+                    curve_colours=[PALETTE["simple"], PALETTE["double"]], **line_kw)
+    set_labels(ax, EPS_Q_LABEL, "$a'_s$, $a'_d$")
     return finish(ax, None)
 
 

@@ -84,13 +84,13 @@ def legend_texts(ax):
 EVOLUTIONS = {
     "q_over_p": (gp.plot_q_over_p, {}, "$q/p$", lambda ds: [stress_invariants(ds)["q_over_p"]]),
     "eps_p": (gp.plot_volumetric_strain, {}, r"$\varepsilon_p$", lambda ds: [strains(ds)["eps_p"]]),
-    "harmonic": (gp.plot_harmonic_prediction, {}, "$q/p$",
+    "harmonic": (gp.plot_harmonic_prediction, {}, "$q/p$ and its predictions",
                  lambda ds: [harmonic_prediction(ds)[v] for v in ("q_over_p", "prediction", "prediction_cross_term")]),
-    "partial_q": (gp.plot_partial_q_over_p, {}, "$q/p$",
+    "partial_q": (gp.plot_partial_q_over_p, {}, "$q_s/p$, $q_d/p$, $q/p$",
                   lambda ds: [stress_invariants(ds, k)["q_over_p"] for k in ("simple", "double", "all")]),
     "z": (gp.plot_coordination, {}, "$z$", lambda ds: [coordination(ds)["z"]]),
     "a_prime": (gp.plot_fabric_anisotropy, {}, "$a'$", lambda ds: [fabric_anisotropy(ds)["a_prime"]]),
-    "partial_a": (gp.plot_partial_fabric_anisotropy, {}, "$a'$",
+    "partial_a": (gp.plot_partial_fabric_anisotropy, {}, "$a'_s$, $a'_d$",
                   lambda ds: [fabric_anisotropy(ds, k)["a_prime"] for k in ("simple", "double")]),
     "a_n": (gp.plot_force_anisotropy, {"component": "a_n"}, "$a_n$", lambda ds: [force_anisotropies(ds)["a_n"]]),
     "a_t": (gp.plot_force_anisotropy, {"component": "a_t"}, "$a_t$", lambda ds: [force_anisotropies(ds)["a_t"]]),
@@ -138,7 +138,7 @@ def test_successive_calls_on_one_axes_compare_samples(series, other_series):
 
 
 def test_stress_dilatancy_draws_psi_against_phi_in_rad(series):
-    ax = gp.plot_stress_dilatancy([("a", series)])
+    ax = gp.plot_stress_dilatancy([("a", series)], min_strain=0.0)
     angles = friction_and_dilatancy(series)
     np.testing.assert_allclose(ax.lines[0].get_xdata(), angles["phi"].values)
     np.testing.assert_allclose(ax.lines[0].get_ydata(), angles["psi"].values, equal_nan=True)
@@ -149,8 +149,33 @@ def test_stress_dilatancy_draws_psi_against_phi_in_rad(series):
     x, y = ax.lines[1].get_xdata(), ax.lines[1].get_ydata()
     assert (y[1] - y[0]) / (x[1] - x[0]) == pytest.approx(1.0)
     assert x[0] - y[0] == pytest.approx(np.median(phi[ok] - psi[ok]))
-    ax = gp.plot_stress_dilatancy(series, incremental=True)
+    assert len(ax.lines) == 2  # no phi = psi line: it runs through the origin, off both paths
+    ax = gp.plot_stress_dilatancy(series, incremental=True, min_strain=0.0)
     np.testing.assert_allclose(ax.lines[0].get_ydata(), angles["psi_incremental"].values, equal_nan=True)
+
+
+def test_stress_dilatancy_leaves_out_the_early_snapshots_and_labels_its_guides_as_guides(series):
+    eps = strains(series)["eps_q"].values
+    cut = float(np.sort(eps)[2]) + 1e-9  # the three smallest strains fall below it
+    ax = gp.plot_stress_dilatancy({"pentagons": series}, min_strain=cut)
+    angles = friction_and_dilatancy(series)
+    y = ax.lines[0].get_ydata()
+    assert np.isnan(y[eps < cut]).all() and (eps < cut).sum() == 3
+    np.testing.assert_allclose(y[eps >= cut], angles["psi"].values[eps >= cut])
+    # phi_0: the median of phi - psi over the snapshots drawn, the same number as the headline's
+    phi, psi = angles["phi"].values[eps >= cut], angles["psi"].values[eps >= cut]
+    phi_0 = float(np.median(phi - psi))
+    assert gp.macroscopic.friction_offset(series, min_strain=cut) == pytest.approx(phi_0)
+    x, g = ax.lines[1].get_xdata(), ax.lines[1].get_ydata()
+    np.testing.assert_allclose(x - g, phi_0)
+    assert "not a fit" in legend_texts(ax)[1] and f"{phi_0:.2f} rad" in legend_texts(ax)[1]
+    # every point drawn lies within the axes (the early transient no longer sets the range)
+    (x0, x1), (y0, y1) = ax.get_xlim(), ax.get_ylim()
+    for line in ax.lines:
+        xs, ys = np.asarray(line.get_xdata(), float), np.asarray(line.get_ydata(), float)
+        ok = np.isfinite(xs) & np.isfinite(ys)
+        assert ((xs[ok] >= x0) & (xs[ok] <= x1) & (ys[ok] >= y0) & (ys[ok] <= y1)).all()
+    assert any(f"< {cut:g}$ not drawn" in t.get_text() for t in ax.texts)  # the panel says so
 
 
 def test_force_anisotropies_figure_has_a_n_and_a_t_panels(series):
@@ -252,8 +277,8 @@ def test_polar_tangential_force_is_its_magnitude():
     ax = gp.plot_tangential_force_polar(ds, bins=4, time=0)
     np.testing.assert_allclose(ax.lines[0].get_ydata()[[0, 4, 8]], [0.5, 0.5, 0.5])
     fig = gp.plot_angular_forces({"a": ds, "b": ds}, bins=4, time=0)
-    assert len(fig.axes) == 2 and fig.axes[0].name == "polar" and fig.axes[1].name == "rectilinear"
-    assert len(fig.axes[0].lines) == 2 and len(fig.axes[1].lines) == 3  # two samples and the zero line
+    assert len(fig.axes) == 2 and all(ax.name == "rectilinear" for ax in fig.axes)
+    assert len(fig.axes[0].lines) == 3 and len(fig.axes[1].lines) == 3  # two samples and the line at 1 or 0
     assert [t.get_text() for ax in fig.axes for t in ax.texts] == ["(a)", "(b)"]
     with pytest.raises(ParameterError, match="polar"):
         gp.plot_tangential_force_polar(ds, ax=plt.subplots()[1])
@@ -324,8 +349,8 @@ def test_kind_map_colours_simple_blue_and_double_red():
     np.testing.assert_allclose(colours, want)
     np.testing.assert_allclose(lines.get_linewidths(), 3.0 * fn[kept] / fn[kept].max())
     top, mean = fn[kept].max(), fn[kept].mean()
-    assert legend_texts(ax) == ["simple (s)", "double (d)",
-                                *(f"$f_n$ = {newtons(f)}" for f in sorted({mean, top / 2, top}))]
+    names = {mean: r"mean $\langle f_n\rangle$", top / 2: "half the widest", top: "widest line"}
+    assert legend_texts(ax) == ["simple (s)", "double (d)", *(f"{newtons(f)}: {names[f]}" for f in sorted(names))]
 
 
 def test_map_legends_sit_beside_the_packing_with_a_key_of_line_widths_in_newtons():
@@ -337,7 +362,11 @@ def test_map_legends_sit_beside_the_packing_with_a_key_of_line_widths_in_newtons
     legend = ax.get_legend()
     handles = legend.legend_handles
     forces = sorted({fn.mean(), fn.max() / 2, fn.max()})
-    assert legend_texts(ax) == [f"$f_n$ = {newtons(f)}" for f in forces]
+    # each sample width says which force it is, the thinnest the mean, and what N means in 2D
+    assert legend_texts(ax) == [f"{newtons(fn.mean())}: mean " + r"$\langle f_n\rangle$",
+                                f"{newtons(fn.max() / 2)}: half the widest", f"{newtons(fn.max())}: widest line"]
+    assert fn.mean() < fn.max() / 2  # the order above is the order of the forces
+    assert "per m of thickness" in legend.get_title().get_text()
     assert newtons(1376.4) == "1376 N" and newtons(0.01234) == "0.0123 N" and newtons(3.6) == "3.6 N"
     assert newtons(1.4) != newtons(1.2)
     np.testing.assert_allclose([h.get_linewidth() for h in handles], [4.0 * f / fn.max() for f in forces])
@@ -437,17 +466,23 @@ def test_xi_network_curves(series, func, name, ylabel):
     np.testing.assert_allclose(ax.lines[0].get_xdata(), xi[count >= threshold])
 
 
-@pytest.mark.parametrize("func, names", [
-    (gp.plot_contact_proportions, ["k_s", "k_d", "f_s", "f_d"]),
-    (gp.plot_strong_weak_proportions, ["k_s_strong", "k_s_weak", "k_d_strong", "k_d_weak"])])
-def test_proportion_curves(series, func, names):
+def test_proportion_curves(series):
     force_networks = pytest.importorskip("grainview.force_networks")
-    ax = func(series)
     want = force_networks.contact_proportions(series)
+    ax = gp.plot_contact_proportions(series)
     assert len(ax.lines) == 4
-    for line, name in zip(ax.lines, names):
+    for line, name in zip(ax.lines, ["k_s", "k_d", "f_s", "f_d"]):
         np.testing.assert_allclose(line.get_ydata(), want[name].values)
         np.testing.assert_allclose(line.get_xdata(), strains(series)["eps_q"].values)
+    # Fig. 25: the strong network in (a), the weak one in (b), s against d in each
+    fig = gp.plot_strong_weak_proportions(series)
+    for ax, names in zip(fig.axes, (["k_s_strong", "k_d_strong"], ["k_s_weak", "k_d_weak"])):
+        assert len(ax.lines) == 2
+        for line, name in zip(ax.lines, names):
+            np.testing.assert_allclose(line.get_ydata(), want[name].values)
+    assert [ax.get_ylabel().split(",")[1].split()[0] for ax in fig.axes] == ["strong", "weak"]
+    with pytest.raises(ParameterError, match="network"):
+        gp.plot_strong_weak_proportion(series, network="medium")
 
 
 def test_persistence_and_transitions():
@@ -529,7 +564,7 @@ def _with_near_pairs(ds, near_m=1e-3, n_near=40, seed=5):
     return ds
 
 
-def test_xi_anisotropy_counts_near_pairs_when_asked_and_draws_the_papers_inset(series):
+def test_xi_anisotropy_counts_near_pairs_when_asked_and_draws_the_papers_inset_as_a_panel(series):
     from grainview.xi_network import xi_network
 
     near = _with_near_pairs(series)
@@ -539,9 +574,14 @@ def test_xi_anisotropy_counts_near_pairs_when_asked_and_draws_the_papers_inset(s
     np.testing.assert_allclose(ax.lines[0].get_ydata(), want["a_prime"].mean("time").values)
     force_bearing = xi_network(select_snapshots(near, "residual"), xi=xi)["a_prime"].mean("time").values
     assert not np.allclose(want["a_prime"].mean("time").values, force_bearing)  # the pairs change a'(xi)
-    (inset,) = ax.child_axes
-    assert inset.get_xscale() == "log" and inset.get_xlim()[0] < 0.011 and inset.get_xlim()[1] > 0.9
-    assert not gp.plot_xi_anisotropy(near, xi=xi, inset=False).child_axes
+    # the paper's inset is panel (b): the weak forces on a log axis, labelled, hiding nothing of (a)
+    fig = gp.plot_xi_anisotropies(near, xi=xi, near=1e-3, min_contacts=0)
+    whole, weak = fig.axes
+    assert not whole.child_axes
+    np.testing.assert_allclose(whole.lines[0].get_ydata(), want["a_prime"].mean("time").values)
+    assert weak.get_xscale() == "log" and weak.get_xlim()[0] < 0.011 and weak.get_xlim()[1] > 0.9
+    np.testing.assert_allclose(weak.lines[0].get_xdata(), gp.forces.WEAK_XI)
+    assert weak.get_xlabel() == r"$\xi$" and weak.get_ylabel() == r"$a'(\xi)$"
 
 
 def test_the_report_counts_near_pairs_in_fig16_only_when_every_file_holds_them(series):
@@ -553,3 +593,163 @@ def test_the_report_counts_near_pairs_in_fig16_only_when_every_file_holds_them(s
     assert f"pairs within {gap * 1e3:.2g} mm" in line
     gap, line = xi_contacts({"a": near, "b": series})  # one file without near pairs: none counted
     assert gap is None and "force-bearing only" in line
+
+
+# -- one palette, layouts, captions (the report's figures as a reader sees them) --------------
+
+@pytest.fixture(scope="module")
+def pentagons(other_series):
+    """The second synthetic series with pentagons for particles (its contacts unchanged)."""
+    return other_series.assign(n_vertices=other_series["n_vertices"] * 0 + 5)
+
+
+def test_one_palette_pentagons_blue_disks_orange_whatever_the_order(series, pentagons):
+    from grainview.plot._style import PALETTE
+
+    blue, orange = to_rgba(PALETTE["pentagons"]), to_rgba(PALETTE["disks"])
+    assert blue != orange
+    for runs in ({"pentagons": pentagons, "disks": series}, {"disks": series, "pentagons": pentagons}):
+        want = [blue if label == "pentagons" else orange for label in runs]
+        drawn = {"q/p": gp.plot_q_over_p(runs).lines[:2], "P(c)": gp.plot_connectivity_pdf(runs).lines[:2],
+                 "P(theta)": gp.plot_orientation_pdf(runs).lines[:2], "q(xi)": gp.plot_xi_stress(runs).lines[:2],
+                 "<f_n>(theta)": gp.plot_angular_forces(runs).axes[0].lines[:2],
+                 "pdf": gp.plot_force_pdf(runs).lines[0::2],  # the pdf of each sample, then its fit
+                 "phi, psi": gp.plot_stress_dilatancy(runs, min_strain=0.0).lines[0::2]}
+        for name, lines in drawn.items():
+            assert [to_rgba(line.get_color()) for line in lines] == want, name
+    # the ensemble figures: the groups come sorted ("disk" first), the colours stay with the shapes
+    import xarray as xr
+
+    from grainview.plot.ensemble import seed_bands
+    stats = xr.Dataset({"mean": (("group", "eps_q_bin"), [[0.2, 0.3], [0.4, 0.5]]),
+                        "std": (("group", "eps_q_bin"), [[0.01, 0.02], [0.01, 0.02]]),
+                        "n": (("group", "eps_q_bin"), [[3, 3], [3, 3]])},
+                       coords={"group": ["disk", "pentagon"], "eps_q_bin": [0.1, 0.2]})
+    ax = seed_bands(stats, label="q/p")
+    assert [to_rgba(line.get_color()) for line in ax.lines] == [orange, blue]
+    # a second sample of one shape gets a colour of neither shape nor contact kind
+    ax = gp.plot_q_over_p({"a": series, "b": series})
+    second = to_rgba(ax.lines[1].get_color())
+    assert second not in {to_rgba(c) for c in PALETTE.values()}
+
+
+def test_contact_kinds_have_their_own_colours_in_every_figure(pentagons):
+    from grainview.plot._style import PALETTE
+
+    simple, double, every = (to_rgba(PALETTE[k]) for k in ("simple", "double", "all"))
+    samples = {to_rgba(PALETTE["pentagons"]), to_rgba(PALETTE["disks"])}
+    assert not {simple, double, every} & samples  # orange means disks, never double contacts
+    colours = {
+        "18": gp.plot_partial_q_over_p(pentagons).lines,
+        "19": gp.plot_contact_proportions(pentagons).lines,
+        "22": gp.plot_partial_fabric_anisotropy(pentagons).lines,
+        "23": gp.plot_force_pdfs_by_kind(pentagons).axes[0].lines,
+        "25a": gp.plot_strong_weak_proportions(pentagons).axes[0].lines,
+    }
+    want = {"18": [simple, double, every], "19": [simple, double, simple, double], "22": [simple, double],
+            "23": [simple, double], "25a": [simple, double]}
+    for name, lines in colours.items():
+        assert [to_rgba(line.get_color()) for line in lines] == want[name], name
+    assert [to_rgba(c) for c in (KIND_COLOURS[1], KIND_COLOURS[2])] == [simple, double]  # Fig. 24's map
+
+
+@pytest.mark.parametrize("func", [gp.plot_force_pdfs, gp.plot_force_pdfs_by_kind, gp.plot_angular_forces,
+                                  gp.plot_xi_anisotropies, gp.plot_strong_weak_proportions,
+                                  gp.plot_force_anisotropies])
+def test_two_panel_figures_have_panels_of_equal_width(func, series, pentagons):
+    fig = func({"pentagons": pentagons, "disks": series})
+    fig.canvas.draw()
+    widths = [ax.get_position().width for ax in fig.axes]
+    assert len(widths) == 2 and widths[0] == pytest.approx(widths[1], rel=0.01)
+    for ax in fig.axes:  # no legend beside a panel, in the space of the panels' layout
+        if ax.get_legend() is not None:
+            frame, box = ax.get_window_extent(), ax.get_legend().get_window_extent()
+            assert frame.x0 <= box.x0 and box.x1 <= frame.x1
+
+
+def test_a_note_in_a_panel_stays_inside_its_frame(series, pentagons):
+    # a narrow range leaves many contacts outside it: the note names both samples
+    runs = {"pentagons (S1-like)": pentagons, "disks (S2-like)": series}
+    ax = gp.plot_force_pdfs(runs, range=(0.5, 2.0)).axes[1]  # the log-log panel of Fig. 14
+    (note,) = [t for t in ax.texts if t.get_text().startswith("outside")]
+    assert all(label in note.get_text() for label in runs)
+    ax.figure.canvas.draw()
+    frame, box = ax.get_window_extent(), note.get_window_extent()
+    assert frame.x0 <= box.x0 and box.x1 <= frame.x1 and frame.y0 <= box.y0 and box.y1 <= frame.y1
+
+
+def test_angular_forces_share_theta_ticks_and_one_y_scale(series, pentagons):
+    fig = gp.plot_angular_forces({"pentagons": pentagons, "disks": series})
+    normal, tangential = fig.axes
+    assert normal.get_xlim() == tangential.get_xlim() == pytest.approx((0.0, np.pi))
+    labels = [[t.get_text() for t in ax.get_xticklabels()] for ax in fig.axes]
+    assert labels[0] == labels[1] == ["0", r"$\pi/4$", r"$\pi/2$", r"$3\pi/4$", r"$\pi$"]
+    assert np.diff(normal.get_ylim()) == pytest.approx(np.diff(tangential.get_ylim()))
+    for ax in fig.axes:  # the data inside the limits
+        lo, hi = ax.get_ylim()
+        for line in ax.lines[:2]:
+            y = np.asarray(line.get_ydata(), float)
+            assert ((y[np.isfinite(y)] >= lo) & (y[np.isfinite(y)] <= hi)).all()
+    assert tangential.get_legend() is None and normal.get_legend() is not None
+
+
+def test_a_tall_map_is_saved_without_a_blank_margin_on_its_left(tmp_path):
+    import matplotlib.image
+
+    from grainview.plot._style import add_caption
+
+    ds = builders.square_lattice(2, 12)  # a box six times taller than wide
+    for name, func in (("particles", gp.plot_particles), ("chains", gp.plot_force_chains),
+                       ("kinds", gp.plot_contact_kinds), ("classes", gp.plot_force_classes)):
+        ax = func(ds)
+        add_caption(ax.figure, ["a caption line, long enough to be wider than the map itself, as the report's are"])
+        (png, _) = save_figure(ax.figure, tmp_path / name)
+        image = matplotlib.image.imread(png)
+        ink = (image[..., :3] < 0.9).any(axis=2)
+        upper = ink[: ink.shape[0] // 2]  # the map, above the caption
+        first = np.flatnonzero(upper.any(axis=0))[0]
+        assert first / ink.shape[1] < 0.1, name  # the y label starts the image, not blank paper
+
+
+def test_every_report_figure_says_what_it_plots_in_readable_type(series):
+    from grainview.plot._style import CAPTION_FONTSIZE, add_caption
+    from grainview.plot.captions import describe_figure
+
+    for number in gp.FIGURES:
+        assert len(describe_figure(number)) > 40, number
+    assert CAPTION_FONTSIZE >= 8
+    ax = gp.plot_q_over_p(series)
+    add_caption(ax.figure, [describe_figure("03"), "provenance"])
+    (text,) = ax.figure.texts
+    assert text.get_fontsize() == CAPTION_FONTSIZE and text.get_text().startswith("Shear stress ratio q/p")
+
+
+def test_pooled_contacts_counts_different_pairs(series):
+    from grainview.plot.captions import pooled_contacts, sampling_note
+
+    # the synthetic series keeps the same 300 pairs in every snapshot: 300 different contacts
+    assert pooled_contacts(series) == (300, 300.0)
+    # random pairs: counted again by hand with a set of (min, max) pairs
+    ds = builders.mixed_contacts(seed=2, t=4)
+    n = ds.sizes["particle"]
+    pairs, counts = set(), []
+    for k in range(ds.sizes["time"]):
+        c = int(ds["contact_count"][k])
+        i, j, fn = ds["i"].values[k, :c], ds["j"].values[k, :c], ds["fn"].values[k, :c]
+        keep = (fn > 0) & (j < n) & (i < n)
+        pairs |= {(min(a, b), max(a, b)) for a, b in zip(i[keep], j[keep])}
+        counts.append(int(keep.sum()))
+    distinct, per_snapshot = pooled_contacts(ds)
+    assert distinct == len(pairs) > max(counts) and per_snapshot == pytest.approx(np.mean(counts))
+    assert "300 different contacts (1.0 times the 300 of one)" in sampling_note("s", series, residual_strain=0.0)
+
+
+def test_the_transition_caption_gives_the_snapshot_interval(series):
+    from grainview.plot.captions import interval_note
+
+    # the synthetic series: snapshots at t = 0, 1, 2, 3 s, eps_q from strains()
+    d_eps = float(np.median(np.diff(strains(series)["eps_q"].values)))
+    note = interval_note("s", series)
+    assert note.startswith(f"s: snapshots every 1 s, d eps_q = {d_eps:.2g};")
+    every = series.assign_attrs(snapshot_every=200)
+    assert "every 1 s (200 time steps)" in interval_note("s", every)
