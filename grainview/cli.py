@@ -196,9 +196,37 @@ def _simulate(prep, path, *, strain, every, velocity, near_contacts, overwrite, 
                          progress=progress, attrs=attrs, near_contacts=near_contacts, compress=compress)
     unconverged = sum(issubclass(w.category, ConvergenceWarning) for w in caught)
     if unconverged:
-        print(f"{name}: warning: NLGS did not converge (sweep cap or stall test) in {unconverged} step(s)", file=sys.stderr)
+        print(f"{name}: warning: {_unconverged_warning(sim, path, unconverged)}", file=sys.stderr)
     print(f"{name}: wrote {path}", flush=True)
     return path
+
+
+def _unconverged_warning(sim, path, unconverged) -> str:
+    """What the warning on a run's unconverged steps says: how many of the compaction's and of
+    the test's steps stopped at the sweep cap or the stall test, and how far their impulses
+    were from a solution (grainview.convergence), read from the written file."""
+    import netCDF4
+
+    from .convergence import residual_comparison, stop_rule, tolerances, unconverged_in_file
+
+    with netCDF4.Dataset(path) as nc:
+        counts = unconverged_in_file(nc.variables, {k: nc.getncattr(k) for k in nc.ncattrs()})
+    compaction = sim.compaction_unconverged
+    parts, law, quad = [], 0.0, 0.0
+    if compaction is not None:
+        parts.append(f"{compaction.steps} of the compaction's {sim.compaction_steps}")
+        law, quad = compaction.local_law_residual, compaction.residual
+    if counts is not None and counts["of"]:
+        parts.append(f"{counts['steps']} of the test's {counts['of']}")
+        law, quad = max(law, counts["local_law_residual"]), max(quad, counts["residual"])
+    else:
+        counts = {"tolerance": sim.parameters.tolerance, "typical_local_law_residual": None}
+    counts.update(residual=quad, local_law_residual=law, max_iterations=sim.parameters.max_iterations,
+                  max_tolerance=sim.parameters.max_tolerance, stall_sweeps=sim.parameters.stall_sweeps)
+    where = f" ({', '.join(parts)})" if parts else ""
+    return (f"the NLGS did not converge in {unconverged} step(s){where}: stopped at {stop_rule(counts)} before "
+            f"both stopping norms met their tolerances ({tolerances(counts)}); {residual_comparison(counts)}. "
+            f"{path} records the test's per snapshot (nlgs_unconverged_steps), and its report states them")
 
 
 def _progress_flag(args):

@@ -335,8 +335,9 @@ def terminal_table(table: pd.DataFrame, width: int | None = None, column_width: 
     return "\n".join(lines)
 
 
-def write_table(table: pd.DataFrame, out: Path) -> list[Path]:
-    """Write ``table`` as ``headline.md`` (everything, prose included) and ``headline.csv`` (numbers only, :func:`csv_table`: a cell that is
+def write_table(table: pd.DataFrame, out: Path, notes=()) -> list[Path]:
+    """Write ``table`` as ``headline.md`` (everything, prose included; ``notes``: paragraphs
+    written under it) and ``headline.csv`` (numbers only, :func:`csv_table`: a cell that is
     not a number — "not reached", a qualitative statement of the paper — is empty there, so
     the file loads as floats; integers are written as integers, and the particles, the seed
     and the residual window are rows of numbers)."""
@@ -347,6 +348,8 @@ def write_table(table: pd.DataFrame, out: Path) -> list[Path]:
 
     lines = ["| quantity | " + " | ".join(table.columns) + " |", "|---" * (len(table.columns) + 1) + "|"]
     lines += ["| " + " | ".join([str(idx), *(format_cell(v) for v in row)]) + " |" for idx, row in table.iterrows()]
+    for note in notes:
+        lines += ["", note]
     md.write_text("\n".join(lines) + "\n")
     return [csv, md]
 
@@ -501,11 +504,25 @@ def write_report(runs: dict, out, residual_strain: float = RESIDUAL_STRAIN, over
     if log is not None:
         log(f"headline table of {len(runs)} run(s) (residual window eps_q >= {residual_strain:g}) ...")
     table = headline_table(runs, residual_strain)
-    files = write_table(table, out)
+    files = write_table(table, out, notes=convergence_notes(runs))
     captions = {}
     files += write_figures(runs, out / "figures", residual_strain=residual_strain, log=log, captions=captions)
     files.append(write_index(runs, out, captions, residual_strain))
     return {"table": table, "files": files}
+
+
+def convergence_text(ds: xr.Dataset) -> str:
+    """What a run's file says of its steps whose NLGS did not converge, and how far their
+    impulses were from a solution (:func:`grainview.convergence.unconverged_text`)."""
+    from .convergence import unconverged_in_file, unconverged_text
+
+    return unconverged_text(unconverged_in_file(ds, ds.attrs), "the test" if ds.attrs.get("scene") == "biaxial"
+                            else "the run")
+
+
+def convergence_notes(runs: dict) -> list[str]:
+    """The paragraphs under the headline table: each run's :func:`convergence_text`."""
+    return [f"**{label}.** {convergence_text(ds)}" for label, ds in runs.items()]
 
 
 def file_link(source, folder) -> str:
@@ -530,7 +547,8 @@ def write_index(runs: dict, out: Path, captions: dict, residual_strain: float = 
     lines = ["# Report", "", "Force transmission in the runs below, next to Azema, Radjai, Peyroux & Saussine, "
              "Phys. Rev. E 76, 011301 (2007). Residual state: eps_q >= " + f"{residual_strain:g}.", "", "## Runs", ""]
     for label, ds in runs.items():
-        lines += [f"### {label}", "", f"File: {file_link(ds.encoding.get('source'), out)}", ""] + [f"- {line}" for line in describe(ds)] + [""]
+        lines += [f"### {label}", "", f"File: {file_link(ds.encoding.get('source'), out)}", ""] + [f"- {line}" for line in describe(ds)]
+        lines += [f"- {convergence_text(ds)}", ""]
     lines += ["## Headline table", "", "[headline.md](headline.md) (numbers only: [headline.csv](headline.csv))", "",
               "## Figures", ""]
     for stem, caption_lines in captions.items():

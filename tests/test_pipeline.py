@@ -8,7 +8,7 @@ import pytest
 import grainview
 from grainview.cli import main
 from grainview.plot import FIGURES
-from grainview.report import FIGURE_NAMES, NOT_REACHED, PER_RUN_FIGURES, POLYGON_FIGURES
+from grainview.report import FIGURE_NAMES, NOT_REACHED, PER_RUN_FIGURES, POLYGON_FIGURES, convergence_text
 from grainview.strain import residual_window
 
 WINDOW = 0.003
@@ -82,6 +82,12 @@ def test_the_report_index_lists_every_figure_and_the_runs(study):
     for label in ("pentagons", "disks"):
         assert f"### {label}" in index and f"{label}.nc" in index
     assert "30 particles (30 5-gons)" in index and "sigma0 10 kPa" in index
+    # each run's NLGS convergence, as its file records it, in the index and under the headline table
+    headline = (study / "report" / "headline.md").read_text()
+    for label in ("pentagons", "disks"):
+        with grainview.open_dataset(study / f"{label}.nc") as ds:
+            text = convergence_text(ds)
+        assert text.startswith("NLGS convergence: ") and f"- {text}" in index and f"**{label}.** {text}" in headline
 
 
 def test_a_run_short_of_the_residual_window_reports_not_reached(study, tmp_path):
