@@ -24,12 +24,17 @@ from .strain import RESIDUAL_STRAIN, residual_window
 NOT_REACHED = "not reached"
 """Value of a residual-state row of a run that stops short of the residual window."""
 
+PHI_0_ROW = "phi_0 = median(phi - psi), eps_q >= 0.02 (rad)"
+"""Headline row of the stress–dilatancy offset of Fig. 5 (:func:`grainview.plot.macroscopic.friction_offset`),
+over the whole test rather than the residual state."""
+
 # The paper's values (Azema et al. 2007, Secs. III-VI; docs/fidelity.md); strings where the
 # paper gives no number. k_d, q_s/p and q_d/p are implied rather than quoted: see
 # docs/fidelity.md.
 PAPER = {
     "pentagons": {
         "particles": 14400, "q/p (residual)": 0.35, "solid fraction (initial)": 0.80, "z (initial)": 3.20,
+        PHI_0_ROW: "-",
         "z (residual)": 3.75, "z with walls (residual)": "-", "a (residual)": "small (nearly isotropic)",
         "a_n (residual)": "larger than disks", "a_t (residual)": "close to a_n",
         "(a' + a_n + a_t)/2 (residual)": "~q/p", "(a' + a_n + a_t)/(2 + a' a_n) (residual)": "-",
@@ -41,6 +46,7 @@ PAPER = {
     },
     "disks": {
         "particles": 10000, "q/p (residual)": 0.28, "solid fraction (initial)": 0.82, "z (initial)": 3.95,
+        PHI_0_ROW: "-",
         "z (residual)": 3.85, "z with walls (residual)": "-", "a (residual)": "up to ~0.3",
         "a_n (residual)": "smaller than pentagons", "a_t (residual)": "about a_n/2",
         "(a' + a_n + a_t)/2 (residual)": "~q/p", "(a' + a_n + a_t)/(2 + a' a_n) (residual)": "-",
@@ -57,7 +63,7 @@ for _paper in PAPER.values():
                    "residual window": "eps_q >= ~0.3 (Figs. 7, 8, 10)",
                    "double-contact criterion": "LMGC90 shadow overlap (docs/fidelity.md)"})
 
-INITIAL_ROWS = ("solid fraction (initial)", "z (initial)")
+INITIAL_ROWS = ("solid fraction (initial)", "z (initial)", PHI_0_ROW)
 NEAR_FRACTION = 0.01
 """The report's near-contact rows count the pairs within this fraction of the smallest
 diameter (docs/fidelity.md, section 5)."""
@@ -107,6 +113,8 @@ def run_summary(ds: xr.Dataset, residual_strain: float = RESIDUAL_STRAIN) -> dic
     out = describe_run(ds, window, residual_strain)
     out["solid fraction (initial)"] = float(ds.grain.solid_fraction().isel(time=0))
     out["z (initial)"] = float(ds.grain.coordination()["z"].isel(time=0))
+    from .plot.macroscopic import friction_offset
+    out[PHI_0_ROW] = friction_offset(ds)  # Fig. 5's phi_0, over the whole test
     residual_rows = [key for key in PAPER["pentagons"] if key not in out and key not in INITIAL_ROWS]
     if not bool(window.any()):
         out.update({key: NOT_REACHED for key in residual_rows})
@@ -414,6 +422,7 @@ def write_figures(runs: dict, out: Path, time=-1, residual_strain: float = RESID
 
     from .plot import FIGURES, save_figure
     from .plot._style import Residual, add_caption
+    from .plot.captions import describe_figure, interval_note, sampling_note
 
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
@@ -443,9 +452,14 @@ def write_figures(runs: dict, out: Path, time=-1, residual_strain: float = RESID
             result = func(data if number not in PER_RUN_FIGURES else next(iter(data.values())), **kwargs)
             fig = result if hasattr(result, "savefig") else result.figure
             what = "map" if number in MAP_FIGURES else "distribution" if number in DISTRIBUTION_FIGURES else "evolution"
-            lines = [caption(label, ds, what, residual_strain, shown) for label, ds in data.items()]
+            lines = [describe_figure(number)] + [caption(label, ds, what, residual_strain, shown)
+                                                 for label, ds in data.items()]
             if rule is not None:
                 lines.append(rule)
+            if number == "08":  # why P(theta) has spikes: the pooled snapshots share their contacts
+                lines += [sampling_note(label, ds, residual_strain) for label, ds in data.items()]
+            if number == "20":  # Delta gamma depends on the interval between snapshots
+                lines += [interval_note(label, ds) for label, ds in data.items()]
             add_caption(fig, lines)
             if captions is not None:
                 captions[stem] = lines
@@ -462,7 +476,7 @@ def common_force_scale(runs: dict, time=-1):
     largest particle–particle normal force of snapshot ``time`` over all runs, so that equal
     widths mean equal forces from one map to the next. Returns ``(force, caption line)``."""
     from .contacts import selection
-    from .plot.maps import newtons
+    from .plot.maps import force_unit, newtons
 
     largest = 0.0
     for ds in runs.values():
@@ -470,7 +484,9 @@ def common_force_scale(runs: dict, time=-1):
         fn = snap["fn"].where(selection(snap)).max()
         largest = max(largest, float(fn) if np.isfinite(float(fn)) else 0.0)
     names = ", ".join(runs)
-    return largest, f"line widths on one scale for {names}: the widest line is {newtons(largest)}"
+    thickness = float(next(iter(runs.values())).attrs.get("thickness_m", 1.0))
+    return largest, (f"line widths on one scale for {names}: the widest line is {newtons(largest)} "
+                     f"{force_unit(thickness)}")
 
 
 def xi_contacts(runs: dict):
