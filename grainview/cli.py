@@ -8,10 +8,11 @@ never as a traceback.
 from __future__ import annotations
 
 import argparse
+import math
 import sys
 from pathlib import Path
 
-from .errors import ConvergenceWarning, GrainviewError
+from .errors import ConvergenceWarning, GrainviewError, SchemaError
 
 RESIDUAL_STRAIN = 0.3
 """Default start of the residual window (eps_q); the same as grainview.strain.RESIDUAL_STRAIN,
@@ -28,13 +29,13 @@ residual state (eps_q >= 0.3)."""
 def _info(args) -> int:
     from .file_summary import describe_file
 
-    lines, attrs = describe_file(args.file)  # netCDF4 and numpy only: no xarray, dask or pandas to import
-    if args.check:
+    if args.check:  # first, so that every problem is listed
         from .io import open_dataset
         from .validation import validate
 
         with open_dataset(args.file, chunks="auto") as ds:
             validate(ds, source=str(args.file))
+    lines, attrs = describe_file(args.file)  # netCDF4 and numpy only: no xarray, dask or pandas to import
     for line in lines:
         print(line)
     if args.attrs:
@@ -44,7 +45,7 @@ def _info(args) -> int:
     if args.check:
         print(f"valid: every value checked against grainview data contract {version}")
     else:
-        print(f"valid: structure and units follow grainview data contract {version} "
+        print(f"valid: structure, units, times and forces follow grainview data contract {version} "
               "(--check also checks every value)")
     return 0
 
@@ -159,8 +160,26 @@ def _check_test(args):
         raise GrainviewError(f"--strain {args.strain}: expected a vertical strain eps_1 in (0, 1)")
     if args.every < 1:
         raise GrainviewError(f"--every {args.every}: expected a positive number of steps between snapshots")
-    if not (args.velocity > 0):
-        raise GrainviewError(f"--velocity {args.velocity}: expected a positive wall speed in m s-1")
+    if not (math.isfinite(args.velocity) and args.velocity > 0):
+        raise GrainviewError(f"--velocity {args.velocity:g}: expected a finite wall speed > 0 in m/s")
+
+
+MAX_VERTICES = 64
+"""Most vertices a ``--shape`` polygon may have (a polygon of more is a disk for every purpose)."""
+
+
+def _shape_of(text, option=None):
+    """A shape of the command line: a name of :data:`solver.shapes.SHAPES` (disk, pentagon...)
+    or a number of vertices from 3 to :data:`MAX_VERTICES`, as an integer."""
+    from solver.shapes import SHAPES
+
+    text = str(text).strip()
+    if text in SHAPES:
+        return text
+    if text.isdigit() and 3 <= int(text) <= MAX_VERTICES:
+        return int(text)
+    raise GrainviewError(f"{option or f'--shape {text}'}: expected disk, pentagon or a number of vertices from 3 "
+                         f"to {MAX_VERTICES}")
 
 
 def _simulate(prep, path, *, strain, every, velocity, near_contacts, overwrite, progress, scene="biaxial",
@@ -239,17 +258,44 @@ def _simulation_kwargs(args):
                 compress=not args.no_compress)
 
 
+TEMPORARY_NAME_EXTRA = len("..") + 7 + len(".convert")
+"""Bytes the writer's temporary names add to a file's name: ``.<name>.<pid>.part`` and
+``.<name>.<pid>.convert`` (grainview.writer; a process id has at most 7 digits) and the lock's
+``.<name>.writer`` (grainview.locks)."""
+
+
+def longest_output_name(folder) -> int:
+    """The longest file name, in bytes, that ``--out`` may have in ``folder``: the folder's
+    name limit (``PC_NAME_MAX``, 255 on common file systems) less :data:`TEMPORARY_NAME_EXTRA`."""
+    import os
+
+    try:
+        limit = os.pathconf(folder, "PC_NAME_MAX")
+    except (OSError, ValueError, AttributeError):  # not known here (or not POSIX): the common limit
+        limit = 255
+    return limit - TEMPORARY_NAME_EXTRA
+
+
 def _check_output_file(path, overwrite):
     """Check ``--out`` of a run before anything is simulated: a file name in a writable
-    folder, not a folder, not an existing file without --overwrite."""
+    folder, short enough for the writer's temporary names, not a folder, not a link to
+    nowhere, not an existing file without --overwrite."""
     import os
 
     path = Path(path)
+    folder = path.parent if str(path.parent) else Path(".")
+    size = len(os.fsencode(path.name))
+    if folder.is_dir() and size > longest_output_name(folder):
+        raise GrainviewError(f"--out {path.name[:24]}...: a file name of {size} bytes: expected at most "
+                             f"{longest_output_name(folder)} in {folder} (the writer's temporary names add "
+                             f"{TEMPORARY_NAME_EXTRA} bytes to it)")
+    if path.is_symlink() and not path.exists():
+        raise GrainviewError(f"--out {path} is a symbolic link to {os.readlink(path)}, which does not exist; "
+                             "expected a file name (or the link's target folder made first)")
     if path.is_dir():
         raise GrainviewError(f"--out {path} is a folder; expected a file name such as {path / 'run.nc'}")
     if path.exists() and not overwrite:
         raise GrainviewError(f"--out {path} exists; pass --overwrite to replace it")
-    folder = path.parent if str(path.parent) else Path(".")
     if not folder.is_dir():
         raise GrainviewError(f"--out {path}: the folder {folder} does not exist")
     if not os.access(folder, os.W_OK):
@@ -260,14 +306,18 @@ def _check_time_step(args, prep):
     """The time step against the walls' speeds, before any work (solver.stepper.check_time_step)."""
     from solver import Parameters
 
+    _solver_parameters(args)  # a time step of the wrong sign or form is named as such first
     time_step = args.time_step if args.time_step is not None else Parameters().time_step
-    prep.check_time_step(time_step, args.velocity if getattr(args, "scene", "biaxial") == "biaxial" else None)
+    biaxial = getattr(args, "scene", "biaxial") == "biaxial"
+    prep.check_time_step(time_step, args.velocity if biaxial else None)
+    if biaxial:
+        prep.check_test_speed(time_step, args.velocity, args.strain)
 
 
 def _run(args) -> int:
     _check_test(args)
     _check_output_file(args.out, args.overwrite)
-    prep = _preparation(args, args.shape)
+    prep = _preparation(args, _shape_of(args.shape))
     _check_time_step(args, prep)
     _simulate(prep, args.out, scene=args.scene, **_simulation_kwargs(args))
     return 0
@@ -344,7 +394,8 @@ def _ensemble(args) -> int:
         raise GrainviewError("--workers applies to the local cluster; an existing --scheduler has its own workers")
     frictions = _split(args.friction, float, "friction") if args.friction else [None]
     sigma0 = _split(args.sigma0, float, "sigma0") if args.sigma0 else [None]
-    specs = grid(shapes=_split(args.shapes, str, "shapes"), particles=_split(args.particles, int, "particles"),
+    shapes = [_shape_of(s, f"--shapes {args.shapes}") for s in _split(args.shapes, str, "shapes")]
+    specs = grid(shapes=shapes, particles=_split(args.particles, int, "particles"),
                  frictions=frictions, sigma0=sigma0, seeds=range(args.first_seed, args.first_seed + args.seeds),
                  preparation=args.preparation, strain=args.strain, velocity=args.velocity, every=args.every,
                  solver=tuple(sorted(_solver_parameters(args).items())))
@@ -432,16 +483,18 @@ def build_parser() -> argparse.ArgumentParser:
                        "a run short of it reports 'not reached'")
 
     def simulation_options(p, particles=400, strain=DEFAULT_STRAIN, every=200):
-        from solver.preparation import preset_names
+        from solver.preparation import MAX_SEED, MIN_TEST_STEPS, preset_names
 
         p.add_argument("--particles", type=int, default=particles, help=f"particles per sample (default {particles})")
         p.add_argument("--strain", type=float, default=strain,
                        help=f"vertical strain eps_1 of the biaxial test (default {strain}: eps_q ~0.6, "
                        "into the residual state)")
         p.add_argument("--velocity", type=float, default=0.01,
-                       help="speed of the top wall in m/s (default 0.01, the paper's)")
+                       help="speed of the top wall in m/s (default 0.01, the paper's): finite, > 0, and such that "
+                       f"the test takes at least {MIN_TEST_STEPS} time steps and no more than a file's 32-bit step "
+                       "counter holds")
         p.add_argument("--every", type=int, default=every, help=f"steps between snapshots (default {every})")
-        p.add_argument("--seed", type=int, default=0, help="random seed of the deposit (default 0)")
+        p.add_argument("--seed", type=int, default=0, help=f"random seed of the deposit, 0 to {MAX_SEED} (default 0)")
         physics = p.add_argument_group("physics and numerics (defaults: the paper's)")
         physics.add_argument("--friction", type=float, default=None,
                              help="grain-grain friction coefficient of the test (default 0.4)")
@@ -495,7 +548,8 @@ def build_parser() -> argparse.ArgumentParser:
                          "(scene biaxial) compression by the top wall (1 cm/s) with sigma0 held on the right wall.")
     run.add_argument("scene", nargs="?", choices=["biaxial", "isotropic"], default="biaxial",
                      help="biaxial (default) or isotropic (writes the compacted state)")
-    run.add_argument("--shape", default="pentagon", help="pentagon (default), disk, or a number of vertices")
+    run.add_argument("--shape", default="pentagon", help="pentagon (default), disk, or a number of vertices from 3 to "
+                     f"{MAX_VERTICES} (6: hexagons)")
     run.add_argument("--out", default="run.nc", help="output netCDF file (default: run.nc)")
     run.add_argument("--near-contacts", action="store_true",
                      help="also write the pairs within the alert distance that carry no force (with their "
@@ -521,6 +575,8 @@ def build_parser() -> argparse.ArgumentParser:
     report.add_argument("--movie-every", type=int, default=1, help="one movie frame every k snapshots (default 1)")
     residual_option(report)
     report.set_defaults(func=_report)
+    from solver.preparation import MIN_TEST_STEPS
+
     ens = sub.add_parser("ensemble", help="many runs (settings x seeds) on a dask cluster, then their report",
                          description="One biaxial test per (shape, particles, friction, sigma0, seed) on a "
                          "dask.distributed cluster (a local one, one worker per core, or --scheduler), each into "
@@ -528,14 +584,17 @@ def build_parser() -> argparse.ArgumentParser:
                          "skips finished runs and resumes the others. Then the ensemble report: mean +- spread over "
                          "seeds (docs/ensembles.md).")
     ens.add_argument("--out", default="ensemble", help="output folder (default: ensemble)")
-    ens.add_argument("--shapes", default="pentagon", help="comma-separated shapes (default pentagon; e.g. pentagon,disk)")
+    ens.add_argument("--shapes", default="pentagon", help="comma-separated shapes: pentagon, disk or numbers of vertices "
+                     f"from 3 to {MAX_VERTICES} (default pentagon; e.g. pentagon,disk,6)")
     ens.add_argument("--particles", default="400", help="comma-separated particle counts (default 400)")
     ens.add_argument("--friction", default=None, help="comma-separated grain friction values (default: 0.4)")
     ens.add_argument("--sigma0", default=None, help="comma-separated confining stresses in Pa (default: 1e4)")
     ens.add_argument("--seeds", type=int, default=3, help="seeds per setting (default 3)")
     ens.add_argument("--first-seed", type=int, default=0, help="first seed (default 0)")
     ens.add_argument("--strain", type=float, default=DEFAULT_STRAIN, help=f"vertical strain eps_1 (default {DEFAULT_STRAIN})")
-    ens.add_argument("--velocity", type=float, default=0.01, help="speed of the top wall in m/s (default 0.01)")
+    ens.add_argument("--velocity", type=float, default=0.01, help="speed of the top wall in m/s (default 0.01): "
+                     f"finite, > 0, and such that the test takes at least {MIN_TEST_STEPS} time steps and no more than "
+                     "a file's 32-bit step counter holds")
     ens.add_argument("--every", type=int, default=200, help="steps between snapshots (default 200)")
     ens.add_argument("--preparation", default="paper", help=f"named preparation (default paper; {S1S2_HELP})")
     ens.add_argument("--wall-friction", type=float, default=None, help="grain-wall friction (default 0)")
@@ -630,11 +689,40 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
+def _negative_values_attached(argv):
+    """``argv`` with each negative number that follows a long option attached to it
+    (``--time-step -1e-4`` -> ``--time-step=-1e-4``): argparse takes ``-1e-4`` for an option
+    and answers "expected one argument", where the value should parse and then be refused
+    for what it is."""
+    out = []
+    for token in argv:
+        previous = out[-1] if out else ""
+        if (token.startswith("-") and previous.startswith("--") and "=" not in previous
+                and previous != "--" and _is_number(token)):
+            out[-1] = f"{previous}={token}"
+        else:
+            out.append(token)
+    return out
+
+
+def _is_number(text) -> bool:
+    try:
+        float(text)
+    except ValueError:
+        return False
+    return True
+
+
 def main(argv=None) -> int:
     parser = build_parser()
-    args = parser.parse_args(argv)
+    args = parser.parse_args(_negative_values_attached(sys.argv[1:] if argv is None else list(argv)))
     try:
         return args.func(args)
+    except SchemaError as exc:  # one line; `info --check` lists every problem
+        listed = args.command == "info" and getattr(args, "check", False) and len(exc.problems) > 1
+        message = str(exc).replace("\n", "\n  ") if listed else exc.summary()
+        print(f"grainview: error: {message}", file=sys.stderr)
+        return 2
     except (GrainviewError, FileExistsError, FileNotFoundError) as exc:
         # the library's advice names its keyword; on the command line it is the flag
         message = str(exc).replace("\n", "\n  ").replace("overwrite=True", "--overwrite")

@@ -28,6 +28,17 @@ class SchemaError(GrainviewError, ValueError):
         head = f"{len(self.problems)} problem(s) with the grainview data contract{where}:"
         super().__init__("\n  - ".join([head, *self.problems]))
 
+    def summary(self) -> str:
+        """The error in one line: ``<source>: <problem>`` for a single problem, else how many
+        there are, the first, and the command that lists them all (the command line's
+        message; the exception's own message lists every problem)."""
+        where = f"{self.source}: " if self.source else ""
+        if len(self.problems) == 1:
+            return f"{where}{self.problems[0]}"
+        listing = f"'grainview info --check {self.source}'" if self.source else "grainview.validate"
+        return (f"{where}{len(self.problems)} problems with the grainview data contract, first: {self.problems[0]}; "
+                f"{listing} lists them")
+
 
 class FileFormatError(GrainviewError, OSError):
     """A path cannot be read as a grainview netCDF file (missing, not netCDF, truncated)."""

@@ -4,10 +4,13 @@ Importing xarray, pandas and dask takes about a second on its own, longer than t
 summary of a study's file. So the summary that ``grainview info`` prints is read here with
 netCDF4, computed with the pure array functions of :mod:`grainview.arrays` (the same physics
 as the accessors) and formatted by :func:`grainview.summary.summary_lines` (the same lines as
-the report's index). The checks made on the way are those that need no values: the file
-opens as netCDF, its structure and units follow the contract
-(:func:`grainview.schema.structure_problems`, :func:`grainview.schema.unit_problems`), and a
-netCDF-3 file is not shorter than its fixed data and records need. Every value is checked by
+the report's index). The checks made on the way: the file opens as netCDF, it is a grainview
+file, its structure and units follow the contract (:func:`grainview.schema.structure_problems`,
+:func:`grainview.schema.unit_problems`), a netCDF-3 file is neither shorter than its fixed data
+and records need nor longer by records its header does not count, no incomplete snapshot comes
+before complete ones, and the values the summary reads are sound: times increasing strictly,
+finite forces, normal forces >= 0 (:mod:`grainview.file_checks`, the words of
+:func:`grainview.validation.validate`). Every value is checked by
 :func:`grainview.validation.validate` (``grainview info --check``).
 """
 
@@ -18,16 +21,17 @@ import os
 import numpy as np
 
 from .errors import FileFormatError, SchemaError
-from .schema import (complete_snapshots, leading_complete, missing_units, particle_area, structure_problems,
-                     unit_problems)
+from .file_checks import (COUNT_OUT_OF_RANGE, damaged_snapshots, force_problems, foreign_file_problems,
+                          order_problems)
+from .schema import complete_snapshots, missing_units, particle_area, structure_problems, unit_problems
 from .writer import netcdf3_data_bytes
 
 __all__ = ["read_facts", "describe_file"]
 
 
-def _minimum_netcdf3_size(nc) -> int:
-    """Bytes a netCDF-3 file needs at least: its data (:func:`grainview.writer.netcdf3_data_bytes`),
-    the header (a few KiB) not counted. A file shorter than this was cut short."""
+def _netcdf3_data(nc) -> tuple[int, int, int]:
+    """``(fixed, record, n_records)``: bytes of a netCDF-3 file's fixed-size variables and of
+    one record (:func:`grainview.writer.netcdf3_data_bytes`), and the header's record count."""
     fixed, record = [], []
     for var in nc.variables.values():
         is_record = bool(var.dimensions) and nc.dimensions[var.dimensions[0]].isunlimited()
@@ -35,7 +39,25 @@ def _minimum_netcdf3_size(nc) -> int:
         (record if is_record else fixed).append(var.dtype.itemsize * int(np.prod(shape, dtype=np.int64)))
     fixed_bytes, record_bytes = netcdf3_data_bytes(fixed, record)
     n_records = len(nc.dimensions["time"]) if "time" in nc.dimensions else 0
-    return fixed_bytes + n_records * record_bytes
+    return fixed_bytes, record_bytes, n_records
+
+
+def _check_netcdf3_size(nc, source) -> None:
+    """Refuse a netCDF-3 file shorter than its data need (cut short) or longer by whole records
+    than its header counts (:func:`grainview.file_checks.hidden_records`). The header's own
+    size is not known to netCDF4: a file longer than its data by two records or more is
+    measured exactly (:func:`grainview.io.open_dataset`'s check, with scipy), others cannot
+    hide records."""
+    from .file_checks import HIDDEN_RECORDS_TOLERATED
+
+    fixed, record, n_records = _netcdf3_data(nc)
+    needed, size = fixed + n_records * record, os.path.getsize(source)
+    if size < needed:
+        raise FileFormatError(f"{source}: truncated file ({size} bytes, its data need at least {needed})")
+    if record and (size - needed) // record > HIDDEN_RECORDS_TOLERATED:
+        from .io import _check_netcdf3_length
+
+        _check_netcdf3_length(source)
 
 
 def read_facts(path) -> tuple[dict, dict]:
@@ -61,9 +83,11 @@ def read_facts(path) -> tuple[dict, dict]:
     Raises
     ------
     FileFormatError
-        Not a readable netCDF file, or a netCDF-3 file cut short.
+        Not a readable netCDF file, a netCDF-3 file cut short or whose header hides records, an
+        incomplete snapshot before complete ones.
     SchemaError
-        The structure or the units differ from the contract's.
+        Not a grainview file; the structure or the units differ from the contract's; times
+        that do not increase strictly, non-finite forces or negative normal forces.
     """
     import netCDF4
 
@@ -85,49 +109,66 @@ def read_facts(path) -> tuple[dict, dict]:
                      if var.dtype is not str}
         units = {name: (var.getncattr("units") if "units" in var.ncattrs() else None)
                  for name, var in nc.variables.items()}
-        problems = structure_problems(variables, sizes) + unit_problems(units)
+        problems = (foreign_file_problems(variables)
+                    or structure_problems(variables, sizes) + unit_problems(units))
         if problems:
             raise SchemaError(problems, source)
-        if nc.data_model.startswith("NETCDF3"):
-            needed, size = _minimum_netcdf3_size(nc), os.path.getsize(source)
-            if size < needed:
-                raise FileFormatError(f"{source}: truncated file ({size} bytes, its data need at least {needed})")
+        netcdf3 = nc.data_model.startswith("NETCDF3")
+        if netcdf3:
+            _check_netcdf3_size(nc, source)
         attrs = {k: nc.getncattr(k) for k in nc.ncattrs()}
         v = nc.variables
         facts = {"n_vertices": np.asarray(v["n_vertices"][:]), "n_walls": sizes.get("wall", 0),
-                 "n_slots": sizes["contact"], "missing_units": missing_units(units)}
+                 "n_slots": sizes["contact"], "missing_units": missing_units(units),
+                 "size": os.path.getsize(source), "format": "netCDF-3" if netcdf3 else "netCDF-4, compressed"}
         complete = complete_snapshots(v) if "time" in v and sizes.get("time", 0) else np.zeros(0, bool)
-        snapshots = leading_complete(complete)
+        snapshots = damaged_snapshots(complete, source)
         facts["snapshots"] = snapshots
         if not snapshots:
             return facts, attrs
         k = slice(0, snapshots)
         count = np.asarray(v["contact_count"][k])
         facts.update(time=np.asarray(v["time"][k], dtype=float), contact_count=count)
+        problems = order_problems("time", facts["time"], " s")
+        if "step" in v:
+            problems += order_problems("step", np.asarray(v["step"][k]))
+        outside = int(((count < 0) | (count > sizes["contact"])).sum())
+        if outside:
+            problems.append(COUNT_OUT_OF_RANGE.format(count=outside, slots=sizes["contact"]))
+        else:
+            occupied = np.arange(sizes["contact"])[None, :] < count[:, None]
+            fn, ft = np.asarray(v["fn"][k]), np.asarray(v["ft"][k])
+            problems += force_problems(fn, ft, v["i"][k], v["j"][k], occupied)
+        if problems:
+            raise SchemaError(problems, source)
         box_min, box_max = np.asarray(v["box_min"][k]), np.asarray(v["box_max"][k])
         length, height = box_max[:, 0] - box_min[:, 0], box_max[:, 1] - box_min[:, 1]
         solid = float(particle_area(v["radius"][:], facts["n_vertices"]).sum())
-        facts["solid_fraction"] = solid / (length * height)
+        with np.errstate(all="ignore"):  # a box of no size gives an infinite fraction, not a warning
+            facts["solid_fraction"] = solid / (length * height)
         if snapshots > 1:
             eps_1, eps_2 = log_strain(height[-1], height[0]), log_strain(length[-1], length[0])
             facts.update(eps_1=float(eps_1), eps_q=float(eps_1 - eps_2))
-            occupied = np.arange(sizes["contact"])[None, :] < count[:, None]
             volume = length * height * float(attrs.get("thickness_m", 1.0))
-            sigma = stress_tensor(v["fn"][k], v["ft"][k], v["normal"][k], v["branch"][k], occupied, volume)
-            s1, s2, _ = principal(sigma)
-            with np.errstate(invalid="ignore", divide="ignore"):
+            with np.errstate(all="ignore"):  # a NaN normal or branch gives a NaN q/p, not a warning
+                sigma = stress_tensor(fn, ft, v["normal"][k], v["branch"][k], occupied, volume)
+                s1, s2, _ = principal(sigma)
                 facts["q_over_p"] = (s1 - s2) / (s1 + s2)
     return facts, attrs
 
 
 def describe_file(path) -> tuple[list, dict]:
     """The lines ``grainview info`` prints for ``path`` (:func:`read_facts`, formatted by
-    :func:`grainview.summary.summary_lines`, with a note on variables without units) and the
-    file's global attributes."""
+    :func:`grainview.summary.summary_lines`, then the file's size and format, and a note on
+    variables without units) and the file's global attributes."""
     from .summary import summary_lines
 
     facts, attrs = read_facts(path)
     lines = summary_lines(facts, attrs)
+    size = facts["size"]
+    scaled, unit = next(((size / 1024**p, u) for p, u in ((3, "GiB"), (2, "MiB"), (1, "KiB"))
+                         if size >= 1024**p), (size, "bytes"))
+    lines.append(f"file: {scaled:.1f} {unit} ({size:,} bytes), {facts['format']}")
     if facts["missing_units"]:
         lines.append(f"note: {len(facts['missing_units'])} variable(s) carry no units attribute and are read in the "
                      f"contract's units (docs/schema.md): {', '.join(facts['missing_units'])}")

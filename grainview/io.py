@@ -14,7 +14,8 @@ import numpy as np
 import xarray as xr
 
 from .errors import FileFormatError, SchemaError
-from .schema import SCHEMA_VERSION, complete_snapshots, leading_complete
+from .file_checks import damaged_snapshots, hidden_records
+from .schema import SCHEMA_VERSION, complete_snapshots
 from .writer import netcdf3_data_bytes
 
 
@@ -48,6 +49,7 @@ def _check_netcdf3_length(path: str) -> None:
     size = os.path.getsize(path)
     if size < expected:
         raise FileFormatError(f"{path}: truncated file ({size} bytes, its header needs at least {expected})")
+    hidden_records(path, size, header, fixed, record_size, n_records)  # nor longer by records it does not count
 
 
 def _check_version(ds, source):
@@ -130,10 +132,7 @@ def open_dataset(path, chunks: int | dict | None = "auto", validate: bool = Fals
         raise FileFormatError(f"{source}: not a readable netCDF file ({exc})") from exc
     _check_version(ds, source)
     if complete is not None:
-        n_complete = leading_complete(complete)
-        if complete[n_complete:].any():
-            raise FileFormatError(f"{source}: snapshot {n_complete} is incomplete but later ones are "
-                                  "complete; the file is damaged")
+        n_complete = damaged_snapshots(complete, source)
         if n_complete < ds.sizes["time"]:
             ds = ds.isel(time=slice(0, n_complete))
     for name in ("xy", "wall"):

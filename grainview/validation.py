@@ -14,6 +14,8 @@ import xarray as xr
 
 from .contacts import occupied
 from .errors import SchemaError
+from .file_checks import (COUNT_OUT_OF_RANGE, NON_FINITE_FORCES, foreign_file_problems, negative_force_problem,
+                          order_problems)
 from .schema import KIND_DOUBLE, KIND_SIMPLE, VARIABLES, structure_problems, unit_problems
 from .schema import missing_units as _missing_units
 
@@ -29,7 +31,7 @@ def _metadata(ds: xr.Dataset):
 
 
 def _structure_problems(ds: xr.Dataset) -> list[str]:
-    return structure_problems(_metadata(ds)[0], dict(ds.sizes))
+    return foreign_file_problems(ds.variables) or structure_problems(_metadata(ds)[0], dict(ds.sizes))
 
 
 def check_structure(ds: xr.Dataset, source: str | None = None) -> None:
@@ -75,7 +77,7 @@ def _value_checks(ds: xr.Dataset) -> dict[str, xr.DataArray]:
     for name in ("position", "angle"):
         checks[f"{name}: {{}} non-finite value(s)"] = (~np.isfinite(ds[name])).sum()
     count = ds["contact_count"]
-    checks[f"contact_count: {{}} snapshot(s) with a count outside [0, {ds.sizes['contact']}]"] = (
+    checks[COUNT_OUT_OF_RANGE.format(count="{}", slots=ds.sizes["contact"])] = (
         (count < 0) | (count > ds.sizes["contact"])).sum()
     occ = occupied(ds)
     i, j = ds["i"], ds["j"]
@@ -88,7 +90,7 @@ def _value_checks(ds: xr.Dataset) -> dict[str, xr.DataArray]:
     checks[f"kind: {{}} occupied slot(s) with a kind other than {KIND_SIMPLE} (simple) or {KIND_DOUBLE} (double)"] = (
         occ & (ds["kind"] != KIND_SIMPLE) & (ds["kind"] != KIND_DOUBLE)).sum()
     for name in ("fn", "ft"):
-        checks[f"{name}: {{}} NaN or infinite force(s) in occupied slots"] = (occ & ~np.isfinite(ds[name])).sum()
+        checks[NON_FINITE_FORCES.format(name=name, count="{}")] = (occ & ~np.isfinite(ds[name])).sum()
     for name in ("point", "branch"):
         checks[f"{name}: {{}} non-finite vector(s) in occupied slots"] = (
             occ & ~np.isfinite(ds[name]).all("xy")).sum()
@@ -114,6 +116,33 @@ def _value_checks(ds: xr.Dataset) -> dict[str, xr.DataArray]:
     return checks
 
 
+def _per_snapshot(ds: xr.Dataset) -> dict[str, xr.DataArray]:
+    """Lazy per-snapshot arrays that the order and sign checks read: ``time`` and ``step``
+    (where the file has it), and the number of negative normal forces in occupied slots."""
+    arrays = {"time": ds["time"].variable, "negative_fn": (occupied(ds) & (ds["fn"] < 0)).sum("contact")}
+    if "step" in ds.variables:
+        arrays["step"] = ds["step"]
+    return arrays
+
+
+def _per_snapshot_problems(ds: xr.Dataset, values: dict) -> list[str]:
+    """The lines of :func:`_per_snapshot`'s arrays, computed: ``time`` and ``step``
+    increasing strictly, no negative normal force (the first one named: its snapshot is read
+    again, only when there is one)."""
+    problems = order_problems("time", values["time"], " s")
+    if "step" in values:
+        problems += order_problems("step", values["step"])
+    negative = np.asarray(values["negative_fn"])
+    if negative.any():
+        k = int(np.flatnonzero(negative)[0])
+        snap = ds[["fn", "i", "j"]].isel(time=k)
+        fn = np.asarray(snap["fn"].values)
+        slot = int(np.flatnonzero(np.asarray(occupied(ds.isel(time=k)).values) & (fn < 0))[0])
+        problems.append(negative_force_problem(int(negative.sum()), k, slot, int(snap["i"].values[slot]),
+                                               int(snap["j"].values[slot]), float(fn[slot])))
+    return problems
+
+
 def validate(ds: xr.Dataset, source: str | None = None) -> xr.Dataset:
     """Check ``ds`` against the contract; raise one :class:`SchemaError` listing every problem.
 
@@ -121,8 +150,11 @@ def validate(ds: xr.Dataset, source: str | None = None) -> xr.Dataset:
     contract says; no negative radius, mass or inertia; ``n_vertices`` 0 or >= 3; finite
     positions; ``contact_count`` within the slots; in occupied slots: ids in range and
     ``i < j`` for particle pairs, each pair at most once per snapshot, kind 1 or 2, finite
-    forces, points and branches, unit normals; a box of positive size; every variable's
-    ``units`` those of the contract. On a dask-backed dataset the value checks are computed
+    forces, normal forces >= 0 (the first negative one named by snapshot, slot and bodies),
+    finite points and branches, unit normals; a box of positive size; ``time`` (and ``step``,
+    where the file has it) increasing strictly, so no snapshot is repeated; every variable's
+    ``units`` those of the contract. A file holding none of the contract's variables gets one
+    problem, that it is not a grainview file. On a dask-backed dataset the value checks are computed
     in one pass over the chunks.
 
     Parameters
@@ -146,15 +178,16 @@ def validate(ds: xr.Dataset, source: str | None = None) -> xr.Dataset:
     check_structure(ds, source)  # values cannot be checked reliably on a malformed structure
     problems = _unit_problems(ds)
     checks = _value_checks(ds)
-    values = list(checks.values())
+    per_snapshot = _per_snapshot(ds)
+    values = list(checks.values()) + list(per_snapshot.values())
     if any(dask.is_dask_collection(v) for v in values):
-        (counts,) = dask.compute(values)  # one pass over the chunks
-    else:
-        counts = [v.values for v in values]
-    for message, value in zip(checks, counts):
-        value = int(np.asarray(value))
+        (values,) = dask.compute(values)  # one pass over the chunks
+    values = [np.asarray(getattr(v, "values", v)) for v in values]
+    for message, value in zip(checks, values):
+        value = int(value)
         if value:
             problems.append(message.format(value))
+    problems += _per_snapshot_problems(ds, dict(zip(per_snapshot, values[len(checks):])))
     if problems:
         raise SchemaError(problems, source)
     return ds

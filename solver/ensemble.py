@@ -57,7 +57,7 @@ class RunSpec:
     wall speed in m s-1, steps between snapshots). ``solver``: further :class:`solver.Parameters`
     as sorted (name, value) pairs. ``None`` keeps the preparation's default."""
 
-    shape: str = "pentagon"
+    shape: str | int = "pentagon"  # a name of solver.shapes.SHAPES or a number of vertices
     particles: int = 400
     seed: int = 0
     friction: float | None = None
@@ -72,7 +72,7 @@ class RunSpec:
     @property
     def name(self) -> str:
         """File stem naming the run by its parameters, e.g. ``pentagon_n400_mu0.4_s2``."""
-        parts = [self.shape, f"n{self.particles}"]
+        parts = [str(self.shape), f"n{self.particles}"]
         if self.preparation != "paper":
             parts.append(self.preparation)
         if self.friction is not None:
@@ -99,7 +99,9 @@ class RunSpec:
             parameters = Parameters(**dict(self.solver)).validate()
         except TypeError as exc:
             raise ParameterError(f"solver={self.solver!r}: {exc}; expected fields of solver.Parameters") from None
-        self.sample().check_time_step(parameters.time_step, self.velocity)  # and the preparation's own checks
+        sample = self.sample()  # the preparation's own checks
+        sample.check_time_step(parameters.time_step, self.velocity)
+        sample.check_test_speed(parameters.time_step, self.velocity, self.strain)
         return self
 
     def sample(self):

@@ -34,6 +34,14 @@ from grainview.errors import ParameterError
 
 from .shapes import n_vertices_of
 
+MAX_SEED = 2**31 - 1
+"""Largest seed: files store the seed as a 32-bit integer attribute (netCDF-3 has no wider one)."""
+MIN_TEST_STEPS = 10
+"""Fewest time steps a biaxial test may take to reach its strain (a test of fewer is no test)."""
+MAX_STEP_INDEX = 2**31 - 1
+"""Largest step index a file's ``step`` variable (a 32-bit integer) holds: the compaction's steps
+and the test's together."""
+
 
 @dataclass(frozen=True)
 class Preparation:
@@ -41,7 +49,7 @@ class Preparation:
     where the paper is silent, this project's historical default."""
 
     particles: int = 400
-    shape: str = "pentagon"
+    shape: str | int = "pentagon"  # a name of solver.shapes.SHAPES or a number of vertices
     seed: int = 0
     aspect: float = 2.0
     sigma0: float = 1e4  # Pa
@@ -55,7 +63,8 @@ class Preparation:
     def validate(self):
         checks = [
             ("particles", isinstance(self.particles, (int, np.integer)) and self.particles >= 2, "an integer >= 2"),
-            ("seed", isinstance(self.seed, (int, np.integer)) and self.seed >= 0, "an integer >= 0"),
+            ("seed", isinstance(self.seed, (int, np.integer)) and 0 <= self.seed <= MAX_SEED,
+             f"an integer in 0 .. {MAX_SEED} (files store it as a 32-bit integer)"),
             ("aspect", np.isfinite(self.aspect) and 0.2 <= self.aspect <= 20, "h/l in [0.2, 20]"),
             ("sigma0", np.isfinite(self.sigma0) and self.sigma0 > 0, "a positive stress in Pa"),
             ("friction", np.isfinite(self.friction) and 0 <= self.friction <= 10, "in [0, 10]"),
@@ -88,6 +97,45 @@ class Preparation:
         check_time_step(time_step, self.max_wall_speed, smallest, "a closing wall of the compaction")
         if test_velocity is not None:
             check_time_step(time_step, test_velocity, smallest, "the top wall of the test")
+        return self
+
+    def test_steps(self, time_step, velocity, strain) -> float:
+        """About how many time steps the biaxial test takes to reach ``strain``: the top wall,
+        at ``velocity`` (m s-1), travels h (e^strain - 1) at ``time_step`` (s) per step, where
+        h is the deposit's height, aspect x :func:`solver.packing.box_width_for` (m): the
+        compacted sample is lower, so its test takes somewhat fewer steps."""
+        with np.errstate(over="ignore", divide="ignore"):
+            return float(self.deposit_height() * np.expm1(strain) / (float(velocity) * float(time_step)))
+
+    def deposit_height(self) -> float:
+        """The deposit's height in m: aspect x :func:`solver.packing.box_width_for`."""
+        from .packing import box_width_for
+
+        return self.aspect * box_width_for(self.particles, aspect_ratio=self.aspect)
+
+    def check_test_speed(self, time_step, velocity, strain):
+        """Refuse, before any work, a top-wall speed of the biaxial test that is not finite and
+        positive, with which the test would reach ``strain`` in fewer than
+        :data:`MIN_TEST_STEPS` steps, or would take more steps than a file's step counter
+        holds (:data:`MAX_STEP_INDEX`, less the compaction's :attr:`max_steps`); the count is
+        :meth:`test_steps`. Raises :class:`ParameterError` naming the speeds allowed (m s-1)."""
+        velocity = float(velocity)
+        if not (np.isfinite(velocity) and velocity > 0):
+            raise ParameterError(f"velocity={velocity:g}: expected a finite wall speed > 0 in m/s")
+        steps = self.test_steps(time_step, velocity, strain)
+        at_unit_speed = self.test_steps(time_step, 1.0, strain)  # steps x velocity
+        most = MAX_STEP_INDEX - self.max_steps
+        if steps < MIN_TEST_STEPS:
+            raise ParameterError(
+                f"velocity={velocity:g}: the test would reach eps_1 = {strain:g} in about {steps:.2g} steps of "
+                f"{time_step:g} s ({self.particles} particles deposited about {self.deposit_height():.2g} m high); "
+                f"expected at most {at_unit_speed / MIN_TEST_STEPS:.3g} m/s, for at least "
+                f"{MIN_TEST_STEPS} steps")
+        if steps > most:
+            raise ParameterError(
+                f"velocity={velocity:g}: the test would take about {steps:.3g} steps of {time_step:g} s to reach "
+                f"eps_1 = {strain:g}, more than a file's 32-bit step counter leaves for the test ({most} after the "
+                f"compaction's {self.max_steps}); expected at least {at_unit_speed / most:.3g} m/s")
         return self
 
     def attrs(self) -> dict:

@@ -238,7 +238,8 @@ def test_info_reads_the_file_without_xarray_and_says_what_the_accessors_say(tmp_
         expected = describe(opened)
         q_over_p = opened.grain.stress_invariants()["q_over_p"].values
     lines, attrs = describe_file(path)
-    assert lines == expected and attrs["sigma0_Pa"] == 1e4
+    assert lines[:-1] == expected and attrs["sigma0_Pa"] == 1e4
+    assert lines[-1].startswith("file: ") and f"({path.stat().st_size:,} bytes)" in lines[-1]  # info's own line
     assert f"last {q_over_p[-1]:.3f}" in lines[2] and q_over_p[-1] > 0.1
     assert "sigma0 10 kPa" in lines[3] and "time step 0.5 ms" in lines[4]
 

@@ -105,6 +105,27 @@ def test_ensemble_refuses_to_replace_its_report_before_any_run(tmp_path, monkeyp
     assert (report / "headline.csv").read_text() == "mine"
 
 
+def test_ensemble_replaces_its_report_when_asked_and_keeps_the_runs(tmp_path, monkeypatch, capsys):
+    import solver.ensemble
+
+    paths = _seeds(tmp_path)
+    report = tmp_path / "ens" / "report"
+    report.mkdir(parents=True)
+    (report / "headline.csv").write_text("mine")
+    calls = []
+
+    def finished(specs, folder, **kwargs):  # every run already finished: nothing redone
+        calls.append(kwargs["overwrite"])
+        return [{"path": str(p)} for p in paths]
+    monkeypatch.setattr(solver.ensemble, "run_ensemble", finished)
+    argv = ["ensemble", "--out", str(tmp_path / "ens"), "--seeds", "2", "--progress", "off", "--residual-strain", "0"]
+    assert main([*argv, "--overwrite-report"]) == 0
+    assert calls == [False]  # the runs' files are kept
+    stats = pd.read_csv(report / "headline.csv", header=[0, 1], index_col=0)
+    assert stats.loc["q/p (residual)", ("pentagon", "n")] == 2
+    assert "(2 seeds)" in capsys.readouterr().out
+
+
 # 16. CSV export and headline.csv -------------------------------------------------------
 
 def test_csv_export_flags_the_pairs_without_force_and_names_kinds_and_units(tmp_path):

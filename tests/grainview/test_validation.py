@@ -2,6 +2,7 @@
 
 import numpy as np
 import pytest
+import xarray as xr
 
 import grainview
 from grainview.errors import SchemaError
@@ -108,3 +109,46 @@ def test_wrong_units_are_reported_missing_ones_are_taken_as_the_contracts():
     ds["kind"].attrs["units"] = ""  # another spelling of dimensionless
     del ds["position"].attrs["units"]  # as after an edit that dropped the attributes
     grainview.validate(ds)
+
+
+def _four_snapshots(time=(0.0, 0.5, 1.0, 1.5), step=None):
+    """square_lattice's one snapshot repeated four times at ``time`` (and ``step``)."""
+    ds = builders.square_lattice()
+    ds = xr.concat([ds.isel(time=[0])] * 4, "time", data_vars="minimal").assign_coords(time=list(time))
+    ds["contact_count"] = ds.contact_count.astype("i4")
+    if step is not None:
+        ds["step"] = ("time", np.asarray(step, "i4"))
+    return ds
+
+
+@pytest.mark.parametrize("chunked", [False, True])
+def test_time_must_increase_strictly(chunked):
+    def problems(**kw):
+        ds = _four_snapshots(**kw)
+        return _problems(ds.chunk(time=1) if chunked else ds)
+
+    grainview.validate(_four_snapshots(step=[0, 10, 20, 30]))
+    found = problems(time=(0.0, 0.5, 0.5, 1.5))
+    assert found == ["time: 1 snapshot(s) repeating the previous snapshot's time (first: snapshot 2, time = 0.5 s); "
+                     "expected time to increase strictly (each snapshot written once)"]
+    found = problems(time=(0.0, 1.0, 0.5, 0.2))
+    assert found == ["time: 2 snapshot(s) earlier than the previous snapshot (first: snapshot 2, time = 0.5 s after "
+                     "1 s); expected time to increase strictly"]
+    # the same snapshot written twice: same step, same time
+    found = problems(time=(0.0, 0.5, 0.5, 1.5), step=[0, 10, 10, 30])
+    assert len(found) == 2 and found[1].startswith("step: 1 snapshot(s) repeating the previous snapshot's step "
+                                                   "(first: snapshot 2, step = 10)")
+
+
+@pytest.mark.parametrize("chunked", [False, True])
+def test_a_negative_normal_force_is_refused_with_its_contact_and_snapshot(chunked):
+    ds = _four_snapshots()
+    fn = ds["fn"].values.copy()
+    fn[2, 5], fn[3, 1] = -50.0, -1e-3
+    ds["fn"] = (ds.fn.dims, fn)
+    i, j = int(ds.i[2, 5]), int(ds.j[2, 5])
+    found = _problems(ds.chunk(time=1) if chunked else ds)
+    assert found == [f"fn: 2 negative normal force(s) in occupied slots (first: snapshot 2, slot 5, bodies {i} and "
+                     f"{j}, fn = -50 N); expected fn >= 0 (compression positive)"]
+    fn[2, 5], fn[3, 1] = 0.0, 0.0  # zero: a pair in contact that carries no force
+    grainview.validate(ds.assign(fn=(ds.fn.dims, fn)))

@@ -1,0 +1,152 @@
+"""Checks of the contract on plain numpy arrays, shared by :func:`grainview.validation.validate`
+(xarray, lazily) and ``grainview info`` (netCDF4 alone), so that both say the same words.
+
+Each function returns the problems it finds as lines (empty when there are none), or raises
+:class:`~grainview.errors.FileFormatError` for a damaged file. numpy only: ``grainview info``
+imports this module without xarray.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .errors import FileFormatError
+from .schema import REQUIRED
+
+NOT_A_GRAINVIEW_FILE = ("not a grainview file: none of the contract's particle or contact variables "
+                        "(radius, position, i, j, fn...; docs/schema.md)")
+"""The one problem reported for a file that holds none of the contract's required variables."""
+
+NON_FINITE_FORCES = "{name}: {count} NaN or infinite force(s) in occupied slots"
+"""Template of the problem of non-finite ``fn`` or ``ft`` in occupied slots."""
+
+COUNT_OUT_OF_RANGE = "contact_count: {count} snapshot(s) with a count outside [0, {slots}]"
+"""Template of the problem of ``contact_count`` values outside the contact slots."""
+
+HIDDEN_RECORDS_TOLERATED = 1
+"""Whole records beyond a netCDF-3 header's record count that a killed writer may leave (the
+record it was writing, its bytes on disk before the header's count was raised); more are a
+damaged header."""
+
+
+def foreign_file_problems(names) -> list[str]:
+    """``[NOT_A_GRAINVIEW_FILE]`` when none of the contract's required variables is among
+    ``names`` (the file is of another kind: listing each missing variable would say nothing
+    useful), else ``[]``."""
+    return [] if any(name in names for name in REQUIRED) else [NOT_A_GRAINVIEW_FILE]
+
+
+def damaged_snapshots(complete, source) -> int:
+    """The number of leading complete snapshots of a file; raise :class:`FileFormatError` when
+    an incomplete snapshot (``complete`` False: no time, or its flag unset) comes before a
+    complete one. Only the last snapshot may be incomplete (a writer killed while writing
+    it); one inside the file means the file is damaged.
+
+    Parameters
+    ----------
+    complete : array_like of bool, (T,)
+        :func:`grainview.schema.complete_snapshots` of the file.
+    source : str
+        The file's name, for the message.
+    """
+    complete = np.asarray(complete, bool)
+    leading = int(np.argmin(complete)) if not complete.all() else complete.size
+    if complete[leading:].any():
+        raise FileFormatError(f"{source}: snapshot {leading} is incomplete but later ones are complete; "
+                              "the file is damaged")
+    return leading
+
+
+def order_problems(name, values, unit="") -> list[str]:
+    """``time`` (or ``step``) must increase strictly from snapshot to snapshot: the snapshots
+    that repeat the previous one's value (a snapshot written twice) and those below it.
+
+    Parameters
+    ----------
+    name : str
+        The variable's name, for the messages.
+    values : array_like, (T,)
+        Its value per snapshot (NaN entries are not compared).
+    unit : str
+        Its unit, for the messages (``" s"`` for time).
+
+    Returns
+    -------
+    list of str
+        At most two lines: repeated values, and values below the previous one, each with the
+        first snapshot concerned.
+    """
+    values = np.asarray(values)
+    if values.size < 2:
+        return []
+    step = np.diff(values)
+    problems = []
+    repeated = np.flatnonzero(step == 0) + 1
+    if repeated.size:
+        k = repeated[0]
+        problems.append(f"{name}: {repeated.size} snapshot(s) repeating the previous snapshot's {name} (first: "
+                        f"snapshot {k}, {name} = {values[k]:g}{unit}); expected {name} to increase strictly "
+                        "(each snapshot written once)")
+    earlier = np.flatnonzero(step < 0) + 1
+    if earlier.size:
+        k = earlier[0]
+        problems.append(f"{name}: {earlier.size} snapshot(s) earlier than the previous snapshot (first: snapshot "
+                        f"{k}, {name} = {values[k]:g}{unit} after {values[k - 1]:g}{unit}); expected {name} to "
+                        "increase strictly")
+    return problems
+
+
+def negative_force_problem(count, snapshot, slot, i, j, fn) -> str:
+    """The line naming ``count`` negative normal forces and the first of them: snapshot, slot,
+    the two bodies and the force in N. Normal forces are compressive, ``fn >= 0`` (0: a pair
+    in contact or near that carries no force)."""
+    return (f"fn: {count} negative normal force(s) in occupied slots (first: snapshot {snapshot}, slot {slot}, "
+            f"bodies {i} and {j}, fn = {fn:g} N); expected fn >= 0 (compression positive)")
+
+
+def force_problems(fn, ft, i, j, occupied) -> list[str]:
+    """Non-finite ``fn``/``ft`` and negative ``fn`` in the occupied slots of (T, C) arrays.
+
+    Returns
+    -------
+    list of str
+        The lines :func:`grainview.validation.validate` gives for the same faults.
+    """
+    fn, ft, occupied = np.asarray(fn), np.asarray(ft), np.asarray(occupied, bool)
+    problems = []
+    for name, force in (("fn", fn), ("ft", ft)):
+        count = int((occupied & ~np.isfinite(force)).sum())
+        if count:
+            problems.append(NON_FINITE_FORCES.format(name=name, count=count))
+    with np.errstate(invalid="ignore"):
+        negative = occupied & (fn < 0)
+    if negative.any():
+        k, slot = np.argwhere(negative)[0]
+        problems.append(negative_force_problem(int(negative.sum()), k, slot, int(np.asarray(i)[k, slot]),
+                                               int(np.asarray(j)[k, slot]), float(fn[k, slot])))
+    return problems
+
+
+def hidden_records(source, size, header, fixed, record, n_records) -> None:
+    """Raise :class:`FileFormatError` when a netCDF-3 file's size holds more whole records
+    than its header counts, beyond the :data:`HIDDEN_RECORDS_TOLERATED` one that a killed
+    writer may leave: a lowered record count hides snapshots from every reader.
+
+    Parameters
+    ----------
+    source : str
+        The file's name, for the message.
+    size : int
+        The file's size in bytes.
+    header, fixed, record : int
+        Bytes of the header, of the fixed-size variables and of one record.
+    n_records : int
+        The record count in the header.
+    """
+    if record <= 0:
+        return
+    held = n_records + max(0, (size - header - fixed - n_records * record) // record)
+    if held - n_records > HIDDEN_RECORDS_TOLERATED:
+        raise FileFormatError(f"{source}: its header counts {n_records} snapshots but its size holds {held}: the "
+                              f"header's record count hides {held - n_records} snapshots (the file is damaged)")
+
