@@ -14,58 +14,59 @@ import xarray as xr
 from ..strain import RESIDUAL_STRAIN
 
 DESCRIPTIONS = {
-    "02": "The packing at the end of the isotropic compaction (the first snapshot), particles to scale in the box.",
+    "02": "The packing at the end of the isotropic compaction (the first snapshot), particles to scale in the box",
     "03": "Shear stress ratio q/p = (sigma_1 - sigma_2)/(sigma_1 + sigma_2) against the cumulative shear strain "
-          "eps_q.",
-    "04": "Cumulative volumetric strain eps_p (dilation positive) against eps_q.",
+          "eps_q",
+    "04": "Cumulative volumetric strain eps_p (dilation positive) against eps_q",
     "05": "Stress-dilatancy diagram: dilatancy angle psi (sin psi = eps_p/eps_q) against friction angle phi "
           "(sin phi = q/p), one point per snapshot with eps_q >= 0.02; dotted: guides of slope 1 through phi_0, "
-          "the median of phi - psi (not fits).",
+          "the median of phi - psi (not fits)",
     "06a": "Coordination number z of the force-bearing network (rattlers left out, a double contact counted once) "
-           "against eps_q.",
+           "against eps_q",
     "06b": "Share gamma of the first snapshot's force-bearing contacts present at each snapshot (not necessarily "
-           "without interruption) against eps_q.",
+           "without interruption) against eps_q",
     "07": "P(c): share of the particles (rattlers left out) with exactly c force-bearing contacts, averaged over "
-          "the residual state.",
+          "the residual state",
     "08": "P(theta): probability density of the directions theta of the contact normals (rad^-1), contacts pooled "
-          "over the residual state; polar plot over the full turn.",
-    "09": "Fabric anisotropy a' (signed: > 0 along the major principal stress) against eps_q.",
+          "over the residual state; polar plot over the full turn",
+    "09": "Fabric anisotropy a' (signed: > 0 along the major principal stress) against eps_q",
     "10": "Mean normal force <f_n>(theta) (a) and mean tangential force <f_t>(theta) with its sign (b) of the "
           "contacts of direction theta, both divided by the mean normal force <f_n>, residual state; both panels "
-          "on one y scale (the paper draws polar plots).",
-    "11": "Force anisotropies a_n (a) and a_t (b), signed against the major principal stress, against eps_q.",
+          "on one y scale (the paper draws polar plots)",
+    "11": "Force anisotropies a_n (a) and a_t (b), signed against the major principal stress, against eps_q",
     "12": "q/p (wide pale band) and its harmonic predictions (a' + a_n + a_t)/2 (dashed) and "
           "(a' + a_n + a_t)/(2 + a' a_n) (thin solid) against eps_q; the legend gives each curve's mean over the "
-          "residual state.",
+          "residual state",
     "13": "Normal-force network of one snapshot: each force-bearing contact between particles a segment joining "
-          "their centres, of width proportional to f_n (forces per m of thickness).",
+          "their centres, of width proportional to f_n (forces per m of thickness)",
     "14": "Probability density P of the normal forces f_n/<f_n>, contacts pooled over the residual state: (a) "
           "log-linear, with an exponential fit of the strong forces (f_n > <f_n>), (b) log-log; bars: counting "
-          "errors.",
+          "errors",
     "15": "Shear stress q(xi)/p carried by the contacts with f_n < xi <f_n>, against the cutoff xi, residual "
-          "state (dotted: xi = 1, the mean force).",
+          "state (dotted: xi = 1, the mean force)",
     "16": "Fabric anisotropy a'(xi) of the contacts with f_n < xi <f_n>, against the cutoff xi, residual state: "
-          "(a) every cutoff, (b) the weak forces on a logarithmic axis (the paper's inset).",
+          "(a) every cutoff, (b) the weak forces on a logarithmic axis (the paper's inset)",
     "17": "Force classes of one snapshot: very weak, weak and strong contacts between particles (thresholds in "
-          "the legend).",
+          "the legend)",
     "18": "Shear stress of the simple contacts (q_s/p), of the double contacts (q_d/p) and of all contacts (q/p) "
-          "against eps_q, each divided by the p of the whole sample.",
+          "against eps_q, each divided by the p of the whole sample",
     "19": "Shares of simple and double contacts, k_s and k_d (solid), and their shares of the normal force, "
-          "f_s and f_d (dashed), against eps_q.",
+          "f_s and f_d (dashed), against eps_q",
     "20": "Cumulative shares Delta gamma of the contacts that turned from simple to double (s->d) and from double "
-          "to simple (d->s) between successive snapshots, against eps_q.",
+          "to simple (d->s) between successive snapshots, against eps_q",
     "21": "P(m_s, m_d): share of the particles (rattlers left out) with m_s simple and m_d double contacts, "
-          "averaged over the residual state.",
+          "averaged over the residual state",
     "22": "Fabric anisotropies a'_s and a'_d of the simple and double contacts (partial fabric tensors normalised "
-          "by the number of all contacts) against eps_q.",
+          "by the number of all contacts) against eps_q",
     "23": "Probability density of f_n/<f_n> for the simple and for the double contacts, each normalised over its "
-          "own kind, <f_n> the mean over all contacts, residual state: (a) log-linear, (b) log-log.",
+          "own kind, <f_n> the mean over all contacts, residual state: (a) log-linear, (b) log-log",
     "24": "Normal-force network of one snapshot by contact kind, simple and double, of width proportional to f_n "
-          "(forces per m of thickness).",
+          "(forces per m of thickness)",
     "25": "Shares of all contacts that are strong, f_n > <f_n> (a), and weak, f_n <= <f_n> (b), for the simple "
-          "(k_s) and the double (k_d) contacts, against eps_q.",
+          "(k_s) and the double (k_d) contacts, against eps_q",
 }
-"""Paper figure number -> what the report's figure plots, the first line of its caption."""
+"""Paper figure number -> what the report's figure plots, the first line of its caption (no
+final full stop: the report's index joins a caption's lines with semicolons)."""
 
 
 def describe_figure(number: str) -> str:
@@ -142,7 +143,7 @@ def sampling_note(label: str, ds: xr.Dataset, residual_strain: float = RESIDUAL_
     worth = distinct / per_snapshot if per_snapshot > 0 else float("nan")
     return (f"{label}: the {res.sizes['time']} snapshots pooled hold only {distinct} different contacts "
             f"({worth:.1f} times the {per_snapshot:.0f} of one): contacts last over many snapshots, so the spikes "
-            "of P(theta) are a few long-lived contacts counted in every snapshot, not a texture of the packing.")
+            "of P(theta) are a few long-lived contacts counted in every snapshot, not a texture of the packing")
 
 
 def interval_note(label: str, ds: xr.Dataset) -> str:
@@ -173,7 +174,7 @@ def interval_note(label: str, ds: xr.Dataset) -> str:
     steps = f" ({int(every)} time steps)" if every is not None else ""
     return (f"{label}: snapshots every {dt:.3g} s{steps}, d eps_q = {d_eps:.2g}; Delta gamma counts the changes "
             "seen from one snapshot to the next, so a change and its reversal within one interval are not "
-            "counted and Delta gamma depends on the interval.")
+            "counted and Delta gamma depends on the interval")
 
 
 __all__ = ["DESCRIPTIONS", "describe_figure", "pooled_contacts", "sampling_note", "interval_note"]

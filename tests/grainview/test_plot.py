@@ -337,7 +337,7 @@ def test_force_chain_widths_are_proportional_to_fn():
     np.testing.assert_allclose(segments[-1], [pos[0], pos[0] + [0.0, -R]])
 
 
-def test_kind_map_colours_simple_blue_and_double_red():
+def test_kind_map_colours_simple_and_double_as_every_figure_does():
     ds = pentagon_grid()
     ax = gp.plot_contact_kinds(ds)
     lines = contact_collection(ax)
