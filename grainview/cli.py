@@ -66,6 +66,15 @@ def _export(args) -> int:
     return 0
 
 
+def _convert_peer(args) -> int:
+    from .formats.peers import convert_peer
+
+    count = convert_peer(args.out, args.raw, args.sample, engine=args.format, overwrite=args.overwrite,
+                         compress=not args.no_compress)
+    print(f"wrote {args.out}: {count} snapshots from {args.format} (check it: grainview info {args.out} --check)")
+    return 0
+
+
 def _convert(args) -> int:
     from .formats.lammps import convert_lammps
 
@@ -686,6 +695,17 @@ def build_parser() -> argparse.ArgumentParser:
     lammps.add_argument("--progress", choices=("on", "off"), default="on", help="progress bar (default: on)")
     no_compress_option(lammps)
     lammps.set_defaults(func=_convert)
+    for engine, version in (("box2d", "Box2D 2.3"), ("pymunk", "pymunk")):
+        peer = formats.add_parser(engine, help=f"a {version} run of the cross-check (raw snapshots)",
+                                  description=f"A {version} run of the cross-check harness (benchmarks/crosscheck/): "
+                                  "the engine's folder of raw snapshots (snap_*.npz, meta.json) and the sample it "
+                                  "started from (docs/formats.md).")
+        peer.add_argument("raw", help="the engine's folder of raw snapshots")
+        peer.add_argument("--sample", required=True, help="the cross-check sample's .npz the engine started from")
+        peer.add_argument("--out", required=True, help="the netCDF file to write")
+        peer.add_argument("--overwrite", action="store_true", help="replace an existing --out")
+        no_compress_option(peer)
+        peer.set_defaults(func=_convert_peer)
     return parser
 
 

@@ -5,7 +5,8 @@ of a compacted sample (``grainview run isotropic ...``) as the plain arrays the 
 read; :func:`raw_to_contract` turns a peer's raw snapshots (``peer_common.py``) into a netCDF
 file of the grainview data contract (``docs/schema.md``).
 
-Contract conventions applied here, once for both engines:
+The contract's conventions for the peers' contacts are applied by grainview's peer reader
+(:mod:`grainview.formats.peers`, which this module calls); in short:
 
 * one entry per body pair; ``i < j`` for particle pairs; for a wall contact ``i`` is the
   particle and ``j = N + w`` (walls bottom, right, top, left), which ``i = min, j = max``
@@ -33,18 +34,10 @@ narrow phase: one metric for every engine).
 
 from __future__ import annotations
 
-import glob
-import json
-import os
-
 import numpy as np
 
 from grainview.errors import GrainviewError
-
-WALLS = ("bottom", "right", "top", "left")
-WALL_NORMALS = np.array([[0.0, 1.0], [-1.0, 0.0], [0.0, -1.0], [1.0, 0.0]])
-OPTIONAL = ("velocity", "angular_velocity", "wall_position", "wall_velocity", "wall_force", "normal_impulse", "step",
-            "max_interpenetration")
+from grainview.formats.peers import WALL_NORMALS, WALLS
 
 
 def sample_to_npz(nc_path, npz_path):
@@ -92,46 +85,6 @@ def sample_to_npz(nc_path, npz_path):
     return out
 
 
-def contract_contacts(raw, position, dt):
-    """The contract's contact arrays (dict) from one raw snapshot's pair arrays (module doc),
-    with ``normal_impulse`` (M, 2) = the points' normal forces times the time step ``dt`` (s)."""
-    a, b = raw["a"].astype(np.int64), raw["b"].astype(np.int64)
-    n = len(position)
-    swap = a > b
-    i, j = np.where(swap, b, a), np.where(swap, a, b)
-    sign = np.where(swap, -1.0, 1.0)[:, None]
-    normal = raw["normal"] * sign
-    force = raw["force"] * sign  # exerted by i on j
-    normal = normal / np.linalg.norm(normal, axis=1, keepdims=True)
-    tangent = np.stack([-normal[:, 1], normal[:, 0]], -1)
-    fn = np.sum(force * normal, axis=1)
-    ft = np.sum(force * tangent, axis=1)
-    present = np.arange(2)[None, :] < raw["n_points"][:, None]
-    weights = np.where(present, np.maximum(raw["point_fn"], 0.0), 0.0)
-    weights = np.where((weights.sum(1) > 0)[:, None], weights, present.astype(float))
-    points = np.where(present[..., None], raw["points"], 0.0)
-    point = np.sum(points * weights[..., None], axis=1) / np.sum(weights, axis=1)[:, None]
-    centre_i = position[i]
-    branch = np.where((j >= n)[:, None], point - centre_i, position[np.minimum(j, n - 1)] - centre_i)
-    kind = np.where(raw["n_points"] == 2, 2, 1).astype(np.int8)
-    keep = fn > 0
-    order = np.lexsort((j[keep], i[keep]))
-    contacts = dict(i=i, j=j, kind=kind, normal=normal, fn=fn, ft=ft, point=point, branch=branch,
-                    normal_impulse=np.where(present, raw["point_fn"], 0.0) * dt)
-    return {name: value[keep][order] for name, value in contacts.items()}
-
-
-def wall_forces(contacts, n):
-    """(4, 2) total force (N) exerted by the particles on each wall."""
-    out = np.zeros((4, 2))
-    wall = contacts["j"] >= n
-    normal = contacts["normal"][wall]
-    force = (contacts["fn"][wall, None] * normal
-             + contacts["ft"][wall, None] * np.stack([-normal[:, 1], normal[:, 0]], -1))
-    np.add.at(out, contacts["j"][wall] - n, force)
-    return out
-
-
 def largest_overlap(snap, radius, n_vertices):
     """Largest interpenetration (m) of a snapshot's configuration, by this project's narrow
     phase (particle pairs within 2 % of the smallest diameter, and the walls)."""
@@ -150,41 +103,17 @@ def largest_overlap(snap, radius, n_vertices):
 
 def raw_to_contract(raw_dir, sample_npz, out_path, attrs=None):
     """Write the raw snapshots of ``raw_dir`` (a peer's output) as the contract file
-    ``out_path`` (replaced if it exists); ``attrs`` go to the global attributes with the
-    engine's ``meta.json``. Returns the number of snapshots."""
-    from grainview.writer import SnapshotWriter
+    ``out_path`` (replaced if it exists) with grainview's peer reader
+    (:func:`grainview.formats.peers.convert_peer`, which applies the conventions above), adding
+    the biaxial test's settings to the global attributes and each snapshot's
+    ``max_interpenetration`` by this project's narrow phase. Returns the number of snapshots."""
+    from grainview.formats.peers import convert_peer
 
-    files = sorted(glob.glob(os.path.join(raw_dir, "snap_*.npz")))
-    if not files:
-        raise GrainviewError(f"{raw_dir}: no snapshots (did the engine run?)")
-    with open(os.path.join(raw_dir, "meta.json")) as fh:
-        meta = json.load(fh)
     with np.load(sample_npz) as data:
         sample = {k: data[k] for k in data.files}
     radius, n_vertices = sample["radius"], sample["n_vertices"]
-    n = len(radius)
-    run_attrs = {f"engine_{k}": v for k, v in meta.items()}
-    run_attrs.update({"scene": "biaxial", "sigma0_Pa": float(sample["sigma0"]), "strain_target": meta["strain"],
-                      "wall_velocity_m_s": meta["velocity"], "snapshot_every": meta["every"],
-                      "biaxial_steps": meta["n_steps"], "time_step_s": float(sample["time_step"]),
-                      "friction": float(sample["friction"]), "wall_friction": float(sample["wall_friction"])})
+    run_attrs = {"scene": "biaxial", "sigma0_Pa": float(sample["sigma0"]), "friction": float(sample["friction"]),
+                 "wall_friction": float(sample["wall_friction"])}
     run_attrs.update(attrs or {})
-    with SnapshotWriter.create(out_path, radius=radius, n_vertices=n_vertices, mass=sample["mass"],
-                               inertia=sample["inertia"], n_walls=4, wall_names=WALLS, wall_normal=WALL_NORMALS,
-                               optional=OPTIONAL, attrs=run_attrs, overwrite=True) as writer:
-        for path in files:
-            with np.load(path) as data:
-                snap = {k: data[k] for k in data.files}
-            contacts = contract_contacts(snap, snap["position"], float(sample["time_step"]))
-            normal_impulse = np.zeros((writer.n_slots, 2))
-            normal_impulse[:len(contacts["i"])] = contacts.pop("normal_impulse")
-            walls = snap["wall_position"]
-            box_min = np.array([walls[3, 0], walls[0, 1]])
-            box_max = np.array([walls[1, 0], walls[2, 1]])
-            writer.append(time=float(snap["time"]), position=snap["position"], angle=snap["angle"], contacts=contacts,
-                          box_min=box_min, box_max=box_max, velocity=snap["velocity"],
-                          angular_velocity=snap["angular_velocity"], wall_position=walls,
-                          wall_velocity=snap["wall_velocity"], wall_force=wall_forces(contacts, n),
-                          normal_impulse=normal_impulse,
-                          step=int(snap["step"]), max_interpenetration=largest_overlap(snap, radius, n_vertices))
-    return len(files)
+    return convert_peer(out_path, raw_dir, sample_npz, attrs=run_attrs, overwrite=True, compress=False,
+                        extra=lambda raw: {"max_interpenetration": largest_overlap(raw, radius, n_vertices)})

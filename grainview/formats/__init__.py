@@ -1,6 +1,6 @@
 """Other codes' files, read into datasets of the grainview contract (docs/formats.md).
 
-Each reader is usable three ways: as a function (``open_lammps``), through
+Each reader is usable three ways: as a function (``open_lammps``, ``open_box2d``...), through
 ``grainview.open_dataset(path, format="lammps", ...)`` and ``xr.open_dataset(path,
 engine="lammps", ...)``, and on the command line (``grainview convert lammps ...``).
 """
@@ -13,7 +13,8 @@ from ..errors import ParameterError
 
 __all__ = ["READERS", "open_format"]
 
-READERS = {"lammps": "grainview.formats.lammps:open_lammps"}
+READERS = {"lammps": "grainview.formats.lammps:open_lammps", "box2d": "grainview.formats.peers:open_box2d",
+           "pymunk": "grainview.formats.peers:open_pymunk"}
 """Format name -> the reader that opens it as an in-memory dataset of the contract."""
 
 

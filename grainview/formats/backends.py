@@ -9,7 +9,7 @@ from __future__ import annotations
 
 from xarray.backends import BackendEntrypoint
 
-__all__ = ["LammpsBackend"]
+__all__ = ["LammpsBackend", "Box2dBackend", "PymunkBackend"]
 
 
 class LammpsBackend(BackendEntrypoint):
@@ -39,3 +39,37 @@ class LammpsBackend(BackendEntrypoint):
 
     def guess_can_open(self, filename_or_obj) -> bool:
         return False
+
+
+class _PeerBackend(BackendEntrypoint):
+    """A run of the cross-check's peer engines (:func:`grainview.formats.peers.open_peer`):
+    ``xr.open_dataset(raw_folder, engine=..., sample="sample.npz")``."""
+
+    engine = ""
+    open_dataset_parameters = ("filename_or_obj", "drop_variables", "sample")
+
+    def open_dataset(self, filename_or_obj, *, drop_variables=None, sample=None):
+        from ..errors import ParameterError
+        from .peers import open_peer
+
+        if sample is None:
+            raise ParameterError(f"engine={self.engine!r} needs sample=<the cross-check sample's .npz>")
+        ds = open_peer(filename_or_obj, sample, self.engine)
+        return ds.drop_vars(list(drop_variables or []), errors="ignore")
+
+    def guess_can_open(self, filename_or_obj) -> bool:
+        return False
+
+
+class Box2dBackend(_PeerBackend):
+    """Box2D runs of the cross-check: a folder of raw snapshots and meta.json."""
+
+    engine = "box2d"
+    description = "Box2D runs of grainview's cross-check (raw snapshots) as a grainview dataset"
+
+
+class PymunkBackend(_PeerBackend):
+    """pymunk runs of the cross-check: a folder of raw snapshots and meta.json."""
+
+    engine = "pymunk"
+    description = "pymunk runs of grainview's cross-check (raw snapshots) as a grainview dataset"

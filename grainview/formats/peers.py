@@ -1,0 +1,252 @@
+"""Box2D and pymunk runs of the cross-check as datasets of the contract.
+
+The cross-check harness (``benchmarks/crosscheck/``) drives Box2D 2.3 and pymunk through the
+paper's biaxial test on a sample of this project and saves each engine's state as *raw
+snapshots*: a folder of ``snap_000000.npz``, ``snap_000001.npz``, ... and a ``meta.json`` (the
+engine, its version and settings, the protocol), beside the sample's own ``.npz`` (masses,
+radii, vertex counts, time step). Each raw snapshot holds, in SI units:
+
+* ``time`` (s), ``step``; ``position`` (N, 2), ``angle`` (N,), ``velocity`` (N, 2),
+  ``angular_velocity`` (N,); ``wall_position``, ``wall_velocity`` (4, 2) for the walls bottom,
+  right, top, left;
+* one row per touching body pair, in the engine's order: ``a``, ``b`` (particles 0..N-1,
+  walls N + w), ``normal`` (M, 2) the unit normal from a to b, ``force`` (M, 2) the resultant
+  force exerted by a on b (the pair's impulses of the last step over the time step),
+  ``n_points`` (M,) the points of the engine's contact manifold, ``points`` (M, 2, 2) their
+  positions (NaN when absent) and ``point_fn`` (M, 2) their normal forces.
+
+The contract's conventions applied, once for both engines:
+
+* one entry per body pair, ``i < j`` (for a wall contact ``i`` is the particle and
+  ``j = N + w``); ``normal`` from i to j (the engine's normal, reversed when the engine's first
+  body is j); ``fn``, ``ft`` the components along ``normal`` and ``t = (-n_y, n_x)`` of the
+  force exerted by i on j; only pairs with ``fn > 0`` are kept;
+* ``kind`` 2 (double) when the engine's manifold holds two points (Box2D ``pointCount == 2``,
+  pymunk ``len(contact_point_set.points) == 2``), else 1: a geometric criterion, as this
+  project's solver's edge-to-edge test, not whether both points carry force;
+* ``point``: the application point of the resultant, the manifold's points weighted by their
+  normal forces (by equal weights when none carries any);
+* ``branch``: ``x_j - x_i`` for particle pairs, ``point - x_i`` for wall contacts.
+
+Besides the required variables the file holds ``velocity``, ``angular_velocity``,
+``wall_position``, ``wall_velocity``, ``wall_force`` (the sum of the contact forces exerted by
+the particles on each wall), ``normal_impulse`` (N s: each manifold point's normal force times
+the time step, 0 for a simple contact's second point) and ``step``.
+"""
+
+from __future__ import annotations
+
+import glob
+import json
+import os
+
+import numpy as np
+
+from ..errors import FileFormatError, ParameterError
+
+__all__ = ["WALLS", "WALL_NORMALS", "peer_contacts", "wall_forces", "peer_snapshots", "open_peer", "open_box2d",
+           "open_pymunk", "convert_peer"]
+
+WALLS = ("bottom", "right", "top", "left")
+WALL_NORMALS = np.array([[0.0, 1.0], [-1.0, 0.0], [0.0, -1.0], [1.0, 0.0]])
+"""Inward unit normals of the cross-check's walls."""
+SNAPSHOT_KEYS = ("time", "step", "position", "angle", "velocity", "angular_velocity", "wall_position",
+                 "wall_velocity", "a", "b", "normal", "force", "n_points", "points", "point_fn")
+SAMPLE_KEYS = ("radius", "n_vertices", "mass", "inertia", "time_step")
+OPTIONAL = ("velocity", "angular_velocity", "wall_position", "wall_velocity", "wall_force", "normal_impulse", "step")
+
+
+def peer_contacts(raw, position, dt) -> dict:
+    """The contract's contact arrays of one raw snapshot's pair arrays (module docstring),
+    sorted by (i, j), with ``normal_impulse`` (M, 2) = the points' normal forces times the time
+    step ``dt`` (s)."""
+    a, b = raw["a"].astype(np.int64), raw["b"].astype(np.int64)
+    n = len(position)
+    swap = a > b
+    i, j = np.where(swap, b, a), np.where(swap, a, b)
+    sign = np.where(swap, -1.0, 1.0)[:, None]
+    normal = raw["normal"] * sign
+    force = raw["force"] * sign  # exerted by i on j
+    normal = normal / np.linalg.norm(normal, axis=1, keepdims=True)
+    tangent = np.stack([-normal[:, 1], normal[:, 0]], -1)
+    fn = np.sum(force * normal, axis=1)
+    ft = np.sum(force * tangent, axis=1)
+    present = np.arange(2)[None, :] < raw["n_points"][:, None]
+    weights = np.where(present, np.maximum(raw["point_fn"], 0.0), 0.0)
+    weights = np.where((weights.sum(1) > 0)[:, None], weights, present.astype(float))
+    points = np.where(present[..., None], raw["points"], 0.0)
+    point = np.sum(points * weights[..., None], axis=1) / np.sum(weights, axis=1)[:, None]
+    centre_i = position[i]
+    branch = np.where((j >= n)[:, None], point - centre_i, position[np.minimum(j, n - 1)] - centre_i)
+    kind = np.where(raw["n_points"] == 2, 2, 1).astype(np.int8)
+    keep = fn > 0
+    order = np.lexsort((j[keep], i[keep]))
+    contacts = dict(i=i, j=j, kind=kind, normal=normal, fn=fn, ft=ft, point=point, branch=branch,
+                    normal_impulse=np.where(present, raw["point_fn"], 0.0) * dt)
+    return {name: value[keep][order] for name, value in contacts.items()}
+
+
+def wall_forces(contacts, n) -> np.ndarray:
+    """(4, 2) total force (N) exerted by the particles on each wall, from contract contacts
+    of ``n`` particles."""
+    out = np.zeros((4, 2))
+    wall = contacts["j"] >= n
+    normal = contacts["normal"][wall]
+    force = (contacts["fn"][wall, None] * normal
+             + contacts["ft"][wall, None] * np.stack([-normal[:, 1], normal[:, 0]], -1))
+    np.add.at(out, contacts["j"][wall] - n, force)
+    return out
+
+
+def _load(path, keys, what):
+    try:
+        with np.load(path) as data:
+            missing = [k for k in keys if k not in data.files]
+            if missing:
+                raise FileFormatError(f"{path}: not {what}: it lacks {', '.join(missing)}")
+            return {k: data[k] for k in data.files}
+    except (OSError, ValueError) as exc:
+        raise FileFormatError(f"{path}: cannot be read as {what} ({exc})") from None
+
+
+def peer_snapshots(raw_dir, sample, engine=None):
+    """Read a peer engine's raw snapshots one at a time, as the contract's per-snapshot arrays.
+
+    Parameters
+    ----------
+    raw_dir : str or path-like
+        The engine's output folder (``snap_*.npz`` and ``meta.json``).
+    sample : str or path-like
+        The sample's ``.npz`` the engine started from (``radius``, ``n_vertices``, ``mass``,
+        ``inertia``, ``time_step``).
+    engine : {"box2d", "pymunk"}, optional
+        Refuse a folder written by another engine (``meta.json``'s ``engine``).
+
+    Returns
+    -------
+    (static, iterator)
+        ``static``: the particles' arrays, ``meta`` (the engine's settings) and ``attrs`` (global
+        attributes of the run); the iterator yields one dict per snapshot for
+        :meth:`grainview.writer.SnapshotWriter.append`, with ``raw`` (the raw arrays) besides.
+
+    Raises
+    ------
+    FileFormatError, ParameterError
+        One line: no snapshots, no or bad ``meta.json``, another engine's folder, a sample or
+        snapshot lacking arrays, a snapshot whose particle count differs from the sample's.
+    """
+    raw_dir = os.fspath(raw_dir)
+    files = sorted(glob.glob(os.path.join(raw_dir, "snap_*.npz")))
+    if not files:
+        raise FileFormatError(f"{raw_dir}: no raw snapshots (snap_*.npz): did the engine run?")
+    try:
+        with open(os.path.join(raw_dir, "meta.json")) as fh:
+            meta = json.load(fh)
+    except (OSError, ValueError) as exc:
+        raise FileFormatError(f"{raw_dir}: no readable meta.json ({exc})") from None
+    if engine is not None and meta.get("engine") != engine:
+        raise ParameterError(f"{raw_dir}: written by {meta.get('engine')!r}, not {engine!r}")
+    data = _load(sample, SAMPLE_KEYS, "a cross-check sample")
+    radius = np.asarray(data["radius"], float)
+    n = radius.size
+    dt = float(data["time_step"])
+    attrs = {f"engine_{k}": v for k, v in meta.items() if isinstance(v, (str, int, float))}
+    attrs.update({"source": str(meta.get("engine", "peer engine")), "time_step_s": dt})
+    for key in ("strain", "velocity", "every", "n_steps"):
+        if key in meta:
+            attrs[{"strain": "strain_target", "velocity": "wall_velocity_m_s", "every": "snapshot_every",
+                   "n_steps": "biaxial_steps"}[key]] = meta[key]
+    static = dict(radius=radius, n_vertices=np.asarray(data["n_vertices"], np.int32),
+                  mass=np.asarray(data["mass"], float), inertia=np.asarray(data["inertia"], float), meta=meta,
+                  attrs=attrs, files=files)
+
+    def snapshots():
+        for path in files:
+            raw = _load(path, SNAPSHOT_KEYS, "a raw snapshot of the cross-check")
+            if len(raw["position"]) != n:
+                raise FileFormatError(f"{path}: {len(raw['position'])} particles, the sample has {n}")
+            contacts = peer_contacts(raw, raw["position"], dt)
+            normal_impulse = contacts.pop("normal_impulse")
+            walls = raw["wall_position"]
+            yield dict(time=float(raw["time"]), position=raw["position"], angle=raw["angle"], contacts=contacts,
+                       box_min=np.array([walls[3, 0], walls[0, 1]]), box_max=np.array([walls[1, 0], walls[2, 1]]),
+                       velocity=raw["velocity"], angular_velocity=raw["angular_velocity"], wall_position=walls,
+                       wall_velocity=raw["wall_velocity"], wall_force=wall_forces(contacts, n),
+                       normal_impulse=normal_impulse, step=int(raw["step"]), raw=raw)
+
+    return static, snapshots()
+
+
+def open_peer(raw_dir, sample, engine=None):
+    """A peer engine's run (:func:`peer_snapshots`) as an in-memory dataset of the contract."""
+    from ..dataset import make_dataset
+
+    static, stream = peer_snapshots(raw_dir, sample, engine)
+    snaps = list(stream)
+    n = static["radius"].size
+    slots = max([3 * (n + 4) - 6] + [len(s["contacts"]["i"]) for s in snaps])
+    impulse = np.zeros((len(snaps), slots, 2))
+    for k, s in enumerate(snaps):
+        impulse[k, :len(s["normal_impulse"])] = s["normal_impulse"]
+    optional = {name: np.stack([s[name] for s in snaps]) for name in OPTIONAL if name != "normal_impulse"}
+    optional["normal_impulse"] = impulse
+    return make_dataset(radius=static["radius"], n_vertices=static["n_vertices"], mass=static["mass"],
+                        inertia=static["inertia"], position=np.stack([s["position"] for s in snaps]),
+                        angle=np.stack([s["angle"] for s in snaps]),
+                        contacts=[s["contacts"] for s in snaps], box_min=np.stack([s["box_min"] for s in snaps]),
+                        box_max=np.stack([s["box_max"] for s in snaps]), time=np.array([s["time"] for s in snaps]),
+                        n_walls=4, wall_names=WALLS, attrs=static["attrs"], n_contact_slots=slots,
+                        wall_normal=WALL_NORMALS, **optional)
+
+
+def open_box2d(raw_dir, sample):
+    """A Box2D run of the cross-check (:func:`open_peer` refusing another engine's folder)."""
+    return open_peer(raw_dir, sample, "box2d")
+
+
+def open_pymunk(raw_dir, sample):
+    """A pymunk run of the cross-check (:func:`open_peer` refusing another engine's folder)."""
+    return open_peer(raw_dir, sample, "pymunk")
+
+
+def convert_peer(out, raw_dir, sample, *, engine=None, attrs=None, extra=None, overwrite=False, compress=True) -> int:
+    """Write a peer engine's run as a file of the contract, snapshot by snapshot.
+
+    ``attrs``: more global attributes; ``extra``: a function of a snapshot's raw arrays
+    returning more optional variables for it (the harness adds ``max_interpenetration``,
+    measured by this project's narrow phase). Written under a hidden temporary name, then
+    compressed (unless ``compress=False``) and moved into place; an existing ``out`` is
+    refused unless ``overwrite``. Returns the number of snapshots.
+    """
+    from ..writer import SnapshotWriter, _move_into_place, compress_file
+
+    out = os.fspath(out)
+    if os.path.exists(out) and not overwrite:
+        raise FileExistsError(f"{out} exists; pass overwrite=True to replace it")
+    static, stream = peer_snapshots(raw_dir, sample, engine)
+    run_attrs = dict(static["attrs"], **(attrs or {}))
+    first = next(stream)
+    more = extra(first["raw"]) if extra is not None else {}
+    temporary = os.path.join(os.path.dirname(os.path.abspath(out)), f".{os.path.basename(out)}.{os.getpid()}.peer")
+    count = 0
+    try:
+        with SnapshotWriter.create(temporary, radius=static["radius"], n_vertices=static["n_vertices"],
+                                   mass=static["mass"], inertia=static["inertia"], n_walls=4, wall_names=WALLS,
+                                   wall_normal=WALL_NORMALS, optional=OPTIONAL + tuple(more), attrs=run_attrs) as w:
+            snap = first
+            while snap is not None:
+                raw = snap.pop("raw")
+                added = more if count == 0 else (extra(raw) if extra is not None else {})
+                points = snap.pop("normal_impulse")
+                impulse = np.zeros((w.n_slots, 2))
+                impulse[:len(points)] = points
+                w.append(normal_impulse=impulse, **snap, **added)
+                count += 1
+                snap = next(stream, None)
+        if compress:
+            compress_file(temporary)
+        _move_into_place(temporary, out, overwrite)
+    finally:
+        if os.path.exists(temporary):
+            os.remove(temporary)
+    return count
