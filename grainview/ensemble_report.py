@@ -86,19 +86,22 @@ def format_table(stats: pd.DataFrame, runs: pd.DataFrame | None = None,
         s = stats[group]
         if runs is not None:
             members = runs[runs["group"] == group]
-            total, short = len(members), int((~members[REACHED].astype(bool)).sum())
+            missed = members[~members[REACHED].astype(bool)]
+            total, short = len(members), len(missed)
         else:
             total = short = 0
 
         def cell(row):
-            residual = row.name not in INITIAL_ROWS
+            # a residual row: one the runs short of the window have no number of (not e.g. a whole-test row)
+            residual = (row.name not in INITIAL_ROWS and short > 0 and row.name in missed
+                        and bool(missed[row.name].isna().all()))
             if not np.isfinite(row["mean"]):
                 if residual and short and short == total:
                     return f"{NOT_REACHED} (0 of {total} seeds reach eps_q >= {residual_strain:g})"
                 return "-"
             spread = f" ± {row['std']:.3f}" if np.isfinite(row["std"]) else ""
-            missed = f"; {short} {NOT_REACHED}" if residual and short else ""
-            return f"{row['mean']:.3f}{spread} ({int(row['n'])} seed{'s' if row['n'] != 1 else ''}{missed})"
+            note = f"; {short} {NOT_REACHED}" if residual else ""
+            return f"{row['mean']:.3f}{spread} ({int(row['n'])} seed{'s' if row['n'] != 1 else ''}{note})"
 
         columns[f"{group} (mean ± std)"] = s.apply(cell, axis=1)
         paper = PAPER.get(paper_key(group))

@@ -70,7 +70,8 @@ def test_report_and_study_print_the_table_fitted_to_the_terminal(tmp_path, monke
     path = _write(harmonic_series(n_snapshots=2, n_contacts=20), tmp_path / "a.nc")
     assert main(["report", str(path), "--out", str(tmp_path / "r")]) == 0
     out = capsys.readouterr().out
-    assert max(map(len, out.splitlines())) <= 80
+    table = [line for line in out.splitlines() if not line.startswith("wrote ")]  # the path line is a path
+    assert len(table) > 5 and max(map(len, table)) <= 80
     assert "0.123" in out and "0.1234" not in out
 
 
@@ -87,6 +88,23 @@ def test_ensemble_report_says_not_reached_as_study_and_report_do(tmp_path, capsy
     # a run's initial values are still there
     runs = pd.read_csv(tmp_path / "r" / "runs.csv", index_col=0)
     assert runs["z (initial)"].notna().all() and runs["q/p (residual)"].isna().all()
+
+
+def test_ensemble_report_counts_the_seeds_short_of_the_window(tmp_path):
+    from grainview.ensemble import open_ensemble
+    from grainview.ensemble_report import ensemble_table, format_table
+
+    paths = _seeds(tmp_path)
+    with grainview.open_dataset(paths[1]) as ds:
+        short = ds.isel(time=slice(0, 2)).load()  # stops at eps_q ~0.07
+    _write(short, tmp_path / "short.nc")
+    ens = open_ensemble([paths[0], tmp_path / "short.nc"])
+    stats, runs = ensemble_table(ens, residual_strain=0.1)
+    text = format_table(stats, runs, residual_strain=0.1).iloc[:, 0]
+    q = runs["q/p (residual)"].dropna()
+    assert list(runs["residual window reached"]) == [True, False] and len(q) == 1
+    assert text["q/p (residual)"] == f"{q.iloc[0]:.3f} (1 seed; 1 not reached)"
+    assert text["z (initial)"].endswith("(2 seeds)")  # initial rows count both
 
 
 def test_ensemble_refuses_to_replace_its_report_before_any_run(tmp_path, monkeypatch, capsys):
