@@ -295,6 +295,15 @@ def test_warmup_compiles_the_kernels_and_says_where_the_cache_is(capsys, monkeyp
     assert capsys.readouterr().out == first  # idempotent: the same lines
 
 
+def test_warmup_refuses_a_cache_folder_it_cannot_write_in_one_line(tmp_path, monkeypatch, capsys):
+    blocked = tmp_path / "a_file"
+    blocked.write_text("not a folder")
+    monkeypatch.setenv("NUMBA_CACHE_DIR", str(blocked))
+    assert main(["warmup"]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith(f"grainview: error: NUMBA_CACHE_DIR={blocked}: cannot create the folder") and err.count("\n") == 1
+
+
 @pytest.mark.slow
 def test_warmup_fills_a_cold_cache_that_the_next_process_loads(tmp_path):
     env = {**os.environ, "NUMBA_CACHE_DIR": str(tmp_path / "cache"), "MPLBACKEND": "Agg"}
