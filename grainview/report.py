@@ -113,8 +113,9 @@ def run_summary(ds: xr.Dataset, residual_strain: float = RESIDUAL_STRAIN) -> dic
     out = describe_run(ds, window, residual_strain)
     out["solid fraction (initial)"] = float(ds.grain.solid_fraction().isel(time=0))
     out["z (initial)"] = float(ds.grain.coordination()["z"].isel(time=0))
-    from .plot.macroscopic import friction_offset
-    out[PHI_0_ROW] = friction_offset(ds)  # Fig. 5's phi_0, over the whole test
+    from .plot.macroscopic import EARLY_STRAIN, friction_offset
+    phi_0 = friction_offset(ds)  # Fig. 5's phi_0, over the whole test
+    out[PHI_0_ROW] = phi_0 if np.isfinite(phi_0) else f"{NOT_REACHED}: eps_q < {EARLY_STRAIN:g} throughout"
     residual_rows = [key for key in PAPER["pentagons"] if key not in out and key not in INITIAL_ROWS]
     if not bool(window.any()):
         out.update({key: NOT_REACHED for key in residual_rows})

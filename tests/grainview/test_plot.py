@@ -753,3 +753,17 @@ def test_the_transition_caption_gives_the_snapshot_interval(series):
     assert note.startswith(f"s: snapshots every 1 s, d eps_q = {d_eps:.2g};")
     every = series.assign_attrs(snapshot_every=200)
     assert "every 1 s (200 time steps)" in interval_note("s", every)
+
+
+def test_the_headline_phi_0_is_fig5s_and_says_when_the_run_is_too_short(series):
+    from grainview.plot.macroscopic import friction_offset
+    from grainview.report import NOT_REACHED, PHI_0_ROW, run_summary
+
+    angles = friction_and_dilatancy(series)
+    eps = strains(series)["eps_q"].values
+    kept = eps >= 0.02  # the first snapshot (eps_q = 0) is left out
+    want = float(np.median(angles["phi"].values[kept] - angles["psi"].values[kept]))
+    assert run_summary(series)[PHI_0_ROW] == pytest.approx(want) == friction_offset(series)
+    assert np.isnan(friction_offset(series, min_strain=1.0))
+    short = series.isel(time=[0])  # eps_q = 0 only: no phi_0, and the row says why
+    assert run_summary(short)[PHI_0_ROW] == f"{NOT_REACHED}: eps_q < 0.02 throughout"
