@@ -10,13 +10,13 @@ import os
 
 import numpy as np
 
-from .errors import FileFormatError, OutputError, ParameterError
+from .errors import FileFormatError, GrainviewError, OutputError, ParameterError
 from .locks import WriterLock
 from .schema import (CONTACT_VARIABLES, DEFAULT_WALL_NAMES, OPTIONAL_CONTACT_VARIABLES, REQUIRED, TIME_ATTRS,
                      VARIABLES, complete_snapshots, contact_slots, empty_slots, global_attrs, variable_attrs)
 
 __all__ = ["SnapshotWriter", "compress_file", "decompress_file", "is_compressed", "check_complevel",
-           "netcdf3_data_bytes", "APPEND_FORMAT",
+           "netcdf3_data_bytes", "lock_file", "remove_strays", "APPEND_FORMAT",
            "COMPRESSED_FORMAT", "DEFAULT_COMPLEVEL"]
 
 APPEND_FORMAT = "NETCDF3_64BIT_OFFSET"
@@ -33,11 +33,101 @@ COPY_BLOCK_BYTES = 64 * 2**20
 """At most this many bytes of one variable are held in memory while a file is converted."""
 
 
+TEMPORARY_SUFFIXES = (".part", ".convert")
+"""The hidden files ``.<name>.<pid><suffix>`` a file is written under before it is renamed
+into place (:meth:`SnapshotWriter.create`, :func:`compress_file`, :func:`decompress_file`)."""
+
+
+def _fsync(path: str) -> None:
+    """Flush ``path`` (a file or a folder) to disk; a file system that cannot sync a folder is
+    let be."""
+    fd = os.open(path, os.O_RDONLY)
+    try:
+        os.fsync(fd)
+    except OSError:
+        if not os.path.isdir(path):
+            raise
+    finally:
+        os.close(fd)
+
+
+def _abandon(nc) -> None:
+    """After a failed write or close (a full disk, a file-size limit), netCDF-C's close fails
+    as well and leaves the handle half freed; netCDF4-python keeps it marked open and closes it
+    again when the Dataset is finalised, which crashes the interpreter. One close that ignores
+    the error (what the finaliser itself does) marks it closed."""
+    closer = getattr(nc, "_close", None)
+    if closer is not None and nc.isopen():
+        try:
+            closer(False)
+        except (RuntimeError, OSError):
+            pass
+
+
+def _why(exc) -> str:
+    """``exc``'s message, with the file-size limit (``ulimit -f``) when one is set: HDF5 reports
+    a write beyond it only as "HDF error"."""
+    try:
+        import resource
+
+        limit = resource.getrlimit(resource.RLIMIT_FSIZE)[0]
+    except (ImportError, OSError, ValueError):
+        return str(exc)
+    return str(exc) if limit == resource.RLIM_INFINITY else f"{exc}; the file-size limit, ulimit -f, is {limit} bytes"
+
+
+def _alive(pid: int) -> bool:
+    """Whether process ``pid`` exists on this machine."""
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except PermissionError:  # another user's process
+        return True
+    return True
+
+
+def remove_strays(path) -> list[str]:
+    """Remove the temporary files that killed processes left beside ``path`` (a creation or a
+    conversion stopped by SIGKILL: ``.<name>.<pid>.part`` or ``.convert``). Only for a caller
+    holding ``path``'s writer lock, and only files whose process is gone. Returns their names."""
+    directory, base = os.path.split(os.path.abspath(os.fspath(path)))
+    removed = []
+    try:
+        names = os.listdir(directory)
+    except OSError:
+        return removed
+    for name in names:
+        if not (name.startswith(f".{base}.") and name.endswith(TEMPORARY_SUFFIXES)):
+            continue
+        pid = name[len(base) + 2:].rsplit(".", 1)[0]
+        if not pid.isdigit() or int(pid) == os.getpid() or _alive(int(pid)):
+            continue
+        try:
+            os.remove(os.path.join(directory, name))
+            removed.append(name)
+        except OSError:
+            pass
+    return removed
+
+
+def lock_file(path) -> WriterLock:
+    """Take the writer's lock of ``path`` (:class:`grainview.locks.WriterLock`) and remove the
+    temporary files killed writers left beside it (:func:`remove_strays`)."""
+    lock = WriterLock(path)
+    remove_strays(path)
+    return lock
+
+
 def _move_into_place(temporary: str, path: str, overwrite: bool) -> None:
-    """Rename ``temporary`` to ``path`` atomically; without ``overwrite`` an existing ``path``
-    (even one created meanwhile by another process) is kept and FileExistsError raised."""
+    """Rename ``temporary`` to ``path`` atomically, the file synced to disk before and the
+    folder after; without ``overwrite`` an existing ``path`` (even one created meanwhile by
+    another process) is kept and FileExistsError raised."""
+    _fsync(temporary)
+    folder = os.path.dirname(os.path.abspath(path))
     if overwrite:
         os.replace(temporary, path)
+        _fsync(folder)
         return
     try:
         os.link(temporary, path)  # fails if path exists: no check-then-rename race
@@ -47,8 +137,10 @@ def _move_into_place(temporary: str, path: str, overwrite: bool) -> None:
         if os.path.exists(path):
             raise FileExistsError(f"{path} exists; pass overwrite=True to replace it") from None
         os.replace(temporary, path)
+        _fsync(folder)
         return
     os.remove(temporary)
+    _fsync(folder)
 
 
 def netcdf3_data_bytes(fixed, record_slices) -> tuple[int, int]:
@@ -71,53 +163,67 @@ def is_compressed(path) -> bool:
         return fh.read(8) == b"\x89HDF\r\n\x1a\n"
 
 
-def _convert(path, fmt, complevel=None) -> None:
+def _convert(path, fmt, complevel=None, lock=None) -> None:
     """Rewrite ``path`` in format ``fmt`` (deflated at ``complevel`` when given), holding the
-    writer's lock: written under a temporary name and renamed over ``path`` once complete, so
-    a failure or a kill at any moment leaves the original file as it was. Variables,
-    dimensions (the unlimited ``time`` too), values, fill values and attributes are copied as
-    they are, in the file's order; no value passes through a float conversion."""
+    writer's lock (``lock``, or one taken here): written under a temporary name, synced, and
+    renamed over ``path`` once complete, the folder synced after, so a failure or a kill at any
+    moment leaves the original file as it was (a kill leaves the temporary file, which the next
+    process that takes the lock removes). Variables, dimensions (the unlimited ``time`` too),
+    values, fill values and attributes are copied as they are, in the file's order; no value
+    passes through a float conversion. An I/O failure (a full disk, a file-size limit) raises
+    :class:`OutputError` in one line."""
     import netCDF4
 
     path = os.fspath(path)
     directory, base = os.path.split(os.path.abspath(path))
     temporary = os.path.join(directory, f".{base}.{os.getpid()}.convert")
-    # A netCDF-3 file may be appended to: hold its writer's lock while it is copied. A
-    # compressed file is never appended to, and HDF5 holds a shared lock of its own on it
-    # while it is read, which the writer's exclusive lock would collide with: no lock.
-    lock = None if is_compressed(path) else WriterLock(path)
+    own = lock is None
+    if own:
+        lock = lock_file(path)
+    src = dst = None
     try:
-        with netCDF4.Dataset(path) as src, netCDF4.Dataset(temporary, "w", format=fmt) as dst:
-            src.set_auto_maskandscale(False)
-            dst.set_auto_maskandscale(False)
-            for name, dim in src.dimensions.items():
-                dst.createDimension(name, None if dim.isunlimited() else len(dim))
-            for name, var in src.variables.items():
-                attrs = {k: var.getncattr(k) for k in var.ncattrs()}
-                fill = attrs.pop("_FillValue", None)
-                deflate = complevel is not None and var.dtype.kind != "S" and var.ndim > 0
-                out = dst.createVariable(name, var.dtype, var.dimensions, fill_value=fill,
-                                         **({"zlib": True, "complevel": complevel, "shuffle": True} if deflate else {}))
-                out.setncatts(attrs)
-                var.set_auto_chartostring(False)  # character arrays copied as characters
-                out.set_auto_chartostring(False)
-                if var.ndim == 0:
-                    out.assignValue(var.getValue())
-                    continue
-                rows = var.shape[0]
-                row_bytes = max(1, var.dtype.itemsize * int(np.prod(var.shape[1:], dtype=np.int64)))
-                step = max(1, COPY_BLOCK_BYTES // row_bytes)
-                for start in range(0, rows, step):
-                    stop = min(rows, start + step)
-                    out[start:stop] = var[start:stop]
-            dst.setncatts({k: src.getncattr(k) for k in src.ncattrs()})
-        os.replace(temporary, path)
-    except BaseException:
+        src = netCDF4.Dataset(path)
+        dst = netCDF4.Dataset(temporary, "w", format=fmt)
+        src.set_auto_maskandscale(False)
+        dst.set_auto_maskandscale(False)
+        for name, dim in src.dimensions.items():
+            dst.createDimension(name, None if dim.isunlimited() else len(dim))
+        for name, var in src.variables.items():
+            attrs = {k: var.getncattr(k) for k in var.ncattrs()}
+            fill = attrs.pop("_FillValue", None)
+            deflate = complevel is not None and var.dtype.kind != "S" and var.ndim > 0
+            out = dst.createVariable(name, var.dtype, var.dimensions, fill_value=fill,
+                                     **({"zlib": True, "complevel": complevel, "shuffle": True} if deflate else {}))
+            out.setncatts(attrs)
+            var.set_auto_chartostring(False)  # character arrays copied as characters
+            out.set_auto_chartostring(False)
+            if var.ndim == 0:
+                out.assignValue(var.getValue())
+                continue
+            rows = var.shape[0]
+            row_bytes = max(1, var.dtype.itemsize * int(np.prod(var.shape[1:], dtype=np.int64)))
+            step = max(1, COPY_BLOCK_BYTES // row_bytes)
+            for start in range(0, rows, step):
+                stop = min(rows, start + step)
+                out[start:stop] = var[start:stop]
+        dst.setncatts({k: src.getncattr(k) for k in src.ncattrs()})
+        dst.close()
+        src.close()
+        _move_into_place(temporary, path, overwrite=True)
+    except BaseException as exc:
+        for nc in (dst, src):
+            if nc is not None:
+                _abandon(nc)
         if os.path.exists(temporary):
             os.remove(temporary)
+        if isinstance(exc, (RuntimeError, OSError)) and not isinstance(exc, GrainviewError):
+            what = "compressed" if complevel is not None else f"uncompressed ({fmt})"
+            error = OutputError(f"{path}: could not be rewritten {what} ({_why(exc)}); the file is unchanged")
+            error.reason = _why(exc)  # for a caller that words the message its own way
+            raise error from exc
         raise
     finally:
-        if lock is not None:
+        if own:
             lock.release()
 
 
@@ -128,10 +234,11 @@ def check_complevel(complevel) -> int:
     return int(complevel)
 
 
-def compress_file(path, complevel: int = DEFAULT_COMPLEVEL) -> None:
+def compress_file(path, complevel: int = DEFAULT_COMPLEVEL, lock=None) -> None:
     """Rewrite the finished file ``path`` compressed (:data:`COMPRESSED_FORMAT`, zlib at
     ``complevel`` with byte shuffling), in place and atomically; :func:`grainview.open_dataset`
-    reads it unchanged. A file already compressed is left alone.
+    reads it unchanged. A file already compressed is left alone, so a compression stopped
+    midway (the file still netCDF-3) is simply done again.
 
     Parameters
     ----------
@@ -139,18 +246,41 @@ def compress_file(path, complevel: int = DEFAULT_COMPLEVEL) -> None:
         A netCDF file of the contract that no other process is writing.
     complevel : int
         zlib level, 1 (fastest) to 9 (smallest).
+    lock : grainview.locks.WriterLock, optional
+        ``path``'s writer lock, already held by the caller (default: taken here).
+
+    Raises
+    ------
+    grainview.locks.FileLockedError
+        Another process is writing ``path``.
+    OutputError
+        The rewrite failed (a full disk, a file-size limit); ``path`` is unchanged.
     """
     complevel = check_complevel(complevel)
-    if not is_compressed(path):
-        _convert(path, COMPRESSED_FORMAT, complevel)
+    own = lock is None
+    if own:
+        lock = lock_file(path)  # the format is read under the lock: no conversion meanwhile
+    try:
+        if not is_compressed(path):
+            _convert(path, COMPRESSED_FORMAT, complevel, lock=lock)
+    finally:
+        if own:
+            lock.release()
 
 
-def decompress_file(path) -> None:
+def decompress_file(path, lock=None) -> None:
     """Rewrite ``path`` uncompressed in :data:`APPEND_FORMAT`, in place and atomically, so that
     a run can append snapshots to it again (:mod:`solver.restart`). A netCDF-3 file is left
-    alone."""
-    if is_compressed(path):
-        _convert(path, APPEND_FORMAT)
+    alone. ``lock`` and the errors: as for :func:`compress_file`."""
+    own = lock is None
+    if own:
+        lock = lock_file(path)
+    try:
+        if is_compressed(path):
+            _convert(path, APPEND_FORMAT, lock=lock)
+    finally:
+        if own:
+            lock.release()
 
 
 class SnapshotWriter:
@@ -169,10 +299,13 @@ class SnapshotWriter:
             w.append(time=t, position=x, angle=a, contacts=c, box_min=lo, box_max=hi)
     """
 
-    def __init__(self, nc, path, lock=None):
+    def __init__(self, nc, path, lock=None, owns_lock=True):
         self._nc = nc
         self.path = path
         self._lock = lock
+        self._owns_lock = owns_lock  # released by close(); a lock the caller gave is the caller's
+        self.advice = "free space or raise the file-size limit (ulimit -f)"
+        """What a failed :meth:`append` tells the user to do (the solver adds how to resume)."""
         self._failed = False  # a write failed (a full disk): closed without flushing again
         self.n_particles = nc.dimensions["particle"].size
         self.n_slots = nc.dimensions["contact"].size
@@ -181,7 +314,7 @@ class SnapshotWriter:
     @classmethod
     def create(cls, path, *, radius, n_vertices, mass, inertia, n_walls=0, wall_names=None,
                wall_normal=None, optional=(),
-               attrs=None, n_contact_slots=None, overwrite=False, format=APPEND_FORMAT):
+               attrs=None, n_contact_slots=None, overwrite=False, format=APPEND_FORMAT, lock=None):
         """Create ``path`` with the static particle data, ready for :meth:`append`.
 
         Parameters
@@ -209,6 +342,9 @@ class SnapshotWriter:
             Replace an existing ``path`` (refused while another process writes it).
         format : str, default :data:`APPEND_FORMAT`
             The netCDF format (netCDF-3, appended in place).
+        lock : grainview.locks.WriterLock, optional
+            ``path``'s writer lock, already held by the caller, who releases it (default: taken
+            here before anything is written, released by :meth:`close`).
 
         Returns
         -------
@@ -223,19 +359,36 @@ class SnapshotWriter:
             The folder does not exist.
         grainview.locks.FileLockedError
             Another process is writing ``path``.
+        OutputError
+            The file could not be written (a full disk, a file-size limit): nothing is left at
+            ``path``, nor a temporary file.
         ParameterError
             An unknown optional variable.
         """
-        import netCDF4
-
         path = os.fspath(path)
         if os.path.exists(path) and not overwrite:
             raise FileExistsError(f"{path} exists; pass overwrite=True to replace it")
         folder = os.path.dirname(os.path.abspath(path))
         if not os.path.isdir(folder):  # named here, not by the hidden temporary file's name
             raise FileNotFoundError(f"cannot write {path}: the folder {folder} does not exist")
-        if os.path.exists(path) and not is_compressed(path):  # a compressed file is a finished run
-            WriterLock.check_free(path)  # never replace a file another run is still writing
+        own = lock is None
+        if own:
+            lock = lock_file(path)  # never replace a file another run is still writing
+        try:
+            nc = cls._create(path, radius, n_vertices, mass, inertia, n_walls, wall_names, wall_normal, optional,
+                             attrs, n_contact_slots, overwrite, format)
+        except BaseException:
+            if own:
+                lock.release()
+            raise
+        return cls(nc, path, lock, own)
+
+    @staticmethod
+    def _create(path, radius, n_vertices, mass, inertia, n_walls, wall_names, wall_normal, optional, attrs,
+                n_contact_slots, overwrite, format):
+        """:meth:`create`'s file, under the lock: written, moved into place and opened to append."""
+        import netCDF4
+
         radius = np.asarray(radius, "f8")
         n = radius.shape[0]
         slots = n_contact_slots or contact_slots(n, n_walls)
@@ -249,8 +402,9 @@ class SnapshotWriter:
         # leaves either no file or a valid empty one, never a partial header.
         directory, base = os.path.split(os.path.abspath(path))
         temporary = os.path.join(directory, f".{base}.{os.getpid()}.part")
-        nc = netCDF4.Dataset(temporary, "w", format=format)
+        nc = None
         try:
+            nc = netCDF4.Dataset(temporary, "w", format=format)
             nc.set_auto_mask(False)
             nc.createDimension("time", None)
             nc.createDimension("particle", n)
@@ -292,39 +446,51 @@ class SnapshotWriter:
             nc.setncatts(global_attrs(n, n_walls, attrs))
             nc.close()
             _move_into_place(temporary, path, overwrite)
-        except BaseException:
-            if nc.isopen():
-                nc.close()
+        except BaseException as exc:
+            if nc is not None:
+                _abandon(nc)
             if os.path.exists(temporary):
                 os.remove(temporary)
+            if isinstance(exc, (RuntimeError, OSError)) and not isinstance(exc, (GrainviewError, FileExistsError)):
+                raise OutputError(f"{path}: could not be created ({_why(exc)}); nothing was written") from exc
             raise
-        lock = WriterLock(path)
-        try:
-            nc = netCDF4.Dataset(path, "a")
-        except BaseException:
-            lock.release()
-            raise
+        nc = netCDF4.Dataset(path, "a")
         nc.set_auto_mask(False)
-        return cls(nc, path, lock)
+        return nc
 
     @classmethod
-    def open_append(cls, path):
+    def open_append(cls, path, lock=None):
         """Open an existing file of the contract to append further snapshots (refused with
         :class:`grainview.locks.FileLockedError` while another process writes it). A compressed
-        file is first rewritten uncompressed (:func:`decompress_file`)."""
+        file is first rewritten uncompressed (:func:`decompress_file`). ``lock``: as for
+        :meth:`create` (whoever reads the file's last snapshot to go on from it takes the lock
+        first and passes it here, so that no other process appends in between)."""
         import netCDF4
 
-        if os.path.exists(path):
-            decompress_file(path)  # a finished, compressed run: netCDF-3 again, to append in place
-        lock = WriterLock(path) if os.path.exists(path) else None
+        path = os.fspath(path)
+        if not os.path.exists(path):
+            raise FileFormatError(f"cannot open {path} for appending: no such file")
+        own = lock is None
+        if own:
+            lock = lock_file(path)
         try:
-            nc = netCDF4.Dataset(os.fspath(path), "a")
-        except OSError as exc:
-            if lock is not None:
+            decompress_file(path, lock=lock)  # a finished, compressed run: netCDF-3 again, to append in place
+            try:
+                nc = netCDF4.Dataset(path, "a")
+            except OSError as exc:
+                raise FileFormatError(f"cannot open {path} for appending: {exc}") from exc
+        except BaseException:
+            if own:
                 lock.release()
-            raise FileFormatError(f"cannot open {path} for appending: {exc}") from exc
+            raise
         nc.set_auto_mask(False)
-        return cls(nc, path, lock)
+        return cls(nc, path, lock, own)
+
+    def take_lock(self):
+        """Hand the writer's lock over to the caller, who releases it: :meth:`close` keeps it
+        (to compress the closed file before another process may take it)."""
+        self._owns_lock = False
+        return self._lock
 
     def attribute(self, name, default=None):
         """The file's global attribute ``name`` (``default`` when it has none)."""
@@ -368,8 +534,8 @@ class SnapshotWriter:
             self._append(**snapshot)
         except (RuntimeError, OSError) as exc:
             self._failed = True
-            raise OutputError(f"{self.path}: could not write snapshot {k} ({exc}); the file keeps its {k} "
-                              "complete snapshots: free space and resume the run") from exc
+            raise OutputError(f"{self.path}: could not write snapshot {k} ({_why(exc)}); the file keeps its {k} "
+                              f"complete snapshots: {self.advice}") from exc
 
     def _append(self, *, time, position, angle, contacts, box_min, box_max, **optional):
         """Write one snapshot; ``contacts`` is a dict of the contact variables with one
@@ -422,22 +588,11 @@ class SnapshotWriter:
                                       "were written before") from exc
             self._abandon(nc)
         finally:
-            if self._lock is not None:
+            if self._lock is not None and self._owns_lock:
                 self._lock.release()
-                self._lock = None
+            self._lock = None
 
-    @staticmethod
-    def _abandon(nc):
-        """After a failed write or close (a full disk), netCDF-C's close fails as well and leaves
-        the handle half freed; netCDF4-python keeps it marked open and closes it again when the
-        Dataset is finalised, which crashes the interpreter. One close that ignores the error
-        (what the finaliser itself does) marks it closed."""
-        closer = getattr(nc, "_close", None)
-        if closer is not None and nc.isopen():
-            try:
-                closer(False)
-            except (RuntimeError, OSError):
-                pass
+    _abandon = staticmethod(_abandon)
 
     def __enter__(self):
         return self

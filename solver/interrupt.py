@@ -52,6 +52,31 @@ def interruptible():
             signal.signal(signum, old)
 
 
+@contextlib.contextmanager
+def sigterm_raises():
+    """Within the block, SIGTERM raises :class:`Terminated` at once (at the next Python
+    instruction), for the phases that are not a loop of steps: creating, compressing or
+    decompressing a run's file, whose ``except``/``finally`` clauses then remove their
+    temporary file and leave the run's file as it was. Only in the main thread (a worker
+    thread cannot set handlers: there it does nothing); the previous handler is restored."""
+    if sys.platform == "win32":
+        yield
+        return
+
+    def handler(_signum, _frame):
+        raise Terminated()
+
+    try:
+        previous = signal.signal(signal.SIGTERM, handler)
+    except ValueError:  # not the main thread
+        yield
+        return
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGTERM, previous if previous is not None else signal.SIG_DFL)
+
+
 def stop_exception(state) -> BaseException:
     """The exception that ends a run stopped by ``state``'s signal: :class:`Terminated` for
     SIGTERM, KeyboardInterrupt for Ctrl-C."""

@@ -21,16 +21,19 @@ f over its contacts (f = f_n n + f_t t, force of i on j = the wall).
 
 from __future__ import annotations
 
+import shlex
+import sys
 import warnings
 
 import numpy as np
 
 from grainview.schema import DIAGNOSTICS
-from grainview.errors import ParameterError
+from grainview.errors import OutputError, ParameterError
 from grainview.writer import DEFAULT_COMPLEVEL, SnapshotWriter, compress_file
 
 from . import __version__
 from .contact_points import point_forces, rank_in_pair
+from .interrupt import Terminated, sigterm_raises
 
 OPTIONAL = ("velocity", "angular_velocity", "wall_position", "wall_velocity", "wall_force",
             "normal_impulse", "tangential_impulse", "gap", *DIAGNOSTICS)
@@ -172,6 +175,11 @@ class Recorder:
     finished file is rewritten compressed (:func:`grainview.writer.compress_file`, zlib at
     ``compress``: True or a level 1-9; False, None or 0 keeps it uncompressed). A run stopped by Ctrl-C
     or an error stays netCDF-3, ready to be resumed.
+
+    The file's writer lock (:mod:`grainview.locks`) is held from before the file is created or
+    read until it is closed and compressed. SIGTERM while the file is created, made netCDF-3 again
+    or compressed stops at once, the file as it was (a compression stopped so leaves the
+    finished run netCDF-3: :func:`compress_finished` or ``python -m solver.restart`` does it again).
     """
 
     def __init__(self, path, sim, attrs=None, overwrite=False, optional=OPTIONAL, near_contacts=False,
@@ -186,21 +194,27 @@ class Recorder:
         params["near_contacts_m"] = "none" if self.near is None else self.near
         self.sim = sim
         sim.take_unconverged()  # each snapshot counts the unconverged steps since the one before it
-        self.writer = SnapshotWriter.create(
-            path, radius=sim.radius, n_vertices=sim.n_vertices, mass=sim.mass, inertia=sim.inertia,
-            n_walls=sim.n_walls, wall_names=sim.walls.names, wall_normal=sim.walls.normal,
-            optional=optional, attrs=params, overwrite=overwrite)
+        with sigterm_raises():
+            self.writer = SnapshotWriter.create(
+                path, radius=sim.radius, n_vertices=sim.n_vertices, mass=sim.mass, inertia=sim.inertia,
+                n_walls=sim.n_walls, wall_names=sim.walls.names, wall_normal=sim.walls.normal,
+                optional=optional, attrs=params, overwrite=overwrite)
+        self._hold(resumable=params.get("scene") == "biaxial", own=True)
 
     @classmethod
-    def append_to(cls, path, sim, compress=DEFAULT_COMPLEVEL):
+    def append_to(cls, path, sim, compress=DEFAULT_COMPLEVEL, lock=None):
         """Go on recording ``sim`` at the end of the existing file ``path`` (a resumed run,
         :mod:`solver.restart`); the file's attributes are left as they are. A compressed file
-        is made netCDF-3 again to append to, and compressed again at the end (``compress``)."""
+        is made netCDF-3 again to append to, and compressed again at the end (``compress``).
+        ``lock``: ``path``'s writer lock, taken by the caller before it read the state ``sim``
+        comes from (the caller releases it); default: taken here."""
         recorder = cls.__new__(cls)
         recorder.compress = compress_level(compress)
         recorder.sim = sim
         sim.take_unconverged()
-        recorder.writer = SnapshotWriter.open_append(path)
+        with sigterm_raises():
+            recorder.writer = SnapshotWriter.open_append(path, lock=lock)
+        recorder._hold(resumable=True, own=lock is None)
         near = recorder.writer.attribute("near_contacts_m", "none")
         recorder.near = None if isinstance(near, str) else float(near)
         return recorder
@@ -226,16 +240,60 @@ class Recorder:
             nlgs_unconverged_local_law_residual=unconverged.local_law_residual,
             max_interpenetration=info.max_interpenetration if info else 0.0, kinetic_energy=sim.kinetic_energy())
 
+    def _hold(self, resumable, own):
+        """Keep the writer's lock until the file is closed and compressed (released then when
+        ``own``), and say in a failed write's message how to go on."""
+        self._lock = self.writer.take_lock()
+        self._owns_lock = own
+        self.resumable = resumable
+        path = shlex.quote(str(self.writer.path))
+        self.writer.advice += (f", then resume it: python -m solver.restart {path}" if resumable
+                               else ", then run it again, replacing the file")
+
+    def _release(self):
+        lock, self._lock = self._lock, None
+        if lock is not None and self._owns_lock:
+            lock.release()
+
     def close(self):
-        self.writer.close()
+        """Close the file (uncompressed) and release its writer lock."""
+        try:
+            self.writer.close()
+        finally:
+            self._release()
 
     def __enter__(self):
         return self
 
     def __exit__(self, exc_type, exc, traceback):
-        self.close()
-        if exc_type is None and self.compress:
-            compress_file(self.writer.path, self.compress)
+        try:
+            self.writer.close()
+            if exc_type is None and self.compress:
+                compress_finished(self.writer.path, self.compress, self._lock, self.resumable)
+        finally:
+            self._release()
+
+
+def compress_finished(path, level, lock=None, resumable=True) -> None:
+    """Compress the finished run ``path`` at zlib ``level`` (:func:`grainview.writer.compress_file`,
+    holding ``lock`` when given), SIGTERM stopping it at once. Either way the run stays
+    whole: a failure (a full disk, a file-size limit) raises :class:`OutputError` in one line,
+    SIGTERM prints one and raises :class:`solver.interrupt.Terminated`, and the file is left
+    netCDF-3, complete; ``resumable`` (a biaxial test) says that ``python -m solver.restart``
+    compresses it later."""
+    later = (f"compress it later with: python -m solver.restart {shlex.quote(str(path))}" if resumable
+             else "it reads as it is")
+    with sigterm_raises():
+        try:
+            compress_file(path, level, lock=lock)
+        except Terminated:
+            print(f"terminated (SIGTERM) while compressing {path}: the run is complete and kept uncompressed "
+                  f"(netCDF-3); {later}", file=sys.stderr)
+            raise
+        except OutputError as exc:
+            raise OutputError(f"{path}: the run is complete but could not be compressed "
+                              f"({getattr(exc, 'reason', exc)}); it is kept "
+                              f"uncompressed (netCDF-3): {later}") from exc
 
 
 def compress_level(compress) -> int:

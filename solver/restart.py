@@ -42,8 +42,8 @@ import numpy as np
 
 from grainview.errors import ConvergenceWarning, FileFormatError, GrainviewError
 
-from .interrupt import Terminated
-from .output import Recorder
+from .interrupt import Terminated, sigterm_raises
+from .output import Recorder, compress_finished, compress_level
 from .scenes import biaxial_steps
 from .stepper import Parameters, Simulation
 from .walls import Walls
@@ -200,15 +200,36 @@ def resume(path, progress=None, compress=True) -> int:
     docstring). Ctrl-C stops again after the current step, with instructions to resume.
     ``progress``: a tqdm bar (None: when stderr is a terminal). A compressed file is made
     netCDF-3 again to append to and, once the test has finished, compressed again
-    (``compress``: True, a zlib level 1-9, or False).
+    (``compress``: True, a zlib level 1-9, or False); a finished test whose file is still
+    netCDF-3 (its compression was stopped) is compressed now.
+
+    The file's writer lock is taken before its last snapshot is read and held until the file
+    is closed and compressed, so two resumes of one file never both append: the second raises
+    :class:`grainview.locks.FileLockedError` naming the first. Taking the lock also removes the
+    temporary files of killed writers (:func:`grainview.writer.remove_strays`).
     """
-    sim, test = load_state(path)
-    first = sim.step_index - test["first_step"] + 1
-    if first > test["n_steps"]:
-        return 0
-    with Recorder.append_to(path, sim, compress=compress) as recorder:
-        biaxial_steps(sim, recorder, first=first, n_steps=test["n_steps"], every=test["every"], progress=progress)
-    return test["n_steps"] - first + 1
+    from grainview.writer import is_compressed, lock_file
+
+    level = compress_level(compress)
+    source = os.fspath(path)
+    if not os.path.exists(source):
+        raise FileFormatError(f"{source}: no such file")
+    with sigterm_raises():
+        lock = lock_file(source)
+    try:
+        with sigterm_raises():
+            sim, test = load_state(source)
+        first = sim.step_index - test["first_step"] + 1
+        if first > test["n_steps"]:
+            if level and not is_compressed(source):
+                compress_finished(source, level, lock)
+            return 0
+        with Recorder.append_to(source, sim, compress=level, lock=lock) as recorder:
+            biaxial_steps(sim, recorder, first=first, n_steps=test["n_steps"], every=test["every"],
+                          progress=progress)
+        return test["n_steps"] - first + 1
+    finally:
+        lock.release()
 
 
 def main(argv=None) -> int:

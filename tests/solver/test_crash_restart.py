@@ -305,8 +305,19 @@ def test_a_run_killed_while_creating_its_file_leaves_no_partial_file(tmp_path):
                            capture_output=True, text=True, timeout=120)
     assert child.returncode == -signal.SIGKILL, child.stderr
     assert not path.exists()
-    leftovers = [p.name for p in tmp_path.iterdir()]  # only the hidden temporary file
-    assert len(leftovers) == 1 and leftovers[0].startswith(".new.nc.") and leftovers[0].endswith(".part")
+    leftovers = sorted(p.name for p in tmp_path.iterdir())  # the hidden temporary file and the lock's note
+    assert leftovers == [f".new.nc.{child_pid(leftovers)}.part", ".new.nc.writer"]
+    # the next run on the path takes the lock over and removes the dead creator's strays
+    with Recorder(path, compaction_sample(6, "disk", seed=0), compress=False) as rec:
+        rec.write()
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["new.nc"]
+    with grainview.open_dataset(path) as ds:
+        assert ds.sizes["time"] == 1
+
+
+def child_pid(names):
+    """The process id in the name ``.<name>.<pid>.part`` of a temporary file."""
+    return next(n.split(".")[-2] for n in names if n.endswith(".part"))
 
 
 @pytest.mark.parametrize("method", ["off", "anderson"])
@@ -382,3 +393,175 @@ def test_a_full_disk_ends_in_one_line_and_a_valid_resumable_file(tmp_path, monke
         assert resume(path, progress=False) > 0
     with grainview.open_dataset(path, chunks=None) as done:
         assert done.sizes["time"] == SNAPSHOTS
+
+
+# --- two resumes, a stopped compression, a file-size limit (issue 34) ----------------------
+def _env():
+    return dict(os.environ, PYTHONPATH=os.pathsep.join([str(REPO), os.environ.get("PYTHONPATH", "")]))
+
+
+def _restart(path, *python_args, timeout=120):
+    """``python -m solver.restart PATH`` in a subprocess."""
+    return subprocess.run([sys.executable, *python_args, "-m", "solver.restart", str(path), "--progress", "off"],
+                          cwd=REPO, env=_env(), capture_output=True, text=True, timeout=timeout)
+
+
+def _nearly_finished(reference, path, missing=3):
+    """The reference run as a run killed ``2 * missing`` steps before its end leaves it:
+    netCDF-3, its last ``missing`` snapshots not complete."""
+    from grainview.writer import decompress_file
+
+    path.write_bytes(reference.read_bytes())
+    decompress_file(path)
+    with netCDF4.Dataset(path, "a") as nc:
+        nc.variables["complete"][-missing:] = 0
+    return path
+
+
+def _finished_uncompressed(reference, path):
+    """The reference run as a run stopped during its final compression leaves it."""
+    from grainview.writer import decompress_file
+
+    path.write_bytes(reference.read_bytes())
+    decompress_file(path)
+    return path
+
+
+PAUSED_RESUME = """
+import sys, warnings
+warnings.simplefilter("ignore")
+import solver.restart as restart
+
+real = restart.load_state
+
+def load_and_wait(path):  # the state read, the test decides when the run goes on
+    state = real(path)
+    print("read", flush=True)
+    sys.stdin.readline()
+    return state
+
+restart.load_state = load_and_wait
+sys.exit(restart.main([sys.argv[1], "--progress", "off"]))
+"""
+
+
+def test_a_second_resume_of_a_file_being_resumed_is_refused_and_the_file_ends_right(reference, tmp_path):
+    """Two resumes of one file: the first, paused between reading the last snapshot and
+    appending, holds the file; the second is refused in one line naming it instead of appending
+    the same tail (the first would then have appended it again, to a file finished meanwhile)."""
+    path = _nearly_finished(reference, tmp_path / "run.nc")
+    first = subprocess.Popen([sys.executable, "-c", PAUSED_RESUME, str(path)], cwd=REPO, env=_env(),
+                             stdin=subprocess.PIPE, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    try:
+        assert first.stdout.readline().strip() == "read"
+        second = _restart(path)
+        out, err = first.communicate("\n", timeout=120)
+    finally:
+        if first.poll() is None:
+            first.kill()
+            first.wait()
+    assert second.returncode == 2, second.stderr
+    assert second.stderr.count("\n") == 1 and "Traceback" not in second.stderr
+    assert f"being written by process {first.pid}" in second.stderr
+    assert first.returncode == 0, err
+    assert out.strip().endswith("resumed for 6 steps, complete")
+    assert path.read_bytes() == reference.read_bytes()  # 65 snapshots, the uninterrupted run's bytes
+    third = _restart(path)
+    assert third.returncode == 0 and third.stdout.strip().endswith("already complete"), third.stderr
+    assert path.read_bytes() == reference.read_bytes()
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["run.nc"]
+
+
+STOPPED_COMPRESSING = """
+import os, signal, sys, time, warnings
+warnings.simplefilter("ignore")
+real = os.replace
+
+def stop_before_rename(src, dst):  # the compressed copy is written, not yet renamed into place
+    if str(src).endswith(".convert"):
+        os.kill(os.getpid(), getattr(signal, sys.argv[2]))
+        time.sleep(10)
+    return real(src, dst)
+
+os.replace = stop_before_rename
+import solver.restart as restart
+sys.exit(restart.main([sys.argv[1], "--progress", "off"]))
+"""
+
+
+@pytest.mark.parametrize("stop", ["SIGKILL", "SIGTERM"])
+def test_a_run_stopped_while_compressing_is_compressed_by_the_next_resume(reference, tmp_path, stop):
+    """SIGKILL during the final compression leaves the finished run netCDF-3 with the
+    compression's temporary file and the lock's note; SIGTERM stops it with one line, cleaned
+    up. Either way the file holds the whole run, and the next resume compresses it (removing
+    what a killed process left): the uninterrupted run's bytes."""
+    reference_data, _ = _variables(reference)
+    path = _nearly_finished(reference, tmp_path / "run.nc")
+    child = subprocess.run([sys.executable, "-c", STOPPED_COMPRESSING, str(path), stop], cwd=REPO, env=_env(),
+                           capture_output=True, text=True, timeout=120)
+    assert "Traceback" not in child.stderr
+    if stop == "SIGKILL":
+        assert child.returncode == -signal.SIGKILL, child.stderr
+        left = sorted(p.name for p in tmp_path.iterdir())
+        assert left[1:] == [".run.nc.writer", "run.nc"] and left[0].startswith(".run.nc.")
+        assert left[0].endswith(".convert"), left
+    else:
+        assert child.returncode == 143, child.stderr
+        assert child.stderr.count("\n") == 1 and "terminated (SIGTERM) while compressing" in child.stderr
+        assert "python -m solver.restart" in child.stderr
+        assert sorted(p.name for p in tmp_path.iterdir()) == ["run.nc"]
+    with netCDF4.Dataset(path) as nc:
+        assert nc.data_model == "NETCDF3_64BIT_OFFSET"
+    assert _check_complete_snapshots(path, reference_data) == SNAPSHOTS
+    done = _restart(path)
+    assert done.returncode == 0 and done.stdout.strip().endswith("already complete"), done.stderr
+    assert path.read_bytes() == reference.read_bytes()
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["run.nc"]
+
+
+LIMITED = """
+import os, resource, signal, sys
+signal.signal(signal.SIGXFSZ, signal.SIG_IGN)  # a write beyond the limit fails with EFBIG
+limit = int(sys.argv[1])
+resource.setrlimit(resource.RLIMIT_FSIZE, (limit, limit))
+os.execv(sys.executable, [sys.executable, *sys.argv[2:]])
+"""
+
+
+def _restart_limited(path, limit):
+    """``python -m solver.restart PATH`` under a file-size limit (``ulimit -f``) of ``limit`` bytes."""
+    return subprocess.run([sys.executable, "-c", LIMITED, str(limit), "-m", "solver.restart", str(path),
+                           "--progress", "off"], cwd=REPO, env=_env(), capture_output=True, text=True, timeout=120)
+
+
+def test_a_file_size_limit_ends_a_resume_in_one_line_and_leaves_the_file_resumable(reference, tmp_path):
+    """EFBIG while a finished run is compressed, and while a compressed run is made netCDF-3
+    again to be resumed: one line each, the file unchanged and without strays; the run then
+    resumes to the uninterrupted run's bytes."""
+    from grainview.writer import compress_file
+
+    packed_size = reference.stat().st_size
+    finished = _finished_uncompressed(reference, tmp_path / "finished.nc")
+    before = finished.read_bytes()
+    assert len(before) > 1.5 * packed_size
+    done = _restart_limited(finished, packed_size // 2)
+    assert done.returncode == 2 and "Traceback" not in done.stderr, done.stderr
+    assert done.stderr.count("\n") == 1
+    assert "the run is complete but could not be compressed" in done.stderr
+    assert "kept uncompressed" in done.stderr and f"ulimit -f, is {packed_size // 2} bytes" in done.stderr
+    assert finished.read_bytes() == before
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["finished.nc"]
+    assert _restart(finished).returncode == 0
+    assert finished.read_bytes() == reference.read_bytes()
+
+    partial = _nearly_finished(reference, tmp_path / "partial.nc")
+    compress_file(partial)
+    before = partial.read_bytes()
+    done = _restart_limited(partial, len(before) // 2)
+    assert done.returncode == 2 and "Traceback" not in done.stderr, done.stderr  # was a segmentation fault
+    assert done.stderr.count("\n") == 1 and "could not be rewritten uncompressed" in done.stderr
+    assert "the file is unchanged" in done.stderr
+    assert partial.read_bytes() == before
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["finished.nc", "partial.nc"]
+    assert _restart(partial).returncode == 0
+    assert partial.read_bytes() == reference.read_bytes()
