@@ -280,7 +280,7 @@ def _wall_contacts(particles, position, snap, fixes, where):
         on_wall = -on_particle
         loaded = np.einsum("ij,ij->i", on_wall, n) > 0
         tensile += int((~loaded).sum())
-        p, n, on_wall, point, arm, length = (x[loaded] for x in (p, n, on_wall, point, arm, length))
+        p, n, wall, on_wall, point, arm, length = (x[loaded] for x in (p, n, wall, on_wall, point, arm, length))
         t = np.stack([-n[:, 1], n[:, 0]], axis=1)
         out["i"].append(p)
         out["j"].append(n_particles + wall)

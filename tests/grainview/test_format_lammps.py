@@ -283,3 +283,29 @@ def test_grainview_open_dataset_reads_the_format_lazily(ds):
     np.testing.assert_array_equal(z.compute().values, ds.grain.coordination()["z"].values)
     with pytest.raises(ParameterError, match="format='gromacs': expected 'grainview' or one of lammps"):
         grainview.open_dataset(files["particles"], format="gromacs")
+
+
+def _pull_on_the_floor(text):
+    """The walls dump with the floor's force on the first touching particle of the last
+    snapshot reversed (a tensile contact, as viscous damping gives one that separates)."""
+    head, tail = text.rsplit("ITEM: TIMESTEP\n", 1)
+    lines = tail.split("\n")
+    for k, line in enumerate(lines[9:], start=9):
+        values = line.split()
+        if values and float(values[1]) == 1.0:  # f_floor[1]: touching
+            values[3] = repr(-float(values[3]))  # f_floor[3]: fy on the particle
+            lines[k] = " ".join(values)
+            return head + "ITEM: TIMESTEP\n" + "\n".join(lines)
+    raise AssertionError("no particle touches the floor")
+
+
+def test_tensile_contacts_are_left_out_with_a_warning(tmp_path, ds):
+    folder = _edited(tmp_path, "tensile", ("walls", _pull_on_the_floor))
+    files = dump_files(folder)
+    with pytest.warns(UserWarning, match="1 touching pair"):
+        pulled = open_lammps(files["particles"], files["contacts"], files["walls"], log=files["log"])
+    assert int(pulled["contact_count"][-1]) == int(ds["contact_count"][-1]) - 1
+    with pytest.warns(UserWarning, match="1 touching pair"):
+        convert_lammps(tmp_path / "pulled.nc", files["particles"], files["contacts"], files["walls"], log=files["log"])
+    np.testing.assert_array_equal(grainview.open_dataset(tmp_path / "pulled.nc", chunks=None)["fn"].values,
+                                  pulled["fn"].values)
