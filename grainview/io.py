@@ -15,41 +15,90 @@ import xarray as xr
 
 from .errors import FileFormatError, SchemaError
 from .file_checks import damaged_snapshots, hidden_records
+from .locks import being_written
 from .schema import SCHEMA_VERSION, complete_snapshots
 from .writer import netcdf3_data_bytes
+
+
+def _header_reader():
+    """scipy's netCDF-3 reader made to parse the header and the fixed-size variables only: the
+    header's record count is kept as ``header_records`` and no record is mapped, so that a file
+    whose last record is still being written (its count already raised, its bytes not all
+    there) parses as well as a whole one."""
+    from scipy.io import netcdf_file
+
+    class HeaderOnly(netcdf_file):
+        def _read_numrecs(self):
+            super()._read_numrecs()
+            self.__dict__["header_records"] = self._recs
+            self.__dict__["_recs"] = 0
+
+    return HeaderOnly
 
 
 def _check_netcdf3_length(path: str) -> None:
     """Raise FileFormatError when a netCDF-3 file is shorter than its header says.
 
     netCDF-3 readers return zeros for the missing bytes of a truncated file instead of
-    failing, so the length is checked: header + fixed-size variables + records.
+    failing, so the length is checked: header + fixed-size variables + records. While a
+    writer holds the file (:func:`grainview.locks.being_written`) its last record may be
+    short: it is being written (the writer raises the record count before all of the record's
+    bytes reach the file); it reads with ``complete`` = 0 there, and :func:`open_dataset` drops
+    it. The file is opened once, so that a file replaced meanwhile (a finished run being
+    compressed) is checked whole.
     """
     with open(path, "rb") as fh:
         magic = fh.read(4)
-    if magic[:3] != b"CDF" or magic[3:] not in (b"\x01", b"\x02"):
-        return
-    from scipy.io import netcdf_file
-
-    try:
-        nc = netcdf_file(path, "r", mmap=True)
-    except (ValueError, TypeError, OSError, IndexError) as exc:  # the header points beyond the end
-        raise FileFormatError(f"{path}: truncated or damaged netCDF-3 file ({os.path.getsize(path)} bytes): "
-                              f"its header describes data beyond its end ({exc})") from exc
-    with nc:
-        header = nc.fp.tell()
+        if magic[:3] != b"CDF" or magic[3:] not in (b"\x01", b"\x02"):
+            return
+        fh.seek(0)
+        size = os.fstat(fh.fileno()).st_size
+        try:
+            nc = _header_reader()(fh, "r", mmap=False)
+        except (ValueError, TypeError, OSError, IndexError) as exc:  # the header points beyond the end
+            raise FileFormatError(f"{path}: truncated or damaged netCDF-3 file ({size} bytes): "
+                                  f"its header describes data beyond its end ({exc})") from exc
+        header = fh.tell()
         records = [v for v in nc.variables.values() if v.isrec]
         fixed, record_size = netcdf3_data_bytes(
             [v.data.nbytes for v in nc.variables.values() if not v.isrec],
             [v.itemsize() * int(np.prod(v.shape[1:], dtype=np.int64)) for v in records])
-        n_records = max((v.shape[0] for v in records), default=0)
-        expected = header + fixed + n_records * record_size
-        for v in nc.variables.values():  # drop the mmap references before closing
-            v.data = None
-    size = os.path.getsize(path)
-    if size < expected:
-        raise FileFormatError(f"{path}: truncated file ({size} bytes, its header needs at least {expected})")
+        n_records = nc.header_records if records else 0
+    needed = header + fixed + n_records * record_size
+    if size < needed and n_records and being_written(path):
+        needed -= record_size  # every record but the one being written
+    if size < needed:
+        raise FileFormatError(f"{path}: truncated file ({size} bytes, its header needs at least {needed})")
     hidden_records(path, size, header, fixed, record_size, n_records)  # nor longer by records it does not count
+
+
+REOPEN_ATTEMPTS = 3
+"""How many times :func:`open_dataset` opens a file that is replaced while it is opened."""
+
+
+def _open(source):
+    """The dataset of ``source`` (not chunked) and its snapshots' ``complete`` mask (None
+    without ``time``). netCDF-C reads a file's format and then opens it again by its name: a
+    finished run compressed in between (renamed over the name) fails as "Unknown file format".
+    A failure on a file whose name now points to another file is therefore tried again."""
+    for attempt in range(REOPEN_ATTEMPTS):
+        before = os.stat(source)
+        try:
+            _check_netcdf3_length(source)
+            ds = xr.open_dataset(source, engine="netcdf4", chunks=None, cache=False,
+                                 decode_times=False, mask_and_scale=True)
+            complete = complete_snapshots(ds.variables) if "time" in ds.variables and "time" in ds.dims else None
+            return ds, complete
+        except (OSError, ValueError, RuntimeError, KeyError, TypeError, IndexError) as exc:
+            try:
+                replaced = not os.path.samestat(before, os.stat(source))
+            except OSError:
+                replaced = False
+            if replaced and attempt + 1 < REOPEN_ATTEMPTS:
+                continue
+            if isinstance(exc, FileFormatError):
+                raise
+            raise FileFormatError(f"{source}: not a readable netCDF file ({exc})") from exc
 
 
 def _check_version(ds, source):
@@ -121,15 +170,7 @@ def open_dataset(path, chunks: int | dict | None = "auto", validate: bool = Fals
     source = os.fspath(path)
     if not os.path.exists(source):
         raise FileFormatError(f"{source}: no such file")
-    try:
-        _check_netcdf3_length(source)
-        ds = xr.open_dataset(source, engine="netcdf4", chunks=None, cache=False,
-                             decode_times=False, mask_and_scale=True)
-        complete = complete_snapshots(ds.variables) if "time" in ds.variables and "time" in ds.dims else None
-    except FileFormatError:
-        raise
-    except (OSError, ValueError, RuntimeError, KeyError, TypeError, IndexError) as exc:
-        raise FileFormatError(f"{source}: not a readable netCDF file ({exc})") from exc
+    ds, complete = _open(source)
     _check_version(ds, source)
     if complete is not None:
         n_complete = damaged_snapshots(complete, source)
