@@ -214,22 +214,30 @@ def resume(path, progress=None, compress=True) -> int:
     source = os.fspath(path)
     if not os.path.exists(source):
         raise FileFormatError(f"{source}: no such file")
-    with sigterm_raises():
-        lock = lock_file(source)
+    lock = None
     try:
-        with sigterm_raises():
-            sim, test = load_state(source)
-        first = sim.step_index - test["first_step"] + 1
-        if first > test["n_steps"]:
+        try:  # SIGTERM before the first step: one line, the file as it was
+            with sigterm_raises():
+                lock = lock_file(source)
+                sim, test = load_state(source)
+                first = sim.step_index - test["first_step"] + 1
+                finished = first > test["n_steps"]
+                if not finished:  # a compressed file is made netCDF-3 again here
+                    recorder = Recorder.append_to(source, sim, compress=level, lock=lock)
+        except Terminated:
+            print(f"terminated (SIGTERM) before the run went on: {source} is as it was", file=sys.stderr)
+            raise
+        if finished:
             if level and not is_compressed(source):
                 compress_finished(source, level, lock)
             return 0
-        with Recorder.append_to(source, sim, compress=level, lock=lock) as recorder:
+        with recorder:
             biaxial_steps(sim, recorder, first=first, n_steps=test["n_steps"], every=test["every"],
                           progress=progress)
         return test["n_steps"] - first + 1
     finally:
-        lock.release()
+        if lock is not None:
+            lock.release()
 
 
 def main(argv=None) -> int:

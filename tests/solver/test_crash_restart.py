@@ -519,6 +519,24 @@ def test_a_run_stopped_while_compressing_is_compressed_by_the_next_resume(refere
     assert sorted(p.name for p in tmp_path.iterdir()) == ["run.nc"]
 
 
+def test_sigterm_while_a_compressed_run_is_made_netcdf3_again_leaves_it_as_it_was(reference, tmp_path):
+    """A resume of a compressed, unfinished run first rewrites it netCDF-3: SIGTERM then stops
+    it with one line, the compressed file unchanged and no temporary file left."""
+    from grainview.writer import compress_file
+
+    path = _nearly_finished(reference, tmp_path / "run.nc")
+    compress_file(path)
+    before = path.read_bytes()
+    child = subprocess.run([sys.executable, "-c", STOPPED_COMPRESSING, str(path), "SIGTERM"], cwd=REPO, env=_env(),
+                           capture_output=True, text=True, timeout=120)
+    assert child.returncode == 143 and "Traceback" not in child.stderr, child.stderr
+    assert child.stderr.count("\n") == 1 and "terminated (SIGTERM) before the run went on" in child.stderr
+    assert path.read_bytes() == before
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["run.nc"]
+    assert _restart(path).returncode == 0
+    assert path.read_bytes() == reference.read_bytes()
+
+
 LIMITED = """
 import os, resource, signal, sys
 signal.signal(signal.SIGXFSZ, signal.SIG_IGN)  # a write beyond the limit fails with EFBIG
