@@ -41,11 +41,17 @@ into place (:meth:`SnapshotWriter.create`, :func:`compress_file`, :func:`decompr
 def _fsync(path: str) -> None:
     """Flush ``path`` (a file or a folder) to disk; a file system that cannot sync a folder is
     let be."""
-    fd = os.open(path, os.O_RDONLY)
+    folder = os.path.isdir(path)
+    try:
+        fd = os.open(path, os.O_RDONLY)
+    except OSError:
+        if folder:  # a system that cannot open a folder (Windows)
+            return
+        raise
     try:
         os.fsync(fd)
     except OSError:
-        if not os.path.isdir(path):
+        if not folder:
             raise
     finally:
         os.close(fd)
@@ -115,7 +121,8 @@ def lock_file(path) -> WriterLock:
     """Take the writer's lock of ``path`` (:class:`grainview.locks.WriterLock`) and remove the
     temporary files killed writers left beside it (:func:`remove_strays`)."""
     lock = WriterLock(path)
-    remove_strays(path)
+    if lock.held:  # without locks (no fcntl) another process may be writing them
+        remove_strays(path)
     return lock
 
 

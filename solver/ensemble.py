@@ -193,7 +193,9 @@ def run_one(spec: RunSpec, folder, *, overwrite=False, progress=None, compress=T
         warnings.simplefilter("always")
         if state == "finished":
             _check_settings(path, spec)
-            action, steps = "finished already", 0
+            # resume() of a finished test takes nothing further: it compresses a file whose
+            # compression was stopped and removes what killed writers left beside it
+            action, steps = "finished already", resume(path, progress=progress, compress=compress)
         elif state == "partial":
             _check_settings(path, spec)
             action, steps = "resumed", resume(path, progress=progress, compress=compress)

@@ -135,3 +135,29 @@ def test_specs_are_checked():
     with pytest.raises(ParameterError, match="workers"):
         ensemble.local_cluster(workers=0)
     assert RunSpec(shape="disk", particles=40, friction=0.2, seed=3).name == "disk_n40_mu0.2_s3"
+
+
+def test_a_finished_run_whose_compression_was_stopped_is_compressed_on_rerun(killed, tmp_path):
+    """A worker killed while compressing a finished run leaves it netCDF-3, with the
+    compression's temporary file and the lock's note: running the ensemble again finds it
+    finished, compresses it and removes what the dead worker left."""
+    import subprocess
+    import sys
+
+    from grainview.writer import decompress_file
+
+    specs, results, _, _ = killed
+    path = tmp_path / os.path.basename(results[1]["path"])
+    path.write_bytes(open(results[1]["path"], "rb").read())
+    decompress_file(path)
+    dead = subprocess.run([sys.executable, "-c", "import os; print(os.getpid())"], capture_output=True, text=True)
+    stray = tmp_path / f".{path.name}.{int(dead.stdout)}.convert"
+    stray.write_bytes(b"half a compressed copy")
+    (tmp_path / f".{path.name}.writer").write_text(f"process {int(dead.stdout)} on a machine")
+    result = run_one(specs[1], tmp_path)
+    assert result["action"] == "finished already" and result["steps"] == 0
+    assert is_compressed(path)
+    assert sorted(p.name for p in tmp_path.iterdir()) == [path.name]
+    with grainview.open_dataset(path, chunks=None) as ds, \
+            grainview.open_dataset(results[1]["path"], chunks=None) as done:
+        xr.testing.assert_identical(ds, done)
