@@ -16,7 +16,7 @@ from .schema import (CONTACT_VARIABLES, DEFAULT_WALL_NAMES, OPTIONAL_CONTACT_VAR
                      VARIABLES, complete_snapshots, contact_slots, empty_slots, global_attrs, variable_attrs)
 
 __all__ = ["SnapshotWriter", "compress_file", "decompress_file", "is_compressed", "check_complevel",
-           "netcdf3_data_bytes", "lock_file", "remove_strays", "APPEND_FORMAT",
+           "netcdf3_data_bytes", "lock_file", "remove_strays", "last_complete_value", "APPEND_FORMAT",
            "COMPRESSED_FORMAT", "DEFAULT_COMPLEVEL"]
 
 APPEND_FORMAT = "NETCDF3_64BIT_OFFSET"
@@ -124,6 +124,19 @@ def lock_file(path) -> WriterLock:
     if lock.held:  # without locks (no fcntl) another process may be writing them
         remove_strays(path)
     return lock
+
+
+def last_complete_value(path, name):
+    """The value of variable ``name`` at the last complete snapshot of the file ``path`` (either
+    format), or None when it has no complete snapshot or no such variable."""
+    import netCDF4
+
+    with netCDF4.Dataset(os.fspath(path)) as nc:
+        nc.set_auto_mask(False)
+        if name not in nc.variables:
+            return None
+        complete = np.flatnonzero(complete_snapshots(nc.variables))
+        return nc.variables[name][complete[-1]].item() if complete.size else None
 
 
 def _move_into_place(temporary: str, path: str, overwrite: bool) -> None:

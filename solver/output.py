@@ -28,8 +28,8 @@ import warnings
 import numpy as np
 
 from grainview.schema import DIAGNOSTICS
-from grainview.errors import OutputError, ParameterError
-from grainview.writer import DEFAULT_COMPLEVEL, SnapshotWriter, compress_file
+from grainview.errors import FileFormatError, OutputError, ParameterError
+from grainview.writer import DEFAULT_COMPLEVEL, SnapshotWriter, compress_file, last_complete_value, lock_file
 
 from . import __version__
 from .contact_points import point_forces, rank_in_pair
@@ -207,14 +207,31 @@ class Recorder:
         :mod:`solver.restart`); the file's attributes are left as they are. A compressed file
         is made netCDF-3 again to append to, and compressed again at the end (``compress``).
         ``lock``: ``path``'s writer lock, taken by the caller before it read the state ``sim``
-        comes from (the caller releases it); default: taken here."""
+        comes from (the caller releases it); default: taken here.
+
+        Raises :class:`FileFormatError`, the file untouched, when the file's last complete
+        snapshot is not the state's step (``sim.step_index``): another process appended to it
+        after the state was read."""
         recorder = cls.__new__(cls)
         recorder.compress = compress_level(compress)
         recorder.sim = sim
         sim.take_unconverged()
+        own = lock is None
         with sigterm_raises():
-            recorder.writer = SnapshotWriter.open_append(path, lock=lock)
-        recorder._hold(resumable=True, own=lock is None)
+            if own:
+                lock = lock_file(path)
+            try:
+                last = last_complete_value(path, "step")
+                if last is not None and last != sim.step_index:
+                    raise FileFormatError(f"{path}: its last snapshot is at step {last}, not at step {sim.step_index} "
+                                          "of the state to go on from (another process appended to it since the "
+                                          "state was read): read the state again")
+                recorder.writer = SnapshotWriter.open_append(path, lock=lock)
+            except BaseException:
+                if own:
+                    lock.release()
+                raise
+        recorder._hold(resumable=True, own=own)
         near = recorder.writer.attribute("near_contacts_m", "none")
         recorder.near = None if isinstance(near, str) else float(near)
         return recorder

@@ -472,6 +472,21 @@ def test_a_second_resume_of_a_file_being_resumed_is_refused_and_the_file_ends_ri
     assert sorted(p.name for p in tmp_path.iterdir()) == ["run.nc"]
 
 
+def test_appending_a_state_the_file_has_moved_past_is_refused_and_the_file_untouched(reference, tmp_path):
+    """Recorder.append_to checks, under the lock, that the file still ends at the state's step:
+    a state read before another process finished (and compressed) the file is refused."""
+    path = _nearly_finished(reference, tmp_path / "run.nc")
+    sim, _ = load_state(path)  # step of snapshot 61
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        assert resume(path, progress=False) == 6  # meanwhile another resume finished the run
+    with pytest.raises(FileFormatError, match=f"last snapshot is at step {sim.step_index + 6}, not at step "
+                                              f"{sim.step_index} .*read the state again"):
+        Recorder.append_to(path, sim)
+    assert path.read_bytes() == reference.read_bytes()  # neither decompressed nor appended to
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["run.nc"]  # the lock released
+
+
 STOPPED_COMPRESSING = """
 import os, signal, sys, time, warnings
 warnings.simplefilter("ignore")
