@@ -52,10 +52,15 @@ def being_written(path) -> bool:
     words = text.split()
     if len(words) != 4 or words[0] != "process" or not words[1].isdigit():
         return True  # a note being written: its process has just taken the lock
-    if words[3] != socket.gethostname():
+    return words[3] != socket.gethostname() or process_alive(int(words[1]))
+
+
+def process_alive(pid: int) -> bool:
+    """Whether process ``pid`` exists on this machine (POSIX; True where it cannot be asked)."""
+    if fcntl is None:  # Windows: os.kill(pid, 0) would send CTRL_C_EVENT
         return True
     try:
-        os.kill(int(words[1]), 0)
+        os.kill(pid, 0)
     except ProcessLookupError:
         return False
     except PermissionError:  # another user's process

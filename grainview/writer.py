@@ -11,7 +11,7 @@ import os
 import numpy as np
 
 from .errors import FileFormatError, GrainviewError, OutputError, ParameterError
-from .locks import WriterLock
+from .locks import WriterLock, process_alive
 from .schema import (CONTACT_VARIABLES, DEFAULT_WALL_NAMES, OPTIONAL_CONTACT_VARIABLES, REQUIRED, TIME_ATTRS,
                      VARIABLES, complete_snapshots, contact_slots, empty_slots, global_attrs, variable_attrs)
 
@@ -82,17 +82,6 @@ def _why(exc) -> str:
     return str(exc) if limit == resource.RLIM_INFINITY else f"{exc}; the file-size limit, ulimit -f, is {limit} bytes"
 
 
-def _alive(pid: int) -> bool:
-    """Whether process ``pid`` exists on this machine."""
-    try:
-        os.kill(pid, 0)
-    except ProcessLookupError:
-        return False
-    except PermissionError:  # another user's process
-        return True
-    return True
-
-
 def remove_strays(path) -> list[str]:
     """Remove the temporary files that killed processes left beside ``path`` (a creation or a
     conversion stopped by SIGKILL: ``.<name>.<pid>.part`` or ``.convert``). Only for a caller
@@ -107,7 +96,7 @@ def remove_strays(path) -> list[str]:
         if not (name.startswith(f".{base}.") and name.endswith(TEMPORARY_SUFFIXES)):
             continue
         pid = name[len(base) + 2:].rsplit(".", 1)[0]
-        if not pid.isdigit() or int(pid) == os.getpid() or _alive(int(pid)):
+        if not pid.isdigit() or int(pid) == os.getpid() or process_alive(int(pid)):
             continue
         try:
             os.remove(os.path.join(directory, name))
