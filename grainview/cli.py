@@ -93,6 +93,15 @@ def _convert(args) -> int:
     return 0
 
 
+def _convert_lmgc90(args) -> int:
+    from .formats.lmgc90 import convert_lmgc90
+
+    count = convert_lmgc90(args.out, args.run, overwrite=args.overwrite, compress=not args.no_compress,
+                           progress=args.progress != "off")
+    print(f"wrote {args.out}: {count} snapshots from LMGC90 (check it: grainview info {args.out} --check)")
+    return 0
+
+
 def _demo(args) -> int:
     from . import open_dataset
     from .dataset import netcdf_options
@@ -695,6 +704,18 @@ def build_parser() -> argparse.ArgumentParser:
     lammps.add_argument("--progress", choices=("on", "off"), default="on", help="progress bar (default: on)")
     no_compress_option(lammps)
     lammps.set_defaults(func=_convert)
+    lmgc90 = formats.add_parser("lmgc90", help="an LMGC90 2D rigid run (DATBOX + OUTBOX text files)",
+                                description="An LMGC90 2D rigid run: its folder holding DATBOX/BODIES.DAT and "
+                                "BULK_BEHAV.DAT (RBDY2 bodies with one DISKx, regular POLYG or JONCx contactor) and "
+                                "OUTBOX/DOF.OUT.n with Vloc_Rloc.OUT.n (DKDKx, DKJCx, PLPLx, PLJCx, DKPLx). "
+                                "Contacts: body pairs with a compressive normal force; two points on a pair make a "
+                                "double contact (docs/formats.md).")
+    lmgc90.add_argument("run", help="the run folder (holding DATBOX/ and OUTBOX/)")
+    lmgc90.add_argument("--out", required=True, help="the netCDF file to write")
+    lmgc90.add_argument("--overwrite", action="store_true", help="replace an existing --out")
+    lmgc90.add_argument("--progress", choices=("on", "off"), default="on", help="progress bar (default: on)")
+    no_compress_option(lmgc90)
+    lmgc90.set_defaults(func=_convert_lmgc90)
     for engine, version in (("box2d", "Box2D 2.3"), ("pymunk", "pymunk")):
         peer = formats.add_parser(engine, help=f"a {version} run of the cross-check (raw snapshots)",
                                   description=f"A {version} run of the cross-check harness (benchmarks/crosscheck/): "

@@ -9,7 +9,7 @@ from __future__ import annotations
 
 from xarray.backends import BackendEntrypoint
 
-__all__ = ["LammpsBackend", "Box2dBackend", "PymunkBackend"]
+__all__ = ["LammpsBackend", "Box2dBackend", "PymunkBackend", "Lmgc90Backend"]
 
 
 class LammpsBackend(BackendEntrypoint):
@@ -73,3 +73,23 @@ class PymunkBackend(_PeerBackend):
 
     engine = "pymunk"
     description = "pymunk runs of grainview's cross-check (raw snapshots) as a grainview dataset"
+
+
+class Lmgc90Backend(BackendEntrypoint):
+    """LMGC90 2D rigid runs (:func:`grainview.formats.lmgc90.open_lmgc90`).
+
+    ``xr.open_dataset("run_folder", engine="lmgc90")``: the path is the run's folder, holding
+    ``DATBOX/`` (BODIES.DAT, BULK_BEHAV.DAT) and ``OUTBOX/`` (DOF.OUT.n, Vloc_Rloc.OUT.n).
+    """
+
+    description = "LMGC90 2D rigid runs (DATBOX and OUTBOX text files) as a grainview dataset"
+    url = "https://git-xen.lmgc.univ-montp2.fr/lmgc90/lmgc90_user"
+    open_dataset_parameters = ("filename_or_obj", "drop_variables")
+
+    def open_dataset(self, filename_or_obj, *, drop_variables=None):
+        from .lmgc90 import open_lmgc90
+
+        return open_lmgc90(filename_or_obj).drop_vars(list(drop_variables or []), errors="ignore")
+
+    def guess_can_open(self, filename_or_obj) -> bool:
+        return False

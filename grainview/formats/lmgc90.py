@@ -1,0 +1,451 @@
+"""LMGC90 2D rigid runs (disks, polygons, walls) as datasets of the grainview contract.
+
+An LMGC90 run folder holds ``DATBOX/`` (the model: ``BODIES.DAT``, ``BULK_BEHAV.DAT``) and
+``OUTBOX/`` (``DOF.OUT.n`` and ``Vloc_Rloc.OUT.n``, one snapshot each; the file layer is
+:mod:`grainview.formats.lmgc90_text`). The reader takes RBDY2 bodies with one contactor each:
+``DISKx`` (a disk), ``POLYG`` (a polygon, which must be regular) or ``JONCx`` (a wall), and the
+contact families ``DKDKx``, ``DKJCx``, ``PLPLx``, ``PLJCx`` and ``DKPLx``.
+
+How the contract's quantities are made (docs/formats.md states the same for users):
+
+* Particles are the DISKx and POLYG bodies in the order of BODIES.DAT; the JONCx bodies are the
+  walls ``N + w``. Four axis-aligned JONCx around the particles are named ``bottom, right, top,
+  left`` (in that order) and their inner faces are the sample box; other walls are named
+  ``jonc<number>`` in file order, and the box is then the particles' bounding box.
+* ``position = reference + X(1:2)`` (DOF.OUT's displacement from BODIES.DAT's node),
+  ``velocity = V(1:2)``, ``angular_velocity = V(3)``. A disk's ``angle`` is ``X(3)``; a
+  polygon's is the angle of its first vertex in BODIES.DAT plus ``X(3)``, so that vertex k lies
+  at ``angle + 2 pi k / n`` (the contract's regular n-gon); its ``radius`` is the distance of
+  the vertices from the centre. A POLYG whose vertices are not a regular polygon centred on the
+  body's node is refused.
+* ``mass = density pi avrd^2`` (``density`` the bulk behaviour's ``Umas``), ``inertia = mass
+  gyrd^2``; LMGC90's 2D bodies are slabs of unit thickness (``thickness_m = 1``).
+* LMGC90 writes, for each candidate-antagonist entry, the unit normal ``n = (n(1), n(2))``
+  pointing from the antagonist to the candidate, ``t = (n_y, -n_x)``, and the mean forces over
+  the step ``rln/H``, ``rlt/H``: the force exerted on the candidate by the antagonist is
+  ``rln n + rlt t``. For a contract contact of bodies ``i < j`` (a particle and a wall: ``i``
+  the particle) the normal is the unit vector from ``i`` to ``j`` (``-n`` when ``i`` is the
+  candidate, ``n`` otherwise), the force exerted by ``i`` on ``j`` follows by Newton's third
+  law, and ``fn``, ``ft`` are its components along the normal and ``(-normal_y, normal_x)``:
+  ``fn = rln`` and ``ft = -rlt`` in both cases.
+* Two entries of the same body pair (two PLPLx, or two PLJCx, points of a face-to-face contact)
+  are one double contact (``kind = 2``): the resultant force, applied at the mean of the two
+  points weighted by their normal forces (their midpoint when both are zero). Every other pair
+  is simple (``kind = 1``). A pair is written when its normal force is compressive
+  (``fn > 0``); LMGC90's entries within the alert distance that carry nothing are left out.
+* ``branch = x_j - x_i`` for particle pairs, the contact point minus ``x_i`` for wall contacts;
+  ``gap`` is the smallest ``gapTT`` of the pair's points; ``point`` is LMGC90's contact point
+  (``coo1, coo2``). ``wall_force`` is the total force exerted by the particles on each wall.
+* ``time`` and ``step`` are DOF.OUT's header's.
+
+Every function checks its input first and refuses bad input in one line
+(:class:`grainview.errors.FileFormatError`).
+"""
+
+from __future__ import annotations
+
+import math
+import os
+
+import numpy as np
+
+from ..errors import FileFormatError
+from .lmgc90_text import output_files, read_bodies, read_bulk_behav, read_dof, read_vloc_rloc
+
+__all__ = ["lmgc90_snapshots", "open_lmgc90", "convert_lmgc90", "FAMILIES", "BOX_WALLS", "regular_polygon"]
+
+FAMILIES = ("DKDKx", "DKJCx", "PLPLx", "PLJCx", "DKPLx")
+"""The contact families the reader takes (candidate contactor, then antagonist)."""
+BOX_WALLS = ("bottom", "right", "top", "left")
+"""Names (and order) of the walls of a box of four JONCx."""
+_PARTICLE_CONTACTORS = {"DISKx", "POLYG"}
+_IRREGULAR = "irregular POLYG: the contract holds regular polygons only until vertex lists are added"
+
+
+def regular_polygon(vertices, rtol=1e-5):
+    """Radius, vertex count and first-vertex angle of a regular polygon centred on the origin.
+
+    Parameters
+    ----------
+    vertices : array_like, (n, 2)
+        The vertices (m), in any rotational order.
+    rtol : float
+        Relative tolerance on the distances and the angular spacing (BODIES.DAT writes 8
+        significant digits).
+
+    Returns
+    -------
+    (float, int, float) or None
+        ``(R, n, phi)``: vertex k at ``R (cos(phi + 2 pi k/n), sin(phi + 2 pi k/n))``; None when
+        the vertices are not those of a regular polygon centred on the origin.
+    """
+    v = np.asarray(vertices, float)
+    n = v.shape[0]
+    if n < 3:
+        return None
+    r = np.hypot(v[:, 0], v[:, 1])
+    radius = float(r.mean())
+    if radius <= 0 or np.abs(r - radius).max() > rtol * radius or np.abs(v.mean(axis=0)).max() > rtol * radius:
+        return None
+    phi = math.atan2(v[0, 1], v[0, 0])
+    offset = np.sort(np.mod(np.arctan2(v[:, 1], v[:, 0]) - phi + rtol, 2 * np.pi) - rtol)
+    if np.abs(offset - 2 * np.pi * np.arange(n) / n).max() > rtol * 2 * np.pi:
+        return None
+    return radius, n, phi
+
+
+class _Model:
+    """The static part of a run, from DATBOX: particles, walls and how bodies map to them."""
+
+    def __init__(self, datbox):
+        bodies_path = os.path.join(datbox, "BODIES.DAT")
+        behav_path = os.path.join(datbox, "BULK_BEHAV.DAT")
+        for path in (bodies_path, behav_path):
+            if not os.path.isfile(path):
+                raise FileFormatError(f"{datbox}: no {os.path.basename(path)} (an LMGC90 run folder holds "
+                                      "DATBOX/BODIES.DAT and DATBOX/BULK_BEHAV.DAT, and OUTBOX/)")
+        bodies = read_bodies(bodies_path)
+        density, self.gravity = read_bulk_behav(behav_path)
+        particles, walls = [], []
+        for body in bodies:
+            where = f"{bodies_path}: body {body.number}"
+            if body.model != "RBDY2":
+                raise FileFormatError(f"{where}: a {body.model} body; only 2D rigid bodies (RBDY2) can be read")
+            if len(body.contactors) != 1:
+                raise FileFormatError(f"{where}: {len(body.contactors)} contactors; the contract holds one shape per "
+                                      "body (DISKx, POLYG or JONCx)")
+            kind = body.contactors[0].kind
+            if kind in _PARTICLE_CONTACTORS:
+                particles.append(body)
+            elif kind == "JONCx":
+                walls.append(body)
+            else:
+                raise FileFormatError(f"{where}: unknown contactor type {kind!r}; expected DISKx, POLYG or JONCx")
+        if not particles:
+            raise FileFormatError(f"{bodies_path}: no DISKx or POLYG body (no particles)")
+        n = len(particles)
+        self.radius, self.n_vertices, self.angle0 = np.zeros(n), np.zeros(n, "i4"), np.zeros(n)
+        self.mass, self.inertia = np.zeros(n), np.zeros(n)
+        for k, body in enumerate(particles):
+            where = f"{bodies_path}: body {body.number}"
+            tact = body.contactors[0]
+            if tact.kind == "DISKx":
+                self.radius[k] = tact.values.get("byrd", float("nan"))
+            else:
+                shape = regular_polygon(tact.vertices)
+                if shape is None:
+                    raise FileFormatError(f"{where}: {_IRREGULAR}")
+                self.radius[k], self.n_vertices[k], self.angle0[k] = shape
+            if body.behav not in density:
+                raise FileFormatError(f"{where}: bulk behaviour {body.behav!r} is not in {behav_path}")
+            if not (self.radius[k] > 0 and body.avrd > 0 and body.gyrd > 0):
+                raise FileFormatError(f"{where}: radius, avrd and gyrd must be > 0")
+            self.mass[k] = density[body.behav] * math.pi * body.avrd ** 2
+            self.inertia[k] = self.mass[k] * body.gyrd ** 2
+        self.reference = np.array([body.reference[:2] for body in particles])
+        self.numbers = np.array([body.number for body in particles], np.int64)
+        self.kinds = [body.contactors[0].kind for body in particles]
+        self.wall_bodies = walls
+        self.source = bodies_path
+        self.box_walls = False  # set by name_walls on the first snapshot
+        self.walls, self.wall_names = [], []
+
+    @property
+    def n(self):
+        return self.radius.size
+
+    def name_walls(self, dof):
+        """Name the walls from their place in the first snapshot; four axis-aligned JONCx
+        around the particles make a box (:data:`BOX_WALLS`)."""
+        walls = self.wall_bodies
+        self.body_index = {int(b): k for k, b in enumerate(self.numbers)}
+        if not walls:
+            return
+        state = {int(b): x for b, x in zip(dof.numbers, dof.X)}
+        missing = [int(b.number) for b in walls if int(b.number) not in state]
+        missing += [int(b) for b in self.numbers if int(b) not in state]
+        if missing:
+            raise FileFormatError(f"body {missing[0]} of {self.source} is not in the first DOF.OUT")
+        centre = (self.reference + np.array([state[int(b)][:2] for b in self.numbers])).mean(axis=0)
+        named = {}
+        for body in walls:
+            x = body.reference + state[int(body.number)]
+            angle = math.remainder(x[2], math.pi)
+            if abs(angle) < 1e-6:
+                name = "bottom" if x[1] < centre[1] else "top"
+            elif abs(abs(angle) - math.pi / 2) < 1e-6:
+                name = "left" if x[0] < centre[0] else "right"
+            else:
+                break
+            named.setdefault(name, body)
+        if len(walls) == 4 and len(named) == 4:
+            self.walls = [named[name] for name in BOX_WALLS]
+            self.wall_names = list(BOX_WALLS)
+            self.box_walls = True
+        else:
+            self.walls = list(walls)
+            self.wall_names = [f"jonc{body.number}" for body in walls]
+            self.box_walls = False
+        self.body_index.update({int(body.number): self.n + w for w, body in enumerate(self.walls)})
+
+
+def _state(model, dof, where):
+    """Positions, angles, velocities of the particles and the walls' positions from a DOF record."""
+    row = {int(b): k for k, b in enumerate(dof.numbers)}
+    missing = [int(b) for b in model.numbers if int(b) not in row]
+    missing += [int(w.number) for w in model.wall_bodies if int(w.number) not in row]
+    if missing:
+        raise FileFormatError(f"{where}: body {missing[0]} of BODIES.DAT is not in the file")
+    k = np.array([row[int(b)] for b in model.numbers])
+    X, V = dof.X[k], dof.V[k]
+    walls = np.array([w.reference + dof.X[row[int(w.number)]] for w in model.walls]).reshape(-1, 3)
+    return model.reference + X[:, :2], model.angle0 + X[:, 2], V[:, :2].copy(), V[:, 2].copy(), walls
+
+
+def _box(model, position, walls):
+    if model.box_walls:
+        half = [w.contactors[0].values.get("axe2", 0.0) for w in model.walls]
+        bottom, right, top, left = walls[:, :2]
+        return (np.array([left[0] + half[3], bottom[1] + half[0]]),
+                np.array([right[0] - half[1], top[1] - half[2]]))
+    return (position - model.radius[:, None]).min(axis=0), (position + model.radius[:, None]).max(axis=0)
+
+
+def _contacts(model, position, vloc, where):
+    """Contract contacts (dict of arrays) and the total force on each wall, from one
+    Vloc_Rloc record."""
+    n = model.n
+    pairs = {}
+    for entry in vloc.entries:
+        if entry.family not in FAMILIES:
+            raise FileFormatError(f"{where}: unknown contactor type: contact family {entry.family!r} "
+                                  f"({entry.cd_kind} on {entry.an_kind}); expected one of {', '.join(FAMILIES)}")
+        try:
+            cd, an = model.body_index[entry.cd], model.body_index[entry.an]
+        except KeyError as exc:
+            raise FileFormatError(f"{where}: {entry.family} entry on body {exc.args[0]}, which is not a body of "
+                                  f"{model.source}") from None
+        if cd >= n:
+            raise FileFormatError(f"{where}: {entry.family} entry whose candidate (body {entry.cd}) is a wall")
+        pairs.setdefault((min(cd, an), max(cd, an)), []).append((entry, cd))
+    out = {k: [] for k in ("i", "j", "kind", "normal", "fn", "ft", "point", "branch", "gap")}
+    wall_force = np.zeros((len(model.wall_names), 2))
+    for (i, j), points in pairs.items():
+        if len(points) > 2:
+            raise FileFormatError(f"{where}: {len(points)} entries on the pair of bodies {points[0][0].cd} and "
+                                  f"{points[0][0].an}; a 2D contact has at most two points")
+        force = np.zeros(2)
+        fn_points, xy = [], []
+        first = points[0][0]
+        nuc = np.array(first.normal)
+        normal = -nuc if points[0][1] == i else nuc  # from i to j
+        for entry, cd in points:
+            e_n = np.array(entry.normal)
+            e_t = np.array([e_n[1], -e_n[0]])
+            on_cd = entry.rln * e_n + entry.rlt * e_t  # exerted by the antagonist on the candidate
+            force += -on_cd if cd == i else on_cd  # exerted by i on j
+            fn_points.append(entry.rln)
+            xy.append(entry.point)
+        fn = float(force @ normal)
+        if not fn > 0:
+            continue
+        tangent = np.array([-normal[1], normal[0]])
+        weights = np.array(fn_points)
+        xy = np.array(xy)
+        point = (weights @ xy) / weights.sum() if weights.sum() > 0 else xy.mean(axis=0)
+        out["i"].append(i)
+        out["j"].append(j)
+        out["kind"].append(len(points))
+        out["normal"].append(normal)
+        out["fn"].append(fn)
+        out["ft"].append(float(force @ tangent))
+        out["point"].append(point)
+        out["branch"].append(position[j] - position[i] if j < n else point - position[i])
+        out["gap"].append(min(entry.gap for entry, _ in points))
+        if j >= n:
+            wall_force[j - n] += force
+    dtypes = {"i": "i4", "j": "i4", "kind": "i1"}
+    contacts = {k: np.array(v, dtypes.get(k, "f8")) for k, v in out.items()}
+    for k in ("normal", "point", "branch"):
+        contacts[k] = contacts[k].reshape(-1, 2)
+    return contacts, wall_force
+
+
+def _run_folders(run):
+    run = os.fspath(run)
+    if not os.path.isdir(run):
+        raise FileFormatError(f"{run}: no such folder (expected an LMGC90 run folder holding DATBOX/ and OUTBOX/)")
+    datbox, outbox = os.path.join(run, "DATBOX"), os.path.join(run, "OUTBOX")
+    if not os.path.isdir(datbox) or not os.path.isfile(os.path.join(datbox, "BODIES.DAT")):
+        raise FileFormatError(f"{run}: no DATBOX/BODIES.DAT (expected an LMGC90 run folder holding DATBOX/ and "
+                              "OUTBOX/)")
+    return run, datbox, outbox
+
+
+def lmgc90_snapshots(run):
+    """Read an LMGC90 2D run snapshot by snapshot, as the contract's per-snapshot arrays.
+
+    Parameters
+    ----------
+    run : str or path-like
+        The run folder, holding ``DATBOX/BODIES.DAT``, ``DATBOX/BULK_BEHAV.DAT`` and
+        ``OUTBOX/DOF.OUT.n``, ``OUTBOX/Vloc_Rloc.OUT.n``.
+
+    Returns
+    -------
+    (static, iterator)
+        ``static``: a dict of the particles' ``radius``, ``n_vertices``, ``mass``, ``inertia``
+        (arrays, (N,)), ``n_walls``, ``wall_names`` and ``attrs`` (the conversion's provenance);
+        the iterator yields one dict per snapshot with ``time`` (s), ``step``, ``position``
+        (N, 2), ``angle`` (N,), ``velocity`` (N, 2), ``angular_velocity`` (N,), ``contacts``
+        (dict of contract contact arrays), ``box_min``, ``box_max`` (2,) and, with walls,
+        ``wall_force`` (W, 2). DATBOX and the first snapshot are read at once; the iterator
+        reads the rest one snapshot at a time.
+
+    Raises
+    ------
+    FileFormatError
+        One line naming what is wrong: a missing DATBOX or OUTBOX file, a body with another
+        contactor than DISKx, POLYG or JONCx, an irregular POLYG, an unknown contact family, a
+        truncated file, DOF.OUT and Vloc_Rloc.OUT of different steps.
+    """
+    run, datbox, outbox = _run_folders(run)
+    model = _Model(datbox)
+    files = output_files(outbox)
+    n_first, dof_path, vloc_path = files[0]
+    first = read_dof(dof_path)
+    model.name_walls(first)
+    attrs = {"source": "LMGC90", "lmgc90_run": os.path.basename(os.path.abspath(run)), "thickness_m": 1.0,
+             "lmgc90_gravity_m_s2": np.asarray(model.gravity[:2], float),
+             "lmgc90_contact_rule": "body pairs with a compressive normal force; two points on a pair make a double "
+                                    "contact"}
+    static = dict(radius=model.radius, n_vertices=model.n_vertices, mass=model.mass, inertia=model.inertia,
+                  n_walls=len(model.wall_names), wall_names=list(model.wall_names) or None, attrs=attrs)
+
+    def snapshots():
+        for k, (number, dof_file, vloc_file) in enumerate(files):
+            dof = first if k == 0 else read_dof(dof_file)
+            vloc = read_vloc_rloc(vloc_file)
+            if vloc.step != dof.step:
+                raise FileFormatError(f"{vloc_file}: step {vloc.step}, but {os.path.basename(dof_file)} is at step "
+                                      f"{dof.step} (a snapshot's two files must be of the same step)")
+            position, angle, velocity, omega, walls = _state(model, dof, dof_file)
+            contacts, wall_force = _contacts(model, position, vloc, vloc_file)
+            box_min, box_max = _box(model, position, walls)
+            snap = dict(time=dof.time, step=dof.step, position=position, angle=angle, velocity=velocity,
+                        angular_velocity=omega, contacts=contacts, box_min=box_min, box_max=box_max)
+            if model.wall_names:
+                snap["wall_force"] = wall_force
+            yield snap
+
+    return static, snapshots()
+
+
+def open_lmgc90(run, *, progress=False):
+    """An LMGC90 2D run as an in-memory dataset of the contract.
+
+    Parameters
+    ----------
+    run : str or path-like
+        The run folder (:func:`lmgc90_snapshots`).
+    progress : bool, default False
+        Show a progress bar over the snapshots.
+
+    Returns
+    -------
+    xarray.Dataset
+        A dataset of the contract (docs/schema.md; the conversion's rules: docs/formats.md)
+        with ``velocity``, ``angular_velocity``, ``step``, ``gap`` and, with walls,
+        ``wall_force``. For a run too large for memory, :func:`convert_lmgc90` writes a file
+        snapshot by snapshot instead.
+    """
+    from ..dataset import make_dataset
+
+    static, stream = lmgc90_snapshots(run)
+    if progress:
+        from tqdm.auto import tqdm
+
+        stream = tqdm(stream, desc="lmgc90", unit=" snapshots")
+    snaps = list(stream)
+    optional = {"step": np.array([s["step"] for s in snaps], "i4"),
+                "velocity": np.stack([s["velocity"] for s in snaps]),
+                "angular_velocity": np.stack([s["angular_velocity"] for s in snaps])}
+    if static["n_walls"]:
+        optional["wall_force"] = np.stack([s["wall_force"] for s in snaps])
+    return make_dataset(radius=static["radius"], n_vertices=static["n_vertices"], mass=static["mass"],
+                        inertia=static["inertia"], position=np.stack([s["position"] for s in snaps]),
+                        angle=np.stack([s["angle"] for s in snaps]), contacts=[s["contacts"] for s in snaps],
+                        box_min=np.stack([s["box_min"] for s in snaps]), box_max=np.stack([s["box_max"] for s in snaps]),
+                        time=np.array([s["time"] for s in snaps]), n_walls=static["n_walls"],
+                        wall_names=static["wall_names"], attrs=static["attrs"], **optional)
+
+
+def convert_lmgc90(out, run, *, overwrite=False, compress=True, progress=False):
+    """Convert an LMGC90 2D run into a file of the contract, snapshot by snapshot.
+
+    Each snapshot (a DOF.OUT.n and its Vloc_Rloc.OUT.n) is read and appended to the file in
+    turn (:class:`grainview.writer.SnapshotWriter`), so a run of any length converts in the
+    memory of one snapshot. The file is written under a hidden temporary name, validated,
+    compressed (unless ``compress=False``) and only then moved to ``out``: bad input anywhere
+    leaves nothing behind.
+
+    Parameters
+    ----------
+    out : str or path-like
+        The netCDF file to write; an existing one is refused unless ``overwrite``.
+    run : str or path-like
+        The LMGC90 run folder (:func:`lmgc90_snapshots`).
+    overwrite : bool, default False
+        Replace an existing ``out``.
+    compress : bool, default True
+        Write the finished file compressed (docs/schema.md, "Compression").
+    progress : bool, default False
+        Show a progress bar over the snapshots.
+
+    Returns
+    -------
+    int
+        The number of snapshots written.
+
+    Raises
+    ------
+    FileExistsError
+        ``out`` exists and ``overwrite`` is False (checked before any work).
+    FileFormatError, SchemaError
+        Bad input (one line); nothing is written.
+    """
+    from ..io import open_dataset
+    from ..writer import SnapshotWriter, _move_into_place, compress_file
+
+    out = os.fspath(out)
+    if os.path.exists(out) and not overwrite:
+        raise FileExistsError(f"{out} exists; pass overwrite=True to replace it")
+    folder = os.path.dirname(os.path.abspath(out))
+    if not os.path.isdir(folder):
+        raise FileFormatError(f"{out}: the folder {folder} does not exist")
+    static, stream = lmgc90_snapshots(run)
+    temporary = os.path.join(folder, f".{os.path.basename(out)}.{os.getpid()}.lmgc90")
+    optional = ("step", "gap", "velocity", "angular_velocity") + (("wall_force",) if static["n_walls"] else ())
+    if progress:
+        from tqdm.auto import tqdm
+
+        stream = tqdm(stream, desc=f"lmgc90 -> {os.path.basename(out)}", unit=" snapshots")
+    count = 0
+    try:
+        with SnapshotWriter.create(temporary, radius=static["radius"], n_vertices=static["n_vertices"],
+                                   mass=static["mass"], inertia=static["inertia"], n_walls=static["n_walls"],
+                                   wall_names=static["wall_names"], optional=optional,
+                                   attrs=static["attrs"]) as writer:
+            for snap in stream:
+                writer.append(**snap)
+                count += 1
+        open_dataset(temporary, chunks=None, validate=True).close()
+        if compress:
+            compress_file(temporary)
+        _move_into_place(temporary, out, overwrite)
+    finally:
+        if progress:
+            stream.close()
+        if os.path.exists(temporary):
+            os.remove(temporary)
+    return count
