@@ -375,7 +375,8 @@ def open_lmgc90(run, *, progress=False):
     return make_dataset(radius=static["radius"], n_vertices=static["n_vertices"], mass=static["mass"],
                         inertia=static["inertia"], position=np.stack([s["position"] for s in snaps]),
                         angle=np.stack([s["angle"] for s in snaps]), contacts=[s["contacts"] for s in snaps],
-                        box_min=np.stack([s["box_min"] for s in snaps]), box_max=np.stack([s["box_max"] for s in snaps]),
+                        box_min=np.stack([s["box_min"] for s in snaps]),
+                        box_max=np.stack([s["box_max"] for s in snaps]),
                         time=np.array([s["time"] for s in snaps]), n_walls=static["n_walls"],
                         wall_names=static["wall_names"], attrs=static["attrs"], **optional)
 

@@ -220,6 +220,14 @@ def read_bulk_behav(path) -> tuple:
     return density, gravity
 
 
+def _one_record(lines, start, path):
+    """Refuse a file holding several ``$steps`` records (LMGC90's append mode)."""
+    later = [k for k in range(start, len(lines)) if lines[k].startswith("$steps")]
+    if later:
+        raise FileFormatError(f"{path}: line {later[0] + 1}: a second '$steps' record; the reader takes one snapshot "
+                              "per file (DOF.OUT.n, Vloc_Rloc.OUT.n), not files written in append mode")
+
+
 def _header(lines, path):
     for k, line in enumerate(lines):
         text = line.strip()
@@ -257,6 +265,7 @@ def read_dof(path) -> DofSnapshot:
     path = os.fspath(path)
     lines = _lines(path)
     step, time, start = _header(lines, path)
+    _one_record(lines, start, path)
     numbers, X, V = [], [], []
     k, finished = start, False
     while k < len(lines):
@@ -341,6 +350,7 @@ def read_vloc_rloc(path) -> VlocSnapshot:
     path = os.fspath(path)
     lines = _lines(path)
     step, time, start = _header(lines, path)
+    _one_record(lines, start, path)
     starts = [k for k in range(start, len(lines)) if lines[k].startswith("$icdan")]
     entries = []
     for n, k in enumerate(starts):
@@ -389,7 +399,8 @@ def _entry(block, path, line, last):
                               "(more than 99999 bodies?)") from None
     return VlocEntry(family=family, cd=cd, an=an, cd_kind=data[title.index("cdtac")],
                      an_kind=data[title.index("antac")], behav=data[title.index("behav")],
-                     status=data[title.index("sttus")] if "sttus" in title else data[-2], rlt=found["rlt"], rln=found["rln"], gap=found["gap"],
+                     status=data[title.index("sttus")] if "sttus" in title else data[-2], rlt=found["rlt"],
+                     rln=found["rln"], gap=found["gap"],
                      normal=(found["n1"], found["n2"]), point=(found["x"], found["y"]))
 
 
