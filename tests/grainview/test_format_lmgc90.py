@@ -14,6 +14,7 @@ plain-Python parse (Fortran's fixed columns), with a balance law, or with forces
 
 from __future__ import annotations
 
+import importlib.util
 import math
 import os
 import re
@@ -466,12 +467,12 @@ def test_the_command_line_converts_and_refuses_in_one_line(tmp_path):
 
 
 def _lmgc90():
-    sys.path.insert(0, str(DATA))
-    try:
-        import make_fixtures
-    finally:
-        sys.path.remove(str(DATA))
-    return make_fixtures
+    """tests/data/lmgc90/make_fixtures.py, loaded under its own name (the LAMMPS fixtures'
+    script has the same file name)."""
+    spec = importlib.util.spec_from_file_location("lmgc90_make_fixtures", DATA / "make_fixtures.py")
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
 
 
 @pytest.mark.skipif(_lmgc90().find_build() is None,
