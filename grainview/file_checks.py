@@ -127,10 +127,16 @@ def force_problems(fn, ft, i, j, occupied) -> list[str]:
     return problems
 
 
-def hidden_records(source, size, header, fixed, record, n_records) -> None:
-    """Raise :class:`FileFormatError` when a netCDF-3 file's size holds more whole records
-    than its header counts, beyond the :data:`HIDDEN_RECORDS_TOLERATED` one that a killed
-    writer may leave: a lowered record count hides snapshots from every reader.
+def hidden_records(source, size, header, fixed, record, n_records, complete=None) -> None:
+    """Raise :class:`FileFormatError` when a netCDF-3 file holds more complete records than
+    its header counts, beyond the :data:`HIDDEN_RECORDS_TOLERATED` one that a killed writer
+    may leave: a lowered record count hides snapshots from every reader.
+
+    The netCDF library grows a file it writes by blocks, so a file being written (or whose
+    writer was killed) is often longer than its counted records by several records' worth of
+    bytes that hold no snapshot. When the ``complete`` flags of those would-be records are
+    given, only the ones set count as hidden; without them (a file without the flag), every
+    whole record the size holds does.
 
     Parameters
     ----------
@@ -142,10 +148,16 @@ def hidden_records(source, size, header, fixed, record, n_records) -> None:
         Bytes of the header, of the fixed-size variables and of one record.
     n_records : int
         The record count in the header.
+    complete : sequence of bool, optional
+        Whether each whole record the size holds beyond the counted ones has its ``complete``
+        flag set.
     """
     if record <= 0:
         return
-    held = n_records + max(0, (size - header - fixed - n_records * record) // record)
+    if complete is not None:
+        held = n_records + int(sum(bool(flag) for flag in complete))
+    else:
+        held = n_records + max(0, (size - header - fixed - n_records * record) // record)
     if held - n_records > HIDDEN_RECORDS_TOLERATED:
         raise FileFormatError(f"{source}: its header counts {n_records} snapshots but its size holds {held}: the "
                               f"header's record count hides {held - n_records} snapshots (the file is damaged)")

@@ -24,7 +24,8 @@ def _header_reader():
     """scipy's netCDF-3 reader made to parse the header and the fixed-size variables only: the
     header's record count is kept as ``header_records`` and no record is mapped, so that a file
     whose last record is still being written (its count already raised, its bytes not all
-    there) parses as well as a whole one."""
+    there) parses as well as a whole one. ``begins`` maps each variable to the offset of its
+    data (of its first record, for a record variable)."""
     from scipy.io import netcdf_file
 
     class HeaderOnly(netcdf_file):
@@ -32,6 +33,11 @@ def _header_reader():
             super()._read_numrecs()
             self.__dict__["header_records"] = self._recs
             self.__dict__["_recs"] = 0
+
+        def _read_var(self):
+            var = super()._read_var()
+            self.__dict__.setdefault("begins", {})[var[0]] = var[7]  # the variable's first byte
+            return var
 
     return HeaderOnly
 
@@ -64,12 +70,22 @@ def _check_netcdf3_length(path: str) -> None:
             [v.data.nbytes for v in nc.variables.values() if not v.isrec],
             [v.itemsize() * int(np.prod(v.shape[1:], dtype=np.int64)) for v in records])
         n_records = nc.header_records if records else 0
+        flags = None
+        complete = nc.variables.get("complete")
+        if complete is not None and complete.isrec and record_size:
+            # the flag of every whole record the file's size holds beyond the counted ones
+            beyond = max(0, (size - header - fixed - n_records * record_size) // record_size)
+            flags = []
+            for k in range(n_records, n_records + beyond):
+                fh.seek(nc.begins["complete"] + k * record_size)
+                flags.append(fh.read(1))
     needed = header + fixed + n_records * record_size
     if size < needed and n_records and being_written(path):
         needed -= record_size  # every record but the one being written
     if size < needed:
         raise FileFormatError(f"{path}: truncated file ({size} bytes, its header needs at least {needed})")
-    hidden_records(path, size, header, fixed, record_size, n_records)  # nor longer by records it does not count
+    hidden_records(path, size, header, fixed, record_size, n_records,  # nor longer by records it does not count
+                   None if flags is None else [flag == b"\x01" for flag in flags])
 
 
 REOPEN_ATTEMPTS = 3
