@@ -535,7 +535,7 @@ def convert_lammps(out, particles, contacts, walls=None, *, log=None, time_step=
                 tensile += snap.pop("tensile")
                 writer.append(**snap)
                 count += 1
-        open_dataset(temporary, chunks=None, validate=True).close()
+        open_dataset(temporary, validate=True).close()  # chunked: checked a few snapshots at a time
         if compress:
             compress_file(temporary)
         _move_into_place(temporary, out, overwrite)
