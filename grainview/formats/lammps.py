@@ -51,6 +51,7 @@ import warnings
 import numpy as np
 
 from ..errors import FileFormatError, ParameterError
+from ..schema import contact_slots
 from .lammps_dump import LammpsLog, iter_dump, read_log
 
 __all__ = ["lammps_snapshots", "open_lammps", "convert_lammps", "WALL_NAMES", "PARTICLE_COLUMNS", "PAIR_COLUMNS"]
@@ -406,7 +407,9 @@ def lammps_snapshots(particles, contacts, walls=None, *, log=None, time_step=Non
                   wall_names=list(WALL_NAMES) if walls is not None else None, attrs=attrs)
 
     def snapshots():
-        for snaps in _chain_first(first, stream):
+        from .convert import chain_first
+
+        for snaps in chain_first(first, stream):
             part, pairs = snaps[0], snaps[1]
             where = f"{os.fspath(contacts)}: step {part.timestep}"
             position, extra = static_particles.state(part)
@@ -420,11 +423,6 @@ def lammps_snapshots(particles, contacts, walls=None, *, log=None, time_step=Non
                        box_min=part.bounds[:2, 0].copy(), box_max=part.bounds[:2, 1].copy(), **extra)
 
     return static, snapshots()
-
-
-def _chain_first(first, stream):
-    yield first
-    yield from stream
 
 
 def open_lammps(particles, contacts, walls=None, *, log=None, time_step=None, columns=None, inertia="auto",
@@ -457,7 +455,7 @@ def open_lammps(particles, contacts, walls=None, *, log=None, time_step=None, co
         if all(name in s for s in snaps):
             optional[name] = np.stack([s[name] for s in snaps])
     n = static["radius"].size
-    slots = max([3 * (n + static["n_walls"]) - 6] + [len(s["contacts"]["i"]) for s in snaps])
+    slots = max([contact_slots(n, static["n_walls"])] + [len(s["contacts"]["i"]) for s in snaps])
     return make_dataset(radius=static["radius"], mass=static["mass"], inertia=static["inertia"],
                         position=np.stack([s["position"] for s in snaps]), contacts=[s["contacts"] for s in snaps],
                         box_min=np.stack([s["box_min"] for s in snaps]), box_max=np.stack([s["box_max"] for s in snaps]),
@@ -506,43 +504,20 @@ def convert_lammps(out, particles, contacts, walls=None, *, log=None, time_step=
     FileFormatError, ParameterError, SchemaError
         Bad input (one line); nothing is written.
     """
-    from ..io import open_dataset
-    from ..writer import SnapshotWriter, _move_into_place, compress_file
+    from .convert import chain_first, check_out, write_snapshots
 
-    out = os.fspath(out)
-    if os.path.exists(out) and not overwrite:
-        raise FileExistsError(f"{out} exists; pass overwrite=True to replace it")
-    folder = os.path.dirname(os.path.abspath(out))
-    if not os.path.isdir(folder):
-        raise FileFormatError(f"{out}: the folder {folder} does not exist")
+    out = check_out(out, overwrite)
     static, stream = lammps_snapshots(particles, contacts, walls, log=log, time_step=time_step, columns=columns,
                                       inertia=inertia)
-    temporary = os.path.join(folder, f".{os.path.basename(out)}.{os.getpid()}.lammps")
     first = next(stream)
     optional = ("step", "gap") + tuple(name for name in ("velocity", "angular_velocity") if name in first)
-    if progress:
-        from tqdm.auto import tqdm
+    tensile = []
 
-        stream = tqdm(stream, desc=f"lammps -> {os.path.basename(out)}", unit=" snapshots", initial=1)
-    count = tensile = 0
-    n = static["radius"].size
-    try:
-        with SnapshotWriter.create(temporary, radius=static["radius"], n_vertices=np.zeros(n, "i4"),
-                                   mass=static["mass"], inertia=static["inertia"], n_walls=static["n_walls"],
-                                   wall_names=static["wall_names"], optional=optional,
-                                   attrs=static["attrs"]) as writer:
-            for snap in _chain_first(first, stream):
-                tensile += snap.pop("tensile")
-                writer.append(**snap)
-                count += 1
-        open_dataset(temporary, validate=True).close()  # chunked: checked a few snapshots at a time
-        if compress:
-            compress_file(temporary)
-        _move_into_place(temporary, out, overwrite)
-    finally:
-        if progress:
-            stream.close()
-        if os.path.exists(temporary):
-            os.remove(temporary)
-    _warn_tensile(tensile, count)
+    def prepare(snap):
+        tensile.append(snap.pop("tensile"))
+        return snap
+
+    count = write_snapshots(out, static, chain_first(first, stream), optional, overwrite=overwrite,
+                            compress=compress, progress=progress, label="lammps", prepare=prepare)
+    _warn_tensile(sum(tensile), count)
     return count

@@ -415,38 +415,10 @@ def convert_lmgc90(out, run, *, overwrite=False, compress=True, progress=False):
     FileFormatError, SchemaError
         Bad input (one line); nothing is written.
     """
-    from ..io import open_dataset
-    from ..writer import SnapshotWriter, _move_into_place, compress_file
+    from .convert import check_out, write_snapshots
 
-    out = os.fspath(out)
-    if os.path.exists(out) and not overwrite:
-        raise FileExistsError(f"{out} exists; pass overwrite=True to replace it")
-    folder = os.path.dirname(os.path.abspath(out))
-    if not os.path.isdir(folder):
-        raise FileFormatError(f"{out}: the folder {folder} does not exist")
+    out = check_out(out, overwrite)
     static, stream = lmgc90_snapshots(run)
-    temporary = os.path.join(folder, f".{os.path.basename(out)}.{os.getpid()}.lmgc90")
     optional = ("step", "gap", "velocity", "angular_velocity") + (("wall_force",) if static["n_walls"] else ())
-    if progress:
-        from tqdm.auto import tqdm
-
-        stream = tqdm(stream, desc=f"lmgc90 -> {os.path.basename(out)}", unit=" snapshots")
-    count = 0
-    try:
-        with SnapshotWriter.create(temporary, radius=static["radius"], n_vertices=static["n_vertices"],
-                                   mass=static["mass"], inertia=static["inertia"], n_walls=static["n_walls"],
-                                   wall_names=static["wall_names"], optional=optional,
-                                   attrs=static["attrs"]) as writer:
-            for snap in stream:
-                writer.append(**snap)
-                count += 1
-        open_dataset(temporary, chunks=None, validate=True).close()
-        if compress:
-            compress_file(temporary)
-        _move_into_place(temporary, out, overwrite)
-    finally:
-        if progress:
-            stream.close()
-        if os.path.exists(temporary):
-            os.remove(temporary)
-    return count
+    return write_snapshots(out, static, stream, optional, overwrite=overwrite, compress=compress, progress=progress,
+                           label="lmgc90")

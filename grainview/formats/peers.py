@@ -43,6 +43,7 @@ import os
 import numpy as np
 
 from ..errors import FileFormatError, ParameterError
+from ..schema import contact_slots
 
 __all__ = ["WALLS", "WALL_NORMALS", "peer_contacts", "wall_forces", "peer_snapshots", "open_peer", "open_box2d",
            "open_pymunk", "convert_peer"]
@@ -184,7 +185,7 @@ def open_peer(raw_dir, sample, engine=None):
     static, stream = peer_snapshots(raw_dir, sample, engine)
     snaps = list(stream)
     n = static["radius"].size
-    slots = max([3 * (n + 4) - 6] + [len(s["contacts"]["i"]) for s in snaps])
+    slots = max([contact_slots(n, 4)] + [len(s["contacts"]["i"]) for s in snaps])
     impulse = np.zeros((len(snaps), slots, 2))
     for k, s in enumerate(snaps):
         impulse[k, :len(s["normal_impulse"])] = s["normal_impulse"]
@@ -218,35 +219,22 @@ def convert_peer(out, raw_dir, sample, *, engine=None, attrs=None, extra=None, o
     compressed (unless ``compress=False``) and moved into place; an existing ``out`` is
     refused unless ``overwrite``. Returns the number of snapshots.
     """
-    from ..writer import SnapshotWriter, _move_into_place, compress_file
+    from .convert import chain_first, check_out, write_snapshots
 
-    out = os.fspath(out)
-    if os.path.exists(out) and not overwrite:
-        raise FileExistsError(f"{out} exists; pass overwrite=True to replace it")
+    out = check_out(out, overwrite)
     static, stream = peer_snapshots(raw_dir, sample, engine)
-    run_attrs = dict(static["attrs"], **(attrs or {}))
     first = next(stream)
-    more = extra(first["raw"]) if extra is not None else {}
-    temporary = os.path.join(os.path.dirname(os.path.abspath(out)), f".{os.path.basename(out)}.{os.getpid()}.peer")
-    count = 0
-    try:
-        with SnapshotWriter.create(temporary, radius=static["radius"], n_vertices=static["n_vertices"],
-                                   mass=static["mass"], inertia=static["inertia"], n_walls=4, wall_names=WALLS,
-                                   wall_normal=WALL_NORMALS, optional=OPTIONAL + tuple(more), attrs=run_attrs) as w:
-            snap = first
-            while snap is not None:
-                raw = snap.pop("raw")
-                added = more if count == 0 else (extra(raw) if extra is not None else {})
-                points = snap.pop("normal_impulse")
-                impulse = np.zeros((w.n_slots, 2))
-                impulse[:len(points)] = points
-                w.append(normal_impulse=impulse, **snap, **added)
-                count += 1
-                snap = next(stream, None)
-        if compress:
-            compress_file(temporary)
-        _move_into_place(temporary, out, overwrite)
-    finally:
-        if os.path.exists(temporary):
-            os.remove(temporary)
-    return count
+    more = tuple(extra(first["raw"])) if extra is not None else ()
+    static = dict(static, n_walls=4, wall_names=WALLS, wall_normal=WALL_NORMALS, attrs=dict(static["attrs"],
+                                                                                          **(attrs or {})))
+    slots = contact_slots(static["radius"].size, 4)  # the writer's contact slots
+
+    def prepare(snap):
+        raw = snap.pop("raw")
+        points = snap.pop("normal_impulse")
+        impulse = np.zeros((slots, 2))
+        impulse[:len(points)] = points
+        return dict(snap, normal_impulse=impulse, **(extra(raw) if extra is not None else {}))
+
+    return write_snapshots(out, static, chain_first(first, stream), OPTIONAL + more, overwrite=overwrite,
+                           compress=compress, label="peer", prepare=prepare)
