@@ -59,7 +59,7 @@ def _export(args) -> int:
     validate(ds, source=str(args.file))
     if args.to == "vtk":
         paths = write_vtk(ds, args.out, every=args.every, overwrite=args.overwrite, progress=args.progress != "off")
-        print(f"wrote {len(paths) - 2} VTK files and particles.pvd, contacts.pvd (open in ParaView) to {args.out}")
+        print(f"wrote {len(paths) - 1} VTK files and snapshots.pvd (open it in ParaView or OVITO) to {args.out}")
     else:
         path = write_csv(ds, args.out, every=args.every, overwrite=args.overwrite)
         print(f"wrote {path}")
@@ -645,10 +645,11 @@ def build_parser() -> argparse.ArgumentParser:
                       "normals...: reads the whole file; without it only the structure and units are checked)")
     info.set_defaults(func=_info)
     export = sub.add_parser("export", help="write snapshots as VTK (ParaView, OVITO) or CSV",
-                            description="Export a file of the data contract: --to vtk writes particles "
-                            "(polygons, disks as points with a radius) and contacts (lines with fn, ft, kind, "
-                            "force class) per snapshot plus .pvd time collections; --to csv one tidy contact "
-                            "table (docs/analysis.md).")
+                            description="Export a file of the data contract: --to vtk writes, per snapshot, "
+                            "the particles (points with a radius, and the polygons' outlines) and the contacts "
+                            "(lines with fn, ft, kind, force class) as VTK PolyData in one multi-block file, "
+                            "plus snapshots.pvd, their time collection (ParaView, OVITO); --to csv one tidy "
+                            "contact table (docs/analysis.md).")
     export.add_argument("file", help="netCDF file of the grainview contract")
     export.add_argument("--to", choices=("vtk", "csv"), required=True, help="output format")
     export.add_argument("--out", required=True, help="output folder (created if needed)")

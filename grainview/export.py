@@ -1,19 +1,32 @@
 """Export snapshots to the formats other tools read: VTK (ParaView, OVITO) and CSV (pandas,
 spreadsheets).
 
-VTK, one pair of files per snapshot k, written by meshio (the well-kept VTK writer), and two
-ParaView collections (``.pvd``) that put them on the time axis:
+VTK, written as VTK's XML PolyData (:mod:`grainview.vtk_xml`), per snapshot k:
 
-* ``particles_<k>.vtu``: every polygon as a polygon cell (its vertices by the contract's
-  definition, :func:`grainview.schema.polygon_vertices`), every disk as a vertex cell at its
-  centre with its ``radius`` (ParaView: Glyph by radius); cell fields ``particle`` (index),
-  ``radius`` (m), ``n_vertices``, ``velocity`` (m s-1, when the file has it) and the
-  per-particle fields of :func:`grainview.particle_fields.particle_fields` (c, m_s, m_d,
-  strong, rattler, rotation rad, displacement m);
-* ``contacts_<k>.vtu``: every contact as a line from the centre of i along its branch vector
-  (to the centre of j, or to the contact point on a wall); cell fields ``fn``, ``ft`` (N),
-  ``kind`` (1 simple, 2 double), ``force_class`` (0 a pair without force, 1 very weak, 2 weak,
-  3 strong; paper Fig. 17) and the bodies ``i``, ``j`` (walls are N, N+1, ...).
+* ``particles_<k>.vtp``: every particle as a point at its centre (one vertex cell each), with
+  point data ``id`` (the particle's index, as ``i`` and ``j`` of the contacts), ``radius`` (m;
+  the circumscribed radius of a polygon), ``n_vertices`` (0 for a disk), ``angle`` (rad),
+  ``v`` (velocity, m s-1, z = 0; when the file has it) and the per-particle fields of
+  :func:`grainview.particle_fields.particle_fields` (``c``, ``m_s``, ``m_d``, ``strong``,
+  ``rattler``, ``rotation`` rad, ``displacement`` m);
+* ``polygons_<k>.vtp`` (files with polygons): every polygon's outline as a polygon cell, its
+  vertices by the contract's definition (:func:`grainview.schema.polygon_vertices`), with the
+  same data as cell data;
+* ``contacts_<k>.vtp``: every particle–particle contact as a line from the centre of i along
+  its branch vector to the centre of j, with cell data ``id1``, ``id2`` (i, j), ``fn``, ``ft``
+  (N), ``kind`` (1 simple, 2 double) and ``force_class`` (0 a pair without force, 1 very
+  weak, 2 weak, 3 strong; paper Fig. 17);
+* ``wall_contacts_<k>.vtp``: every particle–wall contact as a line from the centre of i to its
+  contact point on the wall, with cell data ``particle_id`` (i), ``wall_id`` (j - N, the wall's
+  index), ``fn``, ``ft``, ``kind``, ``force_class``;
+* ``snapshot_<k>.vtm``: the four as the named blocks of one multi-block dataset;
+
+and ``snapshots.pvd``, the ParaView collection that puts the ``.vtm`` files on the time axis.
+The names ``id``, ``radius``, ``v``, ``id1``/``id2``, ``particle_id``/``wall_id`` and the
+one-vertex-per-point, two-points-per-line layout are those OVITO's readers of ParaView files
+(written for the DEM code Aspherix) take as particles, their identifiers, radii and
+velocities, and particle–particle and particle–wall contacts; VTK and ParaView read every
+array under its name.
 
 CSV: ``contacts.csv``, the tidy contact table of every exported snapshot
 (:func:`grainview.tables.contacts_table`), one row per occupied contact slot, its columns
@@ -31,15 +44,15 @@ unless ``overwrite``.
 from __future__ import annotations
 
 import os
-import xml.etree.ElementTree as ElementTree
 
 import numpy as np
 import xarray as xr
 
 from .errors import ParameterError
 from .schema import polygon_vertices
+from .vtk_xml import collection, multiblock, polydata, write_xml
 
-__all__ = ["write_vtk", "write_csv", "snapshot_indices", "write_atomically", "CSV_COLUMNS"]
+__all__ = ["write_vtk", "write_csv", "snapshot_indices", "write_atomically", "CSV_COLUMNS", "VTK_BLOCKS"]
 
 CSV_COLUMNS = {
     "snapshot": "index of the snapshot along time",
@@ -122,70 +135,77 @@ def write_atomically(path, overwrite, write):
     os.replace(temporary, path)
 
 
-def _particles_mesh(snap: xr.Dataset, fields: xr.Dataset):
-    import meshio
+VTK_BLOCKS = ("particles", "polygons", "contacts", "wall_contacts")
+"""The blocks of each snapshot's ``.vtm`` file, in order, each the stem of its ``.vtp`` file."""
 
-    position = np.asarray(snap["position"].values, float)
-    angle = np.asarray(snap["angle"].values, float)
-    radius = np.asarray(snap["radius"].values, float)
-    n_vertices = np.asarray(snap["n_vertices"].values, int)
-    points, cells, order = [], [], []
-    start = 0
-    disks = np.flatnonzero(n_vertices == 0)
-    if disks.size:
-        points.append(position[disks])
-        cells.append(meshio.CellBlock("vertex", (start + np.arange(disks.size))[:, None]))
-        order.append(disks)
-        start += disks.size
-    for n in np.unique(n_vertices[n_vertices > 0]):
-        members = np.flatnonzero(n_vertices == n)
-        vertices = polygon_vertices(position[members], radius[members], angle[members], int(n))
-        points.append(vertices.reshape(-1, 2))
-        cells.append(meshio.CellBlock("polygon", start + np.arange(members.size * n).reshape(members.size, n)))
-        order.append(members)
-        start += members.size * n
-    data = {"particle": np.arange(radius.size), "radius": radius, "n_vertices": n_vertices}
+
+def _particle_data(snap: xr.Dataset, fields: xr.Dataset) -> dict:
+    """Per-particle arrays by name: id, radius, n_vertices, angle, v (when present), the fields."""
+    n = snap.sizes["particle"]
+    data = {"id": np.arange(n), "radius": np.asarray(snap["radius"].values, float),
+            "n_vertices": np.asarray(snap["n_vertices"].values, np.int64),
+            "angle": np.asarray(snap["angle"].values, float)}
     if "velocity" in snap:
-        data["velocity"] = np.column_stack([np.asarray(snap["velocity"].values, float), np.zeros(radius.size)])
+        data["v"] = np.column_stack([np.asarray(snap["velocity"].values, float), np.zeros(n)])
     for name in fields.data_vars:
-        data[name] = np.asarray(fields[name].values).astype(float if fields[name].dtype.kind == "f" else np.int64)
-    cell_data = {name: [values[members] for members in order] for name, values in data.items()}
-    xyz = np.column_stack([np.concatenate(points), np.zeros(start)]) if points else np.zeros((0, 3))
-    return meshio.Mesh(xyz, cells, cell_data=cell_data)
+        values = np.asarray(fields[name].values)
+        data[name] = values.astype(float if values.dtype.kind == "f" else np.int64)
+    return data
 
 
-def _contacts_mesh(snap: xr.Dataset, classes: np.ndarray):
-    import meshio
+def _polygons(snap: xr.Dataset, data: dict):
+    """The polygons' outlines, grouped by vertex count: their vertices (one polygon after the
+    other), each polygon's vertex count and its data."""
+    position = np.asarray(snap["position"].values, float)
+    n_vertices = data["n_vertices"]
+    groups = [np.flatnonzero(n_vertices == n) for n in np.unique(n_vertices[n_vertices > 0])]
+    points = [polygon_vertices(position[members], data["radius"][members], data["angle"][members],
+                               int(n_vertices[members[0]])).reshape(-1, 2) for members in groups]
+    order = np.concatenate(groups) if groups else np.arange(0)
+    return (np.concatenate(points) if points else np.zeros((0, 2)), n_vertices[order],
+            {name: values[order] for name, values in data.items()})
 
-    used = np.flatnonzero(np.asarray(snap["kind"].values) > 0)
+
+def _contact_lines(snap: xr.Dataset, classes: np.ndarray, walls: bool):
+    """Line end points (centre of i, then centre of i + branch) and cell data of the occupied
+    slots whose j is a wall (``walls``) or a particle."""
+    n = snap.sizes["particle"]
+    kind = np.asarray(snap["kind"].values)
+    j = np.asarray(snap["j"].values).astype(np.int64)
+    used = np.flatnonzero((kind > 0) & ((j >= n) if walls else (j < n)))
     i = np.asarray(snap["i"].values)[used].astype(np.int64)
     start = np.asarray(snap["position"].values, float)[i]
-    end = start + np.asarray(snap["branch"].values, float)[used]
-    xyz = np.zeros((2 * used.size, 3))
-    xyz[0::2, :2], xyz[1::2, :2] = start, end
-    cells = [meshio.CellBlock("line", np.arange(2 * used.size).reshape(-1, 2))]
-    cell_data = {"fn": [np.asarray(snap["fn"].values, float)[used]], "ft": [np.asarray(snap["ft"].values, float)[used]],
-                 "kind": [np.asarray(snap["kind"].values).astype(np.int64)[used]],
-                 "force_class": [classes[used].astype(np.int64)],
-                 "i": [i], "j": [np.asarray(snap["j"].values)[used].astype(np.int64)]}
-    return meshio.Mesh(xyz, cells, cell_data=cell_data)
+    points = np.empty((2 * used.size, 2))
+    points[0::2], points[1::2] = start, start + np.asarray(snap["branch"].values, float)[used]
+    ids = {"particle_id": i, "wall_id": j[used] - n} if walls else {"id1": i, "id2": j[used]}
+    data = dict(ids, fn=np.asarray(snap["fn"].values, float)[used], ft=np.asarray(snap["ft"].values, float)[used],
+                kind=kind[used].astype(np.int64), force_class=classes[used].astype(np.int64))
+    return points, data
 
 
-def _collection(path, entries, overwrite):
-    """A ParaView ``.pvd`` collection of (time, file name) entries (ElementTree)."""
-    root = ElementTree.Element("VTKFile", type="Collection", version="0.1")
-    collection = ElementTree.SubElement(root, "Collection")
-    for time, name in entries:
-        ElementTree.SubElement(collection, "DataSet", timestep=repr(float(time)), group="", part="0", file=name)
-    write_atomically(path, overwrite, lambda temporary: ElementTree.ElementTree(root).write(temporary, xml_declaration=True))
+def _snapshot_files(snap: xr.Dataset, fields: xr.Dataset, classes: np.ndarray, polygons: bool) -> dict:
+    """The PolyData trees of one snapshot by block name (:data:`VTK_BLOCKS`); None for the
+    contacts of a snapshot without particle-particle contact (no file: OVITO stops on a
+    contacts file without lines)."""
+    data = _particle_data(snap, fields)
+    trees = {"particles": polydata(np.asarray(snap["position"].values, float), verts=True, point_data=data)}
+    if polygons:
+        points, sizes, cell_data = _polygons(snap, data)
+        trees["polygons"] = polydata(points, polys=sizes, cell_data=cell_data)
+    for block, walls in (("contacts", False), ("wall_contacts", True)):
+        points, cell_data = _contact_lines(snap, classes, walls)
+        empty = len(points) == 0 and not walls
+        trees[block] = None if empty else polydata(points, lines=np.full(len(points) // 2, 2), cell_data=cell_data)
+    return trees
 
 
 def write_vtk(ds: xr.Dataset, out_dir, every: int = 1, overwrite: bool = False, progress=None) -> list:
     """Write the VTK files of the module docstring for every ``every``-th snapshot into ``out_dir``.
 
-    For ParaView or OVITO; ``out_dir`` is created if needed. Per snapshot k,
-    ``particles_<k>.vtu`` and ``contacts_<k>.vtu``, then the collections ``particles.pvd`` and
-    ``contacts.pvd``.
+    For ParaView and OVITO (open ``snapshots.pvd``: every snapshot on the time axis, or one
+    ``snapshot_<k>.vtm``); ``out_dir`` is created if needed. Per snapshot k,
+    ``particles_<k>.vtp``, ``polygons_<k>.vtp`` (files with polygons), ``contacts_<k>.vtp``,
+    ``wall_contacts_<k>.vtp`` and ``snapshot_<k>.vtm``, then ``snapshots.pvd``.
 
     Parameters
     ----------
@@ -204,28 +224,27 @@ def write_vtk(ds: xr.Dataset, out_dir, every: int = 1, overwrite: bool = False, 
     Returns
     -------
     list of str
-        The paths written, the two ``.pvd`` collections (particles, contacts) last.
+        The paths written, snapshot by snapshot in the order above, ``snapshots.pvd`` last.
 
     Raises
     ------
     grainview.errors.ParameterError
-        When meshio is not installed, or a file to write exists and ``overwrite`` is False.
+        When a file to write exists and ``overwrite`` is False.
 
     References
     ----------
     Azéma, Radjai, Peyroux & Saussine, Phys. Rev. E 76, 011301 (2007),
     Fig. 17 and Secs. V.B-V.C (the force classes of the contacts); docs/conventions.md §4.
     """
-    try:
-        import meshio
-    except ImportError:
-        raise ParameterError("VTK export needs meshio (pip install meshio)") from None
     from .force_networks import force_class
     from .particle_fields import particle_fields
 
     indices = snapshot_indices(ds, every)
-    targets = [os.path.join(out_dir, f"{stem}_{int(k):05d}.vtu") for k in indices for stem in ("particles", "contacts")]
-    targets += [os.path.join(out_dir, f"{stem}.pvd") for stem in ("particles", "contacts")]
+    polygons = bool((np.asarray(ds["n_vertices"].values) > 0).any())
+    blocks = [block for block in VTK_BLOCKS if polygons or block != "polygons"]
+    targets = [os.path.join(out_dir, name) for k in indices
+               for name in [f"{block}_{int(k):05d}.vtp" for block in blocks] + [f"snapshot_{int(k):05d}.vtm"]]
+    targets.append(os.path.join(out_dir, "snapshots.pvd"))
     existing = [t for t in targets if os.path.exists(t)]
     if existing and not overwrite:  # before anything is written
         raise ParameterError(f"{existing[0]} exists ({len(existing)} of the {len(targets)} files to write); "
@@ -233,27 +252,31 @@ def write_vtk(ds: xr.Dataset, out_dir, every: int = 1, overwrite: bool = False, 
     os.makedirs(out_dir, exist_ok=True)
     fields = particle_fields(ds, walls=True)
     classes = force_class(ds, walls=True)
-    written, particles, contacts = [], [], []
+    written, entries = [], []
     iterator = indices
     if progress:
         from tqdm.auto import tqdm
 
         iterator = tqdm(indices, desc="VTK export", unit="snapshot")
     for k in iterator:
-        snap = ds.isel(time=int(k)).compute()
-        time = float(snap["time"].values)
-        for stem, mesh, entries in (
-                ("particles", _particles_mesh(snap, fields.isel(time=int(k)).compute()), particles),
-                ("contacts", _contacts_mesh(snap, np.asarray(classes.isel(time=int(k)).values)), contacts)):
-            name = f"{stem}_{int(k):05d}.vtu"
-            path = os.path.join(out_dir, name)
-            write_atomically(path, overwrite, lambda temporary, mesh=mesh: meshio.write(temporary, mesh, file_format="vtu"))
+        k = int(k)
+        snap = ds.isel(time=k).compute()
+        trees = _snapshot_files(snap, fields.isel(time=k).compute(), np.asarray(classes.isel(time=k).values), polygons)
+        files = {block: None if tree is None else f"{block}_{k:05d}.vtp" for block, tree in trees.items()}
+        trees[f"snapshot_{k:05d}"], files[f"snapshot_{k:05d}"] = multiblock(files.items()), f"snapshot_{k:05d}.vtm"
+        for block, tree in trees.items():
+            if tree is None:  # no file; one left by an earlier export is not this snapshot's
+                stale = os.path.join(out_dir, f"{block}_{k:05d}.vtp")
+                if os.path.exists(stale):
+                    os.remove(stale)
+                continue
+            path = os.path.join(out_dir, files[block])
+            write_atomically(path, overwrite, lambda temporary, tree=tree: write_xml(tree, temporary))
             written.append(path)
-            entries.append((time, name))
-    for stem, entries in (("particles", particles), ("contacts", contacts)):
-        path = os.path.join(out_dir, f"{stem}.pvd")
-        _collection(path, entries, overwrite)
-        written.append(path)
+        entries.append((float(snap["time"].values), files[f"snapshot_{k:05d}"]))
+    path = os.path.join(out_dir, "snapshots.pvd")
+    write_atomically(path, overwrite, lambda temporary: write_xml(collection(entries), temporary))
+    written.append(path)
     return written
 
 

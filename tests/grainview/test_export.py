@@ -1,5 +1,8 @@
-"""VTK and CSV export, read back: point and cell counts and field values equal the dataset's."""
+"""VTK and CSV export, read back: the VTK files parsed as XML (their structure, what OVITO's
+readers require of it, and every value decoded), the CSV with pandas. The same VTK files loaded
+by VTK's and OVITO's own readers: test_export_clients.py."""
 
+import base64
 import os
 import xml.etree.ElementTree as ElementTree
 
@@ -12,46 +15,125 @@ from grainview.errors import ParameterError
 from grainview.export import write_csv, write_vtk
 
 from .test_lifetimes import SERIES
-from .test_persistence import N, sequence_dataset
-
-meshio = pytest.importorskip("meshio")
+from .test_persistence import N, S, sequence_dataset
 
 
 def polygons_and_disks():
+    """SERIES (a wall contact at every snapshot) on two pentagons, a disk, a triangle and a
+    pentagon at random places and angles, with tangential forces fn / 4 and velocities."""
     ds = sequence_dataset(SERIES)
     ds["n_vertices"] = ("particle", np.array([5, 5, 0, 3, 5], dtype=ds["n_vertices"].dtype))
     rng = np.random.default_rng(0)
     ds["position"] = (("time", "particle", "xy"), rng.uniform(0, 1, ds["position"].shape))
     ds["angle"] = (("time", "particle"), rng.uniform(0, 6, ds["angle"].shape))
+    ds["ft"] = ds["fn"] / 4
+    ds["velocity"] = (("time", "particle", "xy"), rng.uniform(-1, 1, ds["position"].shape))
     return ds
 
 
-def test_vtk_files_read_back(tmp_path):
+def read_vtp(path):
+    """A PolyData file as (VTKFile attributes, Piece attributes, arrays by section and name),
+    each binary DataArray decoded by hand: base64 of a little-endian UInt64 byte count, then
+    the values."""
+    root = ElementTree.parse(path).getroot()
+    piece = root.find("PolyData/Piece")
+    arrays = {}
+    for section in piece:
+        arrays[section.tag] = {}
+        for element in section.iter("DataArray"):
+            assert element.get("format") == "binary"
+            raw = base64.b64decode(element.text)
+            size = int(np.frombuffer(raw[:8], "<u8")[0])
+            assert len(raw) == 8 + size  # the count is the values' bytes
+            values = np.frombuffer(raw[8:], {"Float64": "<f8", "Int64": "<i8"}[element.get("type")])
+            components = int(element.get("NumberOfComponents", 1))
+            arrays[section.tag][element.get("Name")] = values.reshape(-1, components) if components > 1 else values
+    return root.attrib, piece.attrib, arrays
+
+
+def test_vtk_files_hold_the_snapshots(tmp_path):
     ds = polygons_and_disks()
     paths = write_vtk(ds, tmp_path, every=2)
-    # snapshots 0, 2, 4 and the last (5): 4 x 2 files and 2 collections
-    assert len(paths) == 10 and all(os.path.exists(p) for p in paths)
+    # snapshots 0, 2, 4 and the last (5): 4 x (4 .vtp + 1 .vtm) files and the collection
+    assert len(paths) == 21 and all(os.path.exists(p) for p in paths)
+    assert os.path.basename(paths[-1]) == "snapshots.pvd"
     k = 2
-    particles = meshio.read(tmp_path / f"particles_{k:05d}.vtu")
-    blocks = {block.type: block for block in particles.cells}
-    assert blocks["vertex"].data.shape == (1, 1)  # the one disk
-    polygon_cells = sum(len(b.data) for b in particles.cells if b.type == "polygon")
-    assert polygon_cells == 4 and particles.points.shape == (1 + 3 * 5 + 3, 3)
-    ids = np.concatenate(particles.cell_data["particle"])
+    position, angle = ds.position.values[k], ds.angle.values[k]
+
+    # particles: one point and one vertex cell each, the names OVITO maps (id, radius, v)
+    header, piece, arrays = read_vtp(tmp_path / f"particles_{k:05d}.vtp")
+    assert header == {"type": "PolyData", "version": "1.0", "byte_order": "LittleEndian", "header_type": "UInt64"}
+    assert piece == {"NumberOfPoints": "5", "NumberOfVerts": "5"}  # no line or polygon counted
+    np.testing.assert_array_equal(arrays["Points"]["Points"], np.column_stack([position, np.zeros(5)]))
+    np.testing.assert_array_equal(arrays["Verts"]["offsets"], [1, 2, 3, 4, 5])
+    data = arrays["PointData"]
+    np.testing.assert_array_equal(data["id"], np.arange(5))
+    np.testing.assert_array_equal(data["radius"], np.full(5, 0.01))
+    np.testing.assert_array_equal(data["n_vertices"], [5, 5, 0, 3, 5])
+    np.testing.assert_array_equal(data["angle"], angle)
+    np.testing.assert_array_equal(data["v"], np.column_stack([ds.velocity.values[k], np.zeros(5)]))
     fields = ds.grain.particle_fields().isel(time=k)
-    np.testing.assert_array_equal(np.concatenate(particles.cell_data["c"]), fields.c.values[ids])
-    np.testing.assert_allclose(np.concatenate(particles.cell_data["radius"]), ds.radius.values[ids])
-    # the disk's vertex cell sits at its centre; a pentagon's first vertex where the contract puts it
-    disk = int(ids[0])
-    np.testing.assert_allclose(particles.points[blocks["vertex"].data[0, 0], :2],
-                               ds.position.isel(time=k).values[disk])
-    contacts = meshio.read(tmp_path / f"contacts_{k:05d}.vtu")
-    assert len(contacts.cells[0].data) == len(SERIES[k])
-    got = sorted(zip(contacts.cell_data["i"][0], contacts.cell_data["j"][0], contacts.cell_data["fn"][0]))
-    assert got == sorted((i, j, fn) for i, j, _, fn in SERIES[k])
-    tree = ElementTree.parse(tmp_path / "contacts.pvd")
-    entries = [(float(e.get("timestep")), e.get("file")) for e in tree.iter("DataSet")]
-    assert entries == [(float(t), f"contacts_{t:05d}.vtu") for t in (0, 2, 4, 5)]
+    # c by hand from SERIES[2]: (0,1) (1,2) (2,3) and the wall contact of 4
+    np.testing.assert_array_equal(data["c"], [1, 2, 2, 1, 1])
+    np.testing.assert_array_equal(data["rattler"], fields.rattler.values.astype(int))
+
+    # polygons: the 4 outlines, vertex m of polygon p at x_p + R (cos(angle_p + 2 pi m / n), sin(...))
+    _, piece, arrays = read_vtp(tmp_path / f"polygons_{k:05d}.vtp")
+    assert piece == {"NumberOfPoints": str(5 + 5 + 3 + 5), "NumberOfPolys": "4"}
+    ids = arrays["CellData"]["id"]
+    sizes = np.diff(arrays["Polys"]["offsets"], prepend=0)
+    assert sorted(ids) == [0, 1, 3, 4] and list(sizes) == [{0: 5, 1: 5, 3: 3, 4: 5}[p] for p in ids]
+    points = np.split(arrays["Points"]["Points"][arrays["Polys"]["connectivity"]], np.cumsum(sizes)[:-1])
+    for p, n, outline in zip(ids, sizes, points):
+        phase = angle[p] + 2 * np.pi * np.arange(n) / n
+        np.testing.assert_allclose(outline[:, :2], position[p] + 0.01 * np.column_stack([np.cos(phase), np.sin(phase)]),
+                                   rtol=0, atol=1e-15)
+    np.testing.assert_array_equal(arrays["CellData"]["n_vertices"], sizes)
+
+    # particle pairs: a line from the centre of i along the branch vector, id1/id2 = i/j
+    _, piece, arrays = read_vtp(tmp_path / f"contacts_{k:05d}.vtp")
+    pairs = [(i, j, fn) for i, j, _, fn in SERIES[k] if j < N]
+    assert piece == {"NumberOfPoints": str(2 * len(pairs)), "NumberOfLines": str(len(pairs))}
+    cells = arrays["CellData"]
+    got = sorted(zip(cells["id1"], cells["id2"], cells["fn"], cells["ft"]))
+    assert got == sorted((i, j, fn, fn / 4) for i, j, fn in pairs)
+    ends = arrays["Points"]["Points"][:, :2].reshape(-1, 2, 2)
+    np.testing.assert_array_equal(ends[:, 0], position[cells["id1"]])
+    np.testing.assert_allclose(ends[:, 1], position[cells["id1"]] + [0.02, 0.0], rtol=0, atol=1e-15)  # SERIES' branch
+    # kind, and force class against <f_n> = (6 + 1 + 3 + 1) / 4 N over the pairs and the wall
+    # contact: 6 and 3 N strong (3), 1 N weak (2: between 0.1 and 1 <f_n>); (0,1) is double
+    by_pair = {(i, j): (kind, cls) for i, j, kind, cls in zip(cells["id1"], cells["id2"], cells["kind"], cells["force_class"])}
+    assert by_pair == {(0, 1): (2, 3), (1, 2): (1, 2), (2, 3): (1, 3)}
+
+    # particle-wall contacts: particle_id, wall_id (the wall's index, j - N)
+    _, piece, arrays = read_vtp(tmp_path / f"wall_contacts_{k:05d}.vtp")
+    assert piece == {"NumberOfPoints": "2", "NumberOfLines": "1"}
+    cells = arrays["CellData"]
+    assert (cells["particle_id"].tolist(), cells["wall_id"].tolist(), cells["fn"].tolist()) == ([4], [0], [1.0])
+    assert (cells["ft"].tolist(), cells["kind"].tolist(), cells["force_class"].tolist()) == ([0.25], [1], [2])
+
+    # the snapshot's blocks and the time collection
+    blocks = [(e.get("name"), e.get("file")) for e in ElementTree.parse(tmp_path / f"snapshot_{k:05d}.vtm").iter("DataSet")]
+    assert blocks == [(b, f"{b}_{k:05d}.vtp") for b in ("particles", "polygons", "contacts", "wall_contacts")]
+    entries = [(float(e.get("timestep")), e.get("file")) for e in ElementTree.parse(tmp_path / "snapshots.pvd").iter("DataSet")]
+    assert entries == [(float(t), f"snapshot_{t:05d}.vtm") for t in (0, 2, 4, 5)]
+
+
+def test_a_snapshot_without_particle_pairs_has_an_empty_contacts_block(tmp_path):
+    ds = sequence_dataset([[(4, N, S, 1.0)], [(0, 1, S, 2.0), (4, N, S, 1.0)]])  # disks only
+    paths = write_vtk(ds, tmp_path)
+    names = sorted(os.listdir(tmp_path))
+    assert names == sorted(os.path.basename(p) for p in paths)
+    assert "contacts_00000.vtp" not in names and "contacts_00001.vtp" in names
+    assert not [n for n in names if n.startswith("polygons")]  # no polygon in the file
+    blocks = [(e.get("name"), e.get("file")) for e in ElementTree.parse(tmp_path / "snapshot_00000.vtm").iter("DataSet")]
+    assert blocks == [("particles", "particles_00000.vtp"), ("contacts", None), ("wall_contacts", "wall_contacts_00000.vtp")]
+    _, piece, arrays = read_vtp(tmp_path / "wall_contacts_00000.vtp")
+    assert piece == {"NumberOfPoints": "2", "NumberOfLines": "1"} and arrays["CellData"]["wall_id"].tolist() == [0]
+    # a contacts file of an earlier export at that snapshot is not left beside the new files
+    (tmp_path / "contacts_00000.vtp").write_text("old")
+    write_vtk(ds, tmp_path, overwrite=True)
+    assert "contacts_00000.vtp" not in os.listdir(tmp_path)
 
 
 def test_existing_files_are_not_overwritten(tmp_path):
@@ -66,11 +148,11 @@ def test_existing_files_are_not_overwritten(tmp_path):
 def test_one_existing_file_refuses_the_export_before_anything_is_written(tmp_path):
     ds = polygons_and_disks()
     last = ds.sizes["time"] - 1
-    (tmp_path / f"contacts_{last:05d}.vtu").write_text("mine")  # a file of the user's, written last by the export
+    (tmp_path / f"snapshot_{last:05d}.vtm").write_text("mine")  # a file of the user's, written late by the export
     with pytest.raises(ParameterError, match="exists"):
         write_vtk(ds, tmp_path, every=1)
-    assert os.listdir(tmp_path) == [f"contacts_{last:05d}.vtu"]  # nothing else written
-    assert (tmp_path / f"contacts_{last:05d}.vtu").read_text() == "mine"
+    assert os.listdir(tmp_path) == [f"snapshot_{last:05d}.vtm"]  # nothing else written
+    assert (tmp_path / f"snapshot_{last:05d}.vtm").read_text() == "mine"
 
 
 def test_csv_is_the_tidy_table_of_every_snapshot(tmp_path):
@@ -90,7 +172,8 @@ def test_export_command(tmp_path, capsys):
     source = tmp_path / "run.nc"
     ds.to_netcdf(source, **grainview.dataset.netcdf_options(ds))
     assert main(["export", str(source), "--to", "vtk", "--out", str(tmp_path / "vtk"), "--every", "3"]) == 0
-    assert sorted(os.listdir(tmp_path / "vtk"))[:2] == ["contacts.pvd", "contacts_00000.vtu"]
+    assert sorted(os.listdir(tmp_path / "vtk"))[:2] == ["contacts_00000.vtp", "contacts_00003.vtp"]
+    assert "snapshots.pvd" in capsys.readouterr().out
     assert main(["export", str(source), "--to", "csv", "--out", str(tmp_path / "csv")]) == 0
     assert os.path.exists(tmp_path / "csv" / "contacts.csv")
     assert "wrote" in capsys.readouterr().out
