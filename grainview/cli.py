@@ -29,12 +29,22 @@ residual state (eps_q >= 0.3)."""
 def _info(args) -> int:
     from .file_summary import describe_file
 
-    if args.check:  # first, so that every problem is listed
+    if args.check:  # first, so that every problem is listed: the summary's own and every value's
         from .io import open_dataset
         from .validation import validate
 
-        with open_dataset(args.file, chunks="auto") as ds:
-            validate(ds, source=str(args.file))
+        problems = []
+        try:
+            describe_file(args.file)
+        except SchemaError as exc:
+            problems += exc.problems
+        try:
+            with open_dataset(args.file, chunks="auto") as ds:
+                validate(ds, source=str(args.file))
+        except SchemaError as exc:
+            problems += [problem for problem in exc.problems if problem not in problems]
+        if problems:
+            raise SchemaError(problems, source=str(args.file))
     lines, attrs = describe_file(args.file)  # netCDF4 and numpy only: no xarray, dask or pandas to import
     for line in lines:
         print(line)
@@ -59,7 +69,9 @@ def _export(args) -> int:
     validate(ds, source=str(args.file))
     if args.to == "vtk":
         paths = write_vtk(ds, args.out, every=args.every, overwrite=args.overwrite, progress=args.progress != "off")
-        print(f"wrote {len(paths) - 1} VTK files and snapshots.pvd (open it in ParaView or OVITO) to {args.out}")
+        outlines = any(path.endswith("polygons.pvd") for path in paths)
+        print(f"wrote {len(paths)} VTK files to {args.out}: open snapshots.pvd in ParaView or OVITO"
+              + (", and polygons.pvd (the polygons' outlines) in ParaView" if outlines else ""))
     else:
         path = write_csv(ds, args.out, every=args.every, overwrite=args.overwrite)
         print(f"wrote {path}")
@@ -646,10 +658,10 @@ def build_parser() -> argparse.ArgumentParser:
     info.set_defaults(func=_info)
     export = sub.add_parser("export", help="write snapshots as VTK (ParaView, OVITO) or CSV",
                             description="Export a file of the data contract: --to vtk writes, per snapshot, "
-                            "the particles (points with a radius, and the polygons' outlines) and the contacts "
-                            "(lines with fn, ft, kind, force class) as VTK PolyData in one multi-block file, "
-                            "plus snapshots.pvd, their time collection (ParaView, OVITO); --to csv one tidy "
-                            "contact table (docs/analysis.md).")
+                            "the particles (points with a radius) and the contacts (lines with fn, ft, kind, "
+                            "force class) as VTK PolyData in one multi-block file, and the polygons' outlines; "
+                            "snapshots.pvd puts them on the time axis (ParaView, OVITO), polygons.pvd the "
+                            "outlines (ParaView); --to csv one tidy contact table (docs/analysis.md).")
     export.add_argument("file", help="netCDF file of the grainview contract")
     export.add_argument("--to", choices=("vtk", "csv"), required=True, help="output format")
     export.add_argument("--out", required=True, help="output folder (created if needed)")

@@ -160,3 +160,18 @@ def test_a_file_longer_by_the_writers_blocks_is_not_hiding_records(tmp_path, cap
     assert main(["info", str(path), "--check"]) == 0
     out = capsys.readouterr().out
     assert "5 snapshots" in out and "valid" in out
+
+
+def test_info_and_its_check_count_the_same_problems(tmp_path, capsys):
+    """`info` names how many problems a file has and that --check lists them: --check lists all
+    of them, the summary's structural ones (units) as well as the values'."""
+    ds = harmonic_series(n_snapshots=5, n_contacts=20).drop_vars(["mass", "inertia"])
+    ds["radius"].attrs["units"] = "mm"
+    path = tmp_path / "bad.nc"
+    ds.to_netcdf(path, **netcdf_options(ds, compress=False))
+    line = _refused(["info", str(path)], capsys)
+    assert "3 problems" in line and "--check" in line
+    assert main(["info", str(path), "--check"]) == 2
+    err = capsys.readouterr().err
+    listed = [row for row in err.splitlines() if row.strip().startswith("- ")]
+    assert len(listed) == 3 and any("'mm'" in row for row in listed), err
