@@ -9,24 +9,27 @@ VTK, written as VTK's XML PolyData (:mod:`grainview.vtk_xml`), per snapshot k:
   ``v`` (velocity, m s-1, z = 0; when the file has it) and the per-particle fields of
   :func:`grainview.particle_fields.particle_fields` (``c``, ``m_s``, ``m_d``, ``strong``,
   ``rattler``, ``rotation`` rad, ``displacement`` m);
-* ``polygons_<k>.vtp`` (files with polygons): every polygon's outline as a polygon cell, its
-  vertices by the contract's definition (:func:`grainview.schema.polygon_vertices`), with the
-  same data as cell data;
 * ``contacts_<k>.vtp``: every particle–particle contact as a line from the centre of i along
   its branch vector to the centre of j, with cell data ``id1``, ``id2`` (i, j), ``fn``, ``ft``
   (N), ``kind`` (1 simple, 2 double) and ``force_class`` (0 a pair without force, 1 very
-  weak, 2 weak, 3 strong; paper Fig. 17);
+  weak, 2 weak, 3 strong; paper Fig. 17); no file, and an empty block, for a snapshot without
+  particle–particle contact (OVITO 3.17 stops on a contacts file without lines);
 * ``wall_contacts_<k>.vtp``: every particle–wall contact as a line from the centre of i to its
   contact point on the wall, with cell data ``particle_id`` (i), ``wall_id`` (j - N, the wall's
   index), ``fn``, ``ft``, ``kind``, ``force_class``;
-* ``snapshot_<k>.vtm``: the four as the named blocks of one multi-block dataset;
+* ``snapshot_<k>.vtm``: the three as the named blocks of one multi-block dataset;
+* ``polygons_<k>.vtp`` (files with polygons): every polygon's outline as a polygon cell, its
+  vertices by the contract's definition (:func:`grainview.schema.polygon_vertices`), with the
+  particles' data as cell data; not a block of the ``.vtm``: OVITO 3.17 renders such a flat
+  mesh blank, and its Tachyon renderer stopped (segmentation fault) on such a mesh of a few
+  polygons;
 
-and ``snapshots.pvd``, the ParaView collection that puts the ``.vtm`` files on the time axis.
-The names ``id``, ``radius``, ``v``, ``id1``/``id2``, ``particle_id``/``wall_id`` and the
-one-vertex-per-point, two-points-per-line layout are those OVITO's readers of ParaView files
-(written for the DEM code Aspherix) take as particles, their identifiers, radii and
-velocities, and particle–particle and particle–wall contacts; VTK and ParaView read every
-array under its name.
+then ``snapshots.pvd`` and ``polygons.pvd``, the ParaView collections that put the ``.vtm``
+and the polygons' files on the time axis. The names ``id``, ``radius``, ``v``, ``id1``/``id2``,
+``particle_id``/``wall_id`` and the one-vertex-per-point, two-points-per-line layout are those
+OVITO's readers of ParaView files (written for the DEM code Aspherix) take as particles, their
+identifiers, radii and velocities, and particle–particle and particle–wall contacts; VTK and
+ParaView read every array under its name.
 
 CSV: ``contacts.csv``, the tidy contact table of every exported snapshot
 (:func:`grainview.tables.contacts_table`), one row per occupied contact slot, its columns
@@ -135,7 +138,7 @@ def write_atomically(path, overwrite, write):
     os.replace(temporary, path)
 
 
-VTK_BLOCKS = ("particles", "polygons", "contacts", "wall_contacts")
+VTK_BLOCKS = ("particles", "contacts", "wall_contacts")
 """The blocks of each snapshot's ``.vtm`` file, in order, each the stem of its ``.vtp`` file."""
 
 
@@ -184,18 +187,18 @@ def _contact_lines(snap: xr.Dataset, classes: np.ndarray, walls: bool):
 
 
 def _snapshot_files(snap: xr.Dataset, fields: xr.Dataset, classes: np.ndarray, polygons: bool) -> dict:
-    """The PolyData trees of one snapshot by block name (:data:`VTK_BLOCKS`); None for the
-    contacts of a snapshot without particle-particle contact (no file: OVITO stops on a
-    contacts file without lines)."""
+    """The PolyData trees of one snapshot by block name (:data:`VTK_BLOCKS`, then "polygons"
+    when ``polygons``); None for the contacts of a snapshot without particle-particle contact
+    (no file: OVITO stops on a contacts file without lines)."""
     data = _particle_data(snap, fields)
     trees = {"particles": polydata(np.asarray(snap["position"].values, float), verts=True, point_data=data)}
-    if polygons:
-        points, sizes, cell_data = _polygons(snap, data)
-        trees["polygons"] = polydata(points, polys=sizes, cell_data=cell_data)
     for block, walls in (("contacts", False), ("wall_contacts", True)):
         points, cell_data = _contact_lines(snap, classes, walls)
         empty = len(points) == 0 and not walls
         trees[block] = None if empty else polydata(points, lines=np.full(len(points) // 2, 2), cell_data=cell_data)
+    if polygons:
+        points, sizes, cell_data = _polygons(snap, data)
+        trees["polygons"] = polydata(points, polys=sizes, cell_data=cell_data)
     return trees
 
 
@@ -203,9 +206,10 @@ def write_vtk(ds: xr.Dataset, out_dir, every: int = 1, overwrite: bool = False, 
     """Write the VTK files of the module docstring for every ``every``-th snapshot into ``out_dir``.
 
     For ParaView and OVITO (open ``snapshots.pvd``: every snapshot on the time axis, or one
-    ``snapshot_<k>.vtm``); ``out_dir`` is created if needed. Per snapshot k,
-    ``particles_<k>.vtp``, ``polygons_<k>.vtp`` (files with polygons), ``contacts_<k>.vtp``,
-    ``wall_contacts_<k>.vtp`` and ``snapshot_<k>.vtm``, then ``snapshots.pvd``.
+    ``snapshot_<k>.vtm``; in ParaView also ``polygons.pvd``); ``out_dir`` is created if
+    needed. Per snapshot k, ``particles_<k>.vtp``, ``contacts_<k>.vtp``,
+    ``wall_contacts_<k>.vtp``, ``polygons_<k>.vtp`` (files with polygons) and
+    ``snapshot_<k>.vtm``, then ``snapshots.pvd`` and ``polygons.pvd`` (files with polygons).
 
     Parameters
     ----------
@@ -224,7 +228,7 @@ def write_vtk(ds: xr.Dataset, out_dir, every: int = 1, overwrite: bool = False, 
     Returns
     -------
     list of str
-        The paths written, snapshot by snapshot in the order above, ``snapshots.pvd`` last.
+        The paths written, snapshot by snapshot in the order above, the collections last.
 
     Raises
     ------
@@ -241,10 +245,11 @@ def write_vtk(ds: xr.Dataset, out_dir, every: int = 1, overwrite: bool = False, 
 
     indices = snapshot_indices(ds, every)
     polygons = bool((np.asarray(ds["n_vertices"].values) > 0).any())
-    blocks = [block for block in VTK_BLOCKS if polygons or block != "polygons"]
+    stems = list(VTK_BLOCKS) + ["polygons"] * polygons
+    collections = ["snapshots"] + ["polygons"] * polygons
     targets = [os.path.join(out_dir, name) for k in indices
-               for name in [f"{block}_{int(k):05d}.vtp" for block in blocks] + [f"snapshot_{int(k):05d}.vtm"]]
-    targets.append(os.path.join(out_dir, "snapshots.pvd"))
+               for name in [f"{stem}_{int(k):05d}.vtp" for stem in stems] + [f"snapshot_{int(k):05d}.vtm"]]
+    targets += [os.path.join(out_dir, f"{name}.pvd") for name in collections]
     existing = [t for t in targets if os.path.exists(t)]
     if existing and not overwrite:  # before anything is written
         raise ParameterError(f"{existing[0]} exists ({len(existing)} of the {len(targets)} files to write); "
@@ -252,7 +257,7 @@ def write_vtk(ds: xr.Dataset, out_dir, every: int = 1, overwrite: bool = False, 
     os.makedirs(out_dir, exist_ok=True)
     fields = particle_fields(ds, walls=True)
     classes = force_class(ds, walls=True)
-    written, entries = [], []
+    written, entries = [], {name: [] for name in collections}
     iterator = indices
     if progress:
         from tqdm.auto import tqdm
@@ -262,21 +267,26 @@ def write_vtk(ds: xr.Dataset, out_dir, every: int = 1, overwrite: bool = False, 
         k = int(k)
         snap = ds.isel(time=k).compute()
         trees = _snapshot_files(snap, fields.isel(time=k).compute(), np.asarray(classes.isel(time=k).values), polygons)
-        files = {block: None if tree is None else f"{block}_{k:05d}.vtp" for block, tree in trees.items()}
-        trees[f"snapshot_{k:05d}"], files[f"snapshot_{k:05d}"] = multiblock(files.items()), f"snapshot_{k:05d}.vtm"
-        for block, tree in trees.items():
+        files = {stem: None if tree is None else f"{stem}_{k:05d}.vtp" for stem, tree in trees.items()}
+        blocks = multiblock((block, files[block]) for block in VTK_BLOCKS)
+        trees[f"snapshot_{k:05d}"], files[f"snapshot_{k:05d}"] = blocks, f"snapshot_{k:05d}.vtm"
+        for stem, tree in trees.items():
             if tree is None:  # no file; one left by an earlier export is not this snapshot's
-                stale = os.path.join(out_dir, f"{block}_{k:05d}.vtp")
+                stale = os.path.join(out_dir, f"{stem}_{k:05d}.vtp")
                 if os.path.exists(stale):
                     os.remove(stale)
                 continue
-            path = os.path.join(out_dir, files[block])
+            path = os.path.join(out_dir, files[stem])
             write_atomically(path, overwrite, lambda temporary, tree=tree: write_xml(tree, temporary))
             written.append(path)
-        entries.append((float(snap["time"].values), files[f"snapshot_{k:05d}"]))
-    path = os.path.join(out_dir, "snapshots.pvd")
-    write_atomically(path, overwrite, lambda temporary: write_xml(collection(entries), temporary))
-    written.append(path)
+        time = float(snap["time"].values)
+        entries["snapshots"].append((time, files[f"snapshot_{k:05d}"]))
+        if polygons:
+            entries["polygons"].append((time, files["polygons"]))
+    for name in collections:
+        path = os.path.join(out_dir, f"{name}.pvd")
+        write_atomically(path, overwrite, lambda temporary, name=name: write_xml(collection(entries[name]), temporary))
+        written.append(path)
     return written
 
 

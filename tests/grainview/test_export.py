@@ -54,9 +54,9 @@ def read_vtp(path):
 def test_vtk_files_hold_the_snapshots(tmp_path):
     ds = polygons_and_disks()
     paths = write_vtk(ds, tmp_path, every=2)
-    # snapshots 0, 2, 4 and the last (5): 4 x (4 .vtp + 1 .vtm) files and the collection
-    assert len(paths) == 21 and all(os.path.exists(p) for p in paths)
-    assert os.path.basename(paths[-1]) == "snapshots.pvd"
+    # snapshots 0, 2, 4 and the last (5): 4 x (4 .vtp + 1 .vtm) files and the two collections
+    assert len(paths) == 22 and all(os.path.exists(p) for p in paths)
+    assert [os.path.basename(p) for p in paths[-2:]] == ["snapshots.pvd", "polygons.pvd"]
     k = 2
     position, angle = ds.position.values[k], ds.angle.values[k]
 
@@ -112,11 +112,12 @@ def test_vtk_files_hold_the_snapshots(tmp_path):
     assert (cells["particle_id"].tolist(), cells["wall_id"].tolist(), cells["fn"].tolist()) == ([4], [0], [1.0])
     assert (cells["ft"].tolist(), cells["kind"].tolist(), cells["force_class"].tolist()) == ([0.25], [1], [2])
 
-    # the snapshot's blocks and the time collection
+    # the snapshot's blocks (the polygons apart) and the time collections
     blocks = [(e.get("name"), e.get("file")) for e in ElementTree.parse(tmp_path / f"snapshot_{k:05d}.vtm").iter("DataSet")]
-    assert blocks == [(b, f"{b}_{k:05d}.vtp") for b in ("particles", "polygons", "contacts", "wall_contacts")]
-    entries = [(float(e.get("timestep")), e.get("file")) for e in ElementTree.parse(tmp_path / "snapshots.pvd").iter("DataSet")]
-    assert entries == [(float(t), f"snapshot_{t:05d}.vtm") for t in (0, 2, 4, 5)]
+    assert blocks == [(b, f"{b}_{k:05d}.vtp") for b in ("particles", "contacts", "wall_contacts")]
+    for name, stem in (("snapshots", "snapshot_{:05d}.vtm"), ("polygons", "polygons_{:05d}.vtp")):
+        entries = [(float(e.get("timestep")), e.get("file")) for e in ElementTree.parse(tmp_path / f"{name}.pvd").iter("DataSet")]
+        assert entries == [(float(t), stem.format(t)) for t in (0, 2, 4, 5)]
 
 
 def test_a_snapshot_without_particle_pairs_has_an_empty_contacts_block(tmp_path):
@@ -125,7 +126,7 @@ def test_a_snapshot_without_particle_pairs_has_an_empty_contacts_block(tmp_path)
     names = sorted(os.listdir(tmp_path))
     assert names == sorted(os.path.basename(p) for p in paths)
     assert "contacts_00000.vtp" not in names and "contacts_00001.vtp" in names
-    assert not [n for n in names if n.startswith("polygons")]  # no polygon in the file
+    assert not [n for n in names if n.startswith("polygons")]  # no polygon in the file, no outlines
     blocks = [(e.get("name"), e.get("file")) for e in ElementTree.parse(tmp_path / "snapshot_00000.vtm").iter("DataSet")]
     assert blocks == [("particles", "particles_00000.vtp"), ("contacts", None), ("wall_contacts", "wall_contacts_00000.vtp")]
     _, piece, arrays = read_vtp(tmp_path / "wall_contacts_00000.vtp")
