@@ -49,7 +49,7 @@ def _cells(piece, tag: str, sizes) -> None:
 
 def polydata(points, *, verts: bool = False, lines=None, polys=None, point_data=None,
              cell_data=None) -> ElementTree.ElementTree:
-    """A VTK PolyData file: points and one kind of cells made of consecutive points.
+    """A VTK PolyData file: points, and vertex, line or polygon cells of consecutive points.
 
     Parameters
     ----------
