@@ -1,0 +1,107 @@
+"""The README's showcase: docs/figures/headline_400.md is the headline table `grainview study`
+writes with its defaults, and the README quotes that table's numbers.
+
+The first check runs the study (400 particles of each shape to eps_1 = 0.2: 2-3 minutes on
+two free cores, longer on busy ones), so it is marked slow and `.ci/run` runs it apart. Two runs of the study on the
+same machine give the same files bit for bit (one process per sample, each serial), so the
+tables are compared cell for cell, as written: any difference is a change of the solver, of
+the analysis or of the report, and the committed table must be regenerated with the README's
+command. The second check is fast: every number the README's showcase paragraph quotes is the
+committed table's, rounded as quoted.
+"""
+
+from __future__ import annotations
+
+import re
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parents[1]
+SHOWCASE = ROOT / "docs" / "figures" / "headline_400.md"
+README = ROOT / "README.md"
+REGENERATE = ("grainview study --out study --overwrite && cp study/report/figures/"
+              "fig{03_q_over_p,13_force_chains_pentagons,14_force_pdfs}.png docs/figures/ && "
+              "cp study/report/headline.md docs/figures/headline_400.md")
+
+
+def headline_rows(text: str) -> dict:
+    """{quantity: [cells]} of a headline table in Markdown, and {"notes": [paragraphs]} under it."""
+    rows, notes = {}, []
+    for line in text.splitlines():
+        if line.startswith("|---"):
+            continue
+        if line.startswith("|"):
+            cells = [c.strip() for c in line.strip().strip("|").split(" | ")]
+            rows[cells[0]] = cells[1:]
+        elif line.strip():
+            notes.append(line.strip())
+    rows["notes"] = notes
+    return rows
+
+
+def differences(committed: str, fresh: str) -> list[str]:
+    """One line per row (or note) that differs between two headline tables."""
+    old, new = headline_rows(committed), headline_rows(fresh)
+    lines = []
+    for key in dict.fromkeys([*old, *new]):
+        if old.get(key) != new.get(key):
+            lines.append(f"{key}: committed {old.get(key)} , the study gives {new.get(key)}")
+    return lines
+
+
+def test_differences_name_each_changed_row():
+    table = "| quantity | a | b |\n|---|---|---|\n| q/p | 0.546 | 0.350 |\n| z | 2.880 | 3.750 |\n\nnote one\n"
+    assert differences(table, table) == []
+    changed = table.replace("2.880", "2.835").replace("note one", "note two")
+    assert differences(table, changed) == ["z: committed ['2.880', '3.750'] , the study gives ['2.835', '3.750']",
+                                           "notes: committed ['note one'] , the study gives ['note two']"]
+    assert differences(table, table + "| k_s | 0.5 | - |\n")[0].startswith("k_s: committed None")
+
+
+@pytest.mark.slow
+def test_the_committed_headline_is_what_the_study_gives(tmp_path):
+    from grainview.cli import main
+
+    assert main(["study", "--out", str(tmp_path / "study"), "--progress", "off"]) == 0
+    fresh = (tmp_path / "study" / "report" / "headline.md").read_text()
+    changed = differences(SHOWCASE.read_text(), fresh)
+    assert not changed, (f"{SHOWCASE.relative_to(ROOT)} is not what `grainview study` gives today; regenerate it "
+                         f"with `{REGENERATE}` (from the repository root) and update the README's numbers:\n"
+                         + "\n".join(changed))
+
+
+CROSS_TERM = "(a' + a_n + a_t)/(2 + a' a_n) (residual)"
+
+
+def _value(rows, quantity, column):
+    """The committed table's number in ``column`` (0: pentagons, this run; 2: disks, this run)."""
+    return float(rows[quantity][column])
+
+
+def test_the_readme_quotes_the_committed_headline():
+    rows = headline_rows(SHOWCASE.read_text())
+    readme = README.read_text()
+    section = readme[readme.index("## What it looks like"):readme.index("## Speed and accuracy")]
+    section = " ".join(section.split())  # the paragraph's line breaks do not matter
+    disks = section[section.index("**the disks reproduce"):section.index("**The pentagons")]
+    pentagons = section[section.index("**The pentagons"):]
+    pent, disk = 0, 2
+    expected_disks = [f"q/p {_value(rows, 'q/p (residual)', disk):.2f} (paper 0.28",
+                      f"exp(-{_value(rows, 'alpha (strong-force pdf)', disk):.2f} f/<f>) (paper 1.4",
+                      f"fabric anisotropy a {_value(rows, 'a (residual)', disk):.2f} (paper up to ~0.3)",
+                      f"z {_value(rows, 'z (residual)', disk):.2f} against 3.85"]
+    expected_pentagons = [f"q/p {_value(rows, 'q/p (residual)', pent):.2f} against 0.35",
+                          f"fabric anisotropy a {_value(rows, 'a (residual)', pent):.2f} against",
+                          f"z {_value(rows, 'z (residual)', pent):.2f} against 3.75",
+                          f"({rows[CROSS_TERM][pent]} against {rows['q/p (residual)'][pent]} here)"]
+    for phrase in expected_disks:
+        assert phrase in disks, phrase
+    for phrase in expected_pentagons:
+        assert phrase in pentagons, phrase
+    # the steps that ended at the sweep cap, as the notes under the table count them
+    counts = {}
+    for note in rows["notes"]:
+        label, steps, of = re.match(r"\*\*(\w+)\.\*\* NLGS convergence: (\d+) of the test's (\d+) steps", note).groups()
+        counts[label] = f"{int(steps):,} of the {label}' {int(of):,}"
+    assert f"({counts['pentagons']}, {counts['disks']})" in section
