@@ -13,7 +13,7 @@ import os
 import numpy as np
 import xarray as xr
 
-from .errors import FileFormatError, SchemaError
+from .errors import FileFormatError, ParameterError, SchemaError
 from .file_checks import damaged_snapshots, hidden_records
 from .locks import being_written
 from .schema import SCHEMA_VERSION, complete_snapshots
@@ -172,7 +172,10 @@ def open_dataset(path, chunks: int | dict | None = "auto", validate: bool = Fals
     SchemaError
         A schema version newer than this grainview's, or (with ``validate``) any fault.
     """
-    if format != "grainview" or reader_options:
+    if format == "grainview" and reader_options:
+        raise ParameterError(f"{', '.join(sorted(reader_options))}: options of another code's reader; give its "
+                             "format (format='lammps', ...) or leave them out for a grainview file")
+    if format != "grainview":
         from .formats import open_format
 
         ds = open_format(format, path, **reader_options)

@@ -55,6 +55,8 @@ SNAPSHOT_KEYS = ("time", "step", "position", "angle", "velocity", "angular_veloc
                  "wall_velocity", "a", "b", "normal", "force", "n_points", "points", "point_fn")
 SAMPLE_KEYS = ("radius", "n_vertices", "mass", "inertia", "time_step")
 OPTIONAL = ("velocity", "angular_velocity", "wall_position", "wall_velocity", "wall_force", "normal_impulse", "step")
+SNAPSHOT_FIELDS = ("time", "position", "angle", "contacts", "box_min", "box_max", "raw") + OPTIONAL
+"""What :func:`peer_snapshots` yields for each snapshot: the writer's arguments and the raw arrays."""
 
 
 def peer_contacts(raw, position, dt) -> dict:
@@ -223,18 +225,20 @@ def convert_peer(out, raw_dir, sample, *, engine=None, attrs=None, extra=None, o
 
     out = check_out(out, overwrite)
     static, stream = peer_snapshots(raw_dir, sample, engine)
+    if extra is not None:  # each snapshot's extra variables, computed once
+        stream = (dict(snap, **extra(snap["raw"])) for snap in stream)
     first = next(stream)
-    more = tuple(extra(first["raw"])) if extra is not None else ()
+    more = tuple(name for name in first if name not in SNAPSHOT_FIELDS)
     static = dict(static, n_walls=4, wall_names=WALLS, wall_normal=WALL_NORMALS, attrs=dict(static["attrs"],
                                                                                           **(attrs or {})))
     slots = contact_slots(static["radius"].size, 4)  # the writer's contact slots
 
     def prepare(snap):
-        raw = snap.pop("raw")
+        snap.pop("raw")
         points = snap.pop("normal_impulse")
         impulse = np.zeros((slots, 2))
         impulse[:len(points)] = points
-        return dict(snap, normal_impulse=impulse, **(extra(raw) if extra is not None else {}))
+        return dict(snap, normal_impulse=impulse)
 
     return write_snapshots(out, static, chain_first(first, stream), OPTIONAL + more, overwrite=overwrite,
                            compress=compress, label="peer", prepare=prepare)

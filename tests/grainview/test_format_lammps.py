@@ -283,6 +283,8 @@ def test_grainview_open_dataset_reads_the_format_lazily(ds):
     np.testing.assert_array_equal(z.compute().values, ds.grain.coordination()["z"].values)
     with pytest.raises(ParameterError, match="format='gromacs': expected 'grainview' or one of .*lammps"):
         grainview.open_dataset(files["particles"], format="gromacs")
+    with pytest.raises(ParameterError, match="contacts: options of another code's reader; give its format"):
+        grainview.open_dataset(files["particles"], contacts=files["contacts"])
 
 
 def _pull_on_the_floor(text):

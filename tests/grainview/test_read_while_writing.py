@@ -7,7 +7,6 @@ polling a run that appends and then compresses its file never sees a damaged fil
 import os
 import subprocess
 import sys
-import time
 from pathlib import Path
 
 import numpy as np
