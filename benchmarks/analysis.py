@@ -43,7 +43,7 @@ def _lifetimes(ds):
 def write_series(path, n_snapshots, n_contacts, seed=0, attrs=None):
     """Stream a harmonic-model series of ``n_snapshots`` x ``n_contacts`` to ``path`` (global
     attributes ``attrs`` added)."""
-    from grainview.writer import SnapshotWriter
+    from grainview.contract.writer import SnapshotWriter
     from grainview.synthetic import PAIR_LENGTH_M, harmonic_contacts
 
     rng = np.random.default_rng(seed)

@@ -4,7 +4,7 @@ analyses on the compressed file against the same file uncompressed.
     python benchmarks/compression.py [FILE]        # default: study/disks.nc (grainview study)
 
 FILE is copied twice into a temporary folder: one copy is made netCDF-3, the other
-compressed (grainview.writer.compress_file, the solver's default at the end of a run). The
+compressed (grainview.contract.writer.compress_file, the solver's default at the end of a run). The
 analyses (stress invariants, fabric anisotropy, force anisotropies, computed lazily with dask
 from open_dataset's default chunks) run on both copies alternately, ``--repeats`` times; the
 table gives medians and their ratio from this one run.
@@ -45,7 +45,7 @@ def main(argv=None):
     warnings.simplefilter("ignore")
     import grainview
     from common import machine_description
-    from grainview.writer import compress_file, decompress_file
+    from grainview.contract.writer import compress_file, decompress_file
 
     with tempfile.TemporaryDirectory() as tmp:
         plain, packed = os.path.join(tmp, "plain.nc"), os.path.join(tmp, "packed.nc")

@@ -29,7 +29,7 @@ FIXTURES = ROOT / "tests" / "data" / "lammps"
 
 CHILD = r"""
 import json, resource, sys, time, warnings
-import grainview, grainview.io, grainview.writer
+import grainview, grainview.contract.io, grainview.contract.writer
 from grainview.formats.lammps import convert_lammps
 folder, out = sys.argv[1], sys.argv[2]
 stages = {}
@@ -40,8 +40,8 @@ def before(name, function):  # the peak reached before a stage starts
         stages.setdefault(name, peak_mib())
         return function(*args, **kwargs)
     return wrapped
-grainview.io.open_dataset = before("read and written", grainview.io.open_dataset)
-grainview.writer.compress_file = before("validated", grainview.writer.compress_file)
+grainview.contract.io.open_dataset = before("read and written", grainview.contract.io.open_dataset)
+grainview.contract.writer.compress_file = before("validated", grainview.contract.writer.compress_file)
 start = time.perf_counter()
 with warnings.catch_warnings(record=True) as caught:
     warnings.simplefilter("always")
@@ -134,7 +134,7 @@ def main(argv=None) -> int:
         "Peak memory is the process's peak resident set (Python, numpy, xarray, netCDF4 included) when each stage "
         f"ends. One snapshot's arrays take {one_snapshot_mib:.1f} MiB; the whole dump text "
         f"{one['text_bytes'] / 2**20:.0f} MiB. Reading and writing stream: compare the peaks of the "
-        "two rows. Validation reads the file chunk by chunk. The compression (grainview.writer.compress_file, "
+        "two rows. Validation reads the file chunk by chunk. The compression (grainview.contract.writer.compress_file, "
         "the same for every run file) copies each variable in blocks of up to 64 MiB through the netCDF "
         "library, whose chunk caches are per variable: its peak grows with the file until each variable "
         "exceeds a block (compare the rows), which is what bounds it.",

@@ -19,12 +19,13 @@ so that the solver, which writes files of the contract, does not load them.
 import importlib
 
 from . import _register
-from .errors import ConvergenceWarning, FileFormatError, GrainviewError, OutputError, ParameterError, SchemaError
-from .schema import SCHEMA_VERSION
+from .contract.errors import ConvergenceWarning, FileFormatError, GrainviewError, OutputError, ParameterError, SchemaError
+from .contract.schema import SCHEMA_VERSION
 
 __version__ = "0.1.0"
 
-_LAZY = {"open_dataset": "io", "validate": "validation", "make_dataset": "dataset", "SnapshotWriter": "writer",
+_LAZY = {"open_dataset": "opening", "validate": "contract.validation", "make_dataset": "contract.dataset",
+         "SnapshotWriter": "contract.writer",
          "open_ensemble": "ensemble"}
 """Public names imported from their module on first access (PEP 562)."""
 

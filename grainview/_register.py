@@ -1,7 +1,7 @@
 """Registering the ``ds.grain`` accessor without loading xarray before anyone needs it.
 
 ``import grainview`` must make ``ds.grain`` available on every xarray Dataset, yet the solver,
-which imports ``grainview.errors`` and the contract (:mod:`grainview.schema`), must not pay
+which imports ``grainview.contract.errors`` and the contract (:mod:`grainview.contract.schema`), must not pay
 for xarray, pandas and dask. So :func:`register` registers the accessor at once when xarray is
 already loaded, and otherwise the moment xarray's own import completes, through a one-shot
 import hook (:class:`importlib.abc.MetaPathFinder`) that removes itself when it fires. A

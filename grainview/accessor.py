@@ -72,9 +72,9 @@ class GrainAccessor:
 
     def _check_structure(self):
         """Structural check (no data read) before any analysis, so that a malformed dataset
-        gives a :class:`~grainview.errors.SchemaError` naming the problem, not a KeyError."""
+        gives a :class:`~grainview.contract.errors.SchemaError` naming the problem, not a KeyError."""
         if not self._structure_ok:
-            from .validation import check_structure
+            from .contract.validation import check_structure
 
             check_structure(self._ds)
             self._structure_ok = True
@@ -101,7 +101,7 @@ class GrainAccessor:
         return result.assign_coords(self._strains)
 
     def validate(self):
-        """Check the dataset against the contract (:func:`grainview.validation.validate`).
+        """Check the dataset against the contract (:func:`grainview.contract.validation.validate`).
 
         On an ensemble (a ``run`` dimension) each run is checked as its file opens alone
         (:func:`grainview.ensemble.run_dataset`).
@@ -113,10 +113,10 @@ class GrainAccessor:
 
         Raises
         ------
-        grainview.errors.SchemaError
+        grainview.contract.errors.SchemaError
             Listing every problem found (docs/schema.md).
         """
-        from .validation import validate
+        from .contract.validation import validate
 
         if "run" in self._ds.dims:  # an ensemble: each run
             from .ensemble import run_dataset
@@ -176,7 +176,7 @@ class GrainAccessor:
 
         Raises
         ------
-        grainview.errors.ParameterError
+        grainview.contract.errors.ParameterError
             On an ensemble: plot ``run_dataset(ens, k)`` (or a dict of them), or write the
             ensemble's report.
 
@@ -186,7 +186,7 @@ class GrainAccessor:
         Figs. 3-25 (the table in :mod:`grainview.plot`).
         """
         if "run" in self._ds.dims:
-            from .errors import ParameterError
+            from .contract.errors import ParameterError
 
             raise ParameterError("the figures draw runs, not an ensemble: plot run_dataset(ens, k) (or a dict of "
                                  "them), or write the ensemble's report (grainview.ensemble_report)")

@@ -12,7 +12,7 @@ import math
 import sys
 from pathlib import Path
 
-from .errors import ConvergenceWarning, GrainviewError, SchemaError
+from .contract.errors import ConvergenceWarning, GrainviewError, SchemaError
 
 RESIDUAL_STRAIN = 0.3
 """Default start of the residual window (eps_q); the same as grainview.strain.RESIDUAL_STRAIN,
@@ -30,8 +30,8 @@ def _info(args) -> int:
     from .file_summary import describe_file
 
     if args.check:  # first, so that every problem is listed: the summary's own and every value's
-        from .io import open_dataset
-        from .validation import validate
+        from .contract.io import open_dataset
+        from .contract.validation import validate
 
         problems = []
         try:
@@ -62,8 +62,8 @@ def _info(args) -> int:
 
 def _export(args) -> int:
     from .export import write_csv, write_vtk
-    from .io import open_dataset
-    from .validation import validate
+    from .contract.io import open_dataset
+    from .contract.validation import validate
 
     ds = open_dataset(args.file)
     validate(ds, source=str(args.file))
@@ -116,7 +116,7 @@ def _convert_lmgc90(args) -> int:
 
 def _demo(args) -> int:
     from . import open_dataset
-    from .dataset import netcdf_options
+    from .contract.dataset import netcdf_options
     from .synthetic import harmonic_series
 
     if args.snapshots < 2 or args.contacts < 1:
@@ -290,8 +290,8 @@ def _simulation_kwargs(args):
 
 TEMPORARY_NAME_EXTRA = len("..") + 7 + len(".convert")
 """Bytes the writer's temporary names add to a file's name: ``.<name>.<pid>.part`` and
-``.<name>.<pid>.convert`` (grainview.writer; a process id has at most 7 digits) and the lock's
-``.<name>.writer`` (grainview.locks)."""
+``.<name>.<pid>.convert`` (grainview.contract.writer; a process id has at most 7 digits) and the lock's
+``.<name>.writer`` (grainview.contract.locks)."""
 
 
 def longest_output_name(folder) -> int:
@@ -354,7 +354,7 @@ def _run(args) -> int:
 
 
 def _report(args) -> int:
-    from .io import open_dataset
+    from .contract.io import open_dataset
     from .report import write_report
 
     if getattr(args, "ensemble", False):

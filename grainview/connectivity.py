@@ -15,7 +15,7 @@ import xarray as xr
 from ._lift import apply, with_attrs
 from .arrays import connectivity as _conn
 from .contacts import selection
-from .errors import ParameterError
+from .contract.errors import ParameterError
 
 __all__ = ["contact_numbers", "counts_of", "coordination", "connectivity_pdf",
            "joint_connectivity_pdf"]
@@ -118,7 +118,7 @@ def coordination(ds: xr.Dataset, walls: bool = False, min_contacts: int = 1, nea
 
     Raises
     ------
-    grainview.errors.ParameterError
+    grainview.contract.errors.ParameterError
         When ``min_contacts`` is not an integer >= 1.
 
     References
@@ -166,7 +166,7 @@ def connectivity_pdf(ds: xr.Dataset, max_c: int = 10, walls: bool = False, min_c
 
     Raises
     ------
-    grainview.errors.ParameterError
+    grainview.contract.errors.ParameterError
         When ``min_contacts`` is not an integer >= 1.
 
     References
@@ -216,7 +216,7 @@ def joint_connectivity_pdf(ds: xr.Dataset, max_m: int = 8, walls: bool = False, 
 
     Raises
     ------
-    grainview.errors.ParameterError
+    grainview.contract.errors.ParameterError
         When ``min_contacts`` is not an integer >= 1.
 
     References

@@ -13,8 +13,9 @@ from __future__ import annotations
 import numpy as np
 import xarray as xr
 
-from .errors import ParameterError
-from .schema import KIND_DOUBLE, KIND_SIMPLE
+from .contract.errors import ParameterError
+from .contract.schema import KIND_DOUBLE, KIND_SIMPLE
+from .contract.validation import occupied
 
 __all__ = ["n_particles", "snapshot_index", "occupied", "is_wall_contact", "kind_code",
            "check_near", "in_network", "near_attr", "selection"]
@@ -59,32 +60,13 @@ def snapshot_index(ds: xr.Dataset, value, name: str = "time") -> int:
 
     Raises
     ------
-    grainview.errors.ParameterError
+    grainview.contract.errors.ParameterError
         When ``value`` is not an integer in [-T, T).
     """
     n = ds.sizes["time"]
     if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or not -n <= value < n:
         raise ParameterError(f"{name}={value!r}: expected a snapshot index in [{-n}, {n})")
     return int(value) % n
-
-
-def occupied(ds: xr.Dataset) -> xr.DataArray:
-    """Boolean (time, contact): True in the slots that hold a contact.
-
-        slot < contact_count[time]
-
-    Parameters
-    ----------
-    ds : xarray.Dataset
-        A dataset of the contract (docs/schema.md), eager or chunked along ``time``.
-
-    Returns
-    -------
-    xarray.DataArray
-        Boolean (time, contact); lazy on dask input.
-    """
-    slot = xr.DataArray(np.arange(ds.sizes["contact"], dtype="i4"), dims="contact")
-    return slot < ds["contact_count"]
 
 
 def is_wall_contact(ds: xr.Dataset) -> xr.DataArray:
@@ -119,7 +101,7 @@ def kind_code(kind) -> int | None:
 
     Raises
     ------
-    grainview.errors.ParameterError
+    grainview.contract.errors.ParameterError
         For any other value.
 
     References
@@ -155,7 +137,7 @@ def check_near(ds: xr.Dataset, near) -> float | None:
 
     Raises
     ------
-    grainview.errors.ParameterError
+    grainview.contract.errors.ParameterError
         When ``near`` is not None or a number >= 0; when a finite ``near`` is asked of a file
         without the variable ``gap`` or without near pairs (attribute ``near_contacts_m``); when
         ``near`` exceeds the gap up to which the file holds them (docs/analysis.md, "Near

@@ -35,8 +35,8 @@ from pathlib import Path
 import numpy as np
 import xarray as xr
 
-from .errors import ParameterError
-from .schema import EMPTY_ID, EMPTY_KIND
+from .contract.errors import ParameterError
+from .contract.schema import EMPTY_ID, EMPTY_KIND
 
 RUN_PARAMETERS = {
     "shape": ("preparation_shape",),
@@ -141,7 +141,7 @@ def open_ensemble(paths, chunks="auto", validate: bool = False, names=None) -> x
 
     Raises
     ------
-    grainview.errors.ParameterError
+    grainview.contract.errors.ParameterError
         When no file is found, ``names`` does not match the files, two runs share a name, or
         the files differ in variables or walls.
 
@@ -150,7 +150,7 @@ def open_ensemble(paths, chunks="auto", validate: bool = False, names=None) -> x
     >>> ens = open_ensemble("study/*.nc")                                   # doctest: +SKIP
     >>> seed_statistics(ens.grain.fabric_anisotropy()["a"], eps_q_bins=np.arange(0, 0.7, 0.05))  # doctest: +SKIP
     """
-    from .io import open_dataset
+    from .contract.io import open_dataset
 
     files = _paths(paths)
     if names is None:
@@ -455,7 +455,7 @@ def seed_statistics(result, eps_q_bins=None) -> xr.Dataset:
 
     Raises
     ------
-    grainview.errors.ParameterError
+    grainview.contract.errors.ParameterError
         When ``result`` has no ``run`` dimension or ``group`` coordinate, or, with
         ``eps_q_bins``, no ``eps_q`` coordinate or bins that are not increasing finite edges.
     """

@@ -19,7 +19,7 @@ import numpy as np
 import pandas as pd
 
 from .ensemble import run_dataset, seed_statistics
-from .errors import ParameterError
+from .contract.errors import ParameterError
 from .report import INITIAL_ROWS, NOT_REACHED, PAPER, paper_key
 from .strain import RESIDUAL_STRAIN
 

@@ -19,7 +19,7 @@ VTK, written as VTK's XML PolyData (:mod:`grainview.vtk_xml`), per snapshot k:
   index), ``fn``, ``ft``, ``kind``, ``force_class``;
 * ``snapshot_<k>.vtm``: the three as the named blocks of one multi-block dataset;
 * ``polygons_<k>.vtp`` (files with polygons): every polygon's outline as a polygon cell, its
-  vertices by the contract's definition (:func:`grainview.schema.polygon_vertices`), with the
+  vertices by the contract's definition (:mod:`grainview.contract.shapes`), with the
   particles' data as cell data; not a block of the ``.vtm``: OVITO 3.17 renders such a flat
   mesh blank, and its Tachyon renderer stopped (segmentation fault) on such a mesh of a few
   polygons;
@@ -51,8 +51,8 @@ import os
 import numpy as np
 import xarray as xr
 
-from .errors import ParameterError
-from .schema import polygon_vertices
+from .contract.errors import ParameterError
+from .contract.shapes import body_vertices_of, world_vertices
 from .vtk_xml import collection, multiblock, polydata, write_xml
 
 __all__ = ["write_vtk", "write_csv", "snapshot_indices", "write_atomically", "CSV_COLUMNS", "VTK_BLOCKS"]
@@ -97,7 +97,7 @@ def snapshot_indices(ds: xr.Dataset, every: int = 1) -> np.ndarray:
 
     Raises
     ------
-    grainview.errors.ParameterError
+    grainview.contract.errors.ParameterError
         When ``every`` is not an integer >= 1.
     """
     if isinstance(every, bool) or not isinstance(every, (int, np.integer)) or every < 1:
@@ -127,7 +127,7 @@ def write_atomically(path, overwrite, write):
 
     Raises
     ------
-    grainview.errors.ParameterError
+    grainview.contract.errors.ParameterError
         When ``path`` exists and ``overwrite`` is False.
     """
     if os.path.exists(path) and not overwrite:
@@ -162,8 +162,8 @@ def _polygons(snap: xr.Dataset, data: dict):
     position = np.asarray(snap["position"].values, float)
     n_vertices = data["n_vertices"]
     groups = [np.flatnonzero(n_vertices == n) for n in np.unique(n_vertices[n_vertices > 0])]
-    points = [polygon_vertices(position[members], data["radius"][members], data["angle"][members],
-                               int(n_vertices[members[0]])).reshape(-1, 2) for members in groups]
+    world = world_vertices(position, data["angle"], body_vertices_of(snap))
+    points = [world[members, :int(n_vertices[members[0]])].reshape(-1, 2) for members in groups]
     order = np.concatenate(groups) if groups else np.arange(0)
     return (np.concatenate(points) if points else np.zeros((0, 2)), n_vertices[order],
             {name: values[order] for name, values in data.items()})
@@ -232,7 +232,7 @@ def write_vtk(ds: xr.Dataset, out_dir, every: int = 1, overwrite: bool = False, 
 
     Raises
     ------
-    grainview.errors.ParameterError
+    grainview.contract.errors.ParameterError
         When a file to write exists and ``overwrite`` is False.
 
     References
@@ -320,7 +320,7 @@ def write_csv(ds: xr.Dataset, out_dir, every: int = 1, overwrite: bool = False) 
 
     Raises
     ------
-    grainview.errors.ParameterError
+    grainview.contract.errors.ParameterError
         When ``contacts.csv`` exists and ``overwrite`` is False.
 
     References

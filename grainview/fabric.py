@@ -13,7 +13,7 @@ from ._lift import apply, with_attrs
 from .arrays import fabric as _fabric
 from .arrays.tensors import principal, signed_anisotropy
 from .contacts import kind_code, selection
-from .errors import ParameterError
+from .contract.errors import ParameterError
 from .stress import stress_direction
 
 __all__ = ["fabric_tensor", "reference_direction", "fabric_anisotropy", "orientation_pdf",
@@ -80,7 +80,7 @@ def reference_direction(ds, reference):
 
     Raises
     ------
-    grainview.errors.ParameterError
+    grainview.contract.errors.ParameterError
         For any other ``reference``.
 
     References
@@ -229,7 +229,7 @@ def check_bins(bins) -> int:
 
     Raises
     ------
-    grainview.errors.ParameterError
+    grainview.contract.errors.ParameterError
         When ``bins`` is not an integer >= 1.
     """
     if not isinstance(bins, (int, np.integer)) or bins < 1:

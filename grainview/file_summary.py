@@ -5,13 +5,13 @@ summary of a study's file. So the summary that ``grainview info`` prints is read
 netCDF4, computed with the pure array functions of :mod:`grainview.arrays` (the same physics
 as the accessors) and formatted by :func:`grainview.summary.summary_lines` (the same lines as
 the report's index). The checks made on the way: the file opens as netCDF, it is a grainview
-file, its structure and units follow the contract (:func:`grainview.schema.structure_problems`,
-:func:`grainview.schema.unit_problems`), a netCDF-3 file is neither shorter than its fixed data
+file, its structure and units follow the contract (:func:`grainview.contract.schema.structure_problems`,
+:func:`grainview.contract.schema.unit_problems`), a netCDF-3 file is neither shorter than its fixed data
 and records need nor longer by records its header does not count, no incomplete snapshot comes
 before complete ones, and the values the summary reads are sound: times increasing strictly,
-finite forces, normal forces >= 0 (:mod:`grainview.file_checks`, the words of
-:func:`grainview.validation.validate`). Every value is checked by
-:func:`grainview.validation.validate` (``grainview info --check``).
+finite forces, normal forces >= 0 (:mod:`grainview.contract.file_checks`, the words of
+:func:`grainview.contract.validation.validate`). Every value is checked by
+:func:`grainview.contract.validation.validate` (``grainview info --check``).
 """
 
 from __future__ import annotations
@@ -20,18 +20,19 @@ import os
 
 import numpy as np
 
-from .errors import FileFormatError, SchemaError
-from .file_checks import (COUNT_OUT_OF_RANGE, damaged_snapshots, force_problems, foreign_file_problems,
+from .contract.errors import FileFormatError, SchemaError
+from .contract.file_checks import (COUNT_OUT_OF_RANGE, damaged_snapshots, force_problems, foreign_file_problems,
                           order_problems)
-from .schema import complete_snapshots, missing_units, particle_area, structure_problems, unit_problems
-from .writer import netcdf3_data_bytes
+from .contract.schema import complete_snapshots, missing_units, structure_problems, unit_problems
+from .contract.shapes import particle_area
+from .contract.writer import netcdf3_data_bytes
 
 __all__ = ["read_facts", "describe_file"]
 
 
 def _netcdf3_data(nc) -> tuple[int, int, int]:
     """``(fixed, record, n_records)``: bytes of a netCDF-3 file's fixed-size variables and of
-    one record (:func:`grainview.writer.netcdf3_data_bytes`), and the header's record count."""
+    one record (:func:`grainview.contract.writer.netcdf3_data_bytes`), and the header's record count."""
     fixed, record = [], []
     for var in nc.variables.values():
         is_record = bool(var.dimensions) and nc.dimensions[var.dimensions[0]].isunlimited()
@@ -44,20 +45,20 @@ def _netcdf3_data(nc) -> tuple[int, int, int]:
 
 def _check_netcdf3_size(nc, source) -> None:
     """Refuse a netCDF-3 file shorter than its data need (cut short) or longer by whole records
-    than its header counts (:func:`grainview.file_checks.hidden_records`). The header's own
+    than its header counts (:func:`grainview.contract.file_checks.hidden_records`). The header's own
     size is not known to netCDF4: a file longer than its data by two records or more is
-    measured exactly (:func:`grainview.io.open_dataset`'s check, with scipy), others cannot
+    measured exactly (:func:`grainview.contract.io.open_dataset`'s check, with scipy), others cannot
     hide records."""
-    from .file_checks import HIDDEN_RECORDS_TOLERATED
+    from .contract.file_checks import HIDDEN_RECORDS_TOLERATED
 
     fixed, record, n_records = _netcdf3_data(nc)
     needed, size = fixed + n_records * record, os.path.getsize(source)
     if size < needed:
         raise FileFormatError(f"{source}: truncated file ({size} bytes, its data need at least {needed})")
     if record and (size - needed) // record > HIDDEN_RECORDS_TOLERATED:
-        from .io import _check_netcdf3_length
+        from .contract.netcdf3 import check_netcdf3_length
 
-        _check_netcdf3_length(source)
+        check_netcdf3_length(source)
 
 
 def read_facts(path) -> tuple[dict, dict]:

@@ -13,7 +13,7 @@ import xarray as xr
 from ._lift import apply, with_attrs
 from .arrays import force_networks as _net
 from .contacts import near_attr, selection
-from .errors import ParameterError
+from .contract.errors import ParameterError
 
 __all__ = ["force_class", "contact_proportions"]
 
@@ -65,7 +65,7 @@ def force_class(ds: xr.Dataset, very_weak: float = 0.1, strong: float = 1.0, wal
 
     Raises
     ------
-    grainview.errors.ParameterError
+    grainview.contract.errors.ParameterError
         When a threshold is not a finite number >= 0, or ``very_weak > strong``.
 
     References
@@ -149,7 +149,7 @@ def contact_proportions(ds: xr.Dataset, walls: bool = False, very_weak: float = 
 
     Raises
     ------
-    grainview.errors.ParameterError
+    grainview.contract.errors.ParameterError
         When a threshold is not a finite number >= 0, or ``very_weak > strong``.
 
     References

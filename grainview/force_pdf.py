@@ -16,7 +16,7 @@ import xarray as xr
 from ._lift import apply, with_attrs
 from .arrays import force_pdf as _pdf
 from .contacts import kind_code, selection
-from .errors import ParameterError
+from .contract.errors import ParameterError
 
 __all__ = ["force_pdf", "pooled_force_pdf", "strong_force_exponent"]
 
@@ -207,7 +207,7 @@ def strong_force_exponent(pdf: xr.Dataset, low: float = 1.0, high: float = np.in
 
     Raises
     ------
-    grainview.errors.ParameterError
+    grainview.contract.errors.ParameterError
         When ``pdf`` is not such a Dataset, or ``low >= high``.
 
     References

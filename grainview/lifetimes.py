@@ -33,7 +33,7 @@ import xarray as xr
 
 from ._lift import with_attrs
 from .contacts import check_near, n_particles, near_attr
-from .errors import ParameterError
+from .contract.errors import ParameterError
 from .persistence import _blocks, _check_flag, body_count
 
 __all__ = ["contact_events", "kaplan_meier", "lifetime_survival", "median_lifetime_by_force", "strong_persistence"]
@@ -194,7 +194,7 @@ def kaplan_meier(durations, observed):
 
     Raises
     ------
-    grainview.errors.ParameterError
+    grainview.contract.errors.ParameterError
         When ``durations`` and ``observed`` differ in shape.
     """
     durations = np.asarray(durations, dtype=float)

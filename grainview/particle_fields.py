@@ -60,7 +60,7 @@ def particle_fields(ds: xr.Dataset, reference: int = 0, walls: bool = True, near
 
     Raises
     ------
-    grainview.errors.ParameterError
+    grainview.contract.errors.ParameterError
         When ``min_contacts`` is not an integer >= 1, or ``reference`` not a snapshot index.
 
     References

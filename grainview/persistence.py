@@ -19,8 +19,8 @@ import xarray as xr
 
 from ._lift import with_attrs
 from .contacts import check_near, n_particles, near_attr, selection, snapshot_index
-from .errors import ParameterError
-from .schema import KIND_DOUBLE, KIND_SIMPLE
+from .contract.errors import ParameterError
+from .contract.schema import KIND_DOUBLE, KIND_SIMPLE
 
 __all__ = ["body_count", "pair_keys", "time_blocks", "persistence", "type_transitions"]
 
@@ -156,7 +156,7 @@ def persistence(ds: xr.Dataset, reference: int = 0, uninterrupted: bool = False,
 
     Raises
     ------
-    grainview.errors.ParameterError
+    grainview.contract.errors.ParameterError
         When ``uninterrupted`` or ``walls`` is not a bool, or ``reference`` not a snapshot index.
 
     References
@@ -265,7 +265,7 @@ def type_transitions(ds: xr.Dataset, walls: bool = False, near=None) -> xr.Datas
 
     Raises
     ------
-    grainview.errors.ParameterError
+    grainview.contract.errors.ParameterError
         When ``walls`` is not a bool.
 
     References

@@ -18,7 +18,7 @@ import numpy as np
 import pandas as pd
 import xarray as xr
 
-from .errors import ParameterError
+from .contract.errors import ParameterError
 from .strain import RESIDUAL_STRAIN, residual_window
 
 NOT_REACHED = "not reached"

@@ -5,7 +5,7 @@ from __future__ import annotations
 import xarray as xr
 
 from ._lift import with_attrs
-from .schema import particle_area
+from .contract.shapes import particle_area
 
 __all__ = ["thickness", "width", "height", "volume", "solid_fraction", "area"]
 

@@ -13,7 +13,7 @@ import xarray as xr
 from . import sample
 from ._lift import with_attrs
 from .arrays.strain import log_strain
-from .errors import ParameterError
+from .contract.errors import ParameterError
 from .stress import stress_invariants
 
 __all__ = ["time_derivative", "strains", "residual_window", "friction_and_dilatancy",
@@ -132,7 +132,7 @@ def residual_window(ds: xr.Dataset, start: float = RESIDUAL_STRAIN) -> xr.DataAr
 
     Raises
     ------
-    grainview.errors.ParameterError
+    grainview.contract.errors.ParameterError
         When ``start`` is not a finite number >= 0.
 
     References

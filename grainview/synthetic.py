@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .dataset import make_dataset
+from .contract.dataset import make_dataset
 
 PAIR_LENGTH_M = 0.02
 SOLID_FRACTION = 0.1

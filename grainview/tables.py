@@ -13,7 +13,7 @@ import numpy as np
 import xarray as xr
 
 from .contacts import n_particles, occupied, snapshot_index
-from .errors import ParameterError
+from .contract.errors import ParameterError
 from .persistence import body_count
 
 __all__ = ["contacts_table", "contact_graph"]
@@ -96,7 +96,7 @@ def contact_graph(ds: xr.Dataset, time: int = -1, as_networkx: bool = False):
 
     Raises
     ------
-    grainview.errors.ParameterError
+    grainview.contract.errors.ParameterError
         With ``as_networkx=True`` when networkx is not installed.
 
     References

@@ -15,7 +15,7 @@ import xarray as xr
 from ._lift import apply, with_attrs
 from .arrays import xi_network as _xi
 from .contacts import selection
-from .errors import ParameterError
+from .contract.errors import ParameterError
 from .sample import volume
 from .stress import stress_invariants
 
@@ -78,7 +78,7 @@ def xi_network(ds: xr.Dataset, xi=DEFAULT_XI, walls: bool = False, near=None) ->
 
     Raises
     ------
-    grainview.errors.ParameterError
+    grainview.contract.errors.ParameterError
         When ``xi`` is not a non-empty 1-D sequence of finite numbers >= 0.
 
     References

@@ -22,7 +22,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from grainview.errors import ParameterError
+from grainview.contract.errors import ParameterError
 
 __all__ = ["candidate_pairs", "wall_candidates"]
 

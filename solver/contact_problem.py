@@ -20,7 +20,7 @@ from typing import NamedTuple
 
 import numpy as np
 
-from grainview.errors import ParameterError
+from grainview.contract.errors import ParameterError
 
 from . import nlgs, residuals
 

@@ -40,7 +40,7 @@ from pathlib import Path
 
 import numpy as np
 
-from grainview.errors import ConvergenceWarning, FileFormatError, ParameterError
+from grainview.contract.errors import ConvergenceWarning, FileFormatError, ParameterError
 
 EVENT_TOPIC = "grainview-ensemble"
 """Topic of the progress events the workers send to the client (``Worker.log_event``)."""
@@ -159,9 +159,9 @@ def file_state(path) -> str:
 
 def _check_settings(path, spec: RunSpec):
     """Refuse to resume a file written with other settings than ``spec``."""
-    import grainview
+    from grainview.contract.reader import ContractFile
 
-    with grainview.open_dataset(path, chunks=None) as ds:
+    with ContractFile(path) as ds:
         attrs = dict(ds.attrs)
     for key, want in spec.expected_attrs().items():
         have = attrs.get(key)

@@ -1,6 +1,6 @@
 """Narrow phase of contact detection: contact points, normals and gaps of candidate pairs.
 
-Conventions (``grainview.schema``, docs/conventions.md §0): the unit normal ``n`` of a
+Conventions (``grainview.contract.schema``, docs/conventions.md §0): the unit normal ``n`` of a
 contact points from body i to body j; for a wall contact i is the particle and j = N + w, so
 n = -n_w (n_w: the wall's unit normal, pointing into the sample). ``gap`` is the signed
 distance between the two bodies along n at the contact point (m; negative = interpenetration).
@@ -83,8 +83,8 @@ from typing import NamedTuple
 import numpy as np
 from numba import njit, prange
 
-from grainview.errors import ParameterError
-from grainview.schema import KIND_DOUBLE, KIND_SIMPLE
+from grainview.contract.errors import ParameterError
+from grainview.contract.schema import KIND_DOUBLE, KIND_SIMPLE
 
 from .broadphase import check_walls
 from .shapes import Shapes
@@ -114,7 +114,7 @@ class ContactPoints(NamedTuple):
     normal : float64 (P, 2) — unit normal from i to j.
     point : float64 (P, 2) — contact point, m.
     gap : float64 (P,) — signed distance along the normal, m (negative = interpenetration).
-    kind : int8 (P,) — 1 simple, 2 double (``grainview.schema.KIND_SIMPLE``/``KIND_DOUBLE``).
+    kind : int8 (P,) — 1 simple, 2 double (``grainview.contract.schema.KIND_SIMPLE``/``KIND_DOUBLE``).
     pair : int32 (P,) — index of the contact (body pair), 0 .. n_pairs-1; the two points of a
         double contact are adjacent and share it.
     n_pairs : int — number of contacts (pairs) kept.

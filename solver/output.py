@@ -1,5 +1,5 @@
 """Writing a simulation into a netCDF file of the grainview data contract, snapshot by
-snapshot (through :class:`grainview.writer.SnapshotWriter`).
+snapshot (through :class:`grainview.contract.writer.SnapshotWriter`).
 
 Contacts are written per body pair: a double contact's two points become one slot with the
 resultant force and its application point (the fn-weighted mean of the two points, their
@@ -27,9 +27,9 @@ import warnings
 
 import numpy as np
 
-from grainview.schema import DIAGNOSTICS
-from grainview.errors import FileFormatError, OutputError, ParameterError
-from grainview.writer import DEFAULT_COMPLEVEL, SnapshotWriter, compress_file, last_complete_value, lock_file
+from grainview.contract.schema import DIAGNOSTICS
+from grainview.contract.errors import FileFormatError, OutputError, ParameterError
+from grainview.contract.writer import DEFAULT_COMPLEVEL, SnapshotWriter, compress_file, last_complete_value, lock_file
 
 from . import __version__
 from .contact_points import point_forces, rank_in_pair
@@ -172,11 +172,11 @@ class Recorder:
 
     While the run goes on the file is netCDF-3, appended snapshot by snapshot (a killed run
     keeps every completed snapshot). When the ``with`` block ends without an exception, the
-    finished file is rewritten compressed (:func:`grainview.writer.compress_file`, zlib at
+    finished file is rewritten compressed (:func:`grainview.contract.writer.compress_file`, zlib at
     ``compress``: True or a level 1-9; False, None or 0 keeps it uncompressed). A run stopped by Ctrl-C
     or an error stays netCDF-3, ready to be resumed.
 
-    The file's writer lock (:mod:`grainview.locks`) is held from before the file is created or
+    The file's writer lock (:mod:`grainview.contract.locks`) is held from before the file is created or
     read until it is closed and compressed. SIGTERM while the file is created, made netCDF-3 again
     or compressed stops at once, the file as it was (a compression stopped so leaves the
     finished run netCDF-3: :func:`compress_finished` or ``python -m solver.restart`` does it again).
@@ -292,7 +292,7 @@ class Recorder:
 
 
 def compress_finished(path, level, lock=None, resumable=True) -> None:
-    """Compress the finished run ``path`` at zlib ``level`` (:func:`grainview.writer.compress_file`,
+    """Compress the finished run ``path`` at zlib ``level`` (:func:`grainview.contract.writer.compress_file`,
     holding ``lock`` when given), SIGTERM stopping it at once. Either way the run stays
     whole: a failure (a full disk, a file-size limit) raises :class:`OutputError` in one line,
     SIGTERM prints one and raises :class:`solver.interrupt.Terminated`, and the file is left

@@ -35,7 +35,7 @@ from typing import NamedTuple
 import numpy as np
 from numba import njit
 
-from grainview.errors import ParameterError
+from grainview.contract.errors import ParameterError
 
 __all__ = ["deposit", "box_width_for", "size_classes", "Packing", "DEPOSIT_SOLID_FRACTION",
            "PAPER_DIAMETERS", "PAPER_FRACTIONS"]

@@ -30,7 +30,7 @@ from dataclasses import asdict, dataclass, replace
 
 import numpy as np
 
-from grainview.errors import ParameterError
+from grainview.contract.errors import ParameterError
 
 from .shapes import n_vertices_of
 

@@ -1,7 +1,7 @@
 """Resuming a biaxial test from its own output file, and starting a test from any saved snapshot.
 
 A run killed at any moment (SIGKILL, a cluster's wall-time limit, Ctrl-C) leaves a file whose
-complete snapshots all open (:class:`grainview.writer.SnapshotWriter` syncs the file after each
+complete snapshots all open (:class:`grainview.contract.writer.SnapshotWriter` syncs the file after each
 one and marks it ``complete`` last). The last complete snapshot holds the whole state of the
 run, so :func:`resume` rebuilds the :class:`~solver.stepper.Simulation` from it and goes on
 appending to the same file:
@@ -40,7 +40,8 @@ from dataclasses import fields
 
 import numpy as np
 
-from grainview.errors import ConvergenceWarning, FileFormatError, GrainviewError
+from grainview.contract.errors import ConvergenceWarning, FileFormatError, GrainviewError
+from grainview.contract.reader import ContractFile
 
 from .interrupt import Terminated, sigterm_raises
 from .output import Recorder, compress_finished, compress_level
@@ -95,25 +96,24 @@ def _check_resumable(ds, source):
     if ds.attrs.get("scene") != "biaxial":
         raise FileFormatError(f"{source}: cannot resume, scene={ds.attrs.get('scene')!r}: only a biaxial test "
                               "('biaxial') can be resumed")
-    if ds.sizes["time"] == 0:
+    if ds.n_snapshots == 0:
         raise FileFormatError(f"{source}: cannot resume, the file holds no complete snapshot (the run was "
                               "stopped before its first one): start the run again")
 
 
 def _snapshot_state(ds, index, source):
-    """The whole solver state at snapshot ``index`` of an open dataset (plain numpy arrays)."""
-    snap = ds.isel(time=index)
-    count = int(snap["contact_count"])
-    state = {name: snap[name].values.copy() for name in (
+    """The whole solver state at snapshot ``index`` of an open :class:`ContractFile` (plain numpy arrays)."""
+    count = int(ds.snapshot("contact_count", index))
+    state = {name: ds.snapshot(name, index).copy() for name in (
         "position", "angle", "velocity", "angular_velocity", "wall_position", "wall_velocity")}
     for name, value in state.items():
         if not np.all(np.isfinite(value)):
             raise FileFormatError(f"{source}: cannot restart, {name} of snapshot {index} is not finite")
-    state.update({name: ds[name].values.copy() for name in ("radius", "n_vertices", "mass", "inertia", "wall_normal")})
-    state.update({name: snap[name].values[:count].copy()
+    state.update({name: ds.static(name) for name in ("radius", "n_vertices", "mass", "inertia", "wall_normal")})
+    state.update({name: ds.snapshot(name, index)[:count].copy()
                   for name in ("i", "j", "normal_impulse", "tangential_impulse")})
-    state.update(time=float(snap["time"]), step=int(snap["step"]), first_step=int(ds["step"].values[0]),
-                 names=tuple(str(name) for name in ds["wall"].values), attrs=dict(ds.attrs))
+    state.update(time=float(ds.snapshot("time", index)), step=int(ds.snapshot("step", index)),
+                 first_step=int(ds.snapshot("step", 0)), names=ds.wall_names, attrs=dict(ds.attrs))
     return state
 
 
@@ -149,19 +149,17 @@ def load_sample(path, index=-1) -> Simulation:
 
     Raises :class:`FileFormatError` naming what is missing. The file is only read.
     """
-    import grainview
-
     source = os.fspath(path)
-    with grainview.open_dataset(source, chunks=None) as ds:
+    with ContractFile(source) as ds:
         missing = [name for name in STATE_VARIABLES if name not in ds.variables]
         missing += [name for name in WALL_ATTRIBUTES if name not in ds.attrs]
         if missing:
             raise FileFormatError(f"{source}: cannot restart from it, the file lacks {missing} (written by a "
                                   "solver without restart support, or not by this solver)")
-        if ds.sizes["time"] == 0:
+        if ds.n_snapshots == 0:
             raise FileFormatError(f"{source}: the file holds no complete snapshot")
-        if not -ds.sizes["time"] <= int(index) < ds.sizes["time"]:
-            raise FileFormatError(f"{source}: index={index!r} is outside its {ds.sizes['time']} snapshots")
+        if not -ds.n_snapshots <= int(index) < ds.n_snapshots:
+            raise FileFormatError(f"{source}: index={index!r} is outside its {ds.n_snapshots} snapshots")
         state = _snapshot_state(ds, int(index), source)
     sim = _simulation(state, source)
     sim.show_warm_start()  # a test's first snapshot shows the sample's contacts and forces
@@ -177,13 +175,11 @@ def load_state(path):
     file). Raises :class:`FileFormatError` naming what is missing when the file cannot be
     resumed. The file is only read.
     """
-    import grainview
-
     source = os.fspath(path)
-    with grainview.open_dataset(source, chunks=None) as ds:
+    with ContractFile(source) as ds:
         _check_resumable(ds, source)
         state = _snapshot_state(ds, -1, source)
-        snapshots = ds.sizes["time"]
+        snapshots = ds.n_snapshots
     sim = _simulation(state, source)
     attrs = state["attrs"]
     test = {"first_step": state["first_step"], "n_steps": int(attrs["biaxial_steps"]),
@@ -205,10 +201,10 @@ def resume(path, progress=None, compress=True) -> int:
 
     The file's writer lock is taken before its last snapshot is read and held until the file
     is closed and compressed, so two resumes of one file never both append: the second raises
-    :class:`grainview.locks.FileLockedError` naming the first. Taking the lock also removes the
-    temporary files of killed writers (:func:`grainview.writer.remove_strays`).
+    :class:`grainview.contract.locks.FileLockedError` naming the first. Taking the lock also removes the
+    temporary files of killed writers (:func:`grainview.contract.writer.remove_strays`).
     """
-    from grainview.writer import is_compressed, lock_file
+    from grainview.contract.writer import is_compressed, lock_file
 
     level = compress_level(compress)
     source = os.fspath(path)

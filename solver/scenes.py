@@ -9,7 +9,7 @@ from __future__ import annotations
 import sys
 
 import numpy as np
-from grainview.errors import ParameterError
+from grainview.contract.errors import ParameterError
 
 from .interrupt import interruptible, progress_bar, resume_instructions, stop_exception, stop_reason
 from .output import Recorder

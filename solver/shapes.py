@@ -9,7 +9,7 @@ radius ``radius`` R (m; the disk radius for a disk) and its number of vertices `
 so the vertices run counter-clockwise, and edge k (from vertex k to vertex k+1) has the
 outward unit normal of angle ``angle + pi (2k + 1) / n`` at the distance r = R cos(pi/n)
 (the inradius) from the centre. These are the shapes of the data contract
-(``grainview.schema``: ``radius`` is the circumscribed radius, ``n_vertices`` 0 for disks).
+(``grainview.contract.schema``: ``radius`` is the circumscribed radius, ``n_vertices`` 0 for disks).
 
 Formulas (regular n-gon of circumscribed radius R, split into n triangles centre-edge with
 apex angle alpha = 2 pi / n):
@@ -33,8 +33,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from grainview.errors import ParameterError
-from grainview.schema import particle_area, vertex_phases
+from grainview.contract.errors import ParameterError
+from grainview.contract.shapes import particle_area, vertex_phases
 
 __all__ = ["Shapes", "SHAPES", "n_vertices_of", "polygon_area", "polygon_inertia_per_mass", "mass_and_inertia", "vertices", "inradius",
            "check_shapes"]
@@ -60,7 +60,7 @@ def check_shapes(radius, nvert):
     """Validate and convert ``radius`` (float64, > 0, finite) and ``nvert`` (int32, 0 or >= 3).
 
     Returns the two arrays broadcast to a common 1-D shape. Raises
-    :class:`grainview.errors.ParameterError` naming the offending parameter.
+    :class:`grainview.contract.errors.ParameterError` naming the offending parameter.
     """
     radius = np.atleast_1d(np.asarray(radius, dtype=np.float64))
     nvert_in = np.atleast_1d(np.asarray(nvert))
@@ -86,7 +86,7 @@ def check_shapes(radius, nvert):
 
 def polygon_area(radius, nvert):
     """Area (m2) of each body: (n/2) R^2 sin(2 pi/n) for a regular n-gon of circumscribed
-    radius R, pi R^2 for a disk (n = 0). Same definition as ``grainview.schema.particle_area``
+    radius R, pi R^2 for a disk (n = 0). Same definition as ``grainview.contract.shapes.particle_area``
     (the contract's shape definition), which it calls."""
     radius, nvert = check_shapes(radius, nvert)
     return particle_area(radius, nvert)
@@ -140,7 +140,7 @@ class Shapes:
     and edge k (vertex k -> k+1, cyclically) has the outward unit normal of angle
     ``angle + normal_angle[k]``. The polar form makes a world vertex one addition and one
     cosine/sine away from the body's angle, with the same arithmetic as the contract's
-    definition (``grainview.schema.polygon_vertices``), and it describes any polygon that is
+    definition (``grainview.contract.shapes.world_vertices``), and it describes any polygon that is
     star-shaped about its centroid (every convex polygon).
 
     Attributes

@@ -33,7 +33,7 @@ from dataclasses import asdict, dataclass
 
 import numpy as np
 
-from grainview.errors import ConvergenceWarning, ParameterError
+from grainview.contract.errors import ConvergenceWarning, ParameterError
 
 from . import acceleration, broadphase, narrowphase, nlgs, parallel_nlgs, problem_assembly, residuals, warm_start
 from .contact_points import PairIndex, force_vectors, point_keys

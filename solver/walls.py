@@ -12,7 +12,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from grainview.errors import ParameterError
+from grainview.contract.errors import ParameterError
 
 FIXED, VELOCITY, STRESS = 0, 1, 2
 BOX_NAMES = ("bottom", "right", "top", "left")

@@ -71,9 +71,9 @@ def test_no_import_cycle_in_the_packages():
 
 def test_the_array_layer_imports_nothing_of_the_labelled_layer():
     """grainview/arrays holds the physics on plain arrays: it may use its own modules, the
-    numba kernels and the contract's constants, never the xarray topic modules."""
+    numba kernels and the contract layer, never the xarray topic modules."""
     graph = import_graph()
-    allowed = ("grainview.arrays", "grainview._kernels", "grainview.schema")
+    allowed = ("grainview.arrays", "grainview._kernels", "grainview.contract")
     for module, deps in graph.items():
         if module.startswith("grainview.arrays"):
             assert all(dep.startswith(allowed) for dep in deps), (module, sorted(deps))
@@ -96,9 +96,44 @@ def test_importing_the_solver_loads_no_xarray_dask_or_matplotlib():
     assert _modules_after("import solver") == set()
 
 
-def test_reading_files_loads_no_analysis_dask_or_plotting():
-    loaded = _modules_after("import grainview.io")
-    assert {"dask", "matplotlib", "grainview.stress"}.isdisjoint(loaded)
+def _contract_modules() -> list:
+    return sorted(_module_name(path) for path in (ROOT / "grainview" / "contract").glob("*.py"))
+
+
+def test_the_solver_imports_only_the_contract_layer_of_grainview():
+    graph = import_graph()
+    outside = {(module, dep) for module, deps in graph.items() if module.startswith("solver")
+               for dep in deps if dep.startswith("grainview") and not dep.startswith("grainview.contract")}
+    assert outside == set()
+    assert any(dep.startswith("grainview.contract.writer") for dep in graph["solver.output"])  # the graph sees them
+
+
+def test_the_contract_imports_nothing_of_grainview_outside_itself():
+    graph = import_graph()
+    contract = [module for module in graph if module.startswith("grainview.contract")]
+    assert len(contract) == len(_contract_modules()) >= 10
+    for module in contract:
+        assert all(dep.startswith("grainview.contract") for dep in graph[module] if dep.startswith("grainview")), \
+            (module, sorted(graph[module]))
+
+
+def test_importing_the_contract_loads_no_xarray_dask_pandas_or_matplotlib():
+    """Every module of the contract, imported in a fresh interpreter: numpy only."""
+    assert _modules_after("\n".join(f"import {m}" for m in _contract_modules())) == set()
+
+
+def test_opening_a_file_loads_xarray_and_the_accessor_but_no_analysis(tmp_path):
+    import numpy as np
+
+    from grainview.contract.dataset import make_dataset, netcdf_options
+
+    ds = make_dataset(radius=np.ones(2), n_vertices=np.zeros(2, int), mass=np.ones(2), inertia=np.ones(2),
+                      position=np.array([[[0.0, 0.0], [3.0, 0.0]]]), angle=np.zeros((1, 2)),
+                      box_min=np.array([[-1.0, -1.0]]), box_max=np.array([[4.0, 1.0]]), contacts=[{"i": [], "j": [], "kind": [], "normal": np.zeros((0, 2)),
+                                                                    "fn": [], "ft": []}])
+    ds.to_netcdf(tmp_path / "two.nc", **netcdf_options(ds))
+    loaded = _modules_after(f"import grainview.contract.io as io\nio.open_dataset({str(tmp_path / 'two.nc')!r})")
+    assert {"matplotlib", "grainview.stress"}.isdisjoint(loaded)
     assert "xarray" in loaded and "grainview.accessor" in loaded  # ds.grain is registered
 
 

@@ -33,7 +33,7 @@ def main(argv=None):
     args = parser.parse_args(argv)
 
     import solver
-    from grainview.errors import ConvergenceWarning
+    from grainview.contract.errors import ConvergenceWarning
 
     sim = solver.load_sample(args.sample)
     if not math.isfinite(sim.sigma0):  # samples written before isotropic files recorded sigma0_Pa

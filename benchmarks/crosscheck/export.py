@@ -36,7 +36,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from grainview.errors import GrainviewError
+from grainview.contract.errors import GrainviewError
 from grainview.formats.peers import WALL_NORMALS, WALLS
 
 

@@ -14,7 +14,7 @@ from .helpers import dense_sample, fmt
 
 
 def _stress_run(sim, steps, source):
-    from grainview.errors import ConvergenceWarning
+    from grainview.contract.errors import ConvergenceWarning
 
     d = 2 * float(sim.radius.mean())
     overlap, energy, finite, iters, bad = 0.0, [], True, 0, 0

@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import importlib
 
-from ..errors import ParameterError
+from ..contract.errors import ParameterError
 
 __all__ = ["READERS", "open_format"]
 

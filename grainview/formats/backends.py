@@ -28,7 +28,7 @@ class LammpsBackend(BackendEntrypoint):
 
     def open_dataset(self, filename_or_obj, *, drop_variables=None, contacts=None, walls=None, log=None,
                      time_step=None, columns=None, inertia="auto"):
-        from ..errors import ParameterError
+        from ..contract.errors import ParameterError
         from .lammps import open_lammps
 
         if contacts is None:
@@ -49,7 +49,7 @@ class _PeerBackend(BackendEntrypoint):
     open_dataset_parameters = ("filename_or_obj", "drop_variables", "sample")
 
     def open_dataset(self, filename_or_obj, *, drop_variables=None, sample=None):
-        from ..errors import ParameterError
+        from ..contract.errors import ParameterError
         from .peers import open_peer
 
         if sample is None:

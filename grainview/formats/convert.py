@@ -1,7 +1,7 @@
 """Writing another code's run as a file of the contract, the same way for every reader.
 
 A reader yields its run snapshot by snapshot (the static particle data once, then one dict
-per snapshot for :meth:`grainview.writer.SnapshotWriter.append`); :func:`write_snapshots`
+per snapshot for :meth:`grainview.contract.writer.SnapshotWriter.append`); :func:`write_snapshots`
 appends them to a file under a hidden temporary name, checks the finished file against the
 contract, compresses it and only then gives it its name. A run of any length is written in
 the memory of one snapshot, and bad input anywhere leaves nothing behind.
@@ -14,7 +14,7 @@ import os
 
 import numpy as np
 
-from ..errors import FileFormatError
+from ..contract.errors import FileFormatError
 
 __all__ = ["check_out", "write_snapshots"]
 
@@ -43,7 +43,7 @@ def write_snapshots(out, static, snapshots, optional, *, overwrite=False, compre
         ``radius``, ``mass``, ``inertia`` (N,), and optionally ``n_vertices`` (default: disks),
         ``n_walls``, ``wall_names``, ``wall_normal`` and ``attrs`` (global attributes).
     snapshots : iterable of dict
-        One dict per snapshot, as :meth:`~grainview.writer.SnapshotWriter.append` takes it
+        One dict per snapshot, as :meth:`~grainview.contract.writer.SnapshotWriter.append` takes it
         (after ``prepare``).
     optional : sequence of str
         The optional variables the snapshots hold.
@@ -63,8 +63,8 @@ def write_snapshots(out, static, snapshots, optional, *, overwrite=False, compre
     int
         The number of snapshots written.
     """
-    from ..io import open_dataset
-    from ..writer import SnapshotWriter, _move_into_place, compress_file
+    from ..contract.io import open_dataset
+    from ..contract.writer import SnapshotWriter, _move_into_place, compress_file
 
     out = check_out(out, overwrite)
     temporary = os.path.join(os.path.dirname(os.path.abspath(out)), f".{os.path.basename(out)}.{os.getpid()}.{label}")

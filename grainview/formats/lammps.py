@@ -39,7 +39,7 @@ How the contract's quantities are made (docs/formats.md states the same for user
   come out in N/m = Pa over a 1 m slab.
 
 Every function checks its input first and refuses bad input in one line
-(:class:`grainview.errors.FileFormatError` or :class:`~grainview.errors.ParameterError`).
+(:class:`grainview.contract.errors.FileFormatError` or :class:`~grainview.contract.errors.ParameterError`).
 """
 
 from __future__ import annotations
@@ -50,8 +50,8 @@ import warnings
 
 import numpy as np
 
-from ..errors import FileFormatError, ParameterError
-from ..schema import contact_slots
+from ..contract.errors import FileFormatError, ParameterError
+from ..contract.schema import contact_slots
 from .lammps_dump import LammpsLog, iter_dump, read_log
 
 __all__ = ["lammps_snapshots", "open_lammps", "convert_lammps", "WALL_NAMES", "PARTICLE_COLUMNS", "PAIR_COLUMNS"]
@@ -440,7 +440,7 @@ def open_lammps(particles, contacts, walls=None, *, log=None, time_step=None, co
         with ``velocity`` and ``angular_velocity`` when the particles' dump has them, and
         ``step``.
     """
-    from ..dataset import make_dataset
+    from ..contract.dataset import make_dataset
 
     static, stream = lammps_snapshots(particles, contacts, walls, log=log, time_step=time_step, columns=columns,
                                       inertia=inertia)
@@ -474,7 +474,7 @@ def convert_lammps(out, particles, contacts, walls=None, *, log=None, time_step=
     """Convert a LAMMPS 2D granular run into a file of the contract, snapshot by snapshot.
 
     The dumps are read one snapshot at a time and each snapshot is appended to the file as it
-    is read (:class:`grainview.writer.SnapshotWriter`), so a run of any length converts in the
+    is read (:class:`grainview.contract.writer.SnapshotWriter`), so a run of any length converts in the
     memory of one snapshot. The file is written under a hidden temporary name, validated,
     compressed (unless ``compress=False``) and only then moved to ``out``: bad input anywhere
     in the dumps leaves nothing behind.

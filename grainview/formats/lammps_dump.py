@@ -28,7 +28,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..errors import FileFormatError
+from ..contract.errors import FileFormatError
 
 __all__ = ["DumpSnapshot", "LammpsLog", "iter_dump", "read_log"]
 

@@ -39,7 +39,7 @@ How the contract's quantities are made (docs/formats.md states the same for user
 * ``time`` and ``step`` are DOF.OUT's header's.
 
 Every function checks its input first and refuses bad input in one line
-(:class:`grainview.errors.FileFormatError`).
+(:class:`grainview.contract.errors.FileFormatError`).
 """
 
 from __future__ import annotations
@@ -49,7 +49,7 @@ import os
 
 import numpy as np
 
-from ..errors import FileFormatError
+from ..contract.errors import FileFormatError
 from .lmgc90_text import output_files, read_bodies, read_bulk_behav, read_dof, read_vloc_rloc
 
 __all__ = ["lmgc90_snapshots", "open_lmgc90", "convert_lmgc90", "FAMILIES", "BOX_WALLS", "regular_polygon"]
@@ -359,7 +359,7 @@ def open_lmgc90(run, *, progress=False):
         ``wall_force``. For a run too large for memory, :func:`convert_lmgc90` writes a file
         snapshot by snapshot instead.
     """
-    from ..dataset import make_dataset
+    from ..contract.dataset import make_dataset
 
     static, stream = lmgc90_snapshots(run)
     if progress:
@@ -385,7 +385,7 @@ def convert_lmgc90(out, run, *, overwrite=False, compress=True, progress=False):
     """Convert an LMGC90 2D run into a file of the contract, snapshot by snapshot.
 
     Each snapshot (a DOF.OUT.n and its Vloc_Rloc.OUT.n) is read and appended to the file in
-    turn (:class:`grainview.writer.SnapshotWriter`), so a run of any length converts in the
+    turn (:class:`grainview.contract.writer.SnapshotWriter`), so a run of any length converts in the
     memory of one snapshot. The file is written under a hidden temporary name, validated,
     compressed (unless ``compress=False``) and only then moved to ``out``: bad input anywhere
     leaves nothing behind.

@@ -22,7 +22,7 @@ A 2D rigid LMGC90 run keeps its model in ``DATBOX/`` and writes its results into
   ``mod_DKDKx``, ``mod_DKJCx``, ``mod_PLPLx``, ``mod_PLJCx``, ``mod_DKPLx``).
 
 Numbers are Fortran's: ``0.1234567D+01``, and ``0.1234567+100`` for three-digit exponents.
-Every function refuses a file it cannot read in one line (:class:`grainview.errors.FileFormatError`).
+Every function refuses a file it cannot read in one line (:class:`grainview.contract.errors.FileFormatError`).
 """
 
 from __future__ import annotations
@@ -33,7 +33,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..errors import FileFormatError
+from ..contract.errors import FileFormatError
 
 __all__ = ["Body", "Contactor", "DofSnapshot", "VlocEntry", "VlocSnapshot", "fortran_float", "read_bodies",
            "read_bulk_behav", "read_dof", "read_vloc_rloc", "output_files"]

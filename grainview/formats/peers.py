@@ -42,8 +42,8 @@ import os
 
 import numpy as np
 
-from ..errors import FileFormatError, ParameterError
-from ..schema import contact_slots
+from ..contract.errors import FileFormatError, ParameterError
+from ..contract.schema import contact_slots
 
 __all__ = ["WALLS", "WALL_NORMALS", "peer_contacts", "wall_forces", "peer_snapshots", "open_peer", "open_box2d",
            "open_pymunk", "convert_peer"]
@@ -130,7 +130,7 @@ def peer_snapshots(raw_dir, sample, engine=None):
     (static, iterator)
         ``static``: the particles' arrays, ``meta`` (the engine's settings) and ``attrs`` (global
         attributes of the run); the iterator yields one dict per snapshot for
-        :meth:`grainview.writer.SnapshotWriter.append`, with ``raw`` (the raw arrays) besides.
+        :meth:`grainview.contract.writer.SnapshotWriter.append`, with ``raw`` (the raw arrays) besides.
 
     Raises
     ------
@@ -182,7 +182,7 @@ def peer_snapshots(raw_dir, sample, engine=None):
 
 def open_peer(raw_dir, sample, engine=None):
     """A peer engine's run (:func:`peer_snapshots`) as an in-memory dataset of the contract."""
-    from ..dataset import make_dataset
+    from ..contract.dataset import make_dataset
 
     static, stream = peer_snapshots(raw_dir, sample, engine)
     snaps = list(stream)

@@ -15,7 +15,7 @@ from pathlib import Path
 import numpy as np
 import xarray as xr
 
-from ..errors import ParameterError
+from ..contract.errors import ParameterError
 from ..strain import RESIDUAL_STRAIN, residual_window, strains
 
 EPS_Q_LABEL = r"$\varepsilon_q$"
@@ -268,7 +268,7 @@ def save_figure(fig, path, dpi: int = 150) -> list[Path]:
 
     Raises
     ------
-    grainview.errors.ParameterError
+    grainview.contract.errors.ParameterError
         When ``fig`` is neither a Figure nor Axes.
     """
     figure = getattr(fig, "figure", fig) if not hasattr(fig, "savefig") else fig

@@ -13,7 +13,7 @@ from __future__ import annotations
 import numpy as np
 import xarray as xr
 
-from ..errors import ParameterError
+from ..contract.errors import ParameterError
 from ..forces import angular_force_averages, force_anisotropies
 from ._style import (EPS_Q_LABEL, PALETTE, PI_TICK_LABELS, axis_label, datasets, draw_evolutions, finish, get_axes,
                      legend_in_first, new_figure, sample_colour, select_snapshots, series_label, set_labels, tidy_polar,
@@ -67,7 +67,7 @@ def angular_profile(ds: xr.Dataset, component: str = "fn", time="residual", bins
 
     Raises
     ------
-    grainview.errors.ParameterError
+    grainview.contract.errors.ParameterError
         When ``component`` is neither "fn" nor "ft".
 
     References
@@ -413,7 +413,7 @@ def plot_force_anisotropy(data, ax=None, label=None, component: str = "a_n", bin
 
     Raises
     ------
-    grainview.errors.ParameterError
+    grainview.contract.errors.ParameterError
         When ``component`` is neither "a_n" nor "a_t".
 
     References
@@ -505,7 +505,7 @@ def force_pdf_of(ds: xr.Dataset, scale: str = "log-linear", time="residual", bin
 
     Raises
     ------
-    grainview.errors.ParameterError
+    grainview.contract.errors.ParameterError
         When ``scale`` is neither "log-linear" nor "log-log".
 
     References
@@ -1154,7 +1154,7 @@ def plot_strong_weak_proportion(data, ax=None, label=None, network: str = "stron
 
     Raises
     ------
-    grainview.errors.ParameterError
+    grainview.contract.errors.ParameterError
         When ``network`` is neither "strong" nor "weak".
 
     References

@@ -18,8 +18,8 @@ import xarray as xr
 from matplotlib.collections import EllipseCollection, LineCollection, PolyCollection
 
 from ..contacts import selection
-from ..errors import ParameterError
-from ..schema import polygon_vertices
+from ..contract.errors import ParameterError
+from ..contract.shapes import body_vertices_of, world_vertices
 from ._style import PALETTE, axis_label, get_axes, single_dataset, snapshot_index
 
 PARTICLE_FACE = "0.92"
@@ -97,9 +97,10 @@ def plot_particles(data, ax=None, time: int = -1, facecolor=PARTICLE_FACE, edgec
     if disks.any():
         faces(EllipseCollection(2 * radius[disks], 2 * radius[disks], np.zeros(disks.sum()), units="xy",
                                 offsets=position[disks], offset_transform=ax.transData, **style), disks)
+    outlines = world_vertices(position, angle, body_vertices_of(ds))
     for n in np.unique(n_vertices[~disks]):
         sel = n_vertices == n
-        faces(PolyCollection(polygon_vertices(position[sel], radius[sel], angle[sel], int(n)), **style), sel)
+        faces(PolyCollection(outlines[sel, :int(n)], **style), sel)
     _frame(ax, ds, k)
     return ax
 
@@ -144,7 +145,7 @@ def plot_particle_map(data, field: str = "c", ax=None, time: int = -1, reference
 
     Raises
     ------
-    grainview.errors.ParameterError
+    grainview.contract.errors.ParameterError
         When ``field`` is not one of :data:`PARTICLE_FIELDS`.
 
     References

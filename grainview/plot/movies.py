@@ -14,7 +14,7 @@ import os
 import numpy as np
 
 from ..contacts import selection
-from ..errors import ParameterError
+from ..contract.errors import ParameterError
 from ._style import single_dataset
 
 __all__ = ["animate"]
@@ -76,7 +76,7 @@ def animate(data, path, kind: str = "force_chains", every: int = 1, fps: int = 8
 
     Raises
     ------
-    grainview.errors.ParameterError
+    grainview.contract.errors.ParameterError
         For an unknown ``kind``, an existing ``path`` without ``overwrite``, a name that is
         neither .gif nor .mp4, or an .mp4 without ffmpeg.
 

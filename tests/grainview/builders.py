@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from grainview.dataset import make_dataset
+from grainview.contract.dataset import make_dataset
 
 R = 0.01  # disk radius, m
 

@@ -8,7 +8,7 @@ import xarray as xr
 import grainview
 from grainview.cli import main
 from grainview.synthetic import harmonic_series
-from grainview.writer import is_compressed
+from grainview.contract.writer import is_compressed
 
 
 def test_demo_writes_a_valid_file_and_a_table_equal_to_the_accessors(tmp_path, capsys):
@@ -35,7 +35,7 @@ def test_demo_writes_a_valid_file_and_a_table_equal_to_the_accessors(tmp_path, c
 def test_info_prints_summary_and_validates(tmp_path, capsys):
     ds = harmonic_series(n_snapshots=2, n_contacts=50)
     path = tmp_path / "s.nc"
-    ds.to_netcdf(path, **grainview.dataset.netcdf_options(ds))
+    ds.to_netcdf(path, **grainview.contract.dataset.netcdf_options(ds))
     assert main(["info", str(path)]) == 0
     out = capsys.readouterr().out
     assert "100 particles" in out and "2 snapshots" in out and "valid" in out
@@ -178,7 +178,7 @@ def test_library_advice_is_given_as_the_flag(monkeypatch, capsys):
 
 
 def test_report_of_an_ensemble_shows_mean_and_spread(tmp_path, capsys):
-    from grainview.dataset import netcdf_encoding
+    from grainview.contract.dataset import netcdf_encoding
 
     paths = []
     for seed in range(3):
@@ -197,7 +197,7 @@ def test_report_of_an_ensemble_shows_mean_and_spread(tmp_path, capsys):
 
 
 def test_info_reports_variables_without_units(tmp_path, capsys):
-    from grainview.dataset import netcdf_encoding
+    from grainview.contract.dataset import netcdf_encoding
 
     ds = harmonic_series(n_snapshots=2, n_contacts=20)
     del ds["fn"].attrs["units"], ds["radius"].attrs["units"]
@@ -230,7 +230,7 @@ def test_info_reads_the_file_without_xarray_and_says_what_the_accessors_say(tmp_
     path = tmp_path / "run.nc"
     ds = harmonic_series(n_snapshots=4, n_contacts=300, anisotropy=(0.2, 0.3, 0.1), seed=3)
     ds.attrs.update(scene="biaxial", sigma0_Pa=1e4, solver_friction=0.4, solver_time_step=5e-4)
-    ds.to_netcdf(path, **grainview.dataset.netcdf_options(ds))
+    ds.to_netcdf(path, **grainview.contract.dataset.netcdf_options(ds))
     done = subprocess.run([sys.executable, "-c", INFO_IMPORTS, str(path)], capture_output=True, text=True, timeout=120)
     assert done.returncode == 0, done.stderr
     assert done.stdout.strip().splitlines()[-1] == "[]"
@@ -249,7 +249,7 @@ def test_info_checks_structure_at_once_and_every_value_with_check(tmp_path, caps
 
     ds = harmonic_series(n_snapshots=3, n_contacts=50)
     path = tmp_path / "s.nc"
-    ds.to_netcdf(path, **grainview.dataset.netcdf_options(ds, compress=False))
+    ds.to_netcdf(path, **grainview.contract.dataset.netcdf_options(ds, compress=False))
     with netCDF4.Dataset(path, "a") as nc:
         nc.variables["kind"][1, 3] = 7  # a value fault: the structure is intact
     assert main(["info", str(path)]) == 0
@@ -259,7 +259,7 @@ def test_info_checks_structure_at_once_and_every_value_with_check(tmp_path, caps
     assert err.startswith("grainview: error:") and "kind: 1 occupied slot(s) with a kind other than 1" in err
     # a structural fault is found without --check
     bad = tmp_path / "bad.nc"
-    ds.drop_vars("fn").to_netcdf(bad, **grainview.dataset.netcdf_options(ds.drop_vars("fn")))
+    ds.drop_vars("fn").to_netcdf(bad, **grainview.contract.dataset.netcdf_options(ds.drop_vars("fn")))
     assert main(["info", str(bad)]) == 2
     assert "variable 'fn' is missing" in capsys.readouterr().err
     # a netCDF-3 file cut in half: refused, one line

@@ -56,7 +56,7 @@ def test_the_velocity_rule_is_the_number_of_steps_of_the_test():
     assert prep.test_steps(5e-4, 0.01, 0.2) == pytest.approx(steps, rel=1e-12)
     fastest = height * (np.exp(0.2) - 1) / (MIN_TEST_STEPS * 5e-4)
     prep.check_test_speed(5e-4, 0.999 * fastest, 0.2)
-    with pytest.raises(grainview.errors.ParameterError, match=f"at most {fastest:.3g} m/s"):
+    with pytest.raises(grainview.contract.errors.ParameterError, match=f"at most {fastest:.3g} m/s"):
         prep.check_test_speed(5e-4, 1.001 * fastest, 0.2)
 
 
@@ -75,7 +75,7 @@ def test_the_longest_accepted_name_is_written_and_compressed(tmp_path):
     """The limit is the writer's: a file of the longest accepted name is created, appended and
     compressed (its temporary names fit)."""
     from grainview.cli import longest_output_name
-    from grainview.writer import compress_file
+    from grainview.contract.writer import compress_file
 
     from . import builders
     from .test_schema_io import _write  # a file written by SnapshotWriter, as the solver writes it

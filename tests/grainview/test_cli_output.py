@@ -15,7 +15,7 @@ import pytest
 
 import grainview
 from grainview.cli import build_parser, main
-from grainview.dataset import netcdf_encoding
+from grainview.contract.dataset import netcdf_encoding
 from grainview.synthetic import harmonic_series
 
 from .test_near_contacts import chain

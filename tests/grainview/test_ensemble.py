@@ -11,9 +11,9 @@ import pytest
 import xarray as xr
 
 import grainview
-from grainview.dataset import netcdf_encoding
+from grainview.contract.dataset import netcdf_encoding
 from grainview.ensemble import run_dataset, seed_statistics
-from grainview.errors import ParameterError
+from grainview.contract.errors import ParameterError
 from grainview.synthetic import harmonic_series
 
 from .conftest import raise_if_dask_computes

@@ -11,7 +11,7 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from grainview.errors import ParameterError
+from grainview.contract.errors import ParameterError
 from grainview.export import write_csv, write_vtk
 
 from .test_lifetimes import SERIES
@@ -171,7 +171,7 @@ def test_export_command(tmp_path, capsys):
 
     ds = polygons_and_disks()
     source = tmp_path / "run.nc"
-    ds.to_netcdf(source, **grainview.dataset.netcdf_options(ds))
+    ds.to_netcdf(source, **grainview.contract.dataset.netcdf_options(ds))
     assert main(["export", str(source), "--to", "vtk", "--out", str(tmp_path / "vtk"), "--every", "3"]) == 0
     assert sorted(os.listdir(tmp_path / "vtk"))[:2] == ["contacts_00000.vtp", "contacts_00003.vtp"]
     assert "snapshots.pvd" in capsys.readouterr().out

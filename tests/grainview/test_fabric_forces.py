@@ -7,7 +7,7 @@ from hypothesis import given, settings, strategies as st
 
 from grainview import make_dataset
 from grainview.synthetic import harmonic_contacts
-from grainview.errors import ParameterError
+from grainview.contract.errors import ParameterError
 
 from . import builders
 from .conftest import raise_if_dask_computes

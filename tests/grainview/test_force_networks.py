@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 
 from grainview import make_dataset
-from grainview.errors import ParameterError
+from grainview.contract.errors import ParameterError
 from grainview.force_networks import contact_proportions, force_class
 
 from . import builders

@@ -6,7 +6,7 @@ import pytest
 import xarray as xr
 
 from grainview import make_dataset
-from grainview.errors import ParameterError
+from grainview.contract.errors import ParameterError
 from grainview.force_pdf import force_pdf, pooled_force_pdf, strong_force_exponent
 
 from . import builders

@@ -17,7 +17,7 @@ import pytest
 import xarray as xr
 
 import grainview
-from grainview.errors import FileFormatError, ParameterError
+from grainview.contract.errors import FileFormatError, ParameterError
 from grainview.formats.lammps import convert_lammps, open_lammps
 
 DATA = Path(__file__).resolve().parents[1] / "data" / "lammps"

@@ -28,7 +28,7 @@ import pytest
 import xarray as xr
 
 import grainview
-from grainview.errors import FileFormatError
+from grainview.contract.errors import FileFormatError
 from grainview.formats.lmgc90 import convert_lmgc90, open_lmgc90, regular_polygon
 from grainview.formats.lmgc90_text import fortran_float
 

@@ -15,7 +15,7 @@ import pytest
 import xarray as xr
 
 import grainview
-from grainview.errors import FileFormatError, ParameterError
+from grainview.contract.errors import FileFormatError, ParameterError
 from grainview.formats.peers import convert_peer, open_peer
 
 DATA = Path(__file__).resolve().parents[1] / "data" / "peers"

@@ -9,8 +9,8 @@ import pytest
 
 import grainview
 from grainview.cli import main
-from grainview.dataset import netcdf_options
-from grainview.errors import FileFormatError, SchemaError
+from grainview.contract.dataset import netcdf_options
+from grainview.contract.errors import FileFormatError, SchemaError
 from grainview.synthetic import harmonic_series
 
 

@@ -4,7 +4,7 @@ by hand, chunked equal to eager under a scheduler that counts computes."""
 import numpy as np
 import pytest
 
-from grainview.errors import ParameterError
+from grainview.contract.errors import ParameterError
 from grainview.lifetimes import contact_events, kaplan_meier, lifetime_survival
 
 from .conftest import raise_if_dask_computes

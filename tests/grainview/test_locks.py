@@ -11,8 +11,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from grainview.locks import FileLockedError
-from grainview.writer import SnapshotWriter
+from grainview.contract.locks import FileLockedError
+from grainview.contract.writer import SnapshotWriter
 
 pytest.importorskip("fcntl")
 REPO = Path(__file__).resolve().parents[2]
@@ -20,7 +20,7 @@ REPO = Path(__file__).resolve().parents[2]
 HOLDER = """
 import sys, time
 import numpy as np
-from grainview.writer import SnapshotWriter
+from grainview.contract.writer import SnapshotWriter
 w = SnapshotWriter.create(sys.argv[1], radius=np.ones(3), n_vertices=0, mass=1.0, inertia=1.0)
 print("ready", flush=True)
 time.sleep(60)
@@ -66,7 +66,7 @@ def test_a_note_removed_by_a_releasing_holder_is_not_taken(tmp_path, monkeypatch
     """The lock is flock on the note ``.NAME.writer``, which a holder removes as it releases: a
     process that opened the note just before that must not hold the removed one (two writers
     would then hold "the" lock), so it takes the note at the path again."""
-    from grainview import locks
+    from grainview.contract import locks
 
     path = tmp_path / "run.nc"
     note = tmp_path / ".run.nc.writer"
@@ -93,7 +93,7 @@ def test_a_note_removed_by_a_releasing_holder_is_not_taken(tmp_path, monkeypatch
 def subprocess_lock(path):
     """Take ``path``'s lock in another process; raise what it raised."""
     env = dict(os.environ, PYTHONPATH=os.pathsep.join([str(REPO), os.environ.get("PYTHONPATH", "")]))
-    done = subprocess.run([sys.executable, "-c", "import sys\nfrom grainview.locks import WriterLock\n"
+    done = subprocess.run([sys.executable, "-c", "import sys\nfrom grainview.contract.locks import WriterLock\n"
                            "try:\n    WriterLock(sys.argv[1])\nexcept Exception as e:\n    print(e)\n",
                            str(path)], env=env, capture_output=True, text=True, timeout=60)
     if done.stdout.strip():

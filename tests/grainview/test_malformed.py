@@ -8,9 +8,9 @@ import pytest
 from hypothesis import HealthCheck, given, settings, strategies as st
 
 import grainview
-from grainview.errors import FileFormatError, GrainviewError, SchemaError
-from grainview.dataset import netcdf_encoding
-from grainview.schema import VARIABLES
+from grainview.contract.errors import FileFormatError, GrainviewError, SchemaError
+from grainview.contract.dataset import netcdf_encoding
+from grainview.contract.schema import VARIABLES
 
 from . import builders
 

@@ -6,7 +6,7 @@ import pytest
 
 from grainview import make_dataset
 from grainview.contacts import selection
-from grainview.errors import ParameterError
+from grainview.contract.errors import ParameterError
 
 from .conftest import raise_if_dask_computes
 

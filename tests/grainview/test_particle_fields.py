@@ -9,7 +9,7 @@ import numpy as np  # noqa: E402
 import pytest  # noqa: E402
 import xarray as xr  # noqa: E402
 
-from grainview.errors import ParameterError  # noqa: E402
+from grainview.contract.errors import ParameterError  # noqa: E402
 
 from .conftest import raise_if_dask_computes  # noqa: E402
 from .test_lifetimes import SERIES  # noqa: E402

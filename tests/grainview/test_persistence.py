@@ -6,7 +6,7 @@ import pytest
 
 from grainview import make_dataset
 from grainview import persistence as persistence_module
-from grainview.errors import ParameterError
+from grainview.contract.errors import ParameterError
 from grainview.persistence import pair_keys, persistence, type_transitions
 
 from .conftest import raise_if_dask_computes

@@ -17,7 +17,7 @@ from matplotlib.colors import to_rgba  # noqa: E402
 import grainview  # noqa: E402
 from grainview import plot as gp  # noqa: E402
 from grainview.connectivity import connectivity_pdf, coordination, joint_connectivity_pdf  # noqa: E402
-from grainview.errors import ParameterError  # noqa: E402
+from grainview.contract.errors import ParameterError  # noqa: E402
 from grainview.fabric import fabric_anisotropy, orientation_pdf  # noqa: E402
 from grainview.forces import force_anisotropies, harmonic_prediction  # noqa: E402
 from grainview.plot import PlotAccessor, save_figure  # noqa: E402

@@ -13,9 +13,9 @@ import numpy as np
 import pytest
 
 import grainview
-from grainview.errors import FileFormatError
-from grainview.locks import WriterLock, being_written
-from grainview.writer import netcdf3_data_bytes
+from grainview.contract.errors import FileFormatError
+from grainview.contract.locks import WriterLock, being_written
+from grainview.contract.writer import netcdf3_data_bytes
 
 from .test_schema_io import _write
 from . import builders
@@ -27,10 +27,10 @@ REPO = Path(__file__).resolve().parents[2]
 def _layout(path):
     """(bytes up to the end of the last record, bytes of one record) of a netCDF-3 file; the
     file itself may be padded beyond its last record."""
-    from grainview.io import _header_reader
+    from grainview.contract.netcdf3 import header_reader
 
     with open(path, "rb") as fh:
-        nc = _header_reader()(fh, "r", mmap=False)
+        nc = header_reader()(fh, "r", mmap=False)
         header = fh.tell()
         records = [v for v in nc.variables.values() if v.isrec]
         fixed, record = netcdf3_data_bytes([v.data.nbytes for v in nc.variables.values() if not v.isrec],
@@ -81,7 +81,7 @@ def test_the_note_of_a_killed_writer_does_not_count_as_a_writer(tmp_path):
 WRITER = """
 import sys, time
 import numpy as np
-from grainview.writer import SnapshotWriter, compress_file
+from grainview.contract.writer import SnapshotWriter, compress_file
 n, slots = 3000, 6000
 w = SnapshotWriter.create(sys.argv[1], radius=np.full(n, 0.01), n_vertices=0, mass=1.0, inertia=1.0,
                           n_contact_slots=slots, attrs={"scene": "test"})
@@ -134,8 +134,7 @@ def test_a_file_replaced_while_it_is_opened_is_opened_again(tmp_path, monkeypatc
     is not retried."""
     import xarray as xr
 
-    from grainview import io
-    from grainview.writer import compress_file
+    from grainview.contract.writer import compress_file
 
     path = _write(builders.mixed_contacts(t=3), tmp_path / "run.nc")
     packed = tmp_path / "packed.nc"
@@ -151,7 +150,7 @@ def test_a_file_replaced_while_it_is_opened_is_opened_again(tmp_path, monkeypatc
             raise OSError(-51, "NetCDF: Unknown file format")
         return real(*args, **kwargs)
 
-    monkeypatch.setattr(io.xr, "open_dataset", compressed_meanwhile)
+    monkeypatch.setattr(xr, "open_dataset", compressed_meanwhile)
     with grainview.open_dataset(path, chunks=None) as ds:
         assert ds.sizes["time"] == 3
     assert len(calls) == 2
@@ -160,7 +159,7 @@ def test_a_file_replaced_while_it_is_opened_is_opened_again(tmp_path, monkeypatc
         calls.append(args[0])
         raise OSError(-51, "NetCDF: Unknown file format")
 
-    monkeypatch.setattr(io.xr, "open_dataset", always_failing)
+    monkeypatch.setattr(xr, "open_dataset", always_failing)
     calls.clear()
     with pytest.raises(FileFormatError, match="not a readable netCDF file"):
         grainview.open_dataset(path)

@@ -70,8 +70,8 @@ def test_long_series_open_in_several_chunks(tmp_path):
     import os
 
     import grainview
-    from grainview.dataset import netcdf_encoding
-    from grainview.io import MIN_CHUNK_SNAPSHOTS
+    from grainview.contract.dataset import netcdf_encoding
+    from grainview.contract.io import MIN_CHUNK_SNAPSHOTS
     from grainview.synthetic import harmonic_series
 
     ds = harmonic_series(n_snapshots=200, n_contacts=50)

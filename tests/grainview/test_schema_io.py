@@ -7,9 +7,9 @@ import pytest
 import xarray as xr
 
 import grainview
-from grainview.errors import FileFormatError, SchemaError
-from grainview.schema import TIME_ATTRS, contact_slots
-from grainview.writer import SnapshotWriter
+from grainview.contract.errors import FileFormatError, SchemaError
+from grainview.contract.schema import TIME_ATTRS, contact_slots
+from grainview.contract.writer import SnapshotWriter
 
 from . import builders
 
@@ -135,7 +135,7 @@ def test_newer_schema_version_is_refused(tmp_path):
     ds = builders.two_disks()
     ds.attrs["grainview_schema_version"] = "99.0"
     path = tmp_path / "future.nc"
-    ds.to_netcdf(path, **grainview.dataset.netcdf_options(ds))
+    ds.to_netcdf(path, **grainview.contract.dataset.netcdf_options(ds))
     with pytest.raises(SchemaError, match="newer than this grainview"):
         grainview.open_dataset(path)
 
@@ -143,7 +143,7 @@ def test_newer_schema_version_is_refused(tmp_path):
 def test_to_netcdf_with_contract_encoding_round_trips(tmp_path):
     ds = builders.mixed_contacts()
     path = tmp_path / "x.nc"
-    ds.to_netcdf(path, **grainview.dataset.netcdf_options(ds, compress=False))
+    ds.to_netcdf(path, **grainview.contract.dataset.netcdf_options(ds, compress=False))
     back = grainview.open_dataset(path, chunks=None)
     xr.testing.assert_equal(back[["i", "j", "kind", "fn"]], ds[["i", "j", "kind", "fn"]])
 
@@ -152,18 +152,18 @@ def test_a_zlib_copy_is_smaller_and_opens_and_validates_unchanged(tmp_path):
     from grainview.synthetic import harmonic_series
     ds = harmonic_series(n_snapshots=4, n_contacts=2000)
     plain, packed = tmp_path / "plain.nc", tmp_path / "zlib.nc"
-    ds.to_netcdf(plain, format="NETCDF4_CLASSIC", encoding=grainview.dataset.netcdf_encoding(ds))
-    ds.to_netcdf(packed, format="NETCDF4_CLASSIC", encoding=grainview.dataset.netcdf_encoding(ds, zlib=True))
+    ds.to_netcdf(plain, format="NETCDF4_CLASSIC", encoding=grainview.contract.dataset.netcdf_encoding(ds))
+    ds.to_netcdf(packed, format="NETCDF4_CLASSIC", encoding=grainview.contract.dataset.netcdf_encoding(ds, zlib=True))
     assert packed.stat().st_size < plain.stat().st_size
     back = grainview.open_dataset(packed, chunks=None)  # eager: no dask thread touches HDF5
     assert back["fn"].encoding.get("zlib") is True
     xr.testing.assert_identical(back[list(ds.data_vars)].reset_coords(drop=True),
                                 grainview.open_dataset(plain, chunks=None)[list(ds.data_vars)].reset_coords(drop=True))
     grainview.validate(back)
-    from grainview.errors import ParameterError
+    from grainview.contract.errors import ParameterError
     for bad in (0, 10, 4.5):
         with pytest.raises(ParameterError, match="complevel"):
-            grainview.dataset.netcdf_encoding(ds, zlib=True, complevel=bad)
+            grainview.contract.dataset.netcdf_encoding(ds, zlib=True, complevel=bad)
 
 
 @pytest.mark.parametrize("fraction", [0.1, 0.5, 0.9, 0.999])

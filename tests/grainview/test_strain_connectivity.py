@@ -6,7 +6,7 @@ import xarray as xr
 from hypothesis import given, settings, strategies as st
 
 from grainview import make_dataset
-from grainview.errors import ParameterError
+from grainview.contract.errors import ParameterError
 
 from . import builders
 from .conftest import raise_if_dask_computes
@@ -120,7 +120,7 @@ def test_lazy_equals_eager():
 
 
 def test_solid_fraction_of_disks_and_pentagons():
-    from grainview.schema import particle_area
+    from grainview.contract.shapes import particle_area
     assert particle_area(1.0, 0) == pytest.approx(np.pi, rel=RTOL)
     assert particle_area(1.0, 4) == pytest.approx(2.0, rel=RTOL)  # square of diagonal 2
     assert particle_area(2.0, 6) == pytest.approx(6 * np.sqrt(3) / 4 * 4, rel=RTOL)  # 6 triangles of side 2

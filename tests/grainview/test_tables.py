@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from grainview.errors import ParameterError
+from grainview.contract.errors import ParameterError
 
 from .test_lifetimes import SERIES
 from .test_persistence import N, sequence_dataset

@@ -5,7 +5,7 @@ import pytest
 import xarray as xr
 
 import grainview
-from grainview.errors import SchemaError
+from grainview.contract.errors import SchemaError
 
 from . import builders
 from .conftest import raise_if_dask_computes

@@ -8,7 +8,7 @@ from grainview.arrays import fabric as fabric_arrays
 from grainview.arrays import stress as stress_arrays
 from grainview.arrays.tensors import principal, signed_anisotropy
 from grainview._kernels.xi_network import count_below
-from grainview.errors import ParameterError
+from grainview.contract.errors import ParameterError
 from grainview.fabric import fabric_anisotropy
 from grainview.stress import stress_invariants
 from grainview.xi_network import xi_network

@@ -4,7 +4,7 @@ import warnings
 
 import numpy as np
 
-from grainview.errors import ConvergenceWarning
+from grainview.contract.errors import ConvergenceWarning
 
 G = 9.81  # m s-2
 R = 0.0125  # m, circumscribed radius of the paper's smallest particles

@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from grainview.schema import polygon_vertices
+from grainview.contract.shapes import regular_vertices, world_vertices
 
 
 def all_pairs(pos, radius, alert):
@@ -22,7 +22,7 @@ def all_pairs(pos, radius, alert):
 
 def polygon(x, y, r, theta, n):
     """(n, 2) vertices of a regular n-gon, counter-clockwise (the contract's convention)."""
-    return polygon_vertices([[x, y]], [r], theta, n)[0]
+    return world_vertices([[x, y]], [theta], regular_vertices(r, n)[None])[0]
 
 
 def outward_normals(verts):

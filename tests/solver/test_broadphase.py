@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from grainview.errors import ParameterError
+from grainview.contract.errors import ParameterError
 from solver.broadphase import candidate_pairs, wall_candidates
 
 from . import naive_geometry as naive

@@ -14,9 +14,9 @@ import pytest
 import xarray as xr
 
 import grainview
-from grainview.errors import ParameterError
-from grainview.locks import FileLockedError
-from grainview.writer import SnapshotWriter, compress_file, decompress_file, is_compressed
+from grainview.contract.errors import ParameterError
+from grainview.contract.locks import FileLockedError
+from grainview.contract.writer import SnapshotWriter, compress_file, decompress_file, is_compressed
 from solver import compaction_sample, isotropic_compaction
 from solver.output import Recorder
 
@@ -164,7 +164,7 @@ def test_compressed_files_can_be_opened_again_and_again_with_dask_threads(tmp_pa
     (a segmentation fault) when a file read by dask's threads was opened again in the same
     process; the classic data model stores strings as characters. Run in a subprocess, so
     that a crash fails this test instead of ending the test session."""
-    from grainview.dataset import netcdf_options
+    from grainview.contract.dataset import netcdf_options
     from grainview.synthetic import harmonic_series
 
     paths = []

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 from scipy import sparse
 
-from grainview.errors import ParameterError
+from grainview.contract.errors import ParameterError
 from solver import nlgs
 from solver.contact_problem import solve_contact_problem
 

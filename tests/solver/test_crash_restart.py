@@ -23,8 +23,8 @@ import numpy as np
 import pytest
 
 import grainview
-from grainview.errors import FileFormatError
-from grainview.schema import VARIABLES
+from grainview.contract.errors import FileFormatError
+from grainview.contract.schema import VARIABLES
 from solver import biaxial_test, compaction_sample, isotropic_compaction
 from solver.output import Recorder, point_impulses
 from solver.restart import load_state, resume
@@ -283,7 +283,7 @@ def test_files_that_cannot_be_resumed_say_why(reference, tmp_path):
 
 CREATE_AND_DIE = """
 import os, signal, sys
-import grainview.writer as writer
+import grainview.contract.writer as writer
 from solver import compaction_sample
 from solver.output import Recorder
 
@@ -361,8 +361,8 @@ def test_a_full_disk_ends_in_one_line_and_a_valid_resumable_file(tmp_path, monke
     run stops with an OutputError naming the file and the snapshots kept; the file opens with
     them and the run resumes."""
     import grainview
-    from grainview.errors import OutputError
-    from grainview.writer import SnapshotWriter
+    from grainview.contract.errors import OutputError
+    from grainview.contract.writer import SnapshotWriter
 
     sim = compaction_sample(RUN["n"], "pentagon", seed=RUN["seed"])
     with warnings.catch_warnings():
@@ -409,7 +409,7 @@ def _restart(path, *python_args, timeout=120):
 def _nearly_finished(reference, path, missing=3):
     """The reference run as a run killed ``2 * missing`` steps before its end leaves it:
     netCDF-3, its last ``missing`` snapshots not complete."""
-    from grainview.writer import decompress_file
+    from grainview.contract.writer import decompress_file
 
     path.write_bytes(reference.read_bytes())
     decompress_file(path)
@@ -420,7 +420,7 @@ def _nearly_finished(reference, path, missing=3):
 
 def _finished_uncompressed(reference, path):
     """The reference run as a run stopped during its final compression leaves it."""
-    from grainview.writer import decompress_file
+    from grainview.contract.writer import decompress_file
 
     path.write_bytes(reference.read_bytes())
     decompress_file(path)
@@ -537,7 +537,7 @@ def test_a_run_stopped_while_compressing_is_compressed_by_the_next_resume(refere
 def test_sigterm_while_a_compressed_run_is_made_netcdf3_again_leaves_it_as_it_was(reference, tmp_path):
     """A resume of a compressed, unfinished run first rewrites it netCDF-3: SIGTERM then stops
     it with one line, the compressed file unchanged and no temporary file left."""
-    from grainview.writer import compress_file
+    from grainview.contract.writer import compress_file
 
     path = _nearly_finished(reference, tmp_path / "run.nc")
     compress_file(path)
@@ -571,7 +571,7 @@ def test_a_file_size_limit_ends_a_resume_in_one_line_and_leaves_the_file_resumab
     """EFBIG while a finished run is compressed, and while a compressed run is made netCDF-3
     again to be resumed: one line each, the file unchanged and without strays; the run then
     resumes to the uninterrupted run's bytes."""
-    from grainview.writer import compress_file
+    from grainview.contract.writer import compress_file
 
     packed_size = reference.stat().st_size
     finished = _finished_uncompressed(reference, tmp_path / "finished.nc")

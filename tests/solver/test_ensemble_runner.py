@@ -14,8 +14,8 @@ import xarray as xr
 
 import grainview
 from grainview.ensemble import run_dataset
-from grainview.errors import ParameterError
-from grainview.writer import is_compressed
+from grainview.contract.errors import ParameterError
+from grainview.contract.writer import is_compressed
 from solver import ensemble
 from solver.ensemble import RunSpec, grid, run_ensemble, run_one
 
@@ -144,7 +144,7 @@ def test_a_finished_run_whose_compression_was_stopped_is_compressed_on_rerun(kil
     import subprocess
     import sys
 
-    from grainview.writer import decompress_file
+    from grainview.contract.writer import decompress_file
 
     specs, results, _, _ = killed
     path = tmp_path / os.path.basename(results[1]["path"])

@@ -11,7 +11,7 @@ from pathlib import Path
 import pytest
 
 import grainview
-from grainview.writer import is_compressed
+from grainview.contract.writer import is_compressed
 
 resource = pytest.importorskip("resource")
 REPO = Path(__file__).resolve().parents[2]
@@ -42,7 +42,7 @@ def plain(tmp_path_factory):
     import netCDF4
     import numpy as np
 
-    from grainview.writer import netcdf3_data_bytes
+    from grainview.contract.writer import netcdf3_data_bytes
 
     path = tmp_path_factory.mktemp("plain") / "iso.nc"
     done = _run(path, 0, "--no-compress")

@@ -8,7 +8,7 @@ import pytest
 from hypothesis import assume, given, settings
 from hypothesis import strategies as st
 
-from grainview.errors import ParameterError
+from grainview.contract.errors import ParameterError
 from solver.broadphase import candidate_pairs, wall_candidates
 from solver.narrowphase import ContactPoints, detect
 from solver.shapes import Shapes

@@ -8,7 +8,7 @@ import math
 import numpy as np
 import pytest
 
-from grainview.errors import ParameterError
+from grainview.contract.errors import ParameterError
 from solver.broadphase import candidate_pairs, wall_candidates
 from solver.narrowphase import detect
 from solver.packing import CLEARANCE, box_width_for, deposit, size_classes

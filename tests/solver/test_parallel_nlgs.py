@@ -14,7 +14,7 @@ import numba
 import numpy as np
 import pytest
 
-from grainview.errors import ConvergenceWarning
+from grainview.contract.errors import ConvergenceWarning
 from solver import Parameters, compaction_sample, nlgs, parallel_nlgs
 
 from .conftest import compacted_problem
@@ -171,7 +171,7 @@ def test_runs_with_domains_are_deterministic_and_refuse_other_orders():
         assert run(1) == run(threads)
     finally:
         numba.set_num_threads(threads)
-    from grainview.errors import ParameterError
+    from grainview.contract.errors import ParameterError
 
     with pytest.raises(ParameterError, match="domains"):
         Parameters(domains=2, shuffle=True, acceleration="off").validate()

@@ -107,7 +107,7 @@ def test_head_on_collision_conserves_momentum_and_is_inelastic(recovery_speed, s
 
 
 def test_masses_and_inertia_of_regular_polygons():
-    from grainview.schema import particle_area
+    from grainview.contract.shapes import particle_area
     # a square of circumscribed radius 1: side sqrt(2), area 2, I = m s^2/6 = m/3
     m, inertia = mass_and_inertia(1.0, 4, density=1.0)
     assert m == pytest.approx(2.0, rel=1e-14) and inertia == pytest.approx(2.0 / 3, rel=1e-14)

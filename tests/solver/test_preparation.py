@@ -6,8 +6,8 @@ import warnings
 import numpy as np
 import pytest
 
-from grainview.errors import ParameterError
-from grainview.schema import particle_area
+from grainview.contract.errors import ParameterError
+from grainview.contract.shapes import particle_area
 from solver import compaction_sample, isotropic_compaction
 from solver.preparation import PRESETS, Preparation, prepare_sample, preparation
 from solver.scenes import inertia_number_speed

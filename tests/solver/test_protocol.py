@@ -9,8 +9,8 @@ import numpy as np
 import pytest
 
 import grainview
-from grainview.errors import ParameterError
-from grainview.schema import particle_area
+from grainview.contract.errors import ParameterError
+from grainview.contract.shapes import particle_area
 from solver.preparation import prepare_sample, preparation
 from solver import (Parameters, Simulation, Walls, biaxial_test, compaction_sample, is_equilibrium,
                     isotropic_compaction)

@@ -11,7 +11,7 @@ import warnings
 import numpy as np
 import pytest
 
-from grainview.errors import ConvergenceWarning
+from grainview.contract.errors import ConvergenceWarning
 from solver import acceleration, nlgs, parallel_nlgs
 
 from .conftest import compacted_problem

@@ -7,7 +7,7 @@ tilted plane, head-on collision -- are in test_physics.py.)"""
 import numpy as np
 import pytest
 
-from grainview.errors import ParameterError
+from grainview.contract.errors import ParameterError
 from solver import Parameters, Simulation, Walls, gravity_scene
 
 from .conftest import EXACT, G, PENTAGON_ON_EDGE, R

@@ -7,7 +7,7 @@ import warnings
 import numpy as np
 import pytest
 
-from grainview.errors import ConvergenceWarning
+from grainview.contract.errors import ConvergenceWarning
 from solver import Parameters, Simulation, Walls, compaction_sample, gravity_scene
 
 G = 9.81

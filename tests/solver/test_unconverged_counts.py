@@ -12,7 +12,7 @@ import numpy as np
 import pytest
 
 import grainview
-from grainview.errors import ConvergenceWarning
+from grainview.contract.errors import ConvergenceWarning
 from solver import compaction_sample, isotropic_compaction
 from solver.output import Recorder
 

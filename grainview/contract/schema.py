@@ -2,14 +2,15 @@
 
 This module is the single source of truth for the contract that ``docs/schema.md``
 describes in prose: the table :data:`VARIABLES`, the sentinels of empty contact slots, the
-global attributes and the shapes' areas. It needs numpy only, so the solver can use it
+global attributes. A particle's shape is
+defined in :mod:`grainview.contract.shapes`. It needs numpy only, so the solver can use it
 without loading xarray. Built on it:
 
-* :func:`grainview.dataset.make_dataset` assembles an in-memory :class:`xarray.Dataset`
+* :func:`grainview.contract.dataset.make_dataset` assembles an in-memory :class:`xarray.Dataset`
   from plain arrays (used by tests, demos and anyone converting another code's output);
-* :class:`grainview.writer.SnapshotWriter` creates a netCDF file and appends snapshots one
+* :class:`grainview.contract.writer.SnapshotWriter` creates a netCDF file and appends snapshots one
   at a time while a simulation runs (used by the solver);
-* :func:`grainview.validation.validate` checks a dataset against the same table.
+* :func:`grainview.contract.validation.validate` checks a dataset against the same table.
 
 Conventions (docs/conventions.md §0): 2D, SI units, a slab of thickness
 ``thickness_m`` (global attribute, 1 m by default) so that forces are in N and stresses in Pa.
@@ -72,8 +73,12 @@ class Var:
 
 VARIABLES: dict[str, Var] = {
     # per particle (static)
-    "radius": Var(("particle",), "f8", "m", "circumscribed radius (disk radius for disks)"),
-    "n_vertices": Var(("particle",), "i4", "1", "number of vertices (0 = disk, >= 3 = regular polygon)"),
+    "radius": Var(("particle",), "f8", "m", "circumscribed radius: a disk's radius, a polygon's farthest vertex "
+                  "from its centroid"),
+    "n_vertices": Var(("particle",), "i4", "1", "number of vertices (0 = disk, >= 3 = polygon)"),
+    "vertices": Var(("particle", "vertex", "xy"), "f8", "m", "polygon vertices in the particle's own frame "
+                    "(centroid at the origin, counter-clockwise; NaN beyond n_vertices and for disks); "
+                    "absent: regular polygons", False),
     "mass": Var(("particle",), "f8", "kg", "particle mass"),
     "inertia": Var(("particle",), "f8", "kg m2", "moment of inertia about the centre of mass"),
     # per particle and time
@@ -139,35 +144,6 @@ DIAGNOSTICS = ("step", "nlgs_iterations", "nlgs_residual", "local_law_residual",
 """The solver's per-snapshot diagnostics (optional variables along ``time``); the
 ``nlgs_unconverged_*`` ones count the steps since the previous snapshot, the others describe
 the snapshot's own last step."""
-
-
-def particle_area(radius, n_vertices):
-    """Area of each particle in m2: pi R^2 for a disk (n = 0), (n/2) R^2 sin(2 pi/n) for a
-    regular n-gon of circumscribed radius R. Part of the contract's shape definition."""
-    radius = np.asarray(radius, dtype=float)
-    n = np.asarray(n_vertices)
-    safe_n = np.where(n >= 3, n, 3)
-    polygon = 0.5 * safe_n * radius**2 * np.sin(2 * np.pi / safe_n)
-    return np.where(n >= 3, polygon, np.pi * radius**2)
-
-
-def vertex_phases(n_vertices: int) -> np.ndarray:
-    """(n,) body-frame polar angles (rad) of the vertices of a regular n-gon: 2 pi k/n,
-    k = 0 .. n-1, so that vertex 0 lies at the particle's ``angle`` and the vertices run
-    counter-clockwise. Part of the contract's shape definition (what ``angle`` means); the
-    solver's shape table (``solver.shapes.Shapes``) and :func:`polygon_vertices` both read it."""
-    return 2.0 * np.pi * np.arange(n_vertices) / n_vertices
-
-
-def polygon_vertices(position, radius, angle, n_vertices: int) -> np.ndarray:
-    """(P, n, 2) vertices in m of P regular n-gons of one vertex count ``n_vertices``: vertex k
-    at position + R (cos(angle + 2 pi k/n), sin(angle + 2 pi k/n)), counter-clockwise, R the
-    circumscribed radius. Part of the contract's shape definition (what ``angle`` means)."""
-    position = np.asarray(position, dtype=float).reshape(-1, 2)
-    radius = np.asarray(radius, dtype=float).reshape(-1)
-    angle = np.broadcast_to(np.asarray(angle, dtype=float), radius.shape)
-    phase = angle[:, None] + vertex_phases(n_vertices)
-    return position[:, None, :] + radius[:, None, None] * np.stack([np.cos(phase), np.sin(phase)], -1)
 
 
 def complete_snapshots(variables) -> np.ndarray:
@@ -250,7 +226,7 @@ def structure_problems(variables: dict, sizes: dict) -> list[str]:
     ``variables`` maps each variable name to ``(dims, dtype)``; ``sizes`` each dimension to
     its length. Reported: a required variable missing, dims other than the contract's (or in
     another order), an integer variable stored as floats or the reverse, an ``xy`` of size
-    other than 2. Shared by :func:`grainview.validation.validate` (xarray) and ``grainview
+    other than 2. Shared by :func:`grainview.contract.validation.validate` (xarray) and ``grainview
     info`` (netCDF4 alone), so that both say the same."""
     problems = []
     for name, var in VARIABLES.items():

@@ -1,7 +1,7 @@
 """Writing a netCDF file of the data contract snapshot by snapshot, safe against a killed run.
 
 :class:`SnapshotWriter` is what the solver writes through (:mod:`solver.output`); it needs
-netCDF4 and numpy only. The contract it writes is :mod:`grainview.schema`.
+netCDF4 and numpy only. The contract it writes is :mod:`grainview.contract.schema`.
 """
 
 from __future__ import annotations
@@ -14,6 +14,7 @@ from .errors import FileFormatError, GrainviewError, OutputError, ParameterError
 from .locks import WriterLock, process_alive
 from .schema import (CONTACT_VARIABLES, DEFAULT_WALL_NAMES, OPTIONAL_CONTACT_VARIABLES, REQUIRED, TIME_ATTRS,
                      VARIABLES, complete_snapshots, contact_slots, empty_slots, global_attrs, variable_attrs)
+from .shapes import shape_problems
 
 __all__ = ["SnapshotWriter", "compress_file", "decompress_file", "is_compressed", "check_complevel",
            "netcdf3_data_bytes", "lock_file", "remove_strays", "last_complete_value", "APPEND_FORMAT",
@@ -107,7 +108,7 @@ def remove_strays(path) -> list[str]:
 
 
 def lock_file(path) -> WriterLock:
-    """Take the writer's lock of ``path`` (:class:`grainview.locks.WriterLock`) and remove the
+    """Take the writer's lock of ``path`` (:class:`grainview.contract.locks.WriterLock`) and remove the
     temporary files killed writers left beside it (:func:`remove_strays`)."""
     lock = WriterLock(path)
     if lock.held:  # without locks (no fcntl) another process may be writing them
@@ -255,12 +256,12 @@ def compress_file(path, complevel: int = DEFAULT_COMPLEVEL, lock=None) -> None:
         A netCDF file of the contract that no other process is writing.
     complevel : int
         zlib level, 1 (fastest) to 9 (smallest).
-    lock : grainview.locks.WriterLock, optional
+    lock : grainview.contract.locks.WriterLock, optional
         ``path``'s writer lock, already held by the caller (default: taken here).
 
     Raises
     ------
-    grainview.locks.FileLockedError
+    grainview.contract.locks.FileLockedError
         Another process is writing ``path``.
     OutputError
         The rewrite failed (a full disk, a file-size limit); ``path`` is unchanged.
@@ -323,7 +324,7 @@ class SnapshotWriter:
     @classmethod
     def create(cls, path, *, radius, n_vertices, mass, inertia, n_walls=0, wall_names=None,
                wall_normal=None, optional=(),
-               attrs=None, n_contact_slots=None, overwrite=False, format=APPEND_FORMAT, lock=None):
+               attrs=None, n_contact_slots=None, overwrite=False, format=APPEND_FORMAT, lock=None, vertices=None):
         """Create ``path`` with the static particle data, ready for :meth:`append`.
 
         Parameters
@@ -333,7 +334,12 @@ class SnapshotWriter:
         radius, mass, inertia : array_like, (N,)
             Circumscribed radii (m), masses (kg) and moments of inertia (kg m2).
         n_vertices : array_like, (N,)
-            0 for a disk, n >= 3 for a regular n-gon.
+            0 for a disk, n >= 3 for a polygon.
+        vertices : array_like, (N, V, 2), optional
+            The polygons' vertices in their own frames, m (centroid at the origin,
+            counter-clockwise, NaN beyond each one's ``n_vertices`` and for disks:
+            :mod:`grainview.contract.shapes`), written as ``vertices``; without it the polygons
+            are regular.
         n_walls : int, default 0
             Number of walls (bodies N, N+1, ...).
         wall_names : sequence of str, optional
@@ -346,19 +352,19 @@ class SnapshotWriter:
         attrs : dict, optional
             Global attributes added to the contract's.
         n_contact_slots : int, optional
-            Size of the ``contact`` dimension (default: :func:`grainview.schema.contact_slots`).
+            Size of the ``contact`` dimension (default: :func:`grainview.contract.schema.contact_slots`).
         overwrite : bool, default False
             Replace an existing ``path`` (refused while another process writes it).
         format : str, default :data:`APPEND_FORMAT`
             The netCDF format (netCDF-3, appended in place).
-        lock : grainview.locks.WriterLock, optional
+        lock : grainview.contract.locks.WriterLock, optional
             ``path``'s writer lock, already held by the caller, who releases it (default: taken
             here before anything is written, released by :meth:`close`).
 
         Returns
         -------
         SnapshotWriter
-            Holding the file open and its writer's lock (:mod:`grainview.locks`).
+            Holding the file open and its writer's lock (:mod:`grainview.contract.locks`).
 
         Raises
         ------
@@ -366,7 +372,7 @@ class SnapshotWriter:
             ``path`` exists and ``overwrite`` is False.
         FileNotFoundError
             The folder does not exist.
-        grainview.locks.FileLockedError
+        grainview.contract.locks.FileLockedError
             Another process is writing ``path``.
         OutputError
             The file could not be written (a full disk, a file-size limit): nothing is left at
@@ -385,7 +391,7 @@ class SnapshotWriter:
             lock = lock_file(path)  # never replace a file another run is still writing
         try:
             nc = cls._create(path, radius, n_vertices, mass, inertia, n_walls, wall_names, wall_normal, optional,
-                             attrs, n_contact_slots, overwrite, format)
+                             attrs, n_contact_slots, overwrite, format, vertices)
         except BaseException:
             if own:
                 lock.release()
@@ -394,7 +400,7 @@ class SnapshotWriter:
 
     @staticmethod
     def _create(path, radius, n_vertices, mass, inertia, n_walls, wall_names, wall_normal, optional, attrs,
-                n_contact_slots, overwrite, format):
+                n_contact_slots, overwrite, format, vertices=None):
         """:meth:`create`'s file, under the lock: written, moved into place and opened to append."""
         import netCDF4
 
@@ -406,6 +412,12 @@ class SnapshotWriter:
             raise ParameterError(f"unknown optional variables {unknown}")
         if not n_walls:
             optional = [o for o in optional if "wall" not in VARIABLES[o].dims]
+        if vertices is not None:
+            vertices = np.asarray(vertices, "f8")
+            problems = shape_problems(radius, n_vertices, vertices) if vertices.ndim == 3 and \
+                vertices.shape[::2] == (n, 2) else [f"vertices: expected shape (N, V, 2) with N = {n}, got {vertices.shape}"]
+            if problems:
+                raise ParameterError("; ".join(problems))
         # The header and the static data are written under a temporary name and the file is
         # moved into place once they are on disk: a run killed while the file is being created
         # leaves either no file or a valid empty one, never a partial header.
@@ -421,6 +433,8 @@ class SnapshotWriter:
             if any("contact_point" in VARIABLES[o].dims for o in optional):
                 nc.createDimension("contact_point", 2)  # the two points of a double contact
             nc.createDimension("xy", 2)
+            if vertices is not None:
+                nc.createDimension("vertex", vertices.shape[1])
             nc.createDimension("xy_strlen", 1)
             xy = nc.createVariable("xy", "S1", ("xy", "xy_strlen"))
             xy[:] = np.array([[b"x"], [b"y"]])
@@ -440,6 +454,8 @@ class SnapshotWriter:
             names = [*REQUIRED, *optional]
             if n_walls and wall_normal is not None:
                 names.append("wall_normal")
+            if vertices is not None:
+                names.append("vertices")
             names.append("complete")  # defined last: the last bytes of each record
             for name in dict.fromkeys(names):
                 var = VARIABLES[name]
@@ -449,6 +465,8 @@ class SnapshotWriter:
             static = {"radius": radius, "n_vertices": n_vertices, "mass": mass, "inertia": inertia}
             if "wall_normal" in nc.variables:
                 static["wall_normal"] = wall_normal
+            if vertices is not None:
+                static["vertices"] = vertices
             for name, value in static.items():
                 nc.variables[name][:] = np.broadcast_to(np.asarray(value, VARIABLES[name].dtype),
                                                         nc.variables[name].shape)
@@ -470,7 +488,7 @@ class SnapshotWriter:
     @classmethod
     def open_append(cls, path, lock=None):
         """Open an existing file of the contract to append further snapshots (refused with
-        :class:`grainview.locks.FileLockedError` while another process writes it). A compressed
+        :class:`grainview.contract.locks.FileLockedError` while another process writes it). A compressed
         file is first rewritten uncompressed (:func:`decompress_file`). ``lock``: as for
         :meth:`create` (whoever reads the file's last snapshot to go on from it takes the lock
         first and passes it here, so that no other process appends in between)."""

@@ -2,17 +2,22 @@
 the encoding that writes one to netCDF with the contract's sentinels intact.
 
 :func:`make_dataset` is how tests, demos and other codes' converters produce a dataset that
-every analysis accepts; the contract itself (names, dims, units) is :mod:`grainview.schema`.
+every analysis accepts; the contract itself (names, dims, units) is :mod:`grainview.contract.schema`.
 """
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 import numpy as np
-import xarray as xr
 
 from .errors import ParameterError
 from .schema import (CONTACT_VARIABLES, DEFAULT_WALL_NAMES, OPTIONAL_CONTACT_VARIABLES, TIME_ATTRS, VARIABLES,
                      XY, contact_slots, empty_slots, global_attrs, variable_attrs)
+from .shapes import inertia_per_mass, particle_area, shape_problems
+
+if TYPE_CHECKING:
+    import xarray as xr
 
 __all__ = ["make_dataset", "netcdf_encoding", "netcdf_options"]
 
@@ -70,8 +75,9 @@ def make_dataset(
         Snapshot times, s (default 0, 1, ..., T-1).
     n_vertices, mass, inertia, angle : array_like, optional
         Vertex counts (0 for a disk), masses (kg), moments of inertia (kg m2) and angles
-        (rad, broadcast to (T, N)); defaults are disks of ``density`` (kg m-3) in a slab of
-        unit thickness at zero angle.
+        (rad, broadcast to (T, N)); defaults are disks, masses and inertias those of each
+        particle's shape (:mod:`grainview.contract.shapes`; regular polygons unless the optional
+        ``vertices`` are given) of ``density`` (kg m-3) in a slab of unit thickness, at zero angle.
     density : float, default 2600.0
         Density of the default masses, kg m-3.
     n_walls : int, default 0
@@ -81,7 +87,7 @@ def make_dataset(
     attrs : dict, optional
         Global attributes added to the contract's.
     n_contact_slots : int, optional
-        Size of the ``contact`` dimension (default: :func:`grainview.schema.contact_slots`).
+        Size of the ``contact`` dimension (default: :func:`grainview.contract.schema.contact_slots`).
     **optional
         Any optional contract variable (``velocity``, ``wall_force``, ``step``...).
 
@@ -92,7 +98,7 @@ def make_dataset(
 
     Raises
     ------
-    grainview.errors.ParameterError
+    grainview.contract.errors.ParameterError
         When the arrays disagree in size, a snapshot holds more contacts than slots, a wall
         contact lacks ``point`` or ``branch``, or an optional variable is unknown.
     """
@@ -105,9 +111,13 @@ def make_dataset(
     if len(contacts) != t:
         raise ParameterError(f"contacts has {len(contacts)} snapshots, position has {t}")
     n_vertices = np.zeros(n, "i4") if n_vertices is None else np.broadcast_to(np.asarray(n_vertices, "i4"), (n,))
-    area = np.pi * radius**2
+    if "vertices" in optional:
+        problems = shape_problems(radius, n_vertices, np.asarray(optional["vertices"], "f8"))
+        if problems:
+            raise ParameterError("; ".join(problems))
+    area = particle_area(radius, n_vertices, optional.get("vertices"))
     mass = density * area if mass is None else np.broadcast_to(np.asarray(mass, "f8"), (n,))
-    inertia = 0.5 * mass * radius**2 if inertia is None else np.broadcast_to(np.asarray(inertia, "f8"), (n,))
+    inertia = mass * inertia_per_mass(radius, n_vertices, optional.get("vertices")) if inertia is None else np.broadcast_to(np.asarray(inertia, "f8"), (n,))
     angle = np.zeros((t, n)) if angle is None else np.broadcast_to(np.asarray(angle, "f8"), (t, n))
     slots = n_contact_slots or contact_slots(n, n_walls)
 
@@ -163,6 +173,8 @@ def make_dataset(
     for name, value in arrays.items():
         var = VARIABLES[name]
         variables[name] = (var.dims, np.asarray(value).astype(var.dtype, copy=False), variable_attrs(name))
+    import xarray as xr
+
     ds = xr.Dataset(variables, coords=_coords(np.arange(t, dtype="f8") if time is None else time, n_walls, wall_names))
     ds.attrs = global_attrs(n, n_walls, attrs)
     return ds
@@ -174,7 +186,7 @@ def netcdf_encoding(ds: xr.Dataset, zlib: bool = False, complevel: int = 4) -> d
     Integers get no ``_FillValue`` (xarray would turn masked integers into floats on
     reading); floats use NaN as fill value. With ``zlib`` the contract's variables are also
     deflated at ``complevel`` (1-9, with byte shuffling), for a file in
-    :data:`grainview.writer.COMPRESSED_FORMAT` (docs/schema.md, "Compression");
+    :data:`grainview.contract.writer.COMPRESSED_FORMAT` (docs/schema.md, "Compression");
     :func:`grainview.open_dataset` reads it unchanged. :func:`netcdf_options` gives the format
     and the encoding together.
 
@@ -196,7 +208,7 @@ def netcdf_encoding(ds: xr.Dataset, zlib: bool = False, complevel: int = 4) -> d
     --------
     >>> ds = grainview.open_dataset("run.nc")                                  # doctest: +SKIP
     >>> ds.to_netcdf("run-zlib.nc", format="NETCDF4_CLASSIC",
-    ...              encoding=grainview.dataset.netcdf_encoding(ds, zlib=True))  # doctest: +SKIP
+    ...              encoding=grainview.contract.dataset.netcdf_encoding(ds, zlib=True))  # doctest: +SKIP
     """
     if zlib:
         from .writer import check_complevel
@@ -217,8 +229,8 @@ def netcdf_encoding(ds: xr.Dataset, zlib: bool = False, complevel: int = 4) -> d
 def netcdf_options(ds: xr.Dataset, compress: bool = True, complevel: int = 4) -> dict:
     """Keyword arguments of ``Dataset.to_netcdf`` that write ``ds`` as the solver writes a finished run.
 
-    Compressed (:data:`grainview.writer.COMPRESSED_FORMAT`, zlib at ``complevel``) or, with
-    ``compress=False``, netCDF-3 (the format of :data:`grainview.writer.APPEND_FORMAT`, under
+    Compressed (:data:`grainview.contract.writer.COMPRESSED_FORMAT`, zlib at ``complevel``) or, with
+    ``compress=False``, netCDF-3 (the format of :data:`grainview.contract.writer.APPEND_FORMAT`, under
     xarray's name ``NETCDF3_64BIT``); the contract's integer sentinels kept either way
     (:func:`netcdf_encoding`).
 
@@ -238,7 +250,7 @@ def netcdf_options(ds: xr.Dataset, compress: bool = True, complevel: int = 4) ->
 
     Examples
     --------
-    >>> ds.to_netcdf("copy.nc", **grainview.dataset.netcdf_options(ds))      # doctest: +SKIP
+    >>> ds.to_netcdf("copy.nc", **grainview.contract.dataset.netcdf_options(ds))      # doctest: +SKIP
     """
     from .writer import APPEND_FORMAT, COMPRESSED_FORMAT
 

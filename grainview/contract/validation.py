@@ -1,23 +1,25 @@
 """Checking a dataset against the data contract.
 
 :func:`validate` collects every problem it finds and raises them together as one
-:class:`~grainview.errors.SchemaError`. On a dask-backed dataset the value checks are lazy
+:class:`~grainview.contract.errors.SchemaError`. On a dask-backed dataset the value checks are lazy
 reductions computed in a single pass over the chunks, so a file larger than memory is checked
 without being loaded, and nothing is ever written back.
 """
 
 from __future__ import annotations
 
-import dask
-import numpy as np
-import xarray as xr
+from typing import TYPE_CHECKING
 
-from .contacts import occupied
+import numpy as np
+
 from .errors import SchemaError
 from .file_checks import (COUNT_OUT_OF_RANGE, NON_FINITE_FORCES, foreign_file_problems, negative_force_problem,
                           order_problems)
 from .schema import KIND_DOUBLE, KIND_SIMPLE, VARIABLES, structure_problems, unit_problems
 from .schema import missing_units as _missing_units
+
+if TYPE_CHECKING:
+    import xarray as xr
 
 UNIT_NORMAL_TOLERANCE = 1e-6
 """Largest accepted | |n| - 1 | for an occupied contact normal."""
@@ -37,11 +39,23 @@ def _structure_problems(ds: xr.Dataset) -> list[str]:
 def check_structure(ds: xr.Dataset, source: str | None = None) -> None:
     """Raise :class:`SchemaError` for structural problems only (missing variables, dims,
     dtypes): cheap, reads no data. The analyses call it before computing anything."""
+    import xarray as xr
+
     if not isinstance(ds, xr.Dataset):
         raise SchemaError(f"expected an xarray.Dataset, got {type(ds).__name__}", source)
     problems = _structure_problems(ds)
     if problems:
         raise SchemaError(problems, source or ds.encoding.get("source"))
+
+
+def occupied(ds: xr.Dataset) -> xr.DataArray:
+    """Boolean (time, contact): True in the slots that hold a contact, ``slot <
+    contact_count[time]`` (docs/schema.md: a snapshot's contacts fill its first slots); lazy on
+    dask input."""
+    import xarray as xr
+
+    slot = xr.DataArray(np.arange(ds.sizes["contact"], dtype="i4"), dims="contact")
+    return slot < ds["contact_count"]
 
 
 def _duplicate_counts(keys):
@@ -53,7 +67,7 @@ def _duplicate_counts(keys):
 
 def _unit_problems(ds: xr.Dataset) -> list[str]:
     """Variables whose ``units`` attribute differs from the contract's
-    (:func:`grainview.schema.unit_problems`)."""
+    (:func:`grainview.contract.schema.unit_problems`)."""
     return unit_problems(_metadata(ds)[1])
 
 
@@ -105,6 +119,8 @@ def _value_checks(ds: xr.Dataset) -> dict[str, xr.DataArray]:
                 checks[f"{name}: {{}} non-finite value(s) in occupied slots"] = bad.sum()
             else:
                 checks[f"{name}: {{}} non-finite value(s)"] = bad.sum()
+    import xarray as xr
+
     keys = xr.where(occ, i.astype(np.int64) * (n + n_walls) + j.astype(np.int64), -1)
     duplicates = xr.apply_ufunc(_duplicate_counts, keys, input_core_dims=[["contact"]], dask="parallelized",
                                 output_dtypes=[np.int64])
@@ -174,6 +190,9 @@ def validate(ds: xr.Dataset, source: str | None = None) -> xr.Dataset:
     SchemaError
         Every problem found, listed together.
     """
+    import dask
+    import xarray as xr
+
     source = source or (ds.encoding.get("source") if isinstance(ds, xr.Dataset) else None)
     check_structure(ds, source)  # values cannot be checked reliably on a malformed structure
     problems = _unit_problems(ds)

@@ -1,8 +1,8 @@
-"""Checks of the contract on plain numpy arrays, shared by :func:`grainview.validation.validate`
+"""Checks of the contract on plain numpy arrays, shared by :func:`grainview.contract.validation.validate`
 (xarray, lazily) and ``grainview info`` (netCDF4 alone), so that both say the same words.
 
 Each function returns the problems it finds as lines (empty when there are none), or raises
-:class:`~grainview.errors.FileFormatError` for a damaged file. numpy only: ``grainview info``
+:class:`~grainview.contract.errors.FileFormatError` for a damaged file. numpy only: ``grainview info``
 imports this module without xarray.
 """
 
@@ -10,8 +10,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from .errors import FileFormatError
-from .schema import REQUIRED
+from .errors import FileFormatError, SchemaError
+from .schema import REQUIRED, SCHEMA_VERSION
 
 NOT_A_GRAINVIEW_FILE = ("not a grainview file: none of the contract's particle or contact variables "
                         "(radius, position, i, j, fn...; docs/schema.md)")
@@ -45,7 +45,7 @@ def damaged_snapshots(complete, source) -> int:
     Parameters
     ----------
     complete : array_like of bool, (T,)
-        :func:`grainview.schema.complete_snapshots` of the file.
+        :func:`grainview.contract.schema.complete_snapshots` of the file.
     source : str
         The file's name, for the message.
     """
@@ -110,7 +110,7 @@ def force_problems(fn, ft, i, j, occupied) -> list[str]:
     Returns
     -------
     list of str
-        The lines :func:`grainview.validation.validate` gives for the same faults.
+        The lines :func:`grainview.contract.validation.validate` gives for the same faults.
     """
     fn, ft, occupied = np.asarray(fn), np.asarray(ft), np.asarray(occupied, bool)
     problems = []
@@ -162,3 +162,15 @@ def hidden_records(source, size, header, fixed, record, n_records, complete=None
         raise FileFormatError(f"{source}: its header counts {n_records} snapshots but its size holds {held}: the "
                               f"header's record count hides {held - n_records} snapshots (the file is damaged)")
 
+
+def check_version(version, source) -> None:
+    """Refuse a schema version newer (by its major number) than this grainview's."""
+    if version is None:
+        return
+    try:
+        major = int(str(version).split(".")[0])
+    except ValueError:
+        raise SchemaError(f"global attribute grainview_schema_version={version!r} is not a version number", source)
+    if major > int(SCHEMA_VERSION.split(".")[0]):
+        raise SchemaError(f"file has schema version {version}, newer than this grainview understands "
+                          f"({SCHEMA_VERSION}); upgrade grainview", source)
