@@ -1,0 +1,277 @@
+"""Force chains after Peters, Muthuswamy, Wibowo & Tordesillas, Phys. Rev. E 72, 041307 (2005),
+on plain arrays (docs/analysis.md, "Force chains").
+
+For each snapshot:
+
+1. the stress of each particle p from its own contacts, compression positive,
+
+       sigma_p = (1/V_p) sum_{c of p} s_pc f^c (x) (x^c - x_p),
+
+   f^c = f_n n + f_t t the force of body i on body j (docs/conventions.md §0), x^c the
+   contact's application point (``point``), x_p the centre of p, s_pc = +1 when p is body i of
+   the contact and -1 when it is body j, V_p the particle's volume (area times the slab
+   thickness); wall contacts load their particle like any other. Summed over the particles,
+   sum_p V_p sigma_p = sum_c f^c (x) l^c = V sigma, the sample's stress (docs/conventions.md §3),
+   since (x^c - x_i) - (x^c - x_j) = x_j - x_i = l^c;
+2. its principal stresses sigma_1 >= sigma_2 (of the symmetric part) and major direction
+   theta_1;
+3. the *chain particles*: sigma_1 above the mean of sigma_1 over the snapshot's particles, and
+   a major direction (sigma_1 - sigma_2 > :data:`ISOTROPY_TOLERANCE` |sigma_1|: an isotropic
+   stress has none);
+4. a *link* for each force-bearing contact between two chain particles whose branch vector
+   makes an angle of at most ``angle`` with the major direction of both (|cos| >= cos angle);
+5. chains: the connected sets of linked particles of at least ``min_size`` (3) particles.
+
+The connected sets come from a union-find kernel (:mod:`grainview._kernels.force_chains`); the
+rest is vectorised over every snapshot at once.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .._kernels.force_chains import label_components
+from .signature import CONTACT, CONTACT_XY, PARTICLE, SCALAR, TENSOR, core_dims
+from .tensors import principal
+from .vectors import force_vectors
+
+PARTICLE_XY = ("particle", "xy")
+PARTICLE_TENSOR = ("particle",) + TENSOR
+LENGTH = ("length",)
+
+ISOTROPY_TOLERANCE = 1e-9
+"""A particle stress with sigma_1 - sigma_2 <= this times |sigma_1| is isotropic: it has no
+major direction, so the particle links nothing (an isotropically loaded particle's computed
+direction would be round-off)."""
+
+
+def _rows(a, tail):
+    """``a`` as a C-contiguous array of rows: (R,) + its last ``tail`` axes."""
+    a = np.asarray(a)
+    return np.ascontiguousarray(a.reshape((-1,) + a.shape[a.ndim - tail:]))
+
+
+@core_dims(CONTACT, CONTACT, CONTACT, CONTACT, CONTACT_XY, CONTACT_XY, CONTACT, PARTICLE_XY,
+           out=(PARTICLE_TENSOR,))
+def particle_moments(i, j, fn, ft, normal, point, mask, position):
+    """Sum over each particle's contacts of s f (x) (x^c - x_p), N m (..., P, 2, 2).
+
+        M_p,ab = sum_{c of p} s_pc f^c_a (x^c - x_p)_b,
+
+    s_pc = +1 for body i, -1 for body j of contact c; only the slots of ``mask`` count, and only
+    the particle side of a wall contact (j >= P). ``i, j, fn, ft, mask`` (..., C),
+    ``normal, point`` (..., C, 2), ``position`` (..., P, 2). sigma_p = M_p / V_p, and
+    sum_p M_p = sum_c f (x) l.
+    """
+    lead = np.broadcast_shapes(np.shape(fn), np.shape(mask), np.shape(i))
+    n_part = np.shape(position)[-2]
+    i = _rows(np.broadcast_to(i, lead), 1).astype(np.int64)
+    j = _rows(np.broadcast_to(j, lead), 1).astype(np.int64)
+    mask = _rows(np.broadcast_to(mask, lead), 1).astype(bool)
+    force = _rows(force_vectors(np.broadcast_to(fn, lead), np.broadcast_to(ft, lead),
+                                np.broadcast_to(normal, lead + (2,))), 2)
+    point = _rows(np.broadcast_to(point, lead + (2,)), 2)
+    position = _rows(np.broadcast_to(position, lead[:-1] + np.shape(position)[-2:]), 2)
+    n_rows = i.shape[0]
+    row = np.arange(n_rows)[:, None]
+    moments = np.zeros((n_rows * n_part, 4))
+    for body, sign in ((i, 1.0), (j, -1.0)):
+        use = mask & (body >= 0) & (body < n_part)
+        safe = np.where(use, body, 0)
+        arm = point - position[row, safe]
+        where = (row * n_part + safe)[use]
+        f, r = force[use], arm[use]
+        for k, (a, b) in enumerate(((0, 0), (0, 1), (1, 0), (1, 1))):
+            moments[:, k] += sign * np.bincount(where, weights=f[:, a] * r[:, b], minlength=n_rows * n_part)
+    return moments.reshape(lead[:-1] + (n_part, 2, 2))
+
+
+def chain_particles(sigma_1, sigma_2):
+    """Boolean (..., P): sigma_1 above the mean of sigma_1 over the last axis, with a major
+    direction (sigma_1 - sigma_2 > :data:`ISOTROPY_TOLERANCE` |sigma_1|)."""
+    sigma_1 = np.asarray(sigma_1, float)
+    anisotropic = (sigma_1 - np.asarray(sigma_2, float)) > ISOTROPY_TOLERANCE * np.abs(sigma_1)
+    return (sigma_1 > sigma_1.mean(-1, keepdims=True)) & anisotropic
+
+
+def chain_links(i, j, branch, mask, candidate, theta_1, angle):
+    """Boolean (..., C): the slots of ``mask`` between two particles of ``candidate`` (..., P)
+    whose branch vector lies within ``angle`` (degrees) of both particles' major directions
+    ``theta_1`` (..., P, rad): |cos(phi_l - theta_1)| >= cos(angle), phi_l the branch's angle."""
+    n_part = np.shape(candidate)[-1]
+    i = np.asarray(i)
+    j = np.asarray(j)
+    pair = np.asarray(mask, bool) & (i >= 0) & (j >= 0) & (j < n_part) & (i < n_part)
+    si = np.where(pair, i, 0)
+    sj = np.where(pair, j, 0)
+    both = pair & np.take_along_axis(candidate, si, -1) & np.take_along_axis(candidate, sj, -1)
+    length = np.hypot(branch[..., 0], branch[..., 1])
+    with np.errstate(invalid="ignore", divide="ignore"):
+        ux, uy = branch[..., 0] / length, branch[..., 1] / length
+    limit = np.cos(np.deg2rad(angle))
+    aligned = both & (length > 0)
+    for s in (si, sj):
+        theta = np.take_along_axis(theta_1, s, -1)
+        aligned &= np.abs(ux * np.cos(theta) + uy * np.sin(theta)) >= limit
+    return aligned
+
+
+def components(i, j, link, n_particles, min_size=3):
+    """Chain id (..., P) of each particle: the connected sets of the ``link`` graph of at least
+    ``min_size`` particles, numbered 0, 1, ... per snapshot in the order of their smallest
+    particle index; -1 outside (:func:`grainview._kernels.force_chains.label_components`)."""
+    link = np.asarray(link, bool)
+    lead = link.shape[:-1]
+    i = _rows(np.broadcast_to(i, link.shape), 1).astype(np.int64)
+    j = _rows(np.broadcast_to(j, link.shape), 1).astype(np.int64)
+    flat = _rows(link, 1)
+    ends = np.concatenate([i[flat], j[flat]])
+    if ends.size and (ends.min() < 0 or ends.max() >= n_particles):
+        raise ValueError(f"a linked contact names a body outside the particles 0 .. {n_particles - 1}")
+    return label_components(i, j, flat, int(n_particles), int(min_size)).reshape(lead + (n_particles,))
+
+
+def chain_sizes(chain):
+    """Number of particles (..., P) of chain k at index k (0 beyond the snapshot's chains)."""
+    chain = np.asarray(chain)
+    n_part = chain.shape[-1]
+    rows = _rows(chain, 1)
+    where = (np.arange(rows.shape[0])[:, None] * n_part + rows)[rows >= 0]
+    return np.bincount(where, minlength=rows.size).reshape(chain.shape)
+
+
+@core_dims(CONTACT, CONTACT, CONTACT, CONTACT, CONTACT_XY, CONTACT_XY, CONTACT_XY, CONTACT, PARTICLE_XY, PARTICLE,
+           out=(PARTICLE, CONTACT, PARTICLE, PARTICLE, PARTICLE, SCALAR, LENGTH, SCALAR, SCALAR, SCALAR, SCALAR))
+def force_chains(i, j, fn, ft, normal, point, branch, mask, position, volume, angle=45.0, min_size=3,
+                 max_length=50):
+    """Force chains of every snapshot and their statistics (module docstring, steps 1-5).
+
+    ``i, j, fn, ft, mask`` (..., C), ``normal, point, branch`` (..., C, 2), ``position``
+    (..., P, 2) m, ``volume`` (..., P) m^3; ``angle`` in degrees. Returns, per snapshot:
+
+    * ``chain`` (..., P): chain id, -1 outside chains;
+    * ``link`` (..., C): the contacts linking two particles of the same chain;
+    * ``sigma_1``, ``sigma_2`` (..., P): principal stresses of each particle, Pa;
+    * ``theta_1`` (..., P): its major direction in [0, pi), rad (NaN when isotropic);
+    * ``n_chains`` (...);
+    * ``length_count`` (..., L): chains of ``min_size``, ..., ``max_length`` particles, the last
+      bin counting every chain of ``max_length`` particles or more;
+    * ``orientation`` (...): mean orientation of the chains' links, the axial mean
+      phi = (1/2) atan2(sum sin 2 phi_l, sum cos 2 phi_l) in [0, pi), rad (NaN without chains);
+    * ``particle_fraction`` (...): particles in chains / P;
+    * ``deviator_fraction`` (...): the share of the deviatoric stress carried by the chains,
+      (D_chains : D)/(D : D), D = dev(sum_p V_p sigma_p) over all particles and D_chains the
+      same sum over the chain particles (equal to q_chains/q when both deviators are
+      aligned; the chains and the other particles add up to 1); 0 without chains, NaN for an
+      isotropic sample stress;
+    * ``pressure_fraction`` (...): tr(sum_chains V_p sigma_p)/tr(sum_p V_p sigma_p).
+    """
+    moments = particle_moments(i, j, fn, ft, normal, point, mask, position)
+    volume = np.asarray(volume, float)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        stress = moments / volume[..., None, None]
+    sigma_1, sigma_2, theta_1 = principal(stress)
+    candidate = chain_particles(sigma_1, sigma_2)
+    theta_1 = np.where((sigma_1 - sigma_2) > ISOTROPY_TOLERANCE * np.abs(sigma_1), theta_1, np.nan)
+    branch = np.asarray(branch, float)
+    links = chain_links(i, j, branch, mask, candidate, np.nan_to_num(theta_1), angle)
+    n_part = np.shape(position)[-2]
+    chain = components(np.broadcast_to(i, links.shape), np.broadcast_to(j, links.shape), links, n_part, min_size)
+    member = chain >= 0
+    si = np.where(links, np.asarray(i), 0)
+    link = links & (np.take_along_axis(chain, si, -1) >= 0)
+
+    sizes = chain_sizes(chain)
+    n_chains = (sizes > 0).sum(-1)
+    n_bins = max_length - min_size + 1
+    binned = np.clip(sizes, 0, max_length) - min_size
+    rows = _rows(binned, 1)
+    where = (np.arange(rows.shape[0])[:, None] * n_bins + rows)[rows >= 0]
+    length_count = np.bincount(where, minlength=rows.shape[0] * n_bins).reshape(sizes.shape[:-1] + (n_bins,))
+
+    phi = 2.0 * np.arctan2(branch[..., 1], branch[..., 0])
+    s = np.where(link, np.sin(phi), 0.0).sum(-1)
+    c = np.where(link, np.cos(phi), 0.0).sum(-1)
+    orientation = np.where(link.any(-1), np.mod(0.5 * np.arctan2(s, c), np.pi), np.nan)
+
+    symmetric = 0.5 * (moments + np.swapaxes(moments, -1, -2))
+    total = symmetric.sum(-3)
+    in_chains = np.where(member[..., None, None], symmetric, 0.0).sum(-3)
+    eye = np.eye(2)
+    dev_total = total - 0.5 * np.trace(total, axis1=-2, axis2=-1)[..., None, None] * eye
+    dev_chains = in_chains - 0.5 * np.trace(in_chains, axis1=-2, axis2=-1)[..., None, None] * eye
+    norm = (dev_total * dev_total).sum((-2, -1))
+    share = (dev_chains * dev_total).sum((-2, -1))
+    with np.errstate(invalid="ignore", divide="ignore"):
+        deviator_fraction = np.where(member.any(-1), share / np.where(norm > 0, norm, np.nan), 0.0)
+        pressure = np.trace(total, axis1=-2, axis2=-1)
+        pressure_fraction = np.where(member.any(-1),
+                                     np.trace(in_chains, axis1=-2, axis2=-1) / np.where(pressure != 0, pressure, np.nan),
+                                     0.0)
+    particle_fraction = member.mean(-1)
+    return (chain, link, sigma_1, sigma_2, theta_1, n_chains, length_count, orientation, particle_fraction,
+            deviator_fraction, pressure_fraction)
+
+
+def follow_chains(chain):
+    """Chains followed from snapshot to snapshot by their shared members.
+
+    Chain a of snapshot t-1 continues as chain b of snapshot t when they share particles and
+    each is the other's best match (b shares more of a's members than any other chain of t, and
+    a more of b's than any other chain of t-1; ties go to the smaller id). Every other chain
+    starts a new track.
+
+    Parameters
+    ----------
+    chain : array_like of int, (T, P)
+        Chain ids (:func:`force_chains`), -1 outside chains.
+
+    Returns
+    -------
+    track : numpy.ndarray of int64, (T, P)
+        Track id of each particle's chain, -1 outside chains; tracks numbered in the order
+        they start.
+    first, last : numpy.ndarray of int64, (K,)
+        First and last snapshot index of each of the K tracks.
+    size : numpy.ndarray of float, (K,)
+        Mean number of particles of each track over its snapshots.
+    """
+    chain = np.asarray(chain, np.int64)
+    n_time = chain.shape[0]
+    track = np.full(chain.shape, -1, np.int64)
+    first, last, total = [], [], []
+    previous = np.zeros(0, np.int64)  # track of each chain id of the previous snapshot
+    for t in range(n_time):
+        ids = chain[t]
+        n_here = int(ids.max()) + 1 if ids.size else 0
+        mapping = np.full(max(n_here, 0), -1, np.int64)
+        if t > 0 and n_here > 0 and previous.size > 0:
+            both = (chain[t - 1] >= 0) & (ids >= 0)
+            code, shared = np.unique(chain[t - 1][both] * n_here + ids[both], return_counts=True)
+            if code.size:
+                a, b = code // n_here, code % n_here
+                best_b = np.lexsort((b, -shared, a))  # per a: most shared first, then smallest b
+                keep_a = np.r_[True, a[best_b][1:] != a[best_b][:-1]]
+                best_a = np.lexsort((a, -shared, b))
+                keep_b = np.r_[True, b[best_a][1:] != b[best_a][:-1]]
+                mutual = np.intersect1d(best_b[keep_a], best_a[keep_b])
+                mapping[b[mutual]] = previous[a[mutual]]
+        for k in np.flatnonzero(mapping < 0):
+            mapping[k] = len(first)
+            first.append(t)
+            last.append(t)
+            total.append(0)
+        sizes = np.bincount(ids[ids >= 0], minlength=n_here)
+        for k in range(n_here):
+            last[mapping[k]] = t
+            total[mapping[k]] += sizes[k]
+        track[t] = np.where(ids >= 0, mapping[np.maximum(ids, 0)] if n_here else -1, -1)
+        previous = mapping
+    first = np.asarray(first, np.int64)
+    last = np.asarray(last, np.int64)
+    size = np.asarray(total, float) / np.maximum(last - first + 1, 1)
+    return track, first, last, size
+
+
+__all__ = ["particle_moments", "chain_particles", "chain_links", "components", "chain_sizes", "force_chains",
+           "follow_chains", "ISOTROPY_TOLERANCE"]
