@@ -53,6 +53,8 @@ from .forces import (plot_angular_forces, plot_contact_proportions, plot_force_a
                      plot_strong_weak_proportion, plot_strong_weak_proportions, plot_tangential_force,
                      plot_tangential_force_polar, plot_type_transitions, plot_xi_anisotropies, plot_xi_anisotropy,
                      plot_xi_stress)
+from .chains import (animate_chains, plot_chain_fractions, plot_chain_lengths, plot_chain_lifetimes,
+                     plot_chain_map)
 from .macroscopic import (plot_harmonic_prediction, plot_partial_q_over_p, plot_q_over_p,
                           plot_stress_dilatancy, plot_volumetric_strain)
 from .movies import animate
@@ -146,12 +148,19 @@ class PlotAccessor:
     connectivity_map = _delegate(plot_connectivity_map)
     rattler_map = _delegate(plot_rattler_map)
     rotation_map = _delegate(plot_rotation_map)
+    # force chains (Peters et al. 2005; grainview.force_chains)
+    chain_map = _delegate(plot_chain_map)
+    chain_fractions = _delegate(plot_chain_fractions)
+    chain_lengths = _delegate(plot_chain_lengths)
+    chain_lifetimes = _delegate(plot_chain_lifetimes)
     # movies
     animate = _delegate(animate)
+    animate_chains = _delegate(animate_chains)
 
 
 __all__ = ["PlotAccessor", "save_figure", "FIGURES", "animate", *(f.__name__ for f in FIGURES.values()),
            "plot_particles", "plot_particle_map", "plot_connectivity_map", "plot_rattler_map", "plot_rotation_map",
            "plot_normal_force_polar", "plot_tangential_force_polar", "plot_tangential_force",
            "plot_force_anisotropy", "plot_normal_force", "plot_xi_anisotropy", "plot_strong_weak_proportion",
-           "plot_force_pdf", "plot_force_pdf_by_kind"]
+           "plot_force_pdf", "plot_force_pdf_by_kind", "plot_chain_map", "plot_chain_fractions", "plot_chain_lengths",
+           "plot_chain_lifetimes", "animate_chains"]
