@@ -152,6 +152,7 @@ class GrainAccessor:
     force_class = _Delegate("force_networks")
     contact_proportions = _Delegate("force_networks")
     xi_network = _Delegate("xi_network")
+    network_persistence = _Delegate("network_topology")
     force_chains = _Delegate("force_chains")
     # contact history (these compute, one time-chunk at a time)
     persistence = _Delegate("persistence")

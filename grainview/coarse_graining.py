@@ -1,0 +1,264 @@
+"""Coarse-grained continuum fields on a grid: density, solid fraction, momentum and velocity,
+kinetic and contact stress, fabric (Goldhirsch, Granular Matter 12, 239 (2010); Weinhart,
+Thornton, Luding & Bokhove, Granular Matter 14, 289 (2012)); their stress invariants and
+profiles across the sample (docs/analysis.md, "Coarse-grained fields").
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import xarray as xr
+
+from . import sample
+from ._lift import apply, with_attrs
+from .arrays import coarse_graining as _cg
+from .arrays.tensors import principal
+from .contacts import selection
+from .contract.errors import ParameterError
+from .contract.shapes import particle_area
+
+__all__ = ["coarse_grained", "field_invariants", "profile", "KERNELS"]
+
+KERNELS = ("gaussian",)
+"""The coarse-graining kernels: the Gaussian cut at ``cutoff`` widths and renormalised."""
+
+_FIELDS = {
+    "density": ("kg m-3", "coarse-grained density rho = (1/t) sum_i m_i phi(r - r_i)"),
+    "solid_fraction": ("1", "coarse-grained solid fraction nu = sum_i A_i phi(r - r_i)"),
+    "momentum": ("kg m-2 s-1", "coarse-grained momentum density j = (1/t) sum_i m_i v_i phi(r - r_i)"),
+    "velocity": ("m s-1", "coarse-grained velocity V = j / rho"),
+    "kinetic_stress": ("Pa", "kinetic stress (1/t) sum_i m_i v'_i (x) v'_i phi(r - r_i), v' = v - V"),
+    "contact_stress": ("Pa", "contact stress (1/t) sum_c f (x) l psi_c(r), psi_c the kernel along the branch"),
+    "fabric": ("1", "coarse-grained fabric sum_c n (x) n psi_c / sum_c psi_c"),
+}
+
+
+def _positive(value, name, unit):
+    if isinstance(value, bool) or not isinstance(value, (int, float, np.integer, np.floating)) \
+            or not np.isfinite(value) or value <= 0:
+        raise ParameterError(f"{name}={value!r}: expected a number > 0{unit}")
+    return float(value)
+
+
+def _spacing(spacing):
+    values = spacing if isinstance(spacing, (list, tuple, np.ndarray)) else (spacing, spacing)
+    if len(values) != 2:
+        raise ParameterError(f"spacing={spacing!r}: expected a grid spacing > 0 in m, or a pair (dx, dy)")
+    return tuple(_positive(v, "spacing", " in m (or a pair (dx, dy) of them)") for v in values)
+
+
+def _grid(ds, spacing, x, y):
+    """The grid's x and y coordinates (m): given, or cells of ``spacing`` covering every snapshot's box."""
+    if x is not None and y is not None:
+        if spacing is not None:
+            raise ParameterError("give either spacing= or the grid's x= and y=, not both")
+        return _cg.check_grid(x, "x"), _cg.check_grid(y, "y")
+    if spacing is None or (x is None) != (y is None):
+        raise ParameterError("the grid: expected spacing= (m), or both x= and y= (coordinates in m)")
+    dx, dy = _spacing(spacing)
+    box = xr.Dataset({"lo": ds["box_min"].min("time"), "hi": ds["box_max"].max("time")}).compute()  # one read
+    lo, hi = np.asarray(box["lo"].values, dtype=float), np.asarray(box["hi"].values, dtype=float)
+    return _cg.grid_nodes(lo[0], hi[0], dx), _cg.grid_nodes(lo[1], hi[1], dy)
+
+
+def _areas(ds: xr.Dataset) -> xr.DataArray:
+    """Each particle's area A_i (particle,), m2, from its shape (:func:`grainview.contract.shapes.particle_area`)."""
+    args, core = [ds["radius"], ds["n_vertices"]], [[], []]
+    if "vertices" in ds.variables:
+        args.append(ds["vertices"])
+        core.append(list(ds["vertices"].dims[1:]))
+    return xr.apply_ufunc(particle_area, *args, input_core_dims=core, dask="parallelized", output_dtypes=[float])
+
+
+def coarse_grained(ds: xr.Dataset, width, spacing=None, kernel: str = "gaussian", cutoff: float = 3.0,
+                   x=None, y=None) -> xr.Dataset:
+    """Coarse-grained fields of every snapshot on a regular grid (time, y, x).
+
+    Each particle is spread with a Gaussian kernel of standard deviation w = ``width``, cut at
+    c = ``cutoff`` w and renormalised to integral 1,
+    phi(r) = exp(-|r|^2/(2 w^2)) / (2 pi w^2 (1 - exp(-c^2/(2 w^2)))) (m^-2); each contact
+    along its branch vector l (from the centre of i to the centre of j; to the contact point for
+    a wall contact) with the kernel integrated exactly along it, psi_c(r) = int_0^1
+    phi(r - r_i - u l) du. With t the slab thickness (attribute ``thickness_m``):
+
+        rho     = (1/t) sum_i m_i phi            nu = sum_i A_i phi
+        j       = (1/t) sum_i m_i v_i phi        V  = j / rho
+        sigma^k = (1/t) sum_i m_i (v_i - V) (x) (v_i - V) phi
+        sigma^c = (1/t) sum_c f (x) l psi_c      F  = sum_c n (x) n psi_c / sum_c psi_c
+
+    f = f_n n + f_t t the force of i on j, so that both stresses are positive in compression
+    (docs/conventions.md §1). The contact stress integrates exactly:
+    (1/A) int sigma^c dA = (1/V) sum_c f (x) l, the Love–Weber stress of
+    :func:`grainview.stress.stress_tensor` (V = A t), and int rho dA t = sum_i m_i, where the grid
+    covers every kernel; on the grid these integrals are sums times the cell area, exact up to
+    the quadrature of the kernel by the grid (spacing well under the width: docs/analysis.md).
+    The contact stress sums every contact the file holds, wall contacts included, as
+    :func:`grainview.stress.stress_tensor`; the fabric the force-bearing particle–particle
+    contacts, as :func:`grainview.fabric.fabric_tensor`. Masses are the file's, areas those of
+    the particles' shapes (:func:`grainview.contract.shapes.particle_area`).
+
+    Parameters
+    ----------
+    ds : xarray.Dataset
+        A dataset of the contract (docs/schema.md), eager or chunked along ``time``.
+    width : float
+        Kernel width w (standard deviation of the Gaussian), m; about a particle diameter
+        resolves the packing's structure, a few diameters its continuum fields.
+    spacing : float or (float, float), optional
+        Grid spacing (dx, dy) in m: cells of that side covering the union of the snapshots' boxes,
+        nodes at their centres (reads ``box_min`` and ``box_max``). Or give ``x`` and ``y``.
+    kernel : {"gaussian"}, default "gaussian"
+        The kernel (:data:`KERNELS`).
+    cutoff : float, default 3
+        Kernel radius c in widths; the kernel is zero beyond it.
+    x, y : array_like, optional
+        The grid's coordinates in m (strictly increasing), instead of ``spacing``; nothing is
+        read to build the grid then.
+
+    Returns
+    -------
+    xarray.Dataset
+        Over (time, y, x), with coordinates ``x``, ``y`` in m: ``density`` (kg m-3),
+        ``solid_fraction`` (1), ``contact_stress`` (xy_a, xy_b; Pa), ``fabric`` (xy_a, xy_b; 1,
+        NaN where no contact reaches), and, when the file has particle velocities, ``momentum``
+        (xy; kg m-2 s-1), ``velocity`` (xy; m s-1, NaN where rho = 0) and ``kinetic_stress``
+        (xy_a, xy_b; Pa). Attributes: the kernel, its width and cutoff, the grid spacing.
+        Lazy on dask input.
+
+    Raises
+    ------
+    grainview.contract.errors.ParameterError
+        For a width, spacing or cutoff that is not a number > 0, an unknown kernel, or a grid
+        given both ways or neither.
+
+    References
+    ----------
+    Goldhirsch, Granular Matter 12, 239 (2010); Weinhart, Thornton, Luding & Bokhove,
+    Granular Matter 14, 289 (2012); docs/analysis.md, "Coarse-grained fields".
+    """
+    width = _positive(width, "width", " (kernel width in m)")
+    cutoff = _positive(cutoff, "cutoff", " (kernel radius in widths)")
+    if not isinstance(kernel, str) or kernel not in KERNELS:
+        raise ParameterError(f"kernel={kernel!r}: expected one of {', '.join(map(repr, KERNELS))}")
+    gx, gy = _grid(ds, spacing, x, y)
+    has_velocity = "velocity" in ds.variables
+    velocity = ds["velocity"] if has_velocity else xr.zeros_like(ds["position"])
+    area = _areas(ds)
+    outputs = apply(_cg.coarse_grained_fields, ds["position"], velocity, ds["mass"], area, ds["i"], ds["fn"],
+                    ds["ft"], ds["normal"], ds["branch"], selection(ds, walls=True, near=np.inf),
+                    selection(ds, walls=False), sample.thickness(ds),
+                    output_sizes={"y": gy.size, "x": gx.size},
+                    kwargs={"x": gx, "y": gy, "width": width, "cutoff": cutoff})
+    fields = {}
+    for name, da in zip(_FIELDS, outputs):
+        if name in ("momentum", "velocity", "kinetic_stress") and not has_velocity:
+            continue
+        units, long_name = _FIELDS[name]
+        fields[name] = with_attrs(da, name, units, long_name)
+    out = xr.Dataset(fields).assign_coords(
+        x=("x", gx, {"units": "m", "long_name": "grid node x"}),
+        y=("y", gy, {"units": "m", "long_name": "grid node y"}))
+    if has_velocity:
+        out = out.assign_coords(xy=ds["xy"])
+    out.attrs = {"kernel": kernel, "width_m": width, "cutoff_widths": cutoff,
+                 "spacing_m": [float(np.diff(gx).mean()) if gx.size > 1 else np.nan,
+                               float(np.diff(gy).mean()) if gy.size > 1 else np.nan],
+                 "thickness_m": sample.thickness(ds)}
+    return out
+
+
+def field_invariants(fields: xr.Dataset, stress: str = "total") -> xr.Dataset:
+    """p, q, q/p and the major direction of a coarse-grained stress field, node by node.
+
+        p = (s1 + s2)/2,    q = (s1 - s2)/2
+
+    with s1 >= s2 the principal values of the symmetric part of the stress (Pa), as
+    :func:`grainview.stress.stress_invariants` for the whole sample.
+
+    Parameters
+    ----------
+    fields : xarray.Dataset
+        The result of :func:`coarse_grained`.
+    stress : {"total", "contact", "kinetic"}, default "total"
+        Which stress: contact + kinetic (the contact stress alone when the fields have no
+        kinetic stress), or one of the two.
+
+    Returns
+    -------
+    xarray.Dataset
+        ``p``, ``q`` (Pa), ``q_over_p`` (1; NaN where p = 0) and ``theta_sigma`` (rad, in
+        [0, pi)) over (time, y, x); lazy when ``fields`` is.
+
+    Raises
+    ------
+    grainview.contract.errors.ParameterError
+        For another ``stress``, or "kinetic" of fields without velocities.
+
+    References
+    ----------
+    Azéma, Radjai, Peyroux & Saussine, Phys. Rev. E 76, 011301 (2007), Sec. III;
+    docs/conventions.md §1.
+    """
+    if stress not in ("total", "contact", "kinetic"):
+        raise ParameterError(f"stress={stress!r}: expected 'total', 'contact' or 'kinetic'")
+    if stress == "kinetic" and "kinetic_stress" not in fields:
+        raise ParameterError("stress='kinetic': these fields have no kinetic stress (the file has no velocities)")
+    sigma = {"contact": fields.get("contact_stress"), "kinetic": fields.get("kinetic_stress")}.get(stress)
+    if stress == "total":
+        sigma = fields["contact_stress"] + fields["kinetic_stress"] if "kinetic_stress" in fields \
+            else fields["contact_stress"]
+    s1, s2, theta = apply(principal, sigma)
+    p = (s1 + s2) / 2
+    q = (s1 - s2) / 2
+    with np.errstate(invalid="ignore", divide="ignore"):
+        ratio = q / p.where(p != 0)
+    return xr.Dataset({
+        "p": with_attrs(p, "p", "Pa", f"mean stress p = (s1 + s2)/2 of the {stress} stress"),
+        "q": with_attrs(q, "q", "Pa", f"stress deviator q = (s1 - s2)/2 of the {stress} stress"),
+        "q_over_p": with_attrs(ratio, "q_over_p", "1", "normalised shear stress q/p"),
+        "theta_sigma": with_attrs(theta, "theta_sigma", "rad", "major principal stress direction"),
+    }, attrs={"stress": stress})
+
+
+def profile(field: xr.DataArray, across: str = "x", inside=None) -> xr.DataArray:
+    """A field averaged along the grid's other axis: its profile across the sample along ``across``.
+
+        <g>(x) = (1/n_y) sum_y g(x, y)    (across="x")
+
+    over the nodes where ``g`` is defined (NaN skipped), optionally only those of ``inside``
+    (a boolean field, e.g. ``fields.solid_fraction > 0.5`` to leave out the boundary layer).
+    A shear band crossing the sample shows as a peak or a dip of the profile.
+
+    Parameters
+    ----------
+    field : xarray.DataArray
+        A field over (..., y, x), e.g. ``coarse_grained(...)["solid_fraction"]``.
+    across : {"x", "y"}, default "x"
+        The axis the profile runs along; the average runs over the other one.
+    inside : xarray.DataArray of bool, optional
+        The nodes averaged (broadcast against ``field``).
+
+    Returns
+    -------
+    xarray.DataArray
+        The profile over (..., across), in the field's units; lazy when ``field`` is.
+
+    Raises
+    ------
+    grainview.contract.errors.ParameterError
+        When ``across`` is not "x" or "y".
+
+    References
+    ----------
+    Weinhart, Thornton, Luding & Bokhove, Granular Matter 14, 289 (2012) (depth profiles);
+    docs/analysis.md, "Coarse-grained fields".
+    """
+    if across not in ("x", "y"):
+        raise ParameterError(f"across={across!r}: expected 'x' or 'y'")
+    other = "y" if across == "x" else "x"
+    values = field if inside is None else field.where(inside)
+    out = values.mean(other, skipna=True)
+    out.attrs = dict(field.attrs)
+    if "long_name" in out.attrs:
+        out.attrs["long_name"] = f"{out.attrs['long_name']}, averaged over {other}"
+    return out
