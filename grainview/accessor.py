@@ -164,6 +164,8 @@ class GrainAccessor:
     # one snapshot in other tools' forms
     contacts_table = _Delegate("tables")
     contact_graph = _Delegate("tables")
+    # continuum fields
+    coarse_grained = _Delegate("coarse_graining")
 
     @property
     def plot(self):
