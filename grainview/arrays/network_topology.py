@@ -1,0 +1,274 @@
+"""Topology of the force network: persistent homology of the contact graph filtered by
+decreasing normal force, its Betti curves, and its short cycles by force class.
+
+The filtration. Each contact c of the selection is an edge between its two bodies with the
+value xi_c = f_n,c / <f_n> (<f_n> the mean over the selection, the xi-network's scale). The
+complex at threshold xi holds the edges with xi_c >= xi (the complement of the xi-network
+f_n < xi <f_n>: the network stronger than xi), their nodes, and every triangle of three such
+edges (the clique, or flag, complex: a triangle enters with its weakest edge). Lowering xi
+from +inf to 0 adds edges, so features are born at a larger xi than they die; a node enters
+with its strongest contact. A feature alive at the end (xi = 0: the whole selection) has
+death = -inf. Betti curves: beta_k(xi) = #{features of dimension k : birth >= xi > death}.
+
+Dimension 0 (connected components) comes from the project's own union-find
+(:func:`grainview._kernels.network_topology.union_find_pairs`); dimension 1 (loops not filled
+by triangles) from gudhi's persistence of the flag complex (an optional dependency,
+``pip install 'grainview[topology]'``). Zero-persistence pairs (birth == death) are left out.
+
+References
+----------
+Kramár, Goullet, Kondic & Mischaikow, Phys. Rev. E 87, 042207 (2013) (persistence of force
+networks); Tordesillas, Walker & Lin, Phys. Rev. E 81, 011302 (2010) (3- and 4-cycles).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .._kernels.network_topology import cycle_counts, union_find_pairs
+from ..contract.errors import ParameterError
+from .force_pdf import mean_normal_force
+from .signature import CONTACT, core_dims
+
+FEATURE = ("feature",)
+XI = ("xi",)
+STRONG_EDGES = ("strong_edges",)
+N_STRONG_EDGES = 5
+"""Size of the ``strong_edges`` dimension: a cycle of 3 or 4 edges has 0 to 4 strong edges."""
+
+GUDHI_MISSING = ("dimension 1 of the force network's persistence needs the TDA library gudhi: "
+                 "pip install 'grainview[topology]' (dimensions=(0,) computes the rest without it)")
+
+
+def gudhi_module():
+    """The gudhi module, or a :class:`~grainview.contract.errors.ParameterError` in one line
+    saying how to install it."""
+    try:
+        import gudhi
+    except ImportError:
+        raise ParameterError(GUDHI_MISSING) from None
+    return gudhi
+
+
+def filtration_edges(fn, i, j, mask):
+    """One snapshot's graph: the selected contacts as edges sorted by decreasing value.
+
+    Parameters
+    ----------
+    fn : ndarray, shape (C,)
+        Normal forces (N).
+    i, j : ndarray of int, shape (C,)
+        The contacts' bodies.
+    mask : ndarray of bool, shape (C,)
+        The selected contacts.
+
+    Returns
+    -------
+    u, v : ndarray of int64, shape (E,)
+        The edges' endpoints (u < v), each pair once (a pair listed twice keeps its larger force).
+    value : ndarray of float64, shape (E,)
+        xi_e = f_n / <f_n> (dimensionless), <f_n> the mean over the selection; non-increasing.
+    """
+    mask = np.asarray(mask, bool)
+    if not mask.any():
+        empty = np.empty(0, np.int64)
+        return empty, empty, np.empty(0)
+    a = np.asarray(i)[mask].astype(np.int64)
+    b = np.asarray(j)[mask].astype(np.int64)
+    value = np.asarray(fn, np.float64)[mask] / mean_normal_force(fn, mask)
+    if np.any(a == b) or np.any(a < 0) or np.any(b < 0):
+        raise ParameterError("network persistence: a selected contact joins a body to itself or to a "
+                             "negative body id; expected two different bodies >= 0")
+    u, v = np.minimum(a, b), np.maximum(a, b)
+    order = np.lexsort((-value, v, u))  # by pair, the largest value first
+    u, v, value = u[order], v[order], value[order]
+    first = np.ones(u.size, bool)
+    first[1:] = (u[1:] != u[:-1]) | (v[1:] != v[:-1])
+    u, v, value = u[first], v[first], value[first]
+    order = np.argsort(-value, kind="stable")
+    return u[order], v[order], value[order]
+
+
+def _check_nodes(u, v, n_nodes):
+    if u.size and max(u.max(), v.max()) >= n_nodes:
+        raise ParameterError(f"network persistence: a contact names body {max(u.max(), v.max())}, "
+                             f"expected ids below {n_nodes} (particles and walls)")
+
+
+def diagram_0(u, v, value, n_nodes):
+    """0-dimensional diagram by the project's union-find (elder rule).
+
+    Parameters
+    ----------
+    u, v, value : ndarray
+        Edges as :func:`filtration_edges` gives them (sorted by decreasing value).
+    n_nodes : int
+        Node ids are in [0, n_nodes).
+
+    Returns
+    -------
+    birth, death : ndarray of float64
+        One pair per component's life, birth > death; death = -inf for the components of the
+        whole graph.
+    """
+    _check_nodes(u, v, n_nodes)
+    if u.size and np.any(np.diff(value) > 0):
+        raise ParameterError("network persistence: edges must be sorted by decreasing value")
+    birth, death, _ = union_find_pairs(int(n_nodes), np.ascontiguousarray(u, np.int64),
+                                       np.ascontiguousarray(v, np.int64), np.ascontiguousarray(value, np.float64))
+    return birth, death
+
+
+def diagrams_gudhi(u, v, value, n_nodes):
+    """0- and 1-dimensional diagrams of the flag complex by gudhi (the filtration negated, as
+    gudhi's filtrations increase).
+
+    Parameters
+    ----------
+    u, v, value : ndarray
+        Edges as :func:`filtration_edges` gives them.
+    n_nodes : int
+        Node ids are in [0, n_nodes).
+
+    Returns
+    -------
+    dict
+        ``{0: (birth, death), 1: (birth, death)}`` in xi, death = -inf for a feature that never
+        dies; zero-persistence pairs left out.
+    """
+    gudhi = gudhi_module()
+    _check_nodes(u, v, n_nodes)
+    out = {0: (np.empty(0), np.empty(0)), 1: (np.empty(0), np.empty(0))}
+    if u.size == 0:
+        return out
+    node_birth = np.full(int(n_nodes), -np.inf)
+    np.maximum.at(node_birth, u, value)
+    np.maximum.at(node_birth, v, value)
+    nodes = np.flatnonzero(np.isfinite(node_birth))
+    tree = gudhi.SimplexTree()
+    tree.insert_batch(nodes[None, :], -node_birth[nodes])
+    tree.insert_batch(np.stack([u, v]), -np.asarray(value, float))
+    tree.expansion(2)
+    tree.compute_persistence(homology_coeff_field=2, min_persistence=0.0, persistence_dim_max=True)
+    for dim in (0, 1):
+        pairs = np.asarray(tree.persistence_intervals_in_dimension(dim), float).reshape(-1, 2)
+        out[dim] = (-pairs[:, 0], -pairs[:, 1])
+    return out
+
+
+def betti_curve(birth, death, xi):
+    """beta(xi) = #{features : birth >= xi > death} at each threshold of ``xi`` (K,).
+
+    Parameters
+    ----------
+    birth, death : ndarray of float
+        One dimension's diagram (birth >= death).
+    xi : ndarray of float, shape (K,)
+        Thresholds (dimensionless).
+
+    Returns
+    -------
+    ndarray of int64, shape (K,)
+    """
+    xi = np.asarray(xi, float)
+    born = np.sort(np.asarray(birth, float))
+    dead = np.sort(np.asarray(death, float))
+    # birth >= xi counts born.size - #{birth < xi}; death >= xi implies birth >= xi
+    return (np.searchsorted(dead, xi, side="left") - np.searchsorted(born, xi, side="left")).astype(np.int64)
+
+
+def short_cycles(u, v, value, n_nodes, strong=1.0):
+    """Counts of the 3-cycles and the chordless 4-cycles by their number of strong edges.
+
+    An edge is strong when xi_e >= ``strong`` (f_n >= strong <f_n>; ``strong=1``: the strong
+    network of Radjai et al., the complement of the xi-network at xi = 1).
+
+    Parameters
+    ----------
+    u, v, value : ndarray
+        Edges as :func:`filtration_edges` gives them.
+    n_nodes : int
+        Node ids are in [0, n_nodes).
+    strong : float, default 1
+        The strong-force threshold in units of <f_n>.
+
+    Returns
+    -------
+    triangles, squares : ndarray of int64, shape (5,)
+        Element k: the cycles with k strong edges (``triangles[4]`` is 0).
+    """
+    _check_nodes(u, v, n_nodes)
+    triangles, squares = cycle_counts(int(n_nodes), np.ascontiguousarray(u, np.int64),
+                                      np.ascontiguousarray(v, np.int64),
+                                      (np.asarray(value) >= strong).astype(np.int64))
+    return np.concatenate([triangles, [0]]), squares
+
+
+@core_dims(CONTACT, CONTACT, CONTACT, CONTACT, out=(FEATURE, FEATURE, FEATURE, XI, XI, STRONG_EDGES, STRONG_EDGES))
+def network_persistence(fn, i, j, mask, xi, n_nodes, n_features, strong=1.0, dimension_1=True):
+    """Persistence diagrams, Betti curves and short cycles of each snapshot's force network.
+
+    Parameters
+    ----------
+    fn : ndarray, shape (..., C)
+        Normal forces (N), f_n > 0 compressive.
+    i, j : ndarray of int, shape (..., C)
+        The contacts' bodies (particles 0..N-1, walls N + w).
+    mask : ndarray of bool, shape (..., C)
+        The contacts of the network.
+    xi : ndarray, shape (K,)
+        Thresholds of the Betti curves, in units of <f_n>.
+    n_nodes : int
+        Body ids are in [0, n_nodes).
+    n_features : int
+        Length of the padded ``feature`` axis; the most persistent features are kept.
+    strong : float, default 1
+        Strong-force threshold of the cycle counts, in units of <f_n>.
+    dimension_1 : bool, default True
+        Compute the 1-dimensional diagram (needs gudhi); otherwise it is empty and beta_1 = -1.
+
+    Returns
+    -------
+    birth, death : ndarray of float64, shape (..., n_features)
+        In units of <f_n>; death = -inf for a feature that never dies; NaN padding. Features
+        in decreasing persistence birth - death (the never-dying first), then by dimension.
+    dimension : ndarray of int8, shape (..., n_features)
+        0 or 1; -1 in the padding.
+    beta_0, beta_1 : ndarray of int64, shape (..., K)
+        Betti curves.
+    triangles, squares : ndarray of int64, shape (..., 5)
+        3-cycles and chordless 4-cycles with k = 0..4 strong edges.
+    """
+    if dimension_1:
+        gudhi_module()
+    fn = np.asarray(fn)
+    lead = fn.shape[:-1]
+    flat = [np.asarray(a).reshape(-1, fn.shape[-1]) for a in (fn, i, j, mask)]
+    rows = flat[0].shape[0]
+    xi = np.asarray(xi, float)
+    birth = np.full((rows, n_features), np.nan)
+    death = np.full((rows, n_features), np.nan)
+    dimension = np.full((rows, n_features), -1, np.int8)
+    beta = np.full((2, rows, xi.size), -1, np.int64)
+    triangles = np.zeros((rows, N_STRONG_EDGES), np.int64)
+    squares = np.zeros((rows, N_STRONG_EDGES), np.int64)
+    for r in range(rows):
+        u, v, value = filtration_edges(*(a[r] for a in flat))
+        diagrams = {0: diagram_0(u, v, value, n_nodes)}
+        if dimension_1:
+            diagrams[1] = diagrams_gudhi(u, v, value, n_nodes)[1]
+        for dim, (b, d) in diagrams.items():
+            beta[dim, r] = betti_curve(b, d, xi)
+        b = np.concatenate([diagrams[dim][0] for dim in diagrams])
+        d = np.concatenate([diagrams[dim][1] for dim in diagrams])
+        k = np.concatenate([np.full(diagrams[dim][0].size, dim, np.int8) for dim in diagrams])
+        order = np.lexsort((-b, k, -(b - d)))[:n_features]
+        birth[r, :order.size], death[r, :order.size], dimension[r, :order.size] = b[order], d[order], k[order]
+        triangles[r], squares[r] = short_cycles(u, v, value, n_nodes, strong)
+    shape = lambda a: a.reshape(lead + a.shape[1:])  # noqa: E731
+    return (shape(birth), shape(death), shape(dimension), shape(beta[0]), shape(beta[1]), shape(triangles),
+            shape(squares))
+
+
+__all__ = ["filtration_edges", "diagram_0", "diagrams_gudhi", "betti_curve", "short_cycles",
+           "network_persistence", "gudhi_module", "FEATURE", "XI", "STRONG_EDGES"]
