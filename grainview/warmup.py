@@ -102,12 +102,13 @@ def _stages(folder):
         with open_dataset(Path(folder) / "pentagon.nc") as ds:
             ds.grain.xi_network().compute()
             ds.grain.coarse_grained(width=0.05, spacing=0.05).compute()
+            ds.grain.network_persistence(dimensions=(0,)).compute()
 
     return [("solver: pentagon steps (plain, Anderson, shuffled, stall test, 2 domains)", solver_shape("pentagon")),
             ("solver: disk steps (plain, Anderson, shuffled, stall test, 2 domains)", solver_shape("disk")),
             ("solver: a written biaxial test and its residuals", written),
             ("solver: a contact problem given as a matrix", matrix),
-            ("analysis: the xi-network, the coarse-grained fields", analysis)]
+            ("analysis: the xi-network, the coarse-grained fields, the network's topology", analysis)]
 
 
 def warm_up(log=print) -> dict:
