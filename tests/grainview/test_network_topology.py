@@ -294,3 +294,35 @@ def test_dimension_0_needs_no_gudhi_and_dimension_1_says_so(monkeypatch):
 def test_bad_arguments(kwargs, match):
     with pytest.raises(ParameterError, match=match):
         network_persistence(hand_made(), **{"dimensions": (0,), **kwargs})
+
+
+# ---------------------------------------------------------------- figures
+
+
+def test_figures_draw_the_analysis_with_labelled_axes():
+    pytest.importorskip("gudhi")
+    import matplotlib.pyplot as plt
+
+    from grainview.plot.topology import (plot_betti_curves, plot_cycle_counts, plot_network_topology,
+                                         plot_persistence_diagram)
+
+    ds = builders.square_lattice(4, 3, 2.0, 5.0)  # 12 particles; diagram: 4 components, 6 loops
+    result = network_persistence(ds)
+    ax = plot_persistence_diagram(ds, label="lattice")
+    points = [c.get_offsets() for c in ax.collections]
+    assert [len(p) for p in points] == [4, 6]
+    never = ax.get_lines()[1].get_ydata()[0]  # the "never" line, below zero
+    assert never < 0 and sorted(points[0][:, 1]) == pytest.approx([never] + [2 / (58 / 17)] * 3)
+    assert "birth" in ax.get_xlabel() and r"\langle f_n\rangle" in ax.get_ylabel()
+    ax = plot_betti_curves({"lattice": ds})
+    beta_1 = [line for line in ax.get_lines() if "beta_1" in line.get_label()][0]
+    np.testing.assert_allclose(beta_1.get_ydata(), result.beta_1.values[0] / 12)
+    assert ax.get_xlabel() == r"$\xi = f_n/\langle f_n\rangle$" and "per particle" in ax.get_ylabel()
+    ax = plot_cycle_counts(ds, label="lattice")
+    heights = [patch.get_height() for patch in ax.patches]
+    assert heights[5:] == pytest.approx([0, 0, 0.5, 0, 0])  # 6 squares, 2 strong edges each, over 12 particles
+    with pytest.raises(ParameterError, match="per_particle"):
+        plot_cycle_counts(result)
+    fig = plot_network_topology({"a": ds, "b": ds})
+    assert len(fig.axes) == 3 and all(a.get_xlabel() and a.get_ylabel() for a in fig.axes)
+    plt.close("all")
