@@ -17,7 +17,8 @@ from .contacts import selection
 from .contract.errors import ParameterError
 from .contract.shapes import particle_area
 
-__all__ = ["coarse_grained", "field_invariants", "profile", "KERNELS"]
+__all__ = ["coarse_grained", "field_invariants", "scalar_field", "interior", "profile", "mean_diameter", "KERNELS",
+           "QUANTITIES"]
 
 KERNELS = ("gaussian",)
 """The coarse-graining kernels: the Gaussian cut at ``cutoff`` widths and renormalised."""
@@ -53,7 +54,7 @@ def _grid(ds, spacing, x, y):
         if spacing is not None:
             raise ParameterError("give either spacing= or the grid's x= and y=, not both")
         return _cg.check_grid(x, "x"), _cg.check_grid(y, "y")
-    if spacing is None or (x is None) != (y is None):
+    if (x is None) != (y is None):
         raise ParameterError("the grid: expected spacing= (m), or both x= and y= (coordinates in m)")
     dx, dy = _spacing(spacing)
     box = xr.Dataset({"lo": ds["box_min"].min("time"), "hi": ds["box_max"].max("time")}).compute()  # one read
@@ -70,7 +71,23 @@ def _areas(ds: xr.Dataset) -> xr.DataArray:
     return xr.apply_ufunc(particle_area, *args, input_core_dims=core, dask="parallelized", output_dtypes=[float])
 
 
-def coarse_grained(ds: xr.Dataset, width, spacing=None, kernel: str = "gaussian", cutoff: float = 3.0,
+def mean_diameter(ds: xr.Dataset) -> float:
+    """The particles' mean diameter 2 <R> (m), R the circumscribed radius: the default kernel width.
+
+    Parameters
+    ----------
+    ds : xarray.Dataset
+        A dataset of the contract.
+
+    Returns
+    -------
+    float
+        2 <R>, m.
+    """
+    return 2.0 * float(ds["radius"].mean())
+
+
+def coarse_grained(ds: xr.Dataset, width=None, spacing=None, kernel: str = "gaussian", cutoff: float = 3.0,
                    x=None, y=None) -> xr.Dataset:
     """Coarse-grained fields of every snapshot on a regular grid (time, y, x).
 
@@ -101,12 +118,14 @@ def coarse_grained(ds: xr.Dataset, width, spacing=None, kernel: str = "gaussian"
     ----------
     ds : xarray.Dataset
         A dataset of the contract (docs/schema.md), eager or chunked along ``time``.
-    width : float
+    width : float, optional
         Kernel width w (standard deviation of the Gaussian), m; about a particle diameter
-        resolves the packing's structure, a few diameters its continuum fields.
+        resolves the packing's structure, a few diameters its continuum fields. Default: the
+        mean particle diameter (:func:`mean_diameter`).
     spacing : float or (float, float), optional
         Grid spacing (dx, dy) in m: cells of that side covering the union of the snapshots' boxes,
-        nodes at their centres (reads ``box_min`` and ``box_max``). Or give ``x`` and ``y``.
+        nodes at their centres (reads ``box_min`` and ``box_max``). Default w/2. Or give ``x``
+        and ``y``.
     kernel : {"gaussian"}, default "gaussian"
         The kernel (:data:`KERNELS`).
     cutoff : float, default 3
@@ -122,8 +141,9 @@ def coarse_grained(ds: xr.Dataset, width, spacing=None, kernel: str = "gaussian"
         ``solid_fraction`` (1), ``contact_stress`` (xy_a, xy_b; Pa), ``fabric`` (xy_a, xy_b; 1,
         NaN where no contact reaches), and, when the file has particle velocities, ``momentum``
         (xy; kg m-2 s-1), ``velocity`` (xy; m s-1, NaN where rho = 0) and ``kinetic_stress``
-        (xy_a, xy_b; Pa). Attributes: the kernel, its width and cutoff, the grid spacing.
-        Lazy on dask input.
+        (xy_a, xy_b; Pa). The snapshots' boxes as coordinates ``box_min``, ``box_max`` (time,
+        xy; m). Attributes: the kernel, its width and cutoff, the grid spacing. Lazy on dask
+        input.
 
     Raises
     ------
@@ -136,7 +156,9 @@ def coarse_grained(ds: xr.Dataset, width, spacing=None, kernel: str = "gaussian"
     Goldhirsch, Granular Matter 12, 239 (2010); Weinhart, Thornton, Luding & Bokhove,
     Granular Matter 14, 289 (2012); docs/analysis.md, "Coarse-grained fields".
     """
-    width = _positive(width, "width", " (kernel width in m)")
+    width = mean_diameter(ds) if width is None else _positive(width, "width", " (kernel width in m)")
+    if spacing is None and x is None and y is None:
+        spacing = width / 2
     cutoff = _positive(cutoff, "cutoff", " (kernel radius in widths)")
     if not isinstance(kernel, str) or kernel not in KERNELS:
         raise ParameterError(f"kernel={kernel!r}: expected one of {', '.join(map(repr, KERNELS))}")
@@ -158,13 +180,25 @@ def coarse_grained(ds: xr.Dataset, width, spacing=None, kernel: str = "gaussian"
     out = xr.Dataset(fields).assign_coords(
         x=("x", gx, {"units": "m", "long_name": "grid node x"}),
         y=("y", gy, {"units": "m", "long_name": "grid node y"}))
-    if has_velocity:
-        out = out.assign_coords(xy=ds["xy"])
+    out = out.assign_coords(xy=ds["xy"], box_min=ds["box_min"], box_max=ds["box_max"])
     out.attrs = {"kernel": kernel, "width_m": width, "cutoff_widths": cutoff,
                  "spacing_m": [float(np.diff(gx).mean()) if gx.size > 1 else np.nan,
                                float(np.diff(gy).mean()) if gy.size > 1 else np.nan],
                  "thickness_m": sample.thickness(ds)}
     return out
+
+
+def _stress_of(fields: xr.Dataset, stress: str) -> xr.DataArray:
+    """The stress tensor field named by ``stress`` (see :func:`field_invariants`), Pa."""
+    if stress not in ("total", "contact", "kinetic"):
+        raise ParameterError(f"stress={stress!r}: expected 'total', 'contact' or 'kinetic'")
+    if stress == "kinetic" and "kinetic_stress" not in fields:
+        raise ParameterError("stress='kinetic': these fields have no kinetic stress (the file has no velocities)")
+    if stress == "contact" or (stress == "total" and "kinetic_stress" not in fields):
+        return fields["contact_stress"]
+    if stress == "kinetic":
+        return fields["kinetic_stress"]
+    return fields["contact_stress"] + fields["kinetic_stress"]
 
 
 def field_invariants(fields: xr.Dataset, stress: str = "total") -> xr.Dataset:
@@ -199,14 +233,7 @@ def field_invariants(fields: xr.Dataset, stress: str = "total") -> xr.Dataset:
     Azéma, Radjai, Peyroux & Saussine, Phys. Rev. E 76, 011301 (2007), Sec. III;
     docs/conventions.md §1.
     """
-    if stress not in ("total", "contact", "kinetic"):
-        raise ParameterError(f"stress={stress!r}: expected 'total', 'contact' or 'kinetic'")
-    if stress == "kinetic" and "kinetic_stress" not in fields:
-        raise ParameterError("stress='kinetic': these fields have no kinetic stress (the file has no velocities)")
-    sigma = {"contact": fields.get("contact_stress"), "kinetic": fields.get("kinetic_stress")}.get(stress)
-    if stress == "total":
-        sigma = fields["contact_stress"] + fields["kinetic_stress"] if "kinetic_stress" in fields \
-            else fields["contact_stress"]
+    sigma = _stress_of(fields, stress)
     s1, s2, theta = apply(principal, sigma)
     p = (s1 + s2) / 2
     q = (s1 - s2) / 2
@@ -218,6 +245,119 @@ def field_invariants(fields: xr.Dataset, stress: str = "total") -> xr.Dataset:
         "q_over_p": with_attrs(ratio, "q_over_p", "1", "normalised shear stress q/p"),
         "theta_sigma": with_attrs(theta, "theta_sigma", "rad", "major principal stress direction"),
     }, attrs={"stress": stress})
+
+
+QUANTITIES = {
+    "sigma_xx": ("Pa", "sigma_xx", "normal stress sigma_xx"),
+    "sigma_yy": ("Pa", "sigma_yy", "normal stress sigma_yy"),
+    "sigma_xy": ("Pa", "sigma_xy", "shear stress (sigma_xy + sigma_yx)/2"),
+    "p": ("Pa", "p", "mean stress p = (s1 + s2)/2"),
+    "q": ("Pa", "q", "stress deviator q = (s1 - s2)/2"),
+    "q_over_p": ("1", "q/p", "normalised shear stress q/p"),
+    "solid_fraction": ("1", "nu", "solid fraction"),
+    "density": ("kg m-3", "rho", "density"),
+    "speed": ("m s-1", "|V|", "speed of the coarse-grained velocity |V|"),
+    "fabric_anisotropy": ("1", "a", "fabric anisotropy a = 2 (F_1 - F_2)"),
+    "shear_rate": ("s-1", "gamma_dot", "shear rate sqrt((dVx/dx - dVy/dy)^2 + (dVx/dy + dVy/dx)^2)"),
+}
+"""The scalar fields :func:`scalar_field` derives: name -> (units, symbol, long name)."""
+
+
+def scalar_field(fields: xr.Dataset, name: str, stress: str = "total") -> xr.DataArray:
+    """One scalar field (time, y, x) of the coarse-grained fields, by name (:data:`QUANTITIES`).
+
+        sigma_xx, sigma_yy, sigma_xy = (sigma_xy + sigma_yx)/2,  p, q, q/p (:func:`field_invariants`),
+        solid_fraction nu,  density rho,  speed |V|,  fabric anisotropy a = 2 (F_1 - F_2),
+        shear rate gamma_dot = sqrt((dV_x/dx - dV_y/dy)^2 + (dV_x/dy + dV_y/dx)^2)
+
+    gamma_dot (s-1) is twice the largest shear rate of the symmetric velocity gradient, by
+    central differences on the grid (:meth:`xarray.DataArray.differentiate`): shear bands show
+    as its ridges.
+
+    the stresses of ``stress`` (contact + kinetic by default), in Pa.
+
+    Parameters
+    ----------
+    fields : xarray.Dataset
+        The result of :func:`coarse_grained`.
+    name : str
+        One of :data:`QUANTITIES`.
+    stress : {"total", "contact", "kinetic"}, default "total"
+        Which stress the stress quantities are of (:func:`field_invariants`).
+
+    Returns
+    -------
+    xarray.DataArray
+        The field, named ``name``, with its ``units`` and ``long_name``; lazy when ``fields`` is.
+
+    Raises
+    ------
+    grainview.contract.errors.ParameterError
+        For an unknown ``name``, or ``speed`` or ``shear_rate`` of fields without velocities.
+
+    References
+    ----------
+    Weinhart, Thornton, Luding & Bokhove, Granular Matter 14, 289 (2012); docs/conventions.md §1-2.
+    """
+    if name not in QUANTITIES:
+        raise ParameterError(f"name={name!r}: expected one of {', '.join(QUANTITIES)}")
+    units, _, long_name = QUANTITIES[name]
+    if name in ("p", "q", "q_over_p"):
+        da = field_invariants(fields, stress)[name]
+    elif name.startswith("sigma_"):
+        sigma = _stress_of(fields, stress)
+        a, b = {"sigma_xx": ("x", "x"), "sigma_yy": ("y", "y"), "sigma_xy": ("x", "y")}[name]
+        da = 0.5 * (sigma.sel(xy_a=a, xy_b=b, drop=True) + sigma.sel(xy_a=b, xy_b=a, drop=True))
+        long_name = f"{long_name} of the {stress} stress"
+    elif name in ("speed", "shear_rate"):
+        if "velocity" not in fields:
+            raise ParameterError(f"name={name!r}: these fields have no velocity (the file has no velocities)")
+        vx, vy = fields["velocity"].sel(xy="x", drop=True), fields["velocity"].sel(xy="y", drop=True)
+        if name == "speed":
+            da = np.hypot(vx, vy)
+        else:
+            da = np.hypot(vx.differentiate("x") - vy.differentiate("y"), vx.differentiate("y") + vy.differentiate("x"))
+    elif name == "fabric_anisotropy":
+        f1, f2, _ = apply(principal, fields["fabric"])
+        da = 2 * (f1 - f2)
+    else:
+        da = fields[name]
+    return with_attrs(da, name, units, long_name)
+
+
+def interior(fields: xr.Dataset, margin: float | None = None) -> xr.DataArray:
+    """Boolean (time, y, x): the grid nodes at least ``margin`` inside each snapshot's box.
+
+        box_min + margin <= (x, y) <= box_max - margin
+
+    Within a few kernel widths of the walls the fields fall off (the kernel reaches past the
+    packing: 2.3% of it at two widths), so profiles and averages of the bulk leave that layer out.
+
+    Parameters
+    ----------
+    fields : xarray.Dataset
+        The result of :func:`coarse_grained` (its ``box_min``, ``box_max`` coordinates).
+    margin : float, optional
+        Distance from the box's edges, m; default two kernel widths.
+
+    Returns
+    -------
+    xarray.DataArray
+        Boolean (time, y, x); lazy when ``fields`` is.
+
+    Raises
+    ------
+    grainview.contract.errors.ParameterError
+        When ``margin`` is not a number >= 0.
+    """
+    margin = 2 * fields.attrs["width_m"] if margin is None else margin
+    if isinstance(margin, bool) or not isinstance(margin, (int, float, np.integer, np.floating)) \
+            or not np.isfinite(margin) or margin < 0:
+        raise ParameterError(f"margin={margin!r}: expected a distance >= 0 in m")
+    lo, hi = fields["box_min"] + margin, fields["box_max"] - margin
+    inside = ((fields["x"] >= lo.sel(xy="x", drop=True)) & (fields["x"] <= hi.sel(xy="x", drop=True))
+              & (fields["y"] >= lo.sel(xy="y", drop=True)) & (fields["y"] <= hi.sel(xy="y", drop=True)))
+    return inside.transpose(..., "y", "x").rename("interior")
 
 
 def profile(field: xr.DataArray, across: str = "x", inside=None) -> xr.DataArray:

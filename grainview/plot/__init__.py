@@ -55,6 +55,7 @@ from .forces import (plot_angular_forces, plot_contact_proportions, plot_force_a
                      plot_xi_stress)
 from .chains import (animate_chains, plot_chain_fractions, plot_chain_lengths, plot_chain_lifetimes,
                      plot_chain_map)
+from .fields import plot_field_maps, plot_field_profiles
 from .macroscopic import (plot_harmonic_prediction, plot_partial_q_over_p, plot_q_over_p,
                           plot_stress_dilatancy, plot_volumetric_strain)
 from .movies import animate
@@ -153,6 +154,9 @@ class PlotAccessor:
     chain_fractions = _delegate(plot_chain_fractions)
     chain_lengths = _delegate(plot_chain_lengths)
     chain_lifetimes = _delegate(plot_chain_lifetimes)
+    # coarse-grained fields (grainview.coarse_graining)
+    field_maps = _delegate(plot_field_maps)
+    field_profiles = _delegate(plot_field_profiles)
     # movies
     animate = _delegate(animate)
     animate_chains = _delegate(animate_chains)
@@ -163,4 +167,4 @@ __all__ = ["PlotAccessor", "save_figure", "FIGURES", "animate", *(f.__name__ for
            "plot_normal_force_polar", "plot_tangential_force_polar", "plot_tangential_force",
            "plot_force_anisotropy", "plot_normal_force", "plot_xi_anisotropy", "plot_strong_weak_proportion",
            "plot_force_pdf", "plot_force_pdf_by_kind", "plot_chain_map", "plot_chain_fractions", "plot_chain_lengths",
-           "plot_chain_lifetimes", "animate_chains"]
+           "plot_chain_lifetimes", "animate_chains", "plot_field_maps", "plot_field_profiles"]

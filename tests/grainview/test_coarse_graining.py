@@ -9,7 +9,7 @@ import xarray as xr
 from grainview import sample
 from grainview._kernels.coarse_graining import spread_points, spread_segments
 from grainview.arrays.stress import stress_tensor as love_weber
-from grainview.coarse_graining import coarse_grained, field_invariants, profile
+from grainview.coarse_graining import coarse_grained, field_invariants, interior, profile, scalar_field
 from grainview.contract.dataset import make_dataset
 from grainview.contract.errors import ParameterError
 from grainview.fabric import fabric_tensor
@@ -275,6 +275,8 @@ def test_chunked_equals_eager_and_stays_lazy():
 def test_without_velocities_there_are_no_kinetic_fields():
     out = coarse_grained(builders.two_disks(), width=0.01, spacing=0.005)
     assert set(out.data_vars) == {"density", "solid_fraction", "contact_stress", "fabric"}
+    default = coarse_grained(builders.two_disks())  # width: the mean diameter 2 R; spacing: half of it
+    assert default.attrs["width_m"] == 2 * R and default.attrs["spacing_m"] == pytest.approx([R, R])
     with pytest.raises(ParameterError, match="no kinetic stress"):
         field_invariants(out, stress="kinetic")
 
@@ -294,7 +296,6 @@ def test_profile_by_hand():
     (dict(width="1", spacing=0.01), "width='1'"),
     (dict(width=0.01, spacing=0.0), "spacing=0.0"),
     (dict(width=0.01, spacing=(0.01, 0.01, 0.01)), "pair"),
-    (dict(width=0.01), "expected spacing="),
     (dict(width=0.01, x=[0.0, 0.1]), "expected spacing="),
     (dict(width=0.01, spacing=0.01, x=[0.0], y=[0.0]), "not both"),
     (dict(width=0.01, x=[0.1, 0.0], y=[0.0]), "x: expected finite, strictly increasing"),
@@ -309,3 +310,70 @@ def test_bad_arguments_say_what_was_expected(kwargs, match):
         profile(xr.DataArray(np.zeros((2, 2)), dims=("y", "x")), across="z")
     with pytest.raises(ParameterError, match="stress='all'"):
         field_invariants(xr.Dataset(), stress="all")
+
+
+# -- derived fields and figures --------------------------------------------------------------
+
+def test_scalar_fields_by_hand():
+    """On the square lattice (sigma = diag(100, 250) Pa inside): sigma_yy 250, sigma_xy 0, p 175,
+    q/p 3/7; with a uniform velocity, speed |v0| and no shear rate; the fabric anisotropy 0."""
+    base = builders.square_lattice(20, 20, fx=2.0, fy=5.0)
+    ds = base.assign(velocity=(("time", "particle", "xy"), np.tile([0.3, 0.4], (1, 400, 1)), {"units": "m s-1"}))
+    x = y = np.linspace(9 * A, 10 * A, 3)
+    out = coarse_grained(ds, width=1.5 * A, x=x, y=y, cutoff=8)
+    expected = {"sigma_yy": 250.0, "sigma_xx": 100.0, "p": 175.0, "q": 75.0, "q_over_p": 75 / 175, "speed": 0.5}
+    for name, value in expected.items():
+        np.testing.assert_allclose(scalar_field(out, name).values, value, rtol=1e-6)
+    assert scalar_field(out, "sigma_yy").attrs["units"] == "Pa"
+    for name in ("sigma_xy", "fabric_anisotropy", "shear_rate"):
+        np.testing.assert_allclose(scalar_field(out, name).values, 0.0, atol=1e-6 * {"sigma_xy": 250}.get(name, 1))
+    np.testing.assert_allclose(scalar_field(out, "sigma_yy", stress="contact").values, 250.0, rtol=1e-6)
+    with pytest.raises(ParameterError, match="name='tau'"):
+        scalar_field(out, "tau")
+
+
+def test_shear_rate_of_a_simple_shear_by_hand():
+    """Velocities v = (g y, 0) on a square lattice: dVx/dy = g, so gamma_dot = g inside (the
+    coarse-grained velocity of a linear field is linear where the kernel is whole)."""
+    base = builders.square_lattice(20, 20)
+    g = 2.0
+    velocity = np.stack([g * base.position.values[..., 1], np.zeros((1, 400))], axis=-1)
+    ds = base.assign(velocity=(("time", "particle", "xy"), velocity, {"units": "m s-1"}))
+    x = y = np.linspace(8 * A, 11 * A, 7)
+    rate = scalar_field(coarse_grained(ds, width=1.5 * A, x=x, y=y, cutoff=8), "shear_rate")
+    np.testing.assert_allclose(rate.values, g, rtol=1e-6)
+    assert rate.attrs["units"] == "s-1"
+
+
+def test_interior_leaves_out_the_walls_layer():
+    ds = builders.square_lattice(10, 10)  # box [-R, 19 R] on both axes
+    out = coarse_grained(ds, width=R, x=[-R, 0.5 * R, 9 * R, 17.5 * R, 19 * R], y=[9 * R])
+    inside = interior(out)  # 2 widths from the edges: [R, 17 R]
+    assert inside.isel(time=0, y=0).values.tolist() == [False, False, True, False, False]
+    assert interior(out, margin=0.0).isel(time=0, y=0).values.tolist() == [True] * 5
+    with pytest.raises(ParameterError, match="margin=-1"):
+        interior(out, margin=-1)
+
+
+def test_field_figures_draw_the_fields_with_units():
+    import matplotlib
+
+    matplotlib.use("Agg")
+    from grainview.plot import plot_field_maps, plot_field_profiles
+
+    ds = builders.square_lattice(12, 12, fx=2.0, fy=5.0)
+    fig = ds.grain.plot.field_maps(width=1.5 * A, spacing=A / 2)
+    assert len(fig.axes) == 6  # three maps and their colour bars
+    labels = [ax.get_ylabel() for ax in fig.axes]
+    assert labels[:3] == ["$y$ (m)"] * 3 and fig.axes[0].get_xlabel() == "$x$ (m)"
+    assert labels[3:] == [r"$\sigma_{yy}$ (Pa)", "$q/p$", r"$\nu$"]
+    fields = coarse_grained(ds, width=1.5 * A, spacing=A / 2)
+    fig = plot_field_profiles(ds, fields=fields, names=["sigma_yy"], across="y", margin=0.0)
+    line = fig.axes[0].lines[0]
+    np.testing.assert_allclose(line.get_ydata(), profile(scalar_field(fields, "sigma_yy"), across="y").isel(time=0))
+    assert fig.axes[0].get_xlabel() == "$y$ (m)" and fig.axes[0].get_ylabel() == r"$\sigma_{yy}$ (Pa)"
+    with pytest.raises(ParameterError, match="names="):
+        plot_field_maps(ds, names=["tau"], width=A)
+    with pytest.raises(ParameterError, match="fields has 1 snapshots, the dataset 2"):
+        plot_field_maps(ds.isel(time=[0, 0]), fields=fields)
+    matplotlib.pyplot.close("all")
