@@ -8,7 +8,9 @@ the report's index). The checks made on the way: the file opens as netCDF, it is
 file, its structure and units follow the contract (:func:`grainview.contract.schema.structure_problems`,
 :func:`grainview.contract.schema.unit_problems`), a netCDF-3 file is neither shorter than its fixed data
 and records need nor longer by records its header does not count, no incomplete snapshot comes
-before complete ones, and the values the summary reads are sound: times increasing strictly,
+before complete ones, the polygons' ``vertices`` (where the file has them) follow the contract's
+rules for shapes (:func:`grainview.contract.shapes.shape_problems`), and the values the summary
+reads are sound: times increasing strictly,
 finite forces, normal forces >= 0 (:mod:`grainview.contract.file_checks`, the words of
 :func:`grainview.contract.validation.validate`). Every value is checked by
 :func:`grainview.contract.validation.validate` (``grainview info --check``).
@@ -24,7 +26,7 @@ from .contract.errors import FileFormatError, SchemaError
 from .contract.file_checks import (COUNT_OUT_OF_RANGE, damaged_snapshots, force_problems, foreign_file_problems,
                           order_problems)
 from .contract.schema import complete_snapshots, missing_units, structure_problems, unit_problems
-from .contract.shapes import particle_area
+from .contract.shapes import particle_area, regular_polygons, shape_problems
 from .contract.writer import netcdf3_data_bytes
 
 __all__ = ["read_facts", "describe_file"]
@@ -72,10 +74,12 @@ def read_facts(path) -> tuple[dict, dict]:
     Returns
     -------
     facts : dict
-        What :func:`grainview.summary.summary_lines` reads: ``n_vertices``, ``n_walls``,
+        What :func:`grainview.summary.summary_lines` reads: ``n_vertices``, ``regular``
+        (which polygons are regular, :func:`grainview.contract.shapes.regular_polygons`), ``n_walls``,
         ``n_slots``, ``snapshots`` (complete ones), ``time`` (s), ``contact_count``,
         ``solid_fraction``, ``eps_1`` and ``eps_q`` of the last snapshot (log strains against
-        the first, docs/conventions.md §6) and ``q_over_p`` per snapshot (q/p of the stress
+        the first, docs/conventions.md §6; the particles' areas from their shapes,
+        :func:`grainview.contract.shapes.particle_area`) and ``q_over_p`` per snapshot (q/p of the stress
         sigma = (1/V) sum_c f^c (x) l^c over every pair the file holds, paper Eq. M), plus
         ``missing_units``.
     attrs : dict
@@ -87,7 +91,9 @@ def read_facts(path) -> tuple[dict, dict]:
         Not a readable netCDF file, a netCDF-3 file cut short or whose header hides records, an
         incomplete snapshot before complete ones.
     SchemaError
-        Not a grainview file; the structure or the units differ from the contract's; times
+        Not a grainview file; the structure or the units differ from the contract's; the
+        ``vertices`` break the contract's rules for shapes
+        (:func:`grainview.contract.shapes.shape_problems`); times
         that do not increase strictly, non-finite forces or negative normal forces.
     """
     import netCDF4
@@ -119,7 +125,14 @@ def read_facts(path) -> tuple[dict, dict]:
             _check_netcdf3_size(nc, source)
         attrs = {k: nc.getncattr(k) for k in nc.ncattrs()}
         v = nc.variables
-        facts = {"n_vertices": np.asarray(v["n_vertices"][:]), "n_walls": sizes.get("wall", 0),
+        radius, n_vertices = np.asarray(v["radius"][:], float), np.asarray(v["n_vertices"][:])
+        vertices = np.asarray(v["vertices"][:], float) if "vertices" in v else None
+        if vertices is not None:
+            problems = shape_problems(radius, n_vertices, vertices)
+            if problems:
+                raise SchemaError(problems, source)
+        facts = {"n_vertices": n_vertices, "regular": regular_polygons(radius, n_vertices, vertices),
+                 "n_walls": sizes.get("wall", 0),
                  "n_slots": sizes["contact"], "missing_units": missing_units(units),
                  "size": os.path.getsize(source), "format": "netCDF-3" if netcdf3 else "netCDF-4, compressed"}
         complete = complete_snapshots(v) if "time" in v and sizes.get("time", 0) else np.zeros(0, bool)
@@ -144,7 +157,7 @@ def read_facts(path) -> tuple[dict, dict]:
             raise SchemaError(problems, source)
         box_min, box_max = np.asarray(v["box_min"][k]), np.asarray(v["box_max"][k])
         length, height = box_max[:, 0] - box_min[:, 0], box_max[:, 1] - box_min[:, 1]
-        solid = float(particle_area(v["radius"][:], facts["n_vertices"]).sum())
+        solid = float(particle_area(radius, n_vertices, vertices).sum())
         with np.errstate(all="ignore"):  # a box of no size gives an infinite fraction, not a warning
             facts["solid_fraction"] = solid / (length * height)
         if snapshots > 1:

@@ -5,7 +5,7 @@ from __future__ import annotations
 import xarray as xr
 
 from ._lift import with_attrs
-from .contract.shapes import particle_area
+from .contract.shapes import particle_area_of
 
 __all__ = ["thickness", "width", "height", "volume", "solid_fraction", "area"]
 
@@ -103,7 +103,9 @@ def solid_fraction(ds: xr.Dataset) -> xr.DataArray:
 
         solid fraction = sum_i A_i / (l h)
 
-    A_i the area of particle i (disk or regular polygon, m2). The paper reports 0.80 for the
+    A_i the area of particle i, m2: pi R^2 for a disk, the shoelace area of a polygon's
+    vertices (:func:`grainview.contract.shapes.particle_area`; the regular n-gon's
+    (n/2) R^2 sin(2 pi/n) in a file without ``vertices``). The paper reports 0.80 for the
     pentagons S1 and 0.82 for the disks S2 (Sec. II.B). Particles outside the box are counted too.
 
     Parameters
@@ -121,7 +123,7 @@ def solid_fraction(ds: xr.Dataset) -> xr.DataArray:
     Azéma, Radjai, Peyroux & Saussine, Phys. Rev. E 76, 011301 (2007),
     Sec. II.B.
     """
-    solid = float(particle_area(ds["radius"].values, ds["n_vertices"].values).sum())
+    solid = float(particle_area_of(ds).sum())
     return with_attrs(solid / area(ds), "solid_fraction", "1", "solid fraction")
 
 

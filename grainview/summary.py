@@ -12,8 +12,12 @@ def describe(ds) -> list:
     q/p reached, and the settings a physicist asks for first, in readable units (what the
     report's index says of each run; ``grainview info`` prints the same lines from the file,
     :func:`grainview.file_summary.describe_file`)."""
+    from .contract.shapes import regular_polygons
+
     snapshots = ds.sizes.get("time", 0)
+    vertices = ds["vertices"].values if "vertices" in ds.variables else None
     facts = {"n_vertices": ds["n_vertices"].values, "n_walls": ds.sizes.get("wall", 0),
+             "regular": regular_polygons(ds["radius"].values, ds["n_vertices"].values, vertices),
              "n_slots": ds.sizes["contact"], "snapshots": snapshots}
     if snapshots:
         facts.update(time=ds["time"].values, contact_count=ds["contact_count"].values)
@@ -26,18 +30,34 @@ def describe(ds) -> list:
     return summary_lines(facts, ds.attrs)
 
 
+def shape_counts(n_vertices, regular=None) -> str:
+    """The particles' shapes in words, with their counts: disks, regular polygons by vertex
+    count ("400 5-gons") and the irregular convex polygons together with the range of their
+    vertex counts ("100 irregular convex polygons with 4-9 vertices"); ``regular`` (per
+    particle, :func:`grainview.contract.shapes.regular_polygons`) absent: every polygon is
+    regular."""
+    n_vertices = np.asarray(n_vertices).reshape(-1)
+    regular = n_vertices >= 3 if regular is None else np.asarray(regular, bool).reshape(-1)
+    irregular = (n_vertices >= 3) & ~regular
+    counts = [(int(k), int(((n_vertices == k) & ~irregular).sum())) for k in np.unique(n_vertices[~irregular])]
+    words = [f"{c} {'disks' if k == 0 else f'{k}-gons'}" for k, c in counts]
+    if irregular.any():
+        low, high = int(n_vertices[irregular].min()), int(n_vertices[irregular].max())
+        words.append(f"{int(irregular.sum())} irregular convex polygons with "
+                     f"{low if low == high else f'{low}-{high}'} vertices")
+    return ", ".join(words)
+
+
 def summary_lines(facts: dict, attrs: dict) -> list:
     """The summary's lines from its numbers: ``facts`` holds ``n_vertices`` (per particle),
+    optionally ``regular`` (per particle: which polygons are regular; all of them when absent),
     ``n_walls``, ``n_slots``, ``snapshots`` and, when there are snapshots, ``time`` (s),
     ``contact_count``, optionally ``solid_fraction`` (per snapshot) and, with more than one
     snapshot, ``eps_1``, ``eps_q`` (last snapshot) and ``q_over_p`` (per snapshot); ``attrs``
     the file's global attributes."""
     a = attrs
-    n_vertices = np.asarray(facts["n_vertices"])
-    shapes = {int(k): int((n_vertices == k).sum()) for k in sorted(set(n_vertices.tolist()))}
-    lines = [f"{n_vertices.size} particles ("
-             + ", ".join(f"{c} {'disks' if k == 0 else f'{k}-gons'}" for k, c in shapes.items())
-             + f"), {facts['n_walls']} walls, {facts['n_slots']} contact slots"]
+    lines = [f"{np.size(facts['n_vertices'])} particles ({shape_counts(facts['n_vertices'], facts.get('regular'))}), "
+             f"{facts['n_walls']} walls, {facts['n_slots']} contact slots"]
     snapshots = facts["snapshots"]
     if snapshots:
         t = facts["time"]

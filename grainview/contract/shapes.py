@@ -36,6 +36,9 @@ CENTROID_TOLERANCE = 1e-9
 """Largest accepted |centroid| of a polygon's vertices, relative to its circumscribed radius."""
 RADIUS_TOLERANCE = 1e-9
 """Largest accepted relative difference between ``radius`` and a polygon's farthest vertex."""
+REGULAR_TOLERANCE = 1e-6
+"""Largest spread, relative to the circumscribed radius, of a polygon's vertex distances from
+its centroid and of its edge lengths for it to count as regular (:func:`regular_polygons`)."""
 
 
 def vertex_phases(n_vertices: int) -> np.ndarray:
@@ -155,6 +158,35 @@ def inertia_per_mass(radius, n_vertices, vertices=None) -> np.ndarray:
     return np.where(n.reshape(-1) >= 3, polar, 0.5 * radius.reshape(-1) ** 2).reshape(radius.shape)
 
 
+def regular_polygons(radius, n_vertices, vertices=None) -> np.ndarray:
+    """(P,) bool: which particles are regular polygons.
+
+    A convex polygon whose vertices all lie at its circumscribed radius R from its centroid
+    and whose edges all have one length is regular, whatever its orientation in its own frame;
+    both are checked within :data:`REGULAR_TOLERANCE` R. Disks are not polygons (False).
+    Without ``vertices`` (a file of the old layout) every polygon is regular.
+    """
+    n = np.asarray(n_vertices).astype(np.int64).reshape(-1)
+    polygon = n >= 3
+    if vertices is None or not polygon.any():
+        return polygon
+    radius = np.asarray(radius, dtype=float).reshape(-1)
+    v, nxt, own = _shifted(body_vertices(radius, n, vertices))
+    edge = np.hypot(*(nxt - v).transpose(2, 0, 1))
+    distance = np.hypot(v[..., 0], v[..., 1])
+    tolerance = REGULAR_TOLERANCE * radius
+    on_circle = np.all(~own | (np.abs(distance - radius[:, None]) <= tolerance[:, None]), axis=-1)
+    spread = np.where(own, edge, -np.inf).max(-1) - np.where(own, edge, np.inf).min(-1)
+    return polygon & on_circle & (spread <= tolerance)
+
+
+def particle_area_of(ds) -> np.ndarray:
+    """:func:`particle_area` of a dataset of the contract (as :func:`body_vertices_of` reads
+    it): from its ``vertices`` when it has them, the regular polygons' closed form otherwise."""
+    vertices = ds["vertices"].values if "vertices" in ds.variables else None
+    return particle_area(ds["radius"].values, ds["n_vertices"].values, vertices)
+
+
 def shape_problems(radius, n_vertices, vertices) -> list[str]:
     """The contract's problems of a file's shapes, one line each (empty when there are none).
 
@@ -216,3 +248,16 @@ def body_vertices_of(ds) -> np.ndarray:
     the regular polygons of ``radius`` and ``n_vertices`` otherwise."""
     vertices = ds["vertices"].values if "vertices" in ds.variables else None
     return body_vertices(ds["radius"].values, ds["n_vertices"].values, vertices)
+
+
+def particle_inradius(radius, n_vertices, vertices=None) -> np.ndarray:
+    """(P,) inradius of each particle, m: the smallest distance from the centroid to an edge
+    line; R for a disk, R cos(pi/n) for a regular n-gon of circumscribed radius R when
+    ``vertices`` is not given, :func:`polygon_properties`'s inradius of the vertices otherwise."""
+    radius = np.asarray(radius, dtype=float)
+    n = np.asarray(n_vertices)
+    if vertices is None:
+        safe_n = np.where(n >= 3, n, 3)
+        return np.where(n >= 3, radius * np.cos(np.pi / safe_n), radius)
+    inner = polygon_properties(body_vertices(radius, n, vertices))["inradius"]
+    return np.where(n.reshape(-1) >= 3, inner, radius.reshape(-1)).reshape(radius.shape)

@@ -16,6 +16,7 @@ from .errors import SchemaError
 from .file_checks import (COUNT_OUT_OF_RANGE, NON_FINITE_FORCES, foreign_file_problems, negative_force_problem,
                           order_problems)
 from .schema import KIND_DOUBLE, KIND_SIMPLE, VARIABLES, structure_problems, unit_problems
+from .shapes import shape_problems
 from .schema import missing_units as _missing_units
 
 if TYPE_CHECKING:
@@ -84,8 +85,10 @@ def _value_checks(ds: xr.Dataset) -> dict[str, xr.DataArray]:
     checks = {}
     radius = ds["radius"]
     checks["radius: {} particle(s) with negative or non-finite radius"] = (~(np.isfinite(radius) & (radius > 0))).sum()
-    nv = ds["n_vertices"]
-    checks["n_vertices: {} particle(s) with a value that is neither 0 (disk) nor >= 3"] = ((nv != 0) & (nv < 3)).sum()
+    if "vertices" not in ds.variables:  # with them, the shapes' checks say it (_shape_problems)
+        nv = ds["n_vertices"]
+        checks["n_vertices: {} particle(s) with a value that is neither 0 (disk) nor >= 3"] = (
+            (nv != 0) & (nv < 3)).sum()
     for name in ("mass", "inertia"):
         checks[f"{name}: {{}} particle(s) with negative or non-finite {name}"] = (~(np.isfinite(ds[name]) & (ds[name] > 0))).sum()
     for name in ("position", "angle"):
@@ -112,7 +115,7 @@ def _value_checks(ds: xr.Dataset) -> dict[str, xr.DataArray]:
     checks[f"normal: {{}} occupied slot(s) whose normal is not a unit vector (| |n| - 1 | > {UNIT_NORMAL_TOLERANCE:g}, or NaN)"] = (
         occ & ~(abs(norm - 1) <= UNIT_NORMAL_TOLERANCE)).sum()
     for name, var in VARIABLES.items():
-        if not var.required and not var.is_integer and name in ds.variables:
+        if not var.required and not var.is_integer and name in ds.variables and "vertex" not in var.dims:
             bad = ~np.isfinite(ds[name])
             if "contact" in var.dims:  # empty slots hold the fill value
                 bad = bad & occ
@@ -130,6 +133,15 @@ def _value_checks(ds: xr.Dataset) -> dict[str, xr.DataArray]:
     checks["box_min, box_max: {} snapshot(s) where the box is not finite with box_max above box_min "
            "in x and y"] = (~box_ok).sum()
     return checks
+
+
+def _shape_problems(ds: xr.Dataset) -> list[str]:
+    """The problems of the file's ``vertices`` (:func:`grainview.contract.shapes.shape_problems`:
+    their NaN padding, convex and counter-clockwise polygons centred on their centroid, ``radius``
+    the farthest vertex); none for a file without them (regular polygons)."""
+    if "vertices" not in ds.variables:
+        return []
+    return shape_problems(ds["radius"].values, ds["n_vertices"].values, ds["vertices"].values)
 
 
 def _per_snapshot(ds: xr.Dataset) -> dict[str, xr.DataArray]:
@@ -163,7 +175,10 @@ def validate(ds: xr.Dataset, source: str | None = None) -> xr.Dataset:
     """Check ``ds`` against the contract; raise one :class:`SchemaError` listing every problem.
 
     Checked: every required variable present with its dims and an integer/float dtype as the
-    contract says; no negative radius, mass or inertia; ``n_vertices`` 0 or >= 3; finite
+    contract says; no negative radius, mass or inertia; ``n_vertices`` 0 or >= 3; the
+    polygons' ``vertices``, where the file has them, convex, counter-clockwise, centred on
+    their centroid, ``radius`` their farthest vertex, NaN beyond each one's count
+    (:func:`grainview.contract.shapes.shape_problems`); finite
     positions; ``contact_count`` within the slots; in occupied slots: ids in range and
     ``i < j`` for particle pairs, each pair at most once per snapshot, kind 1 or 2, finite
     forces, normal forces >= 0 (the first negative one named by snapshot, slot and bodies),
@@ -195,7 +210,7 @@ def validate(ds: xr.Dataset, source: str | None = None) -> xr.Dataset:
 
     source = source or (ds.encoding.get("source") if isinstance(ds, xr.Dataset) else None)
     check_structure(ds, source)  # values cannot be checked reliably on a malformed structure
-    problems = _unit_problems(ds)
+    problems = _unit_problems(ds) + _shape_problems(ds)
     checks = _value_checks(ds)
     per_snapshot = _per_snapshot(ds)
     values = list(checks.values()) + list(per_snapshot.values())
