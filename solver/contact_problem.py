@@ -1,4 +1,4 @@
-"""A frictional contact problem given directly by its matrix: u = W r + q, solved by the NLGS.
+"""A frictional contact problem given directly by its matrix: u = W r + q, solved by a method of choice.
 
 This is the form in which FCLIB stores 2D frictional contact problems and in which other
 solvers (Siconos, LMGC90's exports) exchange them: n contact points, their impulses
@@ -9,40 +9,27 @@ each point. Every point k must satisfy Signorini and Coulomb:
 
     r_n >= 0,  u_n >= 0,  r_n u_n = 0;   |r_t| <= mu r_n,  and u_t != 0 => r_t = -mu r_n sign(u_t).
 
-:func:`solve_contact_problem` runs the same point-by-point exact local solver and the same two
-stopping norms as the time stepper's NLGS (:mod:`solver.nlgs`), and reports the natural-map
-residual of the result (:mod:`solver.residuals`), which is zero exactly at a solution.
+:func:`solve_contact_problem` validates the problem and hands it to the method named by
+``method`` (:data:`solver.contact_solvers.SOLVERS`): by default the same point-by-point exact
+local solver and the same two stopping norms as the time stepper's NLGS (:mod:`solver.nlgs`);
+``newton`` (semi-smooth Newton, :mod:`solver.nonsmooth_newton`) and ``pcg`` (projected conjugate
+gradient, :mod:`solver.projected_cg`) stop on the natural-map residual instead. Every method's
+result reports the natural-map residual (:mod:`solver.contact_solution`), zero exactly at a
+solution.
 """
 
 from __future__ import annotations
 
-from typing import NamedTuple
+import inspect
 
 import numpy as np
 
 from grainview.contract.errors import ParameterError
 
-from . import nlgs, residuals
+from .contact_solution import ContactSolution
+from .contact_solvers import solver
 
 __all__ = ["ContactSolution", "solve_contact_problem"]
-
-
-class ContactSolution(NamedTuple):
-    """Result of :func:`solve_contact_problem`.
-
-    impulse : (n, 2) r per point (normal, tangential); velocity : (n, 2) u = W r + q;
-    iterations : sweeps run; residual, max_residual : the NLGS stopping norms of the last sweep;
-    local_law_residual : |F| / |r| of the natural map (0 at a solution; with r = 0, |F| itself);
-    converged : both stopping norms met within ``max_iterations``.
-    """
-
-    impulse: np.ndarray
-    velocity: np.ndarray
-    iterations: int
-    residual: float
-    max_residual: float
-    local_law_residual: float
-    converged: bool
 
 
 def _validate(W, q, mu):
@@ -71,9 +58,9 @@ def _validate(W, q, mu):
     return W, q, mu, n
 
 
-def solve_contact_problem(W, q, mu, *, tolerance=1e-10, max_tolerance=None, max_iterations=10_000,
-                          initial=None) -> ContactSolution:
-    """Solve the 2D frictional contact problem u = W r + q (module docstring) by NLGS.
+def solve_contact_problem(W, q, mu, *, method="nlgs", tolerance=1e-10, max_iterations=10_000, initial=None,
+                          **options) -> ContactSolution:
+    """Solve the 2D frictional contact problem u = W r + q (module docstring) by ``method``.
 
     Parameters
     ----------
@@ -81,37 +68,31 @@ def solve_contact_problem(W, q, mu, *, tolerance=1e-10, max_tolerance=None, max_
         tangential velocity of point k).
     q : (2n,) free local velocities (m s-1 for impulses in N s).
     mu : scalar or (n,), friction coefficients.
-    tolerance, max_tolerance : the NLGS's quadratic and max norms (:mod:`solver.nlgs`);
-        ``max_tolerance`` defaults to 60 x ``tolerance`` (about the time stepper's ratio).
-    max_iterations : sweep cap.
+    method : a name of :data:`solver.contact_solvers.SOLVERS`: ``nlgs`` (default), ``newton``,
+        ``pcg``.
+    tolerance : the method's stopping tolerance: for ``nlgs`` its quadratic norm (its max norm
+        ``max_tolerance``, an option, defaults to 60 x ``tolerance``); for the others the
+        natural-map residual |F| / |r|.
+    max_iterations : the method's iteration cap (sweeps, Newton steps, gradient steps).
     initial : (n, 2) or (2n,) starting impulses (default 0).
+    options : further keywords of the method (``max_tolerance`` for ``nlgs``).
 
     Returns
     -------
-    ContactSolution.
+    ContactSolution (:mod:`solver.contact_solution`).
     """
+    solve = solver(method)
     W, q, mu, n = _validate(W, q, mu)
-    if max_tolerance is None:
-        max_tolerance = 60.0 * tolerance
-    for name, value in (("tolerance", tolerance), ("max_tolerance", max_tolerance)):
-        if not (np.isfinite(value) and value > 0):
-            raise ParameterError(f"{name}={value!r}: expected a positive number")
+    if not (np.isfinite(tolerance) and tolerance > 0):
+        raise ParameterError(f"tolerance={tolerance!r}: expected a positive number")
     if int(max_iterations) < 1:
         raise ParameterError(f"max_iterations={max_iterations!r}: expected an integer >= 1")
     r = np.zeros((n, 2)) if initial is None else np.array(initial, dtype=np.float64).reshape(-1)
     if r.size != 2 * n or not np.all(np.isfinite(r)):
         raise ParameterError(f"initial must hold 2 finite impulses per point ({2 * n} values), got {r.size}")
-    r = r.reshape(n, 2)
-    rn, rt = r[:, 0].copy(), r[:, 1].copy()
-    iterations, quad, worst = nlgs.solve_matrix(W.indptr.astype(np.int64), W.indices.astype(np.int64), W.data, q,
-                                                mu, rn, rt, float(tolerance), float(max_tolerance),
-                                                int(max_iterations))
-    impulse = np.stack([rn, rt], -1)
-    velocity = (W @ impulse.reshape(-1) + q).reshape(n, 2)
-    diagonal = W.diagonal()[0::2]
-    violation = np.stack(residuals.natural_maps(rn, rt, velocity[:, 0].copy(), velocity[:, 1].copy(), mu,
-                                                1.0 / diagonal), -1)
-    size = float(np.linalg.norm(impulse))
-    law = float(np.linalg.norm(violation)) / size if size > 0 else float(np.linalg.norm(violation))
-    converged = bool(quad <= tolerance and worst <= max_tolerance)
-    return ContactSolution(impulse, velocity, int(iterations), float(quad), float(worst), law, converged)
+    known = set(inspect.signature(solve).parameters) - {"W", "q", "mu", "tolerance", "max_iterations", "initial"}
+    unknown = sorted(set(options) - known)
+    if unknown:
+        raise ParameterError(f"method={method!r} has no option {', '.join(unknown)}; its options: "
+                             f"{', '.join(sorted(known)) or 'none'}")
+    return solve(W, q, mu, float(tolerance), int(max_iterations), r.reshape(n, 2), **options)
