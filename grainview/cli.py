@@ -114,6 +114,50 @@ def _convert_lmgc90(args) -> int:
     return 0
 
 
+def _mercurydpm_units(text):
+    """``--units si`` or ``--units length=L,mass=M,time=T`` as the reader's ``units``."""
+    if text.strip().lower() == "si":
+        return "si"
+    try:
+        return {key.strip(): float(value) for key, value in (item.split("=", 1) for item in text.split(","))}
+    except ValueError:
+        raise GrainviewError(f"--units {text}: expected si or length=L,mass=M,time=T (the SI value of one unit of "
+                             "the run: m, kg, s)") from None
+
+
+def _convert_mercurydpm(args) -> int:
+    import warnings
+
+    from .formats.mercurydpm import convert_mercurydpm
+
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        count = convert_mercurydpm(args.out, args.data, args.fstat, args.restart,
+                                   units=_mercurydpm_units(args.units), overwrite=args.overwrite,
+                                   compress=not args.no_compress, progress=args.progress != "off")
+    for note in caught:
+        print(f"note: {note.message}")
+    print(f"wrote {args.out}: {count} snapshots from MercuryDPM (check it: grainview info {args.out} --check)")
+    return 0
+
+
+def _convert_pegs(args) -> int:
+    import warnings
+
+    from .formats.pegs import convert_pegs
+
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        count = convert_pegs(args.out, args.adjacency, args.positions, metres_per_pixel=args.metres_per_pixel,
+                             force_unit_n=args.force_unit_n, frame_interval_s=args.frame_interval,
+                             thickness_m=args.thickness, density_kg_m3=args.density, overwrite=args.overwrite,
+                             compress=not args.no_compress, progress=args.progress != "off")
+    for note in caught:
+        print(f"note: {note.message}")
+    print(f"wrote {args.out}: {count} frames from PeGS2 (check it: grainview info {args.out} --check)")
+    return 0
+
+
 def _demo(args) -> int:
     from . import open_dataset
     from .contract.dataset import netcdf_options
@@ -729,6 +773,43 @@ def build_parser() -> argparse.ArgumentParser:
     lmgc90.add_argument("--progress", choices=("on", "off"), default="on", help="progress bar (default: on)")
     no_compress_option(lmgc90)
     lmgc90.set_defaults(func=_convert_lmgc90)
+    mercury = formats.add_parser("mercurydpm", help="a MercuryDPM 2D run (.data + .fstat + .restart)",
+                                 description="A MercuryDPM 2D run: its .data (particles), .fstat (contacts, each "
+                                 "pair written from both sides) and .restart (dimensions, masses, walls). MercuryDPM "
+                                 "has no units of its own: say which (--units). Contacts: overlapping pairs with a "
+                                 "compressive normal force, one per pair (docs/formats.md).")
+    mercury.add_argument("data", help="the run's .data file")
+    mercury.add_argument("--fstat", help="the run's .fstat file (default: beside the .data, same name)")
+    mercury.add_argument("--restart", help="the run's .restart file (default: beside the .data, same name)")
+    mercury.add_argument("--units", required=True, help="si (the run is in m, kg, s), or length=L,mass=M,time=T: the "
+                         "SI value of one length, mass and time unit of the run (m, kg, s)")
+    mercury.add_argument("--out", required=True, help="the netCDF file to write")
+    mercury.add_argument("--overwrite", action="store_true", help="replace an existing --out")
+    mercury.add_argument("--progress", choices=("on", "off"), default="on", help="progress bar (default: on)")
+    no_compress_option(mercury)
+    mercury.set_defaults(func=_convert_mercurydpm)
+    pegs = formats.add_parser("pegs", help="a photoelastic experiment solved by PeGS2 (adjacency list + positions)",
+                              description="A photoelastic experiment solved by PeGS2: its adjacency lists (rows "
+                              "frame, id1, id2, tangential force, normal force; id2 -1 a wall) and the disks "
+                              "(particle_positions.txt of particleTrack, or the *_centers.txt of particleDetect), in "
+                              "pixels. The scale and the force unit are required (docs/formats.md).")
+    pegs.add_argument("adjacency", nargs="+", help="Adjacency_list.txt, or the frames' *_Adjacency.txt")
+    pegs.add_argument("--positions", nargs="+", required=True,
+                      help="particle_positions.txt, or the frames' *_centers.txt")
+    pegs.add_argument("--metres-per-pixel", type=float, required=True, help="the image scale, m per pixel "
+                      "(PeGS2's metersperpixel)")
+    pegs.add_argument("--force-unit-n", type=float, required=True, help="newtons per force unit of the adjacency "
+                      "list (1 when PeGS2's fsigma is calibrated in N)")
+    pegs.add_argument("--frame-interval", type=float, default=1.0, help="time between frames, s (default: 1)")
+    pegs.add_argument("--thickness", type=float, default=1.0, help="the disks' thickness, m (default: 1; stresses "
+                      "are per this thickness)")
+    pegs.add_argument("--density", type=float, default=1000.0, help="the disks' density for their masses, kg/m^3 "
+                      "(not measured; default: 1000)")
+    pegs.add_argument("--out", required=True, help="the netCDF file to write")
+    pegs.add_argument("--overwrite", action="store_true", help="replace an existing --out")
+    pegs.add_argument("--progress", choices=("on", "off"), default="on", help="progress bar (default: on)")
+    no_compress_option(pegs)
+    pegs.set_defaults(func=_convert_pegs)
     for engine, version in (("box2d", "Box2D 2.3"), ("pymunk", "pymunk")):
         peer = formats.add_parser(engine, help=f"a {version} run of the cross-check (raw snapshots)",
                                   description=f"A {version} run of the cross-check harness (benchmarks/crosscheck/): "

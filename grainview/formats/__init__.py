@@ -14,7 +14,8 @@ from ..contract.errors import ParameterError
 __all__ = ["READERS", "open_format"]
 
 READERS = {"lammps": "grainview.formats.lammps:open_lammps", "box2d": "grainview.formats.peers:open_box2d",
-           "pymunk": "grainview.formats.peers:open_pymunk", "lmgc90": "grainview.formats.lmgc90:open_lmgc90"}
+           "pymunk": "grainview.formats.peers:open_pymunk", "lmgc90": "grainview.formats.lmgc90:open_lmgc90",
+           "mercurydpm": "grainview.formats.mercurydpm:open_mercurydpm", "pegs": "grainview.formats.pegs:open_pegs"}
 """Format name -> the reader that opens it as an in-memory dataset of the contract."""
 
 

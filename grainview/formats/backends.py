@@ -9,7 +9,7 @@ from __future__ import annotations
 
 from xarray.backends import BackendEntrypoint
 
-__all__ = ["LammpsBackend", "Box2dBackend", "PymunkBackend", "Lmgc90Backend"]
+__all__ = ["LammpsBackend", "Box2dBackend", "PymunkBackend", "Lmgc90Backend", "MercuryDpmBackend", "PegsBackend"]
 
 
 class LammpsBackend(BackendEntrypoint):
@@ -90,6 +90,58 @@ class Lmgc90Backend(BackendEntrypoint):
         from .lmgc90 import open_lmgc90
 
         return open_lmgc90(filename_or_obj).drop_vars(list(drop_variables or []), errors="ignore")
+
+    def guess_can_open(self, filename_or_obj) -> bool:
+        return False
+
+
+class MercuryDpmBackend(BackendEntrypoint):
+    """MercuryDPM 2D runs (:func:`grainview.formats.mercurydpm.open_mercurydpm`).
+
+    ``xr.open_dataset("run.data", engine="mercurydpm", units="si")``: the path is the run's
+    ``.data`` file; ``fstat`` and ``restart`` default to the files beside it with the same stem;
+    ``units`` (required: ``"si"`` or ``{"length": m, "mass": kg, "time": s}``) is passed on.
+    """
+
+    description = "MercuryDPM 2D runs (.data, .fstat, .restart) as a grainview dataset"
+    url = "https://www.mercurydpm.org"
+    open_dataset_parameters = ("filename_or_obj", "drop_variables", "fstat", "restart", "units")
+
+    def open_dataset(self, filename_or_obj, *, drop_variables=None, fstat=None, restart=None, units=None):
+        from .mercurydpm import open_mercurydpm
+
+        ds = open_mercurydpm(filename_or_obj, fstat, restart, units=units)
+        return ds.drop_vars(list(drop_variables or []), errors="ignore")
+
+    def guess_can_open(self, filename_or_obj) -> bool:
+        return False
+
+
+class PegsBackend(BackendEntrypoint):
+    """Photoelastic experiments solved by PeGS2 (:func:`grainview.formats.pegs.open_pegs`).
+
+    ``xr.open_dataset("Adjacency_list.txt", engine="pegs", positions="particle_positions.txt",
+    metres_per_pixel=4.375e-5, force_unit_n=1)``: the path is the adjacency list; ``positions``,
+    ``metres_per_pixel`` and ``force_unit_n`` are required, ``frame_interval_s``,
+    ``thickness_m`` and ``density_kg_m3`` optional.
+    """
+
+    description = "PeGS2 photoelastic adjacency lists and particle positions as a grainview dataset"
+    url = "https://github.com/jekollmer/PEGS"
+    open_dataset_parameters = ("filename_or_obj", "drop_variables", "positions", "metres_per_pixel", "force_unit_n",
+                               "frame_interval_s", "thickness_m", "density_kg_m3")
+
+    def open_dataset(self, filename_or_obj, *, drop_variables=None, positions=None, metres_per_pixel=None,
+                     force_unit_n=None, frame_interval_s=1.0, thickness_m=1.0, density_kg_m3=1000.0):
+        from ..contract.errors import ParameterError
+        from .pegs import open_pegs
+
+        if positions is None:
+            raise ParameterError("engine='pegs' needs positions=<particle_positions.txt or the *_centers.txt files> "
+                                 "besides the adjacency list")
+        ds = open_pegs(filename_or_obj, positions, metres_per_pixel=metres_per_pixel, force_unit_n=force_unit_n,
+                       frame_interval_s=frame_interval_s, thickness_m=thickness_m, density_kg_m3=density_kg_m3)
+        return ds.drop_vars(list(drop_variables or []), errors="ignore")
 
     def guess_can_open(self, filename_or_obj) -> bool:
         return False

@@ -1,0 +1,452 @@
+"""MercuryDPM 2D runs (``.data`` + ``.fstat`` + ``.restart``) as datasets of the grainview contract.
+
+A MercuryDPM run named ``NAME`` writes ``NAME.data`` (particles, per snapshot), ``NAME.fstat``
+(contacts, per snapshot) and ``NAME.restart`` (the model: dimensions, species, walls, particle
+masses). The file layer is :mod:`grainview.formats.mercurydpm_text`; this module builds the
+contract from it. docs/formats.md states the same for users.
+
+* **Units.** MercuryDPM has no units of its own: a run is in whatever consistent units its
+  driver chose, often nondimensional (diameter, density and gravity 1). The reader does not
+  guess: ``units="si"`` says the run is in m, kg, s; otherwise ``units={"length": L, "mass":
+  M, "time": T}`` gives one MercuryDPM unit of each in SI (m, kg, s), and every quantity is
+  scaled by its dimension (forces by ``M L / T^2``).
+* **Particles** are the ``.data`` lines in order (MercuryDPM's particle index); the same
+  particles must be in every snapshot, with the same radii. ``position``, ``velocity``, ``angle``
+  (``angleZ``) and ``angular_velocity`` (the ``.data`` column is ``-omegaZ``, written negated
+  for XBalls) come from ``.data``; ``mass = 1 / invMass`` from ``.restart``, ``inertia = m r^2 /
+  2`` for disks (``particleDimensions 2``) or ``2 m r^2 / 5`` for spheres in a 2D system
+  (``particleDimensions 3``), as MercuryDPM computes them. A 2D system's particles are slabs
+  one length unit thick: ``thickness_m = L``.
+* **Contacts.** ``.fstat`` writes each particle pair twice, once from each side: the line of
+  particle P with body I gives the force on P, ``fn n + ft t``, with ``n`` the unit normal from
+  I to P and ``t`` the unit direction of the tangential force (the second line has ``-n``,
+  ``-t``). A wall contact is written once, from the particle's side, with I = ``-w - 1`` and
+  ``n`` pointing from the particle to the wall, and there the force on the particle is
+  ``-(fn n + ft t)`` (MercuryDPM's own source calls this flip an old bug, and its ``.fstat``
+  reader undoes it the same way). The reader keeps one contact per pair: bodies ``i < j`` (a
+  wall is ``N + w``), ``normal`` the unit vector from i to j, the force exerted by i on j,
+  ``fn``, ``ft`` its components along ``normal`` and ``(-normal_y, normal_x)``; ``point`` is
+  MercuryDPM's contact point (the middle of the overlap), ``branch = x_j - x_i`` (the centre
+  to the contact point for a wall), ``gap = -overlap``. Pairs whose two lines disagree are
+  refused; pairs that do not overlap or whose normal force is tensile (viscous damping as they
+  separate) are left out and counted in a warning.
+* **Walls** are the ``.restart``'s walls in its order. An ``InfiniteWall`` whose outward
+  normal is ``-y, +x, +y, -x`` is named ``bottom, right, top, left``; any other wall
+  ``<type><index>``. ``wall_force`` is the total force the particles exert on each wall.
+* ``time`` is the snapshots' time (MercuryDPM's ``t``, scaled); the box (``box_min``,
+  ``box_max``) is the ``.data`` header's domain (``xmin ymin xmax ymax``).
+
+Every function checks its input and refuses bad input in one line
+(:class:`grainview.contract.errors.FileFormatError` or :class:`~grainview.contract.errors.ParameterError`).
+"""
+
+from __future__ import annotations
+
+import math
+import os
+import warnings
+
+import numpy as np
+
+from ..contract.errors import FileFormatError, ParameterError
+from ..contract.schema import contact_slots
+from .mercurydpm_text import iter_data, iter_fstat, read_restart
+
+__all__ = ["mercurydpm_snapshots", "open_mercurydpm", "convert_mercurydpm", "unit_scales", "BOX_WALLS"]
+
+BOX_WALLS = {(0, -1): "bottom", (1, 0): "right", (0, 1): "top", (-1, 0): "left"}
+"""Names of the axis-aligned InfiniteWalls by their outward normal (pointing out of the sample)."""
+_UNITS_HINT = ("MercuryDPM runs carry no units: give units='si' (m, kg, s) or the SI value of one unit of "
+               "length, mass and time of the run (units={'length': m, 'mass': kg, 'time': s}; --units si or "
+               "--units length=L,mass=M,time=T)")
+
+
+def unit_scales(units) -> dict:
+    """The SI value of one MercuryDPM unit of length, mass and time.
+
+    Parameters
+    ----------
+    units : "si" or dict
+        ``"si"`` (the run is in m, kg, s), or ``{"length": L, "mass": M, "time": T}`` with
+        L in m, M in kg, T in s, each > 0.
+
+    Returns
+    -------
+    dict
+        ``length``, ``mass``, ``time`` and the derived ``velocity = L/T``, ``force = M L /
+        T^2``, ``inertia = M L^2``.
+
+    Raises
+    ------
+    ParameterError
+        ``units`` missing, or not one of the two forms.
+    """
+    if units is None:
+        raise ParameterError(_UNITS_HINT)
+    if isinstance(units, str):
+        if units.lower() != "si":
+            raise ParameterError(f"units={units!r}: {_UNITS_HINT}")
+        units = {"length": 1.0, "mass": 1.0, "time": 1.0}
+    if not isinstance(units, dict) or set(units) != {"length", "mass", "time"}:
+        raise ParameterError(f"units={units!r}: {_UNITS_HINT}")
+    scales = {}
+    for key, value in units.items():
+        try:
+            value = float(value)
+        except (TypeError, ValueError):
+            raise ParameterError(f"units: {key}={value!r} is not a number; {_UNITS_HINT}") from None
+        if isinstance(units[key], bool) or not (math.isfinite(value) and value > 0):
+            raise ParameterError(f"units: {key}={units[key]!r}: expected a finite number > 0")
+        scales[key] = value
+    L, M, T = scales["length"], scales["mass"], scales["time"]
+    scales.update(velocity=L / T, force=M * L / T**2, inertia=M * L**2)
+    return scales
+
+
+def _sibling(data, suffix, given):
+    if given is not None:
+        return os.fspath(given)
+    stem, extension = os.path.splitext(os.fspath(data))
+    return (stem if extension == ".data" else os.fspath(data)) + suffix
+
+
+def _wall_names(restart, source):
+    names, normals = [], []
+    for index, (kind, values) in enumerate(restart.walls):
+        name = f"{kind or 'wall'}{index}"
+        normal = None
+        q = values.get("orientation", [])
+        if kind == "InfiniteWall" and len(q) == 4:
+            w, x, y, z = q
+            normal = np.array([1 - 2 * (y * y + z * z), 2 * (x * y + w * z)])  # the wall's axis (1, 0, 0), rotated
+            key = tuple(int(round(c)) for c in normal)
+            if np.allclose(normal, key, atol=1e-9) and key in BOX_WALLS:
+                normal = np.array(key, float)
+                if BOX_WALLS[key] not in names:
+                    name = BOX_WALLS[key]
+        names.append(name)
+        normals.append(normal)
+    return names, normals
+
+
+class _Model:
+    """The static part of a run: particles (from the first ``.data`` snapshot and ``.restart``),
+    walls and the unit scales."""
+
+    def __init__(self, first, restart, restart_path, data_path, scales):
+        if restart.system_dimensions != 2:
+            raise FileFormatError(f"{restart_path}: systemDimensions {restart.system_dimensions}; only 2D runs "
+                                  "(setDimension(2)) can be read")
+        if restart.particle_dimensions not in (2, 3):
+            raise FileFormatError(f"{restart_path}: particleDimensions {restart.particle_dimensions}; expected 2 "
+                                  "(disks) or 3 (spheres)")
+        n = first.values.shape[0]
+        if len(restart.particles) != n:
+            raise FileFormatError(f"{restart_path}: {len(restart.particles)} particles, but {data_path} has {n} (the "
+                                  "contract needs the same particles throughout)")
+        radius = first.values[:, 4]
+        restart_radius = np.array([p["radius"][0] for p in restart.particles])
+        if not np.allclose(restart_radius, radius, rtol=1e-8, atol=0):
+            k = int(np.argmax(np.abs(restart_radius - radius)))
+            raise FileFormatError(f"{restart_path}: particle {k} has radius {restart_radius[k]:.10g} but "
+                                  f"{radius[k]:.10g} in {data_path} (not the same run?)")
+        inv_mass = np.array([p["invMass"][0] for p in restart.particles])
+        if not (np.all(radius > 0) and np.all(inv_mass > 0)):
+            raise FileFormatError(f"{restart_path}: radii and masses must be > 0 (a fixed particle has invMass 0 and "
+                                  "cannot be held by the contract)")
+        mass = 1.0 / inv_mass
+        factor = 0.5 if restart.particle_dimensions == 2 else 0.4
+        self.n = n
+        self.radius_raw = radius.copy()
+        self.radius = radius * scales["length"]
+        self.mass = mass * scales["mass"]
+        self.inertia = factor * mass * radius**2 * scales["inertia"]
+        self.inertia_rule = "m r^2 / 2 (particleDimensions 2)" if factor == 0.5 else \
+            "2 m r^2 / 5 (particleDimensions 3)"
+        self.wall_names, self.wall_axes = _wall_names(restart, restart_path)
+        self.scales = scales
+        self.data_path = data_path
+
+
+def _particles(model, snap, where):
+    values = snap.values
+    if values.shape[0] != model.n:
+        raise FileFormatError(f"{where}: {values.shape[0]} particles against {model.n} in the first snapshot; the "
+                              "contract needs the same particles throughout")
+    if not np.allclose(values[:, 4], model.radius_raw, rtol=1e-8, atol=0):
+        raise FileFormatError(f"{where}: radii changed during the run; the contract holds one radius per particle")
+    s = model.scales
+    position = values[:, 0:2] * s["length"]
+    return dict(position=position, velocity=values[:, 2:4] * s["velocity"], angle=values[:, 5].copy(),
+                angular_velocity=-values[:, 6] / s["time"])
+
+
+def fstat_contacts(rows, n_particles, n_walls, where):
+    """One contact per body pair from an ``.fstat`` snapshot's lines, in MercuryDPM's units.
+
+    Parameters
+    ----------
+    rows : ndarray, (K, 16)
+        The snapshot's contact lines (:data:`~grainview.formats.mercurydpm_text.FSTAT_COLUMNS`).
+    n_particles, n_walls : int
+        N and the number of walls W (a wall w is body ``N + w``).
+    where : str
+        The file and snapshot, for messages.
+
+    Returns
+    -------
+    (dict, int)
+        Arrays ``i, j`` (i < j), ``normal`` (K', 2, from i to j), ``force`` (K', 2: exerted by
+        i on j), ``point`` (K', 2), ``overlap`` (K',), and the number of lines of touching pairs
+        with a tensile normal force (left out), for the overlapping pairs with ``fn > 0``.
+
+    Raises
+    ------
+    FileFormatError
+        A body index out of range, a particle pair whose two lines disagree, a pair written
+        more than twice.
+    """
+    p = rows[:, 1].astype(np.int64)
+    other = rows[:, 2].astype(np.int64)
+    if np.any(rows[:, 1] != p) or np.any(rows[:, 2] != other):
+        raise FileFormatError(f"{where}: a body index that is not an integer")
+    bad = (p < 0) | (p >= n_particles) | (other >= n_particles) | (other < -n_walls)
+    if bad.any():
+        k = int(np.flatnonzero(bad)[0])
+        raise FileFormatError(f"{where}: a contact of bodies {p[k]} and {other[k]}, but the run has {n_particles} "
+                              f"particles (0..{n_particles - 1}) and {n_walls} walls (-1..{-n_walls})")
+    n = rows[:, 10:12]
+    t = rows[:, 13:15]
+    on_p = rows[:, 8:9] * n + rows[:, 9:10] * t  # as written; for a wall line, minus the force on P
+    wall = other < 0
+    body = np.where(wall, n_particles + (-other - 1), other)
+    i, j = np.minimum(p, body), np.maximum(p, body)
+    # exerted by i on j, and the normal from i to j: a particle line of P = j gives the force on j
+    # (from i) along n from i to j; a line of P = i gives the force on i, to be negated with n; a
+    # wall line (P = i) gives the force exerted by the particle on the wall along n (particle to wall)
+    flip = ~wall & (p == i)
+    force = np.where(flip[:, None], -on_p, on_p)
+    normal = np.where(flip[:, None], -n, n)
+    key = i * np.int64(n_particles + n_walls) + j
+    unique, first, counts = np.unique(key, return_index=True, return_counts=True)
+    if np.any(counts > 2):
+        k = int(first[np.argmax(counts > 2)])
+        raise FileFormatError(f"{where}: the pair {i[k]}-{j[k]} is written {counts.max()} times (expected once per "
+                              "side)")
+    index = np.searchsorted(unique, key)
+    same = np.isclose(force, force[first[index]], rtol=1e-6, atol=1e-9 * np.abs(force).max(initial=1.0)).all(axis=1) \
+        & np.isclose(normal, normal[first[index]], rtol=0, atol=1e-6).all(axis=1)
+    if not same.all():
+        k = int(np.flatnonzero(~same)[0])
+        raise FileFormatError(f"{where}: the two lines of the pair {i[k]}-{j[k]} disagree (force on one is not minus "
+                              "the force on the other)")
+    keep = first
+    i, j, normal, force = i[keep], j[keep], normal[keep], force[keep]
+    point, overlap = rows[keep, 3:5], rows[keep, 6]
+    fn = np.einsum("ij,ij->i", force, normal)
+    touching = overlap > 0
+    loaded = touching & (fn > 0)
+    tensile = int((touching & ~loaded).sum())
+    out = dict(i=i[loaded], j=j[loaded], normal=normal[loaded], force=force[loaded], point=point[loaded],
+               overlap=overlap[loaded])
+    return out, tensile
+
+
+def _contacts(model, position_raw, rows, where):
+    s = model.scales
+    raw, tensile = fstat_contacts(rows, model.n, len(model.wall_names), where)
+    i, j, normal = raw["i"], raw["j"], raw["normal"]
+    length = np.hypot(normal[:, 0], normal[:, 1])
+    if np.any(np.abs(length - 1) > 1e-6):
+        raise FileFormatError(f"{where}: a contact normal that is not a unit vector in the plane (a 3D run?)")
+    normal = normal / length[:, None]
+    force = raw["force"] * s["force"]
+    tangent = np.stack([-normal[:, 1], normal[:, 0]], axis=1)
+    point = raw["point"] * s["length"]
+    on_wall = j >= model.n
+    branch = np.where(on_wall[:, None], point - position_raw[i] * s["length"],
+                      (position_raw[np.minimum(j, model.n - 1)] - position_raw[i]) * s["length"])
+    contacts = dict(i=i.astype("i4"), j=j.astype("i4"), kind=np.ones(i.size, "i1"), normal=normal,
+                    fn=np.einsum("ij,ij->i", force, normal), ft=np.einsum("ij,ij->i", force, tangent), point=point,
+                    branch=branch, gap=-raw["overlap"] * s["length"])
+    wall_force = np.zeros((len(model.wall_names), 2))
+    np.add.at(wall_force, j[on_wall] - model.n, force[on_wall])
+    return contacts, wall_force, tensile
+
+
+def _zip(data_path, fstat_path):
+    """The two files' snapshots side by side, matched by time (one line on a mismatch)."""
+    data, fstat = iter_data(data_path), iter_fstat(fstat_path)
+    while True:
+        d, f = next(data, None), next(fstat, None)
+        if d is None and f is None:
+            return
+        if d is None or f is None:
+            longer, shorter, snap = (fstat_path, data_path, f) if d is None else (data_path, fstat_path, d)
+            raise FileFormatError(f"{longer} has a snapshot at t = {snap.time:.10g} that {shorter} does not have "
+                                  "(the two files must hold the same snapshots)")
+        if not math.isclose(d.time, f.time, rel_tol=1e-9, abs_tol=1e-12):
+            raise FileFormatError(f"mismatched snapshots: {data_path} at t = {d.time:.10g} (line {d.line}), "
+                                  f"{fstat_path} at t = {f.time:.10g} (line {f.line}) (the files must hold the same "
+                                  "snapshots: the same saveCount)")
+        yield d, f
+
+
+def mercurydpm_snapshots(data, fstat=None, restart=None, *, units=None):
+    """Read a MercuryDPM 2D run snapshot by snapshot, as the contract's per-snapshot arrays.
+
+    Parameters
+    ----------
+    data : str or path-like
+        The run's ``.data`` file.
+    fstat, restart : str or path-like, optional
+        Its ``.fstat`` and ``.restart`` (default: beside ``data``, with the same stem).
+    units : "si" or dict
+        The run's units (:func:`unit_scales`); required.
+
+    Returns
+    -------
+    (static, iterator)
+        ``static``: the particles' ``radius``, ``mass``, ``inertia`` (N,), ``n_walls``,
+        ``wall_names``, ``wall_normal`` and ``attrs``; the iterator yields one dict per snapshot
+        with ``time`` (s), ``position``, ``velocity`` (N, 2), ``angle``, ``angular_velocity``
+        (N,), ``contacts``, ``box_min``, ``box_max``, ``wall_force`` (with walls) and
+        ``tensile`` (the lines left out for a tensile normal force).
+
+    Raises
+    ------
+    FileFormatError, ParameterError
+        One line: missing units, a missing or truncated file, a 3D run, particles that differ
+        between the files or the snapshots, snapshots that differ between ``.data`` and
+        ``.fstat``, a body index out of range, a pair whose two lines disagree.
+    """
+    scales = unit_scales(units)
+    data_path = os.fspath(data)
+    fstat_path, restart_path = _sibling(data, ".fstat", fstat), _sibling(data, ".restart", restart)
+    info = read_restart(restart_path)
+    stream = _zip(data_path, fstat_path)
+    first = next(stream, None)
+    if first is None:
+        raise FileFormatError(f"{data_path}: no snapshot (an empty file)")
+    model = _Model(first[0], info, restart_path, data_path, scales)
+    wall_normal = None
+    if model.wall_names and all(axis is not None for axis in model.wall_axes):
+        wall_normal = -np.array(model.wall_axes)  # into the sample
+    attrs = {"source": "MercuryDPM", "mercurydpm_data": os.path.basename(data_path),
+             "mercurydpm_fstat": os.path.basename(fstat_path), "mercurydpm_restart": os.path.basename(restart_path),
+             "mercurydpm_units": f"1 length unit = {scales['length']:.10g} m, 1 mass unit = {scales['mass']:.10g} kg, "
+                                 f"1 time unit = {scales['time']:.10g} s",
+             "mercurydpm_particle_dimensions": info.particle_dimensions, "mercurydpm_inertia": model.inertia_rule,
+             "thickness_m": scales["length"],
+             "mercurydpm_contact_rule": "overlapping pairs with a compressive normal force, one per pair"}
+    if info.version:
+        attrs["mercurydpm_version"] = info.version
+    static = dict(radius=model.radius, mass=model.mass, inertia=model.inertia, n_walls=len(model.wall_names),
+                  wall_names=list(model.wall_names) or None, wall_normal=wall_normal, attrs=attrs)
+
+    def snapshots():
+        from .convert import chain_first
+
+        for d, f in chain_first(first, stream):
+            where = f"{fstat_path}: t = {f.time:.10g} (line {f.line})"
+            state = _particles(model, d, f"{data_path}: t = {d.time:.10g} (line {d.line})")
+            contacts, wall_force, tensile = _contacts(model, d.values[:, 0:2], f.rows, where)
+            box = d.bounds * scales["length"]
+            snap = dict(time=d.time * scales["time"], contacts=contacts, box_min=box[:2].copy(),
+                        box_max=box[2:].copy(), tensile=tensile, **state)
+            if model.wall_names:
+                snap["wall_force"] = wall_force
+            yield snap
+
+    return static, snapshots()
+
+
+def _warn_tensile(count, snapshots):
+    if count:
+        warnings.warn(f"{count} touching pair(s) over {snapshots} snapshot(s) had a tensile normal force (viscous "
+                      "damping as they separate) and were left out of the contacts", UserWarning, stacklevel=3)
+
+
+def open_mercurydpm(data, fstat=None, restart=None, *, units=None, progress=False):
+    """A MercuryDPM 2D run as an in-memory dataset of the contract.
+
+    Arguments as :func:`mercurydpm_snapshots`; ``progress`` shows a progress bar. For a run
+    too large for memory, :func:`convert_mercurydpm` writes a file snapshot by snapshot.
+
+    Returns
+    -------
+    xarray.Dataset
+        A dataset of the contract (docs/schema.md; the conversion's rules: docs/formats.md)
+        with ``velocity``, ``angular_velocity``, ``gap`` and, with walls, ``wall_force``.
+    """
+    from ..contract.dataset import make_dataset
+
+    static, stream = mercurydpm_snapshots(data, fstat, restart, units=units)
+    if progress:
+        from tqdm.auto import tqdm
+
+        stream = tqdm(stream, desc="mercurydpm", unit=" snapshots")
+    snaps = list(stream)
+    _warn_tensile(sum(s["tensile"] for s in snaps), len(snaps))
+    optional = {"velocity": np.stack([s["velocity"] for s in snaps]),
+                "angular_velocity": np.stack([s["angular_velocity"] for s in snaps])}
+    if static["n_walls"]:
+        optional["wall_force"] = np.stack([s["wall_force"] for s in snaps])
+    if static["wall_normal"] is not None:
+        optional["wall_normal"] = static["wall_normal"]
+    n = static["radius"].size
+    slots = max([contact_slots(n, static["n_walls"])] + [len(s["contacts"]["i"]) for s in snaps])
+    return make_dataset(radius=static["radius"], mass=static["mass"], inertia=static["inertia"],
+                        position=np.stack([s["position"] for s in snaps]),
+                        angle=np.stack([s["angle"] for s in snaps]), contacts=[s["contacts"] for s in snaps],
+                        box_min=np.stack([s["box_min"] for s in snaps]),
+                        box_max=np.stack([s["box_max"] for s in snaps]), time=np.array([s["time"] for s in snaps]),
+                        n_walls=static["n_walls"], wall_names=static["wall_names"], attrs=static["attrs"],
+                        n_contact_slots=slots, **optional)
+
+
+def convert_mercurydpm(out, data, fstat=None, restart=None, *, units=None, overwrite=False, compress=True,
+                       progress=False):
+    """Convert a MercuryDPM 2D run into a file of the contract, snapshot by snapshot.
+
+    The ``.data`` and ``.fstat`` files are read one snapshot at a time and each snapshot is
+    appended as it is read, so a run of any length converts in the memory of one snapshot. The
+    file is written under a hidden temporary name, validated, compressed (unless
+    ``compress=False``) and only then moved to ``out``: bad input anywhere leaves nothing.
+
+    Parameters
+    ----------
+    out : str or path-like
+        The netCDF file to write; an existing one is refused unless ``overwrite``.
+    data, fstat, restart, units
+        As :func:`mercurydpm_snapshots`.
+    overwrite, compress, progress : bool
+        Replace an existing ``out``; compress the finished file; show a progress bar.
+
+    Returns
+    -------
+    int
+        The number of snapshots written.
+
+    Raises
+    ------
+    FileExistsError
+        ``out`` exists and ``overwrite`` is False (checked before any work).
+    FileFormatError, ParameterError, SchemaError
+        Bad input (one line); nothing is written.
+    """
+    from .convert import check_out, write_snapshots
+
+    out = check_out(out, overwrite)
+    static, stream = mercurydpm_snapshots(data, fstat, restart, units=units)
+    optional = ("gap", "velocity", "angular_velocity") + (("wall_force",) if static["n_walls"] else ())
+    tensile = []
+
+    def prepare(snap):
+        tensile.append(snap.pop("tensile"))
+        return snap
+
+    count = write_snapshots(out, static, stream, optional, overwrite=overwrite, compress=compress, progress=progress,
+                            label="mercurydpm", prepare=prepare)
+    _warn_tensile(sum(tensile), count)
+    return count
