@@ -41,6 +41,8 @@ def write_snapshots(out, static, snapshots, optional, *, overwrite=False, compre
         The file to write (:func:`check_out` is applied).
     static : dict
         ``radius``, ``mass``, ``inertia`` (N,), and optionally ``n_vertices`` (default: disks),
+        ``vertices`` (N, V, 2: the polygons' own-frame vertices, :mod:`grainview.contract.shapes`;
+        absent: regular polygons),
         ``n_walls``, ``wall_names``, ``wall_normal`` and ``attrs`` (global attributes).
     snapshots : iterable of dict
         One dict per snapshot, as :meth:`~grainview.contract.writer.SnapshotWriter.append` takes it
@@ -78,6 +80,7 @@ def write_snapshots(out, static, snapshots, optional, *, overwrite=False, compre
     try:
         with SnapshotWriter.create(temporary, radius=static["radius"], mass=static["mass"], inertia=static["inertia"],
                                    n_vertices=static.get("n_vertices", np.zeros(n, "i4")),
+                                   vertices=static.get("vertices"),
                                    n_walls=static.get("n_walls", 0), wall_names=static.get("wall_names"),
                                    wall_normal=static.get("wall_normal"), optional=tuple(optional),
                                    attrs=static.get("attrs")) as writer:

@@ -3,7 +3,7 @@
 An LMGC90 run folder holds ``DATBOX/`` (the model: ``BODIES.DAT``, ``BULK_BEHAV.DAT``) and
 ``OUTBOX/`` (``DOF.OUT.n`` and ``Vloc_Rloc.OUT.n``, one snapshot each; the file layer is
 :mod:`grainview.formats.lmgc90_text`). The reader takes RBDY2 bodies with one contactor each:
-``DISKx`` (a disk), ``POLYG`` (a polygon, which must be regular) or ``JONCx`` (a wall), and the
+``DISKx`` (a disk), ``POLYG`` (a convex polygon) or ``JONCx`` (a wall), and the
 contact families ``DKDKx``, ``DKJCx``, ``PLPLx``, ``PLJCx`` and ``DKPLx``.
 
 How the contract's quantities are made (docs/formats.md states the same for users):
@@ -13,11 +13,20 @@ How the contract's quantities are made (docs/formats.md states the same for user
   left`` (in that order) and their inner faces are the sample box; other walls are named
   ``jonc<number>`` in file order, and the box is then the particles' bounding box.
 * ``position = reference + X(1:2)`` (DOF.OUT's displacement from BODIES.DAT's node),
-  ``velocity = V(1:2)``, ``angular_velocity = V(3)``. A disk's ``angle`` is ``X(3)``; a
-  polygon's is the angle of its first vertex in BODIES.DAT plus ``X(3)``, so that vertex k lies
-  at ``angle + 2 pi k / n`` (the contract's regular n-gon); its ``radius`` is the distance of
-  the vertices from the centre. A POLYG whose vertices are not a regular polygon centred on the
-  body's node is refused.
+  ``velocity = V(1:2)``, ``angular_velocity = V(3)``. A disk's ``angle`` is ``X(3)``.
+* A POLYG lists its vertices ``u_k`` relative to the body's node in the reference frame, and
+  LMGC90 puts vertex k at ``reference + X(1:2) + Rot(X(3)) u_k``. A regular one (centred on
+  the node, :func:`regular_polygon`) is the contract's regular n-gon: ``angle`` is the angle of
+  its first vertex in BODIES.DAT plus ``X(3)``, so that vertex k lies at
+  ``angle + 2 pi k / n``; its ``radius`` is the distance of the vertices from the centre. Any
+  other convex POLYG is stored by its vertices (``vertices``, :mod:`grainview.contract.shapes`):
+  with ``g`` the centroid of the ``u_k`` (counter-clockwise; a clockwise list is reversed), the
+  own-frame vertices are ``u_k - g``, ``angle = X(3)`` and ``position = reference + X(1:2) +
+  Rot(X(3)) g`` (the centroid: LMGC90's node usually is it, to BODIES.DAT's 8 digits), so that
+  ``position + Rot(angle) (u_k - g)`` is LMGC90's vertex k; ``radius`` is the farthest vertex
+  from ``g``. A file with such a polygon holds the vertices of every polygon (the regular
+  ones' :func:`grainview.contract.shapes.regular_vertices`). A POLYG that is not convex is
+  refused.
 * ``mass = density pi avrd^2`` (``density`` the bulk behaviour's ``Umas``), ``inertia = mass
   gyrd^2``; LMGC90's 2D bodies are slabs of unit thickness (``thickness_m = 1``).
 * LMGC90 writes, for each candidate-antagonist entry, the unit normal ``n = (n(1), n(2))``
@@ -50,16 +59,18 @@ import os
 import numpy as np
 
 from ..contract.errors import FileFormatError
+from ..contract.shapes import polygon_properties, regular_vertices, shape_problems
 from .lmgc90_text import output_files, read_bodies, read_bulk_behav, read_dof, read_vloc_rloc
 
-__all__ = ["lmgc90_snapshots", "open_lmgc90", "convert_lmgc90", "FAMILIES", "BOX_WALLS", "regular_polygon"]
+__all__ = ["lmgc90_snapshots", "open_lmgc90", "convert_lmgc90", "FAMILIES", "BOX_WALLS", "regular_polygon",
+           "centred_polygon"]
 
 FAMILIES = ("DKDKx", "DKJCx", "PLPLx", "PLJCx", "DKPLx")
 """The contact families the reader takes (candidate contactor, then antagonist)."""
 BOX_WALLS = ("bottom", "right", "top", "left")
 """Names (and order) of the walls of a box of four JONCx."""
 _PARTICLE_CONTACTORS = {"DISKx", "POLYG"}
-_IRREGULAR = "irregular POLYG: the contract holds regular polygons only until vertex lists are added"
+_NOT_CONVEX = "a POLYG whose vertices are not a convex polygon (the contract holds convex polygons only)"
 
 
 def regular_polygon(vertices, rtol=1e-5):
@@ -94,6 +105,34 @@ def regular_polygon(vertices, rtol=1e-5):
     return radius, n, phi
 
 
+def centred_polygon(vertices):
+    """A convex polygon's vertices in its own frame: counter-clockwise (a clockwise list
+    reversed) and shifted so that their centroid is the origin.
+
+    Parameters
+    ----------
+    vertices : array_like, (n, 2)
+        The vertices (m) relative to any point, in the order of the outline.
+
+    Returns
+    -------
+    (ndarray, ndarray) or None
+        ``(v, g)``: the (n, 2) vertices ``u_k - g`` and the centroid ``g`` (2,) of the given
+        ones; None when they are not a convex polygon.
+    """
+    u = np.asarray(vertices, float)
+    if u.ndim != 2 or u.shape[0] < 3:
+        return None
+    if polygon_properties(u[None])["area"][0] < 0:
+        u = u[::-1]
+    g = polygon_properties(u[None])["centroid"][0]
+    v = u - g
+    radius = float(np.hypot(v[:, 0], v[:, 1]).max())
+    if shape_problems([radius], [len(v)], v[None]):
+        return None
+    return v, g
+
+
 class _Model:
     """The static part of a run, from DATBOX: particles, walls and how bodies map to them."""
 
@@ -126,6 +165,8 @@ class _Model:
         n = len(particles)
         self.radius, self.n_vertices, self.angle0 = np.zeros(n), np.zeros(n, "i4"), np.zeros(n)
         self.mass, self.inertia = np.zeros(n), np.zeros(n)
+        self.offset = np.zeros((n, 2))  # the centroid of an irregular POLYG relative to its node
+        own = {}  # particle -> own-frame vertices, for the irregular POLYGs
         for k, body in enumerate(particles):
             where = f"{bodies_path}: body {body.number}"
             tact = body.contactors[0]
@@ -133,15 +174,26 @@ class _Model:
                 self.radius[k] = tact.values.get("byrd", float("nan"))
             else:
                 shape = regular_polygon(tact.vertices)
-                if shape is None:
-                    raise FileFormatError(f"{where}: {_IRREGULAR}")
-                self.radius[k], self.n_vertices[k], self.angle0[k] = shape
+                if shape is not None:
+                    self.radius[k], self.n_vertices[k], self.angle0[k] = shape
+                else:
+                    centred = centred_polygon(tact.vertices)
+                    if centred is None:
+                        raise FileFormatError(f"{where}: {_NOT_CONVEX}")
+                    own[k], self.offset[k] = centred
+                    self.radius[k], self.n_vertices[k] = np.hypot(*own[k].T).max(), len(own[k])
             if body.behav not in density:
                 raise FileFormatError(f"{where}: bulk behaviour {body.behav!r} is not in {behav_path}")
             if not (self.radius[k] > 0 and body.avrd > 0 and body.gyrd > 0):
                 raise FileFormatError(f"{where}: radius, avrd and gyrd must be > 0")
             self.mass[k] = density[body.behav] * math.pi * body.avrd ** 2
             self.inertia[k] = self.mass[k] * body.gyrd ** 2
+        self.vertices = None  # regular polygons only
+        if own:
+            self.vertices = np.full((n, int(self.n_vertices.max()), 2), np.nan)
+            for k in np.flatnonzero(self.n_vertices >= 3):
+                count = int(self.n_vertices[k])
+                self.vertices[k, :count] = own[k] if k in own else regular_vertices(self.radius[k], count)
         self.reference = np.array([body.reference[:2] for body in particles])
         self.numbers = np.array([body.number for body in particles], np.int64)
         self.kinds = [body.contactors[0].kind for body in particles]
@@ -199,7 +251,11 @@ def _state(model, dof, where):
     k = np.array([row[int(b)] for b in model.numbers])
     X, V = dof.X[k], dof.V[k]
     walls = np.array([w.reference + dof.X[row[int(w.number)]] for w in model.walls]).reshape(-1, 3)
-    return model.reference + X[:, :2], model.angle0 + X[:, 2], V[:, :2].copy(), V[:, 2].copy(), walls
+    c, s = np.cos(X[:, 2]), np.sin(X[:, 2])
+    g = model.offset  # an irregular POLYG's centroid, turned with the body
+    centroid = np.stack([c * g[:, 0] - s * g[:, 1], s * g[:, 0] + c * g[:, 1]], -1)
+    return (model.reference + X[:, :2] + centroid, model.angle0 + X[:, 2], V[:, :2].copy(), V[:, 2].copy(),
+            walls)
 
 
 def _box(model, position, walls):
@@ -295,7 +351,8 @@ def lmgc90_snapshots(run):
     -------
     (static, iterator)
         ``static``: a dict of the particles' ``radius``, ``n_vertices``, ``mass``, ``inertia``
-        (arrays, (N,)), ``n_walls``, ``wall_names`` and ``attrs`` (the conversion's provenance);
+        (arrays, (N,)), ``vertices`` ((N, V, 2), or None when every POLYG is regular),
+        ``n_walls``, ``wall_names`` and ``attrs`` (the conversion's provenance);
         the iterator yields one dict per snapshot with ``time`` (s), ``step``, ``position``
         (N, 2), ``angle`` (N,), ``velocity`` (N, 2), ``angular_velocity`` (N,), ``contacts``
         (dict of contract contact arrays), ``box_min``, ``box_max`` (2,) and, with walls,
@@ -306,7 +363,7 @@ def lmgc90_snapshots(run):
     ------
     FileFormatError
         One line naming what is wrong: a missing DATBOX or OUTBOX file, a body with another
-        contactor than DISKx, POLYG or JONCx, an irregular POLYG, an unknown contact family, a
+        contactor than DISKx, POLYG or JONCx, a POLYG that is not convex, an unknown contact family, a
         truncated file, DOF.OUT and Vloc_Rloc.OUT of different steps.
     """
     run, datbox, outbox = _run_folders(run)
@@ -320,6 +377,7 @@ def lmgc90_snapshots(run):
              "lmgc90_contact_rule": "body pairs with a compressive normal force; two points on a pair make a double "
                                     "contact"}
     static = dict(radius=model.radius, n_vertices=model.n_vertices, mass=model.mass, inertia=model.inertia,
+                  vertices=model.vertices,
                   n_walls=len(model.wall_names), wall_names=list(model.wall_names) or None, attrs=attrs)
 
     def snapshots():
@@ -372,6 +430,8 @@ def open_lmgc90(run, *, progress=False):
                 "angular_velocity": np.stack([s["angular_velocity"] for s in snaps])}
     if static["n_walls"]:
         optional["wall_force"] = np.stack([s["wall_force"] for s in snaps])
+    if static["vertices"] is not None:
+        optional["vertices"] = static["vertices"]
     return make_dataset(radius=static["radius"], n_vertices=static["n_vertices"], mass=static["mass"],
                         inertia=static["inertia"], position=np.stack([s["position"] for s in snaps]),
                         angle=np.stack([s["angle"] for s in snaps]), contacts=[s["contacts"] for s in snaps],

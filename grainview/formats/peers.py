@@ -4,7 +4,9 @@ The cross-check harness (``benchmarks/crosscheck/``) drives Box2D 2.3 and pymunk
 paper's biaxial test on a sample of this project and saves each engine's state as *raw
 snapshots*: a folder of ``snap_000000.npz``, ``snap_000001.npz``, ... and a ``meta.json`` (the
 engine, its version and settings, the protocol), beside the sample's own ``.npz`` (masses,
-radii, vertex counts, time step). Each raw snapshot holds, in SI units:
+radii, vertex counts, time step and, for polygons other than regular ones, ``vertices``: each
+polygon's vertices in its own frame, as the contract stores them, :mod:`grainview.contract.shapes`;
+passed on to the file as they are). Each raw snapshot holds, in SI units:
 
 * ``time`` (s), ``step``; ``position`` (N, 2), ``angle`` (N,), ``velocity`` (N, 2),
   ``angular_velocity`` (N,); ``wall_position``, ``wall_velocity`` (4, 2) for the walls bottom,
@@ -121,15 +123,16 @@ def peer_snapshots(raw_dir, sample, engine=None):
         The engine's output folder (``snap_*.npz`` and ``meta.json``).
     sample : str or path-like
         The sample's ``.npz`` the engine started from (``radius``, ``n_vertices``, ``mass``,
-        ``inertia``, ``time_step``).
+        ``inertia``, ``time_step``; optionally ``vertices``, (N, V, 2) m).
     engine : {"box2d", "pymunk"}, optional
         Refuse a folder written by another engine (``meta.json``'s ``engine``).
 
     Returns
     -------
     (static, iterator)
-        ``static``: the particles' arrays, ``meta`` (the engine's settings) and ``attrs`` (global
-        attributes of the run); the iterator yields one dict per snapshot for
+        ``static``: the particles' arrays (``vertices`` None when the sample has none),
+        ``meta`` (the engine's settings) and ``attrs`` (global attributes of the run); the
+        iterator yields one dict per snapshot for
         :meth:`grainview.contract.writer.SnapshotWriter.append`, with ``raw`` (the raw arrays) besides.
 
     Raises
@@ -161,6 +164,7 @@ def peer_snapshots(raw_dir, sample, engine=None):
                    "n_steps": "biaxial_steps"}[key]] = meta[key]
     static = dict(radius=radius, n_vertices=np.asarray(data["n_vertices"], np.int32),
                   mass=np.asarray(data["mass"], float), inertia=np.asarray(data["inertia"], float), meta=meta,
+                  vertices=np.asarray(data["vertices"], float) if "vertices" in data else None,
                   attrs=attrs, files=files)
 
     def snapshots():
@@ -193,6 +197,8 @@ def open_peer(raw_dir, sample, engine=None):
         impulse[k, :len(s["normal_impulse"])] = s["normal_impulse"]
     optional = {name: np.stack([s[name] for s in snaps]) for name in OPTIONAL if name != "normal_impulse"}
     optional["normal_impulse"] = impulse
+    if static["vertices"] is not None:
+        optional["vertices"] = static["vertices"]
     return make_dataset(radius=static["radius"], n_vertices=static["n_vertices"], mass=static["mass"],
                         inertia=static["inertia"], position=np.stack([s["position"] for s in snaps]),
                         angle=np.stack([s["angle"] for s in snaps]),

@@ -29,7 +29,7 @@ import xarray as xr
 
 import grainview
 from grainview.contract.errors import FileFormatError
-from grainview.formats.lmgc90 import convert_lmgc90, open_lmgc90, regular_polygon
+from grainview.formats.lmgc90 import centred_polygon, convert_lmgc90, open_lmgc90, regular_polygon
 from grainview.formats.lmgc90_text import fortran_float
 
 DATA = Path(__file__).resolve().parents[1] / "data" / "lmgc90"
@@ -182,6 +182,61 @@ def test_regular_polygon_finds_radius_count_and_offset():
     assert regular_polygon([(1, 0), (0, 1), (-1, 0), (0, -1.01)]) is None  # one vertex off the circle
     assert regular_polygon([(1, 0), (0, 1), (-1, 0), (0.6, -0.8)]) is None  # on the circle, unevenly spaced
     assert regular_polygon([(2, 0), (1, 1), (0, 0), (1, -1)]) is None  # a square off the body's node
+
+
+def test_centred_polygon_by_hand():
+    """A right triangle given clockwise around a point off its centroid: reversed to
+    counter-clockwise and shifted by its centroid (1, 1) (legs 3 and 3 from (0, 0): centroid at
+    a third of each leg)."""
+    v, g = centred_polygon([(0, 0), (0, 3), (3, 0)])
+    np.testing.assert_allclose(g, [1.0, 1.0], rtol=0, atol=1e-15)
+    np.testing.assert_allclose(v, [[2, -1], [-1, 2], [-1, -1]], rtol=0, atol=1e-15)  # (3,0), (0,3), (0,0) - g
+    assert centred_polygon([(0, 0), (2, 0), (0.5, 0.5), (0, 2)]) is None  # a dart: not convex
+    assert centred_polygon([(0, 0), (1, 0)]) is None
+
+
+def test_an_irregular_polygon_keeps_lmgc90_vertices(tmp_path):
+    """The first POLYG stretched to a kite (its first vertex moved from x = 0.525 to 1.525 m,
+    so the body's node is far from the polygon's centroid): stored by its vertices, and
+    position + Rot(angle) v_k is LMGC90's vertex k, reference + X(1:2) + Rot(X(3)) u_k, in every
+    snapshot; the other polygons are the regular ones of the file without it."""
+    from grainview.contract.shapes import body_vertices, polygon_properties, world_vertices
+    from grainview.contract.validation import validate
+
+    folder = _copy(tmp_path, "kite", ("DATBOX/BODIES.DAT", _irregular))
+    ds, regular = open_lmgc90(folder), open_lmgc90(SAMPLE)
+    validate(ds)
+    bodies = plain_bodies(folder)
+    particles, _ = particle_bodies(folder)
+    u = np.array(bodies[particles[0]][4])
+    assert u[0, 0] == pytest.approx(1.52501909, rel=1e-9)
+    vertices = ds["vertices"].values
+    assert vertices.shape == (48, 5, 2) and int(ds["n_vertices"][0]) == 5
+    kite = polygon_properties(u[None])
+    np.testing.assert_allclose(vertices[0], u - kite["centroid"][0], rtol=0, atol=1e-14)
+    assert float(ds["radius"][0]) == pytest.approx(np.hypot(*(u - kite["centroid"][0]).T).max(), rel=1e-15)
+    others = np.arange(1, 48)
+    np.testing.assert_array_equal(vertices[others], body_vertices(regular["radius"].values[others],
+                                                                  regular["n_vertices"].values[others])[:, :5])
+    np.testing.assert_array_equal(ds["angle"].values[:, others], regular["angle"].values[:, others])
+    np.testing.assert_array_equal(ds["position"].values[:, others], regular["position"].values[:, others])
+    for k in range(ds.sizes["time"]):
+        dof = plain_dof(folder / "OUTBOX" / f"DOF.OUT.{k + 1}")[particles[0]]
+        c, s = math.cos(dof[2]), math.sin(dof[2])
+        lmgc = u @ np.array([[c, s], [-s, c]]) + [bodies[particles[0]][1] + dof[0], bodies[particles[0]][2] + dof[1]]
+        ours = world_vertices(ds["position"].values[k], ds["angle"].values[k], vertices)[0]
+        np.testing.assert_allclose(ours, lmgc, rtol=0, atol=1e-13)
+        assert float(ds["angle"][k, 0]) == dof[2]
+    # the solid fraction counts the kite's shoelace area instead of the pentagon's
+    before = regular.grain.solid_fraction().values * (regular["box_max"] - regular["box_min"]).prod("xy").values
+    after = ds.grain.solid_fraction().values * (ds["box_max"] - ds["box_min"]).prod("xy").values
+    pentagon = 2.5 * float(regular["radius"][0]) ** 2 * math.sin(2 * math.pi / 5)
+    np.testing.assert_allclose(after - before, kite["area"][0] - pentagon, rtol=1e-12)
+    out = tmp_path / "kite.nc"
+    convert_lmgc90(out, folder)
+    with grainview.open_dataset(out) as on_file:
+        np.testing.assert_array_equal(on_file["vertices"].values, vertices)
+        np.testing.assert_array_equal(on_file["position"].values, ds["position"].values)
 
 
 # --- contacts and forces ----------------------------------------------------------------------
@@ -420,11 +475,21 @@ def _copy(tmp_path, name, edit=None):
 
 
 def _irregular(text):
-    """The first POLYG with one vertex moved off its circle."""
+    """The first POLYG with one vertex moved off its circle, outwards (x 0.525 -> 1.525 m):
+    still convex."""
     head, tail = text.split("POLYG", 1)
     line = tail.split("\n")[1]
     moved = line.replace("coo1= ", "coo1= 1", 1) if "coo1= " in line else line.replace("coo1=-", "coo1=-1", 1)
     return head + "POLYG" + tail.replace(line, moved, 1)
+
+
+def _concave(text):
+    """The first POLYG with its first vertex (on the x axis) pulled to a tenth of its
+    distance: inside the chord of its neighbours, so the outline turns clockwise there."""
+    head, tail = text.split("POLYG", 1)
+    line = tail.split("\n")[1]
+    assert "coo1= 5.2501909E-01" in line
+    return head + "POLYG" + tail.replace(line, line.replace("E-01", "E-02", 1), 1)
 
 
 @pytest.mark.parametrize("name,edit,match", [
@@ -436,8 +501,8 @@ def _irregular(text):
      "unknown contactor type: contact family 'PLALp'"),
     ("no-bodies", ("DATBOX/BODIES.DAT", None), "no DATBOX/BODIES.DAT"),
     ("no-vloc", ("OUTBOX/Vloc_Rloc.OUT.2", None), "DOF.OUT.2 has no Vloc_Rloc.OUT.2"),
-    ("irregular", ("DATBOX/BODIES.DAT", _irregular),
-     "irregular POLYG: the contract holds regular polygons only until vertex lists are added"),
+    ("concave", ("DATBOX/BODIES.DAT", _concave),
+     "body 1: a POLYG whose vertices are not a convex polygon (the contract holds convex polygons only)"),
     ("steps", ("OUTBOX/Vloc_Rloc.OUT.2", lambda t: t.replace("$steps      200", "$steps      201")),
      "must be of the same step"),
     ("not-lmgc90", ("OUTBOX/DOF.OUT.1", lambda t: "hello\n" + t), "not an LMGC90 OUTBOX file"),

@@ -118,3 +118,24 @@ def test_bad_input_gets_one_line_and_writes_nothing(tmp_path, spoil, match):
 def test_another_engines_folder_is_refused():
     with pytest.raises(ParameterError, match="written by 'box2d', not 'pymunk'"):
         grainview.open_dataset(DATA / "box2d", format="pymunk", sample=SAMPLE)
+
+
+def test_a_sample_with_vertex_lists_passes_them_on(tmp_path):
+    """A sample .npz holding ``vertices`` (here the pentagons turned by 0.1 rad in their own
+    frames, a shape the contract accepts) gives them to the dataset and the file unchanged;
+    without the key the file has no ``vertices`` (regular polygons)."""
+    from grainview.contract.shapes import body_vertices
+
+    data = dict(np.load(SAMPLE))
+    radius, n = data["radius"], data["n_vertices"]
+    turn = np.array([[np.cos(0.1), np.sin(0.1)], [-np.sin(0.1), np.cos(0.1)]])
+    data["vertices"] = body_vertices(radius, n) @ turn
+    sample = tmp_path / "sample.npz"
+    np.savez(sample, **data)
+    ds = open_peer(DATA / "box2d", sample)
+    np.testing.assert_array_equal(ds["vertices"].values, data["vertices"])
+    out = tmp_path / "box2d.nc"
+    convert_peer(out, DATA / "box2d", sample, engine="box2d")
+    with grainview.open_dataset(out, validate=True) as on_file:
+        np.testing.assert_array_equal(on_file["vertices"].values, data["vertices"])
+    assert "vertices" not in open_peer(DATA / "box2d", SAMPLE).variables
