@@ -67,7 +67,8 @@ def filtration_edges(fn, i, j, mask):
     u, v : ndarray of int64, shape (E,)
         The edges' endpoints (u < v), each pair once (a pair listed twice keeps its larger force).
     value : ndarray of float64, shape (E,)
-        xi_e = f_n / <f_n> (dimensionless), <f_n> the mean over the selection; non-increasing.
+        xi_e = f_n / <f_n> (dimensionless), <f_n> the mean over the selection (0 for every edge
+        when <f_n> = 0: a selection of unloaded near pairs); non-increasing.
     """
     mask = np.asarray(mask, bool)
     if not mask.any():
@@ -75,7 +76,9 @@ def filtration_edges(fn, i, j, mask):
         return empty, empty, np.empty(0)
     a = np.asarray(i)[mask].astype(np.int64)
     b = np.asarray(j)[mask].astype(np.int64)
-    value = np.asarray(fn, np.float64)[mask] / mean_normal_force(fn, mask)
+    mean = mean_normal_force(fn, mask)
+    forces = np.asarray(fn, np.float64)[mask]
+    value = forces / mean if mean > 0 else np.zeros_like(forces)  # only unloaded pairs: all enter at xi = 0
     if np.any(a == b) or np.any(a < 0) or np.any(b < 0):
         raise ParameterError("network persistence: a selected contact joins a body to itself or to a "
                              "negative body id; expected two different bodies >= 0")

@@ -326,3 +326,11 @@ def test_figures_draw_the_analysis_with_labelled_axes():
     fig = plot_network_topology({"a": ds, "b": ds})
     assert len(fig.axes) == 3 and all(a.get_xlabel() and a.get_ylabel() for a in fig.axes)
     plt.close("all")
+
+
+def test_unloaded_pairs_all_enter_at_zero():
+    """A selection of near pairs only (f_n = 0, <f_n> = 0): every contact at xi = 0, no NaN."""
+    u, v, value = nt.filtration_edges(np.zeros(3), np.array([0, 1, 0]), np.array([1, 2, 2]), np.ones(3, bool))
+    assert value.tolist() == [0.0, 0.0, 0.0]
+    assert as_pairs(*nt.diagram_0(u, v, value, 3)) == [(0.0, -INF)]
+    assert nt.betti_curve(*nt.diagram_0(u, v, value, 3), [0.0, 0.1]).tolist() == [1, 0]
