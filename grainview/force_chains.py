@@ -102,8 +102,9 @@ def force_chains(ds: xr.Dataset, angle: float = DEFAULT_ANGLE, min_size: int = 3
         ``max_length`` particles or more.
     follow : bool, default False
         Also follow the chains from snapshot to snapshot by their shared members
-        (:func:`grainview.arrays.force_chains.follow_chains`) and give their lifetimes. This
-        computes the chain ids (one time chunk at a time); the rest stays lazy.
+        (:func:`grainview.arrays.force_chains.follow_chains`) and give their lifetimes. The
+        tracks need every snapshot's chains, so the result is then computed (in one pass over
+        the data, one time chunk at a time).
 
     Returns
     -------
@@ -121,7 +122,7 @@ def force_chains(ds: xr.Dataset, angle: float = DEFAULT_ANGLE, min_size: int = 3
         chain's track id, and over ``track``: ``first``, ``last`` (snapshot indices),
         ``birth``, ``death`` (s), ``lifetime`` (snapshots seen), ``duration`` (death - birth, s),
         ``mean_size`` (particles) and ``censored`` (seen in the first or last snapshot, so
-        its life may be longer). Lazy on dask input (except the tracks).
+        its life may be longer). Lazy on dask input unless ``follow``.
 
     Raises
     ------
@@ -171,7 +172,8 @@ def force_chains(ds: xr.Dataset, angle: float = DEFAULT_ANGLE, min_size: int = 3
     out = out.assign_coords(length=("length", lengths, {
         "units": "1", "long_name": f"chain length, particles (the last bin: {max_length} or more)"}))
     out.attrs.update(angle_deg=float(angle), min_size=int(min_size), max_length=int(max_length))
-    if follow:
+    if follow:  # the tracks need every snapshot's ids: compute everything in one pass
+        out = out.compute()
         out = out.merge(_tracks(out["chain"], ds["time"]))
     return out
 

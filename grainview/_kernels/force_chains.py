@@ -8,7 +8,7 @@ import numpy as np
 from numba import njit
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def _root(parent, p):
     while parent[p] != p:
         parent[p] = parent[parent[p]]
@@ -16,7 +16,7 @@ def _root(parent, p):
     return p
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def label_components(i, j, link, n_particles, min_size):
     """Chain id of every particle of every row: the connected sets of the graph whose edges are
     the linked contacts, those of at least ``min_size`` particles numbered 0, 1, ... in the
@@ -55,4 +55,62 @@ def label_components(i, j, link, n_particles, min_size):
                     label[root] = following
                     following += 1
                 out[r, p] = label[root]
+    return out
+
+
+@njit(cache=True, nogil=True)
+def accumulate_moments(i, j, fx, fy, px, py, x, y, mask):
+    """Sum over each particle's contacts of s f (x) (x^c - x_p), one row per snapshot.
+
+    Structure of arrays, all (R, C) but the centres ``x``, ``y`` (R, P): bodies ``i``, ``j``
+    (int64), force components ``fx``, ``fy`` (N), application point ``px``, ``py`` (m),
+    ``mask`` (bool). s = +1 for body i and -1 for body j; a body outside [0, P) (a wall, an
+    empty slot) gets nothing. Result (R, P, 2, 2), N m, [a, b] = f_a (x^c - x_p)_b.
+    """
+    n_rows, n_slots = i.shape
+    n_part = x.shape[1]
+    out = np.zeros((n_rows, n_part, 2, 2))
+    for r in range(n_rows):
+        for c in range(n_slots):
+            if not mask[r, c]:
+                continue
+            f0 = fx[r, c]
+            f1 = fy[r, c]
+            for side in range(2):
+                p = i[r, c] if side == 0 else j[r, c]
+                if p < 0 or p >= n_part:
+                    continue
+                s = 1.0 if side == 0 else -1.0
+                a0 = px[r, c] - x[r, p]
+                a1 = py[r, c] - y[r, p]
+                out[r, p, 0, 0] += s * f0 * a0
+                out[r, p, 0, 1] += s * f0 * a1
+                out[r, p, 1, 0] += s * f1 * a0
+                out[r, p, 1, 1] += s * f1 * a1
+    return out
+
+
+@njit(cache=True, nogil=True)
+def aligned_links(i, j, bx, by, mask, candidate, dx, dy, cos_limit):
+    """Boolean (R, C): the slots of ``mask`` between two particles of ``candidate`` (R, P)
+    whose branch vector (``bx``, ``by``) makes |cos| >= ``cos_limit`` with both particles'
+    unit major directions (``dx``, ``dy``, (R, P))."""
+    n_rows, n_slots = i.shape
+    n_part = candidate.shape[1]
+    out = np.zeros((n_rows, n_slots), dtype=np.bool_)
+    for r in range(n_rows):
+        for c in range(n_slots):
+            if not mask[r, c]:
+                continue
+            a = i[r, c]
+            b = j[r, c]
+            if a < 0 or b < 0 or a >= n_part or b >= n_part or not candidate[r, a] or not candidate[r, b]:
+                continue
+            length = np.sqrt(bx[r, c] ** 2 + by[r, c] ** 2)
+            if length == 0.0:
+                continue
+            ux = bx[r, c] / length
+            uy = by[r, c] / length
+            if abs(ux * dx[r, a] + uy * dy[r, a]) >= cos_limit and abs(ux * dx[r, b] + uy * dy[r, b]) >= cos_limit:
+                out[r, c] = True
     return out

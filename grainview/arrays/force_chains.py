@@ -22,15 +22,15 @@ For each snapshot:
    makes an angle of at most ``angle`` with the major direction of both (|cos| >= cos angle);
 5. chains: the connected sets of linked particles of at least ``min_size`` (3) particles.
 
-The connected sets come from a union-find kernel (:mod:`grainview._kernels.force_chains`); the
-rest is vectorised over every snapshot at once.
+The per-contact sums, the link test and the connected sets (union-find) are numba kernels
+(:mod:`grainview._kernels.force_chains`) over every snapshot at once; the rest is numpy.
 """
 
 from __future__ import annotations
 
 import numpy as np
 
-from .._kernels.force_chains import label_components
+from .._kernels.force_chains import accumulate_moments, aligned_links, label_components
 from .signature import CONTACT, CONTACT_XY, PARTICLE, SCALAR, TENSOR, core_dims
 from .tensors import principal
 from .vectors import force_vectors
@@ -65,24 +65,16 @@ def particle_moments(i, j, fn, ft, normal, point, mask, position):
     """
     lead = np.broadcast_shapes(np.shape(fn), np.shape(mask), np.shape(i))
     n_part = np.shape(position)[-2]
-    i = _rows(np.broadcast_to(i, lead), 1).astype(np.int64)
-    j = _rows(np.broadcast_to(j, lead), 1).astype(np.int64)
-    mask = _rows(np.broadcast_to(mask, lead), 1).astype(bool)
-    force = _rows(force_vectors(np.broadcast_to(fn, lead), np.broadcast_to(ft, lead),
-                                np.broadcast_to(normal, lead + (2,))), 2)
-    point = _rows(np.broadcast_to(point, lead + (2,)), 2)
-    position = _rows(np.broadcast_to(position, lead[:-1] + np.shape(position)[-2:]), 2)
-    n_rows = i.shape[0]
-    row = np.arange(n_rows)[:, None]
-    moments = np.zeros((n_rows * n_part, 4))
-    for body, sign in ((i, 1.0), (j, -1.0)):
-        use = mask & (body >= 0) & (body < n_part)
-        safe = np.where(use, body, 0)
-        arm = point - position[row, safe]
-        where = (row * n_part + safe)[use]
-        f, r = force[use], arm[use]
-        for k, (a, b) in enumerate(((0, 0), (0, 1), (1, 0), (1, 1))):
-            moments[:, k] += sign * np.bincount(where, weights=f[:, a] * r[:, b], minlength=n_rows * n_part)
+    force = force_vectors(np.broadcast_to(fn, lead), np.broadcast_to(ft, lead), np.broadcast_to(normal, lead + (2,)))
+    point = np.broadcast_to(point, lead + (2,))
+    position = np.broadcast_to(position, lead[:-1] + (n_part, 2))
+    moments = accumulate_moments(_rows(np.broadcast_to(i, lead), 1).astype(np.int64),
+                                 _rows(np.broadcast_to(j, lead), 1).astype(np.int64),
+                                 _rows(force[..., 0], 1), _rows(force[..., 1], 1),
+                                 _rows(point[..., 0], 1).astype(np.float64), _rows(point[..., 1], 1).astype(np.float64),
+                                 _rows(position[..., 0], 1).astype(np.float64),
+                                 _rows(position[..., 1], 1).astype(np.float64),
+                                 _rows(np.broadcast_to(mask, lead), 1).astype(bool))
     return moments.reshape(lead[:-1] + (n_part, 2, 2))
 
 
@@ -98,22 +90,16 @@ def chain_links(i, j, branch, mask, candidate, theta_1, angle):
     """Boolean (..., C): the slots of ``mask`` between two particles of ``candidate`` (..., P)
     whose branch vector lies within ``angle`` (degrees) of both particles' major directions
     ``theta_1`` (..., P, rad): |cos(phi_l - theta_1)| >= cos(angle), phi_l the branch's angle."""
-    n_part = np.shape(candidate)[-1]
-    i = np.asarray(i)
-    j = np.asarray(j)
-    pair = np.asarray(mask, bool) & (i >= 0) & (j >= 0) & (j < n_part) & (i < n_part)
-    si = np.where(pair, i, 0)
-    sj = np.where(pair, j, 0)
-    both = pair & np.take_along_axis(candidate, si, -1) & np.take_along_axis(candidate, sj, -1)
-    length = np.hypot(branch[..., 0], branch[..., 1])
-    with np.errstate(invalid="ignore", divide="ignore"):
-        ux, uy = branch[..., 0] / length, branch[..., 1] / length
-    limit = np.cos(np.deg2rad(angle))
-    aligned = both & (length > 0)
-    for s in (si, sj):
-        theta = np.take_along_axis(theta_1, s, -1)
-        aligned &= np.abs(ux * np.cos(theta) + uy * np.sin(theta)) >= limit
-    return aligned
+    candidate = np.asarray(candidate, bool)
+    lead = np.broadcast_shapes(np.shape(mask), np.shape(i), np.shape(j))
+    theta_1 = np.broadcast_to(theta_1, candidate.shape)
+    branch = np.broadcast_to(branch, lead + (2,))
+    links = aligned_links(_rows(np.broadcast_to(i, lead), 1).astype(np.int64),
+                          _rows(np.broadcast_to(j, lead), 1).astype(np.int64),
+                          _rows(branch[..., 0], 1).astype(np.float64), _rows(branch[..., 1], 1).astype(np.float64),
+                          _rows(np.broadcast_to(mask, lead), 1).astype(bool), _rows(candidate, 1),
+                          _rows(np.cos(theta_1), 1), _rows(np.sin(theta_1), 1), float(np.cos(np.deg2rad(angle))))
+    return links.reshape(lead)
 
 
 def components(i, j, link, n_particles, min_size=3):

@@ -215,6 +215,47 @@ def test_the_labelling_kernel_matches_a_breadth_first_search():
             np.testing.assert_array_equal(got[r], slow_components(i[r], j[r], link[r], n, min_size))
 
 
+def numpy_moments(i, j, fn, ft, normal, point, mask, position):
+    """The per-particle sums with np.add.at, one side of the contacts at a time."""
+    n_time, n_part = position.shape[:2]
+    out = np.zeros((n_time, n_part, 2, 2))
+    force = np.stack([fn * normal[..., 0] - ft * normal[..., 1], fn * normal[..., 1] + ft * normal[..., 0]], -1)
+    for body, sign in ((i, 1.0), (j, -1.0)):
+        t, c = np.nonzero(mask & (body >= 0) & (body < n_part))
+        p = body[t, c]
+        np.add.at(out, (t, p), sign * force[t, c, :, None] * (point[t, c] - position[t, p])[:, None, :])
+    return out
+
+
+def numpy_links(i, j, branch, mask, candidate, theta, angle):
+    """The link test with whole-array numpy operations."""
+    n_part = candidate.shape[-1]
+    pair = mask & (i >= 0) & (j >= 0) & (i < n_part) & (j < n_part)
+    si, sj = np.where(pair, i, 0), np.where(pair, j, 0)
+    u = branch / np.linalg.norm(branch, axis=-1, keepdims=True)
+    out = pair & np.take_along_axis(candidate, si, -1) & np.take_along_axis(candidate, sj, -1)
+    for s in (si, sj):
+        t = np.take_along_axis(theta, s, -1)
+        out &= np.abs(u[..., 0] * np.cos(t) + u[..., 1] * np.sin(t)) >= np.cos(np.deg2rad(angle))
+    return out
+
+
+def test_the_moment_and_link_kernels_match_numpy_versions():
+    ds = builders.mixed_contacts(seed=8, n=25, m=40, t=4)
+    args = [ds[name].values for name in ("i", "j", "fn", "ft", "normal", "point")]
+    mask = ((ds.i >= 0) & (ds.fn > 0)).values
+    moments = fc.particle_moments(*args, mask, ds.position.values)
+    np.testing.assert_allclose(moments, numpy_moments(*args, mask, ds.position.values), rtol=1e-13, atol=1e-16)
+    rng = np.random.default_rng(9)
+    candidate = rng.uniform(size=(4, 25)) < 0.6
+    theta = rng.uniform(0, np.pi, (4, 25))
+    for angle in (10.0, 45.0, 80.0):
+        got = fc.chain_links(args[0], args[1], ds.branch.values, mask, candidate, theta, angle)
+        want = numpy_links(args[0], args[1], ds.branch.values, mask, candidate, theta, angle)
+        np.testing.assert_array_equal(got, want)
+        assert want.any() and not want.all()
+
+
 def slow_chains(snap, angle):
     """Peters et al.'s steps written out particle by particle for one snapshot."""
     n = snap.sizes["particle"]
