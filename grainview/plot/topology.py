@@ -177,7 +177,7 @@ def plot_cycle_counts(data, ax=None, label=None, per_particle: bool = True):
     return finish(ax, None)
 
 
-def plot_network_topology(data, time=-1):
+def plot_network_topology(data, time=-1, label=None):
     """Three panels: (a) the persistence diagram of the first sample's snapshot ``time``,
     (b) the Betti curves and (c) the cycle counts of every sample, per particle.
 
@@ -187,6 +187,8 @@ def plot_network_topology(data, time=-1):
         Datasets of the contract, one or several samples.
     time : int, default -1
         The snapshot of panel (a).
+    label : str, optional
+        Legend label of a single sample.
 
     Returns
     -------
@@ -197,14 +199,16 @@ def plot_network_topology(data, time=-1):
     Kramár, Goullet, Kondic & Mischaikow, Phys. Rev. E 87, 042207 (2013); Tordesillas, Walker
     & Lin, Phys. Rev. E 81, 011302 (2010).
     """
-    pairs = datasets(data)
-    results = [(name, ds, _result(ds)) for name, ds in pairs]
+    pairs = datasets(data, label)
+    results = [(name, _with_particles(_result(ds), ds)) for name, ds in pairs]
     fig, axes = new_figure(3, width=4.6, height=3.8)
-    first_name, _, first = results[0]
-    plot_persistence_diagram(first, time=time, ax=axes[0], label=first_name)
-    both = [(name, _with_particles(result, ds)) for name, ds, result in results]
-    plot_betti_curves(both, ax=axes[1])
-    plot_cycle_counts(both, ax=axes[2])
+    plot_persistence_diagram(results[0][1], time=time, ax=axes[0], label=results[0][0])
+    if len(results) == 1:  # a single sample keeps its label, None included
+        plot_betti_curves(results[0][1], ax=axes[1], label=results[0][0])
+        plot_cycle_counts(results[0][1], ax=axes[2], label=results[0][0])
+    else:
+        plot_betti_curves(results, ax=axes[1])
+        plot_cycle_counts(results, ax=axes[2])
     return fig
 
 

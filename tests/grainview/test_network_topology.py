@@ -325,6 +325,10 @@ def test_figures_draw_the_analysis_with_labelled_axes():
         plot_cycle_counts(result)
     fig = plot_network_topology({"a": ds, "b": ds})
     assert len(fig.axes) == 3 and all(a.get_xlabel() and a.get_ylabel() for a in fig.axes)
+    fig = ds.grain.plot.network_topology()  # one unlabelled sample: no "None" in the legends
+    labels = [text.get_text() for a in fig.axes if a.get_legend() for text in a.get_legend().get_texts()]
+    assert labels and not any("None" in text for text in labels)
+    assert ds.grain.plot.betti_curves().get_xlabel() == r"$\xi = f_n/\langle f_n\rangle$"
     plt.close("all")
 
 
