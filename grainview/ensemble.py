@@ -219,8 +219,9 @@ def _with_parameters(ens: xr.Dataset, runs, varying) -> xr.Dataset:
         if short == "particles":
             values = [ds.sizes["particle"] for ds in runs]
         if short == "shape" and all(isinstance(v, float) and np.isnan(v) for v in values):
-            values = ["disk" if not ds["n_vertices"].values.any() else f"{int(ds['n_vertices'].max())}-gon"
-                      for ds in runs]
+            from .summary import shape_name
+
+            values = [shape_name(ds) for ds in runs]
         params[short] = ("run", np.asarray(values))
     ens = ens.assign_coords(params)
     short = [k for k in RUN_PARAMETERS if k != "seed" and len(np.unique(ens[k].values.astype(str))) > 1]

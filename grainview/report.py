@@ -77,9 +77,10 @@ def _ratio(a, b):
 
 def describe_run(ds: xr.Dataset, window: xr.DataArray, residual_strain: float) -> dict:
     """The rows that say what a run is: particles, seed, preparation, window, criterion."""
+    from .summary import regular_of, shape_counts
+
     attrs = ds.attrs
     n_vertices = ds["n_vertices"].values
-    shape = "disks" if not n_vertices.any() else f"{int(n_vertices.max())}-gons"
     eps_q = window["eps_q"] if "eps_q" in window.coords else None
     if bool(window.any()):
         lo = float(eps_q.where(window).min()) if eps_q is not None else residual_strain
@@ -93,7 +94,7 @@ def describe_run(ds: xr.Dataset, window: xr.DataArray, residual_strain: float) -
     criterion = ("-" if not n_vertices.any() else
                  "two edges facing within the alert distance" + ("" if alert is None else f" ({float(alert) * 1e3:.2g} mm)"))
     return {
-        "particles": f"{ds.sizes['particle']} {shape}",
+        "particles": shape_counts(n_vertices, regular_of(ds)),
         "seed": str(attrs.get("preparation_seed", attrs.get("solver_seed", "?"))),
         "preparation": str(preparation),
         "residual window": text,
@@ -241,11 +242,10 @@ def description_numbers(ds: xr.Dataset, residual_strain: float = RESIDUAL_STRAIN
 
 def paper_sample(ds: xr.Dataset) -> str | None:
     """The paper's sample whose particles a run has: "disks" (every particle a disk),
-    "pentagons" (every particle a pentagon) or None."""
-    n_vertices = np.asarray(ds["n_vertices"].values)
-    if not n_vertices.any():
-        return "disks"
-    return "pentagons" if (n_vertices == 5).all() else None
+    "pentagons" (every particle a regular pentagon) or None."""
+    from .summary import shape_name
+
+    return {"disk": "disks", "5-gon": "pentagons"}.get(shape_name(ds))
 
 
 def paper_key(label: str) -> str | None:
@@ -394,9 +394,9 @@ def caption(label: str, ds: xr.Dataset, what: str, residual_strain: float = RESI
     over, anything else the range of the evolution."""
     from .plot._style import residual_snapshots
     from .strain import strains
+    from .summary import regular_of, shape_counts
 
-    n_vertices = ds["n_vertices"].values
-    shape = "disks" if not n_vertices.any() else f"{int(n_vertices.max())}-gons"
+    shape = shape_counts(ds["n_vertices"].values, regular_of(ds))
     seed = ds.attrs.get("preparation_seed", ds.attrs.get("solver_seed", "?"))
     preparation = ds.attrs.get("preparation_name", "unknown")
     eps_q = strains(ds)["eps_q"]
@@ -407,7 +407,7 @@ def caption(label: str, ds: xr.Dataset, what: str, residual_strain: float = RESI
         shown = f"averaged over the {residual_snapshots(ds, residual_strain).attrs['window']}"
     else:
         shown = f"every snapshot, eps_q 0-{float(eps_q.max()):.2f} ({ds.sizes['time']} snapshots)"
-    return f"{label}: N = {ds.sizes['particle']} {shape}, seed {seed}, preparation '{preparation}'; {shown}"
+    return f"{label}: {shape}, seed {seed}, preparation '{preparation}'; {shown}"
 
 
 def write_figures(runs: dict, out: Path, time=-1, residual_strain: float = RESIDUAL_STRAIN, log=None,

@@ -12,12 +12,8 @@ def describe(ds) -> list:
     q/p reached, and the settings a physicist asks for first, in readable units (what the
     report's index says of each run; ``grainview info`` prints the same lines from the file,
     :func:`grainview.file_summary.describe_file`)."""
-    from .contract.shapes import regular_polygons
-
     snapshots = ds.sizes.get("time", 0)
-    vertices = ds["vertices"].values if "vertices" in ds.variables else None
-    facts = {"n_vertices": ds["n_vertices"].values, "n_walls": ds.sizes.get("wall", 0),
-             "regular": regular_polygons(ds["radius"].values, ds["n_vertices"].values, vertices),
+    facts = {"n_vertices": ds["n_vertices"].values, "n_walls": ds.sizes.get("wall", 0), "regular": regular_of(ds),
              "n_slots": ds.sizes["contact"], "snapshots": snapshots}
     if snapshots:
         facts.update(time=ds["time"].values, contact_count=ds["contact_count"].values)
@@ -46,6 +42,27 @@ def shape_counts(n_vertices, regular=None) -> str:
         words.append(f"{int(irregular.sum())} irregular convex polygons with "
                      f"{low if low == high else f'{low}-{high}'} vertices")
     return ", ".join(words)
+
+
+def regular_of(ds) -> np.ndarray:
+    """(P,) bool: which particles of a dataset of the contract are regular polygons
+    (:func:`grainview.contract.shapes.regular_polygons` of its ``vertices``, when it has them)."""
+    from .contract.shapes import regular_polygons
+
+    vertices = ds["vertices"].values if "vertices" in ds.variables else None
+    return regular_polygons(ds["radius"].values, ds["n_vertices"].values, vertices)
+
+
+def shape_name(ds) -> str:
+    """One name for a sample's particles: "disk" (every particle a disk), "<n>-gon" (every one
+    a regular n-gon), "irregular polygon" (every one a polygon, some irregular) or "mixed"."""
+    n_vertices = np.asarray(ds["n_vertices"].values)
+    if not n_vertices.any():
+        return "disk"
+    if (n_vertices >= 3).all():
+        return f"{int(n_vertices[0])}-gon" if (n_vertices == n_vertices[0]).all() and regular_of(ds).all() \
+            else "irregular polygon"
+    return "mixed"
 
 
 def summary_lines(facts: dict, attrs: dict) -> list:

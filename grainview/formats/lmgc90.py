@@ -59,7 +59,7 @@ import os
 import numpy as np
 
 from ..contract.errors import FileFormatError
-from ..contract.shapes import polygon_properties, regular_vertices, shape_problems
+from ..contract.shapes import polygon_properties, regular_vertices, shape_problems, vertex_phases
 from .lmgc90_text import output_files, read_bodies, read_bulk_behav, read_dof, read_vloc_rloc
 
 __all__ = ["lmgc90_snapshots", "open_lmgc90", "convert_lmgc90", "FAMILIES", "BOX_WALLS", "regular_polygon",
@@ -100,7 +100,7 @@ def regular_polygon(vertices, rtol=1e-5):
         return None
     phi = math.atan2(v[0, 1], v[0, 0])
     offset = np.sort(np.mod(np.arctan2(v[:, 1], v[:, 0]) - phi + rtol, 2 * np.pi) - rtol)
-    if np.abs(offset - 2 * np.pi * np.arange(n) / n).max() > rtol * 2 * np.pi:
+    if np.abs(offset - vertex_phases(n)).max() > rtol * 2 * np.pi:
         return None
     return radius, n, phi
 

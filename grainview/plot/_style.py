@@ -352,7 +352,7 @@ s->d and d->s), in this order."""
 def shape_key(label=None, ds: xr.Dataset | None = None) -> str | None:
     """The shape a sample is coloured by: "pentagons", "disks" or None (another shape).
 
-    The dataset decides when given (no vertices: disks; five: pentagons); otherwise the label
+    The dataset decides when given (no vertices: disks; regular pentagons: pentagons); otherwise the label
     does ("pent" or "5-gon": pentagons; "disk" or "disc": disks), as for an ensemble's groups.
 
     Parameters
@@ -368,10 +368,9 @@ def shape_key(label=None, ds: xr.Dataset | None = None) -> str | None:
         A sample key of :data:`PALETTE`, or None.
     """
     if ds is not None and "n_vertices" in ds:
-        n_vertices = np.asarray(ds["n_vertices"].values)
-        if not n_vertices.any():
-            return "disks"
-        return "pentagons" if int(n_vertices.max()) == 5 and int(n_vertices.min()) == 5 else None
+        from ..summary import shape_name
+
+        return {"disk": "disks", "5-gon": "pentagons"}.get(shape_name(ds))
     low = str(label or "").lower()
     if "pent" in low or "5-gon" in low:
         return "pentagons"

@@ -11,6 +11,7 @@ import math
 import netCDF4
 import numpy as np
 import pytest
+import xarray as xr
 from matplotlib.collections import PolyCollection
 
 import grainview
@@ -342,3 +343,32 @@ def test_vtk_export_writes_the_true_polygons(tmp_path):
     for outline, want in zip(points, _hand_world()):
         np.testing.assert_allclose(outline[:, :2], want, rtol=0, atol=1e-12)
         np.testing.assert_array_equal(outline[:, 2], 0.0)
+
+
+def test_only_regular_pentagons_are_the_papers_pentagons():
+    """Five vertices are not enough: a sample of irregular pentagons (the regular one with a
+    vertex pulled out, re-centred) is neither the paper's pentagons in the report's table nor
+    in the palette, and its report row and captions say what it is."""
+    from grainview.plot._style import shape_key
+    from grainview.report import caption, describe_run, paper_sample
+    from grainview.summary import shape_name
+
+    kite = regular_vertices(1.0, 5)
+    kite[0, 0] = 2.0
+    kite -= polygon_properties(kite[None])["centroid"][0]
+    grid = np.array([[3.0 * x, 3.0 * y] for x in range(2) for y in range(2)])
+    common = dict(position=grid, contacts=[dict(i=[], j=[], normal=np.zeros((0, 2)), fn=[])],
+                  box_min=[-2.0, -2.0], box_max=[6.0, 6.0])
+    regular = make_dataset(radius=np.ones(4), n_vertices=np.full(4, 5), **common)
+    irregular = make_dataset(radius=np.full(4, np.hypot(*kite.T).max()), n_vertices=np.full(4, 5),
+                             vertices=np.repeat(kite[None], 4, 0), **common)
+    disks = make_dataset(radius=np.ones(4), **common)
+    mixed = make_dataset(radius=np.ones(4), n_vertices=[0, 5, 5, 0], **common)
+    assert [shape_name(ds) for ds in (regular, irregular, disks, mixed)] == [
+        "5-gon", "irregular polygon", "disk", "mixed"]
+    assert [paper_sample(ds) for ds in (regular, irregular, disks, mixed)] == ["pentagons", None, "disks", None]
+    assert [shape_key(ds=ds) for ds in (regular, irregular, disks, mixed)] == ["pentagons", None, "disks", None]
+    window = xr.DataArray(np.zeros(1, bool), dims="time")
+    assert describe_run(irregular, window, 0.3)["particles"] == "4 irregular convex polygons with 5 vertices"
+    assert describe_run(regular, window, 0.3)["particles"] == "4 5-gons"
+    assert caption("mixed", mixed, "map").startswith("mixed: 2 disks, 2 5-gons, seed ?")
