@@ -6,7 +6,7 @@
 # SOURCE: a MercuryDPM source tree (github.com/MercuryDPM/MercuryDPM, or a fork of it; the
 # committed fixtures were made from the fork kuwt/MercuryDPM_fork at fb0ebf1, 2024-07-26, "add
 # collision measure"). BUILD: the build folder (created). Needs cmake, g++ and gfortran (the
-# kernel's small linear-algebra library is Fortran). Only the kernel is built (about 15 minutes
+# kernel's small linear-algebra library is Fortran). Only the kernel is built (about 6 minutes
 # on one core at -O1), then the driver is compiled and linked by hand; the executable is
 # BUILD/Settle2D. tests/data/mercurydpm/make_fixtures.py runs it.
 set -euo pipefail
