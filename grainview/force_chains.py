@@ -134,7 +134,7 @@ def force_chains(ds: xr.Dataset, angle: float = DEFAULT_ANGLE, min_size: int = 3
     ----------
     Peters, Muthuswamy, Wibowo & Tordesillas, Phys. Rev. E 72, 041307 (2005) (the particle
     stress, the above-average criterion, the quasi-linear alignment, chains of three or more);
-    docs/conventions.md §0 and §3; docs/analysis.md, "Force chains".
+    docs/conventions.md §0 and §1; docs/analysis.md, "Force chains".
     """
     _check(angle, min_size, max_length)
     mask = selection(ds, walls=True)

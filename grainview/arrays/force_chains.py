@@ -11,7 +11,7 @@ For each snapshot:
    contact's application point (``point``), x_p the centre of p, s_pc = +1 when p is body i of
    the contact and -1 when it is body j, V_p the particle's volume (area times the slab
    thickness); wall contacts load their particle like any other. Summed over the particles,
-   sum_p V_p sigma_p = sum_c f^c (x) l^c = V sigma, the sample's stress (docs/conventions.md §3),
+   sum_p V_p sigma_p = sum_c f^c (x) l^c = V sigma, the sample's stress (docs/conventions.md §1),
    since (x^c - x_i) - (x^c - x_j) = x_j - x_i = l^c;
 2. its principal stresses sigma_1 >= sigma_2 (of the symmetric part) and major direction
    theta_1;
