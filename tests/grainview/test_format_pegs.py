@@ -136,6 +136,27 @@ def test_a_disks_own_fit_balances_in_the_contracts_axes(raw, tmp_path):
     assert mirrored == {2, 26}
 
 
+def test_a_pair_fitted_on_one_disk_keeps_its_one_estimate(ds, tmp_path):
+    """Without disk 2's row of its contact with disk 13, the pair has only disk 13's fit, whose
+    normal force is tensile (-0.0044): it is left out, with a warning; without disk 13's row of
+    its contact with disk 15, the pair keeps disk 15's estimate (N = 0.01457, T = -0.00743)."""
+    lines = ADJACENCY.read_text().splitlines(keepends=True)
+    for drop, kept, count in (("1,2,13,", None, 32), ("1,13,15,", ("1,15,13,", (12, 14)), 33)):
+        path = tmp_path / "one_sided.txt"
+        path.write_text("".join(line for line in lines if not line.startswith(drop)))
+        if kept is None:
+            with pytest.warns(UserWarning, match="1 contact"):
+                one = open_pegs(path, POSITIONS, metres_per_pixel=SCALE, force_unit_n=FORCE)
+            assert (1, 12) not in set(zip(one["i"][0].values, one["j"][0].values))
+        else:
+            one = open_pegs(path, POSITIONS, metres_per_pixel=SCALE, force_unit_n=FORCE)
+            _, _, _, T, N = (float(v) for v in next(line for line in lines if line.startswith(kept[0])).split(","))
+            m = list(zip(one["i"][0].values, one["j"][0].values)).index(kept[1])
+            assert (float(one["fn"][0, m]), float(one["ft"][0, m])) == (N, T)
+        assert int(one["contact_count"][0]) == count
+        assert one.attrs["pegs_pairs"] == "24 particle pairs fitted on both disks, 1 on one"
+
+
 def test_positions_walls_and_box(ds, raw):
     adjacency, positions = raw
     centre, radius, edge = cartesian(positions)
