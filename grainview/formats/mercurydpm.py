@@ -110,7 +110,8 @@ def _sibling(data, suffix, given):
     return (stem if extension == ".data" else os.fspath(data)) + suffix
 
 
-def _wall_names(restart, source):
+def _wall_names(restart):
+    """Each .restart wall's name and, for an axis-aligned InfiniteWall, its outward normal (2,)."""
     names, normals = [], []
     for index, (kind, values) in enumerate(restart.walls):
         name = f"{kind or 'wall'}{index}"
@@ -163,7 +164,7 @@ class _Model:
         self.inertia = factor * mass * radius**2 * scales["inertia"]
         self.inertia_rule = "m r^2 / 2 (particleDimensions 2)" if factor == 0.5 else \
             "2 m r^2 / 5 (particleDimensions 3)"
-        self.wall_names, self.wall_axes = _wall_names(restart, restart_path)
+        self.wall_names, self.wall_axes = _wall_names(restart)
         self.scales = scales
         self.data_path = data_path
 

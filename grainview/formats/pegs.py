@@ -250,7 +250,8 @@ def pegs_snapshots(adjacency, positions, *, metres_per_pixel=None, force_unit_n=
         radius_px[k] = np.median(pos[pos[:, 1] == v, 4])
     y0 = float((pos[:, 3] + pos[:, 4]).max())
     inner = adj[adj[:, 2] > 0]
-    pair_key = np.column_stack([inner[:, 0], np.minimum(inner[:, 1], inner[:, 2]), np.maximum(inner[:, 1], inner[:, 2])])
+    low, high = np.minimum(inner[:, 1], inner[:, 2]), np.maximum(inner[:, 1], inner[:, 2])
+    pair_key = np.column_stack([inner[:, 0], low, high])
     _, fits = np.unique(pair_key, axis=0, return_counts=True)
     radius = radius_px * scale
     mass = density * math.pi * radius**2 * thickness
@@ -327,8 +328,8 @@ def _frame_contacts(rows, index, position, radius, edge, force_scale, where):
     seen = set()
     for a, T, N in zip(first[wall_rows], rows[wall_rows, 3], rows[wall_rows, 4]):
         if edge[a] == 0:
-            raise FileFormatError(f"{where}: a wall contact (id2 = -1) of particle {a} (index), which is not at an edge "
-                                  "(edge flag 0)")
+            raise FileFormatError(f"{where}: a wall contact (id2 = -1) of particle {a} (index), which is not at an "
+                                  "edge (edge flag 0)")
         if a in seen:
             raise FileFormatError(f"{where}: two wall contacts of particle {a} (index)")
         seen.add(a)

@@ -69,7 +69,8 @@ def expected_contacts(adjacency, positions):
     out = {}
     for (i, j), values in fits.items():
         N, T = np.mean(values, axis=0)
-        normal = np.array(EDGE_NORMAL[edge[i]]) if j >= n else (centre[j] - centre[i]) / np.hypot(*(centre[j] - centre[i]))
+        branch = centre[min(j, n - 1)] - centre[i]
+        normal = np.array(EDGE_NORMAL[edge[i]]) if j >= n else branch / np.hypot(*branch)
         tangent = np.array([-normal[1], normal[0]])
         if N > 0:
             out[(i, j)] = (FORCE * (N * normal + T * tangent), normal)
