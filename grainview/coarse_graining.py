@@ -48,8 +48,9 @@ def _spacing(spacing):
     return tuple(_positive(v, "spacing", " in m (or a pair (dx, dy) of them)") for v in values)
 
 
-def _grid(ds, spacing, x, y):
-    """The grid's x and y coordinates (m): given, or cells of ``spacing`` covering every snapshot's box."""
+def _grid(ds, spacing, x, y, reach):
+    """The grid's x and y coordinates (m): given, or cells of ``spacing`` covering every snapshot's
+    box widened by ``reach`` (m) on every side."""
     if x is not None and y is not None:
         if spacing is not None:
             raise ParameterError("give either spacing= or the grid's x= and y=, not both")
@@ -58,7 +59,7 @@ def _grid(ds, spacing, x, y):
         raise ParameterError("the grid: expected spacing= (m), or both x= and y= (coordinates in m)")
     dx, dy = _spacing(spacing)
     box = xr.Dataset({"lo": ds["box_min"].min("time"), "hi": ds["box_max"].max("time")}).compute()  # one read
-    lo, hi = np.asarray(box["lo"].values, dtype=float), np.asarray(box["hi"].values, dtype=float)
+    lo, hi = np.asarray(box["lo"].values, dtype=float) - reach, np.asarray(box["hi"].values, dtype=float) + reach
     return _cg.grid_nodes(lo[0], hi[0], dx), _cg.grid_nodes(lo[1], hi[1], dy)
 
 
@@ -107,8 +108,8 @@ def coarse_grained(ds: xr.Dataset, width=None, spacing=None, kernel: str = "gaus
     (docs/conventions.md §1). The contact stress integrates exactly:
     (1/A) int sigma^c dA = (1/V) sum_c f (x) l, the Love–Weber stress of
     :func:`grainview.stress.stress_tensor` (V = A t), and int rho dA t = sum_i m_i, where the grid
-    covers every kernel; on the grid these integrals are sums times the cell area, exact up to
-    the quadrature of the kernel by the grid (spacing well under the width: docs/analysis.md).
+    covers every kernel (the default grid does); on the grid these integrals are sums times the
+    cell area, exact up to the quadrature of the kernel by the grid (docs/analysis.md).
     The contact stress sums every contact the file holds, wall contacts included, as
     :func:`grainview.stress.stress_tensor`; the fabric the force-bearing particle–particle
     contacts, as :func:`grainview.fabric.fabric_tensor`. Masses are the file's, areas those of
@@ -123,9 +124,10 @@ def coarse_grained(ds: xr.Dataset, width=None, spacing=None, kernel: str = "gaus
         resolves the packing's structure, a few diameters its continuum fields. Default: the
         mean particle diameter (:func:`mean_diameter`).
     spacing : float or (float, float), optional
-        Grid spacing (dx, dy) in m: cells of that side covering the union of the snapshots' boxes,
-        nodes at their centres (reads ``box_min`` and ``box_max``). Default w/2. Or give ``x``
-        and ``y``.
+        Grid spacing (dx, dy) in m: cells of that side covering the union of the snapshots' boxes
+        widened by the kernel's radius c on every side (so that the grid holds every kernel whole
+        and its integrals are exact), nodes at their centres (reads ``box_min`` and ``box_max``).
+        Default w/2. Or give ``x`` and ``y``.
     kernel : {"gaussian"}, default "gaussian"
         The kernel (:data:`KERNELS`).
     cutoff : float, default 3
@@ -162,7 +164,7 @@ def coarse_grained(ds: xr.Dataset, width=None, spacing=None, kernel: str = "gaus
     cutoff = _positive(cutoff, "cutoff", " (kernel radius in widths)")
     if not isinstance(kernel, str) or kernel not in KERNELS:
         raise ParameterError(f"kernel={kernel!r}: expected one of {', '.join(map(repr, KERNELS))}")
-    gx, gy = _grid(ds, spacing, x, y)
+    gx, gy = _grid(ds, spacing, x, y, _cg.kernel_radius(width, cutoff))
     has_velocity = "velocity" in ds.variables
     velocity = ds["velocity"] if has_velocity else xr.zeros_like(ds["position"])
     area = _areas(ds)

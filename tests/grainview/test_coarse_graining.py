@@ -267,8 +267,13 @@ def test_chunked_equals_eager_and_stays_lazy():
     direct = eager.grain.coarse_grained(width=0.02, spacing=0.01)
     xr.testing.assert_allclose(lazy.compute(), direct, rtol=1e-13, atol=0)
     xr.testing.assert_allclose(cut.compute(), profile(field_invariants(direct).q_over_p, across="y"))
-    # the grid: cells of 1 cm covering the 0.2 m box, nodes at their centres
-    np.testing.assert_allclose(direct.x.values, 0.005 + 0.01 * np.arange(20))
+    # the grid: cells of 1 cm covering the 0.2 m box widened by the kernel's radius 6 cm, nodes at their centres
+    np.testing.assert_allclose(direct.x.values, -0.055 + 0.01 * np.arange(32))
+    # which holds every kernel whole: its integrals are the Love-Weber stress and the mass
+    integral = direct.contact_stress.sum(("x", "y")) * 0.01 ** 2
+    expected = (stress_tensor(eager) * sample.area(eager)).values
+    assert np.abs(integral.values - expected).max() < 5e-3 * np.abs(expected).max()  # the default cutoff's quadrature
+    np.testing.assert_allclose(direct.density.sum(("x", "y")) * 0.01 ** 2, float(eager.mass.sum()), rtol=5e-3)
     assert "eps_q" in direct.coords and direct.attrs["width_m"] == 0.02
 
 
@@ -370,7 +375,9 @@ def test_field_figures_draw_the_fields_with_units():
     fields = coarse_grained(ds, width=1.5 * A, spacing=A / 2)
     fig = plot_field_profiles(ds, fields=fields, names=["sigma_yy"], across="y", margin=0.0)
     line = fig.axes[0].lines[0]
-    np.testing.assert_allclose(line.get_ydata(), profile(scalar_field(fields, "sigma_yy"), across="y").isel(time=0))
+    expected = profile(scalar_field(fields, "sigma_yy"), across="y", inside=interior(fields, margin=0.0)).isel(time=0)
+    np.testing.assert_allclose(line.get_ydata(), expected)
+    assert np.isnan(expected[0]) and np.isfinite(expected).sum() == 24  # the nodes in the 24 R box: 24 of 2 R/2
     assert fig.axes[0].get_xlabel() == "$y$ (m)" and fig.axes[0].get_ylabel() == r"$\sigma_{yy}$ (Pa)"
     with pytest.raises(ParameterError, match="names="):
         plot_field_maps(ds, names=["tau"], width=A)
