@@ -332,7 +332,7 @@ def test_follow_gives_lifetimes(prepare):
     ds = prepare(series(column, column, none, column))
     out = ds.grain.force_chains(follow=True)
     np.testing.assert_array_equal(out.n_chains.values, [1, 1, 0, 1])
-    np.testing.assert_array_equal(out.track.values[:, 0], [0, 0, -1, 1])
+    np.testing.assert_array_equal(out.chain_track.values[:, 0], [0, 0, -1, 1])
     np.testing.assert_array_equal(out.lifetime.values, [2, 1])
     np.testing.assert_array_equal(out.duration.values, [1.0, 0.0])
     np.testing.assert_array_equal(out.censored.values, [True, True])
@@ -362,3 +362,24 @@ def test_eager_equals_chunked():
 def test_bad_parameters_are_named(kwargs, words):
     with pytest.raises(ParameterError, match=words):
         force_chains(column_among_pairs(), **kwargs)
+
+
+def test_an_ensemble_gives_each_run_its_chains_and_tracks(tmp_path):
+    # two runs of different lengths; with follow=True the tracks of each run along 'track'
+    # (a per-particle variable named like that dimension broke the combination along 'run')
+    import grainview
+    from grainview.contract.dataset import netcdf_encoding
+
+    runs = [series(column_among_pairs(), column_among_pairs(), column_among_pairs(load=0.2)),
+            series(column_among_pairs(load=0.2), column_among_pairs())]
+    paths = []
+    for k, ds in enumerate(runs):
+        ds.attrs.update(preparation_seed=np.int32(k))
+        paths.append(tmp_path / f"run{k}.nc")
+        ds.to_netcdf(paths[-1], encoding=netcdf_encoding(ds), format="NETCDF3_64BIT")
+    out = grainview.open_ensemble(paths).grain.force_chains(follow=True)
+    np.testing.assert_array_equal(out.n_chains.values[0], [1, 1, 0])
+    np.testing.assert_array_equal(out.n_chains.values[1, :2], [0, 1])
+    np.testing.assert_array_equal(out.lifetime.values[0, :1], [2])
+    np.testing.assert_array_equal(out.lifetime.values[1, :1], [1])
+    np.testing.assert_array_equal(out.chain_track.values[0, :, 0], [0, 0, -1])
