@@ -243,17 +243,28 @@ MAX_VERTICES = 64
 
 
 def _shape_of(text, option=None):
-    """A shape of the command line: a name of :data:`solver.shapes.SHAPES` (disk, pentagon...)
-    or a number of vertices from 3 to :data:`MAX_VERTICES`, as an integer."""
+    """A shape of the command line: a name of :data:`solver.shapes.SHAPES` (disk, pentagon...),
+    a number of vertices from 3 to :data:`MAX_VERTICES` (as an integer), a family of random
+    convex polygons (:data:`solver.shape_families.FAMILIES`: irregular) or a .json file of vertex
+    lists (read and checked here, given on as an absolute path)."""
+    from solver.shape_families import FAMILIES, SHAPE_FILE_SUFFIX, check_shape
     from solver.shapes import SHAPES
 
     text = str(text).strip()
-    if text in SHAPES:
+    if text in SHAPES or text in FAMILIES:
         return text
     if text.isdigit() and 3 <= int(text) <= MAX_VERTICES:
         return int(text)
-    raise GrainviewError(f"{option or f'--shape {text}'}: expected disk, pentagon or a number of vertices from 3 "
-                         f"to {MAX_VERTICES}")
+    if text.lower().endswith(SHAPE_FILE_SUFFIX):
+        import os
+
+        try:
+            check_shape(text)
+        except GrainviewError as exc:  # its message starts with the file's name
+            raise GrainviewError(f"{option or '--shape'} {exc}") from None
+        return os.path.abspath(text)
+    raise GrainviewError(f"{option or f'--shape {text}'}: expected disk, pentagon, a number of vertices from 3 "
+                         f"to {MAX_VERTICES}, {', '.join(FAMILIES)} or a {SHAPE_FILE_SUFFIX} file of vertex lists")
 
 
 def _simulate(prep, path, *, strain, every, velocity, near_contacts, overwrite, progress, scene="biaxial",
@@ -270,7 +281,9 @@ def _simulate(prep, path, *, strain, every, velocity, near_contacts, overwrite, 
     path = Path(path)
     if path.exists() and not overwrite:
         raise GrainviewError(f"{path} exists; pass --overwrite to replace it")
-    name = prep.shape
+    from solver.shape_families import shape_label
+
+    name = shape_label(prep.shape)
     print(f"{name}: depositing {prep.particles} particles and compacting under {prep.sigma0:g} Pa ...", flush=True)
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
@@ -622,8 +635,9 @@ def build_parser() -> argparse.ArgumentParser:
                          "(scene biaxial) compression by the top wall (1 cm/s) with sigma0 held on the right wall.")
     run.add_argument("scene", nargs="?", choices=["biaxial", "isotropic"], default="biaxial",
                      help="biaxial (default) or isotropic (writes the compacted state)")
-    run.add_argument("--shape", default="pentagon", help="pentagon (default), disk, or a number of vertices from 3 to "
-                     f"{MAX_VERTICES} (6: hexagons)")
+    run.add_argument("--shape", default="pentagon", help="pentagon (default), disk, a number of vertices from 3 to "
+                     f"{MAX_VERTICES} (6: hexagons), irregular (random convex polygons) or a .json file of "
+                     "vertex lists {\"polygons\": [[[x, y], ...], ...]} (docs/solver.md, \"Shapes\")")
     run.add_argument("--out", default="run.nc", help="output netCDF file (default: run.nc)")
     run.add_argument("--near-contacts", action="store_true",
                      help="also write the pairs within the alert distance that carry no force (with their "

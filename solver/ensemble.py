@@ -57,7 +57,7 @@ class RunSpec:
     wall speed in m s-1, steps between snapshots). ``solver``: further :class:`solver.Parameters`
     as sorted (name, value) pairs. ``None`` keeps the preparation's default."""
 
-    shape: str | int = "pentagon"  # a name of solver.shapes.SHAPES or a number of vertices
+    shape: str | int = "pentagon"  # a name of solver.shapes.SHAPES, a number of vertices, a family or a file
     particles: int = 400
     seed: int = 0
     friction: float | None = None
@@ -72,7 +72,9 @@ class RunSpec:
     @property
     def name(self) -> str:
         """File stem naming the run by its parameters, e.g. ``pentagon_n400_mu0.4_s2``."""
-        parts = [str(self.shape), f"n{self.particles}"]
+        from .shape_families import shape_label
+
+        parts = [shape_label(self.shape), f"n{self.particles}"]
         if self.preparation != "paper":
             parts.append(self.preparation)
         if self.friction is not None:

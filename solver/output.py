@@ -170,6 +170,10 @@ class Recorder:
     ``nlgs_unconverged_steps``, ``nlgs_unconverged_residual`` and
     ``nlgs_unconverged_local_law_residual`` (:class:`solver.stepper.Unconverged`).
 
+    A sample with polygons has its shapes written as ``vertices`` (own-frame vertices,
+    :meth:`solver.shapes.Shapes.body_vertices`), regular polygons too; a sample of disks alone
+    has none.
+
     While the run goes on the file is netCDF-3, appended snapshot by snapshot (a killed run
     keeps every completed snapshot). When the ``with`` block ends without an exception, the
     finished file is rewritten compressed (:func:`grainview.contract.writer.compress_file`, zlib at
@@ -198,7 +202,8 @@ class Recorder:
             self.writer = SnapshotWriter.create(
                 path, radius=sim.radius, n_vertices=sim.n_vertices, mass=sim.mass, inertia=sim.inertia,
                 n_walls=sim.n_walls, wall_names=sim.walls.names, wall_normal=sim.walls.normal,
-                optional=optional, attrs=params, overwrite=overwrite)
+                optional=optional, attrs=params, overwrite=overwrite,
+                vertices=sim.shapes.body_vertices() if sim.shapes.max_vertices else None)
         self._hold(resumable=params.get("scene") == "biaxial", own=True)
 
     @classmethod

@@ -9,7 +9,8 @@ residual one), so they are options here, each recorded in the output file's attr
 (``preparation_*``):
 
 * ``particles``, ``shape``, ``seed``: the sample (the paper's size mix, see
-  :mod:`solver.packing`);
+  :mod:`solver.packing`; shapes: regular ones, random convex polygons or a file of them,
+  :mod:`solver.shape_families`);
 * ``aspect``: h/l of the deposit's box (paper: about 2);
 * ``sigma0``: the confining stress (Pa);
 * ``friction``: grain-grain friction of the TEST; ``compaction_friction``: during compaction
@@ -32,7 +33,7 @@ import numpy as np
 
 from grainview.contract.errors import ParameterError
 
-from .shapes import n_vertices_of
+from .shape_families import check_shape
 
 MAX_SEED = 2**31 - 1
 """Largest seed: files store the seed as a 32-bit integer attribute (netCDF-3 has no wider one)."""
@@ -49,7 +50,7 @@ class Preparation:
     where the paper is silent, this project's historical default."""
 
     particles: int = 400
-    shape: str | int = "pentagon"  # a name of solver.shapes.SHAPES or a number of vertices
+    shape: str | int = "pentagon"  # a name of solver.shapes.SHAPES, a number of vertices, a family or a file
     seed: int = 0
     aspect: float = 2.0
     sigma0: float = 1e4  # Pa
@@ -78,7 +79,7 @@ class Preparation:
         ]
         bad = [f"{name}={getattr(self, name)!r}: expected {expected}" for name, ok, expected in checks if not ok]
         try:
-            n_vertices_of(self.shape)
+            check_shape(self.shape)
         except ParameterError as exc:
             bad.append(str(exc))
         if bad:

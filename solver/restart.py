@@ -6,7 +6,10 @@ one and marks it ``complete`` last). The last complete snapshot holds the whole 
 run, so :func:`resume` rebuilds the :class:`~solver.stepper.Simulation` from it and goes on
 appending to the same file:
 
-* particles: ``position``, ``angle``, ``velocity``, ``angular_velocity`` (f8, exact);
+* particles: ``position``, ``angle``, ``velocity``, ``angular_velocity`` (f8, exact); their
+  shapes from ``radius``, ``n_vertices`` and ``vertices`` (:meth:`solver.shapes.Shapes.of`:
+  regular polygons when the file has no ``vertices`` or holds exactly the regular ones, any
+  convex polygon otherwise, with the same tables as the run that wrote them);
 * walls: ``wall_position``, ``wall_velocity`` per snapshot; ``wall_normal`` and the wall names;
   how each wall is driven (global attributes ``wall_mode``, ``wall_stress_Pa``,
   ``wall_mass_kg``, ``wall_max_speed_m_s``, ``wall_length_axis``, see
@@ -40,12 +43,13 @@ from dataclasses import fields
 
 import numpy as np
 
-from grainview.contract.errors import ConvergenceWarning, FileFormatError, GrainviewError
+from grainview.contract.errors import ConvergenceWarning, FileFormatError, GrainviewError, ParameterError
 from grainview.contract.reader import ContractFile
 
 from .interrupt import Terminated, sigterm_raises
 from .output import Recorder, compress_finished, compress_level
 from .scenes import biaxial_steps
+from .shapes import Shapes
 from .stepper import Parameters, Simulation
 from .walls import Walls
 
@@ -110,6 +114,7 @@ def _snapshot_state(ds, index, source):
         if not np.all(np.isfinite(value)):
             raise FileFormatError(f"{source}: cannot restart, {name} of snapshot {index} is not finite")
     state.update({name: ds.static(name) for name in ("radius", "n_vertices", "mass", "inertia", "wall_normal")})
+    state["vertices"] = ds.static("vertices") if "vertices" in ds.variables else None
     state.update({name: ds.snapshot(name, index)[:count].copy()
                   for name in ("i", "j", "normal_impulse", "tangential_impulse")})
     state.update(time=float(ds.snapshot("time", index)), step=int(ds.snapshot("step", index)),
@@ -125,9 +130,12 @@ def _simulation(state, source) -> Simulation:
                   stress=np.asarray(attrs["wall_stress_Pa"], float), mass=np.asarray(attrs["wall_mass_kg"], float),
                   length_axis=np.asarray(attrs["wall_length_axis"], np.int64),
                   max_speed=np.asarray(attrs["wall_max_speed_m_s"], float))
-    sim = Simulation(state["position"], state["angle"], state["radius"], state["n_vertices"], walls,
-                     _parameters(attrs, source), velocity=state["velocity"],
-                     angular_velocity=state["angular_velocity"])
+    try:
+        shapes = Shapes.of(state["radius"], state["n_vertices"], state["vertices"])
+    except ParameterError as exc:
+        raise FileFormatError(f"{source}: cannot restart, its shapes are not the contract's: {exc}") from None
+    sim = Simulation(state["position"], state["angle"], walls=walls, parameters=_parameters(attrs, source),
+                     velocity=state["velocity"], angular_velocity=state["angular_velocity"], shapes=shapes)
     if not (np.array_equal(sim.mass, state["mass"]) and np.array_equal(sim.inertia, state["inertia"])):
         raise FileFormatError(f"{source}: cannot restart, the masses and inertias of the file differ from those "
                               "of its solver parameters (density, thickness)")

@@ -14,25 +14,27 @@ from grainview.contract.errors import ParameterError
 from .interrupt import interruptible, progress_bar, resume_instructions, stop_exception, stop_reason
 from .output import Recorder
 from .packing import PAPER_DIAMETERS, PAPER_FRACTIONS, box_width_for, deposit
-from .shapes import n_vertices_of
+from .shape_families import regular_vertex_count, sample_shapes
 from .stepper import Parameters, Simulation, check_time_step
 from .walls import STRESS, Walls
 
 
 
-def gravity_scene(position, angle, radius, n_vertices, *, gravity=9.81, tilt=0.0, sides=None,
+def gravity_scene(position, angle, radius, n_vertices, *, gravity=9.81, tilt=0.0, sides=None, shapes=None,
                   **parameters) -> Simulation:
     """Particles on a fixed floor (the line y = 0, optional side walls at x = sides[0], sides[1])
     under gravity of magnitude ``gravity`` (m s-2) tilted by ``tilt`` (rad): the vector
     g (sin tilt, -cos tilt), which is the same as a floor inclined by ``tilt`` in a vertical
     gravity field, seen in the floor's frame. ``parameters`` go to :class:`Parameters`
     (friction with the floor is ``wall_friction``). For tests and demonstrations with analytic
-    answers (resting bodies, a column, a block on an inclined plane)."""
+    answers (resting bodies, a column, a block on an inclined plane). ``shapes``: the particles'
+    :class:`solver.shapes.Shapes` (then ``radius`` and ``n_vertices`` are None), as
+    :class:`Simulation` takes them."""
     if not (np.isfinite(gravity) and np.isfinite(tilt)):
         raise ParameterError(f"gravity={gravity!r}, tilt={tilt!r}: expected finite numbers (m s-2, rad)")
     g = (float(gravity) * np.sin(tilt), -float(gravity) * np.cos(tilt))
     params = Parameters(gravity=g, **parameters)
-    return Simulation(position, angle, radius, n_vertices, Walls.floor(sides=sides), params)
+    return Simulation(position, angle, radius, n_vertices, Walls.floor(sides=sides), params, shapes=shapes)
 
 
 def compaction_sample(n=400, shape="pentagon", *, sigma0=1e4, friction=0.4, wall_friction=0.0,
@@ -41,15 +43,19 @@ def compaction_sample(n=400, shape="pentagon", *, sigma0=1e4, friction=0.4, wall
     """A deposited sample in its box, ready for isotropic compaction: bottom and left walls
     fixed, right and top walls pushed by ``sigma0`` (Pa), zero gravity. ``wall_mass``
     defaults to the total particle mass (kg); the pushed walls move inwards at most at
-    ``max_wall_speed`` (m s-1) while they close the loose deposit."""
+    ``max_wall_speed`` (m s-1) while they close the loose deposit. ``shape``: a regular shape,
+    a family of random convex polygons or a file of them (:mod:`solver.shape_families`); the
+    deposit places the circumscribed disks of the size mix either way."""
     if not (np.isfinite(sigma0) and sigma0 > 0):
         raise ParameterError(f"sigma0={sigma0!r}: expected a positive stress in Pa")
-    nv = n_vertices_of(shape)
+    nv = regular_vertex_count(shape)
     width = box_width_for(n, diameters, fractions, aspect_ratio=aspect)
     position, angle, radius, n_vertices, height = deposit(n, diameters, fractions, nvert=nv, width=width, seed=seed)
+    shapes, turned = sample_shapes(shape, radius, seed)
+    angle = angle if turned is None else turned
     walls = Walls.box(width, height + 0.5 * float(radius.min()))
     params = Parameters(time_step=time_step, friction=friction, wall_friction=wall_friction, seed=seed, **parameters)
-    sim = Simulation(position, angle, radius, n_vertices, walls, params)
+    sim = Simulation(position, angle, walls=walls, parameters=params, shapes=shapes)
     mass = float(sim.mass.sum()) if wall_mass is None else float(wall_mass)
     walls.drive_stress("right", sigma0, mass, max_wall_speed)
     walls.drive_stress("top", sigma0, mass, max_wall_speed)

@@ -1,18 +1,23 @@
-"""Shapes of the bodies: disks and regular polygons, their area, mass, inertia and vertices.
+"""Shapes of the bodies: disks, regular polygons and any convex polygon; their area, mass,
+inertia and vertices. The geometry itself is the contract's (:mod:`grainview.contract.shapes`,
+the one place for it); this module builds the solver's table from it.
 
-A body is described by its centre ``pos`` (m), its rotation ``angle`` (rad), its circumscribed
-radius ``radius`` R (m; the disk radius for a disk) and its number of vertices ``nvert``
-(0 = disk, n >= 3 = regular n-gon). Vertex k of a polygon sits at
+A body is described by its centroid ``pos`` (m), its rotation ``angle`` (rad), its circumscribed
+radius ``radius`` R (m; the disk radius for a disk, a polygon's farthest vertex) and its number
+of vertices ``nvert`` (0 = disk, n >= 3 = polygon). A polygon's vertex k, v_k in its own frame,
+sits at pos + Rot(angle) v_k, counter-clockwise. For a regular n-gon (:meth:`Shapes.regular`)
 
     x_k = pos + R (cos(angle + 2 pi k / n), sin(angle + 2 pi k / n)),   k = 0 .. n-1,
 
-so the vertices run counter-clockwise, and edge k (from vertex k to vertex k+1) has the
-outward unit normal of angle ``angle + pi (2k + 1) / n`` at the distance r = R cos(pi/n)
-(the inradius) from the centre. These are the shapes of the data contract
-(``grainview.contract.schema``: ``radius`` is the circumscribed radius, ``n_vertices`` 0 for disks).
+and edge k (from vertex k to vertex k+1) has the outward unit normal of angle
+``angle + pi (2k + 1) / n`` at the distance r = R cos(pi/n) (the inradius) from the centre.
+Any other convex polygon is given by its vertices (:meth:`Shapes.convex`; families and files
+of them in :mod:`solver.shape_families`). These are the shapes of the data contract
+(``radius`` the circumscribed radius, ``n_vertices`` 0 for disks, ``vertices`` the polygons'
+own-frame vertices).
 
 Formulas (regular n-gon of circumscribed radius R, split into n triangles centre-edge with
-apex angle alpha = 2 pi / n):
+apex angle alpha = 2 pi / n; any polygon: the contract's shoelace and fan sums):
 
 * area      A = (n/2) R^2 sin(2 pi / n)                         (disk: pi R^2)
 * inertia   I/m = R^2 (2 + cos(2 pi / n)) / 6 = R^2 (1 + 2 cos^2(pi/n)) / 6
@@ -23,8 +28,8 @@ apex angle alpha = 2 pi / n):
 The shape table (:class:`Shapes`) holds all of this once per simulation: each body's vertices
 and edge normals in its own frame (polar angles measured from the body's ``angle``), its
 inradius, area and inertia per unit mass. Detection, mass and inertia, plotting in tests and
-the peers' exports read the table; nothing else rebuilds a vertex. A new shape (an irregular
-convex polygon) is a new constructor of the table: the kernels read vertex lists of any length.
+the peers' exports read the table; nothing else rebuilds a vertex. The kernels read vertex
+lists of any length, so a regular and an irregular polygon differ only in their table.
 """
 
 from __future__ import annotations
@@ -33,11 +38,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from grainview.contract import shapes as contract
 from grainview.contract.errors import ParameterError
-from grainview.contract.shapes import particle_area, vertex_phases
 
 __all__ = ["Shapes", "SHAPES", "n_vertices_of", "polygon_area", "polygon_inertia_per_mass", "mass_and_inertia", "vertices", "inradius",
-           "check_shapes"]
+           "check_shapes", "polygon_problem"]
 
 
 SHAPES = {"disk": 0, "disks": 0, "pentagon": 5, "pentagons": 5}
@@ -89,16 +94,15 @@ def polygon_area(radius, nvert):
     radius R, pi R^2 for a disk (n = 0). Same definition as ``grainview.contract.shapes.particle_area``
     (the contract's shape definition), which it calls."""
     radius, nvert = check_shapes(radius, nvert)
-    return particle_area(radius, nvert)
+    return contract.particle_area(radius, nvert)
 
 
 def polygon_inertia_per_mass(radius, nvert):
     """Moment of inertia per unit mass I/m (m2) about the centroid: R^2 (2 + cos(2 pi/n))/6
-    for a regular n-gon of circumscribed radius R, R^2/2 for a disk (n = 0)."""
+    for a regular n-gon of circumscribed radius R, R^2/2 for a disk (n = 0)
+    (``grainview.contract.shapes.inertia_per_mass``, which it calls)."""
     radius, nvert = check_shapes(radius, nvert)
-    safe_n = np.where(nvert >= 3, nvert, 3).astype(np.float64)
-    polygon = radius**2 * (2.0 + np.cos(2.0 * np.pi / safe_n)) / 6.0
-    return np.where(nvert >= 3, polygon, 0.5 * radius**2)
+    return contract.inertia_per_mass(radius, nvert)
 
 
 def mass_and_inertia(radius, nvert, density, thickness=1.0):
@@ -116,8 +120,7 @@ def inradius(radius, nvert):
     """Radius of the inscribed circle (m): R cos(pi/n) for a regular n-gon, R for a disk.
     It is the distance from the centre to every edge of the polygon."""
     radius, nvert = check_shapes(radius, nvert)
-    safe_n = np.where(nvert >= 3, nvert, 3).astype(np.float64)
-    return np.where(nvert >= 3, radius * np.cos(np.pi / safe_n), radius)
+    return contract.particle_inradius(radius, nvert)
 
 
 def vertices(pos, angle, radius, nvert):
@@ -126,6 +129,32 @@ def vertices(pos, angle, radius, nvert):
     all rows of disks) are NaN. ``maxn`` is the largest ``nvert`` (0 if all are disks).
     Shorthand for ``Shapes.regular(radius, nvert).world_vertices(pos, angle)``."""
     return Shapes.regular(radius, nvert).world_vertices(pos, angle)
+
+
+def polygon_problem(vertices) -> str | None:
+    """What keeps ``vertices`` (n, 2) from being a convex polygon given counter-clockwise, in
+    a few words, or None: fewer than 3 vertices, a non-finite one, two equal consecutive ones,
+    a clockwise order, a reflex or straight corner, or a boundary that winds more than once
+    (a star polygon). The turn at vertex k is the cross product of edges k-1 and k; a convex
+    counter-clockwise polygon turns left at every vertex, by 2 pi in all."""
+    v = np.asarray(vertices, dtype=np.float64)
+    if v.ndim != 2 or v.shape[1] != 2:
+        return f"expected an (n, 2) array of vertices, got shape {v.shape}"
+    if len(v) < 3:
+        return f"{len(v)} vertices, expected at least 3"
+    if not np.all(np.isfinite(v)):
+        return "a vertex is not finite"
+    edge = np.roll(v, -1, axis=0) - v
+    if np.any(np.all(edge == 0, axis=1)):
+        return "two consecutive vertices are equal"
+    before = np.roll(edge, 1, axis=0)
+    turn = before[:, 0] * edge[:, 1] - before[:, 1] * edge[:, 0]
+    if np.all(turn < 0):
+        return "the vertices run clockwise, expected counter-clockwise"
+    winding = np.sum(np.arctan2(turn, np.sum(before * edge, axis=1))) / (2 * np.pi)
+    if np.any(turn <= 0) or not np.isclose(winding, 1.0):
+        return "not convex (expected every corner to turn left, once around)"
+    return None
 
 
 @dataclass(frozen=True, eq=False)
@@ -152,6 +181,8 @@ class Shapes:
     inradius : (N,) m, the distance from the centre to the nearest edge line (R for a disk).
     area : (N,) m2.
     inertia_per_mass : (N,) m2, I/m about the centroid.
+    vertex_xy : (V, 2) m, the vertices of :meth:`convex` as given (None for :meth:`regular`:
+        the contract's regular vertices); what a file stores (:meth:`body_vertices`).
     """
 
     radius: np.ndarray
@@ -163,6 +194,7 @@ class Shapes:
     inradius: np.ndarray
     area: np.ndarray
     inertia_per_mass: np.ndarray
+    vertex_xy: np.ndarray | None = None
 
     @classmethod
     def regular(cls, radius, n_vertices) -> "Shapes":
@@ -177,53 +209,80 @@ class Shapes:
         normal_angle = np.empty(int(first[-1]))
         for n in np.unique(nvert[nvert >= 3]):
             rows = (first[:-1][nvert == n, None] + np.arange(n)).ravel()
-            vertex_angle[rows] = np.tile(vertex_phases(int(n)), rows.size // n)
+            vertex_angle[rows] = np.tile(contract.vertex_phases(int(n)), rows.size // n)
             normal_angle[rows] = np.tile(np.pi * (2 * np.arange(n) + 1) / n, rows.size // n)
         return cls(radius, nvert, first, vertex_radius, vertex_angle, normal_angle,
                    inradius(radius, nvert), polygon_area(radius, nvert), polygon_inertia_per_mass(radius, nvert))
 
     @classmethod
     def convex(cls, polygons) -> "Shapes":
-        """Convex polygons of any shape, each given by its vertices in its own frame: a list of
-        (n, 2) arrays in m, counter-clockwise, centroid at the origin. The area is the
-        shoelace sum, I/m the fan sum of (A_t/6)(|a|^2 + |b|^2 + a.b) over the triangles
-        centre-a-b divided by the area (module docstring), the bounding radius the farthest
-        vertex, the inradius the nearest edge line. Detection reads these tables as it reads
-        regular ones; the data contract itself stores regular polygons only."""
-        tables = []
-        for b, vertices in enumerate(polygons):
-            v = np.asarray(vertices, dtype=np.float64)
-            if v.ndim != 2 or v.shape[1] != 2 or v.shape[0] < 3 or not np.all(np.isfinite(v)):
-                raise ParameterError(f"polygon {b}: expected an (n, 2) array of n >= 3 finite vertices (m), "
-                                     f"got shape {v.shape}")
-            edge = np.roll(v, -1, axis=0) - v
-            turn = edge[:, 0] * np.roll(edge, -1, axis=0)[:, 1] - edge[:, 1] * np.roll(edge, -1, axis=0)[:, 0]
-            if np.any(turn <= 0):
-                raise ParameterError(f"polygon {b}: the vertices must run counter-clockwise around a convex polygon")
-            cross = v[:, 0] * np.roll(v, -1, axis=0)[:, 1] - v[:, 1] * np.roll(v, -1, axis=0)[:, 0]
-            area = 0.5 * cross.sum()
-            centroid = (cross[:, None] * (v + np.roll(v, -1, axis=0))).sum(0) / (6.0 * area)
-            size = np.abs(v).max()
-            if np.hypot(*centroid) > 1e-9 * size:
-                raise ParameterError(f"polygon {b}: its centroid {centroid.tolist()} m must be at the origin")
-            nxt = np.roll(v, -1, axis=0)
-            polar = (cross / 2.0 / 6.0 * ((v ** 2).sum(1) + (nxt ** 2).sum(1) + (v * nxt).sum(1))).sum()
-            outward = np.column_stack([edge[:, 1], -edge[:, 0]]) / np.hypot(edge[:, 0], edge[:, 1])[:, None]
-            tables.append((v, outward, area, polar / area))
-        n_vertices = np.array([len(t[0]) for t in tables], np.int32)
-        first = np.zeros(n_vertices.size + 1, np.int64)
+        """Bodies of any convex shape, each given in its own frame: an (n, 2) array of its
+        vertices in m (n >= 3, counter-clockwise, centroid at the origin), or a number, the
+        radius in m of a disk. Area, centroid, I/m, circumscribed radius (the farthest vertex)
+        and inradius are the contract's (``grainview.contract.shapes.polygon_properties``),
+        computed polygon by polygon from its own vertices, so that the same vertices give the
+        same tables bit for bit (a run resumed from its file). The vertices are kept as given
+        (:meth:`body_vertices`, what a file stores). Raises :class:`ParameterError` naming the
+        first polygon that is not convex and counter-clockwise (:func:`polygon_problem`) or
+        whose centroid is off the origin."""
+        n_bodies = len(polygons)
+        n_vertices = np.zeros(n_bodies, np.int32)
+        radius, inner = np.zeros(n_bodies), np.zeros(n_bodies)
+        area, polar = np.zeros(n_bodies), np.zeros(n_bodies)
+        rows = []
+        for b, body in enumerate(polygons):
+            if np.ndim(body) == 0:
+                r = float(body)
+                if not (np.isfinite(r) and r > 0):
+                    raise ParameterError(f"body {b}: a disk's radius must be finite and > 0 (m), got {body!r}")
+                radius[b] = inner[b] = r
+                area[b], polar[b] = np.pi * r ** 2, 0.5 * r ** 2
+                continue
+            v = np.asarray(body, dtype=np.float64)
+            problem = polygon_problem(v)
+            if problem:
+                raise ParameterError(f"polygon {b}: {problem}")
+            props = contract.polygon_properties(v[None])
+            if np.hypot(*props["centroid"][0]) > contract.CENTROID_TOLERANCE * props["radius"][0]:
+                raise ParameterError(f"polygon {b}: its centroid {props['centroid'][0].tolist()} m must be at the "
+                                     "origin of its own frame")
+            n_vertices[b] = len(v)
+            radius[b], inner[b] = props["radius"][0], props["inradius"][0]
+            area[b], polar[b] = props["area"][0], props["inertia_per_mass"][0]
+            rows.append(v)
+        first = np.zeros(n_bodies + 1, np.int64)
         np.cumsum(n_vertices, out=first[1:])
-        v = np.concatenate([t[0] for t in tables]) if tables else np.empty((0, 2))
-        outward = np.concatenate([t[1] for t in tables]) if tables else np.empty((0, 2))
-        body = np.repeat(np.arange(n_vertices.size), n_vertices)
-        vertex_radius = np.hypot(v[:, 0], v[:, 1])
-        radius = np.zeros(n_vertices.size)
-        np.maximum.at(radius, body, vertex_radius)
-        inradius = np.full(n_vertices.size, np.inf)
-        np.minimum.at(inradius, body, (outward * v).sum(1))
-        return cls(radius, n_vertices, first, vertex_radius, np.arctan2(v[:, 1], v[:, 0]),
-                   np.arctan2(outward[:, 1], outward[:, 0]), inradius,
-                   np.array([t[2] for t in tables]), np.array([t[3] for t in tables]))
+        v = np.concatenate(rows) if rows else np.empty((0, 2))
+        edge = np.concatenate([np.roll(r, -1, axis=0) - r for r in rows]) if rows else np.empty((0, 2))
+        return cls(radius, n_vertices, first, np.hypot(v[:, 0], v[:, 1]), np.arctan2(v[:, 1], v[:, 0]),
+                   np.arctan2(-edge[:, 0], edge[:, 1]), inner, area, polar, vertex_xy=v)
+
+    @classmethod
+    def of(cls, radius, n_vertices, vertices=None) -> "Shapes":
+        """The shapes of a file of the contract: ``radius`` (P,) m, ``n_vertices`` (P,) and the
+        optional ``vertices`` (P, V, 2) m. Regular ones (:meth:`regular`) when the file has no
+        ``vertices`` or holds exactly the regular polygons' (``grainview.contract.shapes.body_vertices``
+        of its radii and counts, as :meth:`body_vertices` writes them), so that a regular sample
+        read back has the tables it was simulated with; :meth:`convex` of the vertices otherwise."""
+        radius, n_vertices = check_shapes(radius, n_vertices)
+        if vertices is None:
+            return cls.regular(radius, n_vertices)
+        vertices = np.asarray(vertices, dtype=np.float64)
+        if np.array_equal(vertices, contract.body_vertices(radius, n_vertices), equal_nan=True):
+            return cls.regular(radius, n_vertices)
+        return cls.convex([vertices[b, :n] if n else radius[b] for b, n in enumerate(n_vertices)])
+
+    def body_vertices(self) -> np.ndarray:
+        """(N, V, 2) every body's vertices in its own frame, m, NaN beyond its count (all NaN
+        for a disk): the contract's ``vertices`` (``grainview.contract.shapes.body_vertices``).
+        Regular polygons give the contract's regular vertices; polygons given to
+        :meth:`convex` give their vertices exactly as given."""
+        if self.vertex_xy is None:
+            return contract.body_vertices(self.radius, self.n_vertices)
+        out = np.full((len(self), self.max_vertices, 2), np.nan)
+        body = np.repeat(np.arange(len(self)), self.n_vertices)
+        out[body, np.arange(body.size) - self.first_vertex[body]] = self.vertex_xy
+        return out
 
     def __len__(self) -> int:
         return int(self.radius.size)

@@ -183,18 +183,31 @@ class Simulation:
 
     Parameters
     ----------
-    position : (N, 2) m; angle : (N,) rad; radius : (N,) circumscribed radius, m;
+    position : (N, 2) m, centroids; angle : (N,) rad; radius : (N,) circumscribed radius, m;
     n_vertices : (N,) 0 for disks, >= 3 for regular polygons; walls : :class:`Walls`.
+    shapes : :class:`solver.shapes.Shapes`, optional
+        The particles' shapes (any convex polygon, :meth:`Shapes.convex`); given, ``radius``
+        and ``n_vertices`` are left out (None) and taken from it. Without it the particles are
+        disks and regular polygons (:meth:`Shapes.regular` of ``radius`` and ``n_vertices``).
     """
 
-    def __init__(self, position, angle, radius, n_vertices, walls: Walls, parameters: Parameters | None = None,
-                 velocity=None, angular_velocity=None):
+    def __init__(self, position, angle, radius=None, n_vertices=None, walls: Walls | None = None,
+                 parameters: Parameters | None = None, velocity=None, angular_velocity=None,
+                 shapes: Shapes | None = None):
         p = (parameters or Parameters()).validate()
         self.parameters = p
         self.position = np.array(position, dtype=float).reshape(-1, 2)
         n = len(self.position)
         if n == 0:
             raise ParameterError("the sample is empty: expected at least one particle")
+        if walls is None:
+            raise ParameterError("walls: expected the scene's Walls (solver.walls.Walls)")
+        if shapes is not None:
+            if not isinstance(shapes, Shapes) or len(shapes) != n:
+                raise ParameterError(f"shapes: expected a solver.shapes.Shapes of the {n} particles")
+            if radius is not None or n_vertices is not None:
+                raise ParameterError("radius and n_vertices come from shapes when it is given: pass None for them")
+            radius, n_vertices = shapes.radius, shapes.n_vertices
         self.radius = np.array(radius, dtype=float).reshape(n)
         self.n_vertices = np.array(n_vertices, dtype=np.int64).reshape(n)
         self.angle = np.zeros(n) if angle is None else np.array(angle, dtype=float).reshape(n)
@@ -205,7 +218,7 @@ class Simulation:
         if np.any((self.n_vertices != 0) & (self.n_vertices < 3)):
             raise ParameterError("n_vertices must be 0 (disk) or >= 3 (regular polygon)")
         self.walls = walls
-        self.shapes = Shapes.regular(self.radius, self.n_vertices)
+        self.shapes = Shapes.regular(self.radius, self.n_vertices) if shapes is None else shapes
         self.mass, self.inertia = self.shapes.mass_and_inertia(p.density, p.thickness)
         w = len(walls)
         self.n_particles, self.n_walls = n, w

@@ -1,0 +1,337 @@
+"""Any convex polygon in the solver: the shape table from the contract's geometry, the family of
+random convex polygons and files of vertex lists, a sample of them simulated, written, checked
+and resumed bit for bit, and regular samples unchanged."""
+
+import json
+import warnings
+
+import numpy as np
+import pytest
+
+import grainview
+from grainview.cli import main
+from grainview.contract import shapes as contract
+from grainview.contract.errors import ParameterError
+from grainview.contract.reader import ContractFile
+from solver import Parameters, Simulation, Walls, biaxial_test, compaction_sample, isotropic_compaction
+from solver.output import Recorder
+from solver.restart import load_sample, load_state, resume
+from solver.shape_families import (IRREGULAR, check_shape, random_convex_polygons, read_polygons, sample_shapes,
+                                   shape_label)
+from solver.shapes import Shapes, polygon_problem
+
+from .conftest import EXACT, G
+
+TABLES = ("radius", "n_vertices", "first_vertex", "vertex_radius", "vertex_angle", "normal_angle", "inradius", "area",
+          "inertia_per_mass")
+
+
+def _same_tables(a: Shapes, b: Shapes):
+    for name in TABLES:
+        np.testing.assert_array_equal(getattr(a, name), getattr(b, name), err_msg=name)
+
+
+# --- the geometry ----------------------------------------------------------------------------
+
+def test_contract_inradius_closed_form_and_from_vertices():
+    # regular n-gon: R cos(pi/n); disk: R; a 2 x 1 rectangle given by its vertices: 1/2
+    radius, n = np.array([2.0, 2.0, 1.0]), np.array([4, 6, 0])
+    np.testing.assert_allclose(contract.particle_inradius(radius, n), [np.sqrt(2.0), np.sqrt(3.0), 1.0], rtol=1e-15)
+    np.testing.assert_allclose(contract.particle_inradius(radius, n, contract.body_vertices(radius, n)),
+                               [np.sqrt(2.0), np.sqrt(3.0), 1.0], rtol=1e-14)
+    rectangle = np.array([[[1.0, -0.5], [1.0, 0.5], [-1.0, 0.5], [-1.0, -0.5]]])
+    assert contract.particle_inradius([np.sqrt(1.25)], [4], rectangle)[0] == pytest.approx(0.5, rel=1e-15)
+
+
+def test_regular_tables_are_the_closed_forms_bit_for_bit():
+    """The regular path's tables, now computed by the contract's functions, are the closed forms
+    the solver always used, bit for bit (so regular trajectories are unchanged)."""
+    rng = np.random.default_rng(7)
+    radius = rng.uniform(0.01, 0.03, 12)
+    n = np.array([5, 0, 3, 5, 6, 0, 4, 5, 3, 64, 7, 5], np.int32)
+    table = Shapes.regular(radius, n)
+    safe = np.where(n >= 3, n, 3).astype(np.float64)
+    np.testing.assert_array_equal(table.area, np.where(n >= 3, 0.5 * safe * radius ** 2 * np.sin(2 * np.pi / safe),
+                                                       np.pi * radius ** 2))
+    np.testing.assert_array_equal(table.inertia_per_mass,
+                                  np.where(n >= 3, radius ** 2 * (2.0 + np.cos(2.0 * np.pi / safe)) / 6.0,
+                                           0.5 * radius ** 2))
+    np.testing.assert_array_equal(table.inradius, np.where(n >= 3, radius * np.cos(np.pi / safe), radius))
+    phase = np.concatenate([2.0 * np.pi * np.arange(k) / k for k in n if k])
+    normal = np.concatenate([np.pi * (2 * np.arange(k) + 1) / k for k in n if k])
+    np.testing.assert_array_equal(table.vertex_angle, phase)
+    np.testing.assert_array_equal(table.normal_angle, normal)
+    np.testing.assert_array_equal(table.vertex_radius, np.repeat(radius, n))
+    assert table.vertex_xy is None
+    # what a file stores for them reads back as the same regular table
+    again = Shapes.of(radius, n, table.body_vertices())
+    assert again.vertex_xy is None
+    _same_tables(again, table)
+
+
+def test_a_right_triangle_against_a_hand_computation():
+    # legs a (x) and b (y): area ab/2, centroid (a/3, b/3), I/m about it (a^2 + b^2)/18,
+    # circumradius: the farthest vertex from the centroid, (2a/3, -b/3) for a > b
+    a, b = 0.04, 0.03
+    local = np.array([[0.0, 0.0], [a, 0.0], [0.0, b]]) - [a / 3, b / 3]
+    table = Shapes.convex([local])
+    assert table.area[0] == pytest.approx(a * b / 2, rel=1e-14)
+    assert table.inertia_per_mass[0] == pytest.approx((a ** 2 + b ** 2) / 18, rel=1e-13)
+    assert table.radius[0] == pytest.approx(np.hypot(2 * a / 3, b / 3), rel=1e-15)
+    # distances from the centroid to the legs b/3, a/3 and to the hypotenuse ab / (3 sqrt(a^2 + b^2))
+    assert table.inradius[0] == pytest.approx(a * b / (3 * np.hypot(a, b)), rel=1e-13)
+    mass, inertia = table.mass_and_inertia(2000.0, thickness=0.1)
+    assert mass[0] == pytest.approx(2000.0 * 0.1 * a * b / 2, rel=1e-14)
+    assert inertia[0] == pytest.approx(mass[0] * (a ** 2 + b ** 2) / 18, rel=1e-13)
+    np.testing.assert_array_equal(table.body_vertices()[0], local)  # kept exactly as given
+
+
+def test_a_rectangle_from_a_file_scaled_to_a_particle(tmp_path):
+    """A file's 3 x 1 rectangle scaled to a circumscribed radius R: its half-diagonal is R, so
+    its sides are a = 6R/sqrt(10), b = 2R/sqrt(10), its area a b and I/m = (a^2 + b^2)/12 =
+    (2R)^2/12 = R^2/3."""
+    shapes, angle = sample_shapes(_write(tmp_path, [[[0, 0], [3, 0], [3, 1], [0, 1]]]), [0.02, 0.01], seed=4)
+    a, b = 2 * 0.02 * 3 / np.sqrt(10), 2 * 0.02 / np.sqrt(10)
+    assert shapes.n_vertices.tolist() == [4, 4]
+    np.testing.assert_allclose(shapes.radius, [0.02, 0.01], rtol=1e-15)
+    np.testing.assert_allclose(shapes.inertia_per_mass, np.array([0.02, 0.01]) ** 2 / 3, rtol=1e-14)
+    assert shapes.area[0] == pytest.approx(a * b, rel=1e-14)
+    assert angle.shape == (2,) and np.all((0 <= angle) & (angle < 2 * np.pi)) and angle[0] != angle[1]
+
+
+@pytest.mark.parametrize("vertices, words", [
+    ([[0, 0], [1, 0]], "2 vertices, expected at least 3"),
+    ([[0, 0], [0, 1], [1, 0]], "clockwise"),
+    ([[0, 0], [2, 0], [1, 0.2], [1, 2]], "not convex"),
+    ([[0, 0], [1, 0], [2, 0], [1, 1]], "not convex"),  # a straight corner
+    ([[0, 0], [1, 0], [1, 0], [0, 1]], "equal"),
+    ([[np.cos(a), np.sin(a)] for a in 4 * np.pi * np.arange(5) / 5], "not convex"),  # a pentagram turns left
+    ([[0, 0], [np.nan, 0], [0, 1]], "not finite"),
+])
+def test_polygon_problems_are_named(vertices, words):
+    assert words in polygon_problem(vertices)
+    with pytest.raises(ParameterError, match=words):
+        Shapes.convex([vertices])
+
+
+def test_the_irregular_family_is_convex_centred_unit_and_seeded():
+    polygons = random_convex_polygons(200, np.random.default_rng(3))
+    counts = np.array([len(v) for v in polygons])
+    assert counts.min() >= 3 and counts.max() <= IRREGULAR.max_vertices and len(set(counts)) >= 4
+    assert (counts >= IRREGULAR.min_vertices).mean() > 0.9  # the hull rarely drops a vertex
+    for v in polygons:
+        assert polygon_problem(v) is None
+    width = max(counts)
+    padded = np.array([np.vstack([v, np.full((width - len(v), 2), np.nan)]) for v in polygons])
+    assert contract.shape_problems(np.ones(200), counts, padded) == []  # centroid 0, farthest vertex 1
+    props = contract.polygon_properties(padded)
+    inner = props["inradius"]
+    assert inner.min() > 0.3 and np.ptp(inner) > 0.2  # not slivers, and not all alike
+    assert np.abs(props["centroid"]).max() < 1e-15
+    again = random_convex_polygons(200, np.random.default_rng(3))
+    assert all(np.array_equal(u, v) for u, v in zip(polygons, again))
+
+
+def _write(folder, polygons, name="shapes.json"):
+    path = folder / name
+    path.write_text(json.dumps({"polygons": polygons}))
+    return str(path)
+
+
+@pytest.mark.parametrize("content, words", [
+    ({"polygons": [[[0, 0], [0, 1], [1, 0]]]}, "polygon 0: the vertices run clockwise"),
+    ({"polygons": [[[0, 0], [1, 0], [0, 1]], [[0, 0], [1, 0]]]}, "polygon 1: 2 vertices, expected at least 3"),
+    ({"polygons": [[[0, 0], [2, 0], [1, 0.2], [1, 2]]]}, "polygon 0: not convex"),
+    ({"polygons": [[[0, 0], ["a", 0], [1, 1]]]}, "polygon 0 is not a list of [x, y] pairs"),
+    ({"polygons": []}, "no list of polygons"),
+    ({"shapes": 1}, "no list of polygons"),
+    ("not json", "cannot read it"),
+])
+def test_bad_shape_files_are_one_line(tmp_path, capsys, content, words):
+    path = tmp_path / "shapes.json"
+    path.write_text(content if isinstance(content, str) else json.dumps(content))
+    with pytest.raises(ParameterError) as caught:
+        read_polygons(path)
+    assert words in str(caught.value) and str(path) in str(caught.value)
+    out = tmp_path / "run.nc"
+    assert main(["run", "--shape", str(path), "--particles", "10", "--out", str(out), "--progress", "off"]) == 2
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1 and words in err and err.startswith("grainview: error: --shape")
+    assert not out.exists()
+
+
+def test_shape_names_files_and_labels(tmp_path):
+    assert check_shape("irregular") == "irregular" and check_shape(5) == 5
+    with pytest.raises(ParameterError, match="'hexagram': expected 'disk', 'pentagon'.*irregular.*json"):
+        check_shape("hexagram")
+    with pytest.raises(ParameterError, match="no such file"):
+        check_shape(str(tmp_path / "missing.json"))
+    assert shape_label(str(tmp_path / "grains.json")) == "grains" and shape_label("irregular") == "irregular"
+    from solver.ensemble import RunSpec
+
+    path = _write(tmp_path, [[[0, 0], [1, 0], [0, 1]]], "triangles.json")
+    assert RunSpec(shape=path, particles=40, strain=0.01).validate().name == "triangles_n40_s0"
+
+
+# --- statics ---------------------------------------------------------------------------------
+
+def test_a_triangle_resting_on_its_leg_splits_its_weight_by_the_lever_rule():
+    """A right triangle (legs a along the floor, b up) under gravity: the floor carries its
+    weight m g, at its two bottom corners; moments about the centroid (a/3 from the right
+    angle) give 2/3 of it at the right angle and 1/3 at the other corner."""
+    a, b = 0.04, 0.02
+    local = np.array([[0.0, 0.0], [a, 0.0], [0.0, b]]) - [a / 3, b / 3]
+    sim = Simulation([[0.1, b / 3]], [0.0], walls=Walls.floor(), shapes=Shapes.convex([local]),
+                     parameters=Parameters(gravity=(0, -G), **EXACT))
+    for _ in range(10):
+        sim.step()
+    weight = sim.mass[0] * G
+    assert sim.mass[0] == pytest.approx(2600.0 * a * b / 2, rel=1e-14)
+    force = sim.impulse[:, 0] / sim.parameters.time_step
+    x = sim.points.point[:, 0]
+    assert len(force) == 2 and np.all(sim.points.kind == 2)
+    np.testing.assert_allclose(sorted(x), [0.1 - a / 3, 0.1 + 2 * a / 3], atol=1e-12)
+    np.testing.assert_allclose(force[np.argsort(x)], [2 * weight / 3, weight / 3], rtol=1e-6)
+    np.testing.assert_allclose(sim.wall_forces()[0], [0.0, -weight], rtol=1e-6)
+    assert np.abs(sim.velocity[0]).max() < 1e-12 and abs(sim.angular_velocity[0]) < 1e-10
+
+
+# --- a sample of random convex polygons, end to end ------------------------------------------
+
+RUN = dict(n=30, seed=4, compaction_steps=1500, strain=0.0006, every=2)  # compaction settles in about 950 steps
+
+
+def _irregular_run(path, stop_after=None):
+    """The irregular sample deposited, compacted a little and sheared into ``path``; with
+    ``stop_after``, stopped (as Ctrl-C would) right after that many snapshots."""
+    sim = compaction_sample(RUN["n"], "irregular", seed=RUN["seed"], max_wall_speed=0.2)
+    written = []
+    write = Recorder.write
+
+    def write_and_stop(recorder):
+        write(recorder)
+        written.append(1)
+        if stop_after is not None and len(written) == stop_after:
+            raise KeyboardInterrupt
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        isotropic_compaction(sim, max_steps=RUN["compaction_steps"], progress=False)
+        assert sim.settled
+        Recorder.write = write_and_stop
+        try:
+            biaxial_test(sim, path, strain=RUN["strain"], every=RUN["every"], progress=False)
+        except KeyboardInterrupt:
+            pass
+        finally:
+            Recorder.write = write
+    return sim
+
+
+@pytest.fixture(scope="module")
+def irregular_run(tmp_path_factory):
+    path = tmp_path_factory.mktemp("irregular") / "irregular.nc"
+    return path, _irregular_run(path)
+
+
+def test_irregular_deposit_overlaps_nothing():
+    """The deposit places the circumscribed disks: however each polygon is turned, no two
+    polygons (nor a polygon and a wall) overlap."""
+    sim = compaction_sample(60, "irregular", seed=9)
+    assert not np.all(sim.shapes.n_vertices == sim.shapes.n_vertices[0])  # irregular: counts differ
+    sim.step_alert = 0.5 * float(sim.radius.min())
+    points = sim.detect()
+    assert len(points.gap) > 0 and points.gap.min() > 0.0
+    lo, hi = sim.walls.box_bounds()
+    world = sim.shapes.world_vertices(sim.position, sim.angle)
+    assert np.nanmin(world[..., 0]) > lo[0] and np.nanmax(world[..., 0]) < hi[0] and np.nanmin(world[..., 1]) > lo[1]
+    # positions and sizes are the regular deposit's (same seed); only shapes and angles differ
+    pentagons = compaction_sample(60, "pentagon", seed=9)
+    np.testing.assert_array_equal(sim.position, pentagons.position)
+    np.testing.assert_allclose(sim.radius, pentagons.radius, rtol=1e-15)
+
+
+def test_irregular_sample_is_written_and_validates(irregular_run, capsys):
+    path, sim = irregular_run
+    with grainview.open_dataset(path, validate=True, chunks=None) as ds:
+        np.testing.assert_array_equal(ds.vertices.values, sim.shapes.body_vertices())
+        np.testing.assert_array_equal(ds.n_vertices.values, sim.shapes.n_vertices)
+        np.testing.assert_array_equal(ds.mass.values, sim.mass)
+        assert ds.sizes["time"] == 1 + int(np.ceil(ds.attrs["biaxial_steps"] / RUN["every"]))
+        assert int((ds.kind.values[-1] == 2).sum()) > 5 and int(ds.contact_count[-1]) >= RUN["n"]
+        # the contacts' stress holds the confining stress the right wall keeps
+        sigma_xx = ds.grain.stress_tensor().sel(xy_a="x", xy_b="x").values
+        np.testing.assert_allclose(sigma_xx, 1e4, rtol=0.2)
+        assert float(ds.max_interpenetration.max()) < 1e-3 * 2 * sim.radius.min()
+    assert main(["info", str(path), "--check"]) == 0
+    assert "valid: every value checked" in capsys.readouterr().out
+
+
+def test_irregular_sample_resumes_bit_for_bit(irregular_run, tmp_path):
+    path, sim = irregular_run
+    restored, test = load_state(path)
+    assert restored.shapes.vertex_xy is not None  # rebuilt as convex polygons from the file's vertices
+    _same_tables(restored.shapes, sim.shapes)
+    np.testing.assert_array_equal(restored.mass, sim.mass)
+    np.testing.assert_array_equal(restored.inertia, sim.inertia)
+    stopped = tmp_path / "stopped.nc"
+    _irregular_run(stopped, stop_after=4)
+    with grainview.open_dataset(stopped, chunks=None) as ds:
+        assert ds.sizes["time"] == 4
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        assert resume(stopped, progress=False) == test["n_steps"] - 2 * 3
+    assert stopped.read_bytes() == path.read_bytes()
+
+
+def test_regular_samples_write_their_vertices_and_read_back_regular(tmp_path):
+    sim = compaction_sample(12, "pentagon", seed=1)
+    path = tmp_path / "pentagons.nc"
+    with Recorder(path, sim, attrs={"scene": "isotropic"}) as recorder:
+        recorder.write()
+    with ContractFile(path) as ds:
+        vertices = ds.static("vertices")
+    np.testing.assert_array_equal(vertices, contract.body_vertices(sim.radius, np.full(12, 5)))
+    loaded = load_sample(path)
+    assert loaded.shapes.vertex_xy is None
+    _same_tables(loaded.shapes, sim.shapes)
+    disks = compaction_sample(12, "disk", seed=1)
+    with Recorder(tmp_path / "disks.nc", disks, attrs={"scene": "isotropic"}) as recorder:
+        recorder.write()
+    with ContractFile(tmp_path / "disks.nc") as ds:
+        assert "vertices" not in ds.variables
+
+
+def test_simulation_takes_shapes_or_radii_not_both():
+    shapes = Shapes.convex([[[0.01, -0.005], [0.01, 0.005], [-0.01, 0.005], [-0.01, -0.005]]])
+    with pytest.raises(ParameterError, match="radius and n_vertices come from shapes"):
+        Simulation([[0.0, 0.1]], [0.0], [0.01], [4], Walls.floor(), shapes=shapes)
+    with pytest.raises(ParameterError, match="shapes: expected a solver.shapes.Shapes of the 2 particles"):
+        Simulation([[0.0, 0.1], [0.1, 0.1]], [0.0, 0.0], walls=Walls.floor(), shapes=shapes)
+    sim = Simulation([[0.0, 0.1]], [0.0], walls=Walls.floor(), shapes=shapes)
+    assert sim.radius[0] == pytest.approx(np.hypot(0.01, 0.005)) and sim.n_vertices.tolist() == [4]
+
+
+# --- the command line ------------------------------------------------------------------------
+
+@pytest.mark.parametrize("shape", ["irregular", "file"])
+def test_run_shape_irregular_or_a_file_from_the_command_line(tmp_path, capsys, shape):
+    if shape == "file":
+        shape = _write(tmp_path, [[[0, 0], [2, 0], [2, 1], [0, 1]], [[0, 0], [1, 0], [0, 1]]], "bricks.json")
+    out = tmp_path / "run.nc"
+    assert main(["run", "isotropic", "--shape", shape, "--particles", "12", "--preparation", "fast",
+                 "--out", str(out), "--progress", "off"]) == 0
+    printed = capsys.readouterr().out
+    assert ("bricks: wrote" if shape.endswith(".json") else "irregular: wrote") in printed
+    with grainview.open_dataset(out, validate=True, chunks=None) as ds:
+        counts = ds.n_vertices.values
+        vertices = ds.vertices.values
+        assert ds.attrs["preparation_shape"] == shape
+    if shape.endswith(".json"):  # particle k takes the file's polygon k mod 2
+        assert counts.tolist() == [4, 3] * 6
+        props = contract.polygon_properties(vertices)
+        np.testing.assert_allclose(props["inertia_per_mass"][::2], ds.radius.values[::2] ** 2 / 3, rtol=1e-13)
+    else:
+        assert len(set(counts.tolist())) > 1 and counts.min() >= 3
+    assert main(["info", str(out), "--check"]) == 0
+    assert "valid: every value checked" in capsys.readouterr().out
