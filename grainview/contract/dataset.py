@@ -115,6 +115,8 @@ def make_dataset(
         problems = shape_problems(radius, n_vertices, np.asarray(optional["vertices"], "f8"))
         if problems:
             raise ParameterError("; ".join(problems))
+        if np.shape(optional["vertices"])[1] == 0:  # disks only: nothing to store
+            optional = {k: v for k, v in optional.items() if k != "vertices"}
     area = particle_area(radius, n_vertices, optional.get("vertices"))
     mass = density * area if mass is None else np.broadcast_to(np.asarray(mass, "f8"), (n,))
     inertia = mass * inertia_per_mass(radius, n_vertices, optional.get("vertices")) if inertia is None else np.broadcast_to(np.asarray(inertia, "f8"), (n,))

@@ -418,6 +418,8 @@ class SnapshotWriter:
                 vertices.shape[::2] == (n, 2) else [f"vertices: expected shape (N, V, 2) with N = {n}, got {vertices.shape}"]
             if problems:
                 raise ParameterError("; ".join(problems))
+            if vertices.shape[1] == 0:  # disks only: nothing to store (a vertex dimension of size 0 is unlimited)
+                vertices = None
         # The header and the static data are written under a temporary name and the file is
         # moved into place once they are on disk: a run killed while the file is being created
         # leaves either no file or a valid empty one, never a partial header.

@@ -372,3 +372,25 @@ def test_only_regular_pentagons_are_the_papers_pentagons():
     assert describe_run(irregular, window, 0.3)["particles"] == "4 irregular convex polygons with 5 vertices"
     assert describe_run(regular, window, 0.3)["particles"] == "4 5-gons"
     assert caption("mixed", mixed, "map").startswith("mixed: 2 disks, 2 5-gons, seed ?")
+
+
+def test_vertices_of_disks_only_are_not_written(tmp_path):
+    """body_vertices of a sample of disks is (P, 0, 2): a vertex dimension of size 0 would be
+    netCDF's unlimited one, a second beside time; the writer and make_dataset leave it out
+    (nothing to store), and the file opens and validates as disks."""
+    radius, n = [1.0, 1.0], [0, 0]
+    empty = body_vertices(radius, n)
+    assert empty.shape == (2, 0, 2)
+    contacts = dict(i=[], j=[], kind=[], normal=np.zeros((0, 2)), fn=[], ft=[], point=np.zeros((0, 2)),
+                    branch=np.zeros((0, 2)))
+    path = tmp_path / "disks.nc"
+    with SnapshotWriter.create(path, radius=radius, n_vertices=n, mass=[1.0, 1.0], inertia=[0.5, 0.5],
+                               vertices=empty) as writer:
+        writer.append(time=0.0, position=[[0.0, 0.0], [3.0, 0.0]], angle=[0.0, 0.0], contacts=contacts,
+                      box_min=[-2.0, -2.0], box_max=[5.0, 2.0])
+    with grainview.open_dataset(path, validate=True) as ds:
+        assert "vertices" not in ds.variables
+    ds = make_dataset(radius=radius, n_vertices=n, position=[[0.0, 0.0], [3.0, 0.0]], contacts=[contacts],
+                      box_min=[-2.0, -2.0], box_max=[5.0, 2.0], vertices=empty)
+    assert "vertices" not in ds.variables
+    ds.to_netcdf(tmp_path / "made.nc", **grainview.contract.dataset.netcdf_options(ds))
