@@ -114,3 +114,74 @@ def aligned_links(i, j, bx, by, mask, candidate, dx, dy, cos_limit):
             if abs(ux * dx[r, a] + uy * dy[r, a]) >= cos_limit and abs(ux * dx[r, b] + uy * dy[r, b]) >= cos_limit:
                 out[r, c] = True
     return out
+
+
+@njit(cache=True, nogil=True)
+def follow_tracks(chain):
+    """Tracks of the chains of consecutive rows (snapshots) of ``chain`` (T, P) int64 (chain ids
+    0 .. K_t - 1, -1 outside chains): chain a of row t-1 and chain b of row t are one track when
+    they share particles and each is the other's best match (most shared particles, ties to the
+    smaller id); every other chain starts a new track, numbered in the order they start.
+
+    Returns ``track`` (T, P) int64 (-1 outside chains) and, per track, ``first``, ``last`` (row
+    indices) and ``total`` (particles summed over its rows), each (K,) int64.
+    """
+    n_time, n_part = chain.shape
+    track = np.full((n_time, n_part), -1, dtype=np.int64)
+    capacity = 0
+    for t in range(n_time):
+        capacity += chain[t].max() + 1 if n_part > 0 else 0
+    first = np.empty(max(capacity, 0), dtype=np.int64)
+    last = np.empty(max(capacity, 0), dtype=np.int64)
+    total = np.zeros(max(capacity, 0), dtype=np.int64)
+    previous = np.empty(0, dtype=np.int64)
+    n_tracks = 0
+    codes = np.empty(n_part, dtype=np.int64)
+    for t in range(n_time):
+        n_here = chain[t].max() + 1 if n_part > 0 else 0
+        mapping = np.full(n_here, -1, dtype=np.int64)
+        n_prev = previous.shape[0]
+        if t > 0 and n_here > 0 and n_prev > 0:
+            m = 0
+            for p in range(n_part):
+                if chain[t - 1, p] >= 0 and chain[t, p] >= 0:
+                    codes[m] = chain[t - 1, p] * n_here + chain[t, p]
+                    m += 1
+            pairs = np.sort(codes[:m])
+            best_b = np.full(n_prev, -1, dtype=np.int64)
+            count_b = np.zeros(n_prev, dtype=np.int64)
+            best_a = np.full(n_here, -1, dtype=np.int64)
+            count_a = np.zeros(n_here, dtype=np.int64)
+            k = 0
+            while k < m:  # runs of equal codes, in increasing (a, b)
+                end = k
+                while end < m and pairs[end] == pairs[k]:
+                    end += 1
+                a = pairs[k] // n_here
+                b = pairs[k] % n_here
+                shared = end - k
+                if shared > count_b[a]:
+                    count_b[a] = shared
+                    best_b[a] = b
+                if shared > count_a[b]:
+                    count_a[b] = shared
+                    best_a[b] = a
+                k = end
+            for b in range(n_here):
+                a = best_a[b]
+                if a >= 0 and best_b[a] == b:
+                    mapping[b] = previous[a]
+        for b in range(n_here):
+            if mapping[b] < 0:
+                mapping[b] = n_tracks
+                first[n_tracks] = t
+                n_tracks += 1
+        for p in range(n_part):
+            c = chain[t, p]
+            if c >= 0:
+                track[t, p] = mapping[c]
+                total[mapping[c]] += 1
+        for b in range(n_here):
+            last[mapping[b]] = t
+        previous = mapping
+    return track, first[:n_tracks], last[:n_tracks], total[:n_tracks]

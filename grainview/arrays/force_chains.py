@@ -30,7 +30,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .._kernels.force_chains import accumulate_moments, aligned_links, label_components
+from .._kernels.force_chains import accumulate_moments, aligned_links, follow_tracks, label_components
 from .signature import CONTACT, CONTACT_XY, PARTICLE, SCALAR, TENSOR, core_dims
 from .tensors import principal
 from .vectors import force_vectors
@@ -205,7 +205,7 @@ def follow_chains(chain):
     Chain a of snapshot t-1 continues as chain b of snapshot t when they share particles and
     each is the other's best match (b shares more of a's members than any other chain of t, and
     a more of b's than any other chain of t-1; ties go to the smaller id). Every other chain
-    starts a new track.
+    starts a new track (:func:`grainview._kernels.force_chains.follow_tracks`).
 
     Parameters
     ----------
@@ -222,41 +222,11 @@ def follow_chains(chain):
     size : numpy.ndarray of float, (K,)
         Mean number of particles of each track over its snapshots.
     """
-    chain = np.asarray(chain, np.int64)
-    n_time = chain.shape[0]
-    track = np.full(chain.shape, -1, np.int64)
-    first, last, total = [], [], []
-    previous = np.zeros(0, np.int64)  # track of each chain id of the previous snapshot
-    for t in range(n_time):
-        ids = chain[t]
-        n_here = int(ids.max()) + 1 if ids.size else 0
-        mapping = np.full(max(n_here, 0), -1, np.int64)
-        if t > 0 and n_here > 0 and previous.size > 0:
-            both = (chain[t - 1] >= 0) & (ids >= 0)
-            code, shared = np.unique(chain[t - 1][both] * n_here + ids[both], return_counts=True)
-            if code.size:
-                a, b = code // n_here, code % n_here
-                best_b = np.lexsort((b, -shared, a))  # per a: most shared first, then smallest b
-                keep_a = np.r_[True, a[best_b][1:] != a[best_b][:-1]]
-                best_a = np.lexsort((a, -shared, b))
-                keep_b = np.r_[True, b[best_a][1:] != b[best_a][:-1]]
-                mutual = np.intersect1d(best_b[keep_a], best_a[keep_b])
-                mapping[b[mutual]] = previous[a[mutual]]
-        for k in np.flatnonzero(mapping < 0):
-            mapping[k] = len(first)
-            first.append(t)
-            last.append(t)
-            total.append(0)
-        sizes = np.bincount(ids[ids >= 0], minlength=n_here)
-        for k in range(n_here):
-            last[mapping[k]] = t
-            total[mapping[k]] += sizes[k]
-        track[t] = np.where(ids >= 0, mapping[np.maximum(ids, 0)] if n_here else -1, -1)
-        previous = mapping
-    first = np.asarray(first, np.int64)
-    last = np.asarray(last, np.int64)
-    size = np.asarray(total, float) / np.maximum(last - first + 1, 1)
-    return track, first, last, size
+    chain = np.ascontiguousarray(chain, dtype=np.int64)
+    if chain.ndim != 2:
+        raise ValueError(f"chain: expected (time, particle) ids, got shape {chain.shape}")
+    track, first, last, total = follow_tracks(chain)
+    return track, first, last, total / np.maximum(last - first + 1, 1)
 
 
 __all__ = ["particle_moments", "chain_particles", "chain_links", "components", "chain_sizes", "force_chains",

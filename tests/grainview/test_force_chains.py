@@ -295,6 +295,61 @@ def test_chains_match_a_particle_by_particle_version(angle):
 
 # -- following chains ----------------------------------------------------------------------------
 
+def numpy_follow(chain):
+    """Tracks with np.unique and np.lexsort, snapshot by snapshot (the mutual best matches)."""
+    chain = np.asarray(chain, np.int64)
+    n_time = chain.shape[0]
+    track = np.full(chain.shape, -1, np.int64)
+    first, last, total = [], [], []
+    previous = np.zeros(0, np.int64)  # track of each chain id of the previous snapshot
+    for t in range(n_time):
+        ids = chain[t]
+        n_here = int(ids.max()) + 1 if ids.size else 0
+        mapping = np.full(max(n_here, 0), -1, np.int64)
+        if t > 0 and n_here > 0 and previous.size > 0:
+            both = (chain[t - 1] >= 0) & (ids >= 0)
+            code, shared = np.unique(chain[t - 1][both] * n_here + ids[both], return_counts=True)
+            if code.size:
+                a, b = code // n_here, code % n_here
+                best_b = np.lexsort((b, -shared, a))  # per a: most shared first, then smallest b
+                keep_a = np.r_[True, a[best_b][1:] != a[best_b][:-1]]
+                best_a = np.lexsort((a, -shared, b))
+                keep_b = np.r_[True, b[best_a][1:] != b[best_a][:-1]]
+                mutual = np.intersect1d(best_b[keep_a], best_a[keep_b])
+                mapping[b[mutual]] = previous[a[mutual]]
+        for k in np.flatnonzero(mapping < 0):
+            mapping[k] = len(first)
+            first.append(t)
+            last.append(t)
+            total.append(0)
+        sizes = np.bincount(ids[ids >= 0], minlength=n_here)
+        for k in range(n_here):
+            last[mapping[k]] = t
+            total[mapping[k]] += sizes[k]
+        track[t] = np.where(ids >= 0, mapping[np.maximum(ids, 0)] if n_here else -1, -1)
+        previous = mapping
+    first = np.asarray(first, np.int64)
+    last = np.asarray(last, np.int64)
+    return track, first, last, np.asarray(total, float) / np.maximum(last - first + 1, 1)
+def test_the_tracking_kernel_matches_a_numpy_version():
+    rng = np.random.default_rng(11)
+    chain = -np.ones((40, 60), np.int64)
+    for t in range(40):  # chains drawn as runs of a shuffled order, kept in part from one row to the next
+        order = rng.permutation(60) if t == 0 or rng.uniform() < 0.3 else order
+        cuts = np.sort(rng.choice(np.arange(1, 60), rng.integers(3, 12), replace=False))
+        for k, part in enumerate(np.split(order, cuts)):
+            if part.size >= 3 and rng.uniform() < 0.7:
+                chain[t, part] = k
+        ids = np.unique(chain[t][chain[t] >= 0])  # renumber 0, 1, ... like force_chains
+        chain[t] = np.where(chain[t] >= 0, np.searchsorted(ids, chain[t]), -1)
+    chain[7] = -1  # a snapshot without chains
+    got = fc.follow_chains(chain)
+    want = numpy_follow(chain)
+    for g, w in zip(got, want):
+        np.testing.assert_array_equal(g, w)
+    assert got[1].size > 40 and (got[2] > got[1]).any()  # many tracks, some longer than a snapshot
+
+
 def test_tracks_follow_shared_members():
     ids = -np.ones((4, 10), int)
     ids[0, [0, 1, 2]] = 0; ids[0, [5, 6, 7]] = 1          # two chains
