@@ -302,6 +302,20 @@ def test_regular_samples_write_their_vertices_and_read_back_regular(tmp_path):
         assert "vertices" not in ds.variables
 
 
+def test_a_file_of_disks_and_irregular_polygons_reads_back_as_both():
+    """Shapes.of on a file's layout mixing a disk and a triangle: the disk's radius, area and
+    I/m (pi r^2, r^2/2) and the triangle's from its vertices (legs a, b: ab/2, (a^2 + b^2)/18)."""
+    a, b = 0.03, 0.02
+    triangle = np.array([[0.0, 0.0], [a, 0.0], [0.0, b]]) - [a / 3, b / 3]
+    vertices = np.full((2, 3, 2), np.nan)
+    vertices[1] = triangle
+    table = Shapes.of([0.01, np.hypot(2 * a / 3, b / 3)], [0, 3], vertices)
+    assert table.n_vertices.tolist() == [0, 3] and table.first_vertex.tolist() == [0, 0, 3]
+    np.testing.assert_allclose(table.area, [np.pi * 1e-4, a * b / 2], rtol=1e-14)
+    np.testing.assert_allclose(table.inertia_per_mass, [0.5e-4, (a ** 2 + b ** 2) / 18], rtol=1e-13)
+    np.testing.assert_array_equal(table.body_vertices(), vertices)
+
+
 def test_simulation_takes_shapes_or_radii_not_both():
     shapes = Shapes.convex([[[0.01, -0.005], [0.01, 0.005], [-0.01, 0.005], [-0.01, -0.005]]])
     with pytest.raises(ParameterError, match="radius and n_vertices come from shapes"):
