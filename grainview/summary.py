@@ -55,14 +55,17 @@ def regular_of(ds) -> np.ndarray:
 
 def shape_name(ds) -> str:
     """One name for a sample's particles: "disk" (every particle a disk), "<n>-gon" (every one
-    a regular n-gon), "irregular polygon" (every one a polygon, some irregular) or "mixed"."""
+    a regular n-gon), "irregular polygon" (every one a polygon, some irregular) or "mixed"
+    (disks and polygons, or regular polygons of several vertex counts)."""
     n_vertices = np.asarray(ds["n_vertices"].values)
     if not n_vertices.any():
         return "disk"
-    if (n_vertices >= 3).all():
-        return f"{int(n_vertices[0])}-gon" if (n_vertices == n_vertices[0]).all() and regular_of(ds).all() \
-            else "irregular polygon"
-    return "mixed"
+    if not (n_vertices >= 3).all():
+        return "mixed"
+    regular = regular_of(ds)
+    if not regular.all():
+        return "irregular polygon"
+    return f"{int(n_vertices[0])}-gon" if (n_vertices == n_vertices[0]).all() else "mixed"
 
 
 def summary_lines(facts: dict, attrs: dict) -> list:

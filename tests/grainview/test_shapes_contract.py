@@ -366,6 +366,7 @@ def test_only_regular_pentagons_are_the_papers_pentagons():
     mixed = make_dataset(radius=np.ones(4), n_vertices=[0, 5, 5, 0], **common)
     assert [shape_name(ds) for ds in (regular, irregular, disks, mixed)] == [
         "5-gon", "irregular polygon", "disk", "mixed"]
+    assert shape_name(make_dataset(radius=np.ones(4), n_vertices=[5, 6, 5, 6], **common)) == "mixed"
     assert [paper_sample(ds) for ds in (regular, irregular, disks, mixed)] == ["pentagons", None, "disks", None]
     assert [shape_key(ds=ds) for ds in (regular, irregular, disks, mixed)] == ["pentagons", None, "disks", None]
     window = xr.DataArray(np.zeros(1, bool), dims="time")
