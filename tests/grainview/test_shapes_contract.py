@@ -395,3 +395,33 @@ def test_vertices_of_disks_only_are_not_written(tmp_path):
                       box_min=[-2.0, -2.0], box_max=[5.0, 2.0], vertices=empty)
     assert "vertices" not in ds.variables
     ds.to_netcdf(tmp_path / "made.nc", **grainview.contract.dataset.netcdf_options(ds))
+
+
+def test_vtk_itself_reads_the_irregular_polygons(tmp_path):
+    """VTK's own reader (the optional clients extra): three polygon cells whose points are the
+    hand-rotated vertices, and each cell's area (vtkCellSizeFilter) its shoelace area."""
+    vtk = pytest.importorskip("vtk")
+    from vtk.util.numpy_support import vtk_to_numpy
+
+    path = tmp_path / "irregular.nc"
+    write_irregular(path)
+    with grainview.open_dataset(path) as ds:
+        write_vtk(ds, tmp_path / "vtk")
+    reader = vtk.vtkXMLPolyDataReader()
+    reader.SetFileName(str(tmp_path / "vtk" / "polygons_00001.vtp"))
+    reader.Update()
+    polygons = reader.GetOutput()
+    assert (polygons.GetNumberOfPolys(), polygons.GetNumberOfPoints()) == (3, 12)
+    points = vtk_to_numpy(polygons.GetPoints().GetData())
+    ids = vtk.vtkIdList()
+    cells = polygons.GetPolys()
+    cells.InitTraversal()
+    for want in _hand_world():
+        assert cells.GetNextCell(ids)
+        outline = points[[ids.GetId(m) for m in range(ids.GetNumberOfIds())]]
+        np.testing.assert_allclose(outline[:, :2], want, rtol=0, atol=1e-12)
+    quality = vtk.vtkCellSizeFilter()
+    quality.SetInputData(polygons)
+    quality.Update()
+    area = vtk_to_numpy(quality.GetOutput().GetCellData().GetArray("Area"))
+    np.testing.assert_allclose(area, [6.0, 4 * A * B, 2.5 * R5 ** 2 * math.sin(0.4 * math.pi)], rtol=1e-12)
