@@ -777,7 +777,7 @@ def build_parser() -> argparse.ArgumentParser:
     lammps.set_defaults(func=_convert)
     lmgc90 = formats.add_parser("lmgc90", help="an LMGC90 2D rigid run (DATBOX + OUTBOX text files)",
                                 description="An LMGC90 2D rigid run: its folder holding DATBOX/BODIES.DAT and "
-                                "BULK_BEHAV.DAT (RBDY2 bodies with one DISKx, regular POLYG or JONCx contactor) and "
+                                "BULK_BEHAV.DAT (RBDY2 bodies with one DISKx, convex POLYG or JONCx contactor) and "
                                 "OUTBOX/DOF.OUT.n with Vloc_Rloc.OUT.n (DKDKx, DKJCx, PLPLx, PLJCx, DKPLx). "
                                 "Contacts: body pairs with a compressive normal force; two points on a pair make a "
                                 "double contact (docs/formats.md).")
