@@ -8,8 +8,6 @@ from __future__ import annotations
 
 import numpy as np
 
-from grainview.contract.shapes import regular_vertices, world_vertices
-
 
 def all_pairs(pos, radius, alert):
     """Every pair i < j with |x_i - x_j| <= r_i + r_j + alert, as a sorted list of tuples."""
@@ -21,8 +19,12 @@ def all_pairs(pos, radius, alert):
 
 
 def polygon(x, y, r, theta, n):
-    """(n, 2) vertices of a regular n-gon, counter-clockwise (the contract's convention)."""
-    return world_vertices([[x, y]], [theta], regular_vertices(r, n)[None])[0]
+    """(n, 2) vertices of a regular n-gon, counter-clockwise (the contract's convention): vertex
+    k at (x, y) + r (cos(theta + 2 pi k/n), sin(theta + 2 pi k/n)), the polar form the solver's
+    shape table evaluates, so that a vertex placed exactly on a wall here is exactly on it for
+    the narrow phase too (the contract's p + Rot(theta) v_k agrees to round-off only)."""
+    phase = theta + 2.0 * np.pi * np.arange(n) / n
+    return np.stack([x + r * np.cos(phase), y + r * np.sin(phase)], -1)
 
 
 def outward_normals(verts):
