@@ -168,9 +168,9 @@ class Shapes:
 
     and edge k (vertex k -> k+1, cyclically) has the outward unit normal of angle
     ``angle + normal_angle[k]``. The polar form makes a world vertex one addition and one
-    cosine/sine away from the body's angle, with the same arithmetic as the contract's
-    definition (``grainview.contract.shapes.world_vertices``), and it describes any polygon that is
-    star-shaped about its centroid (every convex polygon).
+    cosine/sine away from the body's angle; it equals the contract's definition
+    p + Rot(angle) v_k (``grainview.contract.shapes.world_vertices``) to round-off, and it
+    describes any polygon that is star-shaped about its centroid (every convex polygon).
 
     Attributes
     ----------
