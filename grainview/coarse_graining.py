@@ -222,7 +222,7 @@ def field_invariants(fields: xr.Dataset, stress: str = "total") -> xr.Dataset:
     Returns
     -------
     xarray.Dataset
-        ``p``, ``q`` (Pa), ``q_over_p`` (1; NaN where p = 0) and ``theta_sigma`` (rad, in
+        ``p``, ``q`` (Pa), ``q_over_p`` (1; NaN where p <= 0) and ``theta_sigma`` (rad, in
         [0, pi)) over (time, y, x); lazy when ``fields`` is.
 
     Raises
@@ -240,7 +240,7 @@ def field_invariants(fields: xr.Dataset, stress: str = "total") -> xr.Dataset:
     p = (s1 + s2) / 2
     q = (s1 - s2) / 2
     with np.errstate(invalid="ignore", divide="ignore"):
-        ratio = q / p.where(p != 0)
+        ratio = q / p.where(p > 0)
     return xr.Dataset({
         "p": with_attrs(p, "p", "Pa", f"mean stress p = (s1 + s2)/2 of the {stress} stress"),
         "q": with_attrs(q, "q", "Pa", f"stress deviator q = (s1 - s2)/2 of the {stress} stress"),

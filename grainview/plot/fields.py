@@ -56,8 +56,9 @@ def _label(name, units):
 
 def plot_field_maps(data, names=DEFAULT_FIELDS, time: int = -1, width=None, spacing=None, cutoff: float = 3.0,
                     fields=None, stress: str = "total", title: bool = True):
-    """Maps of coarse-grained fields of snapshot ``time``, one panel per quantity, over the
-    sample's box (drawn as a black frame).
+    """Maps of coarse-grained fields of snapshot ``time``, one panel per quantity, over the grid,
+    with the sample's box drawn as a black frame; q/p only inside the box (outside it the ratio
+    of the kernels' tails means nothing).
 
     Parameters
     ----------
@@ -93,7 +94,7 @@ def plot_field_maps(data, names=DEFAULT_FIELDS, time: int = -1, width=None, spac
     Weinhart, Thornton, Luding & Bokhove, Granular Matter 14, 289 (2012); docs/analysis.md,
     "Coarse-grained fields".
     """
-    from ..coarse_graining import scalar_field
+    from ..coarse_graining import interior, scalar_field
 
     _, ds = single_dataset(data)
     names = _names(names)
@@ -103,6 +104,8 @@ def plot_field_maps(data, names=DEFAULT_FIELDS, time: int = -1, width=None, spac
     lo, hi = np.asarray(snap["box_min"].values, float), np.asarray(snap["box_max"].values, float)
     for ax, name in zip(axes, names):
         field = scalar_field(snap, name, stress)
+        if name == "q_over_p":  # a ratio of the kernels' tails means nothing outside the packing
+            field = field.where(interior(snap, margin=0.0))
         values = np.ma.masked_invalid(np.asarray(field.values, float))
         mesh = ax.pcolormesh(snap["x"].values, snap["y"].values, values, shading="nearest",
                              cmap=CMAPS.get(name, "RdBu_r" if name == "sigma_xy" else "inferno"))
