@@ -98,6 +98,7 @@ def _measure(path, mode, case, chunk, repeats):
 
 def run(quick=False):
     folder = study_folder()
+    load_before = os.getloadavg()[0]
     os.makedirs(os.path.join(HERE, "_data"), exist_ok=True)
     tiled = os.path.join(HERE, "_data", f"chains_tiled_14400{'_quick' if quick else ''}.nc")
     if not os.path.exists(tiled):
@@ -120,13 +121,16 @@ def run(quick=False):
                 print(rows[-1], flush=True)
     header = ["sample", "snapshots x particles", "mode", "analysis", "contacts", "median time (s)", "M contacts/s",
               "target 1 M/s", "peak RSS (MiB)"]
+    load = (f"Load average (1 min) {load_before:.1f} at the start and {os.getloadavg()[0]:.1f} at the end, on "
+            f"{os.cpu_count()} cores: above the core count, other work shared the machine and the times are longer "
+            f"than on free cores.")
     return (f"# Force-chain throughput\n\n`python benchmarks/force_chains.py{' --quick' if quick else ''}`: "
             f"ds.grain.force_chains() computed on whole runs, medians of {repeats} runs after one warm-up, "
             f"each sample and mode in a fresh process; eager: the file loaded into memory first; dask: opened "
             f"lazily, {CHUNK} snapshots per chunk, threaded scheduler. Contacts: occupied slots, wall contacts "
             f"included. The stress (p, q) on the same data is the reference: what reading the file and "
             f"dask cost any analysis. The tiled sample is the study's last {10 if quick else 60} pentagon snapshots repeated "
-            f"6 x 6 (module docstring).\n\n{machine_description()}\n\n" + markdown_table(header, rows) + "\n")
+            f"6 x 6 (module docstring).\n\n{machine_description()} {load}\n\n" + markdown_table(header, rows) + "\n")
 
 
 if __name__ == "__main__":
