@@ -7,7 +7,7 @@ cold cache spends its first step compiling, and a signal such as SIGTERM, which 
 acts on between whole steps, waits for that step. :func:`warm_up` runs a tiny workload that
 calls every kernel with the argument types a run uses (pentagons and disks; plain and
 Anderson sweeps; one and two domains; the stall test; the written snapshots and their
-residuals; the xi-network), so that the runs that follow start at once.
+residuals; the analyses' kernels), so that the runs that follow start at once.
 
 The cache lives where numba puts it: ``NUMBA_CACHE_DIR`` when it is set, otherwise a
 ``__pycache__`` folder beside each module (or a user cache folder when that one is not
@@ -103,12 +103,14 @@ def _stages(folder):
             ds.grain.xi_network().compute()
             ds.grain.coarse_grained(width=0.05, spacing=0.05).compute()
             ds.grain.network_persistence(dimensions=(0,)).compute()
+            ds.grain.force_chains(follow=True)
 
     return [("solver: pentagon steps (plain, Anderson, shuffled, stall test, 2 domains)", solver_shape("pentagon")),
             ("solver: disk steps (plain, Anderson, shuffled, stall test, 2 domains)", solver_shape("disk")),
             ("solver: a written biaxial test and its residuals", written),
             ("solver: a contact problem given as a matrix", matrix),
-            ("analysis: the xi-network, the coarse-grained fields, the network's topology", analysis)]
+            ("analysis: the xi-network, the coarse-grained fields, the network's topology, the force chains",
+             analysis)]
 
 
 def warm_up(log=print) -> dict:
