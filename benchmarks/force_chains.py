@@ -129,8 +129,9 @@ def run(quick=False):
             f"each sample and mode in a fresh process; eager: the file loaded into memory first; dask: opened "
             f"lazily, {CHUNK} snapshots per chunk, threaded scheduler. Contacts: occupied slots, wall contacts "
             f"included. The stress (p, q) on the same data is the reference: what reading the file and "
-            f"dask cost any analysis. The tiled sample is the study's last {10 if quick else 60} pentagon snapshots repeated "
-            f"6 x 6 (module docstring).\n\n{machine_description()} {load}\n\n" + markdown_table(header, rows) + "\n")
+            f"dask cost any analysis. The tiled sample is the study's last {10 if quick else 60} pentagon snapshots "
+            f"repeated 6 x 6 (module docstring).\n\n{machine_description()} {load}\n\n"
+            + markdown_table(header, rows) + "\n")
 
 
 if __name__ == "__main__":

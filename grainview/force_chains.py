@@ -118,9 +118,10 @@ def force_chains(ds: xr.Dataset, angle: float = DEFAULT_ANGLE, min_size: int = 3
         ``deviator_fraction`` ((D_chains : D)/(D : D) with D the deviator of
         sum_p V_p sigma_p, the chains' share of q), ``pressure_fraction`` (their share of p);
         over (time, length): ``length_count`` and ``length_pdf`` (the number and fraction of
-        chains of each length, in particles). With ``follow``: ``chain_track`` (time, particle),
-        the track id of the particle's chain (-1 outside chains), and over ``track``: ``first``, ``last`` (snapshot indices),
-        ``birth``, ``death`` (s), ``lifetime`` (snapshots seen), ``duration`` (death - birth, s),
+        chains of each length, in particles; NaN without chains). With ``follow``:
+        ``chain_track`` (time, particle), the track id of the particle's chain (-1 outside
+        chains), and over ``track``: ``first``, ``last`` (snapshot indices), ``birth``,
+        ``death`` (s), ``lifetime`` (snapshots seen), ``duration`` (death - birth, s),
         ``mean_size`` (particles) and ``censored`` (seen in the first or last snapshot, so
         its life may be longer). Lazy on dask input unless ``follow``.
 
@@ -190,7 +191,8 @@ def _tracks(chain: xr.DataArray, time: xr.DataArray) -> xr.Dataset:
                                   "track id of the particle's chain, followed by shared members (-1: no chain)"),
         "first": with_attrs(xr.DataArray(first, dims="track"), "first", "1", "first snapshot of the chain"),
         "last": with_attrs(xr.DataArray(last, dims="track"), "last", "1", "last snapshot of the chain"),
-        "birth": with_attrs(xr.DataArray(times[first], dims="track"), "birth", "s", "time of the chain's first snapshot"),
+        "birth": with_attrs(xr.DataArray(times[first], dims="track"), "birth", "s",
+                            "time of the chain's first snapshot"),
         "death": with_attrs(xr.DataArray(times[last], dims="track"), "death", "s", "time of the chain's last snapshot"),
         "lifetime": with_attrs(xr.DataArray(last - first + 1, dims="track"), "lifetime", "1",
                                "snapshots in which the chain is seen"),

@@ -191,9 +191,8 @@ def force_chains(i, j, fn, ft, normal, point, branch, mask, position, volume, an
     with np.errstate(invalid="ignore", divide="ignore"):
         deviator_fraction = np.where(member.any(-1), share / np.where(norm > 0, norm, np.nan), 0.0)
         pressure = np.trace(total, axis1=-2, axis2=-1)
-        pressure_fraction = np.where(member.any(-1),
-                                     np.trace(in_chains, axis1=-2, axis2=-1) / np.where(pressure != 0, pressure, np.nan),
-                                     0.0)
+        chains_trace = np.trace(in_chains, axis1=-2, axis2=-1)
+        pressure_fraction = np.where(member.any(-1), chains_trace / np.where(pressure != 0, pressure, np.nan), 0.0)
     particle_fraction = member.mean(-1)
     return (chain, link, sigma_1, sigma_2, theta_1, n_chains, length_count, orientation, particle_fraction,
             deviator_fraction, pressure_fraction)

@@ -39,7 +39,7 @@ def column_among_pairs(load=10.0, light=0.5, n_column=5, n_pairs=3, rotation=0.0
                             for k in range(n_pairs)])
     pos = np.concatenate([column, pairs]) @ turn.T
     n = len(pos)
-    up, right = turn @ [0.0, 1.0], turn @ [1.0, 0.0]
+    up = turn @ [0.0, 1.0]
     i = np.array(list(range(n_column - 1)) + [n_column + 2 * k for k in range(n_pairs)] + [0, n_column - 1])
     j = np.array(list(range(1, n_column)) + [n_column + 2 * k + 1 for k in range(n_pairs)] + [n, n + 1])
     branch = np.concatenate([pos[j[:-2]] - pos[i[:-2]], [-R * up, R * up]])
@@ -86,7 +86,8 @@ def confined_hexagonal(nx=6, ny=5, force=1.0):
 
 def series(*snapshots):
     """The snapshots (one-snapshot datasets of the same particles) as one series."""
-    return xr.concat(list(snapshots), "time", data_vars="minimal", coords="minimal", compat="override").assign_coords(time=np.arange(len(snapshots), dtype=float))
+    out = xr.concat(list(snapshots), "time", data_vars="minimal", coords="minimal", compat="override")
+    return out.assign_coords(time=np.arange(len(snapshots), dtype=float))
 
 
 # -- the hand-made packings ---------------------------------------------------------------------
@@ -279,8 +280,9 @@ def slow_chains(snap, angle):
         major[p], direction[p] = values[1], vectors[:, 1]
         isotropic[p] = values[1] - values[0] <= fc.ISOTROPY_TOLERANCE * abs(values[1])
     strong = (major > major.mean()) & ~isotropic
-    link = [strong[i] and strong[j] and all(abs(np.dot(b / np.linalg.norm(b), direction[p])) >= np.cos(np.deg2rad(angle))
-                                            for p in (i, j)) for i, j, b in used]
+    limit = np.cos(np.deg2rad(angle))
+    link = [strong[i] and strong[j] and all(abs(np.dot(b / np.linalg.norm(b), direction[p])) >= limit for p in (i, j))
+            for i, j, b in used]
     return slow_components([u[0] for u in used], [u[1] for u in used], link, n, 3)
 
 
@@ -334,8 +336,10 @@ def numpy_follow(chain):
 def test_the_tracking_kernel_matches_a_numpy_version():
     rng = np.random.default_rng(11)
     chain = -np.ones((40, 60), np.int64)
+    order = rng.permutation(60)
     for t in range(40):  # chains drawn as runs of a shuffled order, kept in part from one row to the next
-        order = rng.permutation(60) if t == 0 or rng.uniform() < 0.3 else order
+        if rng.uniform() < 0.3:
+            order = rng.permutation(60)
         cuts = np.sort(rng.choice(np.arange(1, 60), rng.integers(3, 12), replace=False))
         for k, part in enumerate(np.split(order, cuts)):
             if part.size >= 3 and rng.uniform() < 0.7:
