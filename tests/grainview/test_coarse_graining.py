@@ -384,3 +384,17 @@ def test_field_figures_draw_the_fields_with_units():
     with pytest.raises(ParameterError, match="fields has 1 snapshots, the dataset 2"):
         plot_field_maps(ds.isel(time=[0, 0]), fields=fields)
     matplotlib.pyplot.close("all")
+
+
+def test_solid_fraction_of_polygons_given_by_their_vertices(prepare):
+    """A rectangle 4 cm x 1 cm (vertices in its own frame) and a disk: int nu dA = 4e-4 + pi R^2."""
+    rect = np.array([[0.02, -0.005], [0.02, 0.005], [-0.02, 0.005], [-0.02, -0.005]])
+    vertices = np.full((2, 4, 2), np.nan)
+    vertices[0] = rect
+    radius = [float(np.hypot(0.02, 0.005)), 0.01]
+    contacts = [dict(i=[0], j=[1], kind=[1], normal=[[1.0, 0.0]], fn=[1.0], ft=[0.0])]
+    eager = make_dataset(radius=radius, n_vertices=[4, 0], vertices=vertices, position=[[0.0, 0.0], [0.05, 0.0]],
+                         contacts=contacts, box_min=[-0.03, -0.02], box_max=[0.07, 0.02])
+    x, y = grid_around([-0.03, -0.02], [0.07, 0.02], 0.002, 0.06)
+    out = coarse_grained(prepare(eager), width=0.008, x=x, y=y, cutoff=8).compute()
+    assert float(out.solid_fraction.sum()) * 0.002 ** 2 == pytest.approx(4e-4 + np.pi * 1e-4, rel=1e-9)
