@@ -349,3 +349,37 @@ def test_run_shape_irregular_or_a_file_from_the_command_line(tmp_path, capsys, s
         assert len(set(counts.tolist())) > 1 and counts.min() >= 3
     assert main(["info", str(out), "--check"]) == 0
     assert "valid: every value checked" in capsys.readouterr().out
+
+
+def test_irregular_sample_goes_through_the_report_and_the_vtk_export(irregular_run, tmp_path, capsys):
+    """The solver's irregular run, end to end on the analysis side: the report draws its
+    figures, and the VTK export's polygon cells are the file's vertices turned and moved
+    (p + Rot(angle) v_k), each cell's shoelace area the polygon's own."""
+    from tests.grainview.test_export import read_vtp
+
+    path, sim = irregular_run
+    report = tmp_path / "report"
+    assert main(["report", str(path), "--out", str(report)]) == 0
+    figures = sorted(p.name for p in report.rglob("*.png"))
+    assert len(figures) >= 10 and "irregular convex polygons" in (report / "index.md").read_text()
+    assert main(["export", str(path), "--to", "vtk", "--out", str(tmp_path / "vtk")]) == 0
+    capsys.readouterr()
+    with grainview.open_dataset(path, chunks=None) as ds:
+        k = ds.sizes["time"] - 1
+        vertices, counts = ds.vertices.values, ds.n_vertices.values
+        position, angle = ds.position.values[k], ds.angle.values[k]
+    _, _, arrays = read_vtp(tmp_path / "vtk" / f"polygons_{k:05d}.vtp")
+    points = arrays["Points"]["Points"][:, :2]
+    offsets = arrays["Polys"]["offsets"]
+    assert offsets.size == counts.size and offsets[-1] == counts.sum()
+    ids = arrays["CellData"]["id"]
+    start = np.concatenate([[0], offsets[:-1]])
+    for cell, (first, last) in enumerate(zip(start, offsets)):
+        b = int(ids[cell])
+        own = vertices[b, :counts[b]]
+        c, s = np.cos(angle[b]), np.sin(angle[b])
+        expected = position[b] + own @ np.array([[c, s], [-s, c]])
+        np.testing.assert_allclose(points[first:last], expected, rtol=0, atol=1e-12)
+        x, y = points[first:last].T
+        area = 0.5 * np.sum(x * np.roll(y, -1) - np.roll(x, -1) * y)
+        assert area == pytest.approx(sim.shapes.area[b], rel=1e-10)
