@@ -18,7 +18,8 @@ import numpy as np
 
 from . import residuals
 
-__all__ = ["ContactSolution", "natural_map", "local_law_residual", "contact_solution"]
+__all__ = ["ContactSolution", "natural_map", "natural_map_at", "local_law_residual", "largest_point_residual",
+           "contact_solution"]
 
 
 class ContactSolution(NamedTuple):
@@ -45,13 +46,16 @@ class ContactSolution(NamedTuple):
 def natural_map(W, q, mu, impulse):
     """(F, u): the natural map F (n, 2) N s of every point (module docstring) and the velocity
     u = W r + q (n, 2) m s-1, for impulses ``impulse`` (n, 2) and W in CSR form."""
-    n = mu.size
-    velocity = (W @ impulse.reshape(-1) + q).reshape(n, 2)
-    rho = 1.0 / W.diagonal()[0::2]
+    velocity = (W @ impulse.reshape(-1) + q).reshape(mu.size, 2)
+    return natural_map_at(impulse, velocity, mu, 1.0 / W.diagonal()[0::2]), velocity
+
+
+def natural_map_at(impulse, velocity, mu, rho):
+    """The natural map F (n, 2) of impulses and velocities (n, 2) given, rho = 1 / W_nn (n,)."""
     fn, ft = residuals.natural_maps(np.ascontiguousarray(impulse[:, 0]), np.ascontiguousarray(impulse[:, 1]),
                                     np.ascontiguousarray(velocity[:, 0]), np.ascontiguousarray(velocity[:, 1]),
                                     mu, rho)
-    return np.stack([fn, ft], -1), velocity
+    return np.stack([fn, ft], -1)
 
 
 def local_law_residual(violation, impulse) -> float:

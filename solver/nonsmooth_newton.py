@@ -22,8 +22,9 @@ packing has more contact components than degrees of freedom, so W, and J on the 
 can be singular: the factorised matrix is D_r + D_u (W + eps diag W), eps = 0 at first and
 raised to the next of 1e-10, 1e-8, ... 1e-2 whenever the factorisation fails or no step passes
 the line search (beyond 1e-2 the iterations stop unconverged), lowered one level after each step
-taken. The iterations stop when the natural-map residual
-(:mod:`solver.contact_solution`) is within the tolerance.
+taken. The iterations stop when the natural-map residual (:mod:`solver.contact_solution`) is
+within the tolerance, and, unconverged, when its smallest value has fallen by less than 5% over
+``STALL_STEPS`` steps.
 """
 
 from __future__ import annotations
@@ -42,6 +43,10 @@ ARMIJO = 1e-4
 """Sufficient-decrease constant of the line search."""
 HALVINGS = 30
 """Largest number of step halvings in one line search."""
+STALL_STEPS = 10
+"""The iterations stop when the smallest local-law residual has fallen by less than 5% over
+this many steps (the merit can creep down by tiny steps for ever on a packing whose points sit
+on the kinks of F)."""
 
 
 def alart_curnier(W, q, mu, impulse, rho_n, rho_t):
@@ -88,6 +93,7 @@ def solve(W, q, mu, tolerance, max_iterations, initial) -> ContactSolution:
     level = 0
     iterations = 0
     law = local_law_residual(natural_map(W, q, mu, r)[0], r)
+    best, checked = law, law
     while law > tolerance and iterations < max_iterations:
         step = None
         while step is None and level < len(REGULARISATIONS):
@@ -115,4 +121,9 @@ def solve(W, q, mu, tolerance, max_iterations, initial) -> ContactSolution:
         iterations += 1
         level = max(level - 1, 0)  # back towards the exact Jacobian once a step has passed
         law = local_law_residual(natural_map(W, q, mu, r)[0], r)
+        best = min(best, law)
+        if iterations % STALL_STEPS == 0:
+            if best > 0.95 * checked:
+                break
+            checked = best
     return contact_solution(W, q, mu, r, iterations, law <= tolerance)
