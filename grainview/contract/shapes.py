@@ -192,7 +192,8 @@ def shape_problems(radius, n_vertices, vertices) -> list[str]:
 
     Checked: ``n_vertices`` 0 or >= 3 and within the ``vertex`` dimension; a polygon's first
     ``n_vertices`` rows finite and the rest NaN (a disk's all NaN); every polygon convex and
-    counter-clockwise (each turn v_{k-1} -> v_k -> v_{k+1} strictly to the left), its centroid
+    counter-clockwise (each turn v_{k-1} -> v_k -> v_{k+1} strictly to the left, and the
+    boundary winding once around: the exterior angles sum to 2 pi, no star), its centroid
     at the origin (within :data:`CENTROID_TOLERANCE` R) and ``radius`` its farthest vertex
     (within :data:`RADIUS_TOLERANCE`).
     """
@@ -223,7 +224,11 @@ def shape_problems(radius, n_vertices, vertices) -> list[str]:
     previous = np.take_along_axis(np.nan_to_num(p), previous_index[..., None], axis=-2)
     a, b = current - previous, nxt - current
     turn = a[..., 0] * b[..., 1] - a[..., 1] * b[..., 0]
-    concave = np.any((turn <= 0) & (k[None, :] < count[:, None]), axis=-1)
+    real = k[None, :] < count[:, None]
+    # left turns everywhere still allow a star (a boundary winding more than once): the
+    # exterior angles of a convex polygon add up to one full turn
+    winding = np.where(real, np.arctan2(turn, np.sum(a * b, axis=-1)), 0.0).sum(-1) / (2 * np.pi)
+    concave = np.any((turn <= 0) & real, axis=-1) | ~np.isclose(winding, 1.0)
     ids = np.flatnonzero(polygon)
     if concave.any():
         problems.append(f"vertices: {int(concave.sum())} polygon(s) not convex with counter-clockwise vertices, "

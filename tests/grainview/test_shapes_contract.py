@@ -187,6 +187,16 @@ def test_each_shape_fault_is_one_line(fault, expected):
     assert len(problems) == 1 and problems[0].startswith(expected), problems
 
 
+def test_a_star_polygon_is_not_convex():
+    """The pentagram (a regular pentagon's vertices taken every second one) turns left at every
+    vertex, has its centroid at the origin and its farthest vertex at R, yet winds twice around
+    its centre: it is no convex polygon. The pentagon itself, same vertices in order, is."""
+    pentagon = regular_vertices(R5, 5)
+    assert shape_problems([R5], [5], pentagon[None]) == []
+    problems = shape_problems([R5], [5], pentagon[[0, 2, 4, 1, 3]][None])
+    assert problems == ["vertices: 1 polygon(s) not convex with counter-clockwise vertices, first particle 0"]
+
+
 # --- through the writer, make_dataset, validate and info ---------------------------------------
 
 def irregular_sample():
