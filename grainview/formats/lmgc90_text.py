@@ -39,11 +39,13 @@ __all__ = ["Body", "Contactor", "DofSnapshot", "VlocEntry", "VlocSnapshot", "for
            "read_bulk_behav", "read_dof", "read_vloc_rloc", "output_files"]
 
 _NUMBER = r"[-+]?(?:\d+\.\d*|\.\d+|\d+)(?:[DdEe][-+]?\d+|[-+]\d{3})?"
-_KEY_VALUE = re.compile(r"([A-Za-z][A-Za-z0-9_()/]*)\s*=\s*(" + _NUMBER + ")")
+# a value ends its field: digits followed by anything but a blank are a damaged number, not a shorter one
+_KEY_VALUE = re.compile(r"([A-Za-z][A-Za-z0-9_()/]*)\s*=\s*(" + _NUMBER + r")(?!\S)")
 _STEPS = re.compile(r"^\$steps\s+(\d+)\s+time=\s*(" + _NUMBER + r")\s*$")
 _VLOC_LABELS = {"rlt/H": "rlt", "rln/H": "rln", "vlt =": "vlt", "vln =": "vln", "gapTT": "gap", "n(1)=": "n1",
                 "n(2)=": "n2", "coo1=": "x", "coo2=": "y"}
-_VLOC_VALUE = re.compile("(" + "|".join(re.escape(k) for k in _VLOC_LABELS) + r"|rlt  |rln  )\s*(" + _NUMBER + ")")
+_VLOC_VALUE = re.compile("(" + "|".join(re.escape(k) for k in _VLOC_LABELS) + r"|rlt  |rln  )\s*("
+                         + _NUMBER + r")(?!\S)")
 
 
 def fortran_float(text: str) -> float:

@@ -507,6 +507,11 @@ def _concave(text):
      "must be of the same step"),
     ("not-lmgc90", ("OUTBOX/DOF.OUT.1", lambda t: "hello\n" + t), "not an LMGC90 OUTBOX file"),
     ("appended", ("OUTBOX/Vloc_Rloc.OUT.4", lambda t: t + t), "a second '$steps' record"),
+    # a number garbled inside its field: its leading digits alone ("0.") are no value to keep
+    ("garbled-dof", ("OUTBOX/DOF.OUT.2", lambda t: t.replace("X(1)= 0.", "X(1)= 0.#", 1)),
+     "cannot read the body block"),
+    ("garbled-vloc", ("OUTBOX/Vloc_Rloc.OUT.3", lambda t: re.sub(r"rln/H 0\.(\d)", r"rln/H 0.\1#", t, count=1)),
+     "entry without rln/H"),
 ])
 def test_bad_input_gets_one_line_and_writes_nothing(tmp_path, name, edit, match):
     folder = _copy(tmp_path, name, edit)
