@@ -23,13 +23,14 @@ The problems (benchmarks/_data/, ignored by git):
   q = H v_free + (bias, 0).
 
 Each method starts a Siconos problem from r = 0 and a captured problem from the warm start the
-stepper gave its NLGS (last step's impulses, matched point by point). Time to a target: NLGS sweeps are run in chunks of about 5% of the sweeps done so
-far, the natural-map residual computed between chunks, off the clock (the sweeps continue
+stepper gave its NLGS (last step's impulses, matched point by point). Time to a target: NLGS
+sweeps are run in chunks of about 5% of the sweeps done so far, the natural-map residual computed between chunks, off the clock (the sweeps continue
 from the impulses, as one longer run would); Newton and the projected conjugate gradient are
 run with the target as their tolerance. A method that does not reach a target within its cap
 (NLGS 20,000 sweeps or 120 s, Newton 200 steps, conjugate gradient 20,000 iterations) or stops
 on its stall test (solver.nonsmooth_newton, solver.projected_cg) is reported with the residual
-it ended at (the NLGS: the best it reached), and not run again for the tighter target. One run per cell, the cores shared (nice).
+it ended at (the NLGS: the best it reached), and not run again for the tighter target. One
+run per cell, the cores shared (nice).
 """
 
 from __future__ import annotations
@@ -48,7 +49,7 @@ from scipy import sparse
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, os.path.dirname(HERE))
 sys.path.insert(0, HERE)
-from common import capture_contact_problems, markdown_table, write_results  # noqa: E402
+from common import capture_contact_problems, markdown_table  # noqa: E402
 
 DATA = os.path.join(HERE, "_data", "contact_solvers")
 RESULTS = os.path.join(HERE, "RESULTS-contact-solvers.md")
@@ -67,10 +68,15 @@ def fetch_siconos(mirror):
     """Copy the three 2D problems out of a git mirror of siconos/siconos into DATA."""
     os.makedirs(DATA, exist_ok=True)
     for name in SICONOS:
-        text = subprocess.run(["git", "--git-dir", mirror, "show", f"HEAD:{SICONOS_PATH}/{name}.dat"],
-                              capture_output=True, check=True).stdout
-        with open(os.path.join(DATA, name + ".dat"), "wb") as fh:
-            fh.write(text)
+        found = subprocess.run(["git", "--git-dir", mirror, "show", f"HEAD:{SICONOS_PATH}/{name}.dat"],
+                               capture_output=True)
+        if found.returncode:
+            raise SystemExit(f"--fetch-siconos {mirror}: no {SICONOS_PATH}/{name}.dat at HEAD of that git directory "
+                             "(expected a git mirror of github.com/siconos/siconos)")
+        path = os.path.join(DATA, name + ".dat")
+        with open(path + ".part", "wb") as fh:
+            fh.write(found.stdout)
+        os.replace(path + ".part", path)
 
 
 def read_siconos_fc2d(path):
@@ -168,8 +174,10 @@ def build(particles):
             captured.append((W, q, mu, np.stack([pn, pt], -1)))
             for _ in range(STEPS_APART - 1):
                 sim.step()
-    with open(os.path.join(DATA, f"pentagon_{particles}.pkl"), "wb") as fh:
+    path = os.path.join(DATA, f"pentagon_{particles}.pkl")
+    with open(path + ".part", "wb") as fh:
         pickle.dump(captured, fh)
+    os.replace(path + ".part", path)
     print(f"pentagon, {particles}: {len(captured)} problems ({[c[2].size for c in captured]} points) in "
           f"{time.perf_counter() - start:.0f} s", flush=True)
 
@@ -272,9 +280,13 @@ def measure():
 
 def profile(rows, path=FIGURE):
     """Dolan–Moré performance profiles of the seconds to each target: for every method, the
-    fraction of problems it solves within tau times the fastest method's time."""
+    fraction of problems it solves within tau times the fastest method's time. A problem that
+    its starting impulses solve already (no method iterates) is left out."""
     import matplotlib.pyplot as plt
 
+    trivial = {label for label in {r["problem"] for r in rows}
+               if all(r["iterations"] == 0 for r in rows if r["problem"] == label)}
+    rows = [r for r in rows if r["problem"] not in trivial]
     methods = sorted({r["method"] for r in rows})
     fig, axes = plt.subplots(1, len(TARGETS), figsize=(10, 4), sharey=True)
     for ax, target in zip(axes, TARGETS):
@@ -328,8 +340,10 @@ def table(rows):
 
 def degeneracy(name=SICONOS[1]):
     """Print what makes the 2020-contact problem stall: the spectrum of its stored W (symmetric,
-    but printed to six significant digits), the points its negative modes live on, and where
-    the NLGS's natural-map residual sits after CAPS['nlgs'] sweeps."""
+    but printed to six significant digits), the points its negative modes live on, where the
+    NLGS's natural-map residual sits after CAPS['nlgs'] sweeps, and how far 3000 sweeps get on
+    the stored W and on W with its negative modes removed (entries below 1e-12 of the largest
+    dropped)."""
     from solver import nlgs
     from solver.contact_solution import natural_map
 
@@ -341,7 +355,8 @@ def degeneracy(name=SICONOS[1]):
     negative = np.where(values < 0)[0]
     print(f"eigenvalues: largest {largest:.4g}; {negative.size} negative, down to {values[0]:.3g} "
           f"({values[0] / largest:.1e} of the largest); |lambda| < 1e-6 of the largest: "
-          f"{int(np.sum(np.abs(values) < 1e-6 * largest))}; numerical rank (1e-9) {int(np.sum(values > 1e-9 * largest))}")
+          f"{int(np.sum(np.abs(values) < 1e-6 * largest))}; "
+          f"numerical rank (1e-9) {int(np.sum(values > 1e-9 * largest))}")
     modes = set()
     for j in negative:
         weight = vectors[0::2, j] ** 2 + vectors[1::2, j] ** 2
@@ -359,6 +374,14 @@ def degeneracy(name=SICONOS[1]):
           f"its 10 worst points {worst.tolist()} hold {share[worst].sum():.2f} of |F|^2, "
           f"{len(set(worst.tolist()) & modes)} of them among the negative modes' points; "
           f"the modes' {len(modes)} points hold {share[sorted(modes)].sum():.2f}")
+    repaired = dense - (vectors[:, negative] * values[negative]) @ vectors[:, negative].T
+    repaired = 0.5 * (repaired + repaired.T)
+    repaired = sparse.csr_matrix(np.where(np.abs(repaired) > 1e-12 * np.abs(repaired).max(), repaired, 0.0))
+    for label, matrix in (("stored W", W), ("W without its negative modes", repaired)):
+        rn, rt = np.zeros(mu.size), np.zeros(mu.size)
+        nlgs.solve_matrix(matrix.indptr.astype(np.int64), matrix.indices.astype(np.int64), matrix.data, q, mu, rn, rt,
+                          1e-300, 1e-300, 3000)
+        print(f"NLGS, 3000 sweeps, {label}: residual {law(matrix, q, mu, np.stack([rn, rt], -1)):.2e}")
 
 
 if __name__ == "__main__":

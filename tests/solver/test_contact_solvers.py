@@ -60,7 +60,8 @@ def test_the_hand_made_problems(method, case):
 
 @pytest.mark.parametrize("method", NEW_METHODS)
 def test_a_frictional_block_with_normal_tangential_coupling(method):
-    # sliding with an n-t coupling: u_n = 0 gives r_n (1.5 - 0.2 * 0.4) = 2, r_t = -0.2 r_n, u_t = 1 + 0.4 r_n - 2 * 0.2 r_n
+    # sliding with an n-t coupling: u_n = 0 gives r_n (1.5 - 0.2 * 0.4) = 2, r_t = -0.2 r_n,
+    # u_t = 1 + 0.4 r_n - 2 * 0.2 r_n = 1
     W = np.array([[1.5, 0.4], [0.4, 2.0]])
     s = solve_contact_problem(W, [-2.0, 1.0], 0.2, method=method, tolerance=1e-14)
     rn = 2.0 / (1.5 - 0.2 * 0.4)
