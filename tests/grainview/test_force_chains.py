@@ -159,6 +159,36 @@ def test_an_isotropic_pile_has_no_chain(prepare):
     assert float(out.particle_fraction) == 0.0 and float(out.deviator_fraction) == 0.0
 
 
+def test_an_isotropic_particle_above_the_mean_links_nothing(prepare):
+    """A horizontal column of five disks pressed end to end by 10 N, its middle disk also pressed
+    by 10 N from above and below (two walls), beside three vertical pairs at 0.5 N: the middle
+    disk's stress is isotropic, 20 R/V_p (1 0; 0 1), above the mean of sigma_1 but without a
+    major direction, so it links nothing and the column breaks into two pieces of two."""
+    n_column, n = 5, 11
+    column = np.array([[2 * R * k, 0.0] for k in range(n_column)])
+    pairs = np.concatenate([[[4 * R * k, 6 * R], [4 * R * k, 8 * R]] for k in range(3)])
+    pos = np.concatenate([column, pairs])
+    x, y = np.array([1.0, 0.0]), np.array([0.0, 1.0])
+    i = np.array([0, 1, 2, 3, 5, 7, 9, 0, 4, 2, 2])
+    j = np.array([1, 2, 3, 4, 6, 8, 10, n, n + 1, n + 2, n + 3])
+    normal = np.array([x] * 4 + [y] * 3 + [-x, x, y, -y])
+    branch = np.concatenate([pos[j[:7]] - pos[i[:7]], R * normal[7:]])
+    fn = np.array([10.0] * 4 + [0.5] * 3 + [10.0] * 4)
+    contacts = [dict(i=i, j=j, kind=np.ones(i.size, "i1"), normal=normal, fn=fn, ft=np.zeros(i.size),
+                     branch=branch, point=pos[i] + R * normal)]
+    eager = make_dataset(radius=np.full(n, R), position=pos, contacts=contacts, box_min=pos.min(0) - 2 * R,
+                         box_max=pos.max(0) + 2 * R, n_walls=4, wall_names=["left", "right", "top", "bottom"])
+    out = prepare(eager).grain.force_chains().compute().isel(time=0)
+    np.testing.assert_allclose(out.sigma_1.values[2], 20 * R / VP, rtol=1e-12)
+    np.testing.assert_allclose(out.sigma_2.values[2], 20 * R / VP, rtol=1e-12)
+    assert out.sigma_1.values[2] > out.sigma_1.values.mean() and np.isnan(out.theta_1.values[2])
+    assert int(out.n_chains) == 0 and not out.link.values.any()
+    pieces = force_chains(eager, min_size=2).isel(time=0)  # chains of two: the column's two halves
+    np.testing.assert_array_equal(pieces.chain.values[:5], [0, 0, -1, 1, 1])
+    np.testing.assert_array_equal(fc.chain_particles([3.0, 3.0, 1.0, 1.0], [3.0, 1.0, 1.0, 0.0]),
+                                  [False, True, False, False])
+
+
 def test_the_particle_stresses_add_up_to_the_sample_stress():
     # sum_p V_p sigma_p = sum_c f (x) l = V sigma (walls included): two independent sums
     ds = builders.mixed_contacts(seed=3, t=4)
