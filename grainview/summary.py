@@ -49,8 +49,10 @@ def regular_of(ds) -> np.ndarray:
     (:func:`grainview.contract.shapes.regular_polygons` of its ``vertices``, when it has them)."""
     from .contract.shapes import regular_polygons
 
-    vertices = ds["vertices"].values if "vertices" in ds.variables else None
-    return regular_polygons(ds["radius"].values, ds["n_vertices"].values, vertices)
+    n_vertices = np.asarray(ds["n_vertices"].values)
+    if "vertices" not in ds.variables:  # the contract: without vertices, every polygon is regular
+        return n_vertices >= 3
+    return regular_polygons(ds["radius"].values, n_vertices, ds["vertices"].values)
 
 
 def shape_name(ds) -> str:

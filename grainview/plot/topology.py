@@ -213,6 +213,7 @@ def plot_network_topology(data, time=-1, label=None):
 
 
 def _with_particles(result: xr.Dataset, ds: xr.Dataset) -> xr.Dataset:
-    """``result`` carrying ``ds``'s particle dimension (through ``n_vertices``, which also gives
-    the sample's colour), so that the per-particle figures divide by N."""
-    return result.assign(n_vertices=ds["n_vertices"])
+    """``result`` carrying ``ds``'s particle dimension and shapes (``radius``, ``n_vertices``
+    and ``vertices`` where the file has them: they give the sample's colour,
+    :func:`grainview.plot._style.shape_key`), so that the per-particle figures divide by N."""
+    return result.assign({name: ds[name] for name in ("radius", "n_vertices", "vertices") if name in ds.variables})
