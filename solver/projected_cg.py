@@ -32,85 +32,47 @@ from __future__ import annotations
 
 import numpy as np
 
-from .contact_solution import ContactSolution, contact_solution, local_law_residual, natural_map_at
+from .contact_solution import ContactSolution, contact_solution
+from .projected_cg_kernels import iteration, start
 
-__all__ = ["OPEN", "STICK", "SLIDE_POSITIVE", "SLIDE_NEGATIVE", "cone_projection", "face_projection", "solve"]
+__all__ = ["STALL_ITERATIONS", "solve"]
 
 STALL_ITERATIONS = 500
 """The iterations stop when the smallest local-law residual has fallen by less than 5% over
 this many iterations."""
 
-OPEN, STICK, SLIDE_POSITIVE, SLIDE_NEGATIVE = 0, 1, 2, 3
-"""Point statuses: no impulse; inside the cone; at r_t = +mu r_n; at r_t = -mu r_n."""
-
-
-def cone_projection(y, mu, status, direction_t):
-    """Vertical projection of y (n, 2) onto the cones and the new statuses (module docstring);
-    ``status`` the previous statuses and ``direction_t`` (n,) the tangential search direction
-    (a sliding point with a zero one stays at its edge)."""
-    rn = np.maximum(y[:, 0], 0.0)
-    bound = mu * rn
-    rt = np.clip(y[:, 1], -bound, bound)
-    new = np.where(y[:, 1] >= bound, SLIDE_POSITIVE, np.where(y[:, 1] <= -bound, SLIDE_NEGATIVE, STICK))
-    keep = (new == STICK) & (direction_t == 0.0) & ((status == SLIDE_POSITIVE) | (status == SLIDE_NEGATIVE))
-    new = np.where(keep, status, new)
-    rt = np.where(new == SLIDE_POSITIVE, bound, np.where(new == SLIDE_NEGATIVE, -bound, rt))
-    new = np.where(y[:, 0] > 0.0, new, OPEN)
-    return np.stack([rn, np.where(new == OPEN, 0.0, rt)], -1), new
-
-
-def face_projection(x, status, mask=None):
-    """A direction x (n, 2) projected onto the faces of ``status`` (module docstring). With
-    ``mask`` (n, 2) of booleans, the components where it is False are zeroed as well (the old
-    direction follows the new gradient's zeros)."""
-    xn, xt = x[:, 0], x[:, 1]
-    opening = status == OPEN
-    out_n = np.where(opening, np.maximum(xn, 0.0), xn)
-    out_t = np.where(opening, 0.0, np.where(status == SLIDE_POSITIVE, np.minimum(xt, 0.0),
-                                            np.where(status == SLIDE_NEGATIVE, np.maximum(xt, 0.0), xt)))
-    out = np.stack([out_n, out_t], -1)
-    if mask is not None:
-        out = np.where(mask, out, 0.0)
-    return out
-
 
 def solve(W, q, mu, tolerance, max_iterations, initial) -> ContactSolution:
-    """Projected conjugate-gradient iterations (module docstring) from the impulses
-    ``initial`` (n, 2) until the local-law residual is within ``tolerance`` or
-    ``max_iterations`` iterations."""
+    """Projected conjugate-gradient iterations (module docstring; the passes compiled in
+    :mod:`solver.projected_cg_kernels`) from the impulses ``initial`` (n, 2) until the
+    local-law residual is within ``tolerance`` or ``max_iterations`` iterations."""
     n = mu.size
     diagonal = W.diagonal()
-    jacobi = np.stack([1.0 / diagonal[0::2], 1.0 / np.where(diagonal[1::2] > 0, diagonal[1::2], diagonal[0::2])], -1)
-    start = np.array(initial, dtype=np.float64).reshape(-1, 2)
-    rho = jacobi[:, 0]
-    r, status = cone_projection(start, mu, np.full(n, STICK), np.ones(n))
-    g = -(W @ r.reshape(-1) + q).reshape(-1, 2)
-    w = face_projection(jacobi * g, status)
-    p = w
-    iterations = 0
-    law = local_law_residual(natural_map_at(r, -g, mu, rho), r)
+    jacobi = np.stack([1.0 / diagonal[0::2], 1.0 / np.where(diagonal[1::2] > 0, diagonal[1::2], diagonal[0::2])],
+                      -1).reshape(-1)
+    indptr, indices, data = W.indptr.astype(np.int64), W.indices.astype(np.int64), W.data
+    q = np.ascontiguousarray(q, dtype=np.float64)
+    r = np.array(initial, dtype=np.float64).reshape(-1)
+    status = np.empty(n, np.int64)
+    g, p, Wp = np.empty(2 * n), np.empty(2 * n), np.empty(2 * n)
+    violation, size = start(indptr, indices, data, q, mu, jacobi, r, status, g, p)
+    law = _law(violation, size)
     best, checked = law, law
+    iterations = 0
     while law > tolerance and iterations < max_iterations:
-        if not np.any(p):
-            break  # no direction left: a fixed point of the projections short of the tolerance
-        Wp = (W @ p.reshape(-1)).reshape(-1, 2)
-        pWp = float(np.sum(p * Wp))
-        if not pWp > 0.0:
-            break
-        alpha = float(np.sum(g * p)) / pWp
-        r, status = cone_projection(r + alpha * p, mu, status, p[:, 1])
-        g = -(W @ r.reshape(-1) + q).reshape(-1, 2)
+        violation, size, moved = iteration(indptr, indices, data, q, mu, jacobi, r, status, g, p, Wp)
+        if not moved:
+            break  # no direction with curvature left: a fixed point of the projections
         iterations += 1
-        law = local_law_residual(natural_map_at(r, -g, mu, rho), r)
+        law = _law(violation, size)
         best = min(best, law)
         if iterations % STALL_ITERATIONS == 0:
             if best > 0.95 * checked:
                 break
             checked = best
-        w = face_projection(jacobi * g, status)
-        z = face_projection(p, status, w != 0.0)
-        beta = -float(np.sum(Wp * w)) / pWp
-        p = w + beta * z
-        if float(np.sum(g * p)) <= 0.0:  # not a descent direction: restart on the gradient
-            p = w
-    return contact_solution(W, q, mu, r, iterations, law <= tolerance)
+    return contact_solution(W, q, mu, r.reshape(n, 2), iterations, law <= tolerance)
+
+
+def _law(violation, size):
+    """|F| / |r| from their squares (|F| when r = 0)."""
+    return float(np.sqrt(violation / size)) if size > 0 else float(np.sqrt(violation))
