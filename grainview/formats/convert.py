@@ -20,9 +20,12 @@ __all__ = ["check_out", "write_snapshots"]
 
 
 def check_out(out, overwrite: bool) -> str:
-    """``out`` as a string, refused in one line (before any work) when it exists and
-    ``overwrite`` is False, or when its folder does not exist."""
+    """``out`` as a string, refused in one line (before any work) when it is a folder (with
+    ``overwrite`` too), when it exists and ``overwrite`` is False, or when its folder does not
+    exist."""
     out = os.fspath(out)
+    if os.path.isdir(out):
+        raise FileFormatError(f"{out} is a folder; expected a file name such as {os.path.join(out, 'run.nc')}")
     if os.path.exists(out) and not overwrite:
         raise FileExistsError(f"{out} exists; pass overwrite=True to replace it")
     folder = os.path.dirname(os.path.abspath(out))

@@ -180,6 +180,23 @@ def test_the_file_the_backend_and_the_reader_agree(ds, tmp_path):
         convert_lammps(out, files["particles"], files["contacts"], files["walls"], log=files["log"])
 
 
+def test_an_out_that_is_a_folder_is_refused_first(tmp_path):
+    """--out naming a folder, even with --overwrite: one line saying so, before any reading, and
+    the folder as it was."""
+    files = dump_files()
+    folder = tmp_path / "results"
+    folder.mkdir()
+    (folder / "keep.txt").write_text("mine")
+    done = subprocess.run([sys.executable, "-m", "grainview.cli", "convert", "lammps", "--particles",
+                           str(files["particles"]), "--contacts", str(files["contacts"]), "--log", str(files["log"]),
+                           "--out", str(folder), "--overwrite", "--progress", "off"], capture_output=True, text=True)
+    assert done.returncode != 0 and len(done.stderr.strip().splitlines()) == 1, done.stderr
+    assert f"{folder} is a folder; expected a file name such as {folder / 'run.nc'}" in done.stderr
+    assert sorted(os.listdir(tmp_path)) == ["results"] and os.listdir(folder) == ["keep.txt"]
+    with pytest.raises(FileFormatError, match="is a folder"):
+        convert_lammps(folder, files["particles"], files["contacts"], files["walls"], log=files["log"])
+
+
 def test_columns_named_by_colname_or_mapped_by_hand(tmp_path, ds):
     files = dump_files()
     text = files["contacts"].read_text()
