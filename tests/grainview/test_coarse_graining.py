@@ -119,6 +119,9 @@ def test_density_and_solid_fraction_integrate_to_mass_and_area(prepare):
     areas = [2.5 * 0.01 ** 2 * np.sin(2 * np.pi / 5), np.pi * 0.02 ** 2, 1.5 * 0.015 ** 2 * np.sin(2 * np.pi / 3)]
     assert float(out.solid_fraction.sum() * cell) == pytest.approx(sum(areas), rel=1e-9)
     assert out.density.attrs["units"] == "kg m-3" and out.x.attrs["units"] == "m"
+    # per unit volume too: t int sigma^c dA = sum_c f (x) l, here f = (1, 0) N, l = (0.05, 0.01) m
+    love_weber = out.contact_stress.isel(time=0).sum(("x", "y")).values * cell * 0.5
+    np.testing.assert_allclose(love_weber, [[0.05, 0.01], [0.0, 0.0]], rtol=1e-9, atol=1e-12)
 
 
 def test_default_cutoff_quadrature():

@@ -123,6 +123,15 @@ def test_a_turned_column_is_the_same_chain_along_its_direction(rotation):
     assert float(out.orientation) == pytest.approx(np.mod(np.pi / 2 + rotation, np.pi), abs=1e-12)
 
 
+def test_the_particle_stress_is_per_unit_volume_of_the_slab():
+    # a slab 0.25 m thick: the same forces spread over a quarter of the volume, four times the stress
+    thin = column_among_pairs()
+    thin.attrs["thickness_m"] = 0.25
+    out = force_chains(thin).isel(time=0)
+    np.testing.assert_allclose(out.sigma_1.values, [4 * 2 * 10.0 * R / VP] * 5 + [4 * 0.5 * R / VP] * 6, rtol=1e-12)
+    np.testing.assert_allclose(particle_volume(thin).values, 0.25 * VP, rtol=1e-15)
+
+
 def test_a_column_of_two_is_no_chain():
     out = force_chains(column_among_pairs(n_column=2)).isel(time=0)
     assert int(out.n_chains) == 0 and (out.chain.values == -1).all()
