@@ -1,5 +1,5 @@
 """Force-chain throughput (ds.grain.force_chains, Peters et al. 2005): contacts per second,
-against the target of 1 M contacts/s (issue 38).
+against the target of 1 M contacts/s.
 
 Samples: the study's own runs (``grainview study``: 400 pentagons and 400 disks, 201 snapshots;
 GRAINVIEW_STUDY=folder, default /work/runs/study, else study/), and a paper-size packing of
@@ -134,10 +134,21 @@ def run(quick=False):
             + markdown_table(header, rows) + "\n")
 
 
-if __name__ == "__main__":
-    quick = "--quick" in sys.argv
+def main(argv=None):
+    """Run the benchmark (all of it, or ``--quick``) and write its results; any other argument is
+    refused by argparse in one line before anything runs."""
+    import argparse
+
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("--quick", action="store_true",
+                        help="a short run, printed only (benchmarks/RESULTS-force-chains.md is kept)")
+    quick = parser.parse_args(argv).quick
     text = run(quick=quick)
     print(text)
     if not quick:
         with open(os.path.join(HERE, "RESULTS-force-chains.md"), "w") as fh:
             fh.write(text)
+
+
+if __name__ == "__main__":
+    main()

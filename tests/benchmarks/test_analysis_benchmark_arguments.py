@@ -1,0 +1,39 @@
+"""The throughput benchmarks of the force chains, coarse-grained fields and force-network topology
+refuse an argument they do not take in one line, before measuring anything or rewriting their
+results (``--help`` ran the whole benchmark and rewrote benchmarks/RESULTS-*.md)."""
+
+import os
+import subprocess
+import sys
+
+import pytest
+
+from .conftest import BENCHMARKS
+
+RESULTS = {"force_chains": "RESULTS-force-chains.md", "coarse_graining": "RESULTS-coarse-graining.md",
+           "network_topology": "RESULTS-network-topology.md"}
+
+
+def run_script(name, *args):
+    return subprocess.run([sys.executable, os.path.join(BENCHMARKS, f"{name}.py"), *args], capture_output=True,
+                          text=True, timeout=120)
+
+
+@pytest.mark.parametrize("name", sorted(RESULTS))
+def test_help_and_unknown_arguments_measure_nothing(name):
+    results = os.path.join(BENCHMARKS, RESULTS[name])
+    before = os.stat(results).st_mtime_ns
+    shown = run_script(name, "--help")
+    assert shown.returncode == 0 and shown.stdout.startswith("usage:") and "--" in shown.stdout
+    refused = run_script(name, "--frobnicate")
+    assert refused.returncode == 2 and refused.stdout == ""
+    assert refused.stderr.strip().splitlines()[-1].endswith("unrecognized arguments: --frobnicate")
+    assert "Traceback" not in refused.stderr
+    assert os.stat(results).st_mtime_ns == before
+
+
+def test_repeats_must_be_a_positive_integer():
+    for bad in ("0", "two"):
+        refused = run_script("network_topology", "--repeats", bad)
+        assert refused.returncode == 2 and "--repeats" in refused.stderr.strip().splitlines()[-1]
+        assert "Traceback" not in refused.stderr
