@@ -182,13 +182,16 @@ def make_dataset(
     return ds
 
 
-def netcdf_encoding(ds: xr.Dataset, zlib: bool = False, complevel: int = 4) -> dict:
+def netcdf_encoding(ds: xr.Dataset, zlib: bool = False, complevel: int | None = None) -> dict:
     """Encoding for ``Dataset.to_netcdf`` that keeps the contract's integer sentinels.
 
     Integers get no ``_FillValue`` (xarray would turn masked integers into floats on
     reading); floats use NaN as fill value. With ``zlib`` the contract's variables are also
     deflated at ``complevel`` (1-9, with byte shuffling), for a file in
-    :data:`grainview.contract.writer.COMPRESSED_FORMAT` (docs/schema.md, "Compression");
+    :data:`grainview.contract.writer.COMPRESSED_FORMAT` (docs/schema.md, "Compression"),
+    chunked and filtered as :func:`grainview.contract.writer.compress_file` does (one snapshot
+    per chunk; a per-snapshot variable that zlib shrinks by less than
+    :data:`~grainview.contract.writer.MIN_SAVING` is not deflated);
     :func:`grainview.open_dataset` reads it unchanged. :func:`netcdf_options` gives the format
     and the encoding together.
 
@@ -198,8 +201,9 @@ def netcdf_encoding(ds: xr.Dataset, zlib: bool = False, complevel: int = 4) -> d
         A dataset of the contract.
     zlib : bool
         Deflate the contract's variables.
-    complevel : int
-        zlib level, 1 (fastest) to 9 (smallest); used with ``zlib``.
+    complevel : int, optional
+        zlib level, 1 (fastest) to 9 (smallest); used with ``zlib`` (default:
+        :data:`grainview.contract.writer.DEFAULT_COMPLEVEL`).
 
     Returns
     -------
@@ -212,23 +216,32 @@ def netcdf_encoding(ds: xr.Dataset, zlib: bool = False, complevel: int = 4) -> d
     >>> ds.to_netcdf("run-zlib.nc", format="NETCDF4_CLASSIC",
     ...              encoding=grainview.contract.dataset.netcdf_encoding(ds, zlib=True))  # doctest: +SKIP
     """
-    if zlib:
-        from .writer import check_complevel
+    from . import writer
 
-        complevel = check_complevel(complevel)
+    if zlib:
+        complevel = writer.check_complevel(writer.DEFAULT_COMPLEVEL if complevel is None else complevel)
     enc = {}
     for name in ds.variables:
         if name in VARIABLES:
             floating = ds[name].dtype.kind == "f"
             enc[name] = {"_FillValue": np.nan} if floating else {"_FillValue": None}
             if zlib:
-                enc[name].update(zlib=True, complevel=int(complevel), shuffle=True)
+                deflate = {"zlib": True, "complevel": int(complevel), "shuffle": True}
+                var = ds[name]
+                if var.ndim and var.dims[0] == "time" and var.shape[0]:
+                    row_bytes = var.dtype.itemsize * int(np.prod(var.shape[1:], dtype=np.int64))
+                    rows = writer.chunk_rows(row_bytes, var.shape[0])
+                    enc[name]["chunksizes"] = (rows, *var.shape[1:])
+                    sample = [var[block].values for block in writer.sample_blocks(var.shape[0], rows)]
+                    if writer.deflate_saving(sample, complevel) < writer.MIN_SAVING:
+                        deflate = {}
+                enc[name].update(deflate)
     if "time" in ds.variables:
         enc["time"] = {"_FillValue": np.nan}
     return enc
 
 
-def netcdf_options(ds: xr.Dataset, compress: bool = True, complevel: int = 4) -> dict:
+def netcdf_options(ds: xr.Dataset, compress: bool = True, complevel: int | None = None) -> dict:
     """Keyword arguments of ``Dataset.to_netcdf`` that write ``ds`` as the solver writes a finished run.
 
     Compressed (:data:`grainview.contract.writer.COMPRESSED_FORMAT`, zlib at ``complevel``) or, with
@@ -242,8 +255,9 @@ def netcdf_options(ds: xr.Dataset, compress: bool = True, complevel: int = 4) ->
         A dataset of the contract.
     compress : bool, default True
         Write compressed (NETCDF4_CLASSIC with zlib) rather than netCDF-3.
-    complevel : int, default 4
-        zlib level, 1 (fastest) to 9 (smallest); used with ``compress``.
+    complevel : int, optional
+        zlib level, 1 (fastest) to 9 (smallest); used with ``compress`` (default:
+        :data:`grainview.contract.writer.DEFAULT_COMPLEVEL`).
 
     Returns
     -------

@@ -18,7 +18,7 @@ from .shapes import shape_problems
 
 __all__ = ["SnapshotWriter", "compress_file", "decompress_file", "is_compressed", "check_complevel",
            "netcdf3_data_bytes", "lock_file", "remove_strays", "last_complete_value", "APPEND_FORMAT",
-           "COMPRESSED_FORMAT", "DEFAULT_COMPLEVEL"]
+           "COMPRESSED_FORMAT", "DEFAULT_COMPLEVEL", "chunk_rows", "copy_blocks", "sample_blocks", "deflate_saving"]
 
 APPEND_FORMAT = "NETCDF3_64BIT_OFFSET"
 """The format a run is written in while it goes on: its records are appended in place, so a
@@ -28,10 +28,19 @@ COMPRESSED_FORMAT = "NETCDF4_CLASSIC"
 (strings as character arrays, as in netCDF-3). Not variable-length strings: with them, this
 project's netCDF4 1.7 / HDF5 2.2 can crash the interpreter when a file read before in the
 same process is opened again (docs/schema.md)."""
-DEFAULT_COMPLEVEL = 4
-"""zlib level (1-9) of :func:`compress_file`."""
-COPY_BLOCK_BYTES = 64 * 2**20
-"""At most this many bytes of one variable are held in memory while a file is converted."""
+DEFAULT_COMPLEVEL = 1
+"""zlib level (1-9) of :func:`compress_file`: level 1 makes files within 2% of level 4's size and
+inflates faster (benchmarks/RESULTS-compression.md)."""
+COPY_BLOCK_BYTES = 8 * 2**20
+"""At most this many bytes of one variable (whole chunks, at least one) are held in memory while
+a file is converted."""
+CHUNK_BYTES = 64 * 2**10
+"""Target size of a compressed file's chunk along ``time``: a chunk holds one snapshot, or as many
+as fit in this many bytes when one snapshot of the variable is smaller (see :func:`chunk_rows`)."""
+MIN_SAVING = 0.4
+"""A per-snapshot variable is deflated only when zlib saves at least this fraction of its bytes
+(see :func:`deflate_saving`); data that compress less are stored as they are, since inflating
+them costs the analyses more than the bytes saved (benchmarks/RESULTS-compression.md)."""
 
 
 TEMPORARY_SUFFIXES = (".part", ".convert")
@@ -201,21 +210,33 @@ def _convert(path, fmt, complevel=None, lock=None) -> None:
         for name, var in src.variables.items():
             attrs = {k: var.getncattr(k) for k in var.ncattrs()}
             fill = attrs.pop("_FillValue", None)
-            deflate = complevel is not None and var.dtype.kind != "S" and var.ndim > 0
-            out = dst.createVariable(name, var.dtype, var.dimensions, fill_value=fill,
-                                     **({"zlib": True, "complevel": complevel, "shuffle": True} if deflate else {}))
-            out.setncatts(attrs)
             var.set_auto_chartostring(False)  # character arrays copied as characters
+            row_bytes = max(1, var.dtype.itemsize * int(np.prod(var.shape[1:], dtype=np.int64)))
+            per_snapshot = var.ndim > 0 and var.dimensions[0] == "time"
+            options, rows_per_chunk = {}, 1
+            if complevel is not None and var.dtype.kind != "S" and var.ndim > 0:
+                if per_snapshot:
+                    rows_per_chunk = chunk_rows(row_bytes, var.shape[0])
+                    options["chunksizes"] = (rows_per_chunk, *var.shape[1:])
+                    sample = [var[b] for b in sample_blocks(var.shape[0], rows_per_chunk)]
+                    if deflate_saving(sample, complevel) >= MIN_SAVING:
+                        options.update(zlib=True, complevel=complevel, shuffle=True)
+                else:
+                    options.update(zlib=True, complevel=complevel, shuffle=True)
+            out = dst.createVariable(name, var.dtype, var.dimensions, fill_value=fill, **options)
+            out.setncatts(attrs)
             out.set_auto_chartostring(False)
             if var.ndim == 0:
                 out.assignValue(var.getValue())
                 continue
-            rows = var.shape[0]
-            row_bytes = max(1, var.dtype.itemsize * int(np.prod(var.shape[1:], dtype=np.int64)))
-            step = max(1, COPY_BLOCK_BYTES // row_bytes)
-            for start in range(0, rows, step):
-                stop = min(rows, start + step)
-                out[start:stop] = var[start:stop]
+            # Whole chunks written at once and no chunk cache on either side: the library holds
+            # no variable's chunks while the next is copied, so memory stays at one block.
+            for side in (var, out):
+                if side.chunking() not in (None, "contiguous"):
+                    side.set_var_chunk_cache(size=0)
+            source_rows = var.chunking()[0] if var.chunking() not in (None, "contiguous") else 1
+            for block in copy_blocks(var.shape[0], row_bytes, max(rows_per_chunk, source_rows)):
+                out[block] = var[block]
         dst.setncatts({k: src.getncattr(k) for k in src.ncattrs()})
         dst.close()
         src.close()
@@ -237,6 +258,82 @@ def _convert(path, fmt, complevel=None, lock=None) -> None:
             lock.release()
 
 
+def chunk_rows(row_bytes: int, n_rows: int) -> int:
+    """Snapshots per chunk of a compressed file's per-snapshot variable.
+
+    One snapshot, since the analyses read whole snapshots in dask chunks of any length
+    (:func:`grainview.contract.io.time_chunks`) and a chunk is inflated whole whichever part of it
+    is read; as many snapshots as fill :data:`CHUNK_BYTES` when one snapshot is smaller (a
+    chunk's bookkeeping is then no longer small beside its data), and never more than the file
+    has: ``max(1, min(n_rows, CHUNK_BYTES // row_bytes))``.
+
+    Parameters
+    ----------
+    row_bytes : int
+        Bytes of one snapshot of the variable.
+    n_rows : int
+        Snapshots in the file.
+
+    Returns
+    -------
+    int
+        Snapshots per chunk, >= 1.
+    """
+    return max(1, min(int(n_rows), CHUNK_BYTES // max(1, int(row_bytes))))
+
+
+def copy_blocks(n_rows: int, row_bytes: int, rows_per_chunk: int = 1, budget: int | None = None) -> list[slice]:
+    """The blocks of rows (snapshots) in which a variable is copied: whole chunks, as many as fit
+    in ``budget`` bytes (at least one), in order, covering rows ``0 .. n_rows - 1`` once.
+
+    The largest block holds ``max(rows_per_chunk, (budget // (row_bytes * rows_per_chunk)) *
+    rows_per_chunk)`` rows, whatever ``n_rows`` is: copying a file of any number of snapshots
+    holds at most that much of it in memory.
+
+    Parameters
+    ----------
+    n_rows : int
+        Rows along the first dimension.
+    row_bytes : int
+        Bytes of one row.
+    rows_per_chunk : int, default 1
+        Rows per chunk of the file written (or read); blocks start on chunk boundaries.
+    budget : int, optional
+        Bytes a block may hold (default: :data:`COPY_BLOCK_BYTES`).
+
+    Returns
+    -------
+    list of slice
+    """
+    budget = COPY_BLOCK_BYTES if budget is None else budget
+    rows_per_chunk = max(1, int(rows_per_chunk))
+    step = max(1, int(budget) // max(1, int(row_bytes) * rows_per_chunk)) * rows_per_chunk
+    return [slice(start, min(int(n_rows), start + step)) for start in range(0, int(n_rows), step)]
+
+
+def sample_blocks(n_rows: int, rows_per_chunk: int, count: int = 3) -> list[slice]:
+    """Up to ``count`` chunks spread over the rows (first, middle, last), to measure how well a
+    variable compresses."""
+    chunks = -(-int(n_rows) // rows_per_chunk)
+    picks = sorted({int(k) for k in np.linspace(0, chunks - 1, min(count, chunks))}) if chunks else []
+    return [slice(k * rows_per_chunk, min(int(n_rows), (k + 1) * rows_per_chunk)) for k in picks]
+
+
+def deflate_saving(arrays, complevel: int = DEFAULT_COMPLEVEL) -> float:
+    """Fraction of its bytes that byte shuffling and zlib at ``complevel`` save on ``arrays``
+    (samples of one variable), as the netCDF library's filters would: ``1 - compressed / raw``.
+    0 for no data."""
+    import zlib
+
+    raw = packed = 0
+    for array in arrays:
+        array = np.ascontiguousarray(array)
+        shuffled = array.view(np.uint8).reshape(-1, array.dtype.itemsize).T.tobytes()
+        raw += len(shuffled)
+        packed += len(zlib.compress(shuffled, complevel))
+    return 1.0 - packed / raw if raw else 0.0
+
+
 def check_complevel(complevel) -> int:
     """``complevel`` as an int, or :class:`ParameterError` unless it is a zlib level 1-9."""
     if isinstance(complevel, bool) or not (isinstance(complevel, (int, np.integer)) and 1 <= complevel <= 9):
@@ -249,6 +346,12 @@ def compress_file(path, complevel: int = DEFAULT_COMPLEVEL, lock=None) -> None:
     ``complevel`` with byte shuffling), in place and atomically; :func:`grainview.open_dataset`
     reads it unchanged. A file already compressed is left alone, so a compression stopped
     midway (the file still netCDF-3) is simply done again.
+
+    Per-snapshot variables are chunked one snapshot per chunk (:func:`chunk_rows`) and deflated
+    only when that saves at least :data:`MIN_SAVING` of their bytes (:func:`deflate_saving`, on
+    three chunks); the others are stored as they are. The copy goes block by block
+    (:func:`copy_blocks`) without the library's chunk caches, in memory independent of the
+    number of snapshots.
 
     Parameters
     ----------

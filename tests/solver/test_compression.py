@@ -203,3 +203,83 @@ def test_a_compressed_file_open_in_a_reader_can_be_replaced(run_file, tmp_path):
         reader.communicate("\n", timeout=60)
     with grainview.open_dataset(path, chunks=None) as ds:
         assert ds.sizes["particle"] == 12
+
+
+def test_copy_blocks_cover_every_row_once_in_whole_chunks_within_the_budget():
+    from grainview.contract.writer import copy_blocks
+
+    # 1000 rows of 100 bytes, chunks of 3 rows, 1 kB per block: 3 chunks (900 bytes) per block
+    blocks = copy_blocks(1000, 100, rows_per_chunk=3, budget=1000)
+    assert blocks[0] == slice(0, 9) and blocks[-1] == slice(999, 1000) and len(blocks) == 112
+    assert [i for b in blocks for i in range(b.start, b.stop)] == list(range(1000))
+    assert all(b.start % 3 == 0 for b in blocks)
+    # the largest block does not grow with the number of rows (snapshots)
+    for n_rows in (10, 1000, 100_000):
+        assert max(b.stop - b.start for b in copy_blocks(n_rows, 100, 1, budget=1000)) == min(n_rows, 10)
+    # a row larger than the budget: one row (one chunk) per block
+    assert copy_blocks(4, 5000, budget=1000) == [slice(0, 1), slice(1, 2), slice(2, 3), slice(3, 4)]
+    assert copy_blocks(0, 100) == []
+
+
+def test_chunk_rows_one_snapshot_unless_a_snapshot_is_small():
+    from grainview.contract.writer import CHUNK_BYTES, chunk_rows
+
+    assert chunk_rows(1_600_000, 40) == 1  # 200,000 forces: one snapshot per chunk
+    assert chunk_rows(CHUNK_BYTES, 40) == 1
+    assert chunk_rows(CHUNK_BYTES // 4, 40) == 4
+    assert chunk_rows(8, 100_000) == CHUNK_BYTES // 8  # time: many snapshots per chunk
+    assert chunk_rows(8, 40) == 40  # never beyond the file's snapshots
+    assert chunk_rows(8, 0) == 1
+
+
+def test_deflate_saving_of_incompressible_and_of_empty_slots():
+    from grainview.contract.writer import deflate_saving
+
+    rng = np.random.default_rng(0)
+    assert deflate_saving([rng.integers(0, 256, 10_000, dtype="u1")]) < 0.01  # random bytes do not shrink
+    assert deflate_saving([np.full(10_000, np.nan)]) > 0.99  # empty slots all but vanish
+    # half the slots empty, half random doubles: about half is saved, as zlib says on the same bytes
+    half = np.concatenate([rng.random(5000), np.full(5000, np.nan)])
+    import zlib
+
+    shuffled = half.view("u1").reshape(-1, 8).T.tobytes()
+    assert deflate_saving([half], 1) == pytest.approx(1 - len(zlib.compress(shuffled, 1)) / half.nbytes)
+    assert 0.45 < deflate_saving([half], 1) < 0.6
+    assert deflate_saving([]) == 0.0
+
+
+def _layout(path):
+    with netCDF4.Dataset(path) as nc:
+        return {name: (var.chunking(), bool(var.filters()["zlib"])) for name, var in nc.variables.items()
+                if var.dimensions[:1] == ("time",)}
+
+
+def test_compressed_files_have_one_snapshot_per_chunk_and_deflate_only_what_shrinks(tmp_path):
+    """Every slot of the harmonic series holds a random force: zlib saves little on fn, normal,
+    point (stored as they are) and most of i, j, kind (deflated). compress_file and the xarray
+    path (netcdf_options) make the same layout, and the values read back unchanged."""
+    from grainview.contract.dataset import netcdf_options
+    from grainview.synthetic import harmonic_series
+
+    ds = harmonic_series(n_snapshots=6, n_contacts=20_000, seed=1)
+    plain, packed, direct = tmp_path / "plain.nc", tmp_path / "packed.nc", tmp_path / "direct.nc"
+    ds.to_netcdf(plain, **netcdf_options(ds, compress=False))
+    packed.write_bytes(plain.read_bytes())
+    compress_file(packed)
+    ds.to_netcdf(direct, **netcdf_options(ds))
+    layout = _layout(packed)
+    for name in ("fn", "normal", "point", "position"):
+        assert layout[name][1] is False, name
+    for name in ("i", "j", "kind"):
+        assert layout[name][1] is True, name
+    for name in ("fn", "i", "normal"):
+        assert layout[name][0] == [1, *ds[name].shape[1:]], name  # one snapshot per chunk
+    assert layout["contact_count"][0] == [6]  # small rows: the whole (fixed-size) time axis in one chunk
+    del layout["time"]  # the coordinate: as xarray writes it
+    assert {k: v for k, v in _layout(direct).items() if k != "time"} == layout
+    with grainview.open_dataset(plain, chunks=None) as a, grainview.open_dataset(packed, chunks=None) as b, \
+            grainview.open_dataset(direct, chunks=None) as c:
+        xr.testing.assert_identical(a, b)
+        xr.testing.assert_identical(a, c)
+    with xr.open_dataset(packed, engine="netcdf4") as d:  # plain xarray reads it too
+        np.testing.assert_array_equal(d["fn"].values, ds["fn"].values)
