@@ -55,7 +55,7 @@ from .forces import (plot_angular_forces, plot_contact_proportions, plot_force_a
                      plot_xi_stress)
 from .chains import (animate_chains, plot_chain_fractions, plot_chain_lengths, plot_chain_lifetimes,
                      plot_chain_map)
-from .fields import plot_field_maps, plot_field_profiles
+from .fields import plot_field_maps, plot_field_profiles, plot_shear_band
 from .topology import plot_betti_curves, plot_cycle_counts, plot_network_topology, plot_persistence_diagram
 from .macroscopic import (plot_harmonic_prediction, plot_partial_q_over_p, plot_q_over_p,
                           plot_stress_dilatancy, plot_volumetric_strain)
@@ -173,5 +173,5 @@ __all__ = ["PlotAccessor", "save_figure", "FIGURES", "animate", *(f.__name__ for
            "plot_normal_force_polar", "plot_tangential_force_polar", "plot_tangential_force",
            "plot_force_anisotropy", "plot_normal_force", "plot_xi_anisotropy", "plot_strong_weak_proportion",
            "plot_force_pdf", "plot_force_pdf_by_kind", "plot_chain_map", "plot_chain_fractions", "plot_chain_lengths",
-           "plot_chain_lifetimes", "animate_chains", "plot_field_maps", "plot_field_profiles",
+           "plot_chain_lifetimes", "animate_chains", "plot_field_maps", "plot_field_profiles", "plot_shear_band",
            "plot_persistence_diagram", "plot_betti_curves", "plot_cycle_counts", "plot_network_topology"]

@@ -151,3 +151,57 @@ def test_band_finder_refuses_what_it_cannot_read():
         profile_along(xr.DataArray(np.zeros(3), dims="s"), 10.0)
     with pytest.raises(ParameterError, match="angle='a'"):
         profile_along(rate, "a")
+
+
+# -- the figure ---------------------------------------------------------------------------
+
+def test_the_band_is_drawn_over_the_shear_rate_map():
+    """plot_shear_band draws the band's two half-maximum lines: every point of each satisfies
+    -x sin(angle) + y cos(angle) = its edge; plot_field_maps(band=True) draws the band the finder
+    finds in the drawn snapshot's shear rate, and refuses band= without the shear-rate map."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    from grainview.coarse_graining import coarse_grained, interior
+    from grainview.plot import plot_field_maps, plot_shear_band
+
+    from . import builders
+
+    rate = rate_of(band_velocity(50.0, 0.12, rate_in=4.0, rate_out=1.0))
+    band = find_shear_band(rate, width=0.12)
+    fig = plot_shear_band(rate, band=band, box=([0.0, 0.0], [1.0, 1.0]))
+    lines = [line for line in fig.axes[0].lines if line.get_xdata().size]
+    assert len(lines) == 2
+    t = np.radians(float(band.angle))
+    for line, edge in zip(lines, band.edges.values):
+        x, y = line.get_xdata(), line.get_ydata()
+        np.testing.assert_allclose(-x * np.sin(t) + y * np.cos(t), edge, atol=1e-12)
+    assert "band: 50" in fig.axes[0].get_legend().get_texts()[0].get_text()
+    assert fig.axes[1].get_ylabel() == r"$\dot\gamma$ (s$^{-1}$)"
+
+    uniform = xr.full_like(rate, 2.0)  # no band: nothing drawn, the legend says so
+    fig = plot_shear_band(uniform)
+    assert not [line for line in fig.axes[0].lines if line.get_xdata().size]
+    assert fig.axes[0].get_legend().get_texts()[0].get_text().startswith("no band")
+
+    # a lattice whose particles shear in a strip at 50 deg, through coarse_grained
+    base = builders.square_lattice(24, 24)
+    pos = base.position.values
+    t50 = np.radians(50.0)
+    centre = pos[0].mean(axis=0)
+    s = -(pos[..., 0] - centre[0]) * np.sin(t50) + (pos[..., 1] - centre[1]) * np.cos(t50)
+    speed = np.clip(s, -3 * builders.R, 3 * builders.R)
+    velocity = np.stack([speed * np.cos(t50), speed * np.sin(t50)], axis=-1)
+    ds = base.assign(velocity=(("time", "particle", "xy"), velocity, {"units": "m s-1"}))
+    fields = coarse_grained(ds, width=builders.R, spacing=builders.R / 2)
+    fig = plot_field_maps(ds, fields=fields, names=["shear_rate"], band=True)
+    expected = find_shear_band(scalar_field(fields.isel(time=0), "shear_rate"), inside=interior(fields.isel(time=0)))
+    assert bool(expected.found) and abs(float(expected.angle) - 50.0) <= 2.0
+    drawn = [line for line in fig.axes[0].lines if line.get_xdata().size]
+    t = np.radians(float(expected.angle))
+    for line, edge in zip(drawn, expected.edges.values):
+        np.testing.assert_allclose(-line.get_xdata() * np.sin(t) + line.get_ydata() * np.cos(t), edge, atol=1e-12)
+    assert len(drawn) == 2
+    with pytest.raises(ParameterError, match="expected 'shear_rate' among names"):
+        plot_field_maps(ds, fields=fields, names=["sigma_yy"], band=True)
+    matplotlib.pyplot.close("all")
