@@ -65,8 +65,14 @@ def network_persistence(ds: xr.Dataset, xi=DEFAULT_XI, dimensions=(0, 1), strong
     pair of paths that reach it, loops of the box rather than of the packing. ``walls=True``
     makes each wall one node.
 
-    Dimension 0 and the cycles are the project's own code (union-find, numba); dimension 1 is
-    gudhi's persistence of the flag complex (``pip install 'grainview[topology]'``).
+    All of it is the project's own code (numba kernels): dimension 0 by union-find, dimension 1
+    by the standard reduction over Z/2 of the triangles' boundary matrix (with the twist), the
+    cycles by merging sorted neighbour lists. The complex stops at the triangles: a 4-clique's
+    four triangles (an octahedron's eight) close a 2-sphere, which no tetrahedron fills; its
+    last triangle fills no loop, and the sphere is not reported (dimension 1 is the same as in
+    the full clique complex). The tests check dimension 1 against gudhi
+    (:func:`grainview.arrays.network_topology.diagrams_gudhi`, ``pip install
+    'grainview[topology]'``), which is not needed to compute it.
 
     Parameters
     ----------
@@ -75,7 +81,7 @@ def network_persistence(ds: xr.Dataset, xi=DEFAULT_XI, dimensions=(0, 1), strong
     xi : array_like of float, default 0, 0.05, ..., 5
         Thresholds of the Betti curves, multiples of <f_n> (dimensionless).
     dimensions : (0,) or (0, 1), default (0, 1)
-        The homology dimensions; (0,) needs no gudhi (``beta_1`` is then not returned).
+        The homology dimensions; with (0,) ``beta_1`` is not returned.
     strong : float, default 1
         Strong-force threshold of the cycle counts, in units of <f_n> (dimensionless).
     walls : bool, default False
@@ -100,7 +106,7 @@ def network_persistence(ds: xr.Dataset, xi=DEFAULT_XI, dimensions=(0, 1), strong
     Raises
     ------
     grainview.contract.errors.ParameterError
-        On a bad argument; when dimension 1 is asked and gudhi is not installed.
+        On a bad argument.
 
     References
     ----------
@@ -112,8 +118,6 @@ def network_persistence(ds: xr.Dataset, xi=DEFAULT_XI, dimensions=(0, 1), strong
     xi = _check_xi(xi)
     dims = _check_options(dimensions, strong, max_features)
     dimension_1 = 1 in dims
-    if dimension_1:
-        _topology.gudhi_module()
     n_nodes = body_count(ds) if walls else ds.sizes["particle"]
     bound = ds.sizes["contact"] + n_nodes // 2 + 1
     n_features = bound if max_features is None else int(max_features)

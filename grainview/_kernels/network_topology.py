@@ -1,5 +1,7 @@
 """Numba kernels of the force network's topology: the 0-dimensional persistence diagram by
-union-find, and the counts of 3-cycles and chordless 4-cycles by their number of strong edges.
+union-find, the 1-dimensional diagram of the clique complex by the standard reduction of its
+triangles' boundary matrix over Z/2, and the counts of 3-cycles and chordless 4-cycles by their
+number of strong edges.
 
 Structure of arrays: a graph is given as its edge endpoints ``u``, ``v`` (int64, node ids in
 [0, n_nodes)) and one value per edge; :mod:`grainview.arrays.network_topology` checks them
@@ -205,3 +207,176 @@ def cycle_counts(n_nodes, u, v, strong):
     for k in range(5):
         squares[k] = twice[k] // 2
     return triangles, squares
+
+
+@njit(cache=True)
+def _triangles(n_nodes, u, v):
+    """Every triangle of a simple graph as its three edge ids, largest first.
+
+    Returns
+    -------
+    ndarray of int64, shape (T, 3)
+        Row k: the ids e0 > e1 > e2 of the k-th triangle's edges, the rows in lexicographic
+        order of (e0, e1, e2).
+    """
+    start, neighbour, edge = _adjacency(n_nodes, u, v)
+    count = 0
+    out = np.empty((0, 3), np.int64)
+    for twice in range(2):  # count, then fill
+        if twice == 1:
+            out = np.empty((count, 3), np.int64)
+            count = 0
+        for e in range(u.size):
+            a = min(u[e], v[e])
+            b = max(u[e], v[e])
+            p = start[a]
+            q = start[b]
+            while p < start[a + 1] and q < start[b + 1]:
+                if neighbour[p] < neighbour[q]:
+                    p += 1
+                elif neighbour[p] > neighbour[q]:
+                    q += 1
+                else:
+                    if neighbour[p] > b:
+                        if twice == 1:
+                            x, y, z = e, edge[p], edge[q]
+                            if x < y:
+                                x, y = y, x
+                            if y < z:
+                                y, z = z, y
+                            if x < y:
+                                x, y = y, x
+                            out[count, 0] = x
+                            out[count, 1] = y
+                            out[count, 2] = z
+                        count += 1
+                    p += 1
+                    q += 1
+    if count == 0:
+        return np.empty((0, 3), np.int64)
+    n_edges = u.size
+    order = np.argsort(out[:, 1] * n_edges + out[:, 2], kind="mergesort")
+    out = out[order]
+    order = np.argsort(out[:, 0], kind="mergesort")
+    return out[order]
+
+
+@njit(cache=True)
+def _add_columns(a, b):
+    """Sum over Z/2 of two columns, each its row ids in decreasing order (the symmetric
+    difference, a merge)."""
+    out = np.empty(a.size + b.size, np.int64)
+    p = 0
+    q = 0
+    n = 0
+    while p < a.size and q < b.size:
+        if a[p] > b[q]:
+            out[n] = a[p]
+            p += 1
+            n += 1
+        elif a[p] < b[q]:
+            out[n] = b[q]
+            q += 1
+            n += 1
+        else:
+            p += 1
+            q += 1
+    while p < a.size:
+        out[n] = a[p]
+        p += 1
+        n += 1
+    while q < b.size:
+        out[n] = b[q]
+        q += 1
+        n += 1
+    return out[:n]
+
+
+@njit(cache=True)
+def flag_persistence_1(n_nodes, u, v, value):
+    """1-dimensional persistence of the clique complex of a graph filtered by DECREASING edge
+    value, over Z/2, up to its triangles.
+
+    The filtration: the edges in the given order, which must be by non-increasing ``value``
+    (ties broken by that order), each triangle right after its last edge (the one of largest
+    id; triangles after the same edge by the ids of their other two, lexicographically), so a
+    triangle enters at the smallest value of its three edges. The standard persistence
+    algorithm with the twist (clearing): the boundary matrix of the triangles (rows: edges,
+    columns: triangles in filtration order) is reduced first, left to right, adding to a
+    column the reduced column with the same lowest row (largest edge id) until that row is
+    free or the column is zero. A column left non-zero pairs its lowest edge (a loop born at
+    that edge's value) with the triangle (the loop dies at the triangle's value). Those edges
+    close loops, so they are cleared from the edges' own reduction, which is the union-find of
+    the remaining edges in order: an edge that joins two components is paired with a node
+    (dimension 0); one whose ends are already joined closes a loop, and a loop no triangle
+    kills never dies (death = -inf). Pairs with birth == death are left out.
+
+    A column that reduces to zero is a triangle that closes a 2-cycle (the four triangles of a
+    4-clique, the eight of an octahedron: a sphere of triangles) instead of filling a loop; no
+    tetrahedra are added, so these spheres are never filled, and they are not reported. They
+    change nothing in dimension 1, whose homology depends on the edges and triangles alone.
+
+    Parameters
+    ----------
+    n_nodes : int
+        Node ids are in [0, n_nodes).
+    u, v : ndarray of int64, shape (E,)
+        The edges' endpoints, each pair once, no self-loop.
+    value : ndarray of float64, shape (E,)
+        The edges' filtration values, non-increasing.
+
+    Returns
+    -------
+    birth, death : ndarray of float64, shape (P,)
+        The loops, in the order of the edges that close them: birth = the value of that edge,
+        death = the value of the triangle that fills the loop, -inf if none does; birth > death.
+    n_triangles : int
+        Number of triangles of the whole graph.
+    """
+    n_edges = u.size
+    tri = _triangles(n_nodes, u, v)
+    owner = np.full(n_edges, -1, np.int64)  # the stored reduced column whose lowest row is this edge
+    dies = np.full(n_edges, -1, np.int64)  # the triangle that kills the loop born at this edge
+    column_start = np.empty(tri.shape[0] + 1, np.int64)
+    column_start[0] = 0
+    pool = np.empty(max(16, 3 * tri.shape[0]), np.int64)
+    n_stored = 0
+    for t in range(tri.shape[0]):
+        col = tri[t].copy()
+        while col.size > 0 and owner[col[0]] >= 0:
+            k = owner[col[0]]
+            col = _add_columns(col, pool[column_start[k]:column_start[k + 1]])
+        if col.size == 0:
+            continue  # a 2-cycle closes
+        top = column_start[n_stored]
+        if top + col.size > pool.size:
+            bigger = np.empty(max(2 * pool.size, top + col.size), np.int64)
+            bigger[:top] = pool[:top]
+            pool = bigger
+        pool[top:top + col.size] = col
+        column_start[n_stored + 1] = top + col.size
+        owner[col[0]] = n_stored
+        dies[col[0]] = t
+        n_stored += 1
+    # the edges' columns, the paired ones cleared: union-find in order
+    parent = np.arange(n_nodes)
+    birth = np.empty(n_edges)
+    death = np.empty(n_edges)
+    n = 0
+    for e in range(n_edges):
+        if dies[e] >= 0:
+            x = value[tri[dies[e], 0]]  # the triangle enters with its last edge
+            if value[e] > x:
+                birth[n] = value[e]
+                death[n] = x
+                n += 1
+            continue
+        ra = _find(parent, u[e])
+        rb = _find(parent, v[e])
+        if ra != rb:
+            parent[rb] = ra
+        else:
+            birth[n] = value[e]
+            death[n] = -np.inf
+            n += 1
+    return birth[:n], death[:n], tri.shape[0]

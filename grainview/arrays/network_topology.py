@@ -10,10 +10,17 @@ from +inf to 0 adds edges, so features are born at a larger xi than they die; a 
 with its strongest contact. A feature alive at the end (xi = 0: the whole selection) has
 death = -inf. Betti curves: beta_k(xi) = #{features of dimension k : birth >= xi > death}.
 
-Dimension 0 (connected components) comes from the project's own union-find
-(:func:`grainview._kernels.network_topology.union_find_pairs`); dimension 1 (loops not filled
-by triangles) from gudhi's persistence of the flag complex (an optional dependency,
-``pip install 'grainview[topology]'``). Zero-persistence pairs (birth == death) are left out.
+Both dimensions are the project's own numba kernels: dimension 0 (connected components) the
+union-find of :func:`grainview._kernels.network_topology.union_find_pairs`, dimension 1 (loops
+not filled by triangles) the standard reduction over Z/2 of the triangles' boundary matrix, with
+the twist (:func:`grainview._kernels.network_topology.flag_persistence_1`). The complex stops at
+the triangles: the triangles of a 4-clique (or of an octahedron) close a 2-sphere that no
+tetrahedron fills; the last of them to enter fills no loop and the sphere is not reported.
+Dimension 1 is the same with or without the higher cliques (the homology of dimension 1
+depends on the edges and triangles alone) and the same as gudhi's (``expansion(2)``, Z/2,
+:func:`diagrams_gudhi`: the cross-check, ``pip install 'grainview[topology]'``).
+Zero-persistence pairs (birth == death) are left out; ties between values may change which
+simplex a feature is paired with but not the diagram.
 
 References
 ----------
@@ -25,7 +32,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .._kernels.network_topology import cycle_counts, union_find_pairs
+from .._kernels.network_topology import cycle_counts, flag_persistence_1, union_find_pairs
 from ..contract.errors import ParameterError
 from .force_pdf import mean_normal_force
 from .signature import CONTACT, core_dims
@@ -36,13 +43,13 @@ STRONG_EDGES = ("strong_edges",)
 N_STRONG_EDGES = 5
 """Size of the ``strong_edges`` dimension: a cycle of 3 or 4 edges has 0 to 4 strong edges."""
 
-GUDHI_MISSING = ("dimension 1 of the force network's persistence needs the TDA library gudhi: "
-                 "pip install 'grainview[topology]' (dimensions=(0,) computes the rest without it)")
+GUDHI_MISSING = ("the cross-check of the force network's persistence against the TDA library gudhi needs gudhi: "
+                 "pip install 'grainview[topology]' (network_persistence computes both dimensions without it)")
 
 
 def gudhi_module():
-    """The gudhi module, or a :class:`~grainview.contract.errors.ParameterError` in one line
-    saying how to install it."""
+    """The gudhi module (for :func:`diagrams_gudhi`), or a
+    :class:`~grainview.contract.errors.ParameterError` in one line saying how to install it."""
     try:
         import gudhi
     except ImportError:
@@ -122,9 +129,42 @@ def diagram_0(u, v, value, n_nodes):
     return birth, death
 
 
+def diagram_1(u, v, value, n_nodes):
+    """1-dimensional diagram of the clique complex (edges and triangles) by the project's
+    reduction over Z/2 (:func:`grainview._kernels.network_topology.flag_persistence_1`).
+
+    A loop is born at the value of the edge that closes it and dies at the value of the
+    triangle that fills it, a triangle entering with its weakest edge (the smallest value of
+    its three). A triangle that closes a 2-sphere (the last of a 4-clique's four) fills no loop;
+    the sphere is not reported.
+
+    Parameters
+    ----------
+    u, v, value : ndarray
+        Edges as :func:`filtration_edges` gives them (sorted by decreasing value).
+    n_nodes : int
+        Node ids are in [0, n_nodes).
+
+    Returns
+    -------
+    birth, death : ndarray of float64
+        One pair per loop, birth > death; death = -inf for a loop that no triangle fills.
+    """
+    _check_nodes(u, v, n_nodes)
+    if u.size and np.any(np.diff(value) > 0):
+        raise ParameterError("network persistence: edges must be sorted by decreasing value")
+    birth, death, _ = flag_persistence_1(int(n_nodes), np.ascontiguousarray(u, np.int64),
+                                         np.ascontiguousarray(v, np.int64), np.ascontiguousarray(value, np.float64))
+    return birth, death
+
+
 def diagrams_gudhi(u, v, value, n_nodes):
     """0- and 1-dimensional diagrams of the flag complex by gudhi (the filtration negated, as
-    gudhi's filtrations increase).
+    gudhi's filtrations increase), the cross-check of :func:`diagram_0` and :func:`diagram_1`.
+
+    The complex is expanded to the triangles (``expansion(2)``) and its persistence computed
+    over Z/2 in every dimension up to 2 (``persistence_dim_max=True``); the 2-dimensional
+    classes (spheres of triangles) are not returned.
 
     Parameters
     ----------
@@ -228,7 +268,8 @@ def network_persistence(fn, i, j, mask, xi, n_nodes, n_features, strong=1.0, dim
     strong : float, default 1
         Strong-force threshold of the cycle counts, in units of <f_n>.
     dimension_1 : bool, default True
-        Compute the 1-dimensional diagram (needs gudhi); otherwise it is empty and beta_1 = -1.
+        Compute the 1-dimensional diagram (:func:`diagram_1`); otherwise it is empty and
+        beta_1 = -1.
 
     Returns
     -------
@@ -242,8 +283,6 @@ def network_persistence(fn, i, j, mask, xi, n_nodes, n_features, strong=1.0, dim
     triangles, squares : ndarray of int64, shape (..., 5)
         3-cycles and chordless 4-cycles with k = 0..4 strong edges.
     """
-    if dimension_1:
-        gudhi_module()
     fn = np.asarray(fn)
     lead = fn.shape[:-1]
     flat = [np.asarray(a).reshape(-1, fn.shape[-1]) for a in (fn, i, j, mask)]
@@ -259,7 +298,7 @@ def network_persistence(fn, i, j, mask, xi, n_nodes, n_features, strong=1.0, dim
         u, v, value = filtration_edges(*(a[r] for a in flat))
         diagrams = {0: diagram_0(u, v, value, n_nodes)}
         if dimension_1:
-            diagrams[1] = diagrams_gudhi(u, v, value, n_nodes)[1]
+            diagrams[1] = diagram_1(u, v, value, n_nodes)
         for dim, (b, d) in diagrams.items():
             beta[dim, r] = betti_curve(b, d, xi)
         b = np.concatenate([diagrams[dim][0] for dim in diagrams])
@@ -273,5 +312,5 @@ def network_persistence(fn, i, j, mask, xi, n_nodes, n_features, strong=1.0, dim
             shape(squares))
 
 
-__all__ = ["filtration_edges", "diagram_0", "diagrams_gudhi", "betti_curve", "short_cycles",
+__all__ = ["filtration_edges", "diagram_0", "diagram_1", "diagrams_gudhi", "betti_curve", "short_cycles",
            "network_persistence", "gudhi_module", "FEATURE", "XI", "STRONG_EDGES"]

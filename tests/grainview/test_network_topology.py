@@ -1,9 +1,12 @@
 """Topology of the force network: hand-made graphs with known persistence diagrams, Betti
-curves and cycle counts (eager and chunked, nothing computed until asked); the union-find and
-the cycle kernel against slow, obviously-correct versions; the union-find against gudhi."""
+curves and cycle counts (eager and chunked, nothing computed until asked); the union-find, the
+dimension-1 reduction and the cycle kernel against slow, obviously-correct versions; both
+dimensions against gudhi, on random graphs and on every snapshot of the study's runs."""
 
 import itertools
+import os
 import sys
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -67,6 +70,94 @@ def slow_cycles(u, v, strong):
     return triangles, squares
 
 
+def slow_flag_persistence(u, v, value, seed=0):
+    """The textbook algorithm, no shortcut: every simplex of the clique complex up to the
+    triangles (nodes, edges, triangles) in one list sorted by its value, largest first (a node
+    with its strongest edge, a triangle with its weakest), faces before cofaces at a tie and
+    otherwise in random order; the whole boundary matrix, dense over Z/2; each column reduced
+    by adding the earlier column with the same lowest one. Returns {dimension: sorted
+    [(birth, death)]} for dimensions 0, 1 and 2, zero-persistence pairs left out."""
+    rng = np.random.default_rng(seed)
+    edges = {frozenset((int(a), int(b))): float(x) for a, b, x in zip(u, v, value)}
+    adjacent = {}
+    for a, b in map(tuple, edges):
+        adjacent.setdefault(a, set()).add(b)
+        adjacent.setdefault(b, set()).add(a)
+    simplices = [(frozenset([n]), max(edges[frozenset((n, m))] for m in near)) for n, near in adjacent.items()]
+    simplices += list(edges.items())
+    for a, b in map(sorted, edges):
+        for c in adjacent[a] & adjacent[b]:
+            if c > b:
+                simplices.append((frozenset((a, b, c)), min(edges[frozenset(p)] for p in ((a, b), (b, c), (a, c)))))
+    keys = rng.random(len(simplices))
+    simplices = [simplices[k] for k in sorted(range(len(simplices)),
+                                              key=lambda k: (-simplices[k][1], len(simplices[k][0]), keys[k]))]
+    index = {s: k for k, (s, _) in enumerate(simplices)}
+    boundary = np.zeros((len(simplices), len(simplices)), bool)
+    for k, (s, _) in enumerate(simplices):
+        if len(s) > 1:
+            for face in itertools.combinations(sorted(s), len(s) - 1):
+                boundary[index[frozenset(face)], k] = True
+    owner = {}
+    for k in range(len(simplices)):
+        while boundary[:, k].any():
+            low = np.flatnonzero(boundary[:, k])[-1]
+            if low not in owner:
+                owner[low] = k
+                break
+            boundary[:, k] ^= boundary[:, owner[low]]
+    pairs = {0: [], 1: [], 2: []}
+    for low, k in owner.items():
+        pairs[len(simplices[low][0]) - 1].append((simplices[low][1], simplices[k][1]))
+    paired = set(owner) | set(owner.values())
+    for k, (s, x) in enumerate(simplices):
+        if k not in paired:
+            pairs[len(s) - 1].append((x, -INF))
+    return {dim: sorted((round(b, 12), round(d, 12)) for b, d in p if b != d) for dim, p in pairs.items()}
+
+
+def rank_z2(matrix):
+    """Rank over Z/2 by Gaussian elimination."""
+    m = np.array(matrix, bool)
+    rank = 0
+    for col in range(m.shape[1]):
+        rows = np.flatnonzero(m[rank:, col]) + rank
+        if rows.size == 0:
+            continue
+        m[[rank, rows[0]]] = m[[rows[0], rank]]
+        below = np.flatnonzero(m[:, col])
+        below = below[below != rank]
+        m[below] ^= m[rank]
+        rank += 1
+        if rank == m.shape[0]:
+            break
+    return rank
+
+
+def betti_1_by_ranks(u, v, value, x):
+    """beta_1 of the clique complex (up to triangles) of the edges with value >= x, from its
+    chain groups alone: dim ker d1 - rank d2 = E - rank d1 - rank d2 over Z/2."""
+    keep = value >= x
+    a, b = u[keep], v[keep]
+    nodes = np.unique(np.concatenate([a, b]))
+    if nodes.size == 0:
+        return 0
+    node = {n: k for k, n in enumerate(nodes)}
+    d1 = np.zeros((nodes.size, a.size), bool)
+    d1[[node[n] for n in a], np.arange(a.size)] = True
+    d1[[node[n] for n in b], np.arange(a.size)] = True
+    edge = {frozenset((int(p), int(q))): k for k, (p, q) in enumerate(zip(a, b))}
+    columns = []
+    for tri in itertools.combinations(nodes.tolist(), 3):
+        sides = [edge.get(frozenset(p)) for p in itertools.combinations(tri, 2)]
+        if None not in sides:
+            column = np.zeros(a.size, bool)
+            column[sides] = True
+            columns.append(column)
+    d2 = np.array(columns).T if columns else np.zeros((a.size, 0), bool)
+    return a.size - rank_z2(d1) - rank_z2(d2)
+
+
 def random_graph(seed, n=14, m=30, ties=False):
     rng = np.random.default_rng(seed)
     pairs = set()
@@ -125,19 +216,59 @@ def test_union_find_equals_gudhi(seed, ties):
     assert as_pairs(*nt.diagram_0(u, v, value, 14)) == as_pairs(*library[0])
 
 
+def dense_graph(seed, ties=False):
+    """9 nodes, 22 of the 36 pairs: many triangles, 4-cliques among them."""
+    return random_graph(seed, n=9, m=22, ties=ties)
+
+
+@pytest.mark.parametrize("seed", range(8))
+@pytest.mark.parametrize("ties", [False, True])
+def test_dimension_1_equals_the_textbook_reduction(seed, ties):
+    for u, v, value, n in (dense_graph(seed, ties) + (9,), random_graph(seed, ties=ties) + (14,)):
+        slow = slow_flag_persistence(u, v, value, seed)
+        assert as_pairs(*nt.diagram_1(u, v, value, n)) == slow[1]
+        assert as_pairs(*nt.diagram_0(u, v, value, n)) == slow[0]
+
+
+def test_the_dense_graphs_fill_loops_and_close_spheres():
+    """The graphs of the test above are not trivial: loops that die, loops that never die, and
+    2-spheres (the kernel's zero columns), with and without ties."""
+    for ties in (False, True):
+        slow = [slow_flag_persistence(*dense_graph(seed, ties)) for seed in range(8)]
+        assert sum(np.isfinite(d).sum() for s in slow for _, d in s[1]) >= 10
+        assert sum(np.isinf(d).sum() for s in slow for _, d in s[1]) >= 4
+        assert sum(len(s[2]) for s in slow) >= 20
+
+
+@pytest.mark.parametrize("seed", range(4))
+def test_beta_1_equals_the_ranks_of_the_boundary_maps(seed):
+    """beta_1(xi) = E - rank d1 - rank d2 over Z/2 of the complex above xi, with no persistence."""
+    for u, v, value, n in (dense_graph(seed) + (9,), random_graph(seed) + (14,)):
+        grid = np.r_[0.0, np.sort(value), 50.0]
+        beta = nt.betti_curve(*nt.diagram_1(u, v, value, n), grid)
+        assert beta.tolist() == [betti_1_by_ranks(u, v, value, x) for x in grid]
+        assert beta.max() >= 1
+
+
+@pytest.mark.parametrize("seed", range(6))
+@pytest.mark.parametrize("ties", [False, True])
+def test_dimension_1_equals_gudhi(seed, ties):
+    pytest.importorskip("gudhi")
+    for u, v, value, n in (dense_graph(seed, ties) + (9,), random_graph(seed, ties=ties) + (14,)):
+        assert as_pairs(*nt.diagram_1(u, v, value, n)) == as_pairs(*nt.diagrams_gudhi(u, v, value, n)[1])
+
+
 def test_beta_1_is_the_euler_characteristic_on_a_triangulated_packing():
     """On a planar triangulation (no 2-cycles) beta_1 = beta_0 - V + E - T at every threshold,
     V, E, T the nodes, edges and triangles (trace A^3 / 6) of the network above it."""
-    pytest.importorskip("gudhi")
     ds = builders.hexagonal_lattice(7, 6)
     rng = np.random.default_rng(3)
     n_contacts = int(ds.contact_count[0])
     fn, i, j = rng.exponential(1.0, n_contacts), ds.i.values[0, :n_contacts], ds.j.values[0, :n_contacts]
     u, v, value = nt.filtration_edges(fn, i, j, np.ones(n_contacts, bool))
-    diagrams = nt.diagrams_gudhi(u, v, value, 42)
     grid = np.r_[0.0, np.sort(value), np.sort(value) + 1e-9]
     beta_0 = nt.betti_curve(*nt.diagram_0(u, v, value, 42), grid)
-    beta_1 = nt.betti_curve(*diagrams[1], grid)
+    beta_1 = nt.betti_curve(*nt.diagram_1(u, v, value, 42), grid)
     assert beta_1.max() >= 3
     for x, b0, b1 in zip(grid, beta_0, beta_1):
         keep = value >= x
@@ -164,6 +295,15 @@ GRAPHS = {
     # 1.25 (3-4), 1 (4-5), 0.75 (0-3: the component {3,4,5} born at 1.25 merges into the older
     # one), 0.5 (2-5: the outer loop), 0.25 (1-4: the second loop)
     "two loops sharing an edge": ([0, 1, 3, 4, 0, 2, 1], [1, 2, 4, 5, 3, 5, 4], [7.0, 6.0, 5.0, 4.0, 3.0, 2.0, 1.0]),
+    # a 4-clique: a square of 4 N sides, its diagonals 0-2 of 2 N and 1-3 of 1 N, <f_n> = 19/6 N.
+    # The loop born at 4/<f_n> dies at 2/<f_n> when 0-2 fills it with two triangles; 1-3 brings
+    # two more, which with those close a 2-sphere: the last of the four fills no loop
+    "4-clique": ([0, 1, 2, 3, 0, 1], [1, 2, 3, 0, 2, 3], [4.0, 4.0, 4.0, 4.0, 2.0, 1.0]),
+    # an octahedron: the equator 1-2-3-4 of 4 N, the spokes to the top 0 of 2 N and to the bottom
+    # 5 of 1 N, <f_n> = 7/3 N. The equator's loop is born at 12/7 and filled at 6/7 by the top
+    # cone; the bottom cone closes the sphere
+    "octahedron": ([1, 2, 3, 4, 0, 0, 0, 0, 1, 2, 3, 4], [2, 3, 4, 1, 1, 2, 3, 4, 5, 5, 5, 5],
+                   [4.0] * 4 + [2.0] * 4 + [1.0] * 4),
 }
 EXPECTED = {
     "triangle with one weak edge": dict(d0=[(1.5, -INF)], d1=[], cycles_3=[0, 0, 1, 0, 0], cycles_4=[0] * 5),
@@ -172,6 +312,12 @@ EXPECTED = {
                                       cycles_4=[0] * 5),
     "two loops sharing an edge": dict(d0=[(1.25, 0.75), (1.75, -INF)], d1=[(0.25, -INF), (0.5, -INF)],
                                       cycles_3=[0] * 5, cycles_4=[0, 0, 2, 0, 0]),
+    # each triangle two sides and a diagonal; every 4-cycle has a chord
+    "4-clique": dict(d0=[(24 / 19, -INF)], d1=[(24 / 19, 12 / 19)], d2=[(6 / 19, -INF)], cycles_3=[0, 0, 4, 0, 0],
+                     cycles_4=[0] * 5),
+    # each triangle one equator side; the chordless 4-cycles: the equator, and two through both poles
+    "octahedron": dict(d0=[(12 / 7, -INF)], d1=[(12 / 7, 6 / 7)], d2=[(3 / 7, -INF)], cycles_3=[0, 8, 0, 0, 0],
+                       cycles_4=[2, 0, 0, 0, 1]),
 }
 
 
@@ -194,8 +340,24 @@ def diagram(out, t, dim):
     return as_pairs(snap.birth.values[keep], snap.death.values[keep])
 
 
+@pytest.mark.parametrize("name", GRAPHS)
+def test_hand_made_graphs_by_the_textbook_reduction_and_gudhi(name):
+    """The expected diagrams of the hand-made graphs (dimension 2: the spheres, which the module
+    does not report) are the slow reduction's and, when it is installed, gudhi's."""
+    i, j, fn = (np.array(a) for a in GRAPHS[name])
+    u, v, value = nt.filtration_edges(fn, i, j, np.ones(i.size, bool))
+    want = {dim: as_pairs(*zip(*EXPECTED[name][key])) if EXPECTED[name].get(key) else []
+            for dim, key in enumerate(("d0", "d1", "d2"))}
+    assert slow_flag_persistence(u, v, value) == want
+    assert as_pairs(*nt.diagram_1(u, v, value, 6)) == want[1]
+    try:
+        library = nt.diagrams_gudhi(u, v, value, 6)
+    except ParameterError:  # no gudhi
+        return
+    assert [as_pairs(*library[dim]) for dim in (0, 1)] == [want[0], want[1]]
+
+
 def test_hand_made_graphs_give_their_diagrams(prepare):
-    pytest.importorskip("gudhi")
     ds = prepare(hand_made())
     with raise_if_dask_computes():
         lazy = ds.grain.network_persistence(xi=[0.0, 0.25, 0.3, 0.5, 0.75, 1.0, 1.25, 1.5, 2.0])
@@ -214,6 +376,8 @@ def test_hand_made_graphs_give_their_diagrams(prepare):
     assert diagonal.beta_1.values.tolist() == [0, 0, 1, 1, 1, 1, 0, 0, 0]
     assert out.isel(time=0).beta_1.values.tolist() == [0] * 9  # the triangle's loop never shows
     assert out.isel(time=1).beta_1.values.tolist() == [1, 1, 1, 0, 0, 0, 0, 0, 0]  # born at 0.4
+    assert out.isel(time=4).beta_1.values.tolist() == [0, 0, 0, 0, 1, 1, 1, 0, 0]  # on (12/19, 24/19]
+    assert out.isel(time=5).beta_1.values.tolist() == [0, 0, 0, 0, 0, 1, 1, 1, 0]  # on (6/7, 12/7]
     # padding: NaN births, dimension -1, after the features
     assert np.isnan(out.birth.values[0, 1:]).all() and (out.dimension.values[0, 1:] == -1).all()
     assert out.birth.attrs["units"] == "1" and out.attrs["walls"] == 0
@@ -222,7 +386,6 @@ def test_hand_made_graphs_give_their_diagrams(prepare):
 def test_square_lattice_by_hand(prepare):
     """4 x 3 disks, 9 horizontal contacts of 2 N and 8 vertical of 5 N, <f_n> = 58/17 N: the
     4 vertical columns appear at xi = 85/58, join at 34/58 closing the 6 unit squares."""
-    pytest.importorskip("gudhi")
     ds = prepare(builders.square_lattice(4, 3, 2.0, 5.0))
     with raise_if_dask_computes():
         lazy = network_persistence(ds, xi=[0.0, 0.5, 1.0, 1.5])
@@ -239,7 +402,6 @@ def test_square_lattice_by_hand(prepare):
 
 
 def test_hexagonal_lattice_fills_every_loop():
-    pytest.importorskip("gudhi")
     out = network_persistence(builders.hexagonal_lattice(6, 5), xi=[0.0, 1.0])
     # 4 strips between 5 rows of 6 disks, each a zigzag of 12 disks holding 10 triangles, all of
     # equal (strong) force
@@ -266,7 +428,6 @@ def test_walls_as_nodes():
 
 
 def test_max_features_keeps_the_most_persistent_and_every_count():
-    pytest.importorskip("gudhi")
     ds = builders.square_lattice(4, 3, 2.0, 5.0)
     whole = network_persistence(ds)
     cut = network_persistence(ds, max_features=2)
@@ -275,15 +436,23 @@ def test_max_features_keeps_the_most_persistent_and_every_count():
     np.testing.assert_array_equal(cut.beta_1.values, whole.beta_1.values)
 
 
-def test_dimension_0_needs_no_gudhi_and_dimension_1_says_so(monkeypatch):
+def test_both_dimensions_without_gudhi(monkeypatch):
+    """Without gudhi everything is computed; only the cross-check says, in one line, what it needs."""
     monkeypatch.setitem(sys.modules, "gudhi", None)  # import gudhi raises ImportError
     ds = hand_made()
-    with pytest.raises(ParameterError, match=r"needs the TDA library gudhi: pip install 'grainview\[topology\]'"):
-        ds.grain.network_persistence()
-    out = ds.grain.network_persistence(dimensions=(0,), xi=[0.0, 1.0])
-    assert "beta_1" not in out and set(np.unique(out.dimension.values)) == {-1, 0}
-    assert diagram(out, 3, 0) == as_pairs([1.25, 1.75], [0.75, -INF])
-    assert out.cycles_4.values[3].tolist() == [0, 0, 2, 0, 0]
+    out = ds.grain.network_persistence(xi=[0.0, 1.0])
+    for t, name in enumerate(GRAPHS):
+        want = EXPECTED[name]
+        assert diagram(out, t, 0) == as_pairs(*zip(*want["d0"])), name
+        assert diagram(out, t, 1) == (as_pairs(*zip(*want["d1"])) if want["d1"] else []), name
+    assert out.beta_1.values.tolist() == [[0, 0], [1, 0], [0, 1], [2, 0], [0, 1], [0, 1]]
+    zero = ds.grain.network_persistence(dimensions=(0,), xi=[0.0, 1.0])
+    assert "beta_1" not in zero and set(np.unique(zero.dimension.values)) == {-1, 0}
+    assert diagram(zero, 3, 0) == as_pairs([1.25, 1.75], [0.75, -INF])
+    u, v, value = nt.filtration_edges(np.array([1.0]), np.array([0]), np.array([1]), np.array([True]))
+    with pytest.raises(ParameterError, match=r"needs gudhi: pip install 'grainview\[topology\]'") as error:
+        nt.diagrams_gudhi(u, v, value, 2)
+    assert "\n" not in str(error.value)
 
 
 @pytest.mark.parametrize("kwargs, match", [
@@ -300,7 +469,6 @@ def test_bad_arguments(kwargs, match):
 
 
 def test_figures_draw_the_analysis_with_labelled_axes():
-    pytest.importorskip("gudhi")
     import matplotlib.pyplot as plt
 
     from grainview.plot.topology import (plot_betti_curves, plot_cycle_counts, plot_network_topology,
@@ -338,3 +506,62 @@ def test_unloaded_pairs_all_enter_at_zero():
     assert value.tolist() == [0.0, 0.0, 0.0]
     assert as_pairs(*nt.diagram_0(u, v, value, 3)) == [(0.0, -INF)]
     assert nt.betti_curve(*nt.diagram_0(u, v, value, 3), [0.0, 0.1]).tolist() == [1, 0]
+
+
+# ---------------------------------------------------------------- the study's runs
+
+
+def study_file(label):
+    """A run of ``grainview study`` (GRAINVIEW_STUDY, the repository's study/, or the shared
+    /work/runs/study), or skip."""
+    for folder in (os.environ.get("GRAINVIEW_STUDY"), Path(__file__).parents[2] / "study", "/work/runs/study"):
+        if folder and (Path(folder) / f"{label}.nc").is_file():
+            return Path(folder) / f"{label}.nc"
+    pytest.skip("no study files (grainview study)")
+
+
+def study_graphs(label, every=1):
+    """Each snapshot's network as the module filters it: (u, v, value), the particle count."""
+    import grainview
+    from grainview.contacts import selection
+
+    ds = grainview.open_dataset(study_file(label)).isel(time=slice(None, None, every)).load()
+    mask, fn, i, j = (a.transpose("time", "contact").values for a in (selection(ds), ds.fn, ds.i, ds.j))
+    return ds, [nt.filtration_edges(fn[t], i[t], j[t], mask[t]) for t in range(ds.sizes["time"])]
+
+
+@pytest.mark.parametrize("label", ["pentagons", "disks"])
+def test_study_snapshots_equal_gudhi(label):
+    """Every snapshot of the study's runs: the module's diagrams (dimensions 0 and 1) equal
+    gudhi's as multisets, and its beta_0 and beta_1 curves gudhi's."""
+    pytest.importorskip("gudhi")
+    ds, graphs = study_graphs(label)
+    out = ds.grain.network_persistence().compute()
+    n = ds.sizes["particle"]
+    filled = loops = 0
+    for t, (u, v, value) in enumerate(graphs):
+        library = nt.diagrams_gudhi(u, v, value, n)
+        for dim in (0, 1):
+            assert diagram(out, t, dim) == as_pairs(*library[dim]), (t, dim)
+            np.testing.assert_array_equal(out[f"beta_{dim}"].values[t], nt.betti_curve(*library[dim], out.xi.values))
+        loops += library[1][0].size
+        filled += np.isfinite(library[1][1]).sum()
+    assert ds.sizes["time"] > 150 and loops > 100 * ds.sizes["time"] and filled > 20
+
+
+@pytest.mark.parametrize("label", ["pentagons", "disks"])
+def test_study_snapshots_equal_the_textbook_reduction(label):
+    """Every 25th snapshot of the study's runs (every one: the slow test below)."""
+    _, graphs = study_graphs(label, every=25)
+    for u, v, value in graphs:
+        slow = slow_flag_persistence(u, v, value)
+        assert as_pairs(*nt.diagram_1(u, v, value, 400)) == slow[1]
+        assert as_pairs(*nt.diagram_0(u, v, value, 400)) == slow[0]
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("label", ["pentagons", "disks"])
+def test_every_study_snapshot_equals_the_textbook_reduction(label):
+    _, graphs = study_graphs(label)
+    for u, v, value in graphs:
+        assert as_pairs(*nt.diagram_1(u, v, value, 400)) == slow_flag_persistence(u, v, value)[1]
