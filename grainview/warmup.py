@@ -102,7 +102,7 @@ def _stages(folder):
         with open_dataset(Path(folder) / "pentagon.nc") as ds:
             ds.grain.xi_network().compute()
             ds.grain.coarse_grained(width=0.05, spacing=0.05).compute()
-            ds.grain.network_persistence(dimensions=(0,)).compute()
+            ds.grain.network_persistence().compute()
             ds.grain.force_chains(follow=True)
 
     return [("solver: pentagon steps (plain, Anderson, shuffled, stall test, 2 domains)", solver_shape("pentagon")),
