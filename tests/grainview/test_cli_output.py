@@ -286,7 +286,8 @@ def test_warmup_compiles_the_kernels_and_says_where_the_cache_is(capsys, monkeyp
     for name in ("solver.nlgs.solve", "solver.acceleration.solve_anderson", "solver.parallel_nlgs.solve_domains",
                  "solver.narrowphase._detect_kernel", "solver.broadphase._candidate_pairs_kernel",
                  "solver.packing._deposit_kernel", "solver.residuals.natural_maps",
-                 "grainview._kernels.xi_network.count_below"):
+                 "grainview._kernels.xi_network.count_below",
+                 "grainview._kernels.network_topology.flag_persistence_1"):
         assert name in compiled, name
     cache = os.path.abspath(os.environ["NUMBA_CACHE_DIR"]) if os.environ.get("NUMBA_CACHE_DIR") else "__pycache__"
     assert cache in first and "[1/" in first
