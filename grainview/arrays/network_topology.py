@@ -43,7 +43,7 @@ STRONG_EDGES = ("strong_edges",)
 N_STRONG_EDGES = 5
 """Size of the ``strong_edges`` dimension: a cycle of 3 or 4 edges has 0 to 4 strong edges."""
 
-GUDHI_MISSING = ("the cross-check of the force network's persistence against the TDA library gudhi needs gudhi: "
+GUDHI_MISSING = ("diagrams_gudhi, the cross-check of the force network's persistence, needs the TDA library gudhi: "
                  "pip install 'grainview[topology]' (network_persistence computes both dimensions without it)")
 
 
