@@ -450,7 +450,8 @@ def test_both_dimensions_without_gudhi(monkeypatch):
     assert "beta_1" not in zero and set(np.unique(zero.dimension.values)) == {-1, 0}
     assert diagram(zero, 3, 0) == as_pairs([1.25, 1.75], [0.75, -INF])
     u, v, value = nt.filtration_edges(np.array([1.0]), np.array([0]), np.array([1]), np.array([True]))
-    with pytest.raises(ParameterError, match=r"needs the TDA library gudhi: pip install 'grainview\[topology\]'") as error:
+    needs = r"needs the TDA library gudhi: pip install 'grainview\[topology\]'"
+    with pytest.raises(ParameterError, match=needs) as error:
         nt.diagrams_gudhi(u, v, value, 2)
     assert "\n" not in str(error.value)
 
