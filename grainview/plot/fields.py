@@ -175,7 +175,7 @@ def draw_band(ax, band, clip=None, color="c"):
     lines = []
     for k, s in enumerate(np.asarray(band["edges"].values, float)):
         points = s * normal[:, None] + tangent[:, None] * u
-        label = (f"band: {float(band['angle']):.0f}$^\\circ$, {1e3 * float(band['fwhm']):.0f} mm, "
+        label = (f"band: {float(band['angle']):.0f}°, {1e3 * float(band['fwhm']):.0f} mm, "
                  f"{100 * float(band['share']):.0f}% of the rate") if k == 0 else None
         (line,) = ax.plot(points[0], points[1], "--", color=color, linewidth=1.5, label=label)
         line.set_clip_path(clip if clip is not None else ax.patch)
