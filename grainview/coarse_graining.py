@@ -369,7 +369,9 @@ def profile(field: xr.DataArray, across: str = "x", inside=None) -> xr.DataArray
 
     over the nodes where ``g`` is defined (NaN skipped), optionally only those of ``inside``
     (a boolean field, e.g. ``fields.solid_fraction > 0.5`` to leave out the boundary layer).
-    A shear band crossing the sample shows as a peak or a dip of the profile.
+    A shear band along the other axis shows as a peak or a dip of the profile; an inclined one
+    only in a profile along its own direction (:func:`grainview.shear_bands.profile_along`,
+    :func:`grainview.shear_bands.find_shear_band`).
 
     Parameters
     ----------
