@@ -1,13 +1,19 @@
-"""What compressing a finished run costs and saves: size, time to compress, time of the
-analyses on the compressed file against the same file uncompressed.
+"""What compressing a finished run costs and saves: size, time and memory to compress, and the
+analyses' throughput on the compressed file against the same data uncompressed.
 
-    python benchmarks/compression.py [FILE]        # default: study/disks.nc (grainview study)
+    python benchmarks/compression.py [FILE] [--repeats 3] [--out benchmarks/RESULTS-compression.md]
 
-FILE is copied twice into a temporary folder: one copy is made netCDF-3, the other
-compressed (grainview.contract.writer.compress_file, the solver's default at the end of a run). The
-analyses (stress invariants, fabric anisotropy, force anisotropies, computed lazily with dask
-from open_dataset's default chunks) run on both copies alternately, ``--repeats`` times; the
-table gives medians and their ratio from this one run.
+Without FILE, a synthetic series of 40 snapshots x 200,000 contacts (8 million contacts, every
+slot a contact; benchmarks/analysis.py's writer) is written once into benchmarks/_data. The
+file is copied into a temporary folder in three forms: netCDF-3 (a run while it goes on), the
+default compressed file (grainview.contract.writer.compress_file: one snapshot per chunk,
+zlib 1 only where it saves at least 40%) and, to show what the filter choice buys, every
+variable deflated (zlib 4, the same chunks). Each compression runs in a fresh process, whose
+time and peak resident memory are reported. The analyses (stress invariants, fabric
+anisotropy, force anisotropies, the xi-network with 100 thresholds, every contact's lifetime;
+lazily with dask from open_dataset's default chunks) run on the three files in turn,
+``--repeats`` rounds; the tables give medians, contacts/s and the ratio to netCDF-3 from this
+one run.
 """
 
 from __future__ import annotations
@@ -16,62 +22,151 @@ import argparse
 import os
 import shutil
 import statistics
+import subprocess
 import sys
 import tempfile
 import time
 import warnings
 
+import numpy as np
+
 HERE = os.path.dirname(os.path.abspath(__file__))
+sys.path.insert(0, HERE)
 sys.path.insert(0, os.path.dirname(HERE))
 
+CASES = {
+    "stress invariants": lambda ds: ds.grain.stress_invariants()["q_over_p"],
+    "fabric anisotropy": lambda ds: ds.grain.fabric_anisotropy(),
+    "force anisotropies": lambda ds: ds.grain.force_anisotropies(),
+    "xi-network (K = 100)": lambda ds: _xi(ds),
+    "contact lifetimes": lambda ds: _lifetimes(ds),
+}
 
-def analyses(path) -> float:
-    """Seconds to compute the stress invariants, fabric and force anisotropies of ``path``."""
+COMPRESS = r"""
+import json, resource, sys, time
+import grainview.contract.writer as writer
+path, level, min_saving = sys.argv[1], int(sys.argv[2]), float(sys.argv[3])
+writer.MIN_SAVING = min_saving
+start = time.perf_counter()
+writer.compress_file(path, complevel=level)
+print(json.dumps({"seconds": time.perf_counter() - start,
+                  "peak_mib": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024}))
+"""
+
+
+def _xi(ds):
+    from grainview.xi_network import xi_network
+
+    return xi_network(ds, xi=np.linspace(0, 5, 100))
+
+
+def _lifetimes(ds):
+    from grainview.lifetimes import contact_events
+
+    return contact_events(ds, walls=False)
+
+
+def compress(path, level, min_saving) -> dict:
+    """compress_file on ``path`` in a fresh process: its seconds and peak resident memory (MiB)."""
+    import json
+
+    done = subprocess.run([sys.executable, "-c", COMPRESS, path, str(level), str(min_saving)],
+                          capture_output=True, text=True, check=True, cwd=os.path.dirname(HERE))
+    return json.loads(done.stdout.strip().splitlines()[-1])
+
+
+def timed(path, case) -> float:
+    """Seconds of one analysis of ``path``, opened lazily."""
     import grainview
 
     with grainview.open_dataset(path) as ds:
         start = time.perf_counter()
-        ds.grain.stress_invariants()["q_over_p"].compute()
-        ds.grain.fabric_anisotropy().compute()
-        ds.grain.force_anisotropies().compute()
+        result = CASES[case](ds)
+        if hasattr(result, "compute"):
+            result.compute()
         return time.perf_counter() - start
+
+
+def layout(path) -> str:
+    """Which per-snapshot variables are deflated, and the chunk of ``fn``."""
+    import netCDF4
+
+    with netCDF4.Dataset(path) as nc:
+        deflated = [n for n, v in nc.variables.items() if v.dimensions[:1] == ("time",) and v.filters()["zlib"]]
+        return f"deflated: {', '.join(deflated) or 'none'}; fn chunk {nc.variables['fn'].chunking()}"
 
 
 def main(argv=None):
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    parser.add_argument("file", nargs="?", default="study/disks.nc")
-    parser.add_argument("--repeats", type=int, default=5)
+    parser.add_argument("file", nargs="?", help="a file of the contract (default: the synthetic 8M-contact series)")
+    parser.add_argument("--repeats", type=int, default=3)
+    parser.add_argument("--out", help="markdown file to write (default: print)")
     args = parser.parse_args(argv)
     warnings.simplefilter("ignore")
     import grainview
     from common import machine_description
-    from grainview.contract.writer import compress_file, decompress_file
+    from grainview.contract.writer import decompress_file
 
-    with tempfile.TemporaryDirectory() as tmp:
-        plain, packed = os.path.join(tmp, "plain.nc"), os.path.join(tmp, "packed.nc")
-        shutil.copy(args.file, plain)
-        decompress_file(plain)
-        shutil.copy(plain, packed)
-        start = time.perf_counter()
-        compress_file(packed)
-        seconds = time.perf_counter() - start
-        with grainview.open_dataset(plain, chunks=None) as ds:
-            shape = f"{ds.sizes['particle']} particles, {ds.sizes['time']} snapshots, {ds.sizes['contact']} contact slots"
-        times = {plain: [], packed: []}
+    source = args.file
+    if source is None:
+        from analysis import write_series
+
+        source = os.path.join(HERE, "_data", "series_40x200000.nc")
+        if not os.path.exists(source):
+            os.makedirs(os.path.dirname(source), exist_ok=True)
+            write_series(source, 40, 200_000)
+    with tempfile.TemporaryDirectory(dir=os.path.join(HERE, "_data") if os.path.isdir(os.path.join(HERE, "_data"))
+                                     else None) as tmp:
+        files = {"netCDF-3": os.path.join(tmp, "plain.nc"), "default": os.path.join(tmp, "default.nc"),
+                 "zlib 4, everything": os.path.join(tmp, "all.nc")}
+        shutil.copy(source, files["netCDF-3"])
+        decompress_file(files["netCDF-3"])
+        written = {}
+        for name, level, min_saving in (("default", None, None), ("zlib 4, everything", 4, 0.0)):
+            shutil.copy(files["netCDF-3"], files[name])
+            from grainview.contract.writer import DEFAULT_COMPLEVEL, MIN_SAVING
+
+            written[name] = compress(files[name], level or DEFAULT_COMPLEVEL,
+                                     MIN_SAVING if min_saving is None else min_saving)
+        with grainview.open_dataset(files["netCDF-3"], chunks=None) as ds:
+            contacts = int(ds["contact_count"].sum())
+            shape = (f"{ds.sizes['particle']:,} particles, {ds.sizes['time']} snapshots, {ds.sizes['contact']:,} "
+                     f"contact slots, {contacts:,} contacts")
+        for case in CASES:  # warm-up: numba's kernels, the page cache
+            timed(files["netCDF-3"], case)
+        times = {(name, case): [] for name in files for case in CASES}
         for _ in range(args.repeats):
-            for path in times:
-                times[path].append(analyses(path))
-        size_plain, size_packed = os.path.getsize(plain), os.path.getsize(packed)
-        median = {path: statistics.median(v) for path, v in times.items()}
-    print(machine_description() + "\n")
-    print(f"{os.path.basename(args.file)}: {shape}; analyses = stress invariants + fabric anisotropy + force "
-          f"anisotropies with open_dataset's default chunks; medians of {args.repeats} alternating runs.\n")
-    print("| file | size (MB) | time to write (s) | analyses, median (s) |")
-    print("|---|---|---|---|")
-    print(f"| netCDF-3 (while a run goes on) | {size_plain / 1e6:.1f} | - | {median[plain]:.2f} |")
-    print(f"| compressed (NETCDF4_CLASSIC, zlib 4, shuffle) | {size_packed / 1e6:.1f} | {seconds:.2f} "
-          f"(compress_file) | {median[packed]:.2f} |")
-    print(f"| ratio compressed / netCDF-3 | {size_packed / size_plain:.2f} | | {median[packed] / median[plain]:.2f} |")
+            for case in CASES:
+                for name, path in files.items():
+                    times[name, case].append(timed(path, case))
+        median = {key: statistics.median(v) for key, v in times.items()}
+        sizes = {name: os.path.getsize(path) for name, path in files.items()}
+        layouts = {name: layout(files[name]) for name in written}
+    lines = [machine_description(), "",
+             f"{os.path.basename(source)}: {shape}. Analyses lazily with open_dataset's default chunks; medians "
+             f"of {args.repeats} rounds, the three files in turn within each round.", "",
+             "| file | size (MB) | size / netCDF-3 | compress_file (s) | its peak memory (MiB) |",
+             "|---|---|---|---|---|"]
+    for name in files:
+        w = written.get(name)
+        lines.append(f"| {name} | {sizes[name] / 1e6:.0f} | {sizes[name] / sizes['netCDF-3']:.2f} | "
+                     + (f"{w['seconds']:.1f} | {w['peak_mib']:.0f} |" if w else "- | - |"))
+    lines += ["", "; ".join(f"{name}: {text}" for name, text in layouts.items()), "",
+              "| analysis | " + " | ".join(f"{name}: s, M contacts/s" for name in files)
+              + " | default / netCDF-3 | zlib 4 everything / netCDF-3 |",
+              "|---|" + "---|" * (len(files) + 2)]
+    for case in CASES:
+        cells = [f"{median[name, case]:.2f}, {contacts / median[name, case] / 1e6:.1f}" for name in files]
+        lines.append(f"| {case} | " + " | ".join(cells)
+                     + f" | {median['netCDF-3', case] / median['default', case]:.2f}"
+                     f" | {median['netCDF-3', case] / median['zlib 4, everything', case]:.2f} |")
+    lines += ["", "Ratios are throughputs: the compressed file's contacts/s over netCDF-3's (1 = as fast)."]
+    report = "\n".join(lines) + "\n"
+    if args.out:
+        with open(args.out, "w") as fh:
+            fh.write(report)
+        print(f"wrote {args.out}")
+    print(report)
 
 
 if __name__ == "__main__":

@@ -283,3 +283,25 @@ def test_compressed_files_have_one_snapshot_per_chunk_and_deflate_only_what_shri
         xr.testing.assert_identical(a, c)
     with xr.open_dataset(packed, engine="netcdf4") as d:  # plain xarray reads it too
         np.testing.assert_array_equal(d["fn"].values, ds["fn"].values)
+
+
+def test_files_compressed_the_previous_way_still_open_unchanged(tmp_path):
+    """Files compressed before: zlib 4 on every variable, the netCDF library's own chunks
+    (several snapshots per chunk along a fixed-size time)."""
+    from grainview.contract.dataset import netcdf_encoding
+    from grainview.synthetic import harmonic_series
+
+    ds = harmonic_series(n_snapshots=30, n_contacts=3000, seed=2)
+    old, plain = tmp_path / "old.nc", tmp_path / "plain.nc"
+    encoding = netcdf_encoding(ds)
+    for name in encoding:
+        if name != "time":
+            encoding[name].update(zlib=True, complevel=4, shuffle=True)
+    ds.to_netcdf(old, format="NETCDF4_CLASSIC", encoding=encoding)
+    ds.to_netcdf(plain, format="NETCDF3_64BIT", encoding=netcdf_encoding(ds))
+    with netCDF4.Dataset(old) as nc:
+        assert nc.variables["fn"].filters()["zlib"] and nc.variables["fn"].chunking()[0] > 1
+    with grainview.open_dataset(old) as a, grainview.open_dataset(plain) as b:
+        xr.testing.assert_identical(a.load(), b.load())
+        np.testing.assert_allclose(a.grain.stress_invariants()["q_over_p"].values,
+                                   b.grain.stress_invariants()["q_over_p"].values, rtol=0, atol=0)
