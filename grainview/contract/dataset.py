@@ -229,10 +229,11 @@ def netcdf_encoding(ds: xr.Dataset, zlib: bool = False, complevel: int | None = 
                 deflate = {"zlib": True, "complevel": int(complevel), "shuffle": True}
                 var = ds[name]
                 if var.ndim and var.dims[0] == "time" and var.shape[0]:
-                    row_bytes = var.dtype.itemsize * int(np.prod(var.shape[1:], dtype=np.int64))
-                    rows = writer.chunk_rows(row_bytes, var.shape[0])
-                    enc[name]["chunksizes"] = (rows, *var.shape[1:])
-                    sample = [var[block].values for block in writer.sample_blocks(var.shape[0], rows)]
+                    chunks = writer.chunk_shape(var.shape, var.dtype.itemsize, floating)
+                    fill = np.nan if floating and var.ndim > 1 and chunks[1] < var.shape[1] else None
+                    enc[name]["chunksizes"] = chunks
+                    sample = [writer.without_fill(var[block].values, fill)
+                              for block in writer.sample_blocks(var.shape[0], chunks[0])]
                     if writer.deflate_saving(sample, complevel) < writer.MIN_SAVING:
                         deflate = {}
                 enc[name].update(deflate)

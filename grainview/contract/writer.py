@@ -18,7 +18,7 @@ from .shapes import shape_problems
 
 __all__ = ["SnapshotWriter", "compress_file", "decompress_file", "is_compressed", "check_complevel",
            "netcdf3_data_bytes", "lock_file", "remove_strays", "last_complete_value", "APPEND_FORMAT",
-           "COMPRESSED_FORMAT", "DEFAULT_COMPLEVEL", "chunk_rows", "copy_blocks", "sample_blocks", "deflate_saving"]
+           "COMPRESSED_FORMAT", "DEFAULT_COMPLEVEL", "chunk_rows", "chunk_shape", "copy_blocks", "sample_blocks", "deflate_saving", "without_fill"]
 
 APPEND_FORMAT = "NETCDF3_64BIT_OFFSET"
 """The format a run is written in while it goes on: its records are appended in place, so a
@@ -213,12 +213,16 @@ def _convert(path, fmt, complevel=None, lock=None) -> None:
             var.set_auto_chartostring(False)  # character arrays copied as characters
             row_bytes = max(1, var.dtype.itemsize * int(np.prod(var.shape[1:], dtype=np.int64)))
             per_snapshot = var.ndim > 0 and var.dimensions[0] == "time"
-            options, rows_per_chunk = {}, 1
+            options, rows_per_chunk, columns = {}, 1, None
             if complevel is not None and var.dtype.kind != "S" and var.ndim > 0:
                 if per_snapshot:
-                    rows_per_chunk = chunk_rows(row_bytes, var.shape[0])
-                    options["chunksizes"] = (rows_per_chunk, *var.shape[1:])
-                    sample = [var[b] for b in sample_blocks(var.shape[0], rows_per_chunk)]
+                    chunks = chunk_shape(var.shape, var.dtype.itemsize, fill is not None)
+                    rows_per_chunk = chunks[0]
+                    options["chunksizes"] = chunks
+                    if var.ndim > 1 and chunks[1] < var.shape[1]:
+                        columns = chunks[1]  # chunks of empty slots are left unwritten
+                    stored = fill if columns is not None else None  # the empty slots not stored, or stored
+                    sample = [without_fill(var[b], stored) for b in sample_blocks(var.shape[0], rows_per_chunk)]
                     if deflate_saving(sample, complevel) >= MIN_SAVING:
                         options.update(zlib=True, complevel=complevel, shuffle=True)
                 else:
@@ -236,7 +240,10 @@ def _convert(path, fmt, complevel=None, lock=None) -> None:
                     side.set_var_chunk_cache(size=0)
             source_rows = var.chunking()[0] if var.chunking() not in (None, "contiguous") else 1
             for block in copy_blocks(var.shape[0], row_bytes, max(rows_per_chunk, source_rows)):
-                out[block] = var[block]
+                if columns is None:
+                    out[block] = var[block]
+                else:
+                    _write_occupied(out, block.start, var[block], columns, fill)
         dst.setncatts({k: src.getncattr(k) for k in src.ncattrs()})
         dst.close()
         src.close()
@@ -280,6 +287,63 @@ def chunk_rows(row_bytes: int, n_rows: int) -> int:
         Snapshots per chunk, >= 1.
     """
     return max(1, min(int(n_rows), CHUNK_BYTES // max(1, int(row_bytes))))
+
+
+def chunk_shape(shape, itemsize: int, fill: bool = False) -> tuple:
+    """The chunk of a compressed file's per-snapshot variable of ``shape`` (``time`` first).
+
+    :func:`chunk_rows` snapshots, whole along the other dimensions; for a variable with a fill
+    value (its empty slots) of one snapshot per chunk, the second dimension (``contact``,
+    ``particle``) is cut into pieces of about :data:`CHUNK_BYTES`, so that the pieces that hold
+    only empty slots need not be written at all: HDF5 gives the fill value for a chunk never
+    written, without storing or inflating anything.
+
+    Parameters
+    ----------
+    shape : tuple of int
+        The variable's shape, ``time`` first.
+    itemsize : int
+        Bytes of one value.
+    fill : bool, default False
+        The variable has a fill value.
+
+    Returns
+    -------
+    tuple of int
+    """
+    shape = tuple(int(n) for n in shape)
+    rows = chunk_rows(itemsize * int(np.prod(shape[1:], dtype=np.int64)), shape[0])
+    chunks = [rows, *shape[1:]]
+    if fill and len(shape) > 1 and rows == 1:
+        inner = itemsize * int(np.prod(shape[2:], dtype=np.int64))
+        chunks[1] = max(1, min(shape[1], CHUNK_BYTES // inner))
+    return tuple(chunks)
+
+
+def _fill_mask(array, fill):
+    """Where ``array`` (snapshots first, slots second) holds ``fill`` bit for bit, per slot:
+    True for a slot whose every value (both components of a vector) is the fill value."""
+    unsigned = f"u{array.dtype.itemsize}"
+    same = np.ascontiguousarray(array).view(unsigned) == np.asarray(fill, array.dtype).view(unsigned)
+    return same.reshape(*array.shape[:2], -1).all(axis=-1) if array.ndim > 1 else same
+
+
+def without_fill(array, fill):
+    """The values of ``array`` outside its empty slots (those holding ``fill`` bit for bit), as
+    one flat array: what a compressed file stores of it. ``array`` itself when ``fill`` is None."""
+    if fill is None or array.ndim < 2:
+        return array
+    return np.ascontiguousarray(array)[~_fill_mask(array, fill)]
+
+
+def _write_occupied(out, start, data, columns, fill) -> None:
+    """Write rows ``start ...`` of ``out`` from ``data`` one chunk (``columns`` slots of a row)
+    at a time, skipping the chunks that hold only ``fill``: they stay unwritten and read as it."""
+    empty = _fill_mask(data, fill)
+    for row in range(data.shape[0]):
+        for first in range(0, data.shape[1], columns):
+            if not empty[row, first:first + columns].all():
+                out[start + row, first:first + columns] = data[row, first:first + columns]
 
 
 def copy_blocks(n_rows: int, row_bytes: int, rows_per_chunk: int = 1, budget: int | None = None) -> list[slice]:
@@ -347,9 +411,10 @@ def compress_file(path, complevel: int = DEFAULT_COMPLEVEL, lock=None) -> None:
     reads it unchanged. A file already compressed is left alone, so a compression stopped
     midway (the file still netCDF-3) is simply done again.
 
-    Per-snapshot variables are chunked one snapshot per chunk (:func:`chunk_rows`) and deflated
-    only when that saves at least :data:`MIN_SAVING` of their bytes (:func:`deflate_saving`, on
-    three chunks); the others are stored as they are. The copy goes block by block
+    Per-snapshot variables are chunked one snapshot per chunk (:func:`chunk_shape`), the chunks
+    that hold only empty slots are not written (they read as the fill value), and a variable
+    is deflated only when that saves at least :data:`MIN_SAVING` of the bytes of its slots in
+    use (:func:`deflate_saving`, on three chunks); the others are stored as they are. The copy goes block by block
     (:func:`copy_blocks`) without the library's chunk caches, in memory independent of the
     number of snapshots.
 
