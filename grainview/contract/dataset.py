@@ -14,7 +14,7 @@ import numpy as np
 from .errors import ParameterError
 from .schema import (CONTACT_VARIABLES, DEFAULT_WALL_NAMES, OPTIONAL_CONTACT_VARIABLES, TIME_ATTRS, VARIABLES,
                      XY, contact_slots, empty_slots, global_attrs, variable_attrs)
-from .shapes import inertia_per_mass, particle_area, shape_problems
+from .shapes import has_irregular_polygons, inertia_per_mass, particle_area, shape_problems
 
 if TYPE_CHECKING:
     import xarray as xr
@@ -178,7 +178,7 @@ def make_dataset(
     import xarray as xr
 
     ds = xr.Dataset(variables, coords=_coords(np.arange(t, dtype="f8") if time is None else time, n_walls, wall_names))
-    ds.attrs = global_attrs(n, n_walls, attrs)
+    ds.attrs = global_attrs(n, n_walls, attrs, has_irregular_polygons(radius, n_vertices, optional.get("vertices")))
     return ds
 
 

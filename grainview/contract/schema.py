@@ -26,8 +26,21 @@ from dataclasses import dataclass
 
 import numpy as np
 
-SCHEMA_VERSION = "1.0"
-"""Version of the contract written into every file as ``grainview_schema_version``."""
+SCHEMA_VERSION = "2.0"
+"""The newest version of the contract: this grainview reads files up to its major number and
+refuses newer ones. Written as ``grainview_schema_version`` into the files that need it
+(:func:`schema_version`)."""
+REGULAR_SHAPES_VERSION = "1.0"
+"""The version written into files whose particles are all disks or regular polygons. Such a file
+means the same to every grainview: one before 2.0 reads a polygon as the regular one of its
+``radius`` and ``n_vertices``, which it is. A file holding any other polygon (its ``vertices``,
+version 2.0) is refused by those older readers, instead of being read as regular polygons."""
+
+
+def schema_version(irregular: bool) -> str:
+    """The version a file is written with: :data:`SCHEMA_VERSION` when it holds polygons that
+    are not regular (``irregular``), else :data:`REGULAR_SHAPES_VERSION`."""
+    return SCHEMA_VERSION if irregular else REGULAR_SHAPES_VERSION
 
 XY = ("x", "y")
 
@@ -196,10 +209,12 @@ def empty_slots(shape, name):
     return np.full(shape, np.nan, dtype=var.dtype)
 
 
-def global_attrs(n_particles: int, n_walls: int, attrs: dict | None = None) -> dict:
-    """Global attributes every file carries, merged with the run's own ``attrs``."""
+def global_attrs(n_particles: int, n_walls: int, attrs: dict | None = None, irregular: bool = False) -> dict:
+    """Global attributes every file carries, merged with the run's own ``attrs``; the schema
+    version is :func:`schema_version` of ``irregular`` (the file holds polygons that are not
+    regular)."""
     out = {
-        "grainview_schema_version": SCHEMA_VERSION,
+        "grainview_schema_version": schema_version(irregular),
         "Conventions": "CF-1.8",
         "thickness_m": 1.0,
         "n_particles": int(n_particles),

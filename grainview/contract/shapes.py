@@ -266,3 +266,12 @@ def particle_inradius(radius, n_vertices, vertices=None) -> np.ndarray:
         return np.where(n >= 3, radius * np.cos(np.pi / safe_n), radius)
     inner = polygon_properties(body_vertices(radius, n, vertices))["inradius"]
     return np.where(n.reshape(-1) >= 3, inner, radius.reshape(-1)).reshape(radius.shape)
+
+
+def has_irregular_polygons(radius, n_vertices, vertices=None) -> bool:
+    """Whether any particle is a polygon that is not regular (:func:`regular_polygons`): what
+    makes a file need version 2 of the contract (:func:`grainview.contract.schema.schema_version`)."""
+    n = np.asarray(n_vertices).astype(np.int64).reshape(-1)
+    if vertices is None:
+        return False
+    return bool(np.any((n >= 3) & ~regular_polygons(radius, n, vertices)))

@@ -14,7 +14,7 @@ from .errors import FileFormatError, GrainviewError, OutputError, ParameterError
 from .locks import WriterLock, process_alive
 from .schema import (CONTACT_VARIABLES, DEFAULT_WALL_NAMES, OPTIONAL_CONTACT_VARIABLES, REQUIRED, TIME_ATTRS,
                      VARIABLES, complete_snapshots, contact_slots, empty_slots, global_attrs, variable_attrs)
-from .shapes import shape_problems
+from .shapes import has_irregular_polygons, shape_problems
 
 __all__ = ["SnapshotWriter", "compress_file", "decompress_file", "is_compressed", "check_complevel",
            "netcdf3_data_bytes", "lock_file", "remove_strays", "last_complete_value", "APPEND_FORMAT",
@@ -640,7 +640,7 @@ class SnapshotWriter:
             for name, value in static.items():
                 nc.variables[name][:] = np.broadcast_to(np.asarray(value, VARIABLES[name].dtype),
                                                         nc.variables[name].shape)
-            nc.setncatts(global_attrs(n, n_walls, attrs))
+            nc.setncatts(global_attrs(n, n_walls, attrs, has_irregular_polygons(radius, n_vertices, vertices)))
             nc.close()
             _move_into_place(temporary, path, overwrite)
         except BaseException as exc:

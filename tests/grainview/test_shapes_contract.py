@@ -435,3 +435,33 @@ def test_vtk_itself_reads_the_irregular_polygons(tmp_path):
     quality.Update()
     area = vtk_to_numpy(quality.GetOutput().GetCellData().GetArray("Area"))
     np.testing.assert_allclose(area, [6.0, 4 * A * B, 2.5 * R5 ** 2 * math.sin(0.4 * math.pi)], rtol=1e-12)
+
+
+def test_a_file_of_irregular_polygons_is_version_2_and_older_readers_refuse_it(tmp_path, monkeypatch):
+    """Version 2.0 is written only where the vertices change what a file means: an older
+    grainview (major version 1) reads a polygon as the regular one of its radius and count, so
+    it must refuse a file of irregular polygons, and may open one of regular polygons or disks."""
+    import grainview.contract.file_checks as file_checks
+    from grainview.contract.reader import ContractFile
+
+    write_irregular(tmp_path / "irregular.nc")
+    radius, n, v, position, angle, contacts = irregular_sample()
+    regular = body_vertices(radius, n)  # the same particles, every polygon regular
+    with SnapshotWriter.create(tmp_path / "regular.nc", radius=radius, n_vertices=n, mass=np.ones(4),
+                               inertia=np.ones(4), vertices=regular) as writer:
+        writer.append(time=0.0, position=position, angle=angle, contacts=contacts, box_min=[0.0, 0.0],
+                      box_max=[20.0, 10.0])
+    versions = {}
+    for name in ("irregular", "regular"):
+        with netCDF4.Dataset(tmp_path / f"{name}.nc") as nc:
+            versions[name] = nc.grainview_schema_version
+    assert versions == {"irregular": "2.0", "regular": "1.0"}
+    assert make_dataset(radius=radius, n_vertices=n, vertices=v, position=position, contacts=[contacts],
+                        box_min=[0.0, 0.0], box_max=[20.0, 10.0]).attrs["grainview_schema_version"] == "2.0"
+    monkeypatch.setattr(file_checks, "SCHEMA_VERSION", "1.0")  # a grainview from before the vertices
+    with pytest.raises(SchemaError, match="schema version 2.0, newer than this grainview understands"):
+        grainview.open_dataset(tmp_path / "irregular.nc")
+    with pytest.raises(SchemaError, match="newer than this grainview understands"):
+        ContractFile(tmp_path / "irregular.nc")
+    with grainview.open_dataset(tmp_path / "regular.nc") as ds:
+        assert ds.sizes["particle"] == 4
