@@ -32,6 +32,7 @@ from dataclasses import asdict, dataclass, replace
 import numpy as np
 
 from grainview.contract.errors import ParameterError
+from grainview.contract.schema import MAX_STEP_INDEX
 
 from .shape_families import check_shape
 
@@ -39,9 +40,6 @@ MAX_SEED = 2**31 - 1
 """Largest seed: files store the seed as a 32-bit integer attribute (netCDF-3 has no wider one)."""
 MIN_TEST_STEPS = 10
 """Fewest time steps a biaxial test may take to reach its strain (a test of fewer is no test)."""
-MAX_STEP_INDEX = 2**31 - 1
-"""Largest step index a file's ``step`` variable (a 32-bit integer) holds: the compaction's steps
-and the test's together."""
 
 
 @dataclass(frozen=True)

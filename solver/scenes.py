@@ -10,6 +10,7 @@ import sys
 
 import numpy as np
 from grainview.contract.errors import ParameterError
+from grainview.contract.schema import MAX_STEP_INDEX
 
 from .interrupt import interruptible, progress_bar, resume_instructions, stop_exception, stop_reason
 from .output import Recorder
@@ -184,7 +185,14 @@ def biaxial_test(sim: Simulation, path, *, strain=0.1, velocity=0.01, every=20, 
     lo, hi = sim.walls.box_bounds()
     h0 = float(hi[1] - lo[1])
     travel = h0 * (np.exp(strain) - 1)
-    n_steps = int(np.ceil(travel / velocity / sim.parameters.time_step))
+    steps = travel / velocity / sim.parameters.time_step
+    if not np.isfinite(steps) or sim.step_index + steps > MAX_STEP_INDEX:
+        raise ParameterError(
+            f"the test would take {steps:.3g} steps of {sim.parameters.time_step:g} s to move the top wall "
+            f"{travel:.3g} m at {velocity:g} m/s (the sample is {h0:.3g} m high), beyond a file's step counter "
+            f"({MAX_STEP_INDEX} with the {sim.step_index} steps taken so far): expected a sample of sensible "
+            "height (did the compaction settle?) or a faster wall; nothing was written")
+    n_steps = int(np.ceil(steps))
     sim.walls.drive_velocity("top", (0.0, -velocity))
     run_attrs = {"scene": "biaxial", "strain_target": strain, "wall_velocity_m_s": velocity,
                  "sigma0_Pa": sim.sigma0, "snapshot_every": int(every), "biaxial_steps": n_steps,

@@ -147,6 +147,10 @@ VARIABLES: dict[str, Var] = {
     "complete": Var(("time",), "i1", "1", "1 once the snapshot is completely written", False),
 }
 
+MAX_STEP_INDEX = 2**31 - 1
+"""Largest step index the ``step`` variable (a 32-bit integer) holds: a run's steps, its
+compaction's and its test's together, must stay below it."""
+
 REQUIRED = tuple(name for name, var in VARIABLES.items() if var.required)
 CONTACT_VARIABLES = ("i", "j", "kind", "normal", "fn", "ft", "point", "branch")
 OPTIONAL_CONTACT_VARIABLES = ("gap",)

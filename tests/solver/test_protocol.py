@@ -3,6 +3,7 @@ top walls, biaxial compression at constant lateral stress written in the data co
 parameter errors; determinism. The 400-particle runs are marked slow."""
 
 import hashlib
+import re
 import warnings
 
 import numpy as np
@@ -134,6 +135,20 @@ def test_invalid_samples_and_scenes():
         prepare_sample(preparation("paper", particles=10, shape="disk", max_wall_speed=50.0))
     with pytest.raises(ParameterError, match="no wall named 'ceiling'"):
         sim.walls.drive_velocity("ceiling", (0, -1))
+
+
+def test_a_test_beyond_the_step_counter_is_refused_before_anything_is_written(tmp_path):
+    """The steps are counted from the compacted sample's own height (a compaction that let the
+    walls run away gives a box that no prediction foresaw): beyond the 32-bit step counter the
+    test is refused in one line and no file is made."""
+    sim = compaction_sample(10, "disk")
+    lo, hi = sim.walls.box_bounds()
+    steps = (hi[1] - lo[1]) * (np.exp(0.1) - 1) / 1e-9 / sim.parameters.time_step
+    assert steps > 2**31 - 1
+    with pytest.raises(ParameterError, match=re.escape(f"would take {steps:.3g} steps of")) as caught:
+        biaxial_test(sim, tmp_path / "never.nc", velocity=1e-9)
+    assert "beyond a file's step counter (2147483647" in str(caught.value)
+    assert list(tmp_path.iterdir()) == []
 
 
 def test_existing_file_is_not_overwritten(tmp_path):
