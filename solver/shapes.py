@@ -42,7 +42,7 @@ from grainview.contract import shapes as contract
 from grainview.contract.errors import ParameterError
 
 __all__ = ["Shapes", "SHAPES", "n_vertices_of", "polygon_area", "polygon_inertia_per_mass", "mass_and_inertia", "vertices", "inradius",
-           "check_shapes", "polygon_problem"]
+           "check_shapes", "polygon_problem", "MAX_SLENDERNESS"]
 
 
 SHAPES = {"disk": 0, "disks": 0, "pentagon": 5, "pentagons": 5}
@@ -131,12 +131,23 @@ def vertices(pos, angle, radius, nvert):
     return Shapes.regular(radius, nvert).world_vertices(pos, angle)
 
 
+MAX_SLENDERNESS = 10.0
+"""The largest ratio R / r of a polygon's circumscribed radius R to its inradius r (both about
+its centroid) that the solver accepts. The detection and time-step bounds scale with R, while
+a polygon only 2 r thick is crossed once an interpenetration reaches r: then the separating
+axis flips and the contact pushes the bodies through one another. Measured (docs/solver.md,
+"Shapes"): up to R/r = 10.5 the compaction's largest interpenetration stays below 1% of r;
+from R/r = 15 it reaches 0.05 to 5.6 r, the walls passing through particles."""
+
+
 def polygon_problem(vertices) -> str | None:
-    """What keeps ``vertices`` (n, 2) from being a convex polygon given counter-clockwise, in
-    a few words, or None: fewer than 3 vertices, a non-finite one, two equal consecutive ones,
-    a clockwise order, a reflex or straight corner, or a boundary that winds more than once
-    (a star polygon). The turn at vertex k is the cross product of edges k-1 and k; a convex
-    counter-clockwise polygon turns left at every vertex, by 2 pi in all."""
+    """What keeps ``vertices`` (n, 2) from being a convex polygon given counter-clockwise that
+    the solver can simulate, in a few words, or None: fewer than 3 vertices, a non-finite one,
+    two equal consecutive ones, a clockwise order, a reflex or straight corner or a boundary
+    that winds more than once (a star polygon; the contract's check,
+    ``grainview.contract.shapes.shape_problems``), or a polygon more slender than
+    R / r = :data:`MAX_SLENDERNESS` (circumscribed radius R over inradius r, about the
+    centroid)."""
     v = np.asarray(vertices, dtype=np.float64)
     if v.ndim != 2 or v.shape[1] != 2:
         return f"expected an (n, 2) array of vertices, got shape {v.shape}"
@@ -148,12 +159,21 @@ def polygon_problem(vertices) -> str | None:
     if np.any(np.all(edge == 0, axis=1)):
         return "two consecutive vertices are equal"
     before = np.roll(edge, 1, axis=0)
-    turn = before[:, 0] * edge[:, 1] - before[:, 1] * edge[:, 0]
-    if np.all(turn < 0):
+    if np.all(before[:, 0] * edge[:, 1] - before[:, 1] * edge[:, 0] < 0):
         return "the vertices run clockwise, expected counter-clockwise"
-    winding = np.sum(np.arctan2(turn, np.sum(before * edge, axis=1))) / (2 * np.pi)
-    if np.any(turn <= 0) or not np.isclose(winding, 1.0):
-        return "not convex (expected every corner to turn left, once around)"
+    not_convex = "not convex (expected every corner to turn left, once around)"
+    props = contract.polygon_properties(v[None])
+    if not props["area"][0] > 0:  # a convex counter-clockwise polygon encloses a positive area
+        return not_convex
+    centred = v - props["centroid"][0]
+    props = contract.polygon_properties(centred[None])
+    if contract.shape_problems(props["radius"], [len(v)], centred[None]):
+        return not_convex  # centred and sized as the contract asks, convexity is all it can find
+    slenderness = props["radius"][0] / props["inradius"][0]
+    if not slenderness <= MAX_SLENDERNESS:
+        return (f"too slender: its circumscribed radius is {slenderness:.3g} times its inradius (about the "
+                f"centroid), expected at most {MAX_SLENDERNESS:g} (thinner polygons let walls and particles pass "
+                "through one another)")
     return None
 
 
@@ -223,8 +243,8 @@ class Shapes:
         computed polygon by polygon from its own vertices, so that the same vertices give the
         same tables bit for bit (a run resumed from its file). The vertices are kept as given
         (:meth:`body_vertices`, what a file stores). Raises :class:`ParameterError` naming the
-        first polygon that is not convex and counter-clockwise (:func:`polygon_problem`) or
-        whose centroid is off the origin."""
+        first polygon that is not convex and counter-clockwise or more slender than
+        :data:`MAX_SLENDERNESS` (:func:`polygon_problem`), or whose centroid is off the origin."""
         n_bodies = len(polygons)
         n_vertices = np.zeros(n_bodies, np.int32)
         radius, inner = np.zeros(n_bodies), np.zeros(n_bodies)

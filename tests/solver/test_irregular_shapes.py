@@ -18,7 +18,8 @@ from solver.output import Recorder
 from solver.restart import load_sample, load_state, resume
 from solver.shape_families import (IRREGULAR, check_shape, random_convex_polygons, read_polygons, sample_shapes,
                                    shape_label)
-from solver.shapes import Shapes, polygon_problem
+from solver.preparation import preparation, prepare_sample
+from solver.shapes import MAX_SLENDERNESS, Shapes, polygon_problem
 
 from .conftest import EXACT, G
 
@@ -114,6 +115,62 @@ def test_polygon_problems_are_named(vertices, words):
         Shapes.convex([vertices])
 
 
+def _rectangle(aspect):
+    """A rectangle ``aspect`` x 1 about its centroid: R/r = hypot(aspect, 1) (r = 1/2)."""
+    a = aspect / 2
+    return [[-a, -0.5], [a, -0.5], [a, 0.5], [-a, 0.5]]
+
+
+def test_slender_polygons_are_refused_beyond_the_limit():
+    # rectangle a x 1: R = hypot(a, 1)/2 and r = 1/2 about the centroid, so R/r = hypot(a, 1);
+    # isosceles triangle of base b and height 1: r = 1/3 (to the base), R = hypot(b/2, 1/3)
+    fine = np.sqrt(MAX_SLENDERNESS ** 2 - 1) * (1 - 1e-9)
+    assert polygon_problem(_rectangle(fine)) is None
+    too = np.sqrt(MAX_SLENDERNESS ** 2 - 1) * (1 + 1e-9)
+    assert "too slender" in polygon_problem(_rectangle(too))
+    assert f"{np.hypot(50, 1):.3g} times its inradius" in polygon_problem(_rectangle(50))
+    sliver = [[-25, 0], [25, 0], [0, 1]]  # the review's 50:1 sliver: R/r = 3 hypot(25, 1/3) = 75
+    assert "is 75 times its inradius" in polygon_problem(sliver) and "expected at most 10 " in polygon_problem(sliver)
+    with pytest.raises(ParameterError, match="polygon 1: too slender"):
+        Shapes.convex([0.01, np.array(sliver) - [0, 1 / 3]])
+
+
+@pytest.mark.parametrize("vertices", [
+    [[0, 0], [1, 0], [1, 1], [0, 1]],
+    [[0, 0], [2, 0], [1, 0.2], [1, 2]],
+    [[0, 0], [1, 0], [2, 0], [1, 1]],
+    [[np.cos(a), np.sin(a)] for a in 4 * np.pi * np.arange(5) / 5],
+    [[0, 0], [4, 0], [4.5, 0.5], [4, 1], [0, 1]],
+    [[0, 0], [4, 0], [3.5, 0.5], [4, 1], [0, 1]],
+])
+def test_the_solver_and_the_contract_agree_on_convexity(vertices):
+    v = np.array(vertices, float)
+    v = v - contract.polygon_properties(v[None])["centroid"][0]
+    radius = contract.polygon_properties(v[None])["radius"]
+    assert (polygon_problem(v) is None) == (contract.shape_problems(radius, [len(v)], v[None]) == [])
+
+
+def test_a_too_slender_file_is_refused_before_anything_runs(tmp_path):
+    path = _write(tmp_path, [_rectangle(20)])
+    with pytest.raises(ParameterError, match=r"shapes.json: polygon 0: too slender: .* 20 times its inradius"):
+        prepare_sample(preparation("fast", shape=path, particles=10))
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["shapes.json"]
+
+
+def test_a_slender_but_accepted_rectangle_compacts_without_crossing(tmp_path):
+    # 9 x 1 rectangles (R/r = 9.06): the compaction keeps every grain inside the box and every
+    # interpenetration far below the inradius
+    sim = prepare_sample(preparation("fast", shape=_write(tmp_path, [_rectangle(9)]), particles=12, max_steps=1500))
+    assert sim.compaction_steps > 0
+    n, points = sim.n_particles, sim.detect()
+    inner = sim.shapes.inradius
+    np.testing.assert_allclose(sim.radius / inner, np.hypot(9, 1), rtol=1e-12)
+    depth = -points.gap / inner[points.body_i]
+    assert depth.max() < 0.01
+    low, high = sim.walls.point.min(0), sim.walls.point.max(0)
+    assert np.all((sim.position > low) & (sim.position < high))
+
+
 def test_the_irregular_family_is_convex_centred_unit_and_seeded():
     polygons = random_convex_polygons(200, np.random.default_rng(3))
     counts = np.array([len(v) for v in polygons])
@@ -142,6 +199,8 @@ def _write(folder, polygons, name="shapes.json"):
     ({"polygons": [[[0, 0], [0, 1], [1, 0]]]}, "polygon 0: the vertices run clockwise"),
     ({"polygons": [[[0, 0], [1, 0], [0, 1]], [[0, 0], [1, 0]]]}, "polygon 1: 2 vertices, expected at least 3"),
     ({"polygons": [[[0, 0], [2, 0], [1, 0.2], [1, 2]]]}, "polygon 0: not convex"),
+    # 2 m wide, 1e-12 m high: R/r = 3e12 (the walls ran through such grains to an 8e12 m box)
+    ({"polygons": [[[0, 0], [1, 0], [0, 1]], [[-1, 0], [1, 0], [0, 1e-12]]]}, "polygon 1: too slender"),
     ({"polygons": [[[0, 0], ["a", 0], [1, 1]]]}, "polygon 0 is not a list of [x, y] pairs"),
     ({"polygons": []}, "no list of polygons"),
     ({"shapes": 1}, "no list of polygons"),

@@ -642,13 +642,16 @@ def test_extreme_configurations_stay_finite():
 
 
 def _random_convex(rng, size):
-    """A random convex polygon (4-9 vertices, counter-clockwise) with its centroid at the origin."""
+    """A random convex polygon (4-9 vertices, counter-clockwise) with its centroid at the origin,
+    no more slender than the solver accepts (``solver.shapes.polygon_problem``)."""
     from scipy.spatial import ConvexHull
+
+    from solver.shapes import polygon_problem
 
     while True:
         cloud = rng.normal(size=(rng.integers(5, 12), 2)) * size * rng.uniform(0.5, 1.5, 2)
         hull = cloud[ConvexHull(cloud).vertices]
-        if len(hull) >= 4:
+        if len(hull) >= 4 and polygon_problem(hull) is None:
             break
     x, y = hull[:, 0], hull[:, 1]
     cross = x * np.roll(y, -1) - y * np.roll(x, -1)
