@@ -291,10 +291,9 @@ def animate_chains(data, path, every: int = 1, fps: int = 8, angle: float = 45.0
     """
     import matplotlib.pyplot as plt
 
-    from ..export import snapshot_indices, write_atomically
+    from ..export import snapshot_indices
     from ..force_chains import force_chains
-    from ..strain import strains
-    from .movies import _writer
+    from .movies import _writer, frame_title, save_frames
 
     if os.path.exists(path) and not overwrite:  # before any drawing
         raise ParameterError(f"{path} exists; pass overwrite=True to replace it")
@@ -303,27 +302,13 @@ def animate_chains(data, path, every: int = 1, fps: int = 8, angle: float = 45.0
     frames = snapshot_indices(ds, every)
     shown = ds.isel(time=frames)
     chains = force_chains(shown, angle=angle, min_size=min_size).compute()
-    eps_q = np.asarray(strains(ds)["eps_q"].values, float) if {"box_min", "box_max"} <= set(ds.variables) else None
-    times = np.asarray(ds["time"].values, float)
+    title = frame_title(ds)
     fig, ax = plt.subplots(figsize=(5, 7))
-    rows = list(enumerate(frames))
-    if progress:
-        from tqdm.auto import tqdm
 
-        rows = tqdm(rows, desc="movie (force chains)", unit="frame")
+    def draw(row, k):
+        ax.clear()
+        plot_chain_map(shown, ax=ax, time=row, chains=chains, title=False)
+        ax.set_title(f"{title(k)}: {int(chains['n_chains'][row])} chains", fontsize="small")
 
-    def frames_to(temporary):
-        with writer.saving(fig, temporary, dpi):
-            for row, k in rows:
-                ax.clear()
-                plot_chain_map(shown, ax=ax, time=row, chains=chains, title=False)
-                strain = f"$\\varepsilon_q$ = {eps_q[k]:.3f}, " if eps_q is not None else ""
-                ax.set_title(f"{strain}t = {times[k]:.3g} s (snapshot {int(k)}): "
-                             f"{int(chains['n_chains'][row])} chains", fontsize="small")
-                writer.grab_frame()
-
-    try:
-        write_atomically(str(path), overwrite, frames_to)
-    finally:
-        plt.close(fig)
-    return str(path)
+    return save_frames(fig, path, writer, frames, draw, dpi=dpi, progress=progress, overwrite=overwrite,
+                       desc="movie (force chains)")

@@ -35,6 +35,49 @@ def _writer(path, fps):
     raise ParameterError(f"{path}: expected a .gif or .mp4 file name")
 
 
+def frame_title(ds):
+    """A function of a snapshot index k giving a frame's title: "eps_q = ..., t = ... s
+    (snapshot k)" (eps_q from the boxes, left out when the dataset has none)."""
+    from ..strain import strains
+
+    eps_q = np.asarray(strains(ds)["eps_q"].values, float) if {"box_min", "box_max"} <= set(ds.variables) else None
+    times = np.asarray(ds["time"].values, float)
+
+    def title(k: int) -> str:
+        strain = f"$\\varepsilon_q$ = {eps_q[k]:.3f}, " if eps_q is not None else ""
+        return f"{strain}t = {times[k]:.3g} s (snapshot {k})"
+
+    return title
+
+
+def save_frames(fig, path, writer, frames, draw, *, dpi, progress, overwrite, desc) -> str:
+    """Draw ``draw(row, k)`` for each snapshot index k of ``frames`` (row its position) on
+    ``fig``, grab each as a frame of ``writer``, and write the movie to ``path`` atomically
+    (:func:`grainview.export.write_atomically`); ``fig`` is closed in any case. Returns
+    ``str(path)``."""
+    import matplotlib.pyplot as plt
+
+    from ..export import write_atomically
+
+    rows = list(enumerate(frames))
+    if progress:
+        from tqdm.auto import tqdm
+
+        rows = tqdm(rows, desc=desc, unit="frame")
+
+    def frames_to(temporary):
+        with writer.saving(fig, temporary, dpi):
+            for row, k in rows:
+                draw(row, int(k))
+                writer.grab_frame()
+
+    try:
+        write_atomically(str(path), overwrite, frames_to)
+    finally:
+        plt.close(fig)
+    return str(path)
+
+
 def animate(data, path, kind: str = "force_chains", every: int = 1, fps: int = 8, walls: bool = False,
             max_linewidth: float = 3.0, dpi: int = 90, progress: bool = True, overwrite: bool = False) -> str:
     """Write a movie of every ``every``-th snapshot (and the last) to ``path`` (.gif or .mp4).
@@ -87,8 +130,7 @@ def animate(data, path, kind: str = "force_chains", every: int = 1, fps: int = 8
     """
     import matplotlib.pyplot as plt
 
-    from ..export import snapshot_indices, write_atomically
-    from ..strain import strains
+    from ..export import snapshot_indices
     from .maps import plot_force_chains, plot_force_classes, plot_particles
 
     if kind not in KINDS:
@@ -98,8 +140,7 @@ def animate(data, path, kind: str = "force_chains", every: int = 1, fps: int = 8
     writer = _writer(path, fps)
     _, ds = single_dataset(data)
     frames = snapshot_indices(ds, every)
-    eps_q = np.asarray(strains(ds)["eps_q"].values, float) if {"box_min", "box_max"} <= set(ds.variables) else None
-    times = np.asarray(ds["time"].values, float)
+    title = frame_title(ds)
     force_scale = float(ds["fn"].where(selection(ds, walls=walls)).isel(time=frames).max())
     fig, ax = plt.subplots(figsize=(5, 7) if kind == "connectivity" else (7.5, 7))
     if kind != "connectivity":
@@ -116,29 +157,16 @@ def animate(data, path, kind: str = "force_chains", every: int = 1, fps: int = 8
         norm = mpl.colors.BoundaryNorm(np.arange(-0.5, top + 1.5), ncolors=mpl.colormaps[cmap].N)
         fig.colorbar(mpl.cm.ScalarMappable(norm=norm, cmap=cmap), ax=ax, ticks=np.arange(top + 1),
                      label="contacts c")
-    iterator = list(enumerate(frames))
-    if progress:
-        from tqdm.auto import tqdm
 
-        iterator = tqdm(iterator, desc=f"movie ({kind})", unit="frame")
-    def frames_to(temporary):
-        with writer.saving(fig, temporary, dpi):
-            for row, k in iterator:
-                ax.clear()
-                k = int(k)
-                if kind == "force_chains":
-                    plot_force_chains(ds, ax=ax, time=k, walls=walls, max_linewidth=max_linewidth,
-                                      force_scale=force_scale)
-                elif kind == "force_classes":
-                    plot_force_classes(ds, ax=ax, time=k, walls=walls)
-                else:
-                    plot_particles(ds, ax=ax, time=k, values=contacts[row], cmap=cmap, norm=norm)
-                strain = f"$\\varepsilon_q$ = {eps_q[k]:.3f}, " if eps_q is not None else ""
-                ax.set_title(f"{strain}t = {times[k]:.3g} s (snapshot {k})", fontsize="small")
-                writer.grab_frame()
+    def draw(row, k):
+        ax.clear()
+        if kind == "force_chains":
+            plot_force_chains(ds, ax=ax, time=k, walls=walls, max_linewidth=max_linewidth, force_scale=force_scale)
+        elif kind == "force_classes":
+            plot_force_classes(ds, ax=ax, time=k, walls=walls)
+        else:
+            plot_particles(ds, ax=ax, time=k, values=contacts[row], cmap=cmap, norm=norm)
+        ax.set_title(title(k), fontsize="small")
 
-    try:
-        write_atomically(str(path), overwrite, frames_to)
-    finally:
-        plt.close(fig)
-    return str(path)
+    return save_frames(fig, path, writer, frames, draw, dpi=dpi, progress=progress, overwrite=overwrite,
+                       desc=f"movie ({kind})")
