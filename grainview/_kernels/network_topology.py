@@ -155,23 +155,10 @@ def cycle_counts(n_nodes, u, v, strong):
     start, neighbour, edge = _adjacency(n_nodes, u, v)
     triangles = np.zeros(4, np.int64)
     squares = np.zeros(5, np.int64)
-    # 3-cycles a < b < c: for each edge (a, b), the common neighbours c > b (a merge of two sorted lists)
-    for e in range(u.size):
-        a = min(u[e], v[e])
-        b = max(u[e], v[e])
-        p = start[a]
-        q = start[b]
-        while p < start[a + 1] and q < start[b + 1]:
-            if neighbour[p] < neighbour[q]:
-                p += 1
-            elif neighbour[p] > neighbour[q]:
-                q += 1
-            else:
-                c = neighbour[p]
-                if c > b:
-                    triangles[strong[e] + strong[edge[p]] + strong[edge[q]]] += 1
-                p += 1
-                q += 1
+    # 3-cycles: every triangle once, by its three edges (_triangles)
+    found = _triangles(n_nodes, u, v)
+    for row in range(found.shape[0]):
+        triangles[strong[found[row, 0]] + strong[found[row, 1]] + strong[found[row, 2]]] += 1
     # chordless 4-cycles a - m1 - c - m2 - a: for each node a and each c > a not adjacent to a,
     # the 2-paths a - m - c; two of them whose middles are not adjacent close such a cycle.
     # Each cycle has two diagonals, both non-edges, and is met once from each: counted twice.
