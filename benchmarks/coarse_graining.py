@@ -30,7 +30,7 @@ import time
 import numpy as np
 
 sys.path.insert(0, os.path.dirname(__file__))
-from common import in_fresh_process, machine_description, markdown_table, median_time  # noqa: E402
+from common import in_fresh_process, machine_description, markdown_table, median_time, run_and_record  # noqa: E402
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 TARGET_S = 60.0  # 14,400 particles x 100 snapshots on a 200 x 100 grid
@@ -157,19 +157,9 @@ def run(quick=False):
 
 
 def main(argv=None):
-    """Run the benchmark (all of it, or ``--quick``) and write its results; any other argument is
-    refused by argparse in one line before anything runs."""
-    import argparse
-
-    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    parser.add_argument("--quick", action="store_true",
-                        help="a short run, printed only (benchmarks/RESULTS-coarse-graining.md is kept)")
-    quick = parser.parse_args(argv).quick
-    text = run(quick=quick)
-    print(text)
-    if not quick:
-        with open(os.path.join(HERE, "RESULTS-coarse-graining.md"), "w") as fh:
-            fh.write(text)
+    """Run the benchmark (all of it, or ``--quick``) and write its results
+    (:func:`common.run_and_record`)."""
+    run_and_record(__doc__.split("\n\n")[0], run, "RESULTS-coarse-graining.md", argv)
 
 
 if __name__ == "__main__":

@@ -165,3 +165,21 @@ def write_results(path: str, title: str, intro: str, sections: list) -> str:
         f.write(text)
     print(text)
     return text
+
+
+def run_and_record(description: str, run, results_name: str, argv=None) -> None:
+    """The command line of a benchmark whose ``run(quick=...)`` returns its results as text:
+    ``--quick`` runs a short version and prints it only; without it the text is printed and
+    written to ``benchmarks/<results_name>``. Any other argument (``--help`` included) is
+    answered by argparse before anything is measured."""
+    import argparse
+
+    parser = argparse.ArgumentParser(description=description)
+    parser.add_argument("--quick", action="store_true", help=f"a short run, printed only (benchmarks/{results_name} "
+                        "is kept)")
+    quick = parser.parse_args(argv).quick
+    text = run(quick=quick)
+    print(text)
+    if not quick:
+        with open(os.path.join(os.path.dirname(os.path.abspath(__file__)), results_name), "w") as fh:
+            fh.write(text)

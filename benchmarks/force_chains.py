@@ -24,7 +24,7 @@ import time
 import numpy as np
 
 sys.path.insert(0, os.path.dirname(__file__))
-from common import in_fresh_process, machine_description, markdown_table, median_time  # noqa: E402
+from common import in_fresh_process, machine_description, markdown_table, median_time, run_and_record  # noqa: E402
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 TARGET = 1e6  # contacts per second
@@ -135,19 +135,9 @@ def run(quick=False):
 
 
 def main(argv=None):
-    """Run the benchmark (all of it, or ``--quick``) and write its results; any other argument is
-    refused by argparse in one line before anything runs."""
-    import argparse
-
-    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    parser.add_argument("--quick", action="store_true",
-                        help="a short run, printed only (benchmarks/RESULTS-force-chains.md is kept)")
-    quick = parser.parse_args(argv).quick
-    text = run(quick=quick)
-    print(text)
-    if not quick:
-        with open(os.path.join(HERE, "RESULTS-force-chains.md"), "w") as fh:
-            fh.write(text)
+    """Run the benchmark (all of it, or ``--quick``) and write its results
+    (:func:`common.run_and_record`)."""
+    run_and_record(__doc__.split("\n\n")[0], run, "RESULTS-force-chains.md", argv)
 
 
 if __name__ == "__main__":
