@@ -16,7 +16,7 @@ import numpy as np
 
 from ..contract.errors import FileFormatError
 
-__all__ = ["check_out", "write_snapshots"]
+__all__ = ["check_out", "write_snapshots", "snapshots_dataset"]
 
 
 def check_out(out, overwrite: bool) -> str:
@@ -32,6 +32,45 @@ def check_out(out, overwrite: bool) -> str:
     if not os.path.isdir(folder):
         raise FileFormatError(f"{out}: the folder {folder} does not exist")
     return out
+
+
+def snapshots_dataset(static, snaps, per_snapshot=(), **static_optional):
+    """A run read whole as an in-memory dataset of the contract (what ``open_<format>`` returns;
+    :func:`write_snapshots` is the same run written to a file snapshot by snapshot).
+
+    Parameters
+    ----------
+    static : dict
+        The reader's static data: ``radius``, ``mass``, ``inertia`` (and ``n_vertices`` for
+        polygons; disks without it), ``n_walls``, ``wall_names``, ``attrs``.
+    snaps : list of dict
+        One dict per snapshot: ``time``, ``position``, ``box_min``, ``box_max``, ``contacts``
+        and, where every snapshot has it, ``angle`` (zero otherwise).
+    per_snapshot : sequence of str
+        Optional contract variables stacked over the snapshots where every snapshot has them.
+    **static_optional
+        Optional variables without a time dimension (``vertices``, ``wall_normal``); None is
+        left out.
+
+    Returns
+    -------
+    xarray.Dataset
+        With as many contact slots as the planar bound or the fullest snapshot needs.
+    """
+    from ..contract.dataset import make_dataset
+    from ..contract.schema import contact_slots
+
+    optional = {name: np.stack([s[name] for s in snaps]) for name in per_snapshot if all(name in s for s in snaps)}
+    optional.update({name: value for name, value in static_optional.items() if value is not None})
+    n = static["radius"].size
+    slots = max([contact_slots(n, static["n_walls"])] + [len(s["contacts"]["i"]) for s in snaps])
+    angle = np.stack([s["angle"] for s in snaps]) if all("angle" in s for s in snaps) else None
+    return make_dataset(radius=static["radius"], n_vertices=static.get("n_vertices"), mass=static["mass"],
+                        inertia=static["inertia"], position=np.stack([s["position"] for s in snaps]), angle=angle,
+                        contacts=[s["contacts"] for s in snaps], box_min=np.stack([s["box_min"] for s in snaps]),
+                        box_max=np.stack([s["box_max"] for s in snaps]), time=np.array([s["time"] for s in snaps]),
+                        n_walls=static["n_walls"], wall_names=static["wall_names"], attrs=static["attrs"],
+                        n_contact_slots=slots, **optional)
 
 
 def write_snapshots(out, static, snapshots, optional, *, overwrite=False, compress=True, progress=False,

@@ -51,7 +51,6 @@ import warnings
 import numpy as np
 
 from ..contract.errors import FileFormatError, ParameterError
-from ..contract.schema import contact_slots
 from .lammps_dump import LammpsLog, iter_dump, read_log
 
 __all__ = ["lammps_snapshots", "open_lammps", "convert_lammps", "WALL_NAMES", "PARTICLE_COLUMNS", "PAIR_COLUMNS"]
@@ -440,7 +439,7 @@ def open_lammps(particles, contacts, walls=None, *, log=None, time_step=None, co
         with ``velocity`` and ``angular_velocity`` when the particles' dump has them, and
         ``step``.
     """
-    from ..contract.dataset import make_dataset
+    from .convert import snapshots_dataset
 
     static, stream = lammps_snapshots(particles, contacts, walls, log=log, time_step=time_step, columns=columns,
                                       inertia=inertia)
@@ -450,17 +449,7 @@ def open_lammps(particles, contacts, walls=None, *, log=None, time_step=None, co
         stream = tqdm(stream, desc="lammps", unit=" snapshots")
     snaps = list(stream)
     _warn_tensile(sum(s["tensile"] for s in snaps), len(snaps))
-    optional = {"step": np.array([s["step"] for s in snaps], "i4")}
-    for name in ("velocity", "angular_velocity"):
-        if all(name in s for s in snaps):
-            optional[name] = np.stack([s[name] for s in snaps])
-    n = static["radius"].size
-    slots = max([contact_slots(n, static["n_walls"])] + [len(s["contacts"]["i"]) for s in snaps])
-    return make_dataset(radius=static["radius"], mass=static["mass"], inertia=static["inertia"],
-                        position=np.stack([s["position"] for s in snaps]), contacts=[s["contacts"] for s in snaps],
-                        box_min=np.stack([s["box_min"] for s in snaps]), box_max=np.stack([s["box_max"] for s in snaps]),
-                        time=np.array([s["time"] for s in snaps]), n_walls=static["n_walls"],
-                        wall_names=static["wall_names"], attrs=static["attrs"], n_contact_slots=slots, **optional)
+    return snapshots_dataset(static, snaps, ("step", "velocity", "angular_velocity"))
 
 
 def _warn_tensile(count, snapshots):

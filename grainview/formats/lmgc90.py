@@ -417,7 +417,7 @@ def open_lmgc90(run, *, progress=False):
         ``wall_force``. For a run too large for memory, :func:`convert_lmgc90` writes a file
         snapshot by snapshot instead.
     """
-    from ..contract.dataset import make_dataset
+    from .convert import snapshots_dataset
 
     static, stream = lmgc90_snapshots(run)
     if progress:
@@ -425,20 +425,9 @@ def open_lmgc90(run, *, progress=False):
 
         stream = tqdm(stream, desc="lmgc90", unit=" snapshots")
     snaps = list(stream)
-    optional = {"step": np.array([s["step"] for s in snaps], "i4"),
-                "velocity": np.stack([s["velocity"] for s in snaps]),
-                "angular_velocity": np.stack([s["angular_velocity"] for s in snaps])}
-    if static["n_walls"]:
-        optional["wall_force"] = np.stack([s["wall_force"] for s in snaps])
-    if static["vertices"] is not None:
-        optional["vertices"] = static["vertices"]
-    return make_dataset(radius=static["radius"], n_vertices=static["n_vertices"], mass=static["mass"],
-                        inertia=static["inertia"], position=np.stack([s["position"] for s in snaps]),
-                        angle=np.stack([s["angle"] for s in snaps]), contacts=[s["contacts"] for s in snaps],
-                        box_min=np.stack([s["box_min"] for s in snaps]),
-                        box_max=np.stack([s["box_max"] for s in snaps]),
-                        time=np.array([s["time"] for s in snaps]), n_walls=static["n_walls"],
-                        wall_names=static["wall_names"], attrs=static["attrs"], **optional)
+    walls = ("wall_force",) if static["n_walls"] else ()
+    return snapshots_dataset(static, snaps, ("step", "velocity", "angular_velocity", *walls),
+                             vertices=static["vertices"])
 
 
 def convert_lmgc90(out, run, *, overwrite=False, compress=True, progress=False):

@@ -49,7 +49,6 @@ import warnings
 import numpy as np
 
 from ..contract.errors import FileFormatError, ParameterError
-from ..contract.schema import contact_slots
 from .mercurydpm_text import iter_data, iter_fstat, read_restart
 
 __all__ = ["mercurydpm_snapshots", "open_mercurydpm", "convert_mercurydpm", "unit_scales", "BOX_WALLS"]
@@ -380,7 +379,7 @@ def open_mercurydpm(data, fstat=None, restart=None, *, units=None, progress=Fals
         A dataset of the contract (docs/schema.md; the conversion's rules: docs/formats.md)
         with ``velocity``, ``angular_velocity``, ``gap`` and, with walls, ``wall_force``.
     """
-    from ..contract.dataset import make_dataset
+    from .convert import snapshots_dataset
 
     static, stream = mercurydpm_snapshots(data, fstat, restart, units=units)
     if progress:
@@ -389,21 +388,9 @@ def open_mercurydpm(data, fstat=None, restart=None, *, units=None, progress=Fals
         stream = tqdm(stream, desc="mercurydpm", unit=" snapshots")
     snaps = list(stream)
     _warn_tensile(sum(s["tensile"] for s in snaps), len(snaps))
-    optional = {"velocity": np.stack([s["velocity"] for s in snaps]),
-                "angular_velocity": np.stack([s["angular_velocity"] for s in snaps])}
-    if static["n_walls"]:
-        optional["wall_force"] = np.stack([s["wall_force"] for s in snaps])
-    if static["wall_normal"] is not None:
-        optional["wall_normal"] = static["wall_normal"]
-    n = static["radius"].size
-    slots = max([contact_slots(n, static["n_walls"])] + [len(s["contacts"]["i"]) for s in snaps])
-    return make_dataset(radius=static["radius"], mass=static["mass"], inertia=static["inertia"],
-                        position=np.stack([s["position"] for s in snaps]),
-                        angle=np.stack([s["angle"] for s in snaps]), contacts=[s["contacts"] for s in snaps],
-                        box_min=np.stack([s["box_min"] for s in snaps]),
-                        box_max=np.stack([s["box_max"] for s in snaps]), time=np.array([s["time"] for s in snaps]),
-                        n_walls=static["n_walls"], wall_names=static["wall_names"], attrs=static["attrs"],
-                        n_contact_slots=slots, **optional)
+    walls = ("wall_force",) if static["n_walls"] else ()
+    return snapshots_dataset(static, snaps, ("velocity", "angular_velocity", *walls),
+                             wall_normal=static["wall_normal"])
 
 
 def convert_mercurydpm(out, data, fstat=None, restart=None, *, units=None, overwrite=False, compress=True,

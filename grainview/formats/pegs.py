@@ -54,7 +54,6 @@ import warnings
 import numpy as np
 
 from ..contract.errors import FileFormatError, ParameterError
-from ..contract.schema import contact_slots
 
 __all__ = ["pegs_snapshots", "open_pegs", "convert_pegs", "read_adjacency", "read_positions", "WALL_NAMES",
            "EDGE_WALLS"]
@@ -374,23 +373,14 @@ def open_pegs(adjacency, positions, *, metres_per_pixel=None, force_unit_n=None,
         with ``wall_force`` and ``wall_normal``; the attribute ``pegs_pairs`` counts the pairs
         fitted on both disks and on one.
     """
-    from ..contract.dataset import make_dataset
+    from .convert import snapshots_dataset
 
     static, stream = pegs_snapshots(adjacency, positions, metres_per_pixel=metres_per_pixel,
                                     force_unit_n=force_unit_n, frame_interval_s=frame_interval_s,
                                     thickness_m=thickness_m, density_kg_m3=density_kg_m3)
     snaps = list(stream)
     _report(sum(s["tensile"] for s in snaps), len(snaps))
-    n = static["radius"].size
-    slots = max([contact_slots(n, static["n_walls"])] + [len(s["contacts"]["i"]) for s in snaps])
-    return make_dataset(radius=static["radius"], mass=static["mass"], inertia=static["inertia"],
-                        position=np.stack([s["position"] for s in snaps]),
-                        angle=np.stack([s["angle"] for s in snaps]), contacts=[s["contacts"] for s in snaps],
-                        box_min=np.stack([s["box_min"] for s in snaps]),
-                        box_max=np.stack([s["box_max"] for s in snaps]), time=np.array([s["time"] for s in snaps]),
-                        n_walls=static["n_walls"], wall_names=static["wall_names"], attrs=static["attrs"],
-                        n_contact_slots=slots, wall_force=np.stack([s["wall_force"] for s in snaps]),
-                        wall_normal=static["wall_normal"])
+    return snapshots_dataset(static, snaps, ("wall_force",), wall_normal=static["wall_normal"])
 
 
 def convert_pegs(out, adjacency, positions, *, metres_per_pixel=None, force_unit_n=None, frame_interval_s=1.0,
