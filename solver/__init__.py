@@ -15,7 +15,7 @@ __version__ = "0.1.0"
 
 _NAMES = {"biaxial_test": "scenes", "compaction_sample": "scenes", "gravity_scene": "scenes",
           "is_equilibrium": "scenes", "isotropic_compaction": "scenes", "wall_state": "scenes",
-          "load_sample": "restart", "resume": "restart", "Parameters": "stepper", "Simulation": "stepper",
+          "load_sample": "restart", "resume": "restart", "Parameters": "parameters", "Simulation": "stepper",
           "StepInfo": "stepper", "Walls": "walls"}
 
 

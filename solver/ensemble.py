@@ -95,7 +95,7 @@ class RunSpec:
             raise ParameterError(f"every={self.every!r}: expected a positive whole number of steps")
         if isinstance(self.seed, bool) or int(self.seed) != self.seed or self.seed < 0:
             raise ParameterError(f"seed={self.seed!r}: expected a whole number >= 0")
-        from .stepper import Parameters
+        from .parameters import Parameters
 
         try:
             parameters = Parameters(**dict(self.solver)).validate()

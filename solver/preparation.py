@@ -90,7 +90,7 @@ class Preparation:
         travel farther than the smallest particle radius of the paper's size mix
         (:func:`solver.stepper.check_time_step`)."""
         from .packing import PAPER_DIAMETERS
-        from .stepper import check_time_step
+        from .parameters import check_time_step
 
         smallest = 0.5 * min(PAPER_DIAMETERS)
         check_time_step(time_step, self.max_wall_speed, smallest, "a closing wall of the compaction")
@@ -222,7 +222,7 @@ def prepare_sample(prep: Preparation, progress=None, **parameters):
 
     sim = compaction_sample(prep.particles, prep.shape, sigma0=prep.sigma0, friction=compaction_friction,
                             seed=prep.seed, aspect=prep.aspect, max_wall_speed=prep.max_wall_speed, **parameters)
-    from .stepper import check_time_step
+    from .parameters import check_time_step
 
     check_time_step(sim.parameters.time_step, prep.max_wall_speed, float(sim.radius.min()),
                     "a closing wall of the compaction")

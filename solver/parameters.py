@@ -1,0 +1,235 @@
+"""Every physical and numerical setting of a simulation, in one place: the records, their
+defaults, units, help texts and validators.
+
+* :class:`Parameters`: the time stepper's settings (time step, friction, density, the contact
+  solver's tolerances and caps...); defaults are the paper's (Azema et al. 2007, Sec. II.B);
+* :class:`BiaxialTest`: the biaxial test of a prepared sample (strain, top wall speed,
+  snapshots);
+* :class:`solver.preparation.Preparation`: how a sample is made (its own module).
+
+Each field is declared with :func:`setting`: its default, a one-line help, its unit, and the
+check of its value with what is expected of it. The records validate themselves from these
+declarations (:func:`problems`, then the checks that relate several fields), and the command
+line (:mod:`grainview.cli`) derives its options, defaults and help from them
+(:func:`dataclasses.fields`), so that a setting is declared, defaulted and checked once.
+
+This module imports numpy and the contract's errors only: the command line reads it to build
+its options without loading a numba kernel.
+"""
+
+from __future__ import annotations
+
+from dataclasses import MISSING, dataclass, field, fields
+
+import numpy as np
+
+from grainview.contract.errors import ParameterError
+
+MAX_FRICTION = 10.0
+"""Largest accepted friction coefficient: measured ones lie below ~1.5, and 10 already makes
+every contact stick; a larger number is a typing mistake (1e9 for 1e-9?)."""
+
+ACCELERATIONS = ("off", "anderson")
+"""How the NLGS sweeps are combined: plain (``off``) or Anderson-extrapolated."""
+
+FRICTION_EXPECTED = f"in [0, {MAX_FRICTION:g}] (a Coulomb coefficient)"
+"""What a friction coefficient is expected to be, in every refusal of one."""
+
+
+def setting(default, help, *, unit="", check=None, expected="", choices=None, optional=False):
+    """A field of a settings record with what the validators and the command line need.
+
+    Parameters
+    ----------
+    default
+        The field's default value (a hashable constant).
+    help : str
+        One line saying what the setting is (the command line's help, without the default).
+    unit : str
+        The unit of the value (SI), "" for a number without one.
+    check : callable, optional
+        ``check(value) -> bool``: whether a value is acceptable on its own (relations between
+        fields are the record's ``validate``'s).
+    expected : str
+        What an acceptable value is, for the refusal ``name=value: expected ...``.
+    choices : callable, optional
+        ``choices() -> tuple``: the accepted names of a setting that is one of a list.
+    optional : bool
+        None is accepted (it means the default the help describes).
+    """
+    return field(default=default, metadata={"help": help, "unit": unit, "check": check, "expected": expected,
+                                            "choices": choices, "optional": optional})
+
+
+def problems(record) -> list[tuple[str, object, str]]:
+    """The fields of ``record`` whose value fails its own :func:`setting` check, as
+    ``(name, value, expected)``, in the order of the fields."""
+    out = []
+    for f in fields(record):
+        value, meta = getattr(record, f.name), f.metadata
+        if meta.get("optional") and value is None:
+            continue
+        choices = meta.get("choices")
+        if choices is not None:
+            ok = value in choices()
+            expected = meta.get("expected") or f"one of {choices()}"
+        else:
+            check = meta.get("check")
+            try:
+                ok = check is None or bool(check(value))
+            except (TypeError, ValueError):  # a value of the wrong kind (a string for a number...)
+                ok = False
+            expected = meta.get("expected", "")
+        if not ok:
+            out.append((f.name, value, expected))
+    return out
+
+
+def refusal(name, value, expected) -> str:
+    """The library's words for a refused value: ``name=value: expected ...``."""
+    return f"{name}={value!r}: expected {expected}"
+
+
+def default_of(record_type, name):
+    """The default of field ``name`` of the dataclass ``record_type``."""
+    f = next(f for f in fields(record_type) if f.name == name)
+    return f.default if f.default is not MISSING else f.default_factory()
+
+
+# -- the checks of single values -----------------------------------------------------------------
+def whole(value) -> bool:
+    """Whether ``value`` is a whole number (an int, a numpy integer or a float without a
+    fraction; not a bool)."""
+    return not isinstance(value, (bool, np.bool_)) and isinstance(value, (int, np.integer, float, np.floating)) \
+        and np.isfinite(value) and int(value) == value
+
+
+def positive(value) -> bool:
+    """A finite number > 0."""
+    return bool(np.isfinite(value) and value > 0)
+
+
+def coulomb(value) -> bool:
+    """A Coulomb friction coefficient in [0, :data:`MAX_FRICTION`]."""
+    return bool(np.isfinite(value) and 0 <= value <= MAX_FRICTION)
+
+
+def check_time_step(time_step, speed, smallest_radius, what="a wall"):
+    """Refuse a time step in which a body driven at ``speed`` (m s-1) moves farther than the
+    smallest particle radius ``smallest_radius`` (m): the contacts it meets during a step would
+    be found deep inside the particles, or missed. This is the bound at which the stepper's
+    detection distance is capped (:meth:`solver.stepper.Simulation.alert_for_step`), checked
+    once before any work instead of warned at every step. Raises :class:`ParameterError` naming
+    the largest time step allowed."""
+    speed = float(speed)
+    if not np.isfinite(speed) or speed <= 0:
+        return
+    travel = speed * float(time_step)
+    if travel > smallest_radius:
+        raise ParameterError(
+            f"time_step={time_step:g} s: {what} moving at {speed:g} m s-1 travels {travel:.3g} m per step, more "
+            f"than the smallest particle radius {smallest_radius:.3g} m, so contacts would be missed; expected "
+            f"time_step <= {smallest_radius / speed:.3g} s (the paper's is 5e-4 s)")
+
+
+@dataclass
+class Parameters:
+    """Numerical and physical parameters of the time stepper (:mod:`solver.stepper`);
+    defaults are the paper's (Sec. II.B). Each field's help, unit and check are its
+    :func:`setting`; :meth:`validate` is the one validator."""
+
+    time_step: float = setting(5e-4, "time step", unit="s", check=positive, expected="a positive number of seconds")
+    theta: float = setting(0.5, "theta of the Moreau-Jean scheme", check=lambda v: 0.5 <= v <= 1,
+                           expected="in [0.5, 1]")
+    friction: float = setting(0.4, "grain-grain friction coefficient", check=coulomb, expected=FRICTION_EXPECTED)
+    wall_friction: float = setting(0.0, "grain-wall friction coefficient", check=coulomb, expected=FRICTION_EXPECTED)
+    gravity: tuple = setting((0.0, 0.0), "gravity vector", unit="m s-2",
+                             check=lambda v: len(v) == 2 and bool(np.all(np.isfinite(v))),
+                             expected="a finite 2-vector in m s-2")
+    density: float = setting(2600.0, "density of the grains (not given in the paper; glass-like grains assumed)",
+                             unit="kg m-3", check=positive, expected="> 0 kg m-3")
+    thickness: float = setting(1.0, "slab thickness of the 2D sample", unit="m", check=positive, expected="> 0 m")
+    tolerance: float = setting(1.7e-4, "NLGS tolerance, quadratic norm of the velocity changes over a sweep "
+                               "(docs/solver.md)", check=positive, expected="> 0")
+    max_tolerance: float = setting(1e-2, "NLGS max norm: largest single change over the RMS", check=positive,
+                                   expected="> 0")
+    max_iterations: int = setting(2000, "cap of the NLGS sweeps of a step", check=lambda v: whole(v) and v >= 1,
+                                  expected=">= 1")
+    stall_sweeps: int = setting(0, "stop a step's NLGS when its quadratic norm has fallen less than 5% over this "
+                                "many sweeps (a step that would creep to the sweep cap; 0: never; docs/solver.md)",
+                                check=lambda v: whole(v) and v >= 0,
+                                expected="a whole number of sweeps >= 0 (0: no stall test)")
+    alert: float | None = setting(None, "alert distance (None: 2% of the smallest diameter)", unit="m",
+                                  check=positive, expected="a positive length in m", optional=True)
+    skin: float | None = setting(None, "broad-phase skin (None: 10% of the smallest diameter)", unit="m",
+                                 check=positive, expected="a positive length in m", optional=True)
+    shuffle: bool = setting(False, "random NLGS ordering (plain sweeps only: acceleration 'off')")
+    seed: int = setting(0, "seed of the random NLGS ordering")
+    acceleration: str = setting("anderson", "'anderson': Anderson-accelerated NLGS sweeps, the same local-law "
+                                "residual in less time per step than 'off', plain sweeps (docs/solver.md)",
+                                choices=lambda: ACCELERATIONS)
+    anderson_memory: int = setting(3, "past iterates combined by the Anderson extrapolation",
+                                   check=lambda v: whole(v) and 1 <= v <= 50, expected="an integer in 1..50")
+    anderson_period: int = setting(1, "NLGS sweeps between two Anderson extrapolations",
+                                   check=lambda v: whole(v) and 1 <= v <= 50, expected="an integer in 1..50")
+    domains: int = setting(1, "NLGS domains swept at once, one per core, and as many blocks of the narrow phase "
+                           "(1: the serial sweep; deterministic for a given number; combines with --acceleration; "
+                           "on free cores only; docs/solver.md)",
+                           check=lambda v: isinstance(v, (int, np.integer)) and not isinstance(v, bool)
+                           and 1 <= v <= 64, expected="an integer in 1..64")
+    overlap_recovery_speed: float = setting(1e-3, "cap of the split-impulse separation of overlaps", unit="m s-1",
+                                            check=lambda v: v >= 0, expected=">= 0 m s-1")
+    overlap_recovery_rate: float = setting(0.2, "fraction of an overlap removed per step, below the cap",
+                                           check=lambda v: 0 <= v <= 1, expected="in [0, 1]")
+    overlap_recovery_threshold: float = setting(1e-4, "fraction of the smallest diameter: smaller overlaps are left")
+    overlap_recovery_tolerance: float = setting(1e-2, "NLGS tolerance of the recovery pass (a correction, not "
+                                                "physics)")
+    overlap_recovery_iterations: int = setting(50, "sweep cap of the recovery pass")
+
+    def validate(self):
+        """The parameters themselves, checked: each field's own check (:func:`setting`), then
+        the relations between fields; one :class:`ParameterError` naming every bad value."""
+        bad = [refusal(*p) for p in problems(self)]
+        relations = [
+            ("stall_sweeps", not whole(self.stall_sweeps) or not whole(self.max_iterations)
+             or 2 * int(self.stall_sweeps) <= int(self.max_iterations),
+             f"at most max_iterations/2 = {_half(self.max_iterations)} (the first check only records the best "
+             "norm, so a stall can show at the second; 0: no stall test)"),
+            ("domains", self.domains == 1 or not self.shuffle,
+             "1 with shuffle (the domain-decomposed sweep has its own order)"),
+            ("shuffle", not self.shuffle or self.acceleration == "off",
+             "False with acceleration='anderson' (the random order is an option of the plain sweeps: "
+             "pass acceleration='off' with it)"),
+        ]
+        bad += [refusal(name, getattr(self, name), expected) for name, ok, expected in relations if not ok]
+        if bad:
+            raise ParameterError("invalid solver parameters: " + "; ".join(bad))
+        from .parallel_nlgs import warn_if_threads_sleep
+
+        warn_if_threads_sleep(self.domains)
+        return self
+
+
+def _half(value):
+    return int(value) // 2 if whole(value) else "?"
+
+
+@dataclass(frozen=True)
+class BiaxialTest:
+    """The biaxial test of a prepared sample (:func:`solver.scenes.biaxial_test`): the top wall
+    moves down at ``velocity`` until the vertical strain eps_1 = ln(1 + dh/h0) reaches
+    ``strain``, with a snapshot every ``every`` steps."""
+
+    strain: float = setting(0.2, "vertical strain eps_1 of the biaxial test (eps_q ~0.6, into the residual state)",
+                            check=lambda v: 0 < v < 1, expected="a vertical strain eps_1 in (0, 1)")
+    velocity: float = setting(0.01, "speed of the top wall (the paper's)", unit="m/s", check=positive,
+                              expected="a finite wall speed > 0 in m/s")
+    every: int = setting(200, "steps between snapshots", check=lambda v: whole(v) and v >= 1,
+                         expected="a positive whole number of steps between snapshots")
+
+    def validate(self):
+        """The test itself, checked: one :class:`ParameterError` naming every bad value."""
+        bad = problems(self)
+        if bad:
+            raise ParameterError("; ".join(refusal(*p) for p in bad))
+        return self
