@@ -131,12 +131,118 @@ class ContactPoints(NamedTuple):
 
 
 # ----------------------------------------------------------------------------------------
-# geometry of one pair; each writes up to two points into slot c of the scratch arrays and
-# returns how many. Normal: from the first body (a) to the second (b).
+# the records the kernels pass: one per concept, each a named tuple of arrays (numba reads a
+# field as it reads a loose argument)
+# ----------------------------------------------------------------------------------------
+
+class PlacedShapes(NamedTuple):
+    """The bodies where they stand: centres, rotations and the shape table
+    (:class:`solver.shapes.Shapes`), N bodies owning V vertices in all.
+
+    pos : float64 (N, 2) — centres, m.
+    angle : float64 (N,) — rotations, rad.
+    radius : float64 (N,) — circumscribed radii, m (a disk's radius).
+    n_vertices : int32 (N,) — 0 for a disk, n >= 3 for a polygon.
+    first_vertex : int64 (N + 1,) — body b owns the vertices first_vertex[b]:first_vertex[b + 1].
+    vertex_radius : float64 (V,) — distance of each vertex from its body's centre, m.
+    vertex_angle : float64 (V,) — polar angle of each vertex from its body's rotation, rad.
+    normal_angle : float64 (V,) — polar angle of the outward unit normal of edge k (vertex
+        k -> k + 1) from its body's rotation, rad.
+    """
+
+    pos: np.ndarray
+    angle: np.ndarray
+    radius: np.ndarray
+    n_vertices: np.ndarray
+    first_vertex: np.ndarray
+    vertex_radius: np.ndarray
+    vertex_angle: np.ndarray
+    normal_angle: np.ndarray
+
+
+class Outlines(NamedTuple):
+    """What the pair kernels read of each body: centre, size and outline in the world frame
+    (:func:`_polygon_geometry`), maxn the largest vertex count (at least 1).
+
+    pos : float64 (N, 2) — centres, m.
+    radius : float64 (N,) — circumscribed radii, m.
+    nvert : int32 (N,) — vertex count, 0 for a disk.
+    verts : float64 (N, maxn, 2) — world vertices of each polygon, counter-clockwise, m
+        (rows from nvert on are unused).
+    norms : float64 (N, maxn, 2) — outward unit normal of edge k (vertex k -> k + 1).
+    """
+
+    pos: np.ndarray
+    radius: np.ndarray
+    nvert: np.ndarray
+    verts: np.ndarray
+    norms: np.ndarray
+
+
+class WallLines(NamedTuple):
+    """The walls as detection sees them, W lines.
+
+    point : float64 (W, 2) — a point of each wall line, m.
+    normal : float64 (W, 2) — each wall's unit normal, pointing into the sample.
+    """
+
+    point: np.ndarray
+    normal: np.ndarray
+
+
+class Candidates(NamedTuple):
+    """The broad phase's candidates (:mod:`solver.broadphase`): M particle pairs and K
+    particle-wall pairs; candidate c < M is the pair c, candidate M + k the wall pair k.
+
+    pi, pj : int32 (M,) — the two particles of each pair (any order, pi != pj).
+    wp, ww : int32 (K,) — the particle and the wall of each wall pair.
+    """
+
+    pi: np.ndarray
+    pj: np.ndarray
+    wp: np.ndarray
+    ww: np.ndarray
+
+
+class Slots(NamedTuple):
+    """Scratch of :func:`_detect_kernel`: one slot per candidate c (M + K of them), written
+    only by c in pass 1 and read in pass 2; the normal points from the first body to the second.
+
+    count : int64 (M + K,) — the points kept of c: 1 or 2, 0 when its nearest gap exceeds alert.
+    normal : float64 (M + K, 2) — unit normal of c.
+    point : float64 (M + K, 2, 2) — its one or two points, m.
+    gap : float64 (M + K, 2) — their gaps, m (negative = interpenetration).
+    kind : int8 (M + K,) — KIND_SIMPLE or KIND_DOUBLE.
+    offsets : int64 (M + K + 1,) — the output row of c's first point (prefix sum of count).
+    pair_offsets : int64 (M + K + 1,) — the contact index of c (prefix sum of count > 0).
+    """
+
+    count: np.ndarray
+    normal: np.ndarray
+    point: np.ndarray
+    gap: np.ndarray
+    kind: np.ndarray
+    offsets: np.ndarray
+    pair_offsets: np.ndarray
+
+
+# ----------------------------------------------------------------------------------------
+# geometry of one pair; each writes up to two points into slot c of the scratch ``slots``
+# and returns how many. Normal: from the first body (a) to the second (b).
 # ----------------------------------------------------------------------------------------
 
 @njit(cache=True)
-def _disk_disk(xa, ya, ra, xb, yb, rb, c, normal, point, gap):
+def _disk_disk(a, b, bodies, c, slots):
+    """Contact of disks a and b (module doc); normal from a to b."""
+    xa = bodies.pos[a, 0]
+    ya = bodies.pos[a, 1]
+    ra = bodies.radius[a]
+    xb = bodies.pos[b, 0]
+    yb = bodies.pos[b, 1]
+    rb = bodies.radius[b]
+    normal = slots.normal
+    point = slots.point
+    gap = slots.gap
     dx = xb - xa
     dy = yb - ya
     dist = math.sqrt(dx * dx + dy * dy)
@@ -156,7 +262,18 @@ def _disk_disk(xa, ya, ra, xb, yb, rb, c, normal, point, gap):
 
 
 @njit(cache=True)
-def _disk_wall(x, y, r, px, py, wnx, wny, c, normal, point, gap):
+def _disk_wall(p, w, bodies, walls, c, slots):
+    """Contact of disk p with wall w (module doc); normal from the disk to the wall."""
+    x = bodies.pos[p, 0]
+    y = bodies.pos[p, 1]
+    r = bodies.radius[p]
+    px = walls.point[w, 0]
+    py = walls.point[w, 1]
+    wnx = walls.normal[w, 0]
+    wny = walls.normal[w, 1]
+    normal = slots.normal
+    point = slots.point
+    gap = slots.gap
     s = (x - px) * wnx + (y - py) * wny  # signed distance of the centre to the wall line
     g = s - r
     normal[c, 0] = -wnx
@@ -168,8 +285,15 @@ def _disk_wall(x, y, r, px, py, wnx, wny, c, normal, point, gap):
 
 
 @njit(cache=True)
-def _polygon_block(lo, hi, pos, angle, nvert, first_vertex, vertex_radius, vertex_angle, normal_angle, verts, norms):
+def _polygon_block(lo, hi, placed, verts, norms):
     """The world vertices and edge normals of particles lo..hi-1 (:func:`_polygon_geometry`)."""
+    pos = placed.pos
+    angle = placed.angle
+    nvert = placed.n_vertices
+    first_vertex = placed.first_vertex
+    vertex_radius = placed.vertex_radius
+    vertex_angle = placed.vertex_angle
+    normal_angle = placed.normal_angle
     for p in range(lo, hi):
         s = first_vertex[p]
         for k in range(nvert[p]):
@@ -182,41 +306,43 @@ def _polygon_block(lo, hi, pos, angle, nvert, first_vertex, vertex_radius, verte
 
 
 @njit(cache=True, parallel=True)
-def _polygon_blocks(chunks, pos, angle, nvert, first_vertex, vertex_radius, vertex_angle, normal_angle, verts, norms):
+def _polygon_blocks(chunks, placed, verts, norms):
     """:func:`_polygon_block` over ``chunks`` consecutive blocks of particles at once (a thread each)."""
-    n = pos.shape[0]
+    n = placed.pos.shape[0]
     for d in prange(chunks):
-        _polygon_block(n * d // chunks, n * (d + 1) // chunks, pos, angle, nvert, first_vertex, vertex_radius,
-                       vertex_angle, normal_angle, verts, norms)
+        _polygon_block(n * d // chunks, n * (d + 1) // chunks, placed, verts, norms)
 
 
 @njit(cache=True)
-def _polygon_geometry(pos, angle, nvert, first_vertex, vertex_radius, vertex_angle, normal_angle, chunks=1):
-    """World vertices (N, maxn, 2) and outward unit edge normals (N, maxn, 2) of every polygon
-    from the shape table (:class:`solver.shapes.Shapes`): vertex k at the polar angle
-    angle + vertex_angle[k] and distance vertex_radius[k], the normal of edge k (vertex k -> k+1)
-    at angle + normal_angle[k]. With ``chunks`` > 1 the particles are split into that many
-    consecutive blocks computed at once (a thread each; each particle's entries are its own);
-    with 1 no second thread is woken."""
-    n = pos.shape[0]
+def _polygon_geometry(placed, chunks=1):
+    """The :class:`Outlines` of the bodies ``placed`` (:class:`PlacedShapes`): world vertices
+    (N, maxn, 2) and outward unit edge normals (N, maxn, 2) of every polygon from the shape
+    table, vertex k at the polar angle angle + vertex_angle[k] and distance vertex_radius[k],
+    the normal of edge k (vertex k -> k+1) at angle + normal_angle[k]. With ``chunks`` > 1 the
+    particles are split into that many consecutive blocks computed at once (a thread each; each
+    particle's entries are its own); with 1 no second thread is woken."""
+    n = placed.pos.shape[0]
+    nvert = placed.n_vertices
     maxn = 1
     for p in range(n):
         maxn = max(maxn, nvert[p])
     verts = np.zeros((n, maxn, 2))
     norms = np.zeros((n, maxn, 2))
     if chunks == 1:
-        _polygon_block(0, n, pos, angle, nvert, first_vertex, vertex_radius, vertex_angle, normal_angle, verts, norms)
+        _polygon_block(0, n, placed, verts, norms)
     else:
-        _polygon_blocks(chunks, pos, angle, nvert, first_vertex, vertex_radius, vertex_angle, normal_angle, verts,
-                        norms)
-    return verts, norms
+        _polygon_blocks(chunks, placed, verts, norms)
+    return Outlines(placed.pos, placed.radius, nvert, verts, norms)
 
 
 @njit(cache=True)
-def _best_edge(p, q, verts, norms, nvert):
+def _best_edge(p, q, bodies):
     """Separating-axis search over the edges of polygon p: returns (s, e, k) with
     s = max_e min_k (v_q,k - v_p,e) . n_p,e, e the maximising edge, k the vertex of q
     reaching the minimum (the deepest vertex against edge e)."""
+    verts = bodies.verts
+    norms = bodies.norms
+    nvert = bodies.nvert
     best = -math.inf
     best_e = 0
     best_k = 0
@@ -240,10 +366,17 @@ def _best_edge(p, q, verts, norms, nvert):
 
 
 @njit(cache=True)
-def _polygon_polygon(a, b, verts, norms, nvert, radius, double_alert, c, normal, point, gap):
+def _polygon_polygon(a, b, bodies, double_alert, c, slots):
     """Shadow-overlap contact of polygons a and b; normal from a to b. See the module doc."""
-    sa, ea, ka = _best_edge(a, b, verts, norms, nvert)
-    sb, eb, kb = _best_edge(b, a, verts, norms, nvert)
+    verts = bodies.verts
+    norms = bodies.norms
+    nvert = bodies.nvert
+    radius = bodies.radius
+    normal = slots.normal
+    point = slots.point
+    gap = slots.gap
+    sa, ea, ka = _best_edge(a, b, bodies)
+    sb, eb, kb = _best_edge(b, a, bodies)
     # reference polygon: the one with the larger separation; at a tie (within round-off) a
     if sb > sa + 1e-12 * (radius[a] + radius[b]):
         ref, inc, e, k0, s0, sign = b, a, eb, kb, sb, -1.0
@@ -343,9 +476,17 @@ def _polygon_polygon(a, b, verts, norms, nvert, radius, double_alert, c, normal,
 
 
 @njit(cache=True)
-def _polygon_disk(p, d, pos, verts, norms, nvert, radius, sign, c, normal, point, gap):
+def _polygon_disk(p, d, bodies, sign, c, slots):
     """Contact of polygon p and disk d by the closest feature; the normal points from the
     polygon to the disk, multiplied by ``sign``."""
+    pos = bodies.pos
+    verts = bodies.verts
+    norms = bodies.norms
+    nvert = bodies.nvert
+    radius = bodies.radius
+    normal = slots.normal
+    point = slots.point
+    gap = slots.gap
     cx = pos[d, 0]
     cy = pos[d, 1]
     rd = radius[d]
@@ -396,8 +537,19 @@ def _polygon_disk(p, d, pos, verts, norms, nvert, radius, sign, c, normal, point
 
 
 @njit(cache=True)
-def _polygon_wall(p, verts, nvert, radius, px, py, wnx, wny, double_alert, c, normal, point, gap):
-    """Contact of polygon p with the wall through (px, py) of inward unit normal (wnx, wny)."""
+def _polygon_wall(p, w, bodies, walls, double_alert, c, slots):
+    """Contact of polygon p with wall w, the line through (px, py) of inward unit normal
+    (wnx, wny)."""
+    verts = bodies.verts
+    nvert = bodies.nvert
+    radius = bodies.radius
+    px = walls.point[w, 0]
+    py = walls.point[w, 1]
+    wnx = walls.normal[w, 0]
+    wny = walls.normal[w, 1]
+    normal = slots.normal
+    point = slots.point
+    gap = slots.gap
     n = nvert[p]
     # signed distance of every vertex to the wall line; lowest vertex k0
     k0 = 0
@@ -445,33 +597,41 @@ def _polygon_wall(p, verts, nvert, radius, px, py, wnx, wny, double_alert, c, no
 
 
 @njit(cache=True)
-def _pair_points(a, b, pos, radius, nvert, verts, norms, double_alert, c, normal, point, gap):
+def _pair_points(a, b, bodies, double_alert, c, slots):
     """Contact points between particles a < b, normal from a to b. Returns the count (1 or 2)."""
-    na = nvert[a]
-    nb = nvert[b]
+    na = bodies.nvert[a]
+    nb = bodies.nvert[b]
     if na == 0 and nb == 0:
-        return _disk_disk(pos[a, 0], pos[a, 1], radius[a], pos[b, 0], pos[b, 1], radius[b],
-                          c, normal, point, gap)
+        return _disk_disk(a, b, bodies, c, slots)
     if na == 0:
-        return _polygon_disk(b, a, pos, verts, norms, nvert, radius, -1.0, c, normal, point, gap)
+        return _polygon_disk(b, a, bodies, -1.0, c, slots)
     if nb == 0:
-        return _polygon_disk(a, b, pos, verts, norms, nvert, radius, 1.0, c, normal, point, gap)
-    return _polygon_polygon(a, b, verts, norms, nvert, radius, double_alert, c, normal, point, gap)
+        return _polygon_disk(a, b, bodies, 1.0, c, slots)
+    return _polygon_polygon(a, b, bodies, double_alert, c, slots)
 
 
 @njit(cache=True)
-def _candidate_block(lo, hi, m_pairs, pos, radius, nvert, verts, norms, wall_point, wall_normal, alert,
-                     double_alert, pi, pj, wp, ww, count, normal, point, gap, kind):
+def _candidate_block(lo, hi, bodies, walls, candidates, alert, double_alert, slots):
     """Pass 1 for candidates lo..hi-1: up to two points of candidate c into its own slot
-    (normal[c], point[c], gap[c], kind[c]) and count[c] = their number if the nearest is
-    within ``alert``, else 0."""
+    (slots.normal[c], .point[c], .gap[c], .kind[c]) and slots.count[c] = their number if the
+    nearest is within ``alert``, else 0."""
+    pi = candidates.pi
+    pj = candidates.pj
+    wp = candidates.wp
+    ww = candidates.ww
+    m_pairs = pi.shape[0]
+    nvert = bodies.nvert
+    count = slots.count
+    normal = slots.normal
+    gap = slots.gap
+    kind = slots.kind
     for c in range(lo, hi):
         if c < m_pairs:
             i = pi[c]
             j = pj[c]
             a = min(i, j)
             b = max(i, j)
-            cnt = _pair_points(a, b, pos, radius, nvert, verts, norms, double_alert, c, normal, point, gap)
+            cnt = _pair_points(a, b, bodies, double_alert, c, slots)
             if i > j:
                 normal[c, 0] = -normal[c, 0]
                 normal[c, 1] = -normal[c, 1]
@@ -479,11 +639,9 @@ def _candidate_block(lo, hi, m_pairs, pos, radius, nvert, verts, norms, wall_poi
             p = wp[c - m_pairs]
             w = ww[c - m_pairs]
             if nvert[p] == 0:
-                cnt = _disk_wall(pos[p, 0], pos[p, 1], radius[p], wall_point[w, 0], wall_point[w, 1],
-                                 wall_normal[w, 0], wall_normal[w, 1], c, normal, point, gap)
+                cnt = _disk_wall(p, w, bodies, walls, c, slots)
             else:
-                cnt = _polygon_wall(p, verts, nvert, radius, wall_point[w, 0], wall_point[w, 1],
-                                    wall_normal[w, 0], wall_normal[w, 1], double_alert, c, normal, point, gap)
+                cnt = _polygon_wall(p, w, bodies, walls, double_alert, c, slots)
         kind[c] = KIND_DOUBLE if cnt == 2 else KIND_SIMPLE
         # keep the contact if its nearest point is within the alert distance
         gmin = gap[c, 0]
@@ -493,9 +651,28 @@ def _candidate_block(lo, hi, m_pairs, pos, radius, nvert, verts, norms, wall_poi
 
 
 @njit(cache=True)
-def _compact_block(lo, hi, m_pairs, n_particles, pi, pj, wp, ww, count, offsets, pair_offsets, normal, point, gap,
-                   kind, o_i, o_j, o_normal, o_point, o_gap, o_kind, o_pair):
-    """Pass 2 for candidates lo..hi-1: the kept points of candidate c to rows offsets[c]...."""
+def _compact_block(lo, hi, n_particles, candidates, slots, out):
+    """Pass 2 for candidates lo..hi-1: the kept points of candidate c to rows
+    slots.offsets[c]... of ``out`` (:class:`ContactPoints`), wall w as body n_particles + w."""
+    pi = candidates.pi
+    pj = candidates.pj
+    wp = candidates.wp
+    ww = candidates.ww
+    m_pairs = pi.shape[0]
+    count = slots.count
+    offsets = slots.offsets
+    pair_offsets = slots.pair_offsets
+    normal = slots.normal
+    point = slots.point
+    gap = slots.gap
+    kind = slots.kind
+    o_i = out.body_i
+    o_j = out.body_j
+    o_normal = out.normal
+    o_point = out.point
+    o_gap = out.gap
+    o_kind = out.kind
+    o_pair = out.pair
     for c in range(lo, hi):
         if c < m_pairs:
             bi = pi[c]
@@ -517,71 +694,58 @@ def _compact_block(lo, hi, m_pairs, n_particles, pi, pj, wp, ww, count, offsets,
 
 
 @njit(cache=True, parallel=True)
-def _candidate_blocks(chunks, m_pairs, pos, radius, nvert, verts, norms, wall_point, wall_normal, alert, double_alert,
-                      pi, pj, wp, ww, count, normal, point, gap, kind):
+def _candidate_blocks(chunks, bodies, walls, candidates, alert, double_alert, slots):
     """:func:`_candidate_block` over ``chunks`` consecutive blocks of candidates at once (a thread each)."""
-    m = count.size
+    m = slots.count.size
     for d in prange(chunks):
-        _candidate_block(m * d // chunks, m * (d + 1) // chunks, m_pairs, pos, radius, nvert, verts, norms,
-                         wall_point, wall_normal, alert, double_alert, pi, pj, wp, ww, count, normal, point, gap,
-                         kind)
+        _candidate_block(m * d // chunks, m * (d + 1) // chunks, bodies, walls, candidates, alert, double_alert,
+                         slots)
 
 
 @njit(cache=True, parallel=True)
-def _compact_blocks(chunks, m_pairs, n_particles, pi, pj, wp, ww, count, offsets, pair_offsets, normal, point, gap,
-                    kind, o_i, o_j, o_normal, o_point, o_gap, o_kind, o_pair):
+def _compact_blocks(chunks, n_particles, candidates, slots, out):
     """:func:`_compact_block` over ``chunks`` consecutive blocks of candidates at once (a thread each)."""
-    m = count.size
+    m = slots.count.size
     for d in prange(chunks):
-        _compact_block(m * d // chunks, m * (d + 1) // chunks, m_pairs, n_particles, pi, pj, wp, ww, count, offsets,
-                       pair_offsets, normal, point, gap, kind, o_i, o_j, o_normal, o_point, o_gap, o_kind, o_pair)
+        _compact_block(m * d // chunks, m * (d + 1) // chunks, n_particles, candidates, slots, out)
 
 
 @njit(cache=True)
-def _detect_kernel(pos, angle, radius, nvert, first_vertex, vertex_radius, vertex_angle, normal_angle,
-                   wall_point, wall_normal, alert, double_alert, pi, pj, wp, ww, chunks):
+def _detect_kernel(placed, walls, candidates, alert, double_alert, chunks):
     """Pass 1: up to two points per candidate into fixed slots (each candidate writes only its
     own slot); pass 2: compaction of the kept ones at prefix-sum offsets. With ``chunks`` > 1
     both passes split the candidates into that many consecutive blocks done at once (a thread
     each); as no slot is shared, the result does not depend on ``chunks``. With 1 no second
     thread is woken (a woken thread waits for a busy core), and the allocations stay out of
-    the parallel functions (numba would make each one a parallel region)."""
-    n_particles = pos.shape[0]
-    m_pairs = pi.shape[0]
-    m = m_pairs + wp.shape[0]
-    count = np.zeros(m, np.int64)
-    normal = np.empty((m, 2))
-    point = np.empty((m, 2, 2))
-    gap = np.empty((m, 2))
-    kind = np.empty(m, np.int8)
-    verts, norms = _polygon_geometry(pos, angle, nvert, first_vertex, vertex_radius, vertex_angle, normal_angle,
-                                     chunks)
+    the parallel functions (numba would make each one a parallel region).
+
+    ``placed`` : :class:`PlacedShapes`; ``walls`` : :class:`WallLines`; ``candidates`` :
+    :class:`Candidates`; ``alert``, ``double_alert`` : m (:func:`detect`). Returns the
+    :class:`ContactPoints`."""
+    n_particles = placed.pos.shape[0]
+    m = candidates.pi.shape[0] + candidates.wp.shape[0]
+    slots = Slots(np.zeros(m, np.int64), np.empty((m, 2)), np.empty((m, 2, 2)), np.empty((m, 2)),
+                  np.empty(m, np.int8), np.zeros(m + 1, np.int64), np.zeros(m + 1, np.int64))
+    bodies = _polygon_geometry(placed, chunks)
     if chunks == 1:
-        _candidate_block(0, m, m_pairs, pos, radius, nvert, verts, norms, wall_point, wall_normal, alert, double_alert,
-                         pi, pj, wp, ww, count, normal, point, gap, kind)
+        _candidate_block(0, m, bodies, walls, candidates, alert, double_alert, slots)
     else:
-        _candidate_blocks(chunks, m_pairs, pos, radius, nvert, verts, norms, wall_point, wall_normal, alert,
-                          double_alert, pi, pj, wp, ww, count, normal, point, gap, kind)
-    offsets = np.zeros(m + 1, np.int64)
-    pair_offsets = np.zeros(m + 1, np.int64)
+        _candidate_blocks(chunks, bodies, walls, candidates, alert, double_alert, slots)
+    count = slots.count
+    offsets = slots.offsets
+    pair_offsets = slots.pair_offsets
     for c in range(m):
         offsets[c + 1] = offsets[c] + count[c]
         pair_offsets[c + 1] = pair_offsets[c] + (1 if count[c] > 0 else 0)
     total = offsets[m]
-    o_i = np.empty(total, np.int32)
-    o_j = np.empty(total, np.int32)
-    o_normal = np.empty((total, 2))
-    o_point = np.empty((total, 2))
-    o_gap = np.empty(total)
-    o_kind = np.empty(total, np.int8)
-    o_pair = np.empty(total, np.int32)
+    out = ContactPoints(np.empty(total, np.int32), np.empty(total, np.int32), np.empty((total, 2)),
+                        np.empty((total, 2)), np.empty(total), np.empty(total, np.int8), np.empty(total, np.int32),
+                        pair_offsets[m])
     if chunks == 1:
-        _compact_block(0, m, m_pairs, n_particles, pi, pj, wp, ww, count, offsets, pair_offsets, normal, point, gap,
-                       kind, o_i, o_j, o_normal, o_point, o_gap, o_kind, o_pair)
+        _compact_block(0, m, n_particles, candidates, slots, out)
     else:
-        _compact_blocks(chunks, m_pairs, n_particles, pi, pj, wp, ww, count, offsets, pair_offsets, normal, point,
-                        gap, kind, o_i, o_j, o_normal, o_point, o_gap, o_kind, o_pair)
-    return o_i, o_j, o_normal, o_point, o_gap, o_kind, o_pair, pair_offsets[m]
+        _compact_blocks(chunks, n_particles, candidates, slots, out)
+    return out
 
 
 def _index_array(name, value, upper):
@@ -646,7 +810,7 @@ def detect(pos, angle, shapes, wall_point, wall_normal, alert, pi, pj, wp, ww, d
         raise ParameterError(f"wp and ww must have the same length, got {wp.size} and {ww.size}")
     if not isinstance(threads, (int, np.integer)) or threads < 1:
         raise ParameterError(f"threads={threads!r}: expected an integer >= 1")
-    out = _detect_kernel(pos, angle, shapes.radius, shapes.n_vertices, shapes.first_vertex, shapes.vertex_radius,
-                         shapes.vertex_angle, shapes.normal_angle, wall_point, wall_normal, alert, double_alert,
-                         pi, pj, wp, ww, int(threads))
-    return ContactPoints(*out[:7], int(out[7]))
+    placed = PlacedShapes(pos, angle, shapes.radius, shapes.n_vertices, shapes.first_vertex, shapes.vertex_radius,
+                          shapes.vertex_angle, shapes.normal_angle)
+    return _detect_kernel(placed, WallLines(wall_point, wall_normal), Candidates(pi, pj, wp, ww), alert,
+                          double_alert, int(threads))
