@@ -2,7 +2,7 @@
 (K = 100), persistence and contact lifetimes on a synthetic series opened lazily from
 netCDF, with the peak memory of each measurement; eager (loaded) against dask (lazy).
 
-The series is drawn from the harmonic model (grainview.synthetic) and streamed to disk one
+The series is drawn from the harmonic model (grainview.analysis.synthetic) and streamed to disk one
 snapshot at a time with the solver's writer, so it never has to fit in memory.
 """
 
@@ -26,17 +26,17 @@ CASES = {
 
 
 def _xi(ds):
-    from grainview.xi_network import xi_network
+    from grainview.analysis.xi_network import xi_network
     return xi_network(ds, xi=np.linspace(0, 5, 100))
 
 
 def _persistence(ds):
-    from grainview.persistence import persistence
+    from grainview.analysis.persistence import persistence
     return persistence(ds)
 
 
 def _lifetimes(ds):
-    from grainview.lifetimes import contact_events
+    from grainview.analysis.lifetimes import contact_events
     return contact_events(ds, walls=False)
 
 
@@ -44,7 +44,7 @@ def write_series(path, n_snapshots, n_contacts, seed=0, attrs=None):
     """Stream a harmonic-model series of ``n_snapshots`` x ``n_contacts`` to ``path`` (global
     attributes ``attrs`` added)."""
     from grainview.contract.writer import SnapshotWriter
-    from grainview.synthetic import PAIR_LENGTH_M, harmonic_contacts
+    from grainview.analysis.synthetic import PAIR_LENGTH_M, harmonic_contacts
 
     rng = np.random.default_rng(seed)
     n_part = 2 * n_contacts

@@ -55,13 +55,13 @@ print(json.dumps({"seconds": time.perf_counter() - start,
 
 
 def _xi(ds):
-    from grainview.xi_network import xi_network
+    from grainview.analysis.xi_network import xi_network
 
     return xi_network(ds, xi=np.linspace(0, 5, 100))
 
 
 def _lifetimes(ds):
-    from grainview.lifetimes import contact_events
+    from grainview.analysis.lifetimes import contact_events
 
     return contact_events(ds, walls=False)
 

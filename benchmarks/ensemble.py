@@ -12,7 +12,7 @@ Runner: the same set of small biaxial tests (pentagons and disks, one seed each 
 run by ``solver.ensemble.run_ensemble`` on a LocalCluster of 1 worker, then of 2 workers (cold
 output folders, warm numba cache); efficiency = T(1 worker) / (workers x T(workers)).
 
-Out of core: ``runs`` synthetic harmonic-model series (grainview.synthetic, streamed to disk)
+Out of core: ``runs`` synthetic harmonic-model series (grainview.analysis.synthetic, streamed to disk)
 of ``snapshots`` x ``contacts`` each, two settings of half the runs each, opened with
 ``grainview.open_ensemble``; the stress invariants and the fabric anisotropy of every run and
 snapshot, reduced to mean +- spread over seeds on eps_q bins (``seed_statistics``), computed on
@@ -118,7 +118,7 @@ def out_of_core(folder, runs=16, snapshots=500, contacts=30_000, workers=2, memo
     from distributed import Client, LocalCluster
 
     import grainview
-    from grainview.ensemble import seed_statistics
+    from grainview.analysis.ensemble import seed_statistics
 
     start = time.perf_counter()
     paths = write_ensemble(folder, runs, snapshots, contacts)
@@ -131,7 +131,7 @@ def out_of_core(folder, runs=16, snapshots=500, contacts=30_000, workers=2, memo
     with LocalCluster(n_workers=workers, threads_per_worker=1, memory_limit=memory_limit, dashboard_address=None,
                       env={"NUMBA_NUM_THREADS": "1", "OMP_NUM_THREADS": "1"}) as cluster, Client(cluster) as client:
         pids = list(client.run(os.getpid).values())
-        client.run(lambda: __import__("grainview.stress") and __import__("grainview.fabric"))  # imports, not timed
+        client.run(lambda: __import__("grainview.analysis.stress") and __import__("grainview.analysis.fabric"))  # imports, not timed
         with PeakSampler(pids) as sampler:
             start = time.perf_counter()
             q = ens.grain.stress_invariants()["q_over_p"]

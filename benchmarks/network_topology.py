@@ -76,8 +76,8 @@ def tiled(ds, tiles=TILES):
 
 def parts(ds, repeats):
     """Median seconds of each stage on plain arrays, one snapshot."""
-    from grainview.arrays import network_topology as nt
-    from grainview.contacts import selection
+    from grainview.analysis.arrays import network_topology as nt
+    from grainview.analysis.contacts import selection
 
     snap = ds.isel(time=0)
     fn, i, j = snap["fn"].values, snap["i"].values, snap["j"].values
@@ -139,7 +139,7 @@ def run(repeats=7):
              f"snapshot held in memory, medians of {repeats} calls after one warm-up; the whole analysis is "
              "dimensions 0 and 1 with the Betti curves on 101 thresholds and the 3- and 4-cycle counts; "
              "all of it the project's own code (no gudhi). The parts are the array functions of "
-             "grainview.arrays.network_topology on the same snapshot: the edges, the union-find (dimension 0), "
+             "grainview.analysis.arrays.network_topology on the same snapshot: the edges, the union-find (dimension 0), "
              "the reduction of the triangles' boundary matrix (dimension 1, diagram_1), gudhi's persistence of "
              "the same complex in dimensions 0 and 1 (diagrams_gudhi, the cross-check; nan without gudhi) and "
              "the cycle counts. Samples: the module docstring (the "

@@ -13,7 +13,7 @@ is sheared with plain sweeps (A-off) and with Anderson sweeps (A-and): the same 
 difference is the solver's alone (and the chaotic divergence of two trajectories that any
 change of round-off starts). B is sheared with Anderson sweeps (B-and): the whole study as it
 runs with Anderson sweeps. The headline's residual-state numbers (eps_q >= 0.3;
-grainview.report.run_summary) of each go to benchmarks/_data/same_sample/<shape>_<seed>.json;
+grainview.app.report.run_summary) of each go to benchmarks/_data/same_sample/<shape>_<seed>.json;
 the table gives, per quantity, the seeds' mean and standard deviation of A-off and of B-and, and
 the mean and standard deviation over seeds of the differences A-and - A-off and B-and - A-off.
 
@@ -37,7 +37,7 @@ geometry, or of the path the grains take? Sample B is sheared with Anderson swee
 shear step 30,000 (eps_q about 0.45 for 400 pentagons: the residual state), and every 20th
 step's contact problem up to step 30,400 is re-solved from its warm start at the default
 tolerance and 4, 10 and 100 times tighter (the shear's sweep cap, else 22,000). The q/p of each
-solution's stress tensor (grainview.arrays.stress, the particle-wall contacts included) is
+solution's stress tensor (grainview.analysis.arrays.stress, the particle-wall contacts included) is
 compared on the same geometry. Written to benchmarks/_data/same_sample/static_<shape>_<seed>.json.
 
 Runs two processes at a time (one per core); timings are in the files but the point is the
@@ -109,11 +109,11 @@ def shears(seed: int, shape: str) -> dict:
 def _shear_summary(sim, attrs: dict, path: str) -> dict:
     """Shear ``sim`` (eps_1 = 0.2 at 1 cm/s, a snapshot every 200 steps, near contacts written,
     to the temporary file ``path``): the residual-state summary (eps_q >= 0.3;
-    grainview.report.run_summary), the seconds, and the median and 90th percentile of the
+    grainview.app.report.run_summary), the seconds, and the median and 90th percentile of the
     steps' sweeps, local-law residual and unbalanced-force ratio."""
     import grainview
     import solver
-    from grainview.report import run_summary
+    from grainview.app.report import run_summary
 
     steps = []
     step = sim.step
@@ -184,8 +184,8 @@ def _sd(v) -> str:
 def _q_over_p(problem, pn, pt) -> float:
     """q/p of the stress tensor of one contact problem's impulses (the branch vector of a point
     is r_a - r_b: centre of a to centre of b, or to the contact point for a wall)."""
-    from grainview.arrays.stress import stress_tensor
-    from grainview.arrays.tensors import principal
+    from grainview.analysis.arrays.stress import stress_tensor
+    from grainview.analysis.arrays.tensors import principal
 
     normal = np.stack([problem.nx, problem.ny], -1)
     branch = np.stack([problem.rax - problem.rbx, problem.ray - problem.rby], -1)

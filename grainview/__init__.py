@@ -24,9 +24,9 @@ from .contract.schema import SCHEMA_VERSION
 
 __version__ = "0.1.0"
 
-_LAZY = {"open_dataset": "opening", "validate": "contract.validation", "make_dataset": "contract.dataset",
+_LAZY = {"open_dataset": "formats.opening", "validate": "contract.validation", "make_dataset": "contract.dataset",
          "SnapshotWriter": "contract.writer",
-         "open_ensemble": "ensemble"}
+         "open_ensemble": "analysis.ensemble"}
 """Public names imported from their module on first access (PEP 562)."""
 
 __all__ = [

@@ -1,7 +1,7 @@
 """The ``ds.grain`` accessor: holds the dataset and delegates to the topic modules.
 
-Every method calls the function of the same name in a topic module (:mod:`grainview.stress`,
-:mod:`grainview.fabric`, ...), where the docstring with the formula and the paper reference
+Every method calls the function of the same name in a topic module (:mod:`grainview.analysis.stress`,
+:mod:`grainview.analysis.fabric`, ...), where the docstring with the formula and the paper reference
 lives; the accessor shows that docstring too. Nothing is computed here.
 """
 
@@ -15,7 +15,7 @@ import xarray as xr
 
 class _Delegate:
     """An accessor method that calls the function of the same name in topic module
-    ``grainview.<module>`` on the accessor's dataset, with that function's docstring and
+    ``grainview.analysis.<module>`` on the accessor's dataset, with that function's docstring and
     signature. The topic module is imported on first use, so registering the accessor (which
     happens whenever xarray is imported after grainview) loads no analysis code."""
 
@@ -26,7 +26,7 @@ class _Delegate:
         self.name = name
 
     def function(self):
-        return getattr(importlib.import_module(f"grainview.{self.module}"), self.name)
+        return getattr(importlib.import_module(f"grainview.analysis.{self.module}"), self.name)
 
     def __get__(self, accessor, owner=None):
         func = self.function()
@@ -36,7 +36,7 @@ class _Delegate:
         @functools.wraps(func)
         def method(*args, **kwargs):
             if "run" in accessor._ds.dims:  # an ensemble: the analysis of each run, along run
-                from .ensemble import map_runs
+                from .analysis.ensemble import map_runs
 
                 return map_runs(accessor._ds, lambda one: getattr(one.grain, self.name)(*args, **kwargs))
             accessor._check_structure()
@@ -50,14 +50,14 @@ class GrainAccessor:
 
     Each analysis method calls the function of the same name in a topic module, whose
     docstring it shows; on an ensemble (a ``run`` dimension) it runs per run
-    (:func:`grainview.ensemble.map_runs`). Time series come back with the strains
+    (:func:`grainview.analysis.ensemble.map_runs`). Time series come back with the strains
     :data:`STRAIN_COORDS` as coordinates along ``time`` (when the file has its box).
 
     Parameters
     ----------
     ds : xarray.Dataset
         A dataset of the contract (docs/schema.md), or an ensemble of
-        :func:`grainview.ensemble.open_ensemble`.
+        :func:`grainview.analysis.ensemble.open_ensemble`.
 
     References
     ----------
@@ -94,7 +94,7 @@ class GrainAccessor:
                 or not {"box_min", "box_max"} <= set(ds.variables)):
             return result
         if self._strains is None:
-            from .strain import strains
+            from .analysis.strain import strains
 
             eps = strains(ds)
             self._strains = {name: eps[name] for name in self.STRAIN_COORDS}
@@ -104,7 +104,7 @@ class GrainAccessor:
         """Check the dataset against the contract (:func:`grainview.contract.validation.validate`).
 
         On an ensemble (a ``run`` dimension) each run is checked as its file opens alone
-        (:func:`grainview.ensemble.run_dataset`).
+        (:func:`grainview.analysis.ensemble.run_dataset`).
 
         Returns
         -------
@@ -119,7 +119,7 @@ class GrainAccessor:
         from .contract.validation import validate
 
         if "run" in self._ds.dims:  # an ensemble: each run
-            from .ensemble import run_dataset
+            from .analysis.ensemble import run_dataset
 
             for k in range(self._ds.sizes["run"]):
                 validate(run_dataset(self._ds, k))
@@ -193,7 +193,7 @@ class GrainAccessor:
             from .contract.errors import ParameterError
 
             raise ParameterError("the figures draw runs, not an ensemble: plot run_dataset(ens, k) (or a dict of "
-                                 "them), or write the ensemble's report (grainview.ensemble_report)")
+                                 "them), or write the ensemble's report (grainview.app.ensemble_report)")
         from .plot import PlotAccessor
 
         return PlotAccessor(self._ds)

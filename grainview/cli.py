@@ -15,7 +15,7 @@ from pathlib import Path
 from .contract.errors import ConvergenceWarning, GrainviewError, SchemaError
 
 RESIDUAL_STRAIN = 0.3
-"""Default start of the residual window (eps_q); the same as grainview.strain.RESIDUAL_STRAIN,
+"""Default start of the residual window (eps_q); the same as grainview.analysis.strain.RESIDUAL_STRAIN,
 repeated here so that ``--help`` does not import xarray."""
 S1S2_HELP = ("s1s2: the paper's two initial states, each shape compacted its own way: pentagons with "
              "friction 0.4 as 'paper' (the paper's S1, solid fraction 0.80), disks compacted frictionless (S2, the "
@@ -27,7 +27,7 @@ residual state (eps_q >= 0.3)."""
 
 
 def _info(args) -> int:
-    from .file_summary import describe_file
+    from .app.file_summary import describe_file
 
     if args.check:  # first, so that every problem is listed: the summary's own and every value's
         from .contract.io import open_dataset
@@ -61,7 +61,7 @@ def _info(args) -> int:
 
 
 def _export(args) -> int:
-    from .export import write_csv, write_vtk
+    from .formats.export import write_csv, write_vtk
     from .contract.io import open_dataset
     from .contract.validation import validate
 
@@ -161,7 +161,7 @@ def _convert_pegs(args) -> int:
 def _demo(args) -> int:
     from . import open_dataset
     from .contract.dataset import netcdf_options
-    from .synthetic import harmonic_series
+    from .analysis.synthetic import harmonic_series
 
     if args.snapshots < 2 or args.contacts < 1:
         raise GrainviewError(f"--snapshots {args.snapshots} --contacts {args.contacts}: expected at least 2 "
@@ -188,7 +188,7 @@ def _demo(args) -> int:
 def _warmup(args) -> int:
     import os
 
-    from .warmup import cache_location, warm_up
+    from .app.warmup import cache_location, warm_up
 
     folder = os.environ.get("NUMBA_CACHE_DIR")
     if folder:
@@ -310,10 +310,10 @@ def _simulate(prep, path, *, strain, every, velocity, near_contacts, overwrite, 
 def _unconverged_warning(sim, path, unconverged) -> str:
     """What the warning on a run's unconverged steps says: how many of the compaction's and of
     the test's steps stopped at the sweep cap or the stall test, and how far their impulses
-    were from a solution (grainview.convergence), read from the written file."""
+    were from a solution (grainview.app.convergence), read from the written file."""
     import netCDF4
 
-    from .convergence import residual_comparison, stop_rule, tolerances, unconverged_in_file
+    from .app.convergence import residual_comparison, stop_rule, tolerances, unconverged_in_file
 
     with netCDF4.Dataset(path) as nc:
         counts = unconverged_in_file(nc.variables, {k: nc.getncattr(k) for k in nc.ncattrs()})
@@ -412,7 +412,7 @@ def _run(args) -> int:
 
 def _report(args) -> int:
     from .contract.io import open_dataset
-    from .report import write_report
+    from .app.report import write_report
 
     if getattr(args, "ensemble", False):
         if args.labels or args.movie:
@@ -441,15 +441,15 @@ def _report(args) -> int:
 
 def _terminal_table(table) -> str:
     """A report's table fitted to the terminal's width, rounded as the Markdown
-    (grainview.report.terminal_table)."""
-    from .report import terminal_table
+    (grainview.app.report.terminal_table)."""
+    from .app.report import terminal_table
 
     return terminal_table(table)
 
 
 def _ensemble_report(args) -> int:
-    from .ensemble import open_ensemble
-    from .ensemble_report import write_ensemble_report
+    from .analysis.ensemble import open_ensemble
+    from .app.ensemble_report import write_ensemble_report
 
     ens = open_ensemble(args.files, validate=True)
     result = write_ensemble_report(ens, args.out, residual_strain=args.residual_strain, overwrite=args.overwrite,

@@ -7,7 +7,7 @@ midpoint when both forces vanish). By default only force-bearing contacts (f_n >
 written: pairs within the alert distance that carry nothing are not contacts of the packing.
 With ``near`` (m; the recorder uses the alert distance) the open or unloaded pairs whose gap is
 <= near are written too, with f_n = f_t = 0, so that an analysis can count them as a code that
-keeps every pair within its alert distance does (``grainview.contacts.in_network``); the file
+keeps every pair within its alert distance does (``grainview.analysis.contacts.in_network``); the file
 then says so in its attribute ``near_contacts_m``. ``gap`` is the pair's smallest separation
 along the normal at the start of the step (negative: overlap). :func:`written_pairs` alone
 decides what is written, for the contacts and for the restart impulses alike.

@@ -64,19 +64,86 @@ def test_the_cycle_finder_sees_a_cycle():
 
 def test_no_import_cycle_in_the_packages():
     graph = import_graph()
-    assert "solver.scenes" in graph and "grainview.report" in graph
+    assert "solver.scenes" in graph and "grainview.app.report" in graph
     assert "solver.output" in graph["solver.scenes"]
     assert find_cycles(graph) == []
 
 
 def test_the_array_layer_imports_nothing_of_the_labelled_layer():
-    """grainview/arrays holds the physics on plain arrays: it may use its own modules, the
+    """grainview/analysis/arrays holds the physics on plain arrays: it may use its own modules, the
     numba kernels and the contract layer, never the xarray topic modules."""
     graph = import_graph()
-    allowed = ("grainview.arrays", "grainview._kernels", "grainview.contract")
+    allowed = ("grainview.analysis.arrays", "grainview.analysis._kernels", "grainview.contract")
     for module, deps in graph.items():
-        if module.startswith("grainview.arrays"):
+        if module.startswith("grainview.analysis.arrays"):
             assert all(dep.startswith(allowed) for dep in deps), (module, sorted(deps))
+
+
+ROOMS = {
+    "grainview.contract": 0,
+    "grainview.analysis": 1, "solver": 1,
+    "grainview.formats": 2,
+    "grainview.plot": 3,
+    "grainview.app": 4,
+    "grainview": 5,
+}
+"""The rooms of the packages and their floor: a module may import its own room and the rooms on
+lower floors, never a higher floor or another room of its floor. The drawing reads contract <-
+analysis <- formats (other codes' files, the export) <- plot <- application, with the solver beside
+the analysis on the contract; the package's front door (``grainview/__init__.py``, the ``ds.grain``
+accessor and its registration, the command line) sits on top of them all."""
+
+FRONT_DOOR = {"grainview", "grainview._register", "grainview.accessor", "grainview.cli"}
+"""The only modules of grainview outside a room's folder."""
+
+
+def room_of(module: str) -> str:
+    """The room holding ``module``: the longest room name it starts with, as a package path."""
+    if module in FRONT_DOOR:
+        return "grainview"
+    rooms = [room for room in ROOMS if room != "grainview" and (module == room or module.startswith(room + "."))]
+    if not rooms:
+        raise KeyError(f"{module}: in no room of {sorted(ROOMS)}")
+    return max(rooms, key=len)
+
+
+def wrong_way_imports(graph) -> set:
+    """Every (module, imported module) whose room is on a higher floor than the importer's, or is
+    another room of the same floor."""
+    wrong = set()
+    for module, deps in graph.items():
+        here = room_of(module)
+        for dep in deps:
+            there = room_of(dep)
+            if there != here and ROOMS[there] >= ROOMS[here]:
+                wrong.add((module, dep))
+    return wrong
+
+
+def test_the_room_check_sees_an_import_going_up_or_sideways():
+    graph = {"grainview.analysis.stress": {"grainview.contract.schema", "grainview.analysis._lift"},
+             "grainview.plot.maps": {"grainview.analysis.stress", "grainview.formats.export"},
+             "grainview.contract.schema": set(), "grainview.analysis._lift": set(), "grainview.formats.export": set(),
+             "grainview.app.report": {"grainview.plot.maps", "grainview.accessor"}, "grainview.accessor": set()}
+    assert wrong_way_imports(graph) == {("grainview.app.report", "grainview.accessor")}
+    graph["grainview.analysis.stress"].add("grainview.plot.maps")  # up
+    graph["solver.output"] = {"grainview.analysis._lift"}  # sideways
+    assert wrong_way_imports(graph) == {("grainview.app.report", "grainview.accessor"),
+                                        ("grainview.analysis.stress", "grainview.plot.maps"),
+                                        ("solver.output", "grainview.analysis._lift")}
+    try:
+        room_of("grainview.stress")  # a module left on the flat floor
+    except KeyError as error:
+        assert "grainview.stress: in no room" in str(error)
+    else:
+        raise AssertionError("a module outside every room was given a room")
+
+
+def test_every_import_goes_down_the_rooms():
+    graph = import_graph()
+    assert {room_of(module) for module in graph} == set(ROOMS)  # every module in a room, every room used
+    assert "grainview.plot.maps" in graph and "grainview.analysis.contacts" in graph["grainview.plot.maps"]
+    assert wrong_way_imports(graph) == set()
 
 
 def _modules_after(code: str) -> set:
@@ -87,7 +154,7 @@ def _modules_after(code: str) -> set:
 
     probe = (f"{code}\nimport json, sys\n"
              "print(json.dumps(sorted(m for m in ('xarray', 'dask', 'matplotlib', 'pandas', 'grainview.accessor', "
-             "'grainview.stress') if m in sys.modules)))")
+             "'grainview.analysis.stress') if m in sys.modules)))")
     out = subprocess.run([sys.executable, "-c", probe], capture_output=True, text=True, check=True, cwd=ROOT)
     return set(json.loads(out.stdout.strip().splitlines()[-1]))
 
@@ -133,7 +200,7 @@ def test_opening_a_file_loads_xarray_and_the_accessor_but_no_analysis(tmp_path):
                                                                     "fn": [], "ft": []}])
     ds.to_netcdf(tmp_path / "two.nc", **netcdf_options(ds))
     loaded = _modules_after(f"import grainview.contract.io as io\nio.open_dataset({str(tmp_path / 'two.nc')!r})")
-    assert {"matplotlib", "grainview.stress"}.isdisjoint(loaded)
+    assert {"matplotlib", "grainview.analysis.stress"}.isdisjoint(loaded)
     assert "xarray" in loaded and "grainview.accessor" in loaded  # ds.grain is registered
 
 

@@ -8,8 +8,8 @@ import pytest
 import grainview
 from grainview.cli import main
 from grainview.plot import FIGURES
-from grainview.report import FIGURE_NAMES, NOT_REACHED, PER_RUN_FIGURES, POLYGON_FIGURES, convergence_text
-from grainview.strain import residual_window
+from grainview.app.report import FIGURE_NAMES, NOT_REACHED, PER_RUN_FIGURES, POLYGON_FIGURES, convergence_text
+from grainview.analysis.strain import residual_window
 
 WINDOW = 0.003
 """A residual window the tiny runs reach (they stop near eps_q ~0.008)."""

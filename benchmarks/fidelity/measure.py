@@ -3,7 +3,7 @@
 :func:`window_means` averages every descriptor over the snapshots of a shear-strain window;
 :func:`initial_state` reads the compacted sample. ``near`` is the counting convention: None
 counts the force-bearing contacts (the paper's stated rule), a gap in m adds the pairs within
-that gap (``grainview.contacts.in_network``).
+that gap (``grainview.analysis.contacts.in_network``).
 """
 
 from __future__ import annotations
@@ -33,7 +33,7 @@ def window_means(path, window=(0.4, np.inf), near=None) -> dict:
     anisotropy of the very weak contacts: < 0 when they lie across the major principal
     stress), the solid fraction; plus the window's snapshot count and eps_q range. ``near``:
     the counting convention (module docstring)."""
-    from grainview.force_pdf import pooled_force_pdf, strong_force_exponent
+    from grainview.analysis.force_pdf import pooled_force_pdf, strong_force_exponent
 
     ds = grainview.open_dataset(path, chunks=None)
     eps_q = ds.grain.strains()["eps_q"].values

@@ -1,11 +1,11 @@
-"""Lifting the pure array functions of :mod:`grainview.arrays` to labelled DataArrays.
+"""Lifting the pure array functions of :mod:`grainview.analysis.arrays` to labelled DataArrays.
 
 One helper, :func:`apply`, wraps :func:`xarray.apply_ufunc` with ``dask="parallelized"`` so
 that every topic module gets the same behaviour: the named core dimensions (``contact``,
 ``particle``, ``xy``...) are moved last and must be whole in each chunk, every other
 dimension (``time``) is broadcast, and a dask-backed input gives a lazy result chunked like it.
 The core dimensions of each array function are declared beside it
-(:mod:`grainview.arrays.signature`), so a topic module names only the sizes that depend on
+(:mod:`grainview.analysis.arrays.signature`), so a topic module names only the sizes that depend on
 its call (the number of angular bins...).
 """
 
@@ -25,7 +25,7 @@ def apply(func, *args, core_dims=None, output_core_dims=None, output_sizes=None,
     chunks.
 
     ``core_dims`` (one tuple per argument) and ``output_core_dims`` (one per output) default to
-    the function's declaration (:func:`grainview.arrays.signature.core_dims`). Returns a
+    the function's declaration (:func:`grainview.analysis.arrays.signature.core_dims`). Returns a
     DataArray, or a tuple of them when several outputs are declared; ``attrs`` and ``names``
     (one per output) are set on the results.
     """

@@ -14,8 +14,8 @@ from ._lift import apply, with_attrs
 from .arrays import coarse_graining as _cg
 from .arrays.tensors import principal
 from .contacts import selection
-from .contract.errors import ParameterError
-from .contract.shapes import particle_area
+from ..contract.errors import ParameterError
+from ..contract.shapes import particle_area
 
 __all__ = ["coarse_grained", "field_invariants", "scalar_field", "interior", "profile", "mean_diameter", "KERNELS",
            "QUANTITIES"]
@@ -107,12 +107,12 @@ def coarse_grained(ds: xr.Dataset, width=None, spacing=None, kernel: str = "gaus
     f = f_n n + f_t t the force of i on j, so that both stresses are positive in compression
     (docs/conventions.md §1). The contact stress integrates exactly:
     (1/A) int sigma^c dA = (1/V) sum_c f (x) l, the Love–Weber stress of
-    :func:`grainview.stress.stress_tensor` (V = A t), and int rho dA t = sum_i m_i, where the grid
+    :func:`grainview.analysis.stress.stress_tensor` (V = A t), and int rho dA t = sum_i m_i, where the grid
     covers every kernel (the default grid does); on the grid these integrals are sums times the
     cell area, exact up to the quadrature of the kernel by the grid (docs/analysis.md).
     The contact stress sums every contact the file holds, wall contacts included, as
-    :func:`grainview.stress.stress_tensor`; the fabric the force-bearing particle–particle
-    contacts, as :func:`grainview.fabric.fabric_tensor`. Masses are the file's, areas those of
+    :func:`grainview.analysis.stress.stress_tensor`; the fabric the force-bearing particle–particle
+    contacts, as :func:`grainview.analysis.fabric.fabric_tensor`. Masses are the file's, areas those of
     the particles' shapes (:func:`grainview.contract.shapes.particle_area`).
 
     Parameters
@@ -209,7 +209,7 @@ def field_invariants(fields: xr.Dataset, stress: str = "total") -> xr.Dataset:
         p = (s1 + s2)/2,    q = (s1 - s2)/2
 
     with s1 >= s2 the principal values of the symmetric part of the stress (Pa), as
-    :func:`grainview.stress.stress_invariants` for the whole sample.
+    :func:`grainview.analysis.stress.stress_invariants` for the whole sample.
 
     Parameters
     ----------
@@ -370,8 +370,8 @@ def profile(field: xr.DataArray, across: str = "x", inside=None) -> xr.DataArray
     over the nodes where ``g`` is defined (NaN skipped), optionally only those of ``inside``
     (a boolean field, e.g. ``fields.solid_fraction > 0.5`` to leave out the boundary layer).
     A shear band along the other axis shows as a peak or a dip of the profile; an inclined one
-    only in a profile along its own direction (:func:`grainview.shear_bands.profile_along`,
-    :func:`grainview.shear_bands.find_shear_band`).
+    only in a profile along its own direction (:func:`grainview.analysis.shear_bands.profile_along`,
+    :func:`grainview.analysis.shear_bands.find_shear_band`).
 
     Parameters
     ----------

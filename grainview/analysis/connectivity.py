@@ -15,7 +15,7 @@ import xarray as xr
 from ._lift import apply, with_attrs
 from .arrays import connectivity as _conn
 from .contacts import selection
-from .contract.errors import ParameterError
+from ..contract.errors import ParameterError
 
 __all__ = ["contact_numbers", "counts_of", "coordination", "connectivity_pdf",
            "joint_connectivity_pdf"]
@@ -25,7 +25,7 @@ def contact_numbers(ds: xr.Dataset, kind="all", walls: bool = False, near=None) 
     """c_i (time, particle): number of contacts of each particle, force-bearing ones by default.
 
     A double contact counts once (docs/conventions.md §7). ``near``:
-    :func:`grainview.contacts.in_network`.
+    :func:`grainview.analysis.contacts.in_network`.
 
     Parameters
     ----------
@@ -33,11 +33,11 @@ def contact_numbers(ds: xr.Dataset, kind="all", walls: bool = False, near=None) 
         A dataset of the contract (docs/schema.md), eager or chunked along ``time``.
     kind : {"all", "simple", "double"}, default "all"
         The contacts used: all, simple (vertex–edge and disk contacts) or double (edge–edge)
-        ones (also 1, 2, "s", "d"; :func:`grainview.contacts.kind_code`).
+        ones (also 1, 2, "s", "d"; :func:`grainview.analysis.contacts.kind_code`).
     walls : bool, default False
         Include the particle–wall contacts (default: particle–particle only).
     near : float, optional
-        Which pairs are contacts (:func:`grainview.contacts.in_network`): None (default) the
+        Which pairs are contacts (:func:`grainview.analysis.contacts.in_network`): None (default) the
         force-bearing ones, f_n > 0; a gap threshold in m adds the pairs with gap <= ``near``
         (they carry f_n = 0); ``np.inf`` every pair the file holds.
 
@@ -67,7 +67,7 @@ def counts_of(ds: xr.Dataset, mask: xr.DataArray) -> xr.DataArray:
     ds : xarray.Dataset
         A dataset of the contract (docs/schema.md), eager or chunked along ``time``.
     mask : xarray.DataArray
-        Boolean (time, contact), e.g. :func:`grainview.contacts.selection`.
+        Boolean (time, contact), e.g. :func:`grainview.analysis.contacts.selection`.
 
     Returns
     -------
@@ -106,7 +106,7 @@ def coordination(ds: xr.Dataset, walls: bool = False, min_contacts: int = 1, nea
     min_contacts : int, default 1
         A particle with fewer such contacts is a rattler, left out (default 1: none at all).
     near : float, optional
-        Which pairs are contacts (:func:`grainview.contacts.in_network`): None (default) the
+        Which pairs are contacts (:func:`grainview.analysis.contacts.in_network`): None (default) the
         force-bearing ones, f_n > 0; a gap threshold in m adds the pairs with gap <= ``near``
         (they carry f_n = 0); ``np.inf`` every pair the file holds.
 
@@ -155,7 +155,7 @@ def connectivity_pdf(ds: xr.Dataset, max_c: int = 10, walls: bool = False, min_c
     min_contacts : int, default 1
         A particle with fewer such contacts is a rattler, left out (default 1: none at all).
     near : float, optional
-        Which pairs are contacts (:func:`grainview.contacts.in_network`): None (default) the
+        Which pairs are contacts (:func:`grainview.analysis.contacts.in_network`): None (default) the
         force-bearing ones, f_n > 0; a gap threshold in m adds the pairs with gap <= ``near``
         (they carry f_n = 0); ``np.inf`` every pair the file holds.
 
@@ -204,7 +204,7 @@ def joint_connectivity_pdf(ds: xr.Dataset, max_m: int = 8, walls: bool = False, 
     min_contacts : int, default 1
         A particle with fewer such contacts is a rattler, left out (default 1: none at all).
     near : float, optional
-        Which pairs are contacts (:func:`grainview.contacts.in_network`): None (default) the
+        Which pairs are contacts (:func:`grainview.analysis.contacts.in_network`): None (default) the
         force-bearing ones, f_n > 0; a gap threshold in m adds the pairs with gap <= ``near``
         (they carry f_n = 0); ``np.inf`` every pair the file holds.
 

@@ -13,9 +13,9 @@ from __future__ import annotations
 import numpy as np
 import xarray as xr
 
-from .contract.errors import ParameterError
-from .contract.schema import KIND_DOUBLE, KIND_SIMPLE
-from .contract.validation import occupied
+from ..contract.errors import ParameterError
+from ..contract.schema import KIND_DOUBLE, KIND_SIMPLE
+from ..contract.validation import occupied
 
 __all__ = ["n_particles", "snapshot_index", "occupied", "is_wall_contact", "kind_code",
            "check_near", "in_network", "near_attr", "selection"]

@@ -35,8 +35,8 @@ from pathlib import Path
 import numpy as np
 import xarray as xr
 
-from .contract.errors import ParameterError
-from .contract.schema import EMPTY_ID, EMPTY_KIND
+from ..contract.errors import ParameterError
+from ..contract.schema import EMPTY_ID, EMPTY_KIND
 
 RUN_PARAMETERS = {
     "shape": ("preparation_shape",),
@@ -150,7 +150,7 @@ def open_ensemble(paths, chunks="auto", validate: bool = False, names=None) -> x
     >>> ens = open_ensemble("study/*.nc")                                   # doctest: +SKIP
     >>> seed_statistics(ens.grain.fabric_anisotropy()["a"], eps_q_bins=np.arange(0, 0.7, 0.05))  # doctest: +SKIP
     """
-    from .contract.io import open_dataset
+    from ..contract.io import open_dataset
 
     files = _paths(paths)
     if names is None:
@@ -287,7 +287,7 @@ def run_dataset(ens: xr.Dataset, run) -> xr.Dataset:
     Examples
     --------
     >>> ens = grainview.open_ensemble("ensemble/*.nc")            # doctest: +SKIP
-    >>> grainview.ensemble.run_dataset(ens, 0).grain.stress_invariants()  # doctest: +SKIP
+    >>> grainview.analysis.ensemble.run_dataset(ens, 0).grain.stress_invariants()  # doctest: +SKIP
     """
     if not is_ensemble(ens):
         raise ParameterError("not an ensemble: expected a Dataset with a 'run' dimension (open_ensemble)")

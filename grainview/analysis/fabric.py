@@ -13,7 +13,7 @@ from ._lift import apply, with_attrs
 from .arrays import fabric as _fabric
 from .arrays.tensors import principal, signed_anisotropy
 from .contacts import kind_code, selection
-from .contract.errors import ParameterError
+from ..contract.errors import ParameterError
 from .stress import stress_direction
 
 __all__ = ["fabric_tensor", "reference_direction", "fabric_anisotropy", "orientation_pdf",
@@ -35,11 +35,11 @@ def fabric_tensor(ds: xr.Dataset, kind="all", walls: bool = False, near=None) ->
         A dataset of the contract (docs/schema.md), eager or chunked along ``time``.
     kind : {"all", "simple", "double"}, default "all"
         The contacts used: all, simple (vertex–edge and disk contacts) or double (edge–edge)
-        ones (also 1, 2, "s", "d"; :func:`grainview.contacts.kind_code`).
+        ones (also 1, 2, "s", "d"; :func:`grainview.analysis.contacts.kind_code`).
     walls : bool, default False
         Include the particle–wall contacts (default: particle–particle only).
     near : float, optional
-        Which pairs are contacts (:func:`grainview.contacts.in_network`): None (default) the
+        Which pairs are contacts (:func:`grainview.analysis.contacts.in_network`): None (default) the
         force-bearing ones, f_n > 0; a gap threshold in m adds the pairs with gap <= ``near``
         (they carry f_n = 0); ``np.inf`` every pair the file holds.
 
@@ -70,7 +70,7 @@ def reference_direction(ds, reference):
     ds : xarray.Dataset
         A dataset of the contract (docs/schema.md), eager or chunked along ``time``.
     reference : "stress", None, float or xarray.DataArray
-        ``"stress"`` or None: :func:`grainview.stress.stress_direction`; a number: a fixed angle
+        ``"stress"`` or None: :func:`grainview.analysis.stress.stress_direction`; a number: a fixed angle
         in rad; a DataArray: the direction over time, rad.
 
     Returns
@@ -114,7 +114,7 @@ def fabric_anisotropy(ds: xr.Dataset, kind="all", walls: bool = False, reference
         A dataset of the contract (docs/schema.md), eager or chunked along ``time``.
     kind : {"all", "simple", "double"}, default "all"
         The contacts used: all, simple (vertex–edge and disk contacts) or double (edge–edge)
-        ones (also 1, 2, "s", "d"; :func:`grainview.contacts.kind_code`).
+        ones (also 1, 2, "s", "d"; :func:`grainview.analysis.contacts.kind_code`).
     walls : bool, default False
         Include the particle–wall contacts (default: particle–particle only).
     reference : "stress", float or xarray.DataArray, default "stress"
@@ -122,7 +122,7 @@ def fabric_anisotropy(ds: xr.Dataset, kind="all", walls: bool = False, reference
         direction of the whole sample (docs/conventions.md §3, "Signs"), a fixed angle in rad,
         or a DataArray over time.
     near : float, optional
-        Which pairs are contacts (:func:`grainview.contacts.in_network`): None (default) the
+        Which pairs are contacts (:func:`grainview.analysis.contacts.in_network`): None (default) the
         force-bearing ones, f_n > 0; a gap threshold in m adds the pairs with gap <= ``near``
         (they carry f_n = 0); ``np.inf`` every pair the file holds.
 
@@ -164,11 +164,11 @@ def orientation_pdf(ds: xr.Dataset, bins: int = 36, kind="all", walls: bool = Fa
         Number of angular sectors of [0, pi), centred on theta_k = k pi/bins.
     kind : {"all", "simple", "double"}, default "all"
         The contacts used: all, simple (vertex–edge and disk contacts) or double (edge–edge)
-        ones (also 1, 2, "s", "d"; :func:`grainview.contacts.kind_code`).
+        ones (also 1, 2, "s", "d"; :func:`grainview.analysis.contacts.kind_code`).
     walls : bool, default False
         Include the particle–wall contacts (default: particle–particle only).
     near : float, optional
-        Which pairs are contacts (:func:`grainview.contacts.in_network`): None (default) the
+        Which pairs are contacts (:func:`grainview.analysis.contacts.in_network`): None (default) the
         force-bearing ones, f_n > 0; a gap threshold in m adds the pairs with gap <= ``near``
         (they carry f_n = 0); ``np.inf`` every pair the file holds.
 

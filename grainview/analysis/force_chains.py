@@ -2,7 +2,7 @@
 by the method of Peters, Muthuswamy, Wibowo & Tordesillas, Phys. Rev. E 72, 041307 (2005), and
 followed from snapshot to snapshot (docs/analysis.md, "Force chains").
 
-The physics on plain arrays is :mod:`grainview.arrays.force_chains`; here it is lifted to the
+The physics on plain arrays is :mod:`grainview.analysis.arrays.force_chains`; here it is lifted to the
 labelled dataset, lazily along ``time`` (one snapshot's contacts and particles whole in each
 chunk).
 """
@@ -15,8 +15,8 @@ import xarray as xr
 from ._lift import apply, with_attrs
 from .arrays import force_chains as _chains
 from .contacts import selection
-from .contract.errors import ParameterError
-from .contract.shapes import particle_area
+from ..contract.errors import ParameterError
+from ..contract.shapes import particle_area
 from .sample import thickness
 
 __all__ = ["force_chains", "particle_volume", "DEFAULT_ANGLE"]
@@ -79,11 +79,11 @@ def force_chains(ds: xr.Dataset, angle: float = DEFAULT_ANGLE, min_size: int = 3
 
        x^c the contact's ``point``, x_p the particle's centre, s_pc = +1 for body i and -1 for
        body j, V_p its volume (:func:`particle_volume`); sum_p V_p sigma_p = V sigma, the
-       sample's stress (:func:`grainview.stress.stress_tensor` with walls);
+       sample's stress (:func:`grainview.analysis.stress.stress_tensor` with walls);
     2. its principal stresses sigma_1 >= sigma_2 and major direction theta_1;
     3. the chain particles: sigma_1 above the snapshot's mean of sigma_1 over all particles,
        with a major direction (an isotropic particle stress has none,
-       :data:`grainview.arrays.force_chains.ISOTROPY_TOLERANCE`);
+       :data:`grainview.analysis.arrays.force_chains.ISOTROPY_TOLERANCE`);
     4. a link for each force-bearing contact between two chain particles whose branch vector
        lies within ``angle`` of the major directions of both;
     5. chains: the connected sets of linked particles of at least ``min_size`` particles.
@@ -102,7 +102,7 @@ def force_chains(ds: xr.Dataset, angle: float = DEFAULT_ANGLE, min_size: int = 3
         ``max_length`` particles or more.
     follow : bool, default False
         Also follow the chains from snapshot to snapshot by their shared members
-        (:func:`grainview.arrays.force_chains.follow_chains`) and give their lifetimes. The
+        (:func:`grainview.analysis.arrays.force_chains.follow_chains`) and give their lifetimes. The
         tracks need every snapshot's chains, so the result is then computed (in one pass over
         the data, one time chunk at a time).
 
@@ -180,7 +180,7 @@ def force_chains(ds: xr.Dataset, angle: float = DEFAULT_ANGLE, min_size: int = 3
 
 
 def _tracks(chain: xr.DataArray, time: xr.DataArray) -> xr.Dataset:
-    """The tracks of :func:`grainview.arrays.force_chains.follow_chains` as a Dataset."""
+    """The tracks of :func:`grainview.analysis.arrays.force_chains.follow_chains` as a Dataset."""
     ids = np.asarray(chain.transpose("time", "particle").values)
     track, first, last, size = _chains.follow_chains(ids)
     times = np.asarray(time.values, float)

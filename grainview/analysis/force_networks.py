@@ -13,7 +13,7 @@ import xarray as xr
 from ._lift import apply, with_attrs
 from .arrays import force_networks as _net
 from .contacts import near_attr, selection
-from .contract.errors import ParameterError
+from ..contract.errors import ParameterError
 
 __all__ = ["force_class", "contact_proportions"]
 
@@ -39,7 +39,7 @@ def force_class(ds: xr.Dataset, very_weak: float = 0.1, strong: float = 1.0, wal
 
     <f_n> is the snapshot's mean normal force over the selected contacts. Defaults 0.1 and 1 as
     in the paper (Secs. V.B and V.C). ``near``: which pairs are contacts
-    (:func:`grainview.contacts.in_network`; default the force-bearing ones; with a gap threshold
+    (:func:`grainview.analysis.contacts.in_network`; default the force-bearing ones; with a gap threshold
     the near pairs, f_n = 0, are very weak).
 
     Parameters
@@ -53,7 +53,7 @@ def force_class(ds: xr.Dataset, very_weak: float = 0.1, strong: float = 1.0, wal
     walls : bool, default False
         Include the particle–wall contacts (default: particle–particle only).
     near : float, optional
-        Which pairs are contacts (:func:`grainview.contacts.in_network`): None (default) the
+        Which pairs are contacts (:func:`grainview.analysis.contacts.in_network`): None (default) the
         force-bearing ones, f_n > 0; a gap threshold in m adds the pairs with gap <= ``near``
         (they carry f_n = 0); ``np.inf`` every pair the file holds.
 
@@ -121,7 +121,7 @@ def contact_proportions(ds: xr.Dataset, walls: bool = False, very_weak: float = 
       all contacts (the paper finds about 0.32 = 0.25 simple + 0.07 double for pentagons);
     * n_contacts, and the means mean_fn, mean_fn_simple, mean_fn_double in N.
 
-    ``near``: which pairs are contacts (:func:`grainview.contacts.in_network`): None (default)
+    ``near``: which pairs are contacts (:func:`grainview.analysis.contacts.in_network`): None (default)
     the force-bearing ones; with a gap threshold in m the near pairs count too, with f_n = 0
     (they are very weak). Lazy on dask input.
 
@@ -136,7 +136,7 @@ def contact_proportions(ds: xr.Dataset, walls: bool = False, very_weak: float = 
     strong : float, default 1.0
         Strong threshold, a multiple of <f_n> (finite, >= 0).
     near : float, optional
-        Which pairs are contacts (:func:`grainview.contacts.in_network`): None (default) the
+        Which pairs are contacts (:func:`grainview.analysis.contacts.in_network`): None (default) the
         force-bearing ones, f_n > 0; a gap threshold in m adds the pairs with gap <= ``near``
         (they carry f_n = 0); ``np.inf`` every pair the file holds.
 

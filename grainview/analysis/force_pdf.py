@@ -16,7 +16,7 @@ import xarray as xr
 from ._lift import apply, with_attrs
 from .arrays import force_pdf as _pdf
 from .contacts import kind_code, selection
-from .contract.errors import ParameterError
+from ..contract.errors import ParameterError
 
 __all__ = ["force_pdf", "pooled_force_pdf", "strong_force_exponent"]
 
@@ -112,7 +112,7 @@ def force_pdf(ds: xr.Dataset, bins: int = 50, scale: str = "log", range=None, ki
     walls : bool, default False
         Include the particle–wall contacts (default: particle–particle only).
     near : float, optional
-        Which pairs are contacts (:func:`grainview.contacts.in_network`): None (default) the
+        Which pairs are contacts (:func:`grainview.analysis.contacts.in_network`): None (default) the
         force-bearing ones, f_n > 0; a gap threshold in m adds the pairs with gap <= ``near``
         (they carry f_n = 0); ``np.inf`` every pair the file holds.
 
@@ -159,7 +159,7 @@ def pooled_force_pdf(ds: xr.Dataset, bins: int = 50, scale: str = "log", range=N
     walls : bool, default False
         Include the particle–wall contacts (default: particle–particle only).
     near : float, optional
-        Which pairs are contacts (:func:`grainview.contacts.in_network`): None (default) the
+        Which pairs are contacts (:func:`grainview.analysis.contacts.in_network`): None (default) the
         force-bearing ones, f_n > 0; a gap threshold in m adds the pairs with gap <= ``near``
         (they carry f_n = 0); ``np.inf`` every pair the file holds.
 

@@ -28,7 +28,7 @@ def angular_force_averages(ds: xr.Dataset, bins: int = 36, kind="all", walls: bo
 
     S(theta) = [theta - dtheta/2, theta + dtheta/2] with dtheta = pi/bins, N_c(theta) the
     number of selected contacts whose normal falls in it (paper Eq. fnft, Fig. 10); NaN in
-    empty sectors. ``near``: which pairs are contacts (:func:`grainview.contacts.in_network`;
+    empty sectors. ``near``: which pairs are contacts (:func:`grainview.analysis.contacts.in_network`;
     default force-bearing only).
 
     Parameters
@@ -39,11 +39,11 @@ def angular_force_averages(ds: xr.Dataset, bins: int = 36, kind="all", walls: bo
         Number of angular sectors of [0, pi), centred on theta_k = k pi/bins.
     kind : {"all", "simple", "double"}, default "all"
         The contacts used: all, simple (vertex–edge and disk contacts) or double (edge–edge)
-        ones (also 1, 2, "s", "d"; :func:`grainview.contacts.kind_code`).
+        ones (also 1, 2, "s", "d"; :func:`grainview.analysis.contacts.kind_code`).
     walls : bool, default False
         Include the particle–wall contacts (default: particle–particle only).
     near : float, optional
-        Which pairs are contacts (:func:`grainview.contacts.in_network`): None (default) the
+        Which pairs are contacts (:func:`grainview.analysis.contacts.in_network`): None (default) the
         force-bearing ones, f_n > 0; a gap threshold in m adds the pairs with gap <= ``near``
         (they carry f_n = 0); ``np.inf`` every pair the file holds.
 
@@ -88,11 +88,11 @@ def force_tensors(ds: xr.Dataset, bins: int = 36, kind="all", walls: bool = Fals
         Number of angular sectors of [0, pi), centred on theta_k = k pi/bins.
     kind : {"all", "simple", "double"}, default "all"
         The contacts used: all, simple (vertex–edge and disk contacts) or double (edge–edge)
-        ones (also 1, 2, "s", "d"; :func:`grainview.contacts.kind_code`).
+        ones (also 1, 2, "s", "d"; :func:`grainview.analysis.contacts.kind_code`).
     walls : bool, default False
         Include the particle–wall contacts (default: particle–particle only).
     near : float, optional
-        Which pairs are contacts (:func:`grainview.contacts.in_network`): None (default) the
+        Which pairs are contacts (:func:`grainview.analysis.contacts.in_network`): None (default) the
         force-bearing ones, f_n > 0; a gap threshold in m adds the pairs with gap <= ``near``
         (they carry f_n = 0); ``np.inf`` every pair the file holds.
 
@@ -136,15 +136,15 @@ def force_anisotropies(ds: xr.Dataset, bins: int = 36, kind="all", walls: bool =
         Number of angular sectors of [0, pi), centred on theta_k = k pi/bins.
     kind : {"all", "simple", "double"}, default "all"
         The contacts used: all, simple (vertex–edge and disk contacts) or double (edge–edge)
-        ones (also 1, 2, "s", "d"; :func:`grainview.contacts.kind_code`).
+        ones (also 1, 2, "s", "d"; :func:`grainview.analysis.contacts.kind_code`).
     walls : bool, default False
         Include the particle–wall contacts (default: particle–particle only).
     reference : "stress", float or xarray.DataArray, default "stress"
         The reference direction theta' of the signs (rad): ``"stress"`` the major principal
         stress direction of the whole sample, a fixed angle in rad, or a DataArray over time
-        (:func:`grainview.fabric.reference_direction`).
+        (:func:`grainview.analysis.fabric.reference_direction`).
     near : float, optional
-        Which pairs are contacts (:func:`grainview.contacts.in_network`): None (default) the
+        Which pairs are contacts (:func:`grainview.analysis.contacts.in_network`): None (default) the
         force-bearing ones, f_n > 0; a gap threshold in m adds the pairs with gap <= ``near``
         (they carry f_n = 0); ``np.inf`` every pair the file holds.
 
@@ -195,7 +195,7 @@ def harmonic_prediction(ds: xr.Dataset, bins: int = 36, walls: bool = False, nea
 
     The anisotropies use the contacts selected by ``walls`` (default particle–particle);
     q/p is the stress of the whole sample (wall contacts included). ``near``: which pairs are
-    contacts of the anisotropies (:func:`grainview.contacts.in_network`).
+    contacts of the anisotropies (:func:`grainview.analysis.contacts.in_network`).
 
     Parameters
     ----------
@@ -206,7 +206,7 @@ def harmonic_prediction(ds: xr.Dataset, bins: int = 36, walls: bool = False, nea
     walls : bool, default False
         Include the particle–wall contacts (default: particle–particle only).
     near : float, optional
-        Which pairs are contacts (:func:`grainview.contacts.in_network`): None (default) the
+        Which pairs are contacts (:func:`grainview.analysis.contacts.in_network`): None (default) the
         force-bearing ones, f_n > 0; a gap threshold in m adds the pairs with gap <= ``near``
         (they carry f_n = 0); ``np.inf`` every pair the file holds.
 

@@ -2,7 +2,7 @@
 
 A contact is a pair of bodies {i, j} (particle–particle, and particle–wall with ``walls``)
 present in the network (force-bearing, f_n > 0, unless ``near`` adds the pairs within that gap;
-:func:`grainview.contacts.in_network`), identified as in :mod:`grainview.persistence`. A
+:func:`grainview.analysis.contacts.in_network`), identified as in :mod:`grainview.analysis.persistence`. A
 *life* is a run of consecutive snapshots b, b+1, ..., d-1 in which the pair is present, with
 the pair absent at d: it is born at t_b and dies at t_d, and its lifetime is
 
@@ -33,7 +33,7 @@ import xarray as xr
 
 from ._lift import with_attrs
 from .contacts import check_near, n_particles, near_attr
-from .contract.errors import ParameterError
+from ..contract.errors import ParameterError
 from .persistence import _blocks, _check_flag, body_count
 
 __all__ = ["contact_events", "kaplan_meier", "lifetime_survival", "median_lifetime_by_force", "strong_persistence"]
@@ -115,7 +115,7 @@ def contact_events(ds: xr.Dataset, walls: bool = True, near=None) -> xr.Dataset:
         Follow particle–wall contacts too (``j >= N``).
     near : float, optional
         Gap threshold (m) adding the unloaded pairs within it to the network
-        (:func:`grainview.contacts.in_network`); None counts force-bearing contacts only.
+        (:func:`grainview.analysis.contacts.in_network`); None counts force-bearing contacts only.
 
     Returns
     -------
@@ -165,7 +165,7 @@ def contact_events(ds: xr.Dataset, walls: bool = True, near=None) -> xr.Dataset:
                                    ("birth_fn", "N", "normal force at the first snapshot of the life")):
         out[name] = with_attrs(out[name], name, units, long_name)
     out.attrs.update(walls=int(walls), near=near_attr(near), n_particles=n_particles(ds),
-                     comment="lifetimes resolved to the snapshot interval (grainview.lifetimes)")
+                     comment="lifetimes resolved to the snapshot interval (grainview.analysis.lifetimes)")
     return out
 
 

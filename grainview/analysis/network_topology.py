@@ -2,7 +2,7 @@
 decreasing normal force, Betti curves beta_0(xi), beta_1(xi), and 3- and 4-cycles by force
 class (docs/analysis.md, "Topology of the force network").
 
-Not to be confused with :mod:`grainview.persistence`, the persistence of contacts in TIME.
+Not to be confused with :mod:`grainview.analysis.persistence`, the persistence of contacts in TIME.
 """
 
 from __future__ import annotations
@@ -13,7 +13,7 @@ import xarray as xr
 from ._lift import apply, with_attrs
 from .arrays import network_topology as _topology
 from .contacts import near_attr, selection
-from .contract.errors import ParameterError
+from ..contract.errors import ParameterError
 from .persistence import body_count
 from .xi_network import DEFAULT_XI, _check_xi
 
@@ -44,7 +44,7 @@ def network_persistence(ds: xr.Dataset, xi=DEFAULT_XI, dimensions=(0, 1), strong
     The filtration: each selected contact is an edge of value xi_c = f_n,c / <f_n> (<f_n> the
     snapshot's mean over the selection); the complex at threshold xi holds the edges with
     xi_c >= xi — the network stronger than xi, the complement of the xi-network f_n < xi <f_n>
-    (:func:`grainview.xi_network.xi_network`) — with their bodies, and every triangle of three
+    (:func:`grainview.analysis.xi_network.xi_network`) — with their bodies, and every triangle of three
     such edges (clique complex: a triangle enters with its weakest edge). Lowering xi from the
     largest force to 0 adds contacts: a feature is born at xi = ``birth`` and dies at
     xi = ``death`` <= ``birth``; a body enters with its strongest contact. Dimension 0: the
@@ -71,7 +71,7 @@ def network_persistence(ds: xr.Dataset, xi=DEFAULT_XI, dimensions=(0, 1), strong
     four triangles (an octahedron's eight) close a 2-sphere, which no tetrahedron fills; its
     last triangle fills no loop, and the sphere is not reported (dimension 1 is the same as in
     the full clique complex). The tests check dimension 1 against gudhi
-    (:func:`grainview.arrays.network_topology.diagrams_gudhi`, ``pip install
+    (:func:`grainview.analysis.arrays.network_topology.diagrams_gudhi`, ``pip install
     'grainview[topology]'``), which is not needed to compute it.
 
     Parameters
@@ -87,7 +87,7 @@ def network_persistence(ds: xr.Dataset, xi=DEFAULT_XI, dimensions=(0, 1), strong
     walls : bool, default False
         Include the particle–wall contacts, each wall one node.
     near : float, optional
-        Which pairs are contacts (:func:`grainview.contacts.in_network`); near pairs carry
+        Which pairs are contacts (:func:`grainview.analysis.contacts.in_network`); near pairs carry
         f_n = 0 and enter at xi = 0.
     max_features : int, optional
         Length of the ``feature`` dimension: the most persistent features of each snapshot are

@@ -45,7 +45,7 @@ def particle_fields(ds: xr.Dataset, reference: int = 0, walls: bool = True, near
     walls : bool, default True
         Include the particle–wall contacts; ``False`` leaves them out.
     near : float, optional
-        Which pairs are contacts (:func:`grainview.contacts.in_network`): None (default) the
+        Which pairs are contacts (:func:`grainview.analysis.contacts.in_network`): None (default) the
         force-bearing ones, f_n > 0; a gap threshold in m adds the pairs with gap <= ``near``
         (they carry f_n = 0); ``np.inf`` every pair the file holds.
     min_contacts : int, default 1

@@ -19,8 +19,8 @@ import xarray as xr
 
 from ._lift import with_attrs
 from .contacts import check_near, n_particles, near_attr, selection, snapshot_index
-from .contract.errors import ParameterError
-from .contract.schema import KIND_DOUBLE, KIND_SIMPLE
+from ..contract.errors import ParameterError
+from ..contract.schema import KIND_DOUBLE, KIND_SIMPLE
 
 __all__ = ["body_count", "pair_keys", "time_blocks", "persistence", "type_transitions"]
 
@@ -128,7 +128,7 @@ def persistence(ds: xr.Dataset, reference: int = 0, uninterrupted: bool = False,
 
     C(t) the set of pairs {i, j} in contact at t (particle–particle unless ``walls``;
     force-bearing, f_n > 0, unless ``near`` adds the pairs within that gap,
-    :func:`grainview.contacts.in_network`). With ``uninterrupted=True`` a contact counts only if
+    :func:`grainview.analysis.contacts.in_network`). With ``uninterrupted=True`` a contact counts only if
     present at every snapshot from the reference to t. gamma is 1 at the reference and NaN
     before it (and NaN if the reference holds no contact). Computed (not lazy), streaming one
     time-chunk at a time (paper Sec. IV.A, Fig. 6b; docs/conventions.md §8).
@@ -144,7 +144,7 @@ def persistence(ds: xr.Dataset, reference: int = 0, uninterrupted: bool = False,
     walls : bool, default False
         Include the particle–wall contacts (default: particle–particle only).
     near : float, optional
-        Which pairs are contacts (:func:`grainview.contacts.in_network`): None (default) the
+        Which pairs are contacts (:func:`grainview.analysis.contacts.in_network`): None (default) the
         force-bearing ones, f_n > 0; a gap threshold in m adds the pairs with gap <= ``near``
         (they carry f_n = 0); ``np.inf`` every pair the file holds.
 
@@ -238,7 +238,7 @@ def type_transitions(ds: xr.Dataset, walls: bool = False, near=None) -> xr.Datas
                       / N_c(t-1),
 
     N_c(t-1) the number of contacts at t-1 (particle–particle unless ``walls``; force-bearing
-    unless ``near`` adds near pairs, :func:`grainview.contacts.in_network`); likewise
+    unless ``near`` adds near pairs, :func:`grainview.analysis.contacts.in_network`); likewise
     g_{d->s}. Then
 
         Delta gamma(t) = sum_{t' <= t} g(t'),
@@ -254,7 +254,7 @@ def type_transitions(ds: xr.Dataset, walls: bool = False, near=None) -> xr.Datas
     walls : bool, default False
         Include the particle–wall contacts (default: particle–particle only).
     near : float, optional
-        Which pairs are contacts (:func:`grainview.contacts.in_network`): None (default) the
+        Which pairs are contacts (:func:`grainview.analysis.contacts.in_network`): None (default) the
         force-bearing ones, f_n > 0; a gap threshold in m adds the pairs with gap <= ``near``
         (they carry f_n = 0); ``np.inf`` every pair the file holds.
 

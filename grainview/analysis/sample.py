@@ -5,7 +5,7 @@ from __future__ import annotations
 import xarray as xr
 
 from ._lift import with_attrs
-from .contract.shapes import particle_area_of
+from ..contract.shapes import particle_area_of
 
 __all__ = ["thickness", "width", "height", "volume", "solid_fraction", "area"]
 

@@ -14,7 +14,7 @@ from __future__ import annotations
 import numpy as np
 import xarray as xr
 
-from .contract.errors import ParameterError
+from ..contract.errors import ParameterError
 
 __all__ = ["profile_along", "find_shear_band", "normal_distance", "DEFAULT_ANGLES", "DEFAULT_CONTRAST",
            "DEFAULT_STRIP_CELLS"]

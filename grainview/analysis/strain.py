@@ -13,7 +13,7 @@ import xarray as xr
 from . import sample
 from ._lift import with_attrs
 from .arrays.strain import log_strain
-from .contract.errors import ParameterError
+from ..contract.errors import ParameterError
 from .stress import stress_invariants
 
 __all__ = ["time_derivative", "strains", "residual_window", "friction_and_dilatancy",
@@ -156,7 +156,7 @@ def friction_and_dilatancy(ds: xr.Dataset, reference: int = 0) -> xr.Dataset:
         sin psi_incremental = d eps_p / d eps_q (centred differences in time).
 
     Values of the sines outside [-1, 1] give NaN rather than a clipped angle. q/p is that of
-    the whole sample, wall contacts included (:func:`grainview.stress.stress_invariants`).
+    the whole sample, wall contacts included (:func:`grainview.analysis.stress.stress_invariants`).
 
     Parameters
     ----------

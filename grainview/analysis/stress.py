@@ -3,7 +3,7 @@ stresses of simple and double contacts (paper Eqs. M and sigmasd; docs/conventio
 
 By default the stress includes the particle–wall contacts: with them the sum over contacts
 equals the sum of the particles' tensorial moments exactly (see
-:func:`grainview.arrays.stress.stress_tensor`), i.e. the stress the walls apply.
+:func:`grainview.analysis.arrays.stress.stress_tensor`), i.e. the stress the walls apply.
 """
 
 from __future__ import annotations
@@ -26,7 +26,7 @@ def stress_tensor(ds: xr.Dataset, kind="all", walls: bool = True) -> xr.DataArra
         sigma = (1/V) sum_c f^c (x) l^c
 
     with f^c = f_n n + f_t t the force of contact c (N), l^c its branch vector (m) and V the
-    volume of the sample box (:func:`grainview.sample.volume`, m3); compression positive
+    volume of the sample box (:func:`grainview.analysis.sample.volume`, m3); compression positive
     (paper Eq. M, docs/conventions.md §1).
 
     ``kind="simple"`` or ``"double"`` restricts the sum to one contact kind, so that
@@ -41,7 +41,7 @@ def stress_tensor(ds: xr.Dataset, kind="all", walls: bool = True) -> xr.DataArra
         A dataset of the contract (docs/schema.md), eager or chunked along ``time``.
     kind : {"all", "simple", "double"}, default "all"
         The contacts used: all, simple (vertex–edge and disk contacts) or double (edge–edge)
-        ones (also 1, 2, "s", "d"; :func:`grainview.contacts.kind_code`).
+        ones (also 1, 2, "s", "d"; :func:`grainview.analysis.contacts.kind_code`).
     walls : bool, default True
         Include the particle–wall contacts; ``False`` leaves them out.
 
@@ -86,7 +86,7 @@ def stress_invariants(ds: xr.Dataset, kind="all", walls: bool = True,
         A dataset of the contract (docs/schema.md), eager or chunked along ``time``.
     kind : {"all", "simple", "double"}, default "all"
         The contacts used: all, simple (vertex–edge and disk contacts) or double (edge–edge)
-        ones (also 1, 2, "s", "d"; :func:`grainview.contacts.kind_code`).
+        ones (also 1, 2, "s", "d"; :func:`grainview.analysis.contacts.kind_code`).
     walls : bool, default True
         Include the particle–wall contacts; ``False`` leaves them out.
     sigma : xarray.DataArray, optional

@@ -1,5 +1,5 @@
 """A reader's summary of a dataset of the contract, in a few lines: what the report's index
-says of each run and, read from the file without xarray (:mod:`grainview.file_summary`), what
+says of each run and, read from the file without xarray (:mod:`grainview.app.file_summary`), what
 ``grainview info`` prints."""
 
 from __future__ import annotations
@@ -11,7 +11,7 @@ def describe(ds) -> list:
     """A reader's summary of a dataset of the contract: size and shapes, snapshots, strain and
     q/p reached, and the settings a physicist asks for first, in readable units (what the
     report's index says of each run; ``grainview info`` prints the same lines from the file,
-    :func:`grainview.file_summary.describe_file`)."""
+    :func:`grainview.app.file_summary.describe_file`)."""
     snapshots = ds.sizes.get("time", 0)
     facts = {"n_vertices": ds["n_vertices"].values, "n_walls": ds.sizes.get("wall", 0), "regular": regular_of(ds),
              "n_slots": ds.sizes["contact"], "snapshots": snapshots}
@@ -47,7 +47,7 @@ def shape_counts(n_vertices, regular=None) -> str:
 def regular_of(ds) -> np.ndarray:
     """(P,) bool: which particles of a dataset of the contract are regular polygons
     (:func:`grainview.contract.shapes.regular_polygons` of its ``vertices``, when it has them)."""
-    from .contract.shapes import regular_polygons
+    from ..contract.shapes import regular_polygons
 
     n_vertices = np.asarray(ds["n_vertices"].values)
     if "vertices" not in ds.variables:  # the contract: without vertices, every polygon is regular

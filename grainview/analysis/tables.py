@@ -13,7 +13,7 @@ import numpy as np
 import xarray as xr
 
 from .contacts import n_particles, occupied, snapshot_index
-from .contract.errors import ParameterError
+from ..contract.errors import ParameterError
 from .persistence import body_count
 
 __all__ = ["contacts_table", "contact_graph"]

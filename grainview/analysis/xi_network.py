@@ -15,7 +15,7 @@ import xarray as xr
 from ._lift import apply, with_attrs
 from .arrays import xi_network as _xi
 from .contacts import selection
-from .contract.errors import ParameterError
+from ..contract.errors import ParameterError
 from .sample import volume
 from .stress import stress_invariants
 
@@ -46,7 +46,7 @@ def xi_network(ds: xr.Dataset, xi=DEFAULT_XI, walls: bool = False, near=None) ->
 
     * ``q_over_p``: deviator q(xi) = (s1 - s2)/2 of the stress sigma(xi) = (1/V) sum f (x) l
       over the subset alone, divided by the mean stress p of the WHOLE sample, wall contacts
-      included (:func:`grainview.stress.stress_invariants` with its default ``walls=True``),
+      included (:func:`grainview.analysis.stress.stress_invariants` with its default ``walls=True``),
       paper Fig. 15;
     * ``a_prime``: signed fabric anisotropy of the subset, a'(xi) = 2 (F_1 - F_2)
       cos 2(theta_F - theta_sigma), with F(xi) = (1/N(xi)) sum n (x) n normalised by the
@@ -54,7 +54,7 @@ def xi_network(ds: xr.Dataset, xi=DEFAULT_XI, walls: bool = False, near=None) ->
       paper Fig. 16 (NaN while the subset is empty);
     * ``contact_fraction``: N(xi)/N_c; ``count``: N(xi).
 
-    One sort per snapshot serves every xi (see :mod:`grainview.arrays.xi_network`).
+    One sort per snapshot serves every xi (see :mod:`grainview.analysis.arrays.xi_network`).
 
     Parameters
     ----------
@@ -65,7 +65,7 @@ def xi_network(ds: xr.Dataset, xi=DEFAULT_XI, walls: bool = False, near=None) ->
     walls : bool, default False
         Include the particle–wall contacts (default: particle–particle only).
     near : float, optional
-        Which pairs are contacts (:func:`grainview.contacts.in_network`): None (default) the
+        Which pairs are contacts (:func:`grainview.analysis.contacts.in_network`): None (default) the
         force-bearing ones, f_n > 0; a gap threshold in m adds the pairs with gap <= ``near``
         (they carry f_n = 0); ``np.inf`` every pair the file holds.
         Near pairs carry f_n = 0 and so belong to every xi-network with xi > 0.

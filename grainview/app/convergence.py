@@ -22,7 +22,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .contract.schema import complete_snapshots
+from ..contract.schema import complete_snapshots
 
 COUNT = "nlgs_unconverged_steps"
 """The variable that holds, per snapshot, the unconverged steps since the previous one."""

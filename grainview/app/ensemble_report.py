@@ -1,8 +1,8 @@
 """The report of an ensemble: the headline numbers of every run, reduced over the seeds of
 each setting to mean +- spread with the number of seeds, next to the paper's values.
 
-:func:`ensemble_table` computes :func:`grainview.report.run_summary` for every run of an
-ensemble (:func:`grainview.ensemble.open_ensemble`) and groups the runs by ``group`` (the
+:func:`ensemble_table` computes :func:`grainview.app.report.run_summary` for every run of an
+ensemble (:func:`grainview.analysis.ensemble.open_ensemble`) and groups the runs by ``group`` (the
 parameters other than the seed). Each number is then the mean over the group's seeds, its
 sample standard deviation (ddof = 1) and standard error, and the count of seeds that have it
 (a run short of the residual window counts for none of the residual rows).
@@ -18,10 +18,10 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from .ensemble import run_dataset, seed_statistics
-from .contract.errors import ParameterError
+from ..analysis.ensemble import run_dataset, seed_statistics
+from ..contract.errors import ParameterError
 from .report import INITIAL_ROWS, NOT_REACHED, PAPER, paper_key
-from .strain import RESIDUAL_STRAIN
+from ..analysis.strain import RESIDUAL_STRAIN
 
 DESCRIPTION = ("particles", "seed", "preparation", "residual window", "double-contact criterion")
 """Rows of a run's summary that describe it rather than measure it (left out of the statistics)."""
@@ -33,7 +33,7 @@ REACHED = "residual window reached"
 
 def run_table(ens, residual_strain: float = RESIDUAL_STRAIN, log=None) -> pd.DataFrame:
     """The headline numbers of every run (rows: runs named as ``run``; columns: the rows of
-    :data:`grainview.report.PAPER`, NaN where a run has no number) with the run's ``group`` and
+    :data:`grainview.app.report.PAPER`, NaN where a run has no number) with the run's ``group`` and
     whether it reaches the residual window (:data:`REACHED`). The residual rows are kept when
     a run does not reach the window, so that the report can say so; other rows without any
     number are left out."""
@@ -120,9 +120,9 @@ def write_ensemble_report(ens, out, residual_strain: float = RESIDUAL_STRAIN, ov
     a report is refused unless ``overwrite``."""
     import matplotlib.pyplot as plt
 
-    from .plot._style import save_figure
+    from ..plot._style import save_figure
     from .report import file_link
-    from .plot.ensemble import seed_bands
+    from ..plot.ensemble import seed_bands
 
     out = Path(out)
     if not overwrite and (out / "headline.csv").exists():

@@ -2,8 +2,8 @@
 
 Importing xarray, pandas and dask takes about a second on its own, longer than the whole
 summary of a study's file. So the summary that ``grainview info`` prints is read here with
-netCDF4, computed with the pure array functions of :mod:`grainview.arrays` (the same physics
-as the accessors) and formatted by :func:`grainview.summary.summary_lines` (the same lines as
+netCDF4, computed with the pure array functions of :mod:`grainview.analysis.arrays` (the same physics
+as the accessors) and formatted by :func:`grainview.analysis.summary.summary_lines` (the same lines as
 the report's index). The checks made on the way: the file opens as netCDF, it is a grainview
 file, its structure and units follow the contract (:func:`grainview.contract.schema.structure_problems`,
 :func:`grainview.contract.schema.unit_problems`), a netCDF-3 file is neither shorter than its fixed data
@@ -22,12 +22,12 @@ import os
 
 import numpy as np
 
-from .contract.errors import FileFormatError, SchemaError
-from .contract.file_checks import (COUNT_OUT_OF_RANGE, damaged_snapshots, force_problems, foreign_file_problems,
+from ..contract.errors import FileFormatError, SchemaError
+from ..contract.file_checks import (COUNT_OUT_OF_RANGE, damaged_snapshots, force_problems, foreign_file_problems,
                           order_problems)
-from .contract.schema import complete_snapshots, missing_units, structure_problems, unit_problems
-from .contract.shapes import particle_area, regular_polygons, shape_problems
-from .contract.writer import netcdf3_data_bytes
+from ..contract.schema import complete_snapshots, missing_units, structure_problems, unit_problems
+from ..contract.shapes import particle_area, regular_polygons, shape_problems
+from ..contract.writer import netcdf3_data_bytes
 
 __all__ = ["read_facts", "describe_file"]
 
@@ -51,14 +51,14 @@ def _check_netcdf3_size(nc, source) -> None:
     size is not known to netCDF4: a file longer than its data by two records or more is
     measured exactly (:func:`grainview.contract.io.open_dataset`'s check, with scipy), others cannot
     hide records."""
-    from .contract.file_checks import HIDDEN_RECORDS_TOLERATED
+    from ..contract.file_checks import HIDDEN_RECORDS_TOLERATED
 
     fixed, record, n_records = _netcdf3_data(nc)
     needed, size = fixed + n_records * record, os.path.getsize(source)
     if size < needed:
         raise FileFormatError(f"{source}: truncated file ({size} bytes, its data need at least {needed})")
     if record and (size - needed) // record > HIDDEN_RECORDS_TOLERATED:
-        from .contract.netcdf3 import check_netcdf3_length
+        from ..contract.netcdf3 import check_netcdf3_length
 
         check_netcdf3_length(source)
 
@@ -74,7 +74,7 @@ def read_facts(path) -> tuple[dict, dict]:
     Returns
     -------
     facts : dict
-        What :func:`grainview.summary.summary_lines` reads: ``n_vertices``, ``regular``
+        What :func:`grainview.analysis.summary.summary_lines` reads: ``n_vertices``, ``regular``
         (which polygons are regular, :func:`grainview.contract.shapes.regular_polygons`), ``n_walls``,
         ``n_slots``, ``snapshots`` (complete ones), ``time`` (s), ``contact_count``,
         ``solid_fraction``, ``eps_1`` and ``eps_q`` of the last snapshot (log strains against
@@ -98,9 +98,9 @@ def read_facts(path) -> tuple[dict, dict]:
     """
     import netCDF4
 
-    from .arrays.strain import log_strain
-    from .arrays.stress import stress_tensor
-    from .arrays.tensors import principal
+    from ..analysis.arrays.strain import log_strain
+    from ..analysis.arrays.stress import stress_tensor
+    from ..analysis.arrays.tensors import principal
 
     source = os.fspath(path)
     if not os.path.exists(source):
@@ -173,9 +173,9 @@ def read_facts(path) -> tuple[dict, dict]:
 
 def describe_file(path) -> tuple[list, dict]:
     """The lines ``grainview info`` prints for ``path`` (:func:`read_facts`, formatted by
-    :func:`grainview.summary.summary_lines`, then the file's size and format, and a note on
+    :func:`grainview.analysis.summary.summary_lines`, then the file's size and format, and a note on
     variables without units) and the file's global attributes."""
-    from .summary import summary_lines
+    from ..analysis.summary import summary_lines
 
     facts, attrs = read_facts(path)
     lines = summary_lines(facts, attrs)

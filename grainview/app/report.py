@@ -3,7 +3,7 @@ every figure the data supports.
 
 :func:`headline_table` reduces each run to the numbers the paper quotes (docs/fidelity.md
 lists them with the paper's sections), averaged over its *residual state*: the snapshots with
-eps_q >= ``residual_strain`` (default 0.3, :func:`grainview.strain.residual_window`). A run
+eps_q >= ``residual_strain`` (default 0.3, :func:`grainview.analysis.strain.residual_window`). A run
 that stops short of it reports "not reached" for every residual value instead of another
 state's average. The table also says what it describes: particles, seed, preparation, the
 strain window and its snapshots, and the double-contact criterion of the run.
@@ -18,8 +18,8 @@ import numpy as np
 import pandas as pd
 import xarray as xr
 
-from .contract.errors import ParameterError
-from .strain import RESIDUAL_STRAIN, residual_window
+from ..contract.errors import ParameterError
+from ..analysis.strain import RESIDUAL_STRAIN, residual_window
 
 NOT_REACHED = "not reached"
 """Value of a residual-state row of a run that stops short of the residual window."""
@@ -77,7 +77,7 @@ def _ratio(a, b):
 
 def describe_run(ds: xr.Dataset, window: xr.DataArray, residual_strain: float) -> dict:
     """The rows that say what a run is: particles, seed, preparation, window, criterion."""
-    from .summary import regular_of, shape_counts
+    from ..analysis.summary import regular_of, shape_counts
 
     attrs = ds.attrs
     n_vertices = ds["n_vertices"].values
@@ -105,16 +105,16 @@ def describe_run(ds: xr.Dataset, window: xr.DataArray, residual_strain: float) -
 def run_summary(ds: xr.Dataset, residual_strain: float = RESIDUAL_STRAIN) -> dict:
     """The headline numbers of one run (keys as in :data:`PAPER`), residual values averaged
     over the snapshots with eps_q >= ``residual_strain`` ("not reached" when there are none)."""
-    from .force_networks import contact_proportions
-    from .force_pdf import pooled_force_pdf, strong_force_exponent
-    from .strain import strains
+    from ..analysis.force_networks import contact_proportions
+    from ..analysis.force_pdf import pooled_force_pdf, strong_force_exponent
+    from ..analysis.strain import strains
 
     window = residual_window(ds, residual_strain)
     window = window.assign_coords(eps_q=strains(ds)["eps_q"].compute())
     out = describe_run(ds, window, residual_strain)
     out["solid fraction (initial)"] = float(ds.grain.solid_fraction().isel(time=0))
     out["z (initial)"] = float(ds.grain.coordination()["z"].isel(time=0))
-    from .plot.macroscopic import EARLY_STRAIN, friction_offset
+    from ..plot.macroscopic import EARLY_STRAIN, friction_offset
     phi_0 = friction_offset(ds)  # Fig. 5's phi_0, over the whole test
     out[PHI_0_ROW] = phi_0 if np.isfinite(phi_0) else f"{NOT_REACHED}: eps_q < {EARLY_STRAIN:g} throughout"
     residual_rows = [key for key in PAPER["pentagons"] if key not in out and key not in INITIAL_ROWS]
@@ -159,7 +159,7 @@ def run_summary(ds: xr.Dataset, residual_strain: float = RESIDUAL_STRAIN) -> dic
 def near_gap(runs: dict) -> float | None:
     """The report's near-pair gap (m): :data:`NEAR_FRACTION` of the smallest diameter over
     ``runs``, or None when one of them does not hold its near pairs up to that gap."""
-    from .contacts import check_near
+    from ..analysis.contacts import check_near
 
     gap = NEAR_FRACTION * 2.0 * min(float(ds["radius"].min()) for ds in runs.values())
     try:
@@ -225,7 +225,7 @@ def description_numbers(ds: xr.Dataset, residual_strain: float = RESIDUAL_STRAIN
     """The rows that describe a run, as numbers: its particle count, its seed (None when the
     file records none) and its residual window: first and last eps_q of the snapshots with
     eps_q >= ``residual_strain`` (None when none reaches it) and how many they are."""
-    from .strain import strains
+    from ..analysis.strain import strains
 
     window = np.asarray(residual_window(ds, residual_strain).values, bool)
     inside = np.asarray(strains(ds)["eps_q"].values, float)[window]
@@ -243,7 +243,7 @@ def description_numbers(ds: xr.Dataset, residual_strain: float = RESIDUAL_STRAIN
 def paper_sample(ds: xr.Dataset) -> str | None:
     """The paper's sample whose particles a run has: "disks" (every particle a disk),
     "pentagons" (every particle a regular pentagon) or None."""
-    from .summary import shape_name
+    from ..analysis.summary import shape_name
 
     return {"disk": "disks", "5-gon": "pentagons"}.get(shape_name(ds))
 
@@ -392,9 +392,9 @@ def caption(label: str, ds: xr.Dataset, what: str, residual_strain: float = RESI
     """One line saying what a figure shows of run ``label``: N and shape, seed, preparation,
     and, by ``what``: "map" the snapshot drawn, "distribution" the residual window averaged
     over, anything else the range of the evolution."""
-    from .plot._style import residual_snapshots
-    from .strain import strains
-    from .summary import regular_of, shape_counts
+    from ..plot._style import residual_snapshots
+    from ..analysis.strain import strains
+    from ..analysis.summary import regular_of, shape_counts
 
     shape = shape_counts(ds["n_vertices"].values, regular_of(ds))
     seed = ds.attrs.get("preparation_seed", ds.attrs.get("solver_seed", "?"))
@@ -421,9 +421,9 @@ def write_figures(runs: dict, out: Path, time=-1, residual_strain: float = RESID
     """
     import matplotlib.pyplot as plt  # any backend: matplotlib falls back to Agg without a display
 
-    from .plot import FIGURES, save_figure
-    from .plot._style import Residual, add_caption
-    from .plot.captions import describe_figure, interval_note, sampling_note
+    from ..plot import FIGURES, save_figure
+    from ..plot._style import Residual, add_caption
+    from ..plot.captions import describe_figure, interval_note, sampling_note
 
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
@@ -476,8 +476,8 @@ def common_force_scale(runs: dict, time=-1):
     """The force (N) drawn at the widest line in every run's force-chain map (Fig. 13): the
     largest particle–particle normal force of snapshot ``time`` over all runs, so that equal
     widths mean equal forces from one map to the next. Returns ``(force, caption line)``."""
-    from .contacts import selection
-    from .plot.maps import force_unit, newtons
+    from ..analysis.contacts import selection
+    from ..plot.maps import force_unit, newtons
 
     largest = 0.0
     for ds in runs.values():
@@ -530,7 +530,7 @@ def write_report(runs: dict, out, residual_strain: float = RESIDUAL_STRAIN, over
 
 def convergence_text(ds: xr.Dataset) -> str:
     """What a run's file says of its steps whose NLGS did not converge, and how far their
-    impulses were from a solution (:func:`grainview.convergence.unconverged_text`)."""
+    impulses were from a solution (:func:`grainview.app.convergence.unconverged_text`)."""
     from .convergence import unconverged_in_file, unconverged_text
 
     return unconverged_text(unconverged_in_file(ds, ds.attrs), "the test" if ds.attrs.get("scene") == "biaxial"
@@ -556,9 +556,9 @@ def file_link(source, folder) -> str:
 
 
 def write_index(runs: dict, out: Path, captions: dict, residual_strain: float = RESIDUAL_STRAIN) -> Path:
-    """``out/index.md``: the runs (their settings, :func:`grainview.summary.describe`), the
+    """``out/index.md``: the runs (their settings, :func:`grainview.analysis.summary.describe`), the
     headline table, and every figure file with its caption, in the paper's order."""
-    from .summary import describe
+    from ..analysis.summary import describe
 
     out = Path(out)
     lines = ["# Report", "", "Force transmission in the runs below, next to Azema, Radjai, Peyroux & Saussine, "

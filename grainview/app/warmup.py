@@ -25,7 +25,7 @@ from pathlib import Path
 
 __all__ = ["warm_up", "kernels", "cache_location"]
 
-PACKAGES = ("solver", "grainview._kernels")
+PACKAGES = ("solver", "grainview.analysis._kernels")
 """The packages whose modules hold numba kernels."""
 
 
@@ -97,7 +97,7 @@ def _stages(folder):
         solve_contact_problem(W, np.array([-1.0, 0.2, 0.5, 0.1]), np.array([0.4, 0.4]))
 
     def analysis():
-        from .contract.io import open_dataset
+        from ..contract.io import open_dataset
 
         with open_dataset(Path(folder) / "pentagon.nc") as ds:
             ds.grain.xi_network().compute()
@@ -130,7 +130,7 @@ def warm_up(log=print) -> dict:
         ``{"kernels": number of kernels, "compiled": kernels with a compiled version,
         "missing": [names of the others], "cache": cache_location()}``.
     """
-    from .contract.errors import ConvergenceWarning
+    from ..contract.errors import ConvergenceWarning
 
     with tempfile.TemporaryDirectory(prefix="grainview-warmup-") as folder, warnings.catch_warnings():
         warnings.simplefilter("ignore", ConvergenceWarning)

@@ -1,13 +1,13 @@
 """Export snapshots to the formats other tools read: VTK (ParaView, OVITO) and CSV (pandas,
 spreadsheets).
 
-VTK, written as VTK's XML PolyData (:mod:`grainview.vtk_xml`), per snapshot k:
+VTK, written as VTK's XML PolyData (:mod:`grainview.formats.vtk_xml`), per snapshot k:
 
 * ``particles_<k>.vtp``: every particle as a point at its centre (one vertex cell each), with
   point data ``id`` (the particle's index, as ``i`` and ``j`` of the contacts), ``radius`` (m;
   the circumscribed radius of a polygon), ``n_vertices`` (0 for a disk), ``angle`` (rad),
   ``v`` (velocity, m s-1, z = 0; when the file has it) and the per-particle fields of
-  :func:`grainview.particle_fields.particle_fields` (``c``, ``m_s``, ``m_d``, ``strong``,
+  :func:`grainview.analysis.particle_fields.particle_fields` (``c``, ``m_s``, ``m_d``, ``strong``,
   ``rattler``, ``rotation`` rad, ``displacement`` m);
 * ``contacts_<k>.vtp``: every particle–particle contact as a line from the centre of i along
   its branch vector to the centre of j, with cell data ``id1``, ``id2`` (i, j), ``fn``, ``ft``
@@ -32,7 +32,7 @@ identifiers, radii and velocities, and particle–particle and particle–wall c
 ParaView read every array under its name.
 
 CSV: ``contacts.csv``, the tidy contact table of every exported snapshot
-(:func:`grainview.tables.contacts_table`), one row per occupied contact slot, its columns
+(:func:`grainview.analysis.tables.contacts_table`), one row per occupied contact slot, its columns
 named with their units (:data:`CSV_COLUMNS`, docs/analysis.md "Exports"): ``snapshot``,
 ``time_s``, ``i``, ``j``, ``kind`` ("simple" or "double"), ``wall``, ``loaded`` (f_n > 0:
 the force-bearing contacts; False for the pairs without force, such as the near pairs of a
@@ -51,8 +51,8 @@ import os
 import numpy as np
 import xarray as xr
 
-from .contract.errors import ParameterError
-from .contract.shapes import body_vertices_of, world_vertices
+from ..contract.errors import ParameterError
+from ..contract.shapes import body_vertices_of, world_vertices
 from .vtk_xml import collection, multiblock, polydata, write_xml
 
 __all__ = ["write_vtk", "write_csv", "snapshot_indices", "write_atomically", "CSV_COLUMNS", "VTK_BLOCKS"]
@@ -240,8 +240,8 @@ def write_vtk(ds: xr.Dataset, out_dir, every: int = 1, overwrite: bool = False, 
     Azéma, Radjai, Peyroux & Saussine, Phys. Rev. E 76, 011301 (2007),
     Fig. 17 and Secs. V.B-V.C (the force classes of the contacts); docs/conventions.md §4.
     """
-    from .force_networks import force_class
-    from .particle_fields import particle_fields
+    from ..analysis.force_networks import force_class
+    from ..analysis.particle_fields import particle_fields
 
     indices = snapshot_indices(ds, every)
     polygons = bool((np.asarray(ds["n_vertices"].values) > 0).any())
@@ -297,7 +297,7 @@ _CSV_NAMES = {"time": "time_s", "fn": "fn_N", "ft": "ft_N", "point_x": "point_x_
 def write_csv(ds: xr.Dataset, out_dir, every: int = 1, overwrite: bool = False) -> str:
     """Write ``contacts.csv``: the tidy contact table of every ``every``-th snapshot.
 
-    The table is :func:`grainview.tables.contacts_table`'s, with columns ``snapshot`` and
+    The table is :func:`grainview.analysis.tables.contacts_table`'s, with columns ``snapshot`` and
     ``time_s`` first, the units in the column names, ``kind`` as "simple" or "double" and a
     column ``loaded`` (f_n > 0) that tells the force-bearing contacts from the pairs without
     force (:data:`CSV_COLUMNS`).
@@ -331,7 +331,7 @@ def write_csv(ds: xr.Dataset, out_dir, every: int = 1, overwrite: bool = False) 
     """
     import pandas as pd
 
-    from .tables import contacts_table
+    from ..analysis.tables import contacts_table
 
     os.makedirs(out_dir, exist_ok=True)
     frames = []

@@ -10,8 +10,8 @@ from __future__ import annotations
 
 import os
 
-from .contract import io
-from .contract.errors import ParameterError
+from ..contract import io
+from ..contract.errors import ParameterError
 
 
 def open_dataset(path, chunks: int | dict | None = "auto", validate: bool = False, format: str = "grainview",
@@ -57,13 +57,13 @@ def open_dataset(path, chunks: int | dict | None = "auto", validate: bool = Fals
             raise ParameterError(f"{', '.join(sorted(reader_options))}: options of another code's reader; give its "
                                  "format (format='lammps', ...) or leave them out for a grainview file")
         return io.open_dataset(path, chunks=chunks, validate=validate)
-    from .formats import open_format
+    from . import open_format
 
     ds = open_format(format, path, **reader_options)
     if chunks is not None:
         ds = ds.chunk(io.time_chunks(ds, chunks))
     if validate:
-        from .contract.validation import validate as check
+        from ..contract.validation import validate as check
 
         check(ds, source=os.fspath(path))
     return ds

@@ -16,7 +16,7 @@ import numpy as np
 import xarray as xr
 
 from ..contract.errors import ParameterError
-from ..strain import RESIDUAL_STRAIN, residual_window, strains
+from ..analysis.strain import RESIDUAL_STRAIN, residual_window, strains
 
 EPS_Q_LABEL = r"$\varepsilon_q$"
 """Label of the x axis of every evolution (shear strain, dimensionless)."""
@@ -73,7 +73,7 @@ def select_snapshots(ds: xr.Dataset, time="residual", residual_strain: float = R
 
     ``time``: an integer snapshot index (``-1`` the last); ``"residual"`` (or
     :class:`Residual`, to choose where it starts) the residual state,
-    the snapshots with eps_q >= ``residual_strain`` (:func:`grainview.strain.residual_window`)
+    the snapshots with eps_q >= ``residual_strain`` (:func:`grainview.analysis.strain.residual_window`)
     or, for a run that stops short of it, those with eps_q >= 0.7 max eps_q; the window used
     is described in the result's attribute ``window``; ``"all"`` or None every snapshot; a
     slice or a sequence of indices.
@@ -120,7 +120,7 @@ def residual_snapshots(ds: xr.Dataset, residual_strain: float = RESIDUAL_STRAIN)
 
 def snapshot_index(ds: xr.Dataset, time=-1) -> int:
     """A single snapshot index (maps draw one snapshot); negative counts from the end."""
-    from ..contacts import snapshot_index as index
+    from ..analysis.contacts import snapshot_index as index
 
     return index(ds, time)
 
@@ -132,8 +132,8 @@ def time_mean(da: xr.DataArray) -> xr.DataArray:
 
 
 def eps_q(ds: xr.Dataset) -> np.ndarray:
-    """Shear strain eps_q of every snapshot (:func:`grainview.strain.strains`), as numbers."""
-    from ..strain import strains
+    """Shear strain eps_q of every snapshot (:func:`grainview.analysis.strain.strains`), as numbers."""
+    from ..analysis.strain import strains
     return np.asarray(strains(ds)["eps_q"].values, dtype=float)
 
 
@@ -368,7 +368,7 @@ def shape_key(label=None, ds: xr.Dataset | None = None) -> str | None:
         A sample key of :data:`PALETTE`, or None.
     """
     if ds is not None and "n_vertices" in ds:
-        from ..summary import shape_name
+        from ..analysis.summary import shape_name
 
         return {"disk": "disks", "5-gon": "pentagons"}.get(shape_name(ds))
     low = str(label or "").lower()

@@ -2,7 +2,7 @@
 beside their samples' provenance: how independent the pooled snapshots of a distribution are
 (Fig. 8), and the snapshot interval that transition counts depend on (Fig. 20).
 
-The report (:func:`grainview.report.write_figures`) puts :func:`describe_figure`'s sentence
+The report (:func:`grainview.app.report.write_figures`) puts :func:`describe_figure`'s sentence
 first in every caption, then one provenance line per sample, then the notes.
 """
 
@@ -11,7 +11,7 @@ from __future__ import annotations
 import numpy as np
 import xarray as xr
 
-from ..strain import RESIDUAL_STRAIN
+from ..analysis.strain import RESIDUAL_STRAIN
 
 DESCRIPTIONS = {
     "02": "The packing at the end of the isotropic compaction (the first snapshot), particles to scale in the box",
@@ -88,7 +88,7 @@ def describe_figure(number: str) -> str:
 def pooled_contacts(ds: xr.Dataset, walls: bool = False) -> tuple[int, float]:
     """How many different contacts the snapshots of ``ds`` hold, and how many one holds on average.
 
-    A contact is a pair of bodies (:func:`grainview.persistence.pair_keys`), force-bearing
+    A contact is a pair of bodies (:func:`grainview.analysis.persistence.pair_keys`), force-bearing
     (particle–particle unless ``walls``). The ratio of the two counts is how many snapshots'
     worth of independent contacts a distribution pooled over ``ds`` rests on: 1 when every
     snapshot holds the same contacts, the number of snapshots when none is seen twice.
@@ -107,8 +107,8 @@ def pooled_contacts(ds: xr.Dataset, walls: bool = False) -> tuple[int, float]:
     per_snapshot : float
         The mean number of contacts of a snapshot.
     """
-    from ..contacts import selection
-    from ..persistence import body_count, pair_keys
+    from ..analysis.contacts import selection
+    from ..analysis.persistence import body_count, pair_keys
 
     order = ("time", "contact")
     present = np.asarray(selection(ds, walls=walls).transpose(*order).values, bool)

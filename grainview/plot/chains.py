@@ -1,7 +1,7 @@
-"""Figures of the force chains (Peters et al. 2005; :mod:`grainview.force_chains`): a map of one
+"""Figures of the force chains (Peters et al. 2005; :mod:`grainview.analysis.force_chains`): a map of one
 snapshot's chains coloured over the packing, their share of the particles and of the stress
 along the shear, the pdf of their lengths, the distribution of their lifetimes, and a movie of
-the maps. The chains are computed by :func:`grainview.force_chains.force_chains`; these
+the maps. The chains are computed by :func:`grainview.analysis.force_chains.force_chains`; these
 functions only draw them.
 """
 
@@ -30,7 +30,7 @@ def _chains_of(ds, chains, k, angle, min_size):
     """Snapshot ``k`` of ``chains`` (a result of force_chains over all of ``ds``), or of the
     chains computed for that snapshot alone."""
     if chains is None:
-        from ..force_chains import force_chains
+        from ..analysis.force_chains import force_chains
 
         return force_chains(ds.isel(time=[k]), angle=angle, min_size=min_size).isel(time=0).compute()
     if chains.sizes.get("time") != ds.sizes["time"]:
@@ -59,7 +59,7 @@ def plot_chain_map(data, ax=None, time: int = -1, angle: float = 45.0, min_size:
     time : int, default -1
         Index of the snapshot drawn (negative counts from the end).
     angle : float, default 45
-        Alignment angle of :func:`grainview.force_chains.force_chains`, degrees.
+        Alignment angle of :func:`grainview.analysis.force_chains.force_chains`, degrees.
     min_size : int, default 3
         Fewest particles of a chain.
     chains : xarray.Dataset, optional
@@ -107,7 +107,7 @@ def plot_chain_fractions(data, ax=None, label=None, angle: float = 45.0, min_siz
     the mean stress, against eps_q.
 
     ``particle_fraction``, ``deviator_fraction`` ((D_chains : D)/(D : D), D the deviator of
-    sum_p V_p sigma_p) and ``pressure_fraction`` of :func:`grainview.force_chains.force_chains`;
+    sum_p V_p sigma_p) and ``pressure_fraction`` of :func:`grainview.analysis.force_chains.force_chains`;
     several samples compare on the same axes.
 
     Parameters
@@ -133,7 +133,7 @@ def plot_chain_fractions(data, ax=None, label=None, angle: float = 45.0, min_siz
     Peters, Muthuswamy, Wibowo & Tordesillas, Phys. Rev. E 72, 041307 (2005);
     docs/analysis.md, "Force chains".
     """
-    from ..force_chains import force_chains
+    from ..analysis.force_chains import force_chains
 
     ax = get_axes(ax)
     pairs = datasets(data, label)
@@ -181,7 +181,7 @@ def plot_chain_lengths(data, ax=None, label=None, time="residual", angle: float 
     Peters, Muthuswamy, Wibowo & Tordesillas, Phys. Rev. E 72, 041307 (2005);
     docs/analysis.md, "Force chains".
     """
-    from ..force_chains import force_chains
+    from ..analysis.force_chains import force_chains
 
     ax = get_axes(ax)
     pairs = datasets(data, label)
@@ -228,7 +228,7 @@ def plot_chain_lifetimes(data, ax=None, label=None, angle: float = 45.0, min_siz
     Peters, Muthuswamy, Wibowo & Tordesillas, Phys. Rev. E 72, 041307 (2005);
     docs/analysis.md, "Force chains".
     """
-    from ..force_chains import force_chains
+    from ..analysis.force_chains import force_chains
 
     ax = get_axes(ax)
     pairs = datasets(data, label)
@@ -291,8 +291,8 @@ def animate_chains(data, path, every: int = 1, fps: int = 8, angle: float = 45.0
     """
     import matplotlib.pyplot as plt
 
-    from ..export import snapshot_indices
-    from ..force_chains import force_chains
+    from ..formats.export import snapshot_indices
+    from ..analysis.force_chains import force_chains
     from .movies import _writer, frame_title, save_frames
 
     if os.path.exists(path) and not overwrite:  # before any drawing

@@ -10,7 +10,7 @@ __all__ = ["seed_bands"]
 
 
 def seed_bands(stats, ax=None, label: str = "", units: str = "1"):
-    """Draw :func:`grainview.ensemble.seed_statistics` binned on eps_q: mean and spread per group.
+    """Draw :func:`grainview.analysis.ensemble.seed_statistics` binned on eps_q: mean and spread per group.
 
     Per group the mean as a line and mean +- one standard deviation as a band (none where a
     bin has a single seed), the number of seeds in the legend. A group named after a shape
@@ -20,7 +20,7 @@ def seed_bands(stats, ax=None, label: str = "", units: str = "1"):
     Parameters
     ----------
     stats : xarray.Dataset
-        The result of :func:`grainview.ensemble.seed_statistics` with ``eps_q_bins``: ``mean``,
+        The result of :func:`grainview.analysis.ensemble.seed_statistics` with ``eps_q_bins``: ``mean``,
         ``std``, ``n`` over (group, eps_q_bin).
     ax : matplotlib.axes.Axes, optional
         The axes to draw on (default: new axes on a new figure).

@@ -1,6 +1,6 @@
-"""Figures of the coarse-grained fields (:mod:`grainview.coarse_graining`): maps of a snapshot's
+"""Figures of the coarse-grained fields (:mod:`grainview.analysis.coarse_graining`): maps of a snapshot's
 fields (sigma_yy, q/p, solid fraction...) over the sample, and their profiles across it, where
-shear bands show. The fields are computed by :func:`grainview.coarse_graining.coarse_grained`;
+shear bands show. The fields are computed by :func:`grainview.analysis.coarse_graining.coarse_grained`;
 these functions only draw them.
 """
 
@@ -27,11 +27,11 @@ def _fields_of(ds, fields, k, width, spacing, cutoff):
     """Snapshot ``k`` of ``fields`` (coarse_grained of all of ``ds``), or the fields computed for
     that snapshot alone."""
     if fields is None:
-        from ..coarse_graining import coarse_grained
+        from ..analysis.coarse_graining import coarse_grained
 
         snap = coarse_grained(ds.isel(time=[k]), width=width, spacing=spacing, cutoff=cutoff).isel(time=0)
         if {"box_min", "box_max"} <= set(ds.variables):  # the strains of the whole run, not of this snapshot alone
-            from ..strain import strains
+            from ..analysis.strain import strains
 
             snap = snap.assign_coords(eps_q=strains(ds)["eps_q"].isel(time=k, drop=True))
         return snap.compute()
@@ -42,7 +42,7 @@ def _fields_of(ds, fields, k, width, spacing, cutoff):
 
 
 def _names(names):
-    from ..coarse_graining import QUANTITIES
+    from ..analysis.coarse_graining import QUANTITIES
 
     names = (names,) if isinstance(names, str) else tuple(names)
     if not names or any(name not in QUANTITIES for name in names):
@@ -65,12 +65,12 @@ def plot_field_maps(data, names=DEFAULT_FIELDS, time: int = -1, width=None, spac
     data : xarray.Dataset, dict or list
         One dataset of the contract (a dict or list must hold exactly one).
     names : sequence of str, default ("sigma_yy", "q_over_p", "solid_fraction")
-        The quantities (:data:`grainview.coarse_graining.QUANTITIES`).
+        The quantities (:data:`grainview.analysis.coarse_graining.QUANTITIES`).
     time : int, default -1
         Index of the snapshot drawn (negative counts from the end).
     width, spacing, cutoff : float, optional
         The kernel width, grid spacing (m) and cutoff (widths) of
-        :func:`grainview.coarse_graining.coarse_grained`, when ``fields`` is not given.
+        :func:`grainview.analysis.coarse_graining.coarse_grained`, when ``fields`` is not given.
     fields : xarray.Dataset, optional
         ``coarse_grained(ds, ...)`` of the whole dataset, to draw instead of computing the fields
         of the one snapshot.
@@ -81,7 +81,7 @@ def plot_field_maps(data, names=DEFAULT_FIELDS, time: int = -1, width=None, spac
     band : bool or xarray.Dataset, optional
         Draw a shear band over the shear-rate panel (``"shear_rate"`` among ``names``): True
         finds it in the drawn snapshot's shear rate over the nodes two widths inside the box
-        (:func:`grainview.shear_bands.find_shear_band`, its defaults), or give the finder's
+        (:func:`grainview.analysis.shear_bands.find_shear_band`, its defaults), or give the finder's
         result (e.g. of the mean flow over a strain window). Drawn by :func:`draw_band`.
 
     Returns
@@ -100,7 +100,7 @@ def plot_field_maps(data, names=DEFAULT_FIELDS, time: int = -1, width=None, spac
     Weinhart, Thornton, Luding & Bokhove, Granular Matter 14, 289 (2012); docs/analysis.md,
     "Coarse-grained fields".
     """
-    from ..coarse_graining import interior, scalar_field
+    from ..analysis.coarse_graining import interior, scalar_field
 
     _, ds = single_dataset(data)
     names = _names(names)
@@ -123,7 +123,7 @@ def plot_field_maps(data, names=DEFAULT_FIELDS, time: int = -1, width=None, spac
         frame = ax.add_patch(_frame(lo, hi))
         if name == "shear_rate" and band is not None and band is not False:
             if band is True:
-                from ..shear_bands import find_shear_band
+                from ..analysis.shear_bands import find_shear_band
 
                 found = find_shear_band(field, inside=interior(snap))
             else:
@@ -141,7 +141,7 @@ def plot_field_maps(data, names=DEFAULT_FIELDS, time: int = -1, width=None, spac
 
 
 def draw_band(ax, band, clip=None, color="c"):
-    """Draw a shear band (:func:`grainview.shear_bands.find_shear_band`) over a map: its two
+    """Draw a shear band (:func:`grainview.analysis.shear_bands.find_shear_band`) over a map: its two
     half-maximum lines, s = edges (dashed), where s = -x sin(angle) + y cos(angle), and a legend
     entry with its angle to the x axis, width at half maximum and share of the shear rate in
     the searched strip; "no band" in the legend when the finder found none (nothing drawn).
@@ -195,7 +195,7 @@ def plot_shear_band(rate, band=None, inside=None, box=None, ax=None, title=None)
     rate : xarray.DataArray
         The map over (y, x), coordinates in m, in s-1 (``scalar_field(..., "shear_rate")``).
     band : xarray.Dataset, optional
-        :func:`grainview.shear_bands.find_shear_band` of it; default found over ``inside``.
+        :func:`grainview.analysis.shear_bands.find_shear_band` of it; default found over ``inside``.
     inside : xarray.DataArray of bool, optional
         The nodes drawn and searched (e.g. ``interior(fields).all("time")``); the others blank.
     box : (array_like, array_like), optional
@@ -213,9 +213,9 @@ def plot_shear_band(rate, band=None, inside=None, box=None, ax=None, title=None)
     Raises
     ------
     grainview.contract.errors.ParameterError
-        As :func:`grainview.shear_bands.find_shear_band`.
+        As :func:`grainview.analysis.shear_bands.find_shear_band`.
     """
-    from ..shear_bands import find_shear_band
+    from ..analysis.shear_bands import find_shear_band
 
     band = find_shear_band(rate, inside=inside) if band is None else band
     shown = rate if inside is None else rate.where(inside)
@@ -245,15 +245,15 @@ def _frame(lo, hi):
 def plot_field_profiles(data, names=DEFAULT_FIELDS, time=-1, across: str = "x", width=None, spacing=None,
                         cutoff: float = 3.0, fields=None, margin=None, stress: str = "total", label=None):
     """Profiles across the sample: each quantity averaged over the other grid axis, against
-    ``across``, one panel per quantity (:func:`grainview.coarse_graining.profile`), over the
-    nodes at least ``margin`` inside the box (:func:`grainview.coarse_graining.interior`).
+    ``across``, one panel per quantity (:func:`grainview.analysis.coarse_graining.profile`), over the
+    nodes at least ``margin`` inside the box (:func:`grainview.analysis.coarse_graining.interior`).
 
     Parameters
     ----------
     data : xarray.Dataset, dict or list
         One dataset of the contract (a dict or list must hold exactly one).
     names : sequence of str, default ("sigma_yy", "q_over_p", "solid_fraction")
-        The quantities (:data:`grainview.coarse_graining.QUANTITIES`).
+        The quantities (:data:`grainview.analysis.coarse_graining.QUANTITIES`).
     time : int or sequence of int, default -1
         The snapshot(s) drawn, one curve each (negative counts from the end).
     across : {"x", "y"}, default "x"
@@ -284,7 +284,7 @@ def plot_field_profiles(data, names=DEFAULT_FIELDS, time=-1, across: str = "x", 
     Weinhart, Thornton, Luding & Bokhove, Granular Matter 14, 289 (2012); docs/analysis.md,
     "Coarse-grained fields".
     """
-    from ..coarse_graining import interior, profile, scalar_field
+    from ..analysis.coarse_graining import interior, profile, scalar_field
 
     _, ds = single_dataset(data, label)
     names = _names(names)

@@ -14,7 +14,7 @@ import numpy as np
 import xarray as xr
 
 from ..contract.errors import ParameterError
-from ..forces import angular_force_averages, force_anisotropies
+from ..analysis.forces import angular_force_averages, force_anisotropies
 from ._style import (EPS_Q_LABEL, PALETTE, PI_TICK_LABELS, axis_label, datasets, draw_evolutions, finish, get_axes,
                      legend_in_first, new_figure, sample_colour, select_snapshots, series_label, set_labels, tidy_polar,
                      time_mean, units_of, values)
@@ -31,7 +31,7 @@ def angular_profile(ds: xr.Dataset, component: str = "fn", time="residual", bins
     """<f_n>(theta) or <f_t>(theta) on ``bins`` sectors of [0, pi), averaged over the snapshots ``time``.
 
     ``component="fn"`` gives <f_n>(theta), ``"ft"`` gives <f_t>(theta)
-    (:func:`grainview.forces.angular_force_averages`, paper Eq. fnft). With ``normalise`` each
+    (:func:`grainview.analysis.forces.angular_force_averages`, paper Eq. fnft). With ``normalise`` each
     snapshot's profile is divided by that snapshot's mean normal force
 
         <f_n> = sum_k N_c(theta_k) <f_n>(theta_k) / sum_k N_c(theta_k)
@@ -53,7 +53,7 @@ def angular_profile(ds: xr.Dataset, component: str = "fn", time="residual", bins
         Number of angular sectors of [0, pi), centred on theta_k = k pi/bins.
     kind : {"all", "simple", "double"}, default "all"
         The contacts used: all, simple (vertex–edge and disk contacts) or double (edge–edge)
-        ones (also 1, 2, "s", "d"; :func:`grainview.contacts.kind_code`).
+        ones (also 1, 2, "s", "d"; :func:`grainview.analysis.contacts.kind_code`).
     walls : bool, default False
         Include the particle–wall contacts (default: particle–particle only).
     normalise : bool, default True
@@ -112,7 +112,7 @@ def plot_normal_force_polar(data, ax=None, label=None, time="residual", bins: in
         Number of angular sectors of [0, pi), centred on theta_k = k pi/bins.
     kind : {"all", "simple", "double"}, default "all"
         The contacts used: all, simple (vertex–edge and disk contacts) or double (edge–edge)
-        ones (also 1, 2, "s", "d"; :func:`grainview.contacts.kind_code`).
+        ones (also 1, 2, "s", "d"; :func:`grainview.analysis.contacts.kind_code`).
     walls : bool, default False
         Include the particle–wall contacts (default: particle–particle only).
     normalise : bool, default True
@@ -162,7 +162,7 @@ def plot_tangential_force_polar(data, ax=None, label=None, time="residual", bins
         Number of angular sectors of [0, pi), centred on theta_k = k pi/bins.
     kind : {"all", "simple", "double"}, default "all"
         The contacts used: all, simple (vertex–edge and disk contacts) or double (edge–edge)
-        ones (also 1, 2, "s", "d"; :func:`grainview.contacts.kind_code`).
+        ones (also 1, 2, "s", "d"; :func:`grainview.analysis.contacts.kind_code`).
     walls : bool, default False
         Include the particle–wall contacts (default: particle–particle only).
     normalise : bool, default True
@@ -229,7 +229,7 @@ def plot_tangential_force(data, ax=None, label=None, time="residual", bins: int 
         Number of angular sectors of [0, pi), centred on theta_k = k pi/bins.
     kind : {"all", "simple", "double"}, default "all"
         The contacts used: all, simple (vertex–edge and disk contacts) or double (edge–edge)
-        ones (also 1, 2, "s", "d"; :func:`grainview.contacts.kind_code`).
+        ones (also 1, 2, "s", "d"; :func:`grainview.analysis.contacts.kind_code`).
     walls : bool, default False
         Include the particle–wall contacts (default: particle–particle only).
     normalise : bool, default True
@@ -283,7 +283,7 @@ def plot_normal_force(data, ax=None, label=None, time="residual", bins: int = 36
         Number of angular sectors of [0, pi), centred on theta_k = k pi/bins.
     kind : {"all", "simple", "double"}, default "all"
         The contacts used: all, simple (vertex–edge and disk contacts) or double (edge–edge)
-        ones (also 1, 2, "s", "d"; :func:`grainview.contacts.kind_code`).
+        ones (also 1, 2, "s", "d"; :func:`grainview.analysis.contacts.kind_code`).
     walls : bool, default False
         Include the particle–wall contacts (default: particle–particle only).
     normalise : bool, default True
@@ -384,7 +384,7 @@ def plot_force_anisotropy(data, ax=None, label=None, component: str = "a_n", bin
         a_n = 2 (H^n_1 - H^n_2) / tr H^n,    a_t = 2 (H^t_1 - H^t_2) / tr H^n,
 
     signed by cos 2(theta - theta_sigma) (docs/conventions.md §3 and "Signs";
-    :func:`grainview.forces.force_anisotropies`). Dimensionless.
+    :func:`grainview.analysis.forces.force_anisotropies`). Dimensionless.
 
     Parameters
     ----------
@@ -472,7 +472,7 @@ def force_pdf_of(ds: xr.Dataset, scale: str = "log-linear", time="residual", bin
     """The pdf of f_n/<f_n> over the snapshots ``time``, contacts pooled over them.
 
     Linear bins for ``scale="log-linear"`` and logarithmic bins for ``"log-log"``
-    (:func:`grainview.force_pdf.pooled_force_pdf`).
+    (:func:`grainview.analysis.force_pdf.pooled_force_pdf`).
 
     Parameters
     ----------
@@ -490,10 +490,10 @@ def force_pdf_of(ds: xr.Dataset, scale: str = "log-linear", time="residual", bin
         Number of bins.
     range : (float, float), optional
         (low, high) of f_n/<f_n>; default (0, 6) for ``"log-linear"`` and the default of
-        :func:`grainview.force_pdf.pooled_force_pdf` for ``"log-log"``.
+        :func:`grainview.analysis.force_pdf.pooled_force_pdf` for ``"log-log"``.
     kind : {"all", "simple", "double"}, default "all"
         The contacts used: all, simple (vertex–edge and disk contacts) or double (edge–edge)
-        ones (also 1, 2, "s", "d"; :func:`grainview.contacts.kind_code`).
+        ones (also 1, 2, "s", "d"; :func:`grainview.analysis.contacts.kind_code`).
     walls : bool, default False
         Include the particle–wall contacts (default: particle–particle only).
 
@@ -513,7 +513,7 @@ def force_pdf_of(ds: xr.Dataset, scale: str = "log-linear", time="residual", bin
     Azéma, Radjai, Peyroux & Saussine, Phys. Rev. E 76, 011301 (2007),
     Sec. V.B and Fig. 14 (Fig. 23 by kind).
     """
-    from ..force_pdf import pooled_force_pdf
+    from ..analysis.force_pdf import pooled_force_pdf
     if scale not in SCALES:
         raise ParameterError(f"scale={scale!r}: expected 'log-linear' or 'log-log'")
     if range is None and scale == "log-linear":
@@ -529,7 +529,7 @@ def exponential_fit(pdf: xr.Dataset, alpha: float, threshold: float = 1.0) -> fl
     """Prefactor A of P = A exp(-alpha f/<f_n>) given alpha.
 
     The intercept of the weighted least squares fit ln P = ln A - alpha x of
-    :func:`grainview.force_pdf.strong_force_exponent`, i.e. the count-weighted mean
+    :func:`grainview.analysis.force_pdf.strong_force_exponent`, i.e. the count-weighted mean
 
         ln A = sum_k n_k (ln P_k + alpha x_k) / sum_k n_k
 
@@ -539,7 +539,7 @@ def exponential_fit(pdf: xr.Dataset, alpha: float, threshold: float = 1.0) -> fl
     Parameters
     ----------
     pdf : xarray.Dataset
-        A pdf of :func:`force_pdf_of` (or of :mod:`grainview.force_pdf`).
+        A pdf of :func:`force_pdf_of` (or of :mod:`grainview.analysis.force_pdf`).
     alpha : float
         The exponent, dimensionless.
     threshold : float, default 1.0
@@ -575,7 +575,7 @@ def plot_force_pdf(data, ax=None, label=None, scale: str = "log-linear", time="r
         P = A exp(-alpha f_n/<f_n>)
 
     over the strong forces (f_n > <f_n>) is drawn after each sample's pdf, alpha from
-    :func:`grainview.force_pdf.strong_force_exponent` given in the legend, over the range of
+    :func:`grainview.analysis.force_pdf.strong_force_exponent` given in the legend, over the range of
     the data. Empty bins are not drawn; each bin carries its counting error bar, P / sqrt(n) for
     n contacts in it (:func:`counting_error`; upper bar only for n = 1). Lines per sample: the
     pdf, then the fit when drawn.
@@ -602,10 +602,10 @@ def plot_force_pdf(data, ax=None, label=None, scale: str = "log-linear", time="r
         Number of bins.
     range : (float, float), optional
         (low, high) of f_n/<f_n>; default (0, 6) for ``"log-linear"`` and the default of
-        :func:`grainview.force_pdf.pooled_force_pdf` for ``"log-log"``.
+        :func:`grainview.analysis.force_pdf.pooled_force_pdf` for ``"log-log"``.
     kind : {"all", "simple", "double"}, default "all"
         The contacts used: all, simple (vertex–edge and disk contacts) or double (edge–edge)
-        ones (also 1, 2, "s", "d"; :func:`grainview.contacts.kind_code`).
+        ones (also 1, 2, "s", "d"; :func:`grainview.analysis.contacts.kind_code`).
     walls : bool, default False
         Include the particle–wall contacts (default: particle–particle only).
     fit : bool, default True
@@ -623,7 +623,7 @@ def plot_force_pdf(data, ax=None, label=None, scale: str = "log-linear", time="r
     Azéma, Radjai, Peyroux & Saussine, Phys. Rev. E 76, 011301 (2007),
     Eq. strong (Sec. V.B) and Fig. 14.
     """
-    from ..force_pdf import strong_force_exponent
+    from ..analysis.force_pdf import strong_force_exponent
     ax = get_axes(ax)
     outside = []
     for lab, ds in datasets(data, label):
@@ -740,7 +740,7 @@ def plot_force_pdf_by_kind(data, ax=None, label=None, scale: str = "log-linear",
                            bins: int = 40, range=None, walls: bool = False, **line_kw):
     """Pdfs of f_n/<f_n> for simple (s, solid) and double (d, dashed) contacts (paper Fig. 23).
 
-    Each pdf is normalised over its own contacts (:func:`grainview.force_pdf.pooled_force_pdf`
+    Each pdf is normalised over its own contacts (:func:`grainview.analysis.force_pdf.pooled_force_pdf`
     with ``kind``). Two lines per sample: s then d; with one sample in the contact kinds'
     colours (:data:`grainview.plot._style.PALETTE`), with several in the sample's colour.
 
@@ -766,7 +766,7 @@ def plot_force_pdf_by_kind(data, ax=None, label=None, scale: str = "log-linear",
         Number of bins.
     range : (float, float), optional
         (low, high) of f_n/<f_n>; default (0, 6) for ``"log-linear"`` and the default of
-        :func:`grainview.force_pdf.pooled_force_pdf` for ``"log-log"``.
+        :func:`grainview.analysis.force_pdf.pooled_force_pdf` for ``"log-log"``.
     walls : bool, default False
         Include the particle–wall contacts (default: particle–particle only).
     **line_kw
@@ -849,7 +849,7 @@ def xi_profile(ds: xr.Dataset, xi=None, time="residual", near=None) -> xr.Datase
     """q(xi)/p, a'(xi) and the contact fraction of the xi-network, averaged over the snapshots ``time``.
 
     The xi-network holds the contacts with f_n < xi <f_n> (docs/conventions.md §5;
-    :func:`grainview.xi_network.xi_network`, whose cutoffs are the default).
+    :func:`grainview.analysis.xi_network.xi_network`, whose cutoffs are the default).
 
     Parameters
     ----------
@@ -865,7 +865,7 @@ def xi_profile(ds: xr.Dataset, xi=None, time="residual", near=None) -> xr.Datase
     near : float, optional
         None: the force-bearing contacts (f_n > 0); a gap in m: also the pairs within it,
         which carry no force and so belong to every xi-network (the file must hold them;
-        :func:`grainview.contacts.in_network`).
+        :func:`grainview.analysis.contacts.in_network`).
 
     Returns
     -------
@@ -878,7 +878,7 @@ def xi_profile(ds: xr.Dataset, xi=None, time="residual", near=None) -> xr.Datase
     Azéma, Radjai, Peyroux & Saussine, Phys. Rev. E 76, 011301 (2007),
     Sec. V.C, Figs. 15 and 16; docs/conventions.md §5.
     """
-    from ..xi_network import xi_network
+    from ..analysis.xi_network import xi_network
     subset = select_snapshots(ds, time)
     cutoffs = {} if xi is None else {"xi": np.asarray(xi, float)}
     return xi_network(subset, near=near, **cutoffs).mean("time", keep_attrs=True).compute()
@@ -903,7 +903,7 @@ def plot_xi_stress(data, ax=None, label=None, xi=None, time="residual", min_cont
         the same axes build a comparison.
     xi : array_like of float, optional
         The cutoffs xi >= 0, multiples of <f_n> (default: those of
-        :func:`grainview.xi_network.xi_network`).
+        :func:`grainview.analysis.xi_network.xi_network`).
     time : str, int, slice or sequence of int, default "residual"
         The snapshots averaged over (:func:`grainview.plot._style.select_snapshots`):
         ``"residual"`` the residual state, eps_q >= 0.3 (for a run that stops short of it, the
@@ -948,7 +948,7 @@ def plot_xi_anisotropy(data, ax=None, label=None, xi=None, time="residual", min_
         the same axes build a comparison.
     xi : array_like of float, optional
         The cutoffs xi >= 0, multiples of <f_n> (default: those of
-        :func:`grainview.xi_network.xi_network`).
+        :func:`grainview.analysis.xi_network.xi_network`).
     time : str, int, slice or sequence of int, default "residual"
         The snapshots averaged over (:func:`grainview.plot._style.select_snapshots`):
         ``"residual"`` the residual state, eps_q >= 0.3 (for a run that stops short of it, the
@@ -1044,7 +1044,7 @@ def plot_contact_proportions(data, ax=None, label=None, **line_kw):
 
         k_s = N_s/N_c,   k_d = N_d/N_c,   f_s = k_s <f_n>_s/<f_n>,   f_d = k_d <f_n>_d/<f_n>
 
-    (docs/conventions.md §4; :func:`grainview.force_networks.contact_proportions`). Four lines
+    (docs/conventions.md §4; :func:`grainview.analysis.force_networks.contact_proportions`). Four lines
     per sample: k_s, k_d (solid), f_s, f_d (dashed); with one sample, simple and double in the
     contact kinds' colours (:data:`grainview.plot._style.PALETTE`). Dimensionless.
 
@@ -1072,7 +1072,7 @@ def plot_contact_proportions(data, ax=None, label=None, **line_kw):
     Azéma, Radjai, Peyroux & Saussine, Phys. Rev. E 76, 011301 (2007),
     Sec. VI and Fig. 19 (f_s, f_d with the correction of docs/conventions.md §4).
     """
-    from ..force_networks import contact_proportions
+    from ..analysis.force_networks import contact_proportions
     ax = get_axes(ax)
     curves = [("$k_s$", "k_s"), ("$k_d$", "k_d"), ("$f_s$", "f_s"), ("$f_d$", "f_d")]
     kinds = [PALETTE["simple"], PALETTE["double"]] * 2
@@ -1086,7 +1086,7 @@ def plot_type_transitions(data, ax=None, label=None, **line_kw):
     """Cumulative proportions Delta gamma of s->d and d->s transitions against eps_q (paper Fig. 20).
 
     Simple contacts turned double (s->d) and double turned simple (d->s)
-    (docs/conventions.md §8; :func:`grainview.persistence.type_transitions`). Two lines per
+    (docs/conventions.md §8; :func:`grainview.analysis.persistence.type_transitions`). Two lines per
     sample. Dimensionless; computed.
 
     Parameters
@@ -1113,7 +1113,7 @@ def plot_type_transitions(data, ax=None, label=None, **line_kw):
     Azéma, Radjai, Peyroux & Saussine, Phys. Rev. E 76, 011301 (2007),
     Sec. VI and Fig. 20; docs/conventions.md §8.
     """
-    from ..persistence import type_transitions
+    from ..analysis.persistence import type_transitions
     ax = get_axes(ax)
     curves = [(r"$s\rightarrow d$", "delta_gamma_s_to_d"), (r"$d\rightarrow s$", "delta_gamma_d_to_s")]
     draw_evolutions(ax, datasets(data, label), type_transitions, curves, **line_kw)
@@ -1127,7 +1127,7 @@ def plot_strong_weak_proportion(data, ax=None, label=None, network: str = "stron
     ``network="strong"``: k_s^S and k_d^S, the fractions of all contacts that are simple and
     strong, double and strong; ``"weak"``: k_s^W and k_d^W. Strong means f_n > <f_n>, weak
     f_n <= <f_n>
-    (docs/conventions.md §4; :func:`grainview.force_networks.contact_proportions`). Two lines
+    (docs/conventions.md §4; :func:`grainview.analysis.force_networks.contact_proportions`). Two lines
     per sample, s then d; with one sample in the contact kinds' colours
     (:data:`grainview.plot._style.PALETTE`). Dimensionless.
 
@@ -1162,7 +1162,7 @@ def plot_strong_weak_proportion(data, ax=None, label=None, network: str = "stron
     Azéma, Radjai, Peyroux & Saussine, Phys. Rev. E 76, 011301 (2007),
     Sec. VI and Fig. 25; docs/conventions.md §4.
     """
-    from ..force_networks import contact_proportions
+    from ..analysis.force_networks import contact_proportions
     if network not in ("strong", "weak"):
         raise ParameterError(f"network={network!r}: expected 'strong' or 'weak'")
     ax = get_axes(ax)

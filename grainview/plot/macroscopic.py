@@ -11,9 +11,9 @@ from __future__ import annotations
 import numpy as np
 import xarray as xr
 
-from ..strain import RESIDUAL_STRAIN, friction_and_dilatancy, residual_window, strains
-from ..stress import stress_invariants
-from ..forces import harmonic_prediction
+from ..analysis.strain import RESIDUAL_STRAIN, friction_and_dilatancy, residual_window, strains
+from ..analysis.stress import stress_invariants
+from ..analysis.forces import harmonic_prediction
 from ._style import (EPS_Q_LABEL, PALETTE, axis_label, datasets, draw_evolutions, eps_q, finish, get_axes,
                      sample_colour, series_label, set_labels, values)
 
@@ -21,8 +21,8 @@ from ._style import (EPS_Q_LABEL, PALETTE, axis_label, datasets, draw_evolutions
 def plot_q_over_p(data, ax=None, label=None, **line_kw):
     """Normalised shear stress q/p against eps_q (paper Fig. 3).
 
-    q/p from :func:`grainview.stress.stress_invariants` (wall contacts included,
-    docs/conventions.md §1), eps_q from :func:`grainview.strain.strains`
+    q/p from :func:`grainview.analysis.stress.stress_invariants` (wall contacts included,
+    docs/conventions.md §1), eps_q from :func:`grainview.analysis.strain.strains`
     (docs/conventions.md §6). Both dimensionless.
 
     Parameters
@@ -60,7 +60,7 @@ def plot_volumetric_strain(data, ax=None, label=None, **line_kw):
 
         eps_p = ln(1 + (V - V0)/V0)
 
-    (:func:`grainview.strain.strains`), both strains dimensionless.
+    (:func:`grainview.analysis.strain.strains`), both strains dimensionless.
 
     Parameters
     ----------
@@ -104,7 +104,7 @@ def friction_offset(ds: xr.Dataset, min_strain: float = EARLY_STRAIN, incrementa
         phi_0 = median over the snapshots with eps_q >= min_strain of (phi - psi),
 
     sin phi = q/p, sin psi = eps_p/eps_q (or d eps_p/d eps_q with ``incremental``;
-    :func:`grainview.strain.friction_and_dilatancy`). It is the friction angle at zero
+    :func:`grainview.analysis.strain.friction_and_dilatancy`). It is the friction angle at zero
     dilatancy of Taylor's relation, which the paper's Fig. 5 shows both shapes follow. A median,
     not a fit: the slope is 1 by assumption.
 
@@ -147,7 +147,7 @@ def plot_stress_dilatancy(data, ax=None, label=None, incremental: bool = False, 
 
         sin phi = q/p,    sin psi = eps_p/eps_q (cumulative) or d eps_p/d eps_q (incremental)
 
-    (:func:`grainview.strain.friction_and_dilatancy`). Snapshots where psi is undefined
+    (:func:`grainview.analysis.strain.friction_and_dilatancy`). Snapshots where psi is undefined
     (eps_q = 0) or ill-conditioned (eps_q < ``min_strain``) are not drawn (their line points are
     NaN), and the panel says so.
 
@@ -210,7 +210,7 @@ def plot_harmonic_prediction(data, ax=None, label=None, bins: int = 36, **line_k
         (a' + a_n + a_t)/2
 
     and the same with the cross term, (a' + a_n + a_t)/(2 + a' a_n)
-    (:func:`grainview.forces.harmonic_prediction`, ``bins`` angular sectors). All
+    (:func:`grainview.analysis.forces.harmonic_prediction`, ``bins`` angular sectors). All
     dimensionless. Where the three agree (the disks) they overlap within the snapshots' noise,
     so they are drawn to stay apart even then: q/p as a wide pale band, the predictions as thin
     dashed and thin solid lines over it, all in the sample's colour; each legend entry gives
@@ -264,7 +264,7 @@ def plot_harmonic_prediction(data, ax=None, label=None, bins: int = 36, **line_k
 
 HARMONIC_CURVES = [("$q/p$", "q_over_p"), ("$(a' + a_n + a_t)/2$", "prediction"),
                    ("$(a' + a_n + a_t)/(2 + a' a_n)$", "prediction_cross_term")]
-"""Fig. 12's curves: legend text and variable of :func:`grainview.forces.harmonic_prediction`."""
+"""Fig. 12's curves: legend text and variable of :func:`grainview.analysis.forces.harmonic_prediction`."""
 HARMONIC_STYLES = [dict(linewidth=4.0, alpha=0.35, solid_capstyle="butt"), dict(linewidth=1.0, linestyle="--"),
                    dict(linewidth=0.9, linestyle="-")]
 """Fig. 12's line styles: q/p a wide pale band, the two predictions thin lines over it."""
@@ -274,7 +274,7 @@ def plot_partial_q_over_p(data, ax=None, label=None, **line_kw):
     """q/p of simple (s), double (d) and all (s+d) contacts against eps_q (paper Fig. 18).
 
     Each partial deviator is divided by the p of the whole sample
-    (:func:`grainview.stress.stress_invariants` with ``kind``). Three lines per sample: s, d,
+    (:func:`grainview.analysis.stress.stress_invariants` with ``kind``). Three lines per sample: s, d,
     s+d; with one sample in the contact kinds' colours (:data:`grainview.plot._style.PALETTE`).
     Dimensionless.
 

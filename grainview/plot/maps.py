@@ -17,7 +17,7 @@ import numpy as np
 import xarray as xr
 from matplotlib.collections import EllipseCollection, LineCollection, PolyCollection
 
-from ..contacts import selection
+from ..analysis.contacts import selection
 from ..contract.errors import ParameterError
 from ..contract.shapes import body_vertices_of, world_vertices
 from ._style import PALETTE, axis_label, get_axes, single_dataset, snapshot_index
@@ -108,7 +108,7 @@ def plot_particles(data, ax=None, time: int = -1, facecolor=PARTICLE_FACE, edgec
 PARTICLE_FIELDS = {"c": "contacts c", "m_s": "simple contacts m_s", "m_d": "double contacts m_d",
                    "strong": "strong contacts", "rattler": "rattler (1) or not (0)",
                    "rotation": "rotation (rad)", "displacement": "displacement (m)"}
-"""Fields a particle map can show (:func:`grainview.particle_fields.particle_fields`)."""
+"""Fields a particle map can show (:func:`grainview.analysis.particle_fields.particle_fields`)."""
 
 
 def plot_particle_map(data, field: str = "c", ax=None, time: int = -1, reference: int = 0, walls: bool = True,
@@ -117,7 +117,7 @@ def plot_particle_map(data, field: str = "c", ax=None, time: int = -1, reference
 
     ``field`` is one of :data:`PARTICLE_FIELDS`: contacts, simple/double contacts, strong
     contacts, rattlers, rotation or displacement since ``reference``
-    (:func:`grainview.particle_fields.particle_fields`); ``cividis`` is colour-blind safe
+    (:func:`grainview.analysis.particle_fields.particle_fields`); ``cividis`` is colour-blind safe
     (integer fields get one colour per value).
 
     Parameters
@@ -156,7 +156,7 @@ def plot_particle_map(data, field: str = "c", ax=None, time: int = -1, reference
     """
     import matplotlib as mpl
 
-    from ..particle_fields import particle_fields
+    from ..analysis.particle_fields import particle_fields
 
     if field not in PARTICLE_FIELDS:
         raise ParameterError(f"field={field!r}: expected one of {sorted(PARTICLE_FIELDS)}")
@@ -542,7 +542,7 @@ def plot_force_classes(data, ax=None, time: int = -1, walls: bool = False, very_
 
     Very weak contacts (f_n < ``very_weak`` <f_n>) in blue, weak ones in green, strong ones
     (f_n > ``strong`` <f_n>) in red, as classified by
-    :func:`grainview.force_networks.force_class`. Uniform ``linewidth`` unless
+    :func:`grainview.analysis.force_networks.force_class`. Uniform ``linewidth`` unless
     ``width_by_force``. A legend of the classes.
 
     Parameters
@@ -579,7 +579,7 @@ def plot_force_classes(data, ax=None, time: int = -1, walls: bool = False, very_
     Azéma, Radjai, Peyroux & Saussine, Phys. Rev. E 76, 011301 (2007),
     Secs. V.B and V.C, Fig. 17; docs/conventions.md §4.
     """
-    from ..force_networks import force_class
+    from ..analysis.force_networks import force_class
     _, ds = single_dataset(data)
     k = snapshot_index(ds, time)
     ax = map_axes(ax, ds, k)

@@ -13,7 +13,7 @@ import os
 
 import numpy as np
 
-from ..contacts import selection
+from ..analysis.contacts import selection
 from ..contract.errors import ParameterError
 from ._style import single_dataset
 
@@ -38,7 +38,7 @@ def _writer(path, fps):
 def frame_title(ds):
     """A function of a snapshot index k giving a frame's title: "eps_q = ..., t = ... s
     (snapshot k)" (eps_q from the boxes, left out when the dataset has none)."""
-    from ..strain import strains
+    from ..analysis.strain import strains
 
     eps_q = np.asarray(strains(ds)["eps_q"].values, float) if {"box_min", "box_max"} <= set(ds.variables) else None
     times = np.asarray(ds["time"].values, float)
@@ -53,11 +53,11 @@ def frame_title(ds):
 def save_frames(fig, path, writer, frames, draw, *, dpi, progress, overwrite, desc) -> str:
     """Draw ``draw(row, k)`` for each snapshot index k of ``frames`` (row its position) on
     ``fig``, grab each as a frame of ``writer``, and write the movie to ``path`` atomically
-    (:func:`grainview.export.write_atomically`); ``fig`` is closed in any case. Returns
+    (:func:`grainview.formats.export.write_atomically`); ``fig`` is closed in any case. Returns
     ``str(path)``."""
     import matplotlib.pyplot as plt
 
-    from ..export import write_atomically
+    from ..formats.export import write_atomically
 
     rows = list(enumerate(frames))
     if progress:
@@ -86,7 +86,7 @@ def animate(data, path, kind: str = "force_chains", every: int = 1, fps: int = 8
     movie at ``max_linewidth`` points), ``"force_classes"`` (very weak / weak / strong, paper
     Fig. 17) or ``"connectivity"`` (particles coloured by their contacts, one colour bar for the
     movie). Each frame is titled with its shear strain eps_q and time. Written atomically
-    (:func:`grainview.export.write_atomically`).
+    (:func:`grainview.formats.export.write_atomically`).
 
     Parameters
     ----------
@@ -130,7 +130,7 @@ def animate(data, path, kind: str = "force_chains", every: int = 1, fps: int = 8
     """
     import matplotlib.pyplot as plt
 
-    from ..export import snapshot_indices
+    from ..formats.export import snapshot_indices
     from .maps import plot_force_chains, plot_force_classes, plot_particles
 
     if kind not in KINDS:
@@ -149,7 +149,7 @@ def animate(data, path, kind: str = "force_chains", every: int = 1, fps: int = 8
     if kind == "connectivity":
         import matplotlib as mpl
 
-        from ..particle_fields import particle_fields
+        from ..analysis.particle_fields import particle_fields
 
         contacts = particle_fields(ds, walls=True)["c"].isel(time=frames).values
         top = max(int(contacts.max()), 1)

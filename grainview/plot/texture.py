@@ -11,8 +11,8 @@ from __future__ import annotations
 import numpy as np
 import xarray as xr
 
-from ..connectivity import connectivity_pdf, coordination, joint_connectivity_pdf
-from ..fabric import fabric_anisotropy, orientation_pdf
+from ..analysis.connectivity import connectivity_pdf, coordination, joint_connectivity_pdf
+from ..analysis.fabric import fabric_anisotropy, orientation_pdf
 from ._style import (EPS_Q_LABEL, PALETTE, axis_label, datasets, draw_evolutions, finish, get_axes,
                      sample_colour, tidy_polar, select_snapshots, set_labels, single_dataset, time_mean, units_of,
                      values)
@@ -24,7 +24,7 @@ def plot_coordination(data, ax=None, label=None, walls: bool = False, **line_kw)
         z = sum_i c_i / N'
 
     over the N' non-rattler particles (rattlers left out, a double contact counted once;
-    docs/conventions.md §7; :func:`grainview.connectivity.coordination`). Dimensionless.
+    docs/conventions.md §7; :func:`grainview.analysis.connectivity.coordination`). Dimensionless.
 
     Parameters
     ----------
@@ -64,7 +64,7 @@ def plot_persistence(data, ax=None, label=None, reference: int = 0, **line_kw):
 
         gamma(t) = |C(ref) & C(t)| / |C(ref)|
 
-    (docs/conventions.md §8; :func:`grainview.persistence.persistence`, particle–particle
+    (docs/conventions.md §8; :func:`grainview.analysis.persistence.persistence`, particle–particle
     force-bearing contacts). Dimensionless; computed.
 
     Parameters
@@ -93,7 +93,7 @@ def plot_persistence(data, ax=None, label=None, reference: int = 0, **line_kw):
     Azéma, Radjai, Peyroux & Saussine, Phys. Rev. E 76, 011301 (2007),
     Sec. IV.A and Fig. 6b; docs/conventions.md §8.
     """
-    from ..persistence import persistence
+    from ..analysis.persistence import persistence
     ax = get_axes(ax)
     draw_evolutions(ax, datasets(data, label), lambda ds: persistence(ds, reference=reference), [(None, None)],
                     **line_kw)
@@ -107,7 +107,7 @@ def plot_connectivity_pdf(data, ax=None, label=None, time="residual", max_c: int
     """P(c) against c, averaged over the snapshots ``time`` (paper Fig. 7).
 
     P(c) is the fraction of (non-rattler) particles with exactly c force-bearing contacts
-    (:func:`grainview.connectivity.connectivity_pdf`). Markers only, c >= 1 (P(c) is discrete,
+    (:func:`grainview.analysis.connectivity.connectivity_pdf`). Markers only, c >= 1 (P(c) is discrete,
     and P(0) = 0 by definition once rattlers are left out); one marker series per sample.
 
     Parameters
@@ -156,7 +156,7 @@ def plot_orientation_pdf(data, ax=None, label=None, time="residual", bins: int =
                          walls: bool = False, **line_kw):
     """Polar plot of the density P(theta) of contact-normal orientations (rad-1) (paper Fig. 8).
 
-    Averaged over the snapshots ``time`` (:func:`grainview.fabric.orientation_pdf`). P is
+    Averaged over the snapshots ``time`` (:func:`grainview.analysis.fabric.orientation_pdf`). P is
     pi-periodic; the curve is drawn over the full turn (P(theta + pi) = P(theta)) and closed.
     Needs polar axes (created when ``ax`` is None).
 
@@ -179,7 +179,7 @@ def plot_orientation_pdf(data, ax=None, label=None, time="residual", bins: int =
         Number of angular sectors of [0, pi), centred on theta_k = k pi/bins.
     kind : {"all", "simple", "double"}, default "all"
         The contacts used: all, simple (vertex–edge and disk contacts) or double (edge–edge)
-        ones (also 1, 2, "s", "d"; :func:`grainview.contacts.kind_code`).
+        ones (also 1, 2, "s", "d"; :func:`grainview.analysis.contacts.kind_code`).
     walls : bool, default False
         Include the particle–wall contacts (default: particle–particle only).
     **line_kw
@@ -231,7 +231,7 @@ def plot_fabric_anisotropy(data, ax=None, label=None, walls: bool = False, **lin
 
         a' = 2 (F_1 - F_2) cos 2(theta_F - theta_sigma)
 
-    (docs/conventions.md §2; :func:`grainview.fabric.fabric_anisotropy`). Dimensionless.
+    (docs/conventions.md §2; :func:`grainview.analysis.fabric.fabric_anisotropy`). Dimensionless.
 
     Parameters
     ----------
@@ -270,7 +270,7 @@ def plot_partial_fabric_anisotropy(data, ax=None, label=None, walls: bool = Fals
     """Signed anisotropies a'_s and a'_d of the partial fabric tensors against eps_q (paper Fig. 22).
 
     The partial tensors of simple and double contacts add up, F = F_s + F_d, each normalised by
-    the count of all contacts (:func:`grainview.fabric.fabric_anisotropy` with ``kind``). Two
+    the count of all contacts (:func:`grainview.analysis.fabric.fabric_anisotropy` with ``kind``). Two
     lines per sample: s then d; with one sample in the contact kinds' colours
     (:data:`grainview.plot._style.PALETTE`). Dimensionless.
 
@@ -316,7 +316,7 @@ def plot_joint_connectivity(data, ax=None, label=None, time="residual", max_m: i
     """Grey-level map of P(m_s, m_d), averaged over the snapshots ``time`` (paper Fig. 21).
 
     P(m_s, m_d) is the fraction of (non-rattler) particles with m_s simple and m_d double
-    force-bearing contacts (:func:`grainview.connectivity.joint_connectivity_pdf`). One sample
+    force-bearing contacts (:func:`grainview.analysis.connectivity.joint_connectivity_pdf`). One sample
     per axes; the image's array is P with rows m_d and columns m_s.
 
     Parameters

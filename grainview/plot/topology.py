@@ -1,9 +1,9 @@
-"""Figures of the force network's topology (:func:`grainview.network_topology.network_persistence`):
+"""Figures of the force network's topology (:func:`grainview.analysis.network_topology.network_persistence`):
 a snapshot's persistence diagram, the Betti curves beta_0(xi), beta_1(xi), and the 3- and
 4-cycles by number of strong edges.
 
 Each function takes datasets of the contract (the analysis is run on them with its defaults)
-or the Datasets :func:`~grainview.network_topology.network_persistence` returned (drawn as
+or the Datasets :func:`~grainview.analysis.network_topology.network_persistence` returned (drawn as
 they are); several samples as ``{label: ds}`` or ``[(label, ds), ...]``. The functions only
 draw: every number comes from the topic module.
 """
@@ -25,7 +25,7 @@ def _result(ds: xr.Dataset) -> xr.Dataset:
     """``ds`` itself when it is a result of network_persistence, else the analysis of it."""
     if "birth" in ds and "beta_0" in ds:
         return ds
-    from ..network_topology import network_persistence
+    from ..analysis.network_topology import network_persistence
 
     return network_persistence(ds)
 
@@ -42,7 +42,7 @@ def plot_persistence_diagram(data, time=-1, ax=None, label=None):
     ----------
     data : xarray.Dataset, dict or list
         One dataset of the contract or one result of
-        :func:`~grainview.network_topology.network_persistence` (a single sample).
+        :func:`~grainview.analysis.network_topology.network_persistence` (a single sample).
     time : int, default -1
         The snapshot (an index along ``time``).
     ax : matplotlib.axes.Axes, optional
@@ -95,7 +95,7 @@ def plot_betti_curves(data, ax=None, label=None, per_particle: bool = True):
     ----------
     data : xarray.Dataset, dict or list
         Datasets of the contract or results of
-        :func:`~grainview.network_topology.network_persistence`, one or several samples
+        :func:`~grainview.analysis.network_topology.network_persistence`, one or several samples
         (select the snapshots, e.g. the residual state, before).
     ax : matplotlib.axes.Axes, optional
         The axes to draw on.
@@ -138,7 +138,7 @@ def plot_cycle_counts(data, ax=None, label=None, per_particle: bool = True):
     ----------
     data : xarray.Dataset, dict or list
         Datasets of the contract or results of
-        :func:`~grainview.network_topology.network_persistence`.
+        :func:`~grainview.analysis.network_topology.network_persistence`.
     ax : matplotlib.axes.Axes, optional
         The axes to draw on.
     label : str, optional

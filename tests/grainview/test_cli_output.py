@@ -16,7 +16,7 @@ import pytest
 import grainview
 from grainview.cli import build_parser, main
 from grainview.contract.dataset import netcdf_encoding
-from grainview.synthetic import harmonic_series
+from grainview.analysis.synthetic import harmonic_series
 
 from .test_near_contacts import chain
 
@@ -49,7 +49,7 @@ def _wide_table():
 
 @pytest.mark.parametrize("width", [60, 80, 237])
 def test_terminal_table_fits_the_width_and_rounds_as_the_markdown(width):
-    from grainview.report import terminal_table
+    from grainview.app.report import terminal_table
 
     text = terminal_table(_wide_table(), width=width)
     lines = text.splitlines()
@@ -63,7 +63,7 @@ def test_terminal_table_fits_the_width_and_rounds_as_the_markdown(width):
 
 
 def test_report_and_study_print_the_table_fitted_to_the_terminal(tmp_path, monkeypatch, capsys):
-    import grainview.report as report
+    import grainview.app.report as report
 
     monkeypatch.setenv("COLUMNS", "80")
     monkeypatch.setattr(report, "write_report", lambda runs, out, **kw: {"table": _wide_table(), "files": []})
@@ -91,8 +91,8 @@ def test_ensemble_report_says_not_reached_as_study_and_report_do(tmp_path, capsy
 
 
 def test_ensemble_report_counts_the_seeds_short_of_the_window(tmp_path):
-    from grainview.ensemble import open_ensemble
-    from grainview.ensemble_report import ensemble_table, format_table
+    from grainview.analysis.ensemble import open_ensemble
+    from grainview.app.ensemble_report import ensemble_table, format_table
 
     paths = _seeds(tmp_path)
     with grainview.open_dataset(paths[1]) as ds:
@@ -147,7 +147,7 @@ def test_ensemble_replaces_its_report_when_asked_and_keeps_the_runs(tmp_path, mo
 # 16. CSV export and headline.csv -------------------------------------------------------
 
 def test_csv_export_flags_the_pairs_without_force_and_names_kinds_and_units(tmp_path):
-    from grainview.export import write_csv
+    from grainview.formats.export import write_csv
 
     ds = chain()
     kind = ds["kind"].values.copy()
@@ -171,7 +171,7 @@ def test_export_refusal_names_the_flag_once(tmp_path, capsys):
 
 
 def test_headline_csv_holds_particles_seed_and_window_as_numbers(tmp_path):
-    from grainview.report import headline_table, write_table
+    from grainview.app.report import headline_table, write_table
 
     ds = harmonic_series(n_snapshots=5, n_contacts=50, seed=3)  # eps_q 0 .. 0.147
     ds.attrs.update(preparation_seed=np.int32(3))
@@ -180,7 +180,7 @@ def test_headline_csv_holds_particles_seed_and_window_as_numbers(tmp_path):
     rows = {line.split(",")[0]: line.split(",")[1:] for line in csv.read_text().splitlines()}
     assert rows["particles"] == ["100", "10000"]
     assert rows["seed"] == ["3", ""]
-    eps_q = grainview.strain.strains(ds)["eps_q"].values
+    eps_q = grainview.analysis.strain.strains(ds)["eps_q"].values
     late = eps_q[eps_q >= 0.05]
     assert float(rows["residual window from eps_q"][0]) == pytest.approx(late.min(), rel=1e-12)
     assert float(rows["residual window to eps_q"][0]) == pytest.approx(late.max(), rel=1e-12)
@@ -215,7 +215,7 @@ def test_info_on_the_demo_file_prints_a_solid_fraction_below_one(tmp_path, capsy
 
 
 def test_a_run_labelled_freely_keeps_the_paper_column_of_its_shape():
-    from grainview.report import PAPER, headline_table
+    from grainview.app.report import PAPER, headline_table
 
     disks = harmonic_series(n_snapshots=2, n_contacts=20)
     table = headline_table({"run1": disks}, residual_strain=0.0)
@@ -238,7 +238,7 @@ def test_default_output_folders_are_ignored_by_git():
 
 
 def test_index_links_resolve_from_the_index_folder(tmp_path, monkeypatch):
-    from grainview.report import write_index
+    from grainview.app.report import write_index
 
     runs_dir = tmp_path / "runs"
     runs_dir.mkdir()
@@ -278,7 +278,7 @@ def test_the_s1s2_preparation_is_explained_in_words():
 # 7. warm-up -----------------------------------------------------------------------------
 
 def test_warmup_compiles_the_kernels_and_says_where_the_cache_is(capsys, monkeypatch):
-    from grainview.warmup import kernels
+    from grainview.app.warmup import kernels
 
     assert main(["warmup"]) == 0
     first = capsys.readouterr().out
@@ -286,8 +286,8 @@ def test_warmup_compiles_the_kernels_and_says_where_the_cache_is(capsys, monkeyp
     for name in ("solver.nlgs.solve", "solver.acceleration.solve_anderson", "solver.parallel_nlgs.solve_domains",
                  "solver.narrowphase._detect_kernel", "solver.broadphase._candidate_pairs_kernel",
                  "solver.packing._deposit_kernel", "solver.residuals.natural_maps",
-                 "grainview._kernels.xi_network.count_below",
-                 "grainview._kernels.network_topology.flag_persistence_1"):
+                 "grainview.analysis._kernels.xi_network.count_below",
+                 "grainview.analysis._kernels.network_topology.flag_persistence_1"):
         assert name in compiled, name
     cache = os.path.abspath(os.environ["NUMBA_CACHE_DIR"]) if os.environ.get("NUMBA_CACHE_DIR") else "__pycache__"
     assert cache in first and "[1/" in first

@@ -6,14 +6,14 @@ import numpy as np
 import pytest
 import xarray as xr
 
-from grainview import sample
-from grainview._kernels.coarse_graining import spread_points, spread_segments
-from grainview.arrays.stress import stress_tensor as love_weber
-from grainview.coarse_graining import coarse_grained, field_invariants, interior, profile, scalar_field
+from grainview.analysis import sample
+from grainview.analysis._kernels.coarse_graining import spread_points, spread_segments
+from grainview.analysis.arrays.stress import stress_tensor as love_weber
+from grainview.analysis.coarse_graining import coarse_grained, field_invariants, interior, profile, scalar_field
 from grainview.contract.dataset import make_dataset
 from grainview.contract.errors import ParameterError
-from grainview.fabric import fabric_tensor
-from grainview.stress import stress_tensor
+from grainview.analysis.fabric import fabric_tensor
+from grainview.analysis.stress import stress_tensor
 
 from . import builders
 from .builders import R

@@ -1,5 +1,5 @@
 """What the report and the command line say of a run's unconverged NLGS steps
-(grainview.convergence): the counts and largest residuals read from the file, and the text."""
+(grainview.app.convergence): the counts and largest residuals read from the file, and the text."""
 
 from __future__ import annotations
 
@@ -11,8 +11,8 @@ import pytest
 
 import grainview
 from grainview.cli import _simulate
-from grainview.convergence import unconverged_in_file, unconverged_text
-from grainview.report import convergence_notes, convergence_text
+from grainview.app.convergence import unconverged_in_file, unconverged_text
+from grainview.app.report import convergence_notes, convergence_text
 from solver.preparation import preparation
 
 ATTRS = {"solver_tolerance": 1.7e-4, "solver_max_tolerance": 1e-2, "solver_max_iterations": 2000,

@@ -12,9 +12,9 @@ import xarray as xr
 
 import grainview
 from grainview.contract.dataset import netcdf_encoding
-from grainview.ensemble import run_dataset, seed_statistics
+from grainview.analysis.ensemble import run_dataset, seed_statistics
 from grainview.contract.errors import ParameterError
-from grainview.synthetic import harmonic_series
+from grainview.analysis.synthetic import harmonic_series
 
 from .conftest import raise_if_dask_computes
 
@@ -106,8 +106,8 @@ def test_seed_statistics_against_numpy(files):
 
 
 def test_ensemble_report_spread_against_numpy(files, tmp_path):
-    from grainview.ensemble_report import write_ensemble_report
-    from grainview.report import run_summary
+    from grainview.app.ensemble_report import write_ensemble_report
+    from grainview.app.report import run_summary
 
     ens = grainview.open_ensemble(files)
     result = write_ensemble_report(ens, tmp_path / "report", residual_strain=0.0)

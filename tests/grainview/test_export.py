@@ -12,7 +12,7 @@ import pandas as pd
 import pytest
 
 from grainview.contract.errors import ParameterError
-from grainview.export import write_csv, write_vtk
+from grainview.formats.export import write_csv, write_vtk
 
 from .test_lifetimes import SERIES
 from .test_persistence import N, S, sequence_dataset

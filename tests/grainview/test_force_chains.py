@@ -10,13 +10,13 @@ import numpy as np
 import pytest
 import xarray as xr
 
-from grainview.arrays import force_chains as fc
-from grainview.arrays.tensors import principal
+from grainview.analysis.arrays import force_chains as fc
+from grainview.analysis.arrays.tensors import principal
 from grainview.contract.dataset import make_dataset
 from grainview.contract.errors import ParameterError
-from grainview.force_chains import force_chains, particle_volume
-from grainview.stress import stress_tensor
-from grainview.sample import volume
+from grainview.analysis.force_chains import force_chains, particle_volume
+from grainview.analysis.stress import stress_tensor
+from grainview.analysis.sample import volume
 
 from . import builders
 from .builders import R

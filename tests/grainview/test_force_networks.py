@@ -6,7 +6,7 @@ import pytest
 
 from grainview import make_dataset
 from grainview.contract.errors import ParameterError
-from grainview.force_networks import contact_proportions, force_class
+from grainview.analysis.force_networks import contact_proportions, force_class
 
 from . import builders
 from .conftest import raise_if_dask_computes

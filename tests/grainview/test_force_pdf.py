@@ -7,7 +7,7 @@ import xarray as xr
 
 from grainview import make_dataset
 from grainview.contract.errors import ParameterError
-from grainview.force_pdf import force_pdf, pooled_force_pdf, strong_force_exponent
+from grainview.analysis.force_pdf import force_pdf, pooled_force_pdf, strong_force_exponent
 
 from . import builders
 from .conftest import raise_if_dask_computes

@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 
 from grainview.contract.errors import ParameterError
-from grainview.lifetimes import contact_events, kaplan_meier, lifetime_survival
+from grainview.analysis.lifetimes import contact_events, kaplan_meier, lifetime_survival
 
 from .conftest import raise_if_dask_computes
 from .test_persistence import N, S, D, sequence_dataset

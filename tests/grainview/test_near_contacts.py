@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 
 from grainview import make_dataset
-from grainview.contacts import selection
+from grainview.analysis.contacts import selection
 from grainview.contract.errors import ParameterError
 
 from .conftest import raise_if_dask_computes

@@ -13,10 +13,10 @@ import pytest
 from scipy.sparse import coo_matrix
 from scipy.sparse.csgraph import connected_components
 
-from grainview.arrays import network_topology as nt
+from grainview.analysis.arrays import network_topology as nt
 from grainview.contract.dataset import make_dataset
 from grainview.contract.errors import ParameterError
-from grainview.network_topology import network_persistence
+from grainview.analysis.network_topology import network_persistence
 
 from . import builders
 from .conftest import raise_if_dask_computes
@@ -524,7 +524,7 @@ def study_file(label):
 def study_graphs(label, every=1):
     """Each snapshot's network as the module filters it: (u, v, value), the particle count."""
     import grainview
-    from grainview.contacts import selection
+    from grainview.analysis.contacts import selection
 
     ds = grainview.open_dataset(study_file(label)).isel(time=slice(None, None, every)).load()
     mask, fn, i, j = (a.transpose("time", "contact").values for a in (selection(ds), ds.fn, ds.i, ds.j))

@@ -5,9 +5,9 @@ import numpy as np
 import pytest
 
 from grainview import make_dataset
-from grainview import persistence as persistence_module
+from grainview.analysis import persistence as persistence_module
 from grainview.contract.errors import ParameterError
-from grainview.persistence import pair_keys, persistence, type_transitions
+from grainview.analysis.persistence import pair_keys, persistence, type_transitions
 
 from .conftest import raise_if_dask_computes
 

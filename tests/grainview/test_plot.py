@@ -16,16 +16,16 @@ from matplotlib.colors import to_rgba  # noqa: E402
 
 import grainview  # noqa: E402
 from grainview import plot as gp  # noqa: E402
-from grainview.connectivity import connectivity_pdf, coordination, joint_connectivity_pdf  # noqa: E402
+from grainview.analysis.connectivity import connectivity_pdf, coordination, joint_connectivity_pdf  # noqa: E402
 from grainview.contract.errors import ParameterError  # noqa: E402
-from grainview.fabric import fabric_anisotropy, orientation_pdf  # noqa: E402
-from grainview.forces import force_anisotropies, harmonic_prediction  # noqa: E402
+from grainview.analysis.fabric import fabric_anisotropy, orientation_pdf  # noqa: E402
+from grainview.analysis.forces import force_anisotropies, harmonic_prediction  # noqa: E402
 from grainview.plot import PlotAccessor, save_figure  # noqa: E402
 from grainview.plot._style import select_snapshots  # noqa: E402
 from grainview.plot.maps import CLASS_COLOURS, KIND_COLOURS, contact_collection, newtons  # noqa: E402
-from grainview.strain import friction_and_dilatancy, strains  # noqa: E402
-from grainview.stress import stress_invariants  # noqa: E402
-from grainview.synthetic import harmonic_series  # noqa: E402
+from grainview.analysis.strain import friction_and_dilatancy, strains  # noqa: E402
+from grainview.analysis.stress import stress_invariants  # noqa: E402
+from grainview.analysis.synthetic import harmonic_series  # noqa: E402
 
 from . import builders  # noqa: E402
 
@@ -387,7 +387,7 @@ def test_map_takes_one_sample_and_one_snapshot(series):
 # -- figures of the force-network modules -----------------------------------------------------
 
 def test_tricolor_map_colours_match_force_classes():
-    force_networks = pytest.importorskip("grainview.force_networks")
+    force_networks = pytest.importorskip("grainview.analysis.force_networks")
     ds = pentagon_grid(seed=2)
     ax = gp.plot_force_classes(ds)
     classes = force_networks.force_class(ds).values[0]
@@ -408,7 +408,7 @@ def test_tricolor_map_colours_match_force_classes():
 
 
 def test_force_pdf_log_linear_with_exponential_fit(series, other_series):
-    force_pdf = pytest.importorskip("grainview.force_pdf")
+    force_pdf = pytest.importorskip("grainview.analysis.force_pdf")
     ax = gp.plot_force_pdf({"a": series, "b": other_series}, bins=30)
     assert len(ax.lines) == 4  # pdf and fit per sample
     want = force_pdf.pooled_force_pdf(select_snapshots(series, "residual"), bins=30, scale="linear",
@@ -435,14 +435,14 @@ def test_force_pdf_log_linear_with_exponential_fit(series, other_series):
 
 
 def test_force_pdf_figures_log_log_and_per_kind(series):
-    pytest.importorskip("grainview.force_pdf")
+    pytest.importorskip("grainview.analysis.force_pdf")
     fig = gp.plot_force_pdfs(series, bins=20)
     assert [a.get_xscale() for a in fig.axes] == ["linear", "log"]
     assert len(fig.axes[1].lines) == 1  # no fit in log-log
     fig = gp.plot_force_pdfs_by_kind({"a": series}, bins=20)
     ax = fig.axes[0]
     assert len(ax.lines) == 2 and legend_texts(ax) == ["a, s", "a, d"]
-    from grainview.force_pdf import pooled_force_pdf
+    from grainview.analysis.force_pdf import pooled_force_pdf
     want = pooled_force_pdf(select_snapshots(series, "residual"), bins=20, scale="linear", range=(0.0, 6.0),
                             kind="double")
     p = want["pdf"].values if "time" not in want["pdf"].dims else want["pdf"].mean("time").values
@@ -452,7 +452,7 @@ def test_force_pdf_figures_log_log_and_per_kind(series):
 @pytest.mark.parametrize("func, name, ylabel", [(gp.plot_xi_stress, "q_over_p", r"$q(\xi)/p$"),
                                                  (gp.plot_xi_anisotropy, "a_prime", r"$a'(\xi)$")])
 def test_xi_network_curves(series, func, name, ylabel):
-    xi_network = pytest.importorskip("grainview.xi_network")
+    xi_network = pytest.importorskip("grainview.analysis.xi_network")
     xi = np.array([0.5, 1.0, 2.0, 4.0])
     ax = func(series, xi=xi)
     want = xi_network.xi_network(select_snapshots(series, "residual"), xi=xi)[name].mean("time")
@@ -467,7 +467,7 @@ def test_xi_network_curves(series, func, name, ylabel):
 
 
 def test_proportion_curves(series):
-    force_networks = pytest.importorskip("grainview.force_networks")
+    force_networks = pytest.importorskip("grainview.analysis.force_networks")
     want = force_networks.contact_proportions(series)
     ax = gp.plot_contact_proportions(series)
     assert len(ax.lines) == 4
@@ -486,7 +486,7 @@ def test_proportion_curves(series):
 
 
 def test_persistence_and_transitions():
-    persistence = pytest.importorskip("grainview.persistence")
+    persistence = pytest.importorskip("grainview.analysis.persistence")
     ds = builders.mixed_contacts(seed=1, t=3)  # random pairs and kinds: gamma falls below 1
     ax = gp.plot_persistence({"mixed": ds})
     gamma = persistence.persistence(ds).values
@@ -565,7 +565,7 @@ def _with_near_pairs(ds, near_m=1e-3, n_near=40, seed=5):
 
 
 def test_xi_anisotropy_counts_near_pairs_when_asked_and_draws_the_papers_inset_as_a_panel(series):
-    from grainview.xi_network import xi_network
+    from grainview.analysis.xi_network import xi_network
 
     near = _with_near_pairs(series)
     xi = np.array([0.1, 0.5, 1.0, 2.0])
@@ -585,7 +585,7 @@ def test_xi_anisotropy_counts_near_pairs_when_asked_and_draws_the_papers_inset_a
 
 
 def test_the_report_counts_near_pairs_in_fig16_only_when_every_file_holds_them(series):
-    from grainview.report import NEAR_FRACTION, xi_contacts
+    from grainview.app.report import NEAR_FRACTION, xi_contacts
 
     near = _with_near_pairs(series, near_m=1.0)
     gap, line = xi_contacts({"a": near, "b": near})
@@ -757,7 +757,7 @@ def test_the_transition_caption_gives_the_snapshot_interval(series):
 
 def test_the_headline_phi_0_is_fig5s_and_says_when_the_run_is_too_short(series):
     from grainview.plot.macroscopic import friction_offset
-    from grainview.report import NOT_REACHED, PHI_0_ROW, run_summary
+    from grainview.app.report import NOT_REACHED, PHI_0_ROW, run_summary
 
     angles = friction_and_dilatancy(series)
     eps = strains(series)["eps_q"].values

@@ -1,4 +1,4 @@
-"""The force-chain figures draw what grainview.force_chains computes: the chain map's colours and
+"""The force-chain figures draw what grainview.analysis.force_chains computes: the chain map's colours and
 links on the hand-made column, the fractions' curves, the lengths' pdf, the lifetimes, the movie."""
 
 from __future__ import annotations
@@ -13,11 +13,11 @@ import pytest  # noqa: E402
 from matplotlib.collections import EllipseCollection, LineCollection  # noqa: E402
 
 from grainview.contract.errors import ParameterError  # noqa: E402
-from grainview.force_chains import force_chains  # noqa: E402
+from grainview.analysis.force_chains import force_chains  # noqa: E402
 from grainview.plot import PlotAccessor  # noqa: E402
 from grainview.plot.chains import (animate_chains, plot_chain_fractions, plot_chain_lengths,  # noqa: E402
                                    plot_chain_lifetimes, plot_chain_map)
-from grainview.strain import strains  # noqa: E402
+from grainview.analysis.strain import strains  # noqa: E402
 
 from .test_force_chains import column_among_pairs, series  # noqa: E402
 

@@ -6,9 +6,9 @@ import numpy as np
 import pytest
 import xarray as xr
 
-from grainview.coarse_graining import profile, scalar_field
+from grainview.analysis.coarse_graining import profile, scalar_field
 from grainview.contract.errors import ParameterError
-from grainview.shear_bands import find_shear_band, profile_along
+from grainview.analysis.shear_bands import find_shear_band, profile_along
 
 H = 0.01  # grid spacing of the hand-made fields, m
 GRID = np.round(np.arange(0.0, 1.0 + H / 2, H), 12)
@@ -162,7 +162,7 @@ def test_the_band_is_drawn_over_the_shear_rate_map():
     import matplotlib
 
     matplotlib.use("Agg")
-    from grainview.coarse_graining import coarse_grained, interior
+    from grainview.analysis.coarse_graining import coarse_grained, interior
     from grainview.plot import plot_field_maps, plot_shear_band
 
     from . import builders

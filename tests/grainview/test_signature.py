@@ -1,4 +1,4 @@
-"""The core dimensions declared beside the array functions (grainview.arrays.signature)."""
+"""The core dimensions declared beside the array functions (grainview.analysis.arrays.signature)."""
 
 import inspect
 
@@ -6,10 +6,10 @@ import numpy as np
 import pytest
 import xarray as xr
 
-from grainview import arrays
-from grainview._lift import apply
-from grainview.arrays import connectivity, fabric, force_networks, force_pdf, forces, stress, tensors, xi_network
-from grainview.arrays.signature import TENSOR, core_dims
+from grainview.analysis import arrays
+from grainview.analysis._lift import apply
+from grainview.analysis.arrays import connectivity, fabric, force_networks, force_pdf, forces, stress, tensors, xi_network
+from grainview.analysis.arrays.signature import TENSOR, core_dims
 
 LIFTED = [connectivity.contact_numbers, connectivity.coordination, connectivity.connectivity_pdf,
           connectivity.joint_connectivity_pdf, fabric.fabric_tensor, fabric.orientation_pdf,

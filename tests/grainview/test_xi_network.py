@@ -4,14 +4,14 @@ whole-sample limit, and lattices by hand (ERRATA item 5)."""
 import numpy as np
 import pytest
 
-from grainview.arrays import fabric as fabric_arrays
-from grainview.arrays import stress as stress_arrays
-from grainview.arrays.tensors import principal, signed_anisotropy
-from grainview._kernels.xi_network import count_below
+from grainview.analysis.arrays import fabric as fabric_arrays
+from grainview.analysis.arrays import stress as stress_arrays
+from grainview.analysis.arrays.tensors import principal, signed_anisotropy
+from grainview.analysis._kernels.xi_network import count_below
 from grainview.contract.errors import ParameterError
-from grainview.fabric import fabric_anisotropy
-from grainview.stress import stress_invariants
-from grainview.xi_network import xi_network
+from grainview.analysis.fabric import fabric_anisotropy
+from grainview.analysis.stress import stress_invariants
+from grainview.analysis.xi_network import xi_network
 
 from . import builders
 from .builders import R

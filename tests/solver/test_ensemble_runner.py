@@ -13,7 +13,7 @@ import pytest
 import xarray as xr
 
 import grainview
-from grainview.ensemble import run_dataset
+from grainview.analysis.ensemble import run_dataset
 from grainview.contract.errors import ParameterError
 from grainview.contract.writer import is_compressed
 from solver import ensemble

@@ -2,7 +2,7 @@
 particles' centres) and along segments (the contacts' branch vectors) onto a grid.
 
 Structure of arrays: coordinates and weights come as separate contiguous float64 arrays, one
-row per snapshot; the caller (:mod:`grainview.arrays.coarse_graining`) validates them. Every
+row per snapshot; the caller (:mod:`grainview.analysis.arrays.coarse_graining`) validates them. Every
 kernel adds into ``out`` (B, ny, nx, K), ``K`` the number of quantities carried by each source.
 
 The kernel is the Gaussian of standard deviation w cut at radius c and renormalised,

@@ -4,7 +4,7 @@ triangles' boundary matrix over Z/2, and the counts of 3-cycles and chordless 4-
 number of strong edges.
 
 Structure of arrays: a graph is given as its edge endpoints ``u``, ``v`` (int64, node ids in
-[0, n_nodes)) and one value per edge; :mod:`grainview.arrays.network_topology` checks them
+[0, n_nodes)) and one value per edge; :mod:`grainview.analysis.arrays.network_topology` checks them
 before calling.
 """
 

@@ -2,7 +2,7 @@
 (2010); Weinhart, Thornton, Luding & Bokhove, Granular Matter 14, 289 (2012)).
 
 Each particle i (mass m_i, area A_i, centre r_i, velocity v_i) is spread over the plane with a
-kernel phi (m^-2, integral 1; :mod:`grainview._kernels.coarse_graining`), each contact c along
+kernel phi (m^-2, integral 1; :mod:`grainview.analysis._kernels.coarse_graining`), each contact c along
 its branch vector l^c from the centre of i, with the kernel integrated along it,
 psi_c(r) = int_0^1 phi(r - r_i - u l^c) du. With t the slab thickness (m):
 
@@ -20,8 +20,8 @@ contact point for a wall contact), so that both stresses are positive in compres
 (docs/conventions.md §0-1; the references count tension positive). Because each kernel
 integrates to 1 over the plane, int rho dA t = sum_i m_i, int nu dA = sum_i A_i and
 int sigma^c dA = (1/t) sum_c f (x) l: over a sample of area A, (1/A) int sigma^c dA is the
-Love-Weber stress (1/V) sum_c f (x) l of :func:`grainview.arrays.stress.stress_tensor`, V = A t.
-F has trace 1 and is the fabric tensor of :func:`grainview.arrays.fabric.fabric_tensor` where
+Love-Weber stress (1/V) sum_c f (x) l of :func:`grainview.analysis.arrays.stress.stress_tensor`, V = A t.
+F has trace 1 and is the fabric tensor of :func:`grainview.analysis.arrays.fabric.fabric_tensor` where
 the kernel is wider than the sample.
 """
 
@@ -30,7 +30,7 @@ from __future__ import annotations
 import numpy as np
 
 from .._kernels.coarse_graining import spread_points, spread_segments
-from ..contract.errors import ParameterError
+from ...contract.errors import ParameterError
 from .signature import CONTACT, CONTACT_XY, PARTICLE, SCALAR, TENSOR, core_dims
 from .vectors import force_vectors
 

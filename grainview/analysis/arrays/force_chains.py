@@ -23,7 +23,7 @@ For each snapshot:
 5. chains: the connected sets of linked particles of at least ``min_size`` (3) particles.
 
 The per-contact sums, the link test and the connected sets (union-find) are numba kernels
-(:mod:`grainview._kernels.force_chains`) over every snapshot at once; the rest is numpy.
+(:mod:`grainview.analysis._kernels.force_chains`) over every snapshot at once; the rest is numpy.
 """
 
 from __future__ import annotations
@@ -105,7 +105,7 @@ def chain_links(i, j, branch, mask, candidate, theta_1, angle):
 def components(i, j, link, n_particles, min_size=3):
     """Chain id (..., P) of each particle: the connected sets of the ``link`` graph of at least
     ``min_size`` particles, numbered 0, 1, ... per snapshot in the order of their smallest
-    particle index; -1 outside (:func:`grainview._kernels.force_chains.label_components`)."""
+    particle index; -1 outside (:func:`grainview.analysis._kernels.force_chains.label_components`)."""
     link = np.asarray(link, bool)
     lead = link.shape[:-1]
     i = _rows(np.broadcast_to(i, link.shape), 1).astype(np.int64)
@@ -204,7 +204,7 @@ def follow_chains(chain):
     Chain a of snapshot t-1 continues as chain b of snapshot t when they share particles and
     each is the other's best match (b shares more of a's members than any other chain of t, and
     a more of b's than any other chain of t-1; ties go to the smaller id). Every other chain
-    starts a new track (:func:`grainview._kernels.force_chains.follow_tracks`).
+    starts a new track (:func:`grainview.analysis._kernels.force_chains.follow_tracks`).
 
     Parameters
     ----------

@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..contract.schema import KIND_DOUBLE, KIND_SIMPLE
+from ...contract.schema import KIND_DOUBLE, KIND_SIMPLE
 from .force_pdf import mean_normal_force
 from .signature import CONTACT, SCALAR, core_dims
 

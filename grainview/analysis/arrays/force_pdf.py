@@ -1,7 +1,7 @@
 """Distribution of normal forces normalised by their mean (paper Sec. V.B, Eq. strong, Fig. 14).
 
 Histograms are taken per snapshot with one ``np.bincount`` for all snapshots at once
-(:func:`grainview.arrays.binning.batched_bincount`), after locating every force in the bins
+(:func:`grainview.analysis.arrays.binning.batched_bincount`), after locating every force in the bins
 with ``np.searchsorted`` exactly as ``np.histogram`` does for explicit edges.
 """
 

@@ -11,9 +11,9 @@ with its strongest contact. A feature alive at the end (xi = 0: the whole select
 death = -inf. Betti curves: beta_k(xi) = #{features of dimension k : birth >= xi > death}.
 
 Both dimensions are the project's own numba kernels: dimension 0 (connected components) the
-union-find of :func:`grainview._kernels.network_topology.union_find_pairs`, dimension 1 (loops
+union-find of :func:`grainview.analysis._kernels.network_topology.union_find_pairs`, dimension 1 (loops
 not filled by triangles) the standard reduction over Z/2 of the triangles' boundary matrix, with
-the twist (:func:`grainview._kernels.network_topology.flag_persistence_1`). The complex stops at
+the twist (:func:`grainview.analysis._kernels.network_topology.flag_persistence_1`). The complex stops at
 the triangles: the triangles of a 4-clique (or of an octahedron) close a 2-sphere that no
 tetrahedron fills; the last of them to enter fills no loop and the sphere is not reported.
 Dimension 1 is the same with or without the higher cliques (the homology of dimension 1
@@ -33,7 +33,7 @@ from __future__ import annotations
 import numpy as np
 
 from .._kernels.network_topology import cycle_counts, flag_persistence_1, union_find_pairs
-from ..contract.errors import ParameterError
+from ...contract.errors import ParameterError
 from .force_pdf import mean_normal_force
 from .signature import CONTACT, core_dims
 
@@ -131,7 +131,7 @@ def diagram_0(u, v, value, n_nodes):
 
 def diagram_1(u, v, value, n_nodes):
     """1-dimensional diagram of the clique complex (edges and triangles) by the project's
-    reduction over Z/2 (:func:`grainview._kernels.network_topology.flag_persistence_1`).
+    reduction over Z/2 (:func:`grainview.analysis._kernels.network_topology.flag_persistence_1`).
 
     A loop is born at the value of the edge that closes it and dies at the value of the
     triangle that fills it, a triangle entering with its weakest edge (the smallest value of

@@ -1,10 +1,10 @@
 """Declaring the core dimensions of a batched array function beside the function.
 
-Every function of :mod:`grainview.arrays` works on the LAST axes of its arrays (one snapshot's
+Every function of :mod:`grainview.analysis.arrays` works on the LAST axes of its arrays (one snapshot's
 contacts, particles, a 2x2 tensor) and broadcasts over any leading ones (time). Which named
 dimensions those last axes are is part of the function's definition, like the signature of a
 numpy generalised ufunc ("(contact,xy),(contact)->(xy_a,xy_b)") or of an xgcm grid ufunc, so it
-is declared here, once, with :func:`core_dims`; :func:`grainview._lift.apply` reads it when it
+is declared here, once, with :func:`core_dims`; :func:`grainview.analysis._lift.apply` reads it when it
 lifts the function to labelled arrays.
 """
 
