@@ -10,7 +10,7 @@ each point. Every point k must satisfy Signorini and Coulomb:
     r_n >= 0,  u_n >= 0,  r_n u_n = 0;   |r_t| <= mu r_n,  and u_t != 0 => r_t = -mu r_n sign(u_t).
 
 :func:`solve_contact_problem` validates the problem and hands it to the method named by
-``method`` (:data:`solver.contact_solvers.SOLVERS`): by default the same point-by-point exact
+``method`` (a method of the registry :mod:`solver.contact_solvers` with a matrix entry point): by default the same point-by-point exact
 local solver and the same two stopping norms as the time stepper's NLGS (:mod:`solver.nlgs`);
 ``newton`` (semi-smooth Newton, :mod:`solver.nonsmooth_newton`) and ``pcg`` (projected conjugate
 gradient, :mod:`solver.projected_cg`) stop on the natural-map residual instead. Every method's
@@ -68,7 +68,7 @@ def solve_contact_problem(W, q, mu, *, method="nlgs", tolerance=1e-10, max_itera
         tangential velocity of point k).
     q : (2n,) free local velocities (m s-1 for impulses in N s).
     mu : scalar or (n,), friction coefficients.
-    method : a name of :data:`solver.contact_solvers.SOLVERS`: ``nlgs`` (default), ``newton``,
+    method : a name of :func:`solver.contact_solvers.matrix_methods`: ``nlgs`` (default), ``newton``,
         ``pcg``.
     tolerance : the method's stopping tolerance: for ``nlgs`` its quadratic norm (its max norm
         ``max_tolerance``, an option, defaults to 60 x ``tolerance``); for the others the

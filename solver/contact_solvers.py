@@ -1,62 +1,269 @@
-"""The methods that solve a contact problem given by its matrix, by name.
+"""The one registry of the methods that solve a frictional contact problem, by name.
 
-Every method is a callable ``solve(W, q, mu, tolerance, max_iterations, initial, **options)
--> ContactSolution`` on a validated problem (:func:`solver.contact_problem.solve_contact_problem`
-validates and dispatches through :data:`SOLVERS`): W (2n, 2n) CSR with sorted indices, q (2n,),
-mu (n,), ``initial`` (n, 2) starting impulses. Each stops on its own test:
+A method registers once (:func:`register`) as a :class:`Method`, with one or both of two
+entry points:
+
+``solve(problem, state, limits, **options) -> NLGSResult`` (the stepper's problem)
+    ``problem`` the time step's :class:`solver.nlgs.ContactProblem`; ``state`` a
+    :class:`ContactState`, the warm-start impulses and the free body velocities, updated in
+    place to the solution; ``limits`` a :class:`solver.solve_records.Limits` (the two NLGS
+    norms' tolerances, the sweep cap, the stall test's sweeps);
+    ``options`` the method's own keywords, read from :class:`solver.stepper.Parameters` by
+    :meth:`Method.options`. The result is a :class:`solver.nlgs.NLGSResult`: iterations, and
+    the quadratic and max norms of the NLGS stopping test (:mod:`solver.nlgs`), which the
+    stepper compares with ``Parameters.tolerance`` and ``max_tolerance``. A method with this
+    entry can be chosen by ``Parameters.solver`` (and the command line's ``--solver``).
+``solve_matrix(W, q, mu, tolerance, max_iterations, initial, **options) -> ContactSolution`` (a matrix problem)
+    u = W r + q given by its Delassus matrix (:func:`solver.contact_problem.solve_contact_problem`
+    validates it and dispatches here): W (2n, 2n) CSR with sorted indices, q (2n,), mu (n,),
+    ``initial`` (n, 2) starting impulses; the result a
+    :class:`solver.contact_solution.ContactSolution`.
+
+The methods registered here:
 
 ``nlgs``
-    Point-by-point nonlinear Gauss–Seidel (:func:`solver.nlgs.solve_matrix`): ``tolerance``
-    is its quadratic norm of the impulses' change over a sweep, ``max_tolerance`` (an option,
-    default 60 x ``tolerance``) its max norm; ``max_iterations`` caps the sweeps.
+    Point-by-point nonlinear Gauss–Seidel (:mod:`solver.nlgs`). In the stepper: the serial
+    sweep, in a random order when ``Parameters.shuffle``, or the domain-decomposed sweeps of
+    :mod:`solver.parallel_nlgs` when ``Parameters.domains`` > 1. On a matrix
+    (:func:`solver.nlgs.solve_matrix`): ``tolerance`` its quadratic norm, ``max_tolerance`` (an
+    option, default 60 x ``tolerance``) its max norm, ``max_iterations`` the sweep cap.
+``anderson``
+    NLGS sweeps combined by Anderson extrapolation (:mod:`solver.acceleration`; the stepper's
+    default), ``Parameters.anderson_memory`` past sweeps every ``anderson_period`` sweeps, on
+    ``domains`` domains; no shuffled order. Stepper only.
 ``newton``
     Semi-smooth Newton on Alart–Curnier's function with a line search
     (:mod:`solver.nonsmooth_newton`); ``tolerance`` is the local-law residual
-    (:mod:`solver.contact_solution`).
+    (:mod:`solver.contact_solution`). Matrix only.
 ``pcg``
     Projected conjugate gradient after Renouf & Alart (:mod:`solver.projected_cg`);
-    ``tolerance`` is the local-law residual.
+    ``tolerance`` is the local-law residual. Matrix only.
+
+:data:`ACCELERATIONS` maps the values of the former ``acceleration`` setting (``off``,
+``anderson``; files and scripts written before ``Parameters.solver``) to the methods they name.
+
+Adding a method: write its entry point(s) with the signatures above in a module of its own,
+and add one ``register(Method(...))`` below, saying which ``Parameters`` fields it reads as
+options (``parameters``), whether it runs on several domains (``domains``) and whether it
+visits points in a random order (``shuffle``). The stepper, ``Parameters.validate``, the command
+line's choices and restart read the registry and need no edit; a test should show the new
+method on the analytic scenes of tests/solver/test_physics.py.
+
+This module imports numpy and the contract's errors only (each entry point imports its
+solver's module when called), so the command line and :mod:`solver.parameters` read the
+registry's names without loading a compiled kernel.
 """
 
 from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Callable, NamedTuple
 
 import numpy as np
 
 from grainview.contract.errors import ParameterError
 
-from . import nlgs, nonsmooth_newton, projected_cg
-from .contact_solution import ContactSolution, contact_solution
+from .solve_records import Impulses, Limits, MatrixProblem
 
-__all__ = ["SOLVERS", "solver", "solve_nlgs"]
+__all__ = ["ACCELERATIONS", "ContactState", "Limits", "Method", "matrix_methods", "method", "register",
+           "solver", "solve_nlgs", "stepper_methods"]
 
+
+class ContactState(NamedTuple):
+    """What a stepper method updates in place: the impulses ``pn, pt`` (P,) in N s (warm start on
+    entry) and the bodies' velocities ``vx, vy`` (B,) m s-1 and ``w`` (B,) rad s-1 (the free
+    velocities on entry, the end-of-step ones on return)."""
+
+    pn: np.ndarray
+    pt: np.ndarray
+    vx: np.ndarray
+    vy: np.ndarray
+    w: np.ndarray
+
+
+@dataclass(frozen=True)
+class Method:
+    """One registered way of solving (module docstring).
+
+    name : the name ``Parameters.solver``, ``--solver`` and ``solve_contact_problem(method=)``
+        take; summary : one line saying what it is.
+    solve : the stepper entry point, or None (matrix problems only).
+    solve_matrix : the matrix entry point, or None (the stepper's problem only).
+    parameters : ((Parameters field, option keyword), ...) that :meth:`options` passes to ``solve``.
+    domains : whether ``solve`` runs on several domains (options ``domains``, ``x``: the
+        particles' abscissae in m, ``decomposition``: :func:`solver.parallel_nlgs.decompose`).
+    shuffle : whether ``solve`` can visit the points in a random order (options ``shuffle``,
+        ``seed``).
+    """
+
+    name: str
+    summary: str
+    solve: Callable | None = None
+    solve_matrix: Callable | None = None
+    parameters: tuple = ()
+    domains: bool = False
+    shuffle: bool = False
+
+    @property
+    def in_stepper(self) -> bool:
+        """Whether the time stepper can use it."""
+        return self.solve is not None
+
+    def options(self, parameters, *, x=None, decomposition=None, shuffle=False, seed=0) -> dict:
+        """The keyword options of ``solve`` for the :class:`solver.stepper.Parameters`
+        ``parameters``: the fields of ``self.parameters``, and, where the method takes them,
+        the domains with the particles' abscissae ``x`` and the step's ``decomposition``, and
+        the random order (``shuffle``, ``seed``)."""
+        options = {keyword: getattr(parameters, field) for field, keyword in self.parameters}
+        if self.domains:
+            options.update(domains=parameters.domains, x=x, decomposition=decomposition)
+        if self.shuffle:
+            options.update(shuffle=shuffle, seed=seed)
+        return options
+
+    def problems(self, parameters) -> list:
+        """What in ``parameters`` this method cannot run with, one 'name=value: expected ...'
+        string each (empty when it can)."""
+        bad = []
+        if not self.in_stepper:
+            bad.append(f"solver={self.name!r}: expected one of {', '.join(stepper_methods())} ({self.name} solves "
+                       "a problem given by its matrix only, solver.contact_problem)")
+        if parameters.domains != 1 and not self.domains:
+            bad.append(f"domains={parameters.domains!r}: expected 1 with solver={self.name!r} (it has no "
+                       "domain-decomposed sweeps)")
+        if parameters.shuffle and not self.shuffle:
+            bad.append(f"shuffle={parameters.shuffle!r}: expected False with solver={self.name!r} (the random order "
+                       f"is an option of {', '.join(n for n, m in _METHODS.items() if m.shuffle)})")
+        if parameters.shuffle and parameters.domains != 1:
+            bad.append(f"domains={parameters.domains!r}: expected 1 with shuffle (the domain-decomposed sweep has "
+                       "its own order)")
+        return bad
+
+
+_METHODS: dict[str, Method] = {}
+
+ACCELERATIONS = {"off": "nlgs", "anderson": "anderson"}
+"""The former ``acceleration`` setting's values -> the method each names."""
+
+
+def register(entry: Method) -> Method:
+    """Add ``entry`` to the registry under its name (once: a second method of the same name is
+    refused). Returns it."""
+    if entry.name in _METHODS:
+        raise ValueError(f"a contact solver named {entry.name!r} is already registered")
+    if entry.solve is None and entry.solve_matrix is None:
+        raise ValueError(f"{entry.name!r}: a method needs a stepper entry (solve) or a matrix one (solve_matrix)")
+    _METHODS[entry.name] = entry
+    return entry
+
+
+def stepper_methods() -> tuple:
+    """The names of the methods the time stepper can use, sorted."""
+    return tuple(sorted(name for name, m in _METHODS.items() if m.in_stepper))
+
+
+def matrix_methods() -> tuple:
+    """The names of the methods that solve a problem given by its matrix, sorted."""
+    return tuple(sorted(name for name, m in _METHODS.items() if m.solve_matrix is not None))
+
+
+def method(name: str) -> Method:
+    """The method registered as ``name``; a ParameterError naming the registered ones otherwise."""
+    try:
+        return _METHODS[name]
+    except (KeyError, TypeError):
+        raise ParameterError(f"solver={name!r}: expected one of {', '.join(stepper_methods())} (the time "
+                             f"stepper's); problems given by their matrix: {', '.join(matrix_methods())}") from None
+
+
+def from_acceleration(value: str) -> str:
+    """The method named by a value of the former ``acceleration`` setting (:data:`ACCELERATIONS`);
+    a ParameterError naming the accepted values otherwise."""
+    try:
+        return ACCELERATIONS[value]
+    except (KeyError, TypeError):
+        raise ParameterError(f"acceleration={value!r}: expected one of {', '.join(ACCELERATIONS)} (or solver= one "
+                             f"of {', '.join(stepper_methods())})") from None
+
+
+def acceleration_of(name: str) -> str | None:
+    """The former ``acceleration`` value that names the method ``name`` (None for a method it
+    had no value for)."""
+    return next((value for value, named in ACCELERATIONS.items() if named == name), None)
+
+
+def solver(name: str):
+    """The matrix entry point of the method registered as ``name``; a ParameterError naming the
+    methods that have one otherwise (:func:`solver.contact_problem.solve_contact_problem`)."""
+    entry = _METHODS.get(name) if isinstance(name, str) else None
+    if entry is None or entry.solve_matrix is None:
+        raise ParameterError(f"method={name!r}: expected one of {', '.join(matrix_methods())}")
+    return entry.solve_matrix
+
+
+# -- the registered methods ------------------------------------------------------------------
 
 def solve_nlgs(W, q, mu, tolerance, max_iterations, initial, *, max_tolerance=None) -> ContactSolution:
     """NLGS sweeps (:func:`solver.nlgs.solve_matrix`) until the quadratic norm is within
     ``tolerance`` and the max norm within ``max_tolerance`` (default 60 x ``tolerance``, about
     the time stepper's ratio), or ``max_iterations`` sweeps."""
+    from . import nlgs
+    from .contact_solution import contact_solution
+
     if max_tolerance is None:
         max_tolerance = 60.0 * tolerance
     if not (np.isfinite(max_tolerance) and max_tolerance > 0):
         raise ParameterError(f"max_tolerance={max_tolerance!r}: expected a positive number")
     rn, rt = initial[:, 0].copy(), initial[:, 1].copy()
-    iterations, quad, worst = nlgs.solve_matrix(W.indptr.astype(np.int64), W.indices.astype(np.int64), W.data, q,
-                                                mu, rn, rt, float(tolerance), float(max_tolerance),
-                                                int(max_iterations))
+    matrix = MatrixProblem(W.indptr.astype(np.int64), W.indices.astype(np.int64), W.data, q, mu)
+    iterations, quad, worst = nlgs.solve_matrix(matrix, Impulses(rn, rt),
+                                                Limits(float(tolerance), float(max_tolerance), int(max_iterations), 0))
     converged = bool(quad <= tolerance and worst <= max_tolerance)
     return contact_solution(W, q, mu, np.stack([rn, rt], -1), iterations, converged, quad, worst)
 
 
-SOLVERS = {
-    "nlgs": solve_nlgs,
-    "newton": nonsmooth_newton.solve,
-    "pcg": projected_cg.solve,
-}
-"""Name -> method (module docstring)."""
+def solve_stepper_nlgs(problem, state: ContactState, limits: Limits, *, domains=1, x=None, decomposition=None,
+                       shuffle=False, seed=0) -> NLGSResult:
+    """The stepper's problem by NLGS sweeps: serial (:func:`solver.nlgs.solve_problem`, in a
+    random order seeded by ``seed`` when ``shuffle``) on one domain, domain-decomposed
+    (:func:`solver.parallel_nlgs.solve_problem_domains`, on ``decomposition`` when given) on
+    more."""
+    from . import nlgs, parallel_nlgs
+
+    if domains > 1:
+        return parallel_nlgs.solve_problem_domains(problem, x, *state, domains=domains, decomposition=decomposition,
+                                                   **limits._asdict())
+    return nlgs.solve_problem(problem, *state, shuffle=shuffle, seed=seed, **limits._asdict())
 
 
-def solver(name: str):
-    """The method registered as ``name``; a ParameterError naming the known ones otherwise."""
-    try:
-        return SOLVERS[name]
-    except (KeyError, TypeError):
-        raise ParameterError(f"method={name!r}: expected one of {', '.join(sorted(SOLVERS))}") from None
+def solve_stepper_anderson(problem, state: ContactState, limits: Limits, *, memory=3, period=1, domains=1, x=None,
+                           decomposition=None) -> NLGSResult:
+    """The stepper's problem by Anderson-accelerated NLGS sweeps
+    (:func:`solver.acceleration.solve_problem_anderson`): ``memory`` past sweeps combined every
+    ``period`` sweeps, on ``domains`` domains."""
+    from . import acceleration
+
+    return acceleration.solve_problem_anderson(problem, *state, memory=memory, period=period, domains=domains, x=x,
+                                               decomposition=decomposition, **limits._asdict())
+
+
+def solve_newton(W, q, mu, tolerance, max_iterations, initial) -> ContactSolution:
+    """Semi-smooth Newton (:func:`solver.nonsmooth_newton.solve`)."""
+    from . import nonsmooth_newton
+
+    return nonsmooth_newton.solve(W, q, mu, tolerance, max_iterations, initial)
+
+
+def solve_pcg(W, q, mu, tolerance, max_iterations, initial) -> ContactSolution:
+    """Projected conjugate gradient (:func:`solver.projected_cg.solve`)."""
+    from . import projected_cg
+
+    return projected_cg.solve(W, q, mu, tolerance, max_iterations, initial)
+
+
+register(Method("nlgs", "nonlinear Gauss-Seidel sweeps (serial, shuffled or on domains)", solve=solve_stepper_nlgs,
+                solve_matrix=solve_nlgs, parameters=(), domains=True, shuffle=True))
+register(Method("anderson", "Anderson-accelerated NLGS sweeps (the default)", solve=solve_stepper_anderson,
+                parameters=(("anderson_memory", "memory"), ("anderson_period", "period")), domains=True))
+register(Method("newton", "semi-smooth Newton on Alart-Curnier's function", solve_matrix=solve_newton))
+register(Method("pcg", "projected conjugate gradient (Renouf & Alart)", solve_matrix=solve_pcg))
