@@ -19,6 +19,8 @@ only its own slice of the output.
 
 from __future__ import annotations
 
+from typing import NamedTuple
+
 import numpy as np
 from numba import njit
 
@@ -31,13 +33,28 @@ MAX_CELLS_PER_PARTICLE = 4
 so memory stays O(N) even for a sparse or strongly spread-out set of particles."""
 
 
+class CellList(NamedTuple):
+    """The particles sorted by the square cells of a grid over their centres
+    (:func:`_cell_lists`); cell (cx, cy) has the index c = cy * nx + cx.
+
+    cell_of : int64 (N,) — the cell of each particle.
+    start : int64 (nx * ny + 1,) — the particles of cell c are members[start[c]:start[c + 1]].
+    members : int64 (N,) — the particles by cell, in increasing order within a cell.
+    nx, ny : int — the number of cells along x and along y.
+    """
+
+    cell_of: np.ndarray
+    start: np.ndarray
+    members: np.ndarray
+    nx: int
+    ny: int
+
+
 @njit(cache=True)
 def _cell_lists(pos, cell_size, nx, ny, xmin, ymin):
-    """Cell index of each particle and the particles sorted by cell (counting sort).
-
-    Returns ``cell_of`` (N,), ``start`` (nx*ny + 1,) and ``members`` (N,): the particles of
-    cell c are ``members[start[c]:start[c+1]]``, in increasing particle order.
-    """
+    """Cell index of each particle and the particles sorted by cell (counting sort): the
+    :class:`CellList` of the grid of nx by ny cells of side ``cell_size`` (m) from the corner
+    (xmin, ymin) (m); a centre outside the grid counts in the nearest cell."""
     n = pos.shape[0]
     cell_of = np.empty(n, np.int64)
     counts = np.zeros(nx * ny + 1, np.int64)
@@ -56,14 +73,19 @@ def _cell_lists(pos, cell_size, nx, ny, xmin, ymin):
         c = cell_of[p]
         members[fill[c]] = p
         fill[c] += 1
-    return cell_of, start, members
+    return CellList(cell_of, start, members, nx, ny)
 
 
 @njit(cache=True)
-def _partners(p, pos, radius, alert, cell_of, start, members, nx, ny, out, offset):
-    """Partners j > p of particle p within r_p + r_j + alert; written to ``out[offset:]``
-    when ``out`` is large enough, counted in any case. Returns the count."""
-    c = cell_of[p]
+def _partners(p, pos, radius, alert, cells, out, offset):
+    """Partners j > p of particle p within r_p + r_j + alert (m), found in the 3 x 3 cells of
+    ``cells`` (:class:`CellList`) around p's; written to ``out[offset:]`` when ``out`` is
+    large enough, counted in any case. Returns the count."""
+    start = cells.start
+    members = cells.members
+    nx = cells.nx
+    ny = cells.ny
+    c = cells.cell_of[p]
     cx = c % nx
     cy = c // nx
     count = 0
@@ -93,18 +115,18 @@ def _partners(p, pos, radius, alert, cell_of, start, members, nx, ny, out, offse
 @njit(cache=True)
 def _candidate_pairs_kernel(pos, radius, alert, cell_size, nx, ny, xmin, ymin):
     n = pos.shape[0]
-    cell_of, start, members = _cell_lists(pos, cell_size, nx, ny, xmin, ymin)
+    cells = _cell_lists(pos, cell_size, nx, ny, xmin, ymin)
     empty = np.empty(0, np.int64)
     counts = np.empty(n, np.int64)
     for p in range(n):  # pass 1: count
-        counts[p] = _partners(p, pos, radius, alert, cell_of, start, members, nx, ny, empty, 0)
+        counts[p] = _partners(p, pos, radius, alert, cells, empty, 0)
     offsets = np.zeros(n + 1, np.int64)
     for p in range(n):
         offsets[p + 1] = offsets[p] + counts[p]
     total = offsets[n]
     partner = np.empty(max(total, 1), np.int64)
     for p in range(n):  # pass 2: fill, each particle its own slice, sorted
-        _partners(p, pos, radius, alert, cell_of, start, members, nx, ny, partner, offsets[p])
+        _partners(p, pos, radius, alert, cells, partner, offsets[p])
         partner[offsets[p]:offsets[p + 1]] = np.sort(partner[offsets[p]:offsets[p + 1]])
     pi = np.empty(total, np.int32)
     pj = np.empty(total, np.int32)
