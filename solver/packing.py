@@ -69,6 +69,24 @@ class Packing(NamedTuple):
     height: float
 
 
+class CellGrid(NamedTuple):
+    """The placed disks chained by the square cells of the box, a linked cell list (Allen &
+    Tildesley, "Computer simulation of liquids", Sec. 5.3); cell (cx, cy), of corner
+    (cx size, cy size), has the index cy * ncols + cx.
+
+    head : int64 (ncols * nrows,) — the disk placed last in each cell, -1 for an empty cell.
+    link : int64 (N,) — the disk placed before it in the same cell, -1 at the end of a chain.
+    size : float — the side of a cell, m (at least the largest diameter).
+    ncols, nrows : int — the number of cells along x and along y.
+    """
+
+    head: np.ndarray
+    link: np.ndarray
+    size: float
+    ncols: int
+    nrows: int
+
+
 # -------------------------------------------------------------------- heap of pockets
 
 @njit(cache=True)
@@ -135,16 +153,23 @@ def _pop(hy, hx, hn, s):
 # -------------------------------------------------------------------- deposition kernel
 
 @njit(cache=True)
-def _cell(x, y, cell, ncols, nrows):
-    cx = min(max(int(x / cell), 0), ncols - 1)
-    cy = min(max(int(y / cell), 0), nrows - 1)
+def _cell(x, y, grid):
+    """The cell (cx, cy) of ``grid`` (:class:`CellGrid`) holding the point (x, y), m; a point
+    outside the grid counts in the nearest cell."""
+    cx = min(max(int(x / grid.size), 0), grid.ncols - 1)
+    cy = min(max(int(y / grid.size), 0), grid.nrows - 1)
     return cx, cy
 
 
 @njit(cache=True)
-def _free(x, y, r, pos, radius, head, nxt, cell, ncols, nrows):
-    """True if a disk (x, y, r) overlaps no placed disk (neighbours from the cell list)."""
-    cx, cy = _cell(x, y, cell, ncols, nrows)
+def _free(x, y, r, pos, radius, grid):
+    """True if a disk (x, y, r) (m) overlaps none of the placed disks (centres ``pos``, radii
+    ``radius``, m), its neighbours from ``grid`` (:class:`CellGrid`)."""
+    head = grid.head
+    nxt = grid.link
+    ncols = grid.ncols
+    nrows = grid.nrows
+    cx, cy = _cell(x, y, grid)
     for j in range(max(cy - 1, 0), min(cy + 2, nrows)):
         for i in range(max(cx - 1, 0), min(cx + 2, ncols)):
             q = head[j * ncols + i]
@@ -164,8 +189,9 @@ def _deposit_kernel(class_of, class_radius, width, cell, ncols, nrows, clearance
     n_class = class_radius.shape[0]
     pos = np.empty((n, 2))
     radius = np.empty(n)
-    head = np.full(ncols * nrows, -1, np.int64)
-    nxt = np.full(n, -1, np.int64)
+    grid = CellGrid(np.full(ncols * nrows, -1, np.int64), np.full(n, -1, np.int64), cell, ncols, nrows)
+    head = grid.head
+    nxt = grid.link
     hy = np.empty((n_class, 64 + 16 * n))
     hx = np.empty((n_class, 64 + 16 * n))
     hn = np.zeros(n_class, np.int64)
@@ -184,7 +210,7 @@ def _deposit_kernel(class_of, class_radius, width, cell, ncols, nrows, clearance
         y = 0.0
         while hn[s] > 0:
             y, x = _pop(hy, hx, hn, s)
-            if _free(x, y, r, pos, radius, head, nxt, cell, ncols, nrows):
+            if _free(x, y, r, pos, radius, grid):
                 found = True
                 break
         if not found:
@@ -192,7 +218,7 @@ def _deposit_kernel(class_of, class_radius, width, cell, ncols, nrows, clearance
         pos[p, 0] = x
         pos[p, 1] = y
         radius[p] = r
-        cx, cy = _cell(x, y, cell, ncols, nrows)
+        cx, cy = _cell(x, y, grid)
         c = cy * ncols + cx
         nxt[p] = head[c]
         head[c] = p
