@@ -13,24 +13,25 @@ declarations (:func:`problems`, then the checks that relate several fields), and
 line (:mod:`grainview.cli`) derives its options, defaults and help from them
 (:func:`dataclasses.fields`), so that a setting is declared, defaulted and checked once.
 
-This module imports numpy and the contract's errors only: the command line reads it to build
-its options without loading a numba kernel.
+This module imports numpy, the contract's errors and the solver registry
+(:mod:`solver.contact_solvers`, which loads no kernel before a solve) only: the command line
+reads it to build its options without loading a numba kernel.
 """
 
 from __future__ import annotations
 
-from dataclasses import MISSING, dataclass, field, fields
+from dataclasses import MISSING, InitVar, dataclass, field, fields
 
 import numpy as np
 
 from grainview.contract.errors import ParameterError
 
+from . import contact_solvers
+from .contact_solvers import ACCELERATIONS  # noqa: F401 (the former acceleration's values, read from the registry)
+
 MAX_FRICTION = 10.0
 """Largest accepted friction coefficient: measured ones lie below ~1.5, and 10 already makes
 every contact stick; a larger number is a typing mistake (1e9 for 1e-9?)."""
-
-ACCELERATIONS = ("off", "anderson")
-"""How the NLGS sweeps are combined: plain (``off``) or Anderson-extrapolated."""
 
 FRICTION_EXPECTED = f"in [0, {MAX_FRICTION:g}] (a Coulomb coefficient)"
 """What a friction coefficient is expected to be, in every refusal of one."""
@@ -163,17 +164,18 @@ class Parameters:
                                   check=positive, expected="a positive length in m", optional=True)
     skin: float | None = setting(None, "broad-phase skin (None: 10% of the smallest diameter)", unit="m",
                                  check=positive, expected="a positive length in m", optional=True)
-    shuffle: bool = setting(False, "random NLGS ordering (plain sweeps only: acceleration 'off')")
+    shuffle: bool = setting(False, "random NLGS ordering (a solver that has one: 'nlgs')")
     seed: int = setting(0, "seed of the random NLGS ordering")
-    acceleration: str = setting("anderson", "'anderson': Anderson-accelerated NLGS sweeps, the same local-law "
-                                "residual in less time per step than 'off', plain sweeps (docs/solver.md)",
-                                choices=lambda: ACCELERATIONS)
+    solver: str = setting("anderson", "the contact solver of each step, a method of the registry "
+                          "solver.contact_solvers: 'anderson' (the default), Anderson-accelerated NLGS sweeps, the "
+                          "same local-law residual in less time per step than 'nlgs', plain sweeps (docs/solver.md)",
+                          choices=contact_solvers.stepper_methods)
     anderson_memory: int = setting(3, "past iterates combined by the Anderson extrapolation",
                                    check=lambda v: whole(v) and 1 <= v <= 50, expected="an integer in 1..50")
     anderson_period: int = setting(1, "NLGS sweeps between two Anderson extrapolations",
                                    check=lambda v: whole(v) and 1 <= v <= 50, expected="an integer in 1..50")
     domains: int = setting(1, "NLGS domains swept at once, one per core, and as many blocks of the narrow phase "
-                           "(1: the serial sweep; deterministic for a given number; combines with --acceleration; "
+                           "(1: the serial sweep; deterministic for a given number; combines with either --solver; "
                            "on free cores only; docs/solver.md)",
                            check=lambda v: isinstance(v, (int, np.integer)) and not isinstance(v, bool)
                            and 1 <= v <= 64, expected="an integer in 1..64")
@@ -185,6 +187,22 @@ class Parameters:
     overlap_recovery_tolerance: float = setting(1e-2, "NLGS tolerance of the recovery pass (a correction, not "
                                                 "physics)")
     overlap_recovery_iterations: int = setting(50, "sweep cap of the recovery pass")
+    acceleration: InitVar[str | None] = None
+    """The former name of ``solver`` (files, scripts and command lines from before it):
+    ``'off'`` is ``solver='nlgs'``, ``'anderson'`` ``solver='anderson'``
+    (:data:`solver.contact_solvers.ACCELERATIONS`); given, it sets ``solver``. Read or set
+    afterwards, it is the property :attr:`acceleration` (None for a solver it has no value for)."""
+
+    def __post_init__(self, acceleration):
+        if acceleration is not None:
+            self.solver = contact_solvers.from_acceleration(acceleration)
+
+    def __setstate__(self, state):
+        """Unpickle, also a record pickled before ``solver`` existed (its ``acceleration``)."""
+        if "solver" not in state and "acceleration" in state:
+            state = dict(state)
+            state["solver"] = contact_solvers.from_acceleration(state.pop("acceleration"))
+        self.__dict__.update(state)
 
     def validate(self):
         """The parameters themselves, checked: each field's own check (:func:`setting`), then
@@ -195,19 +213,29 @@ class Parameters:
              or 2 * int(self.stall_sweeps) <= int(self.max_iterations),
              f"at most max_iterations/2 = {_half(self.max_iterations)} (the first check only records the best "
              "norm, so a stall can show at the second; 0: no stall test)"),
-            ("domains", self.domains == 1 or not self.shuffle,
-             "1 with shuffle (the domain-decomposed sweep has its own order)"),
-            ("shuffle", not self.shuffle or self.acceleration == "off",
-             "False with acceleration='anderson' (the random order is an option of the plain sweeps: "
-             "pass acceleration='off' with it)"),
         ]
         bad += [refusal(name, getattr(self, name), expected) for name, ok, expected in relations if not ok]
+        if self.solver in contact_solvers.stepper_methods():  # what the solver cannot run with
+            bad += contact_solvers.method(self.solver).problems(self)
         if bad:
             raise ParameterError("invalid solver parameters: " + "; ".join(bad))
         from .parallel_nlgs import warn_if_threads_sleep
 
         warn_if_threads_sleep(self.domains)
         return self
+
+
+def _acceleration(self):
+    return contact_solvers.acceleration_of(self.solver)
+
+
+def _set_acceleration(self, value):
+    self.solver = contact_solvers.from_acceleration(value)
+
+
+Parameters.acceleration = property(_acceleration, _set_acceleration, doc="The former name of ``solver``: ``'off'`` "
+                                   "for 'nlgs', ``'anderson'`` for 'anderson' (None for another solver); set, it sets "
+                                   "``solver`` (:data:`solver.contact_solvers.ACCELERATIONS`).")
 
 
 def _half(value):
