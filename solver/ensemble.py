@@ -42,6 +42,8 @@ import numpy as np
 
 from grainview.contract.errors import ConvergenceWarning, FileFormatError, ParameterError
 
+from .parameters import BiaxialTest
+
 EVENT_TOPIC = "grainview-ensemble"
 """Topic of the progress events the workers send to the client (``Worker.log_event``)."""
 
@@ -63,9 +65,9 @@ class RunSpec:
     friction: float | None = None
     preparation: str = "paper"
     sigma0: float | None = None
-    strain: float = 0.2
-    velocity: float = 0.01
-    every: int = 200
+    strain: float = BiaxialTest.strain
+    velocity: float = BiaxialTest.velocity
+    every: int = BiaxialTest.every
     near_contacts: bool = True
     solver: tuple = field(default=())
 
@@ -87,12 +89,7 @@ class RunSpec:
 
     def validate(self) -> RunSpec:
         """The spec itself, checked: one clear :class:`ParameterError` naming the bad field."""
-        if not (0 < self.strain < 1):
-            raise ParameterError(f"strain={self.strain!r}: expected a vertical strain eps_1 in (0, 1)")
-        if not (self.velocity > 0):
-            raise ParameterError(f"velocity={self.velocity!r}: expected a positive wall speed in m s-1")
-        if isinstance(self.every, bool) or int(self.every) != self.every or self.every < 1:
-            raise ParameterError(f"every={self.every!r}: expected a positive whole number of steps")
+        BiaxialTest(self.strain, self.velocity, self.every).validate()
         if isinstance(self.seed, bool) or int(self.seed) != self.seed or self.seed < 0:
             raise ParameterError(f"seed={self.seed!r}: expected a whole number >= 0")
         from .parameters import Parameters

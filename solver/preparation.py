@@ -34,6 +34,7 @@ import numpy as np
 from grainview.contract.errors import ParameterError
 from grainview.contract.schema import MAX_STEP_INDEX
 
+from .parameters import FRICTION_EXPECTED, Parameters, coulomb, default_of, positive, problems, refusal, setting
 from .shape_families import check_shape
 
 MAX_SEED = 2**31 - 1
@@ -42,40 +43,45 @@ MIN_TEST_STEPS = 10
 """Fewest time steps a biaxial test may take to reach its strain (a test of fewer is no test)."""
 
 
+def _integer(value) -> bool:
+    return isinstance(value, (int, np.integer)) and not isinstance(value, bool)
+
+
 @dataclass(frozen=True)
 class Preparation:
     """How a sample is prepared (see the module docstring); every default is the paper's or,
-    where the paper is silent, this project's historical default."""
+    where the paper is silent, this project's historical default. Each field's help, unit and
+    check are its :func:`solver.parameters.setting`; :meth:`validate` is the one validator."""
 
-    particles: int = 400
-    shape: str | int = "pentagon"  # a name of solver.shapes.SHAPES, a number of vertices, a family or a file
-    seed: int = 0
-    aspect: float = 2.0
-    sigma0: float = 1e4  # Pa
-    friction: float = 0.4  # grain-grain friction of the test
-    compaction_friction: float | None = None  # None: the test's friction
-    max_wall_speed: float = 0.05  # m s-1
-    max_inertia_number: float | None = None
-    pressure_ramp: float = 0.0  # s
-    max_steps: int = 40000  # compaction step limit
+    particles: int = setting(400, "particles per sample", check=lambda v: _integer(v) and v >= 2,
+                             expected="an integer >= 2")
+    shape: str | int = setting("pentagon", "a name of solver.shapes.SHAPES, a number of vertices, a family or "
+                               "a file (solver.shape_families.check_shape)")
+    seed: int = setting(0, "random seed of the deposit", check=lambda v: _integer(v) and 0 <= v <= MAX_SEED,
+                        expected=f"an integer in 0 .. {MAX_SEED} (files store it as a 32-bit integer)")
+    aspect: float = setting(2.0, "h/l of the sample box", check=lambda v: np.isfinite(v) and 0.2 <= v <= 20,
+                            expected="h/l in [0.2, 20]")
+    sigma0: float = setting(1e4, "confining stress", unit="Pa", check=positive, expected="a positive stress in Pa")
+    friction: float = setting(default_of(Parameters, "friction"), "grain-grain friction coefficient of the test",
+                              check=coulomb, expected=FRICTION_EXPECTED)
+    compaction_friction: float | None = setting(None, "grain friction during compaction (None: the test's)",
+                                                check=coulomb, expected=FRICTION_EXPECTED + " or None",
+                                                optional=True)
+    max_wall_speed: float = setting(0.05, "cap of the closing speed of the pushed walls", unit="m s-1",
+                                    check=lambda v: v > 0, expected="a positive speed in m s-1 (inf: no cap)")
+    max_inertia_number: float | None = setting(None, "cap of the inertia number I = (v/L) d sqrt(rho/sigma0) of "
+                                               "the closing walls (None: the walls close at up to max_wall_speed)",
+                                               check=positive, expected="a positive number or None", optional=True)
+    pressure_ramp: float = setting(0.0, "time over which sigma0 rises from 0 (0: applied at once)", unit="s",
+                                   check=lambda v: np.isfinite(v) and v >= 0, expected="a duration >= 0 in s")
+    max_steps: int = setting(40000, "compaction step limit", check=lambda v: _integer(v) and v >= 1,
+                             expected="an integer >= 1")
 
     def validate(self):
-        checks = [
-            ("particles", isinstance(self.particles, (int, np.integer)) and self.particles >= 2, "an integer >= 2"),
-            ("seed", isinstance(self.seed, (int, np.integer)) and 0 <= self.seed <= MAX_SEED,
-             f"an integer in 0 .. {MAX_SEED} (files store it as a 32-bit integer)"),
-            ("aspect", np.isfinite(self.aspect) and 0.2 <= self.aspect <= 20, "h/l in [0.2, 20]"),
-            ("sigma0", np.isfinite(self.sigma0) and self.sigma0 > 0, "a positive stress in Pa"),
-            ("friction", np.isfinite(self.friction) and 0 <= self.friction <= 10, "in [0, 10]"),
-            ("compaction_friction", self.compaction_friction is None
-             or (np.isfinite(self.compaction_friction) and 0 <= self.compaction_friction <= 10), "in [0, 10] or None"),
-            ("max_wall_speed", self.max_wall_speed > 0, "a positive speed in m s-1 (inf: no cap)"),
-            ("max_inertia_number", self.max_inertia_number is None
-             or (np.isfinite(self.max_inertia_number) and self.max_inertia_number > 0), "a positive number or None"),
-            ("pressure_ramp", np.isfinite(self.pressure_ramp) and self.pressure_ramp >= 0, "a duration >= 0 in s"),
-            ("max_steps", isinstance(self.max_steps, (int, np.integer)) and self.max_steps >= 1, "an integer >= 1"),
-        ]
-        bad = [f"{name}={getattr(self, name)!r}: expected {expected}" for name, ok, expected in checks if not ok]
+        """The preparation itself, checked: each field's own check, then the shape
+        (:func:`solver.shape_families.check_shape`); one :class:`ParameterError` naming every
+        bad value."""
+        bad = [refusal(*p) for p in problems(self)]
         try:
             check_shape(self.shape)
         except ParameterError as exc:
@@ -170,19 +176,11 @@ def preset_name(prep: Preparation) -> str:
 
 
 def record(sim) -> dict:
-    """File attributes of how ``sim`` was prepared: the :class:`Preparation` (``preparation_*``,
-    with ``preparation_name``) and the compaction's outcome (``compaction_*``); {} for a
-    simulation that :func:`prepare_sample` did not make."""
-    prep = sim.preparation
-    if prep is None:
-        return {}
-    out = {**prep.attrs(), "preparation_name": preset_name(prep), "sigma0_Pa": prep.sigma0,
-           "compaction_steps": sim.compaction_steps, "compaction_settled": int(bool(sim.settled)),
-           "compaction_inertia_number": sim.compaction_inertia_number}
-    if sim.compaction_unconverged is not None:  # steps whose NLGS stopped before its tolerances
-        out.update(compaction_unconverged_steps=sim.compaction_unconverged.steps,
-                   compaction_unconverged_local_law_residual=sim.compaction_unconverged.local_law_residual)
-    return out
+    """File attributes of how ``sim`` was prepared: its history's
+    (:meth:`solver.sample_history.SampleHistory.attrs`: the :class:`Preparation` as
+    ``preparation_*`` with ``preparation_name``, and the compaction's outcome as
+    ``compaction_*``); {} for a simulation that :func:`prepare_sample` did not make."""
+    return sim.history.attrs()
 
 
 def preset_names():
@@ -211,12 +209,17 @@ def preparation(name_or_prep="paper", **changes) -> Preparation:
 
 def prepare_sample(prep: Preparation, progress=None, **parameters):
     """Deposit and compact a sample as ``prep`` says; returns the compacted :class:`Simulation`
-    with the test's friction set, and the compaction's outcome in ``sim.settled``,
-    ``sim.compaction_stress``, ``sim.compaction_inertia_number``, ``sim.compaction_steps`` and
-    ``sim.compaction_unconverged`` (its steps whose NLGS did not converge,
-    :class:`solver.stepper.Unconverged`).
-    ``parameters`` go to :class:`solver.Parameters` (time step, tolerances...)."""
+    with the test's friction set, and the sample's history in ``sim.history``
+    (:class:`solver.sample_history.SampleHistory`: the preparation, whether the compaction
+    settled, its wall stresses, largest inertia number, steps and unconverged steps).
+    ``parameters`` go to :class:`solver.Parameters` (time step, tolerances...); the grains'
+    friction is the preparation's (``prep.friction``, ``prep.compaction_friction``), not one of
+    them."""
     prep = prep.validate()
+    if "friction" in parameters:
+        raise ParameterError(f"friction={parameters['friction']!r} among the solver parameters: the grains' "
+                             "friction is the preparation's; expected Preparation(friction=..., "
+                             "compaction_friction=...)")
     compaction_friction = prep.friction if prep.compaction_friction is None else prep.compaction_friction
     from .scenes import compaction_sample, isotropic_compaction  # the solver proper, on first use
 
@@ -226,10 +229,10 @@ def prepare_sample(prep: Preparation, progress=None, **parameters):
 
     check_time_step(sim.parameters.time_step, prep.max_wall_speed, float(sim.radius.min()),
                     "a closing wall of the compaction")
-    sim.compaction_steps = isotropic_compaction(sim, max_steps=prep.max_steps, max_inertia_number=prep.max_inertia_number,
-                                                pressure_ramp=prep.pressure_ramp, progress=progress)
-    sim.compaction_unconverged = sim.take_unconverged()
-    sim.parameters.friction = prep.friction
-    sim.preparation = prep
-    sim.preparation_attrs = record(sim)
+    steps = isotropic_compaction(sim, max_steps=prep.max_steps, max_inertia_number=prep.max_inertia_number,
+                                 pressure_ramp=prep.pressure_ramp, progress=progress)
+    sim.history.compaction_steps = steps
+    sim.history.compaction_unconverged = sim.take_unconverged()
+    sim.set_parameters(friction=prep.friction)
+    sim.history.preparation = prep
     return sim

@@ -48,6 +48,7 @@ from grainview.contract.reader import ContractFile
 
 from .interrupt import Terminated, sigterm_raises
 from .output import Recorder, compress_finished, compress_level
+from .sample_history import SampleHistory
 from .scenes import biaxial_steps
 from .shapes import Shapes
 from .stepper import Parameters, Simulation
@@ -140,8 +141,7 @@ def _simulation(state, source) -> Simulation:
         raise FileFormatError(f"{source}: cannot restart, the masses and inertias of the file differ from those "
                               "of its solver parameters (density, thickness)")
     sim.time, sim.step_index = state["time"], state["step"]
-    sim.sigma0 = float(attrs.get("sigma0_Pa", np.nan))
-    sim.preparation_attrs = {k: v for k, v in attrs.items() if k.startswith(("preparation_", "compaction_"))}
+    sim.history = SampleHistory.from_attrs(attrs)
     sim.set_warm_start(state["i"], state["j"], state["normal_impulse"], state["tangential_impulse"])
     return sim
 
@@ -149,7 +149,8 @@ def _simulation(state, source) -> Simulation:
 def load_sample(path, index=-1) -> Simulation:
     """The simulation at snapshot ``index`` (default: the last complete one) of a file this
     solver wrote, whatever its scene: positions, velocities, walls driven as recorded, solver
-    parameters, the confining stress ``sim.sigma0`` (Pa, NaN if the file does not say) and the
+    parameters, the sample's history ``sim.history`` (its confining stress ``sigma0`` in Pa, NaN if
+    the file does not say; :class:`solver.sample_history.SampleHistory`) and the
     warm start of the next step. Use it to start a test from a saved compacted sample::
 
         sim = load_sample("pentagons_compacted.nc")

@@ -16,7 +16,8 @@ from .interrupt import interruptible, progress_bar, resume_instructions, stop_ex
 from .output import Recorder
 from .packing import PAPER_DIAMETERS, PAPER_FRACTIONS, box_width_for, deposit
 from .shape_families import regular_vertex_count, sample_shapes
-from .stepper import Parameters, Simulation, check_time_step
+from .parameters import BiaxialTest, Parameters, check_time_step
+from .stepper import Simulation
 from .walls import STRESS, Walls
 
 
@@ -60,7 +61,7 @@ def compaction_sample(n=400, shape="pentagon", *, sigma0=1e4, friction=0.4, wall
     mass = float(sim.mass.sum()) if wall_mass is None else float(wall_mass)
     walls.drive_stress("right", sigma0, mass, max_wall_speed)
     walls.drive_stress("top", sigma0, mass, max_wall_speed)
-    sim.sigma0 = sigma0
+    sim.history.sigma0 = sigma0
     return sim
 
 
@@ -97,10 +98,11 @@ def isotropic_compaction(sim: Simulation, *, max_steps=40000, window=200, stress
                          strain_rate_tolerance=1e-3, max_inertia_number=None, pressure_ramp=0.0,
                          progress=None):
     """Step ``sim`` until the last ``window`` steps are at equilibrium (:func:`is_equilibrium`)
-    or for ``max_steps``. Returns the number of steps taken and sets ``sim.settled`` (False
-    when ``max_steps`` ran out first), ``sim.compaction_stress`` (the window's mean wall
-    stresses, Pa) and ``sim.compaction_inertia_number`` (the largest inertia number of a
-    pushed wall over the compaction). The wall speed cap is lifted once settled, so that a
+    or for ``max_steps``. Returns the number of steps taken and records in ``sim.history``
+    (:class:`solver.sample_history.SampleHistory`) ``settled`` (False when ``max_steps`` ran
+    out first), ``compaction_stress`` (the window's mean wall stresses, Pa) and
+    ``compaction_inertia_number`` (the largest inertia number of a pushed wall over the
+    compaction). The wall speed cap is lifted once settled, so that a
     following test drives the walls by their stress alone.
 
     Quasi-static compaction: with ``max_inertia_number`` the inward speed of each pushed wall
@@ -116,7 +118,7 @@ def isotropic_compaction(sim: Simulation, *, max_steps=40000, window=200, stress
         raise ParameterError(f"max_inertia_number={max_inertia_number!r}: expected a positive number (or None)")
     if not (np.isfinite(pressure_ramp) and pressure_ramp >= 0):
         raise ParameterError(f"pressure_ramp={pressure_ramp!r}: expected a duration >= 0 in s")
-    sigma0 = sim.sigma0
+    sigma0 = sim.history.sigma0
     h = sim.parameters.time_step
     driven = np.flatnonzero(sim.walls.mode == STRESS)
     target = sim.walls.stress[driven].copy()
@@ -126,7 +128,7 @@ def isotropic_compaction(sim: Simulation, *, max_steps=40000, window=200, stress
     ramp_steps = int(np.ceil(pressure_ramp / h))
     stresses, rates = deque(maxlen=window), deque(maxlen=window)
     largest_inertia = 0.0
-    sim.settled = False
+    sim.history.settled = False
     with interruptible() as flag, progress_bar(max_steps, "isotropic compaction", progress) as bar:
         for k in range(max_steps):
             if k < ramp_steps:
@@ -144,13 +146,13 @@ def isotropic_compaction(sim: Simulation, *, max_steps=40000, window=200, stress
             rates.append(rate[driven])
             if k >= ramp_steps and len(stresses) == window and k % 10 == 0 and is_equilibrium(
                     stresses, rates, sigma0, stress_tolerance, strain_rate_tolerance):
-                sim.settled = True
+                sim.history.settled = True
                 break
             if flag["stop"]:
                 raise stop_exception(flag)
     sim.walls.stress[driven] = target
-    sim.compaction_stress = np.mean(stresses, axis=0) if stresses else np.zeros(len(driven))
-    sim.compaction_inertia_number = largest_inertia
+    sim.history.compaction_stress = np.mean(stresses, axis=0) if stresses else np.zeros(len(driven))
+    sim.history.compaction_inertia_number = largest_inertia
     sim.walls.max_speed[:] = np.inf
     return k + 1
 
@@ -161,26 +163,22 @@ def _box_size_across(sim):
     return np.where(sim.walls.length_axis == 0, hi[1] - lo[1], hi[0] - lo[0])
 
 
-def biaxial_test(sim: Simulation, path, *, strain=0.1, velocity=0.01, every=20, overwrite=False,
-                 attrs=None, progress=None, near_contacts=False, compress=True):
+def biaxial_test(sim: Simulation, path, *, strain=BiaxialTest.strain, velocity=BiaxialTest.velocity,
+                 every=BiaxialTest.every, overwrite=False, attrs=None, progress=None, near_contacts=False,
+                 compress=True):
     """Biaxial compression of a compacted sample, written to ``path`` every ``every`` steps.
 
     The top wall moves down at ``velocity`` (m s-1) until eps_1 = ln(1 + dh/h0) reaches
-    ``strain``; the right wall keeps the confining stress sigma0; bottom and left are fixed.
+    ``strain`` (defaults and checks: :class:`solver.parameters.BiaxialTest`); the right wall keeps the confining stress sigma0; bottom and left are fixed.
     The snapshot at the start of the test is written first. Ctrl-C stops after the current
     step, with every written snapshot kept. ``near_contacts``: also write the pairs within the
     alert distance that carry no force (:class:`solver.output.Recorder`). The file records the
-    test's settings and how the sample was prepared (``sim.preparation_attrs``: set by
-    :func:`solver.preparation.prepare_sample` and :func:`solver.load_sample`); ``attrs`` adds
+    test's settings and how the sample was prepared (``sim.history``, written by
+    :func:`solver.preparation.prepare_sample` and read back by :func:`solver.load_sample`); ``attrs`` adds
     to them. The file is netCDF-3 while the test runs and is compressed once it has finished
     (``compress``: True, a zlib level 1-9, or False; :class:`solver.output.Recorder`).
     """
-    if not (0 < strain < 1):
-        raise ParameterError(f"strain={strain!r}: expected a vertical strain in (0, 1)")
-    if not (velocity > 0):
-        raise ParameterError(f"velocity={velocity!r}: expected a positive wall speed in m s-1")
-    if isinstance(every, bool) or not isinstance(every, (int, np.integer)) or every < 1:
-        raise ParameterError(f"every={every!r}: expected a positive whole number of steps between snapshots")
+    BiaxialTest(strain, velocity, every).validate()
     check_time_step(sim.parameters.time_step, velocity, float(sim.radius.min()), "the top wall")
     lo, hi = sim.walls.box_bounds()
     h0 = float(hi[1] - lo[1])
@@ -195,8 +193,8 @@ def biaxial_test(sim: Simulation, path, *, strain=0.1, velocity=0.01, every=20, 
     n_steps = int(np.ceil(steps))
     sim.walls.drive_velocity("top", (0.0, -velocity))
     run_attrs = {"scene": "biaxial", "strain_target": strain, "wall_velocity_m_s": velocity,
-                 "sigma0_Pa": sim.sigma0, "snapshot_every": int(every), "biaxial_steps": n_steps,
-                 **sim.preparation_attrs}
+                 "sigma0_Pa": sim.history.sigma0, "snapshot_every": int(every), "biaxial_steps": n_steps,
+                 **sim.history.attrs()}
     run_attrs.update(attrs or {})
     with Recorder(path, sim, attrs=run_attrs, overwrite=overwrite, near_contacts=near_contacts,
                   compress=compress) as rec:

@@ -29,7 +29,7 @@ from __future__ import annotations
 
 import time
 import warnings
-from dataclasses import asdict, dataclass
+from dataclasses import asdict, dataclass, replace
 
 import numpy as np
 
@@ -38,6 +38,7 @@ from grainview.contract.errors import ConvergenceWarning, ParameterError
 from . import acceleration, broadphase, narrowphase, nlgs, parallel_nlgs, problem_assembly, residuals, warm_start
 from .contact_points import PairIndex, force_vectors, point_keys
 from .parameters import ACCELERATIONS, MAX_FRICTION, Parameters, check_time_step  # noqa: F401 (their home)
+from .sample_history import SampleHistory
 from .shapes import Shapes
 from .walls import FIXED, STRESS, VELOCITY, Walls
 
@@ -150,19 +151,31 @@ class Simulation:
         self.points = None
         self.impulse = np.empty((0, 2))
         self.last = None
-        # What the scenes that prepared this simulation found (solver.scenes, solver.preparation)
-        self.sigma0 = np.nan  # Pa, the confining stress the sample was compacted under
-        self.settled = None  # whether the isotropic compaction reached its equilibrium test
-        self.compaction_steps = None  # steps the compaction took
-        self.compaction_stress = None  # Pa, mean stress on each stress-driven wall at its end
-        self.compaction_inertia_number = None  # the largest inertia number of the closing walls
-        self.compaction_unconverged = None  # the compaction's unconverged steps (Unconverged)
-        self.preparation = None  # the solver.preparation.Preparation that made the sample
-        self.preparation_attrs = {}  # the same and the compaction's outcome, as file attributes
+        self.history = SampleHistory()  # how the sample was made (solver.scenes, solver.preparation)
         self.timings = {"broad_phase": 0.0, "narrow_phase": 0.0, "solve": 0.0, "update": 0.0}
         self.counters = {"steps": 0, "broad_phase_runs": 0, "sweeps": 0, "point_sweeps": 0, "recovery_sweeps": 0,
                          "unconverged_steps": 0}
         self.unconverged = Unconverged()  # the unconverged steps since the last take_unconverged()
+
+    FIXED_PARAMETERS = ("density", "thickness", "alert", "skin")
+    """Parameters the simulation is built on (masses, detection distances): :meth:`set_parameters`
+    refuses to change them."""
+
+    def set_parameters(self, **changes) -> Parameters:
+        """Change parameters of the running simulation (the test's friction after a
+        frictionless compaction, a tolerance...): the new :class:`Parameters` are validated
+        whole before they replace the old ones, which stay on a refusal. Returns them."""
+        fixed = sorted(set(changes) & set(self.FIXED_PARAMETERS))
+        if fixed:
+            raise ParameterError(f"{', '.join(fixed)}: fixed when the simulation is built (its masses and "
+                                 "detection distances); expected a new Simulation for another value")
+        self.parameters = replace(self.parameters, **changes).validate()
+        return self.parameters
+
+    @property
+    def preparation_attrs(self) -> dict:
+        """The sample's history as file attributes (:meth:`SampleHistory.attrs`)."""
+        return self.history.attrs()
 
     # -- mobility ---------------------------------------------------------------------------
     def _mobility(self):
@@ -497,3 +510,16 @@ class Simulation:
         d = asdict(self.parameters)
         d.update(alert=self.alert, skin=self.skin)
         return d
+
+
+def _history_alias(name):
+    """``sim.<name>``: the same as ``sim.history.<name>`` (:class:`SampleHistory`), for the
+    scripts that read the sample's history from the simulation."""
+    return property(lambda self: getattr(self.history, name), lambda self, value: setattr(self.history, name, value),
+                    doc=f"``history.{name}`` (:class:`solver.sample_history.SampleHistory`).")
+
+
+for _name in ("sigma0", "settled", "compaction_steps", "compaction_stress", "compaction_inertia_number",
+              "compaction_unconverged", "preparation"):
+    setattr(Simulation, _name, _history_alias(_name))
+del _name
