@@ -61,10 +61,12 @@ WALL_ATTRIBUTES = ("wall_mode", "wall_stress_Pa", "wall_mass_kg", "wall_max_spee
 BIAXIAL_ATTRIBUTES = ("strain_target", "wall_velocity_m_s", "snapshot_every", "biaxial_steps")
 
 
-LATER_PARAMETERS = {"acceleration": "off", "anderson_memory": 5, "anderson_period": 1, "domains": 1,
+LATER_PARAMETERS = {"solver": "nlgs", "anderson_memory": 5, "anderson_period": 1, "domains": 1,
                     "stall_sweeps": 0}
 """Parameters added after files were first written, with the value every older file ran with
-(not the current default, which may change): absent from a file, they take that value."""
+(not the current default, which may change): absent from a file, they take that value. A file
+from before ``solver_solver`` names its solver by ``solver_acceleration``
+(:data:`solver.contact_solvers.ACCELERATIONS`: ``off`` is ``nlgs``)."""
 
 
 def _parameters(attrs, source) -> Parameters:
@@ -89,7 +91,8 @@ def _parameters(attrs, source) -> Parameters:
         else:
             value = float(value)
         values[field.name] = value
-    return Parameters(**values)
+    acceleration = attrs.get("solver_acceleration") if "solver_solver" not in attrs else None
+    return Parameters(**values, acceleration=acceleration)
 
 
 def _check_resumable(ds, source):

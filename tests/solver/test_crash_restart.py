@@ -320,11 +320,14 @@ def child_pid(names):
     return next(n.split(".")[-2] for n in names if n.endswith(".part"))
 
 
-@pytest.mark.parametrize("method", ["off", "anderson"])
-def test_the_sweep_method_is_recorded_and_older_files_load_with_plain_sweeps(tmp_path, method):
+@pytest.mark.parametrize("method", ["nlgs", "anderson"])
+def test_the_solver_is_recorded_and_older_files_load_with_the_solver_they_ran(tmp_path, method):
+    """A file records its solver (solver_solver) and loads with it; a file from before that
+    attribute names it by solver_acceleration ('off': plain sweeps); one from before both ran
+    plain sweeps."""
     from solver import load_sample
 
-    sim = compaction_sample(20, "disk", seed=1, acceleration=method, anderson_memory=4, anderson_period=3,
+    sim = compaction_sample(20, "disk", seed=1, solver=method, anderson_memory=4, anderson_period=3,
                             stall_sweeps=300)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
@@ -333,17 +336,42 @@ def test_the_sweep_method_is_recorded_and_older_files_load_with_plain_sweeps(tmp
     path = tmp_path / "sample.nc"
     with Recorder(str(path), sim, attrs={"scene": "isotropic"}) as rec:
         rec.write()
+    with netCDF4.Dataset(path) as nc:
+        assert nc.getncattr("solver_solver") == method and "solver_acceleration" not in nc.ncattrs()
     loaded = load_sample(path)
-    assert loaded.parameters.acceleration == method and loaded.parameters.anderson_memory == 4
+    assert loaded.parameters.solver == method and loaded.parameters.anderson_memory == 4
     assert loaded.parameters.anderson_period == 3 and loaded.parameters.stall_sweeps == 300
+    with netCDF4.Dataset(path, "a") as nc:  # a file written before the solver's name was recorded
+        nc.delncattr("solver_solver")
+        nc.setncattr("solver_acceleration", {"nlgs": "off", "anderson": "anderson"}[method])
+    assert load_sample(path).parameters.solver == method
     with netCDF4.Dataset(path, "a") as nc:  # a file written before the parameters existed
         nc.delncattr("solver_acceleration")
         nc.delncattr("solver_anderson_memory")
         nc.delncattr("solver_anderson_period")
         nc.delncattr("solver_stall_sweeps")
     older = load_sample(path)
-    assert older.parameters.acceleration == "off" and older.parameters.anderson_memory == 5
+    assert older.parameters.solver == "nlgs" and older.parameters.anderson_memory == 5
     assert older.parameters.anderson_period == 1 and older.parameters.stall_sweeps == 0
+
+
+def test_a_file_from_before_the_solver_attribute_resumes_bit_for_bit(reference, tmp_path):
+    """The reference run (Anderson sweeps) cut short and its solver named the former way
+    (solver_acceleration = 'anderson', no solver_solver): resumed, every snapshot is the
+    uninterrupted run's, bit for bit."""
+    path = _nearly_finished(reference, tmp_path / "run.nc")
+    with netCDF4.Dataset(path, "a") as nc:
+        assert nc.getncattr("solver_solver") == "anderson"
+        nc.delncattr("solver_solver")
+        nc.setncattr("solver_acceleration", "anderson")
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        assert resume(path, progress=False) == 6
+    data, attrs = _variables(path)
+    reference_data, reference_attrs = _variables(reference)
+    _assert_prefix_of(data, reference_data)
+    assert data["time"].size == SNAPSHOTS
+    assert attrs["solver_acceleration"] == "anderson" and "solver_solver" not in attrs
 
 
 def test_the_resume_command_runs_without_warnings(tmp_path):
