@@ -49,6 +49,7 @@ from . import scratch
 from .nlgs import NLGSResult, _apply, delassus_into, stalled, sweep, sweep_norms, velocities_from_impulses
 from .parallel_nlgs import solve_decomposed, start_domains, sweep_domains
 from .residuals import cone_projection
+from .solve_records import AndersonScratch, DelassusBlocks, Impulses, Limits, Velocities
 
 __all__ = ["solve_anderson", "solve_problem_anderson"]
 
@@ -124,18 +125,20 @@ def _residual(gn, gt, xn, xt, fn, ft):
 
 
 @njit(cache=True)
-def _point_history(lo, hi, slot, count, pn, pt, xn, xt, fn, ft, fn_prev, ft_prev, gn_prev, gt_prev, dfn, dft, dgn,
-                   dgt, row, rhs):
+def _point_history(lo, hi, slot, count, impulses, scratch, row, rhs):
     """The history of points lo..hi - 1 after a sweep has mapped the iterate x to G(x) =
-    (pn, pt): f = G(x) - x; when ``slot`` >= 0 the differences dF, dG with the previous sweep
-    are stored in row ``slot`` of the history, and the block's share of the new Gram row
-    (dF_slot . dF_j) and of the right-hand side (dF_j . f) over the ``count`` rows in use is
-    added to ``row`` and ``rhs``; then previous <- current and x <- G(x). Returns the block's
-    share of |f|^2."""
-    f_n, f_t = fn[lo:hi], ft[lo:hi]
-    size = _residual(pn[lo:hi], pt[lo:hi], xn[lo:hi], xt[lo:hi], f_n, f_t)
-    old_fn, old_ft, old_gn, old_gt = fn_prev[lo:hi], ft_prev[lo:hi], gn_prev[lo:hi], gt_prev[lo:hi]
-    g_n, g_t = xn[lo:hi], xt[lo:hi]
+    ``impulses``: f = G(x) - x; when ``slot`` >= 0 the differences dF, dG with the previous
+    sweep are stored in row ``slot`` of the history (:class:`AndersonScratch`), and the block's
+    share of the new Gram row (dF_slot . dF_j) and of the right-hand side (dF_j . f) over the
+    ``count`` rows in use is added to ``row`` and ``rhs``; then previous <- current and
+    x <- G(x). Returns the block's share of |f|^2."""
+    pn, pt = impulses
+    dfn, dft, dgn, dgt = scratch.dfn, scratch.dft, scratch.dgn, scratch.dgt
+    f_n, f_t = scratch.fn[lo:hi], scratch.ft[lo:hi]
+    size = _residual(pn[lo:hi], pt[lo:hi], scratch.xn[lo:hi], scratch.xt[lo:hi], f_n, f_t)
+    old_fn, old_ft = scratch.fn_prev[lo:hi], scratch.ft_prev[lo:hi]
+    old_gn, old_gt = scratch.gn_prev[lo:hi], scratch.gt_prev[lo:hi]
+    g_n, g_t = scratch.xn[lo:hi], scratch.xt[lo:hi]
     if slot >= 0:
         new_fn, new_ft = dfn[slot, lo:hi], dft[slot, lo:hi]
         new_gn, new_gt = dgn[slot, lo:hi], dgt[slot, lo:hi]
@@ -160,13 +163,17 @@ def _point_history(lo, hi, slot, count, pn, pt, xn, xt, fn, ft, fn_prev, ft_prev
 
 
 @njit(cache=True)
-def _body_history(lo, hi, slot, vx, vy, w, hvx, hvy, hw, dvx, dvy, dw):
-    """The velocity history of bodies lo..hi - 1: the change since the previous sweep stored
-    in row ``slot`` (when >= 0), and previous <- current in the same pass. Velocities are
-    linear in the impulses (v = v_free + M^-1 H p), so these are M^-1 H dG."""
+def _body_history(lo, hi, slot, velocities, scratch):
+    """The velocity history of bodies lo..hi - 1: the change of ``velocities`` since the
+    previous sweep stored in row ``slot`` (when >= 0) of the history (:class:`AndersonScratch`),
+    and previous <- current in the same pass. Velocities are linear in the impulses
+    (v = v_free + M^-1 H p), so these are M^-1 H dG."""
+    vx, vy, w = velocities
+    hvx, hvy, hw = scratch.hvx, scratch.hvy, scratch.hw
     if slot >= 0:
-        for new, now, old in ((dvx[slot, lo:hi], vx[lo:hi], hvx[lo:hi]), (dvy[slot, lo:hi], vy[lo:hi], hvy[lo:hi]),
-                              (dw[slot, lo:hi], w[lo:hi], hw[lo:hi])):
+        for new, now, old in ((scratch.dvx[slot, lo:hi], vx[lo:hi], hvx[lo:hi]),
+                              (scratch.dvy[slot, lo:hi], vy[lo:hi], hvy[lo:hi]),
+                              (scratch.dw[slot, lo:hi], w[lo:hi], hw[lo:hi])):
             for i in range(new.size):
                 new[i] = now[i] - old[i]
                 old[i] = now[i]
@@ -177,56 +184,55 @@ def _body_history(lo, hi, slot, vx, vy, w, hvx, hvy, hw, dvx, dvy, dw):
 
 
 @njit(cache=True)
-def _extrapolate_bodies(lo, hi, gamma, count, dvx, dvy, dw, vx, vy, w):
+def _extrapolate_bodies(lo, hi, gamma, count, velocities, scratch):
     """The velocities of bodies lo..hi - 1 at the extrapolated impulses: v - dV gamma."""
-    _subtract_scaled(vx[lo:hi], dvx, lo, hi, gamma, count)
-    _subtract_scaled(vy[lo:hi], dvy, lo, hi, gamma, count)
-    _subtract_scaled(w[lo:hi], dw, lo, hi, gamma, count)
+    vx, vy, w = velocities
+    _subtract_scaled(vx[lo:hi], scratch.dvx, lo, hi, gamma, count)
+    _subtract_scaled(vy[lo:hi], scratch.dvy, lo, hi, gamma, count)
+    _subtract_scaled(w[lo:hi], scratch.dw, lo, hi, gamma, count)
 
 
 @njit(cache=True)
-def _extrapolate_points(lo, hi, gamma, count, dgn, dgt, a, b, nx, ny, rax, ray, rbx, rby, mu, pn, pt, xn, xt, en, et,
-                        vx, vy, w, minv_xx, minv_xy, minv_yy, iinv):
+def _extrapolate_points(lo, hi, gamma, count, problem, impulses, velocities, scratch):
     """The impulses of points lo..hi - 1 at the extrapolation G(x) - dG gamma (computed in the
-    scratch ``en, et``), projected onto each point's Coulomb cone; they become the next
+    scratch's ``fn, ft``), projected onto each point's Coulomb cone; they become the next
     iterate. Where the projection moved an impulse, its change is added to the velocities of
     the point's bodies (which :func:`_extrapolate_bodies` set for the unprojected
     extrapolation)."""
-    e_n, e_t = en[lo:hi], et[lo:hi]
+    pn, pt = impulses
+    e_n, e_t = scratch.fn[lo:hi], scratch.ft[lo:hi]
     e_n[:] = pn[lo:hi]
     e_t[:] = pt[lo:hi]
-    _subtract_scaled(e_n, dgn, lo, hi, gamma, count)
-    _subtract_scaled(e_t, dgt, lo, hi, gamma, count)
-    p_n, p_t, x_n, x_t, friction = pn[lo:hi], pt[lo:hi], xn[lo:hi], xt[lo:hi], mu[lo:hi]
+    _subtract_scaled(e_n, scratch.dgn, lo, hi, gamma, count)
+    _subtract_scaled(e_t, scratch.dgt, lo, hi, gamma, count)
+    p_n, p_t, x_n, x_t, friction = pn[lo:hi], pt[lo:hi], scratch.xn[lo:hi], scratch.xt[lo:hi], problem.mu[lo:hi]
     for q in range(e_n.size):
         qn, qt = cone_projection(e_n[q], e_t[q], friction[q])
         if qn != e_n[q] or qt != e_t[q]:
-            _apply(lo + q, qn - e_n[q], qt - e_t[q], a, b, nx, ny, rax, ray, rbx, rby, vx, vy, w, minv_xx, minv_xy,
-                   minv_yy, iinv)
+            _apply(lo + q, qn - e_n[q], qt - e_t[q], problem, velocities)
         p_n[q], p_t[q] = qn, qt
         x_n[q], x_t[q] = qn, qt
 
 
 @njit(cache=True, parallel=True)
-def _history_blocks(blocks, body_blocks, slot, count, pn, pt, xn, xt, fn, ft, fn_prev, ft_prev, gn_prev, gt_prev,
-                    dfn, dft, dgn, dgt, row, rhs, vx, vy, w, hvx, hvy, hw, dvx, dvy, dw):
+def _history_blocks(blocks, body_blocks, slot, count, impulses, velocities, scratch):
     """:func:`_point_history` over the domains' blocks of points at once (a thread each), then
     over the interface's, and :func:`_body_history` over the blocks of bodies at once; the
-    blocks' sums are added in block order, so the result does not depend on the threads."""
+    blocks' sums are added in block order into the scratch's ``row`` and ``rhs``, so the result
+    does not depend on the threads."""
     n_blocks = blocks.size - 1
     domains = n_blocks - 1
+    row, rhs = scratch.row, scratch.rhs
     memory = row.size
     rows = np.zeros((n_blocks, memory))
     rhss = np.zeros((n_blocks, memory))
     sizes = np.zeros(n_blocks)
     for d in prange(domains):
-        sizes[d] = _point_history(blocks[d], blocks[d + 1], slot, count, pn, pt, xn, xt, fn, ft, fn_prev, ft_prev,
-                                  gn_prev, gt_prev, dfn, dft, dgn, dgt, rows[d], rhss[d])
-    sizes[domains] = _point_history(blocks[domains], blocks[domains + 1], slot, count, pn, pt, xn, xt, fn, ft,
-                                    fn_prev, ft_prev, gn_prev, gt_prev, dfn, dft, dgn, dgt, rows[domains],
-                                    rhss[domains])
+        sizes[d] = _point_history(blocks[d], blocks[d + 1], slot, count, impulses, scratch, rows[d], rhss[d])
+    sizes[domains] = _point_history(blocks[domains], blocks[domains + 1], slot, count, impulses, scratch,
+                                    rows[domains], rhss[domains])
     for d in prange(body_blocks.size - 1):
-        _body_history(body_blocks[d], body_blocks[d + 1], slot, vx, vy, w, hvx, hvy, hw, dvx, dvy, dw)
+        _body_history(body_blocks[d], body_blocks[d + 1], slot, velocities, scratch)
     size = 0.0
     for d in range(n_blocks):
         size += sizes[d]
@@ -237,19 +243,16 @@ def _history_blocks(blocks, body_blocks, slot, count, pn, pt, xn, xt, fn, ft, fn
 
 
 @njit(cache=True, parallel=True)
-def _extrapolate_blocks(blocks, body_blocks, gamma, count, dgn, dgt, dvx, dvy, dw, a, b, nx, ny, rax, ray, rbx, rby,
-                        mu, pn, pt, xn, xt, en, et, vx, vy, w, minv_xx, minv_xy, minv_yy, iinv):
+def _extrapolate_blocks(blocks, body_blocks, gamma, count, problem, impulses, velocities, scratch):
     """:func:`_extrapolate_bodies` over the blocks of bodies at once, then
     :func:`_extrapolate_points` over the domains at once (each writes its own bodies only) and
     over the interface (the last block) alone."""
     for d in prange(body_blocks.size - 1):
-        _extrapolate_bodies(body_blocks[d], body_blocks[d + 1], gamma, count, dvx, dvy, dw, vx, vy, w)
+        _extrapolate_bodies(body_blocks[d], body_blocks[d + 1], gamma, count, velocities, scratch)
     domains = blocks.size - 2
     for d in prange(domains):
-        _extrapolate_points(blocks[d], blocks[d + 1], gamma, count, dgn, dgt, a, b, nx, ny, rax, ray, rbx, rby, mu,
-                            pn, pt, xn, xt, en, et, vx, vy, w, minv_xx, minv_xy, minv_yy, iinv)
-    _extrapolate_points(blocks[domains], blocks[domains + 1], gamma, count, dgn, dgt, a, b, nx, ny, rax, ray, rbx,
-                        rby, mu, pn, pt, xn, xt, en, et, vx, vy, w, minv_xx, minv_xy, minv_yy, iinv)
+        _extrapolate_points(blocks[d], blocks[d + 1], gamma, count, problem, impulses, velocities, scratch)
+    _extrapolate_points(blocks[domains], blocks[domains + 1], gamma, count, problem, impulses, velocities, scratch)
 
 
 @njit(cache=True)
@@ -262,13 +265,43 @@ def scratch_size(points, bodies, memory):
 
 
 @njit(cache=True)
-def solve_anderson(blocks, a, b, nx, ny, rax, ray, rbx, rby, bias, mu, pn, pt, vx, vy, w,
-                   minv_xx, minv_xy, minv_yy, iinv, tol, max_tol, max_iterations, memory, period, stall, work):
-    """Anderson-accelerated NLGS (module docstring); arguments, in-place updates and result as
-    :func:`solver.nlgs.solve` without the ordering options; ``memory`` is m, ``period`` the
-    number of sweeps that make the map G (the history is taken and the iterate extrapolated
-    after every ``period``-th sweep; the stopping norms are checked after every sweep),
-    ``stall`` the sweeps of the stall test (:func:`solver.nlgs.stalled`; 0: none).
+def scratch_records(work, points, bodies, memory):
+    """The :class:`AndersonScratch` and the points' :class:`DelassusBlocks` of
+    :func:`solve_anderson`, cut from ``work`` (at least :func:`scratch_size` floats): history
+    rows (memory x points, memory x bodies), then single arrays of points and of bodies; the
+    small normal equations in new memory."""
+    m, n_bodies = points, bodies
+    history, rows = memory * m, memory * n_bodies
+    dfn = work[0:history].reshape((memory, m))
+    dft = work[history:2 * history].reshape((memory, m))
+    dgn = work[2 * history:3 * history].reshape((memory, m))
+    dgt = work[3 * history:4 * history].reshape((memory, m))
+    start = 4 * history
+    dvx = work[start:start + rows].reshape((memory, n_bodies))
+    dvy = work[start + rows:start + 2 * rows].reshape((memory, n_bodies))
+    dw = work[start + 2 * rows:start + 3 * rows].reshape((memory, n_bodies))
+    start += 3 * rows
+    singles = work[start:start + 11 * m + 3 * n_bodies]
+    blocks = DelassusBlocks(singles[0:m], singles[m:2 * m], singles[2 * m:3 * m])
+    xn, xt, fn, ft = singles[3 * m:4 * m], singles[4 * m:5 * m], singles[5 * m:6 * m], singles[6 * m:7 * m]
+    fn_prev, ft_prev = singles[7 * m:8 * m], singles[8 * m:9 * m]
+    gn_prev, gt_prev = singles[9 * m:10 * m], singles[10 * m:11 * m]
+    hvx = singles[11 * m:11 * m + n_bodies]
+    hvy = singles[11 * m + n_bodies:11 * m + 2 * n_bodies]
+    hw = singles[11 * m + 2 * n_bodies:11 * m + 3 * n_bodies]
+    scratch = AndersonScratch(xn, xt, fn, ft, fn_prev, ft_prev, gn_prev, gt_prev, dfn, dft, dgn, dgt, hvx, hvy, hw,
+                              dvx, dvy, dw, np.zeros((memory, memory)), np.zeros(memory), np.zeros(memory))
+    return scratch, blocks
+
+
+@njit(cache=True)
+def solve_anderson(blocks, problem, impulses, velocities, limits, memory, period, work):
+    """Anderson-accelerated NLGS (module docstring); ``impulses`` (:class:`Impulses`),
+    ``velocities`` (:class:`Velocities`), ``limits`` (:class:`Limits`), in-place updates and
+    result as :func:`solver.nlgs.solve` without the ordering options; ``memory`` is m,
+    ``period`` the number of sweeps that make the map G (the history is taken and the iterate
+    extrapolated after every ``period``-th sweep; the stopping norms are checked after every
+    sweep).
 
     ``blocks`` holds the boundaries of the points' blocks: ``[0, P]`` for the serial sweep over
     all points in their order, or ``[0, p_1, ..., p_D, P]`` for the domain-decomposed sweep of
@@ -277,49 +310,27 @@ def solve_anderson(blocks, a, b, nx, ny, rax, ray, rbx, rby, bias, mu, pn, pt, v
 
     ``work``: a float array of at least :func:`scratch_size` entries, the working memory (its
     contents on entry do not matter: every entry is written before it is read)."""
-    m = a.size
-    n_bodies = vx.size
+    m = problem.a.size
+    n_bodies = velocities.vx.size
     if work.size < scratch_size(m, n_bodies, memory):
         raise ValueError("solve_anderson: the work array is shorter than scratch_size(points, bodies, memory)")
     parallel = blocks.size > 2
     domains = blocks.size - 2
     body_blocks = (np.arange(domains + 1) * n_bodies) // max(domains, 1)
-    # the working arrays, cut from ``work``: history rows (memory x points, memory x bodies),
-    # then single arrays of points and of bodies
-    history, bodies = memory * m, memory * n_bodies
-    dfn = work[0:history].reshape((memory, m))
-    dft = work[history:2 * history].reshape((memory, m))
-    dgn = work[2 * history:3 * history].reshape((memory, m))
-    dgt = work[3 * history:4 * history].reshape((memory, m))
-    start = 4 * history
-    dvx = work[start:start + bodies].reshape((memory, n_bodies))
-    dvy = work[start + bodies:start + 2 * bodies].reshape((memory, n_bodies))
-    dw = work[start + 2 * bodies:start + 3 * bodies].reshape((memory, n_bodies))
-    start += 3 * bodies
-    singles = work[start:start + 11 * m + 3 * n_bodies]
-    wnn, wnt, wtt = singles[0:m], singles[m:2 * m], singles[2 * m:3 * m]
-    xn, xt, fn, ft = singles[3 * m:4 * m], singles[4 * m:5 * m], singles[5 * m:6 * m], singles[6 * m:7 * m]
-    fn_prev, ft_prev = singles[7 * m:8 * m], singles[8 * m:9 * m]
-    gn_prev, gt_prev = singles[9 * m:10 * m], singles[10 * m:11 * m]
-    hvx = singles[11 * m:11 * m + n_bodies]
-    hvy = singles[11 * m + n_bodies:11 * m + 2 * n_bodies]
-    hw = singles[11 * m + 2 * n_bodies:11 * m + 3 * n_bodies]
+    scratch, delassus_blocks = scratch_records(work, m, n_bodies, memory)
     if parallel:
-        start_domains(blocks, a, b, nx, ny, rax, ray, rbx, rby, pn, pt, vx, vy, w, minv_xx, minv_xy, minv_yy, iinv,
-                      wnn, wnt, wtt)
+        start_domains(blocks, problem, impulses, velocities, delassus_blocks)
     else:
-        delassus_into(a, b, nx, ny, rax, ray, rbx, rby, minv_xx, minv_xy, minv_yy, iinv, wnn, wnt, wtt)
-        velocities_from_impulses(a, b, nx, ny, rax, ray, rbx, rby, pn, pt, vx, vy, w, minv_xx, minv_xy, minv_yy,
-                                 iinv)
+        delassus_into(problem, delassus_blocks)
+        velocities_from_impulses(problem, impulses, velocities)
     order = np.arange(m)
     ptr = blocks[:-1].copy()
     points = order[:blocks[-2]]
     interface = order[blocks[-2]:]
-    gram = np.zeros((memory, memory))
-    row = np.zeros(memory)
-    rhs = np.zeros(memory)
-    xn[:] = pn
-    xt[:] = pt
+    gram, row, rhs = scratch.gram, scratch.row, scratch.rhs
+    scratch.xn[:] = impulses.pn
+    scratch.xt[:] = impulses.pt
+    tol, max_tol, max_iterations = limits.tolerance, limits.max_tolerance, limits.max_iterations
     have_prev = False
     count = 0
     head = 0
@@ -329,12 +340,11 @@ def solve_anderson(blocks, a, b, nx, ny, rax, ray, rbx, rby, bias, mu, pn, pt, v
     watch = np.full(2, np.inf)
     for it in range(1, max_iterations + 1):
         if parallel:
-            quad, worst = sweep_norms(*sweep_domains(ptr, points, interface, a, b, nx, ny, rax, ray, rbx, rby, bias, mu,
-                                                     pn, pt, vx, vy, w, minv_xx, minv_xy, minv_yy, iinv, wnn, wnt, wtt))
+            quad, worst = sweep_norms(*sweep_domains(ptr, points, interface, problem, impulses, velocities,
+                                                     delassus_blocks))
         else:
-            quad, worst = sweep_norms(*sweep(order, a, b, nx, ny, rax, ray, rbx, rby, bias, mu, pn, pt, vx, vy, w,
-                                             minv_xx, minv_xy, minv_yy, iinv, wnn, wnt, wtt))
-        if (quad <= tol and worst <= max_tol) or stalled(it, quad, tol, watch, stall):
+            quad, worst = sweep_norms(*sweep(order, problem, impulses, velocities, delassus_blocks))
+        if (quad <= tol and worst <= max_tol) or stalled(it, quad, tol, watch, limits.stall):
             return it, quad, worst
         if it % period != 0 or it == max_iterations:  # the last sweep's iterate is the one its norms describe
             continue
@@ -344,12 +354,10 @@ def solve_anderson(blocks, a, b, nx, ny, rax, ray, rbx, rby, bias, mu, pn, pt, v
         row[:] = 0.0
         rhs[:] = 0.0
         if parallel:
-            size = _history_blocks(blocks, body_blocks, slot, used, pn, pt, xn, xt, fn, ft, fn_prev, ft_prev, gn_prev,
-                                   gt_prev, dfn, dft, dgn, dgt, row, rhs, vx, vy, w, hvx, hvy, hw, dvx, dvy, dw)
+            size = _history_blocks(blocks, body_blocks, slot, used, impulses, velocities, scratch)
         else:
-            size = _point_history(0, m, slot, used, pn, pt, xn, xt, fn, ft, fn_prev, ft_prev, gn_prev, gt_prev, dfn,
-                                  dft, dgn, dgt, row, rhs)
-            _body_history(0, n_bodies, slot, vx, vy, w, hvx, hvy, hw, dvx, dvy, dw)
+            size = _point_history(0, m, slot, used, impulses, scratch, row, rhs)
+            _body_history(0, n_bodies, slot, velocities, scratch)
         have_prev = True
         if size > last or slot < 0:  # the sweeps stopped contracting, or no history yet: plain sweep
             count = 0
@@ -368,12 +376,10 @@ def solve_anderson(blocks, a, b, nx, ny, rax, ray, rbx, rby, bias, mu, pn, pt, v
             head = 0
             continue
         if parallel:
-            _extrapolate_blocks(blocks, body_blocks, gamma, count, dgn, dgt, dvx, dvy, dw, a, b, nx, ny, rax, ray, rbx,
-                                rby, mu, pn, pt, xn, xt, fn, ft, vx, vy, w, minv_xx, minv_xy, minv_yy, iinv)
+            _extrapolate_blocks(blocks, body_blocks, gamma, count, problem, impulses, velocities, scratch)
         else:
-            _extrapolate_bodies(0, n_bodies, gamma, count, dvx, dvy, dw, vx, vy, w)
-            _extrapolate_points(0, m, gamma, count, dgn, dgt, a, b, nx, ny, rax, ray, rbx, rby, mu, pn, pt, xn, xt, fn,
-                                ft, vx, vy, w, minv_xx, minv_xy, minv_yy, iinv)
+            _extrapolate_bodies(0, n_bodies, gamma, count, velocities, scratch)
+            _extrapolate_points(0, m, gamma, count, problem, impulses, velocities, scratch)
     return max_iterations, quad, worst
 
 
@@ -391,17 +397,15 @@ def solve_problem_anderson(problem, pn, pt, vx, vy, w, *, tolerance, max_toleran
     only)."""
     if int(period) < 1 or int(memory) < 1:
         raise ValueError(f"memory={memory!r}, period={period!r}: expected whole numbers >= 1")
-    options = (float(tolerance), float(max_tolerance), int(max_iterations), int(memory), int(period), int(stall))
+    limits = Limits(float(tolerance), float(max_tolerance), int(max_iterations), int(stall))
     if domains > 1:
-        def kernel(dec, geometry, state, masses):
+        def kernel(dec, renumbered, impulses, velocities):
             work = scratch.buffer("anderson", scratch_size(dec.a.size, dec.source.size, int(memory)))
-            return solve_anderson(dec.blocks, *geometry, *state, *masses, *options, work)
+            return solve_anderson(dec.blocks, renumbered, impulses, velocities, limits, int(memory), int(period), work)
 
         return solve_decomposed(problem, x, domains, (pn, pt, vx, vy, w), kernel, decomposition)
     work = scratch.buffer("anderson", scratch_size(problem.a.size, problem.minv_xx.size, int(memory)))
     blocks = np.array([0, problem.a.size], dtype=np.int64)
-    iterations, residual, worst = solve_anderson(
-        blocks, problem.a, problem.b, problem.nx, problem.ny, problem.rax, problem.ray, problem.rbx, problem.rby,
-        problem.bias, problem.mu, pn, pt, vx, vy, w, problem.minv_xx, problem.minv_xy, problem.minv_yy,
-        problem.iinv, *options, work)
+    iterations, residual, worst = solve_anderson(blocks, problem, Impulses(pn, pt), Velocities(vx, vy, w), limits,
+                                                 int(memory), int(period), work)
     return NLGSResult(int(iterations), float(residual), float(worst))

@@ -50,33 +50,11 @@ from typing import NamedTuple
 import numpy as np
 from numba import njit
 
+from .solve_records import ContactProblem, DelassusBlocks, Impulses, Limits, MatrixProblem, Velocities
 
-class ContactProblem(NamedTuple):
-    """The frictional contact problem of one time step, one entry per contact point
-    (structure of arrays; body arrays indexed by body id, particles then walls).
-
-    a, b : int64 (P,) the two bodies of each point (the force acts on b, its reaction on a);
-    nx, ny : (P,) unit normal from a to b; rax, ray, rbx, rby : (P,) lever arms (m) from each
-    body's centre to the point (0 for walls); bias : (P,) Signorini shift b_k (m s-1, module
-    docstring); mu : (P,) friction coefficient; minv_xx, minv_xy, minv_yy : (B,) inverse mass
-    matrix of each body (kg-1; a wall pushed by a stress translates along its normal only);
-    iinv : (B,) inverse moment of inertia (kg-1 m-2).
-    """
-
-    a: np.ndarray
-    b: np.ndarray
-    nx: np.ndarray
-    ny: np.ndarray
-    rax: np.ndarray
-    ray: np.ndarray
-    rbx: np.ndarray
-    rby: np.ndarray
-    bias: np.ndarray
-    mu: np.ndarray
-    minv_xx: np.ndarray
-    minv_xy: np.ndarray
-    minv_yy: np.ndarray
-    iinv: np.ndarray
+__all__ = ["ContactProblem", "NLGSResult", "STALL_IMPROVEMENT", "delassus", "delassus_block", "delassus_into",
+           "local_solve", "norms", "solve", "solve_matrix", "solve_problem", "stalled", "sweep", "sweep_norms",
+           "velocities_from_impulses"]
 
 
 STALL_IMPROVEMENT = 0.05
@@ -97,17 +75,19 @@ def _cross(rx, ry, ex, ey):
 
 
 @njit(cache=True, inline="always")
-def delassus_block(k, a, b, nx, ny, rax, ray, rbx, rby, minv_xx, minv_xy, minv_yy, iinv):
-    """The local 2x2 Delassus block (W_nn, W_nt, W_tt) of point k (s kg-1 with impulses).
+def delassus_block(k, problem):
+    """The local 2x2 Delassus block (W_nn, W_nt, W_tt) of point k of ``problem`` (s kg-1).
 
     For each body: W += e_a^T M^-1 e_b + I^-1 (r x e_a)(r x e_b), e in {n, t}, t = (-n_y, n_x).
     """
+    nx, ny = problem.nx, problem.ny
+    minv_xx, minv_xy, minv_yy, iinv = problem.minv_xx, problem.minv_xy, problem.minv_yy, problem.iinv
     tx, ty = -ny[k], nx[k]
     nn = nt = tt = 0.0
     for side in range(2):
-        body = a[k] if side == 0 else b[k]
-        rx = rax[k] if side == 0 else rbx[k]
-        ry = ray[k] if side == 0 else rby[k]
+        body = problem.a[k] if side == 0 else problem.b[k]
+        rx = problem.rax[k] if side == 0 else problem.rbx[k]
+        ry = problem.ray[k] if side == 0 else problem.rby[k]
         mxx, mxy, myy = minv_xx[body], minv_xy[body], minv_yy[body]
         rn = _cross(rx, ry, nx[k], ny[k])
         rt = _cross(rx, ry, tx, ty)
@@ -118,22 +98,20 @@ def delassus_block(k, a, b, nx, ny, rax, ray, rbx, rby, minv_xx, minv_xy, minv_y
 
 
 @njit(cache=True)
-def delassus_into(a, b, nx, ny, rax, ray, rbx, rby, minv_xx, minv_xy, minv_yy, iinv, w_nn, w_nt, w_tt):
-    """:func:`delassus` written into the given arrays (P,) each."""
-    for k in range(a.size):
-        w_nn[k], w_nt[k], w_tt[k] = delassus_block(k, a, b, nx, ny, rax, ray, rbx, rby, minv_xx, minv_xy, minv_yy,
-                                                   iinv)
+def delassus_into(problem, out):
+    """:func:`delassus` written into ``out`` (:class:`DelassusBlocks` of (P,) arrays)."""
+    for k in range(problem.a.size):
+        out.nn[k], out.nt[k], out.tt[k] = delassus_block(k, problem)
 
 
 @njit(cache=True)
-def delassus(a, b, nx, ny, rax, ray, rbx, rby, minv_xx, minv_xy, minv_yy, iinv):
-    """Local 2x2 Delassus blocks (W_nn, W_nt, W_tt) of every point (:func:`delassus_block`)."""
-    m = a.size
-    w_nn = np.empty(m)
-    w_nt = np.empty(m)
-    w_tt = np.empty(m)
-    delassus_into(a, b, nx, ny, rax, ray, rbx, rby, minv_xx, minv_xy, minv_yy, iinv, w_nn, w_nt, w_tt)
-    return w_nn, w_nt, w_tt
+def delassus(problem):
+    """Local 2x2 Delassus blocks of every point (:func:`delassus_block`), a new
+    :class:`DelassusBlocks`."""
+    m = problem.a.size
+    out = DelassusBlocks(np.empty(m), np.empty(m), np.empty(m))
+    delassus_into(problem, out)
+    return out
 
 
 @njit(cache=True)
@@ -167,31 +145,36 @@ def local_solve(ufn, uft, bias, wnn, wnt, wtt, mu):
 
 
 @njit(cache=True)
-def _relative_velocity(k, a, b, nx, ny, rax, ray, rbx, rby, vx, vy, w):
+def _relative_velocity(k, problem, velocities):
     """Relative velocity (u_n, u_t) of body b with respect to body a at point k (m s-1)."""
-    bb, aa = np.uint64(b[k]), np.uint64(a[k])
-    ubx = vx[bb] - w[bb] * rby[k]
-    uby = vy[bb] + w[bb] * rbx[k]
-    uax = vx[aa] - w[aa] * ray[k]
-    uay = vy[aa] + w[aa] * rax[k]
+    vx, vy, w = velocities
+    bb, aa = np.uint64(problem.b[k]), np.uint64(problem.a[k])
+    ubx = vx[bb] - w[bb] * problem.rby[k]
+    uby = vy[bb] + w[bb] * problem.rbx[k]
+    uax = vx[aa] - w[aa] * problem.ray[k]
+    uay = vy[aa] + w[aa] * problem.rax[k]
     dx, dy = ubx - uax, uby - uay
-    return dx * nx[k] + dy * ny[k], -dx * ny[k] + dy * nx[k]
+    nx, ny = problem.nx[k], problem.ny[k]
+    return dx * nx + dy * ny, -dx * ny + dy * nx
 
 
 @njit(cache=True)
-def _apply(k, dpn, dpt, a, b, nx, ny, rax, ray, rbx, rby, vx, vy, w, minv_xx, minv_xy, minv_yy, iinv):
+def _apply(k, dpn, dpt, problem, velocities):
     """Add the impulse change (dpn, dpt) of point k to the velocities of its two bodies. A body
     that cannot move (zero inverse mass and inertia) is written too, with a zero change: a
     branch around it compiles into a several times slower sweep."""
-    px = dpn * nx[k] - dpt * ny[k]
-    py = dpn * ny[k] + dpt * nx[k]
-    bb, aa = np.uint64(b[k]), np.uint64(a[k])
+    vx, vy, w = velocities
+    minv_xx, minv_xy, minv_yy, iinv = problem.minv_xx, problem.minv_xy, problem.minv_yy, problem.iinv
+    nx, ny = problem.nx[k], problem.ny[k]
+    px = dpn * nx - dpt * ny
+    py = dpn * ny + dpt * nx
+    bb, aa = np.uint64(problem.b[k]), np.uint64(problem.a[k])
     vx[bb] += minv_xx[bb] * px + minv_xy[bb] * py
     vy[bb] += minv_xy[bb] * px + minv_yy[bb] * py
-    w[bb] += iinv[bb] * _cross(rbx[k], rby[k], px, py)
+    w[bb] += iinv[bb] * _cross(problem.rbx[k], problem.rby[k], px, py)
     vx[aa] -= minv_xx[aa] * px + minv_xy[aa] * py
     vy[aa] -= minv_xy[aa] * px + minv_yy[aa] * py
-    w[aa] -= iinv[aa] * _cross(rax[k], ray[k], px, py)
+    w[aa] -= iinv[aa] * _cross(problem.rax[k], problem.ray[k], px, py)
 
 
 @njit(cache=True)
@@ -233,54 +216,58 @@ def stalled(it, quad, tol, watch, stall):
 
 
 @njit(cache=True)
-def solve(a, b, nx, ny, rax, ray, rbx, rby, bias, mu, pn, pt, vx, vy, w,
-          minv_xx, minv_xy, minv_yy, iinv, tol, max_tol, max_iterations, shuffle, seed, stall=0):
-    """Run NLGS sweeps until convergence, a stall (``stall`` sweeps, module docstring) or
-    ``max_iterations`` sweeps; impulses (pn, pt) and velocities are updated in place.
+def solve(problem, impulses, velocities, limits, shuffle, seed):
+    """Run NLGS sweeps until convergence, a stall (``limits.stall`` sweeps, module docstring) or
+    ``limits.max_iterations`` sweeps; ``impulses`` (:class:`Impulses`) and ``velocities``
+    (:class:`Velocities`) are updated in place. ``shuffle`` visits the points in a random order
+    seeded by ``seed``.
 
-    On entry ``pn, pt`` hold the warm-start impulses and ``vx, vy, w`` the free velocities;
-    they are combined first. Returns (iterations, quadratic residual, max residual).
+    On entry ``impulses`` hold the warm start and ``velocities`` the free velocities; they are
+    combined first. Returns (iterations, quadratic residual, max residual).
     """
-    m = a.size
-    wnn, wnt, wtt = delassus(a, b, nx, ny, rax, ray, rbx, rby, minv_xx, minv_xy, minv_yy, iinv)
+    m = problem.a.size
+    blocks = delassus(problem)
     # velocities consistent with the warm-start impulses
-    velocities_from_impulses(a, b, nx, ny, rax, ray, rbx, rby, pn, pt, vx, vy, w, minv_xx, minv_xy, minv_yy, iinv)
+    velocities_from_impulses(problem, impulses, velocities)
     order = np.arange(m)
     state = np.uint64(seed) * np.uint64(0x9E3779B97F4A7C15) + np.uint64(1)  # never 0
     quad = 0.0
     worst = 0.0
     watch = np.full(2, np.inf)
-    for it in range(1, max_iterations + 1):
+    tol, max_tol = limits.tolerance, limits.max_tolerance
+    for it in range(1, limits.max_iterations + 1):
         if shuffle:
             state = _shuffle(order, state)
-        quad, worst = sweep_norms(*sweep(order, a, b, nx, ny, rax, ray, rbx, rby, bias, mu, pn, pt, vx, vy, w,
-                                         minv_xx, minv_xy, minv_yy, iinv, wnn, wnt, wtt))
-        if (quad <= tol and worst <= max_tol) or stalled(it, quad, tol, watch, stall):
+        quad, worst = sweep_norms(*sweep(order, problem, impulses, velocities, blocks))
+        if (quad <= tol and worst <= max_tol) or stalled(it, quad, tol, watch, limits.stall):
             return it, quad, worst
-    return max_iterations, quad, worst
+    return limits.max_iterations, quad, worst
 
 
 @njit(cache=True)
-def sweep(order, a, b, nx, ny, rax, ray, rbx, rby, bias, mu, pn, pt, vx, vy, w,
-          minv_xx, minv_xy, minv_yy, iinv, wnn, wnt, wtt):
+def sweep(order, problem, impulses, velocities, blocks):
     """One Gauss–Seidel sweep over the points in ``order``: each solves its local problem with
-    the others frozen and applies its impulse change to the bodies at once. Returns the sum and
-    the largest of dV_k^2 = dp_k . W_k dp_k over the sweep, and the scale S = sum_k p_k . W_k p_k
-    and number of loaded points of the points swept, at their new impulses (module docstring;
-    each point is swept once, so these are the end-of-sweep values)."""
+    the others frozen and applies its impulse change to the bodies at once. ``blocks``: the
+    points' :class:`DelassusBlocks`. Returns the sum and the largest of dV_k^2 = dp_k . W_k dp_k
+    over the sweep, and the scale S = sum_k p_k . W_k p_k and number of loaded points of the
+    points swept, at their new impulses (module docstring; each point is swept once, so these
+    are the end-of-sweep values)."""
+    pn, pt = impulses
+    wnn, wnt, wtt = blocks
+    bias, mu = problem.bias, problem.mu
     sum_dv2 = 0.0
     max_dv2 = 0.0
     scale = 0.0
     n_active = 0
     for q in range(order.size):
         k = np.uint64(order[q])
-        un, ut = _relative_velocity(k, a, b, nx, ny, rax, ray, rbx, rby, vx, vy, w)
+        un, ut = _relative_velocity(k, problem, velocities)
         ufn = un - wnn[k] * pn[k] - wnt[k] * pt[k]
         uft = ut - wnt[k] * pn[k] - wtt[k] * pt[k]
         new_n, new_t = local_solve(ufn, uft, bias[k], wnn[k], wnt[k], wtt[k], mu[k])
         dpn, dpt = new_n - pn[k], new_t - pt[k]
         if dpn != 0.0 or dpt != 0.0:
-            _apply(k, dpn, dpt, a, b, nx, ny, rax, ray, rbx, rby, vx, vy, w, minv_xx, minv_xy, minv_yy, iinv)
+            _apply(k, dpn, dpt, problem, velocities)
             dv2 = dpn * (wnn[k] * dpn + wnt[k] * dpt) + dpt * (wnt[k] * dpn + wtt[k] * dpt)
             sum_dv2 += dv2
             if dv2 > max_dv2:
@@ -293,9 +280,11 @@ def sweep(order, a, b, nx, ny, rax, ray, rbx, rby, bias, mu, pn, pt, vx, vy, w,
 
 
 @njit(cache=True)
-def norms(sum_dv2, max_dv2, pn, pt, wnn, wnt, wtt):
+def norms(sum_dv2, max_dv2, impulses, blocks):
     """The quadratic and max norms of a sweep (module docstring) from its sum and largest dV^2,
-    the scale computed from the impulses ``pn, pt``."""
+    the scale computed from the :class:`Impulses` and the points' :class:`DelassusBlocks`."""
+    pn, pt = impulses
+    wnn, wnt, wtt = blocks
     scale = 0.0
     n_active = 0
     for k in range(pn.size):
@@ -316,11 +305,12 @@ def sweep_norms(sum_dv2, max_dv2, scale, n_active):
 
 
 @njit(cache=True)
-def velocities_from_impulses(a, b, nx, ny, rax, ray, rbx, rby, pn, pt, vx, vy, w, minv_xx, minv_xy, minv_yy, iinv):
-    """Add the impulses (pn, pt) of every point to the body velocities (vx, vy, w) in place:
+def velocities_from_impulses(problem, impulses, velocities):
+    """Add the :class:`Impulses` of every point to the bodies' :class:`Velocities` in place:
     v = v_free + M^-1 H p when called on the free velocities."""
-    for k in range(a.size):
-        _apply(k, pn[k], pt[k], a, b, nx, ny, rax, ray, rbx, rby, vx, vy, w, minv_xx, minv_xy, minv_yy, iinv)
+    pn, pt = impulses
+    for k in range(problem.a.size):
+        _apply(k, pn[k], pt[k], problem, velocities)
 
 
 def solve_problem(problem: ContactProblem, pn, pt, vx, vy, w, *, tolerance, max_tolerance, max_iterations,
@@ -330,21 +320,24 @@ def solve_problem(problem: ContactProblem, pn, pt, vx, vy, w, *, tolerance, max_
     0: never) or ``max_iterations`` sweeps have run. ``pn, pt`` (P,) hold the warm-start
     impulses (N s) and ``vx, vy, w`` (B,) the free velocities on entry; all five are updated in
     place to the solution. ``shuffle`` visits the points in a random order seeded by ``seed``."""
-    iterations, residual, worst = solve(
-        problem.a, problem.b, problem.nx, problem.ny, problem.rax, problem.ray, problem.rbx, problem.rby,
-        problem.bias, problem.mu, pn, pt, vx, vy, w, problem.minv_xx, problem.minv_xy, problem.minv_yy,
-        problem.iinv, tolerance, max_tolerance, int(max_iterations), bool(shuffle), int(seed), int(stall))
+    iterations, residual, worst = solve(problem, Impulses(pn, pt), Velocities(vx, vy, w),
+                                        Limits(float(tolerance), float(max_tolerance), int(max_iterations),
+                                               int(stall)), bool(shuffle), int(seed))
     return NLGSResult(int(iterations), float(residual), float(worst))
 
 
 @njit(cache=True)
-def solve_matrix(indptr, indices, data, q, mu, rn, rt, tol, max_tol, max_iterations):
-    """NLGS on a frictional contact problem given by its matrix: u = W r + q with W (2n x 2n,
-    CSR ``indptr, indices, data``), rows 2k and 2k+1 the normal and tangential velocity of
-    point k. Each point solves :func:`local_solve` (no Signorini shift: it is in q) with the
+def solve_matrix(matrix, impulses, limits):
+    """NLGS on a frictional contact problem given by its matrix (:class:`MatrixProblem`:
+    u = W r + q with W (2n x 2n, CSR), rows 2k and 2k+1 the normal and tangential velocity of
+    point k). Each point solves :func:`local_solve` (no Signorini shift: it is in q) with the
     others frozen, reading its velocity from its two rows; the stopping norms are those of
-    :func:`solve` with W_k the diagonal 2x2 block. ``rn, rt`` (n,) hold the initial impulses
-    and are updated in place. Returns (iterations, quadratic norm, max norm)."""
+    :func:`solve` with W_k the diagonal 2x2 block (``limits.stall`` is not used). ``impulses``
+    (:class:`Impulses` (n,)) hold the initial impulses and are updated in place. Returns
+    (iterations, quadratic norm, max norm)."""
+    indptr, indices, data, q, mu = matrix
+    rn, rt = impulses
+    tol, max_tol, max_iterations = limits.tolerance, limits.max_tolerance, limits.max_iterations
     n = mu.size
     wnn = np.zeros(n)
     wnt = np.zeros(n)
@@ -381,7 +374,7 @@ def solve_matrix(indptr, indices, data, q, mu, rn, rt, tol, max_tol, max_iterati
             if dv2 > max_dv2:
                 max_dv2 = dv2
             rn[k], rt[k] = new_n, new_t
-        quad, worst = norms(sum_dv2, max_dv2, rn, rt, wnn, wnt, wtt)
+        quad, worst = norms(sum_dv2, max_dv2, impulses, DelassusBlocks(wnn, wnt, wtt))
         if quad <= tol and worst <= max_tol:
             return it, quad, worst
     return max_iterations, quad, worst

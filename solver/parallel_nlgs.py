@@ -43,6 +43,7 @@ from numba import njit, prange
 
 from . import scratch
 from .nlgs import NLGSResult, delassus_into, stalled, sweep, sweep_norms, velocities_from_impulses
+from .solve_records import ContactProblem, DelassusBlocks, Impulses, Limits, Velocities
 
 FREE = -1
 """Domain of a body that never moves (zero inverse mass and inertia): shared by every domain."""
@@ -149,22 +150,19 @@ def partition_points(a, b, body_domain, domains):
 
 
 @njit(cache=True, parallel=True)
-def sweep_domains(ptr, points, interface, a, b, nx, ny, rax, ray, rbx, rby, bias, mu, pn, pt, vx, vy, w,
-                  minv_xx, minv_xy, minv_yy, iinv, wnn, wnt, wtt):
+def sweep_domains(ptr, points, interface, problem, impulses, velocities, blocks):
     """One sweep: every domain at once (a thread each), then the interface serially. Returns
     the sum and the largest dV_k^2 of the sweep, the scale and the number of loaded points, as
-    :func:`solver.nlgs.sweep`."""
+    :func:`solver.nlgs.sweep` (the same arguments after the points' lists)."""
     domains = ptr.size - 1
     partial = np.zeros((domains, 4))
     for d in prange(domains):
-        s, top, scale, active = sweep(points[ptr[d]:ptr[d + 1]], a, b, nx, ny, rax, ray, rbx, rby, bias, mu, pn, pt,
-                                      vx, vy, w, minv_xx, minv_xy, minv_yy, iinv, wnn, wnt, wtt)
+        s, top, scale, active = sweep(points[ptr[d]:ptr[d + 1]], problem, impulses, velocities, blocks)
         partial[d, 0] = s
         partial[d, 1] = top
         partial[d, 2] = scale
         partial[d, 3] = active
-    sum_dv2, max_dv2, scale, n_active = sweep(interface, a, b, nx, ny, rax, ray, rbx, rby, bias, mu, pn, pt, vx, vy,
-                                              w, minv_xx, minv_xy, minv_yy, iinv, wnn, wnt, wtt)
+    sum_dv2, max_dv2, scale, n_active = sweep(interface, problem, impulses, velocities, blocks)
     for d in range(domains):  # in domain order: the same sums whatever the threads did
         sum_dv2 += partial[d, 0]
         max_dv2 = max(max_dv2, partial[d, 1])
@@ -174,21 +172,27 @@ def sweep_domains(ptr, points, interface, a, b, nx, ny, rax, ray, rbx, rby, bias
 
 
 @njit(cache=True)
-def _start_block(lo, hi, a, b, nx, ny, rax, ray, rbx, rby, pn, pt, vx, vy, w, minv_xx, minv_xy, minv_yy, iinv, wnn,
-                 wnt, wtt):
+def points_slice(problem, lo, hi):
+    """The points lo..hi - 1 of ``problem`` as a problem of their own (views; the body arrays
+    whole)."""
+    p = problem
+    return ContactProblem(p.a[lo:hi], p.b[lo:hi], p.nx[lo:hi], p.ny[lo:hi], p.rax[lo:hi], p.ray[lo:hi], p.rbx[lo:hi],
+                          p.rby[lo:hi], p.bias[lo:hi], p.mu[lo:hi], p.minv_xx, p.minv_xy, p.minv_yy, p.iinv)
+
+
+@njit(cache=True)
+def _start_block(lo, hi, problem, impulses, velocities, blocks):
     """The Delassus blocks of points lo..hi - 1 (:func:`solver.nlgs.delassus_into`), then their
     impulses added to their bodies' velocities (:func:`solver.nlgs.velocities_from_impulses`)."""
-    delassus_into(a[lo:hi], b[lo:hi], nx[lo:hi], ny[lo:hi], rax[lo:hi], ray[lo:hi], rbx[lo:hi], rby[lo:hi],
-                  minv_xx, minv_xy, minv_yy, iinv, wnn[lo:hi], wnt[lo:hi], wtt[lo:hi])
-    velocities_from_impulses(a[lo:hi], b[lo:hi], nx[lo:hi], ny[lo:hi], rax[lo:hi], ray[lo:hi], rbx[lo:hi], rby[lo:hi],
-                             pn[lo:hi], pt[lo:hi], vx, vy, w, minv_xx, minv_xy, minv_yy, iinv)
+    part = points_slice(problem, lo, hi)
+    delassus_into(part, DelassusBlocks(blocks.nn[lo:hi], blocks.nt[lo:hi], blocks.tt[lo:hi]))
+    velocities_from_impulses(part, Impulses(impulses.pn[lo:hi], impulses.pt[lo:hi]), velocities)
 
 
 @njit(cache=True, parallel=True)
-def start_domains(blocks, a, b, nx, ny, rax, ray, rbx, rby, pn, pt, vx, vy, w, minv_xx, minv_xy, minv_yy, iinv,
-                  wnn, wnt, wtt):
+def start_domains(blocks, problem, impulses, velocities, delassus_blocks):
     """The start of a domain-decomposed solve, a block of points per thread: each point's
-    Delassus block into ``wnn, wnt, wtt`` (:func:`solver.nlgs.delassus_into`), then the
+    Delassus block into ``delassus_blocks`` (:func:`solver.nlgs.delassus_into`), then the
     impulses added to the velocities (:func:`solver.nlgs.velocities_from_impulses`), the
     domains at once (each writes its own bodies only) and the interface (the last block) after
     them. ``blocks``: ``[0, p_1, ..., p_D, P]`` of the renumbered problem
@@ -197,33 +201,30 @@ def start_domains(blocks, a, b, nx, ny, rax, ray, rbx, rby, pn, pt, vx, vy, w, m
     bit."""
     domains = blocks.size - 2
     for d in prange(domains):  # a loop of D iterations gives each of D threads one domain
-        _start_block(blocks[d], blocks[d + 1], a, b, nx, ny, rax, ray, rbx, rby, pn, pt, vx, vy, w, minv_xx, minv_xy,
-                     minv_yy, iinv, wnn, wnt, wtt)
-    _start_block(blocks[domains], blocks[domains + 1], a, b, nx, ny, rax, ray, rbx, rby, pn, pt, vx, vy, w, minv_xx,
-                 minv_xy, minv_yy, iinv, wnn, wnt, wtt)
+        _start_block(blocks[d], blocks[d + 1], problem, impulses, velocities, delassus_blocks)
+    _start_block(blocks[domains], blocks[domains + 1], problem, impulses, velocities, delassus_blocks)
 
 
 @njit(cache=True)
-def solve_domains(ptr, points, interface, a, b, nx, ny, rax, ray, rbx, rby, bias, mu, pn, pt, vx, vy, w,
-                  minv_xx, minv_xy, minv_yy, iinv, tol, max_tol, max_iterations, stall=0):
+def solve_domains(ptr, points, interface, problem, impulses, velocities, limits):
     """:func:`solver.nlgs.solve` with :func:`sweep_domains` as its sweep (the problem laid out
     as its :class:`Decomposition` says: ``points`` and ``interface`` contiguous, in order)."""
-    m = a.size
-    wnn, wnt, wtt = np.empty(m), np.empty(m), np.empty(m)
+    m = problem.a.size
+    delassus_blocks = DelassusBlocks(np.empty(m), np.empty(m), np.empty(m))
     blocks = np.empty(ptr.size + 1, dtype=np.int64)
     blocks[:ptr.size] = ptr
     blocks[ptr.size] = m
-    start_domains(blocks, a, b, nx, ny, rax, ray, rbx, rby, pn, pt, vx, vy, w, minv_xx, minv_xy, minv_yy, iinv,
-                  wnn, wnt, wtt)
+    start_domains(blocks, problem, impulses, velocities, delassus_blocks)
     quad = 0.0
     worst = 0.0
     watch = np.full(2, np.inf)
-    for it in range(1, max_iterations + 1):
-        quad, worst = sweep_norms(*sweep_domains(ptr, points, interface, a, b, nx, ny, rax, ray, rbx, rby, bias, mu,
-                                                 pn, pt, vx, vy, w, minv_xx, minv_xy, minv_yy, iinv, wnn, wnt, wtt))
-        if (quad <= tol and worst <= max_tol) or stalled(it, quad, tol, watch, stall):
+    tol, max_tol = limits.tolerance, limits.max_tolerance
+    for it in range(1, limits.max_iterations + 1):
+        quad, worst = sweep_norms(*sweep_domains(ptr, points, interface, problem, impulses, velocities,
+                                                 delassus_blocks))
+        if (quad <= tol and worst <= max_tol) or stalled(it, quad, tol, watch, limits.stall):
             return it, quad, worst
-    return max_iterations, quad, worst
+    return limits.max_iterations, quad, worst
 
 
 class Decomposition(NamedTuple):
@@ -270,60 +271,63 @@ class Decomposition(NamedTuple):
         return np.append(self.ptr, self.point_order.size)
 
     def gather(self, problem, pn, pt, vx, vy, w, out=None):
-        """The problem's arrays in the new numbering: (geometry, masses, state) with geometry =
-        (a, b, nx, ny, rax, ray, rbx, rby, bias, mu), masses = (minv_xx, minv_xy, minv_yy, iinv)
-        and state = (pn, pt, vx, vy, w) (copies; :func:`gather_into`), in ``out`` (a float array of
-        at least :attr:`gathered_size` entries) or in new memory."""
-        arrays = gather_into(self.point_order, self.source, problem.nx, problem.ny, problem.rax, problem.ray,
-                             problem.rbx, problem.rby, problem.bias, problem.mu, pn, pt, problem.minv_xx,
-                             problem.minv_xy, problem.minv_yy, problem.iinv, vx, vy, w,
-                             np.empty(self.gathered_size) if out is None else out)
-        return (self.a, self.b, *arrays[:8]), arrays[10:14], (*arrays[8:10], *arrays[14:])
+        """The problem and its state in the new numbering: (:class:`ContactProblem`,
+        :class:`Impulses`, :class:`Velocities`) (copies; :func:`gather_into`), in ``out`` (a
+        float array of at least :attr:`gathered_size` entries) or in new memory."""
+        return gather_into(self, problem, Impulses(pn, pt), Velocities(vx, vy, w),
+                           np.empty(self.gathered_size) if out is None else out)
 
-    def scatter(self, state, pn, pt, vx, vy, w):
-        """Write a solved ``state`` (new numbering) back into the original arrays, in place:
-        every impulse, and the velocities of the bodies that can move (a still wall's
-        velocity is imposed and stays as it was; :func:`scatter_from`)."""
-        scatter_from(self.point_order, self.source, self.moving, *state, pn, pt, vx, vy, w)
+    def scatter(self, impulses, velocities, pn, pt, vx, vy, w):
+        """Write solved ``impulses`` and ``velocities`` (new numbering) back into the original
+        arrays, in place: every impulse, and the velocities of the bodies that can move (a
+        still wall's velocity is imposed and stays as it was; :func:`scatter_from`)."""
+        scatter_from(self, impulses, velocities, Impulses(pn, pt), Velocities(vx, vy, w))
 
 
 @njit(cache=True, parallel=True)
-def gather_into(point_order, source, nx, ny, rax, ray, rbx, rby, bias, mu, pn, pt, minv_xx, minv_xy, minv_yy, iinv,
-                vx, vy, w, out):
-    """Copies in the new numbering of :class:`Decomposition`: the ten point arrays (nx .. pt)
-    taken at ``point_order``, then the seven body arrays (minv_xx .. w) at ``source``, in the
-    order of the arguments, written into ``out`` (10 P + 7 B floats or more). Plain copies,
-    shared among the threads."""
+def gather_into(decomposition, problem, impulses, velocities, out):
+    """Copies in the new numbering of ``decomposition`` (:class:`Decomposition`): the ten
+    point arrays (nx .. rby, bias, mu, pn, pt) taken at its ``point_order``, then the seven body
+    arrays (minv_xx .. iinv, vx, vy, w) at its ``source``, written into ``out`` (10 P + 7 B
+    floats or more). Plain copies, shared among the threads. Returns the renumbered
+    (:class:`ContactProblem`, :class:`Impulses`, :class:`Velocities`), views of ``out``."""
+    point_order, source = decomposition.point_order, decomposition.source
+    p = problem
+    pn, pt = impulses
+    vx, vy, w = velocities
     m = point_order.size
     points = out[:10 * m].reshape((10, m))
     for q in prange(m):
         k = point_order[q]
-        points[0, q], points[1, q], points[2, q], points[3, q], points[4, q] = nx[k], ny[k], rax[k], ray[k], rbx[k]
-        points[5, q], points[6, q], points[7, q], points[8, q], points[9, q] = rby[k], bias[k], mu[k], pn[k], pt[k]
+        points[0, q], points[1, q], points[2, q] = p.nx[k], p.ny[k], p.rax[k]
+        points[3, q], points[4, q], points[5, q] = p.ray[k], p.rbx[k], p.rby[k]
+        points[6, q], points[7, q], points[8, q], points[9, q] = p.bias[k], p.mu[k], pn[k], pt[k]
     n = source.size
     bodies = out[10 * m:10 * m + 7 * n].reshape((7, n))
     for q in prange(n):
         j = source[q]
-        bodies[0, q], bodies[1, q], bodies[2, q], bodies[3, q] = minv_xx[j], minv_xy[j], minv_yy[j], iinv[j]
+        bodies[0, q], bodies[1, q], bodies[2, q], bodies[3, q] = p.minv_xx[j], p.minv_xy[j], p.minv_yy[j], p.iinv[j]
         bodies[4, q], bodies[5, q], bodies[6, q] = vx[j], vy[j], w[j]
-    return (points[0], points[1], points[2], points[3], points[4], points[5], points[6], points[7], points[8],
-            points[9], bodies[0], bodies[1], bodies[2], bodies[3], bodies[4], bodies[5], bodies[6])
+    renumbered = ContactProblem(decomposition.a, decomposition.b, points[0], points[1], points[2], points[3], points[4],
+                                points[5], points[6], points[7], bodies[0], bodies[1], bodies[2], bodies[3])
+    return renumbered, Impulses(points[8], points[9]), Velocities(bodies[4], bodies[5], bodies[6])
 
 
 @njit(cache=True)
-def scatter_from(point_order, source, moving, spn, spt, svx, svy, sw, pn, pt, vx, vy, w):
-    """:meth:`Decomposition.scatter`: impulses back to their points, the moving bodies'
-    velocities back to their bodies, in place."""
+def scatter_from(decomposition, solved_impulses, solved_velocities, impulses, velocities):
+    """:meth:`Decomposition.scatter`: the solved impulses (new numbering) back to their points,
+    the moving bodies' solved velocities back to their bodies, in place."""
+    point_order, source, moving = decomposition.point_order, decomposition.source, decomposition.moving
     for q in range(point_order.size):
         k = point_order[q]
-        pn[k] = spn[q]
-        pt[k] = spt[q]
+        impulses.pn[k] = solved_impulses.pn[q]
+        impulses.pt[k] = solved_impulses.pt[q]
     for i in range(moving.size):
         q = moving[i]
         j = source[q]
-        vx[j] = svx[q]
-        vy[j] = svy[q]
-        w[j] = sw[q]
+        velocities.vx[j] = solved_velocities.vx[q]
+        velocities.vy[j] = solved_velocities.vy[q]
+        velocities.w[j] = solved_velocities.w[q]
 
 
 @njit(cache=True)
@@ -405,18 +409,20 @@ def solve_problem_domains(problem, x, pn, pt, vx, vy, w, *, domains, tolerance, 
     ``x`` (m, the first ``x.size`` bodies); arguments and result otherwise as
     :func:`solver.nlgs.solve_problem`. ``decomposition``: the problem's :func:`decompose`, when
     the caller already has it (:func:`solve_decomposed`)."""
-    def kernel(dec, geometry, state, masses):
-        return solve_domains(dec.ptr, dec.points, dec.interface, *geometry, *state, *masses, tolerance, max_tolerance,
-                             int(max_iterations), int(stall))
+    limits = Limits(float(tolerance), float(max_tolerance), int(max_iterations), int(stall))
+
+    def kernel(dec, renumbered, impulses, velocities):
+        return solve_domains(dec.ptr, dec.points, dec.interface, renumbered, impulses, velocities, limits)
 
     return solve_decomposed(problem, x, domains, (pn, pt, vx, vy, w), kernel, decomposition)
 
 
 def solve_decomposed(problem, x, domains, state, kernel, decomposition=None) -> NLGSResult:
     """Lay ``problem`` out by ``domains`` slabs of the particles (centres' abscissae ``x``, m;
-    :func:`decompose`), run ``kernel(decomposition, geometry, state, masses)`` on the renumbered
-    arrays (:meth:`Decomposition.gather`; it returns sweeps and the two norms) and write the
-    solved impulses and velocities back into ``state`` = (pn, pt, vx, vy, w), in place.
+    :func:`decompose`), run ``kernel(decomposition, problem, impulses, velocities)`` on the
+    renumbered records (:meth:`Decomposition.gather`; it returns sweeps and the two norms) and
+    write the solved impulses and velocities back into ``state`` = (pn, pt, vx, vy, w), in
+    place.
 
     ``decomposition``: the :func:`decompose` of a problem with the same points, bodies and
     masses (another right-hand side or friction, as the overlap recovery's), made from the
@@ -426,7 +432,7 @@ def solve_decomposed(problem, x, domains, state, kernel, decomposition=None) -> 
         raise ValueError(f"the decomposition is of {dec.point_order.size} points on {dec.ptr.size - 1} domains, the "
                          f"problem has {problem.a.size} points on {int(domains)} domains: expected the same")
     out = scratch.buffer("renumbered", dec.gathered_size)
-    geometry, masses, renumbered = dec.gather(problem, *state, out=out)
-    iterations, residual, worst = kernel(dec, geometry, renumbered, masses)
-    dec.scatter(renumbered, *state)
+    renumbered, impulses, velocities = dec.gather(problem, *state, out=out)
+    iterations, residual, worst = kernel(dec, renumbered, impulses, velocities)
+    dec.scatter(impulses, velocities, *state)
     return NLGSResult(int(iterations), float(residual), float(worst))

@@ -24,11 +24,18 @@ from numba import njit
 
 
 @njit(cache=True)
-def assemble(point, normal, gap, body_i, body_j, centre, v_start, omega_start, n_particles, time_step, theta,
-             friction, wall_friction):
+def assemble(points, start, law):
     """Lever arms ra, rb (P, 2) m, normal components nx, ny (P,), Signorini shifts bias (P,)
-    m s-1 and friction coefficients mu (P,) of every point (module docstring). ``centre``
-    and ``v_start`` (bodies, 2), ``omega_start`` (bodies,): particles then walls."""
+    m s-1 and friction coefficients mu (P,) of every point (module docstring), returned with the
+    points' bodies a, b (int64) as (a, b, ra, rb, nx, ny, bias, mu).
+
+    ``points``: the detected points (:class:`solver.narrowphase.ContactPoints`: ``point``,
+    ``normal``, ``gap``, ``body_i``, ``body_j`` are read); ``start``: the bodies at the start of
+    the step (:class:`solver.solve_records.StepStart`, particles then walls); ``law``: time
+    step, theta and friction (:class:`solver.solve_records.StepLaw`)."""
+    point, normal, gap, body_i, body_j = points.point, points.normal, points.gap, points.body_i, points.body_j
+    centre, v_start, omega_start, n_particles = start
+    time_step, theta, friction, wall_friction = law
     m = gap.size
     a = body_i.astype(np.int64)
     b = body_j.astype(np.int64)
@@ -60,10 +67,11 @@ def assemble(point, normal, gap, body_i, body_j, centre, v_start, omega_start, n
     return a, b, ra, rb, nx, ny, bias, mu
 
 
-def assemble_reference(point, normal, gap, body_i, body_j, centre, v_start, omega_start, n_particles, time_step,
-                       theta, friction, wall_friction):
+def assemble_reference(points, start, law):
     """:func:`assemble` with whole-array numpy operations: the slow, plain reference."""
-    h = time_step
+    point, normal, gap, body_i, body_j = points.point, points.normal, points.gap, points.body_i, points.body_j
+    centre, v_start, omega_start, n_particles = start
+    h, theta, friction, wall_friction = law
     a, b = body_i.astype(np.int64), body_j.astype(np.int64)
     ra = point - centre[a]
     rb = point - centre[b]
@@ -79,13 +87,17 @@ def assemble_reference(point, normal, gap, body_i, body_j, centre, v_start, omeg
 
 
 @njit(cache=True)
-def end_gaps(gap, normal, a, b, ra, rb, velocity, omega, time_step):
+def end_gaps(points, problem, velocity, omega, time_step):
     """The gaps (P,) m at the end of the step, to first order: g_k + h u_k . n_k, with u_k the
     relative velocity (b minus a, m s-1) at the point from the bodies' step velocities
-    ``velocity`` (bodies, 2) and ``omega`` (bodies,), lever arms ``ra``, ``rb`` (P, 2) and h
-    the ``time_step``; what the overlap recovery removes where it is negative. Computed as
-    ``(g + h (v_b - v_a) . n) + h (w_b (r_b x n) - w_a (r_a x n))`` with r x n = r_x n_y -
-    r_y n_x, the floating-point order of the stepper's numpy expression it replaces."""
+    ``velocity`` (bodies, 2) and ``omega`` (bodies,), h the ``time_step``, the gaps g_k and
+    normals of the detected ``points`` (:class:`solver.narrowphase.ContactPoints`) and the bodies
+    and lever arms of their :class:`solver.solve_records.ContactProblem`; what the overlap
+    recovery removes where it is negative. Computed as ``(g + h (v_b - v_a) . n) + h (w_b (r_b x
+    n) - w_a (r_a x n))`` with r x n = r_x n_y - r_y n_x, the floating-point order of the
+    stepper's numpy expression it replaces."""
+    gap, normal = points.gap, points.normal
+    a, b = problem.a, problem.b
     m = gap.size
     out = np.empty(m)
     for k in range(m):
@@ -93,7 +105,7 @@ def end_gaps(gap, normal, a, b, ra, rb, velocity, omega, time_step):
         n_x, n_y = normal[k, 0], normal[k, 1]
         translation = gap[k] + time_step * ((velocity[j, 0] - velocity[i, 0]) * n_x
                                             + (velocity[j, 1] - velocity[i, 1]) * n_y)
-        cross_b = rb[k, 0] * n_y - rb[k, 1] * n_x
-        cross_a = ra[k, 0] * n_y - ra[k, 1] * n_x
+        cross_b = problem.rbx[k] * n_y - problem.rby[k] * n_x
+        cross_a = problem.rax[k] * n_y - problem.ray[k] * n_x
         out[k] = translation + time_step * (omega[j] * cross_b - omega[i] * cross_a)
     return out

@@ -34,6 +34,7 @@ import numpy as np
 
 from .contact_solution import ContactSolution, contact_solution
 from .projected_cg_kernels import iteration, start
+from .solve_records import MatrixProblem
 
 __all__ = ["STALL_ITERATIONS", "solve"]
 
@@ -50,17 +51,17 @@ def solve(W, q, mu, tolerance, max_iterations, initial) -> ContactSolution:
     diagonal = W.diagonal()
     jacobi = np.stack([1.0 / diagonal[0::2], 1.0 / np.where(diagonal[1::2] > 0, diagonal[1::2], diagonal[0::2])],
                       -1).reshape(-1)
-    indptr, indices, data = W.indptr.astype(np.int64), W.indices.astype(np.int64), W.data
     q = np.ascontiguousarray(q, dtype=np.float64)
+    matrix = MatrixProblem(W.indptr.astype(np.int64), W.indices.astype(np.int64), W.data, q, mu)
     r = np.array(initial, dtype=np.float64).reshape(-1)
     status = np.empty(n, np.int64)
     g, p, Wp = np.empty(2 * n), np.empty(2 * n), np.empty(2 * n)
-    violation, size = start(indptr, indices, data, q, mu, jacobi, r, status, g, p)
+    violation, size = start(matrix, jacobi, r, status, g, p)
     law = _law(violation, size)
     best, checked = law, law
     iterations = 0
     while law > tolerance and iterations < max_iterations:
-        violation, size, moved = iteration(indptr, indices, data, q, mu, jacobi, r, status, g, p, Wp)
+        violation, size, moved = iteration(matrix, jacobi, r, status, g, p, Wp)
         if not moved:
             break  # no direction with curvature left: a fixed point of the projections
         iterations += 1

@@ -16,8 +16,9 @@ OPEN, STICK, SLIDE_POSITIVE, SLIDE_NEGATIVE = 0, 1, 2, 3
 
 
 @njit(cache=True)
-def multiply(indptr, indices, data, x, out):
-    """out = W x for W in CSR form (``indptr, indices, data``)."""
+def multiply(matrix, x, out):
+    """out = W x for the CSR matrix W of ``matrix`` (:class:`solver.solve_records.MatrixProblem`)."""
+    indptr, indices, data = matrix.indptr, matrix.indices, matrix.data
     for i in range(out.size):
         total = 0.0
         for e in range(indptr[i], indptr[i + 1]):
@@ -57,13 +58,16 @@ def face(xn, xt, status):
 
 
 @njit(cache=True)
-def start(indptr, indices, data, q, mu, jacobi, r, status, g, p):
+def start(matrix, jacobi, r, status, g, p):
     """Project ``r`` onto the cones (statuses into ``status``), g = -(W r + q) and the first
-    direction p = P(D g); returns (|F|^2, |r|^2) of the natural map at r."""
+    direction p = P(D g), for the problem u = W r + q of ``matrix``
+    (:class:`solver.solve_records.MatrixProblem`) and the Jacobi scaling ``jacobi`` (2n,);
+    returns (|F|^2, |r|^2) of the natural map at r."""
+    q, mu = matrix.q, matrix.mu
     n = mu.size
     for k in range(n):
         r[2 * k], r[2 * k + 1], status[k] = project(r[2 * k], r[2 * k + 1], mu[k], STICK, 1.0)
-    multiply(indptr, indices, data, r, g)
+    multiply(matrix, r, g)
     violation = 0.0
     size = 0.0
     for k in range(n):
@@ -77,14 +81,16 @@ def start(indptr, indices, data, q, mu, jacobi, r, status, g, p):
 
 
 @njit(cache=True)
-def iteration(indptr, indices, data, q, mu, jacobi, r, status, g, p, Wp):
+def iteration(matrix, jacobi, r, status, g, p, Wp):
     """One iteration of :mod:`solver.projected_cg` in place on r, status, g = -(W r + q) and the
-    direction p (``Wp`` working memory): the step along p, the projection onto the cones, the new
-    gradient and natural map, then p = w + beta z (p = w when that is no descent direction).
-    Returns (|F|^2, |r|^2, moved), moved False when p has no curvature (p.W p <= 0) and nothing
-    was changed."""
+    direction p (``Wp`` working memory), for the problem of ``matrix``
+    (:class:`solver.solve_records.MatrixProblem`) with the Jacobi scaling ``jacobi``: the step
+    along p, the projection onto the cones, the new gradient and natural map, then p = w + beta z
+    (p = w when that is no descent direction). Returns (|F|^2, |r|^2, moved), moved False when p
+    has no curvature (p.W p <= 0) and nothing was changed."""
+    q, mu = matrix.q, matrix.mu
     n = mu.size
-    multiply(indptr, indices, data, p, Wp)
+    multiply(matrix, p, Wp)
     pWp = 0.0
     gp = 0.0
     for i in range(2 * n):
@@ -96,7 +102,7 @@ def iteration(indptr, indices, data, q, mu, jacobi, r, status, g, p, Wp):
     for k in range(n):
         r[2 * k], r[2 * k + 1], status[k] = project(r[2 * k] + alpha * p[2 * k], r[2 * k + 1] + alpha * p[2 * k + 1],
                                                     mu[k], status[k], p[2 * k + 1])
-    multiply(indptr, indices, data, r, g)
+    multiply(matrix, r, g)
     violation = 0.0
     size = 0.0
     wWp = 0.0

@@ -35,6 +35,7 @@ import numpy as np
 from numba import njit
 
 from .nlgs import _relative_velocity, delassus_block
+from .solve_records import Impulses, Velocities
 
 __all__ = ["cone_projection", "natural_map", "natural_maps", "local_law_residuals", "particle_imbalance",
            "local_law_residual", "unbalanced_ratios"]
@@ -73,28 +74,34 @@ def natural_maps(pn, pt, un, ut, mu, rho):
 
 
 @njit(cache=True, inline="always")
-def _point_natural_map(k, a, b, nx, ny, rax, ray, rbx, rby, bias, mu, pn, pt, vx, vy, w, wnn_k):
+def _point_natural_map(k, problem, impulses, velocities, wnn_k):
     """:func:`natural_map` of point k, its velocity from the bodies' (Signorini shift added)
     and rho = 1 / W_nn."""
-    un, ut = _relative_velocity(k, a, b, nx, ny, rax, ray, rbx, rby, vx, vy, w)
-    return natural_map(pn[k], pt[k], un + bias[k], ut, mu[k], 1.0 / wnn_k)
+    un, ut = _relative_velocity(k, problem, velocities)
+    return natural_map(impulses.pn[k], impulses.pt[k], un + problem.bias[k], ut, problem.mu[k], 1.0 / wnn_k)
 
 
 @njit(cache=True)
-def local_law_residuals(a, b, nx, ny, rax, ray, rbx, rby, bias, mu, pn, pt, vx, vy, w, wnn):
+def local_law_residuals(problem, impulses, velocities, wnn):
     """Natural-map residual (F_n, F_t) (N s) of every point (module docstring), from the
-    impulses ``pn, pt`` and the end-of-step body velocities ``vx, vy, w`` of the contact problem."""
-    m = a.size
+    :class:`solver.solve_records.Impulses` and the end-of-step
+    :class:`solver.solve_records.Velocities` of the :class:`solver.solve_records.ContactProblem`,
+    ``wnn`` (P,) the points' W_nn (s kg-1)."""
+    m = problem.a.size
     fn = np.empty(m)
     ft = np.empty(m)
     for k in range(m):
-        fn[k], ft[k] = _point_natural_map(k, a, b, nx, ny, rax, ray, rbx, rby, bias, mu, pn, pt, vx, vy, w, wnn[k])
+        fn[k], ft[k] = _point_natural_map(k, problem, impulses, velocities, wnn[k])
     return fn, ft
 
 
 @njit(cache=True)
-def particle_imbalance(a, b, nx, ny, rax, ray, rbx, rby, pn, pt, n_particles):
-    """Sum of the contact impulses (x, y; N s) and of their moments (N m s) on each particle."""
+def particle_imbalance(problem, impulses, n_particles):
+    """Sum of the contact impulses (x, y; N s) and of their moments (N m s) on each of the
+    first ``n_particles`` bodies, from the :class:`solver.solve_records.Impulses` of
+    ``problem``'s points."""
+    a, b, nx, ny = problem.a, problem.b, problem.nx, problem.ny
+    pn, pt = impulses
     fx = np.zeros(n_particles)
     fy = np.zeros(n_particles)
     torque = np.zeros(n_particles)
@@ -104,23 +111,24 @@ def particle_imbalance(a, b, nx, ny, rax, ray, rbx, rby, pn, pt, n_particles):
         if b[k] < n_particles:
             fx[b[k]] += px
             fy[b[k]] += py
-            torque[b[k]] += rbx[k] * py - rby[k] * px
+            torque[b[k]] += problem.rbx[k] * py - problem.rby[k] * px
         if a[k] < n_particles:
             fx[a[k]] -= px
             fy[a[k]] -= py
-            torque[a[k]] -= rax[k] * py - ray[k] * px
+            torque[a[k]] -= problem.rax[k] * py - problem.ray[k] * px
     return fx, fy, torque
 
 
 @njit(cache=True)
-def _law_sums(a, b, nx, ny, rax, ray, rbx, rby, bias, mu, pn, pt, vx, vy, w, minv_xx, minv_xy, minv_yy, iinv):
+def _law_sums(problem, impulses, velocities):
     """(sum of |F_k|^2, sum of |r_k|^2) over the points: :func:`local_law_residuals` and the
     impulses' squared norm in one pass, each point's W_nn from :func:`solver.nlgs.delassus_block`."""
+    pn, pt = impulses
     violation = 0.0
     scale = 0.0
-    for k in range(a.size):
-        wnn = delassus_block(k, a, b, nx, ny, rax, ray, rbx, rby, minv_xx, minv_xy, minv_yy, iinv)[0]
-        fn, ft = _point_natural_map(k, a, b, nx, ny, rax, ray, rbx, rby, bias, mu, pn, pt, vx, vy, w, wnn)
+    for k in range(problem.a.size):
+        wnn = delassus_block(k, problem)[0]
+        fn, ft = _point_natural_map(k, problem, impulses, velocities, wnn)
         violation += fn * fn + ft * ft
         scale += pn[k] * pn[k] + pt[k] * pt[k]
     return violation, scale
@@ -131,20 +139,19 @@ def local_law_residual(problem, pn, pt, vx, vy, w) -> float:
     :class:`solver.nlgs.ContactProblem` and its impulses and end velocities; 0 for no points."""
     if problem.a.size == 0:
         return 0.0
-    violation, scale = _law_sums(problem.a, problem.b, problem.nx, problem.ny, problem.rax, problem.ray, problem.rbx,
-                                 problem.rby, problem.bias, problem.mu, pn, pt, vx, vy, w, problem.minv_xx,
-                                 problem.minv_xy, problem.minv_yy, problem.iinv)
+    violation, scale = _law_sums(problem, Impulses(pn, pt), Velocities(vx, vy, w))
     if scale > 0.0:
         return float(np.sqrt(violation) / np.sqrt(scale))
     return 0.0 if violation == 0.0 else float("inf")
 
 
 @njit(cache=True)
-def _unbalanced(a, b, nx, ny, rax, ray, rbx, rby, pn, pt, external_impulse, radius):
+def _unbalanced(problem, impulses, external_impulse, radius):
     """(largest |sum of impulses|, largest |sum of moments| / R, mean |r| of the loaded
     points, loaded points) of :func:`unbalanced_ratios`, in one pass over the points and one
     over the particles."""
-    fx, fy, torque = particle_imbalance(a, b, nx, ny, rax, ray, rbx, rby, pn, pt, radius.size)
+    pn, pt = impulses
+    fx, fy, torque = particle_imbalance(problem, impulses, radius.size)
     total = 0.0
     loaded = 0
     for k in range(pn.size):
@@ -172,9 +179,8 @@ def unbalanced_ratios(problem, pn, pt, external_impulse, radius) -> tuple[float,
     if external_impulse.shape != (len(radius), 2):
         raise ValueError(f"external_impulse has shape {external_impulse.shape}: expected ({len(radius)}, 2), one row "
                          "per particle")
-    force, moment, mean, loaded = _unbalanced(problem.a, problem.b, problem.nx, problem.ny, problem.rax, problem.ray,
-                                              problem.rbx, problem.rby, np.asarray(pn, float), np.asarray(pt, float),
-                                              external_impulse, np.asarray(radius, float))
+    impulses = Impulses(np.asarray(pn, float), np.asarray(pt, float))
+    force, moment, mean, loaded = _unbalanced(problem, impulses, external_impulse, np.asarray(radius, float))
     if loaded == 0:
         return 0.0, 0.0
     return float(force / mean), float(moment / mean)

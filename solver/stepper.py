@@ -40,6 +40,7 @@ from .contact_points import PairIndex, force_vectors, point_keys
 from .parameters import ACCELERATIONS, MAX_FRICTION, Parameters, check_time_step  # noqa: F401 (their home)
 from .sample_history import SampleHistory
 from .shapes import Shapes
+from .solve_records import StepLaw, StepStart
 from .walls import FIXED, STRESS, VELOCITY, Walls
 
 
@@ -367,8 +368,8 @@ class Simulation:
         p = self.parameters
         centre = np.concatenate([self.position, self.walls.point])
         a, b, ra, rb, nx, ny, bias, mu = problem_assembly.assemble(
-            pts.point, pts.normal, pts.gap, pts.body_i, pts.body_j, centre, v_start, omega_start, self.n_particles,
-            float(p.time_step), float(p.theta), float(p.friction), float(p.wall_friction))
+            pts, StepStart(centre, v_start, omega_start, self.n_particles),
+            StepLaw(float(p.time_step), float(p.theta), float(p.friction), float(p.wall_friction)))
         minv, iinv = self._mobility()
         problem = nlgs.ContactProblem(
             a, b, nx, ny, ra[:, 0].copy(), ra[:, 1].copy(), rb[:, 0].copy(), rb[:, 1].copy(), bias, mu,
@@ -421,7 +422,7 @@ class Simulation:
         step_om = (1 - theta) * omega_start + theta * om
         if p.overlap_recovery_speed > 0 and len(a):
             # the end-of-step gaps (first order) tell which overlaps remain
-            g_end = problem_assembly.end_gaps(pts.gap, pts.normal, a, b, ra, rb, step_v, step_om, h)
+            g_end = problem_assembly.end_gaps(pts, problem, step_v, step_om, h)
             if g_end.min() < -p.overlap_recovery_threshold * 2 * float(self.radius.min()):
                 pseudo_v, pseudo_om = self._recover_overlaps(problem, g_end, decomposition)
                 pseudo_v[n + np.flatnonzero(self.walls.mode != STRESS)] = 0.0

@@ -14,6 +14,7 @@ import numpy as np
 import pytest
 
 from solver import acceleration, nlgs, parallel_nlgs, residuals
+from solver.solve_records import Impulses, Limits, Velocities
 
 from .conftest import compacted_problem
 
@@ -30,24 +31,25 @@ def _copy(state):
     return [s.copy() for s in state]
 
 
-def reference_anderson(geometry, masses, state, sweep, iterations, memory, period=1, resets=None):
+def reference_anderson(prob, state, sweep, iterations, memory, period=1, resets=None):
     """Anderson type II on the fixed-point map '``period`` sweeps', with whole vectors: gamma
     from numpy's least squares on the last ``memory`` differences, the extrapolation projected
     on the Coulomb cones, the velocities rebuilt from the free ones; the history is forgotten
     when |f| grows; the last sweep is not extrapolated (its iterate is the one its norms
     describe). Returns the impulses after ``iterations`` sweeps; ``resets``, a list, receives
     the index of each map after which a history was forgotten because |f| grew."""
-    a, b, nx, ny, rax, ray, rbx, rby, bias, mu = geometry
+    mu = prob.mu
     pn, pt, vx, vy, w = state
+    impulses, velocities = Impulses(pn, pt), Velocities(vx, vy, w)
     free = (vx.copy(), vy.copy(), w.copy())
-    wnn, wnt, wtt = nlgs.delassus(a, b, nx, ny, rax, ray, rbx, rby, *masses)
-    nlgs.velocities_from_impulses(a, b, nx, ny, rax, ray, rbx, rby, pn, pt, vx, vy, w, *masses)
+    blocks = nlgs.delassus(prob)
+    nlgs.velocities_from_impulses(prob, impulses, velocities)
     fs, gs, last = [], [], np.inf
     maps = iterations // period
     for k in range(maps):
         x = np.concatenate([pn, pt])
         for _ in range(period):
-            sweep(pn, pt, vx, vy, w, wnn, wnt, wtt)
+            sweep(impulses, velocities, blocks)
         if k == maps - 1:
             break
         g = np.concatenate([pn, pt])
@@ -67,16 +69,8 @@ def reference_anderson(geometry, masses, state, sweep, iterations, memory, perio
         projected = np.array([residuals.cone_projection(e[k], e[m + k], mu[k]) for k in range(m)])
         pn[:], pt[:] = projected[:, 0], projected[:, 1]
         vx[:], vy[:], w[:] = free[0], free[1], free[2]
-        nlgs.velocities_from_impulses(a, b, nx, ny, rax, ray, rbx, rby, pn, pt, vx, vy, w, *masses)
+        nlgs.velocities_from_impulses(prob, impulses, velocities)
     return pn, pt
-
-
-def _geometry(prob):
-    return (prob.a, prob.b, prob.nx, prob.ny, prob.rax, prob.ray, prob.rbx, prob.rby, prob.bias, prob.mu)
-
-
-def _masses(prob):
-    return (prob.minv_xx, prob.minv_xy, prob.minv_yy, prob.iinv)
 
 
 ITERATIONS = 18
@@ -85,13 +79,12 @@ ITERATIONS = 18
 @pytest.mark.parametrize("period", [1, 2, 3])
 def test_serial_kernel_equals_the_numpy_reference(problem, period):
     _, prob, state = problem
-    geometry, masses = _geometry(prob), _masses(prob)
     order = np.arange(prob.a.size)
 
-    def sweep(pn, pt, vx, vy, w, wnn, wnt, wtt):
-        nlgs.sweep(order, *geometry, pn, pt, vx, vy, w, *masses, wnn, wnt, wtt)
+    def sweep(impulses, velocities, blocks):
+        nlgs.sweep(order, prob, impulses, velocities, blocks)
 
-    expected = reference_anderson(geometry, masses, _copy(state), sweep, ITERATIONS, memory=4, period=period)
+    expected = reference_anderson(prob, _copy(state), sweep, ITERATIONS, memory=4, period=period)
     got = _copy(state)
     result = acceleration.solve_problem_anderson(prob, *got, tolerance=0.0, max_tolerance=0.0,
                                                  max_iterations=ITERATIONS, memory=4, period=period)
@@ -101,7 +94,7 @@ def test_serial_kernel_equals_the_numpy_reference(problem, period):
     np.testing.assert_allclose(got[1], expected[1], rtol=0, atol=1e-9 * scale)
     # the incremental velocity updates stay v = v_free + M^-1 H p
     rebuilt = _copy(state)[2:]
-    nlgs.velocities_from_impulses(*geometry[:8], got[0], got[1], *rebuilt, *masses)
+    nlgs.velocities_from_impulses(prob, Impulses(got[0], got[1]), Velocities(*rebuilt))
     for v, r in zip(got[2:], rebuilt):
         np.testing.assert_allclose(v, r, rtol=0, atol=1e-12 * np.abs(r).max())
 
@@ -112,14 +105,13 @@ def test_serial_kernel_equals_the_reference_through_the_safeguard(problem, perio
     be forgotten and plain sweeps kept, in the kernel as in the reference (without the
     safeguard the kernel's iterates leave the reference's)."""
     _, prob, state = problem
-    geometry, masses = _geometry(prob), _masses(prob)
     order = np.arange(prob.a.size)
 
-    def sweep(pn, pt, vx, vy, w, wnn, wnt, wtt):
-        nlgs.sweep(order, *geometry, pn, pt, vx, vy, w, *masses, wnn, wnt, wtt)
+    def sweep(impulses, velocities, blocks):
+        nlgs.sweep(order, prob, impulses, velocities, blocks)
 
     resets = []
-    expected = reference_anderson(geometry, masses, _copy(state), sweep, 40, memory=4, period=period, resets=resets)
+    expected = reference_anderson(prob, _copy(state), sweep, 40, memory=4, period=period, resets=resets)
     assert len(resets) >= 1  # the case this test is for
     got = _copy(state)
     acceleration.solve_problem_anderson(prob, *got, tolerance=0.0, max_tolerance=0.0, max_iterations=40, memory=4,
@@ -133,14 +125,13 @@ def test_serial_kernel_equals_the_reference_through_the_safeguard(problem, perio
 def test_domain_kernel_equals_the_numpy_reference_over_the_domain_sweep(problem, period):
     sim, prob, state = problem
     dec = parallel_nlgs.decompose(prob, sim.position[:, 0], 3)
-    geometry, masses, new_state = dec.gather(prob, *_copy(state))
+    renumbered, new_impulses, new_velocities = dec.gather(prob, *_copy(state))
 
-    def sweep(pn, pt, vx, vy, w, wnn, wnt, wtt):
-        parallel_nlgs.sweep_domains(dec.ptr, dec.points, dec.interface, *geometry, pn, pt, vx, vy, w, *masses,
-                                    wnn, wnt, wtt)
+    def sweep(impulses, velocities, blocks):
+        parallel_nlgs.sweep_domains(dec.ptr, dec.points, dec.interface, renumbered, impulses, velocities, blocks)
 
-    expected = reference_anderson(geometry, masses, [s.copy() for s in new_state], sweep, ITERATIONS, memory=4,
-                                  period=period)
+    expected = reference_anderson(renumbered, [s.copy() for s in (*new_impulses, *new_velocities)], sweep,
+                                  ITERATIONS, memory=4, period=period)
     got = _copy(state)
     acceleration.solve_problem_anderson(prob, *got, tolerance=0.0, max_tolerance=0.0, max_iterations=ITERATIONS,
                                         memory=4, domains=3, x=sim.position[:, 0], period=period)
@@ -237,5 +228,6 @@ def test_a_short_work_array_is_refused(problem):
     m, n = prob.a.size, prob.minv_xx.size
     work = np.empty(acceleration.scratch_size(m, n, 3) - 1)
     with pytest.raises(ValueError, match="work array"):
-        acceleration.solve_anderson(np.array([0, m]), *_geometry(prob), *_copy(state), *_masses(prob), 1e-4, 1e-2, 5,
-                                    3, 2, 0, work)
+        pn, pt, vx, vy, w = _copy(state)
+        acceleration.solve_anderson(np.array([0, m]), prob, Impulses(pn, pt), Velocities(vx, vy, w),
+                                    Limits(1e-4, 1e-2, 5, 0), 3, 2, work)

@@ -8,6 +8,7 @@ from scipy import sparse
 
 from grainview.contract.errors import ParameterError
 from solver import nlgs
+from solver.solve_records import Velocities
 from solver.contact_problem import solve_contact_problem
 
 
@@ -81,12 +82,10 @@ def test_same_solution_as_the_time_steppers_nlgs_on_a_random_system():
                                   minv, iinv)
 
     def local_velocity(pn, pt):
-        vx, vy, w = v0[:, 0].copy(), v0[:, 1].copy(), v0[:, 2].copy()
+        velocities = Velocities(v0[:, 0].copy(), v0[:, 1].copy(), v0[:, 2].copy())
         for k in range(points):
-            nlgs._apply(k, pn[k], pt[k], a, b, nx, ny, rax, ray, rbx, rby, vx, vy, w, minv, np.zeros(bodies),
-                        minv, iinv)
-        return np.array([nlgs._relative_velocity(k, a, b, nx, ny, rax, ray, rbx, rby, vx, vy, w)
-                         for k in range(points)]).reshape(-1)
+            nlgs._apply(k, pn[k], pt[k], problem, velocities)
+        return np.array([nlgs._relative_velocity(k, problem, velocities) for k in range(points)]).reshape(-1)
 
     q = local_velocity(np.zeros(points), np.zeros(points))
     W = np.column_stack([local_velocity(*np.eye(2 * points)[c].reshape(points, 2).T) - q for c in range(2 * points)])

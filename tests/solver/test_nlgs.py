@@ -8,6 +8,7 @@ import numpy as np
 import pytest
 
 from solver import nlgs
+from solver.solve_records import Impulses, Limits, Velocities
 
 
 def _check_local(wnn, wnt, wtt, ufn, uft, bias, mu, pn, pt):
@@ -124,15 +125,16 @@ def test_warm_start_at_the_solution_converges_in_one_sweep():
     v_free = rng.normal(scale=0.1, size=(4, 3))
     v_free[3] = 0.0
     bias = np.zeros(4)
-    args = (a, b, nx, ny, ra[:, 0].copy(), ra[:, 1].copy(), rb[:, 0].copy(), rb[:, 1].copy(), bias, np.zeros(4))
+    problem = nlgs.ContactProblem(a, b, nx, ny, ra[:, 0].copy(), ra[:, 1].copy(), rb[:, 0].copy(), rb[:, 1].copy(),
+                                  bias, np.zeros(4), inv_mass, np.zeros(4), inv_mass.copy(), inv_inertia)
     pn, pt = np.zeros(4), np.zeros(4)
-    v = [v_free[:, k].copy() for k in range(3)]
-    nlgs.solve(*args, pn, pt, *v, inv_mass, np.zeros(4), inv_mass.copy(), inv_inertia, 1e-14, 1e-14, 100_000, False, 0)
+    v = Velocities(*(v_free[:, k].copy() for k in range(3)))
+    nlgs.solve(problem, Impulses(pn, pt), v, Limits(1e-14, 1e-14, 100_000, 0), False, 0)
     assert pn.max() > 0
     # restart from the free velocities with the solution as warm start
-    v = [v_free[:, k].copy() for k in range(3)]
-    it, quad, worst = nlgs.solve(*args, pn.copy(), pt.copy(), *v, inv_mass, np.zeros(4), inv_mass.copy(),
-                                 inv_inertia, 1e-10, 1e-10, 100_000, False, 0)
+    v = Velocities(*(v_free[:, k].copy() for k in range(3)))
+    it, quad, worst = nlgs.solve(problem, Impulses(pn.copy(), pt.copy()), v, Limits(1e-10, 1e-10, 100_000, 0), False,
+                                 0)
     assert it == 1 and quad < 1e-10 and worst < 1e-10
 
 
@@ -144,10 +146,10 @@ def test_iteration_limit_reports_the_residual_reached():
     nx[:] = 0.0
     ny[:] = 1.0
     pn, pt = np.zeros(4), np.zeros(4)
-    v = [v_free[:, k].copy() for k in range(3)]
-    it, quad, worst = nlgs.solve(a, b, nx, ny, ra[:, 0].copy(), ra[:, 1].copy(), rb[:, 0].copy(), rb[:, 1].copy(),
-                                 np.zeros(4), np.zeros(4), pn, pt, *v, inv_mass, np.zeros(4), inv_mass.copy(),
-                                 inv_inertia, 1e-14, 1e-14, 1, False, 0)
+    v = Velocities(*(v_free[:, k].copy() for k in range(3)))
+    problem = nlgs.ContactProblem(a, b, nx, ny, ra[:, 0].copy(), ra[:, 1].copy(), rb[:, 0].copy(), rb[:, 1].copy(),
+                                  np.zeros(4), np.zeros(4), inv_mass, np.zeros(4), inv_mass.copy(), inv_inertia)
+    it, quad, worst = nlgs.solve(problem, Impulses(pn, pt), v, Limits(1e-14, 1e-14, 1, 0), False, 0)
     assert it == 1 and quad > 1e-14  # stopped by the limit, residual reported
 
 
@@ -160,17 +162,18 @@ def test_a_sweep_returns_the_scale_of_its_end_impulses(seed):
     a, b, nx, ny, ra, rb, inv_mass, inv_inertia, H, minv, W = _random_frictionless_system(rng)
     v_free = rng.normal(scale=0.1, size=(4, 3))
     v_free[3] = 0.0
-    geometry = (a, b, nx, ny, ra[:, 0].copy(), ra[:, 1].copy(), rb[:, 0].copy(), rb[:, 1].copy())
-    masses = (inv_mass, np.zeros(4), inv_mass.copy(), inv_inertia)
-    wnn, wnt, wtt = nlgs.delassus(*geometry, *masses)
+    problem = nlgs.ContactProblem(a, b, nx, ny, ra[:, 0].copy(), ra[:, 1].copy(), rb[:, 0].copy(), rb[:, 1].copy(),
+                                  np.zeros(4), np.full(4, 0.3), inv_mass, np.zeros(4), inv_mass.copy(), inv_inertia)
+    blocks = nlgs.delassus(problem)
+    wnn, wnt, wtt = blocks
     pn, pt = np.zeros(4), np.zeros(4)
-    vx, vy, w = (v_free[:, k].copy() for k in range(3))
+    velocities = Velocities(*(v_free[:, k].copy() for k in range(3)))
     for _ in range(3):
-        total, top, scale, active = nlgs.sweep(np.arange(4)[::-1].copy(), *geometry, np.zeros(4), np.full(4, 0.3),
-                                               pn, pt, vx, vy, w, *masses, wnn, wnt, wtt)
+        total, top, scale, active = nlgs.sweep(np.arange(4)[::-1].copy(), problem, Impulses(pn, pt), velocities,
+                                               blocks)
         loaded = pn > 0
         expected = np.sum((pn * (wnn * pn + wnt * pt) + pt * (wnt * pn + wtt * pt))[loaded])
         assert active == loaded.sum() and scale == pytest.approx(expected, rel=1e-14)
         assert nlgs.sweep_norms(total, top, scale, active) == pytest.approx(
-            nlgs.norms(total, top, pn, pt, wnn, wnt, wtt), rel=1e-14)
+            nlgs.norms(total, top, Impulses(pn, pt), blocks), rel=1e-14)
     assert active > 0

@@ -19,6 +19,7 @@ from solver import Parameters, compaction_sample, nlgs, parallel_nlgs
 
 from .conftest import compacted_problem
 from solver.parallel_nlgs import FREE, SHARED
+from solver.solve_records import DelassusBlocks, Impulses, Velocities
 
 
 @pytest.fixture(scope="module")
@@ -99,28 +100,26 @@ def test_each_domain_writes_its_own_contiguous_bodies_and_copies_of_the_still_wa
 def test_parallel_sweep_is_the_serial_sweep_in_domain_order(problem):
     sim, prob, impulse, v_free, omega_free = problem
     dec = parallel_nlgs.decompose(prob, sim.position[:, 0], 2)
-    wnn, wnt, wtt = nlgs.delassus(prob.a, prob.b, prob.nx, prob.ny, prob.rax, prob.ray, prob.rbx, prob.rby,
-                                  prob.minv_xx, prob.minv_xy, prob.minv_yy, prob.iinv)
-    geometry = (prob.a, prob.b, prob.nx, prob.ny, prob.rax, prob.ray, prob.rbx, prob.rby, prob.bias, prob.mu)
-    masses = (prob.minv_xx, prob.minv_xy, prob.minv_yy, prob.iinv)
+    blocks = nlgs.delassus(prob)
     pn, pt, vx, vy, w = _state(impulse, v_free, omega_free)
-    new_geometry, new_masses, parallel = dec.gather(prob, pn, pt, vx, vy, w)
-    nlgs.velocities_from_impulses(*new_geometry[:8], *parallel, *new_masses)
+    renumbered, *parallel = dec.gather(prob, pn, pt, vx, vy, w)
+    nlgs.velocities_from_impulses(renumbered, *parallel)
     serial = _state(impulse, v_free, omega_free)  # the same start, laid out as the problem is
-    dec.scatter(parallel, *serial)
+    dec.scatter(*parallel, *serial)
+    serial_impulses, serial_velocities = Impulses(*serial[:2]), Velocities(*serial[2:])
     order = dec.point_order
     for _ in range(25):
-        a = nlgs.sweep(order, *geometry, *serial, *masses, wnn, wnt, wtt)
-        b = parallel_nlgs.sweep_domains(dec.ptr, dec.points, dec.interface, *new_geometry, *parallel, *new_masses,
-                                        wnn[order], wnt[order], wtt[order])
+        a = nlgs.sweep(order, prob, serial_impulses, serial_velocities, blocks)
+        b = parallel_nlgs.sweep_domains(dec.ptr, dec.points, dec.interface, renumbered, *parallel,
+                                        DelassusBlocks(*(x[order] for x in blocks)))
         # the same updates; the sums differ only by the order of their terms
         assert b[0] == pytest.approx(a[0], rel=1e-12) and b[1] == a[1]
         assert b[2] == pytest.approx(a[2], rel=1e-12) and b[3] == a[3]
-    dec.scatter(parallel, pn, pt, vx, vy, w)
+    dec.scatter(*parallel, pn, pt, vx, vy, w)
     for x, y in zip(serial, (pn, pt, vx, vy, w)):
         np.testing.assert_array_equal(x, y)
     still = np.setdiff1d(np.arange(len(dec.source)), dec.moving)  # copies of the walls keep their velocity
-    np.testing.assert_array_equal(parallel[2][still], serial[2][dec.source[still]])
+    np.testing.assert_array_equal(parallel[1].vx[still], serial[2][dec.source[still]])
     assert serial[0].max() > 0
 
 
@@ -186,19 +185,18 @@ def test_gather_and_scatter_are_numpy_indexing(problem):
     sim, prob, impulse, v_free, omega_free = problem
     dec = parallel_nlgs.decompose(prob, sim.position[:, 0], 3)
     state = _state(impulse, v_free, omega_free)
-    geometry, masses, renumbered = dec.gather(prob, *state)
+    renumbered_problem, *renumbered = dec.gather(prob, *state)
     k, j = dec.point_order, dec.source
-    for got, original in zip(geometry[2:], (prob.nx, prob.ny, prob.rax, prob.ray, prob.rbx, prob.rby, prob.bias,
-                                            prob.mu)):
-        np.testing.assert_array_equal(got, original[k])
-    for got, original in zip(masses, (prob.minv_xx, prob.minv_xy, prob.minv_yy, prob.iinv)):
-        np.testing.assert_array_equal(got, original[j])
+    assert renumbered_problem.a is dec.a and renumbered_problem.b is dec.b
+    for got, original in zip(renumbered_problem[2:], prob[2:]):
+        np.testing.assert_array_equal(got, original[k if original.size == prob.a.size else j])
+    renumbered = (*renumbered[0], *renumbered[1])
     for got, original, index in zip(renumbered, state, (k, k, j, j, j)):
         np.testing.assert_array_equal(got, original[index])
     rng = np.random.default_rng(0)
     solved = tuple(rng.normal(size=x.size) for x in renumbered)
     back = [x.copy() for x in state]
-    dec.scatter(solved, *back)
+    dec.scatter(Impulses(*solved[:2]), Velocities(*solved[2:]), *back)
     expected = [x.copy() for x in state]
     expected[0][k], expected[1][k] = solved[0], solved[1]
     for original, new in zip(expected[2:], solved[2:]):
@@ -214,21 +212,23 @@ def test_start_of_a_domain_solve_is_the_serial_start_bit_for_bit(problem, domain
     point with np.add.at (a different order of the sums: equal to round-off)."""
     sim, prob, impulse, v_free, omega_free = problem
     dec = parallel_nlgs.decompose(prob, sim.position[:, 0], domains)
-    geometry, masses, renumbered = dec.gather(prob, *_state(impulse, v_free, omega_free))
+    renumbered_problem, *state = dec.gather(prob, *_state(impulse, v_free, omega_free))
+    renumbered = (*state[0], *state[1])
     m = dec.a.size
     blocks = np.append(dec.ptr, m)
     threads = [x.copy() for x in renumbered]
-    w_threads = [np.empty(m) for _ in range(3)]
-    parallel_nlgs.start_domains(blocks, *geometry[:8], *threads, *masses, *w_threads)
+    w_threads = DelassusBlocks(np.empty(m), np.empty(m), np.empty(m))
+    parallel_nlgs.start_domains(blocks, renumbered_problem, Impulses(*threads[:2]), Velocities(*threads[2:]),
+                                w_threads)
     serial = [x.copy() for x in renumbered]
-    w_serial = [np.empty(m) for _ in range(3)]
-    nlgs.delassus_into(*geometry[:8], *masses, *w_serial)
-    nlgs.velocities_from_impulses(*geometry[:8], *serial, *masses)
-    for got, want in zip(w_threads + threads, w_serial + serial):
+    w_serial = DelassusBlocks(np.empty(m), np.empty(m), np.empty(m))
+    nlgs.delassus_into(renumbered_problem, w_serial)
+    nlgs.velocities_from_impulses(renumbered_problem, Impulses(*serial[:2]), Velocities(*serial[2:]))
+    for got, want in zip([*w_threads, *threads], [*w_serial, *serial]):
         np.testing.assert_array_equal(got, want)
     # the velocities by numpy: each point's impulse p_n n + p_t t applied at its lever arms
-    a, b, nx, ny, rax, ray, rbx, rby = geometry[:8]
-    minv_xx, minv_xy, minv_yy, iinv = masses
+    a, b, nx, ny, rax, ray, rbx, rby = renumbered_problem[:8]
+    minv_xx, minv_xy, minv_yy, iinv = renumbered_problem[10:]
     pn, pt, vx, vy, w = [x.copy() for x in renumbered]
     fx, fy = pn * nx - pt * ny, pn * ny + pt * nx
     for body, sign, rx, ry in ((a, -1.0, rax, ray), (b, 1.0, rbx, rby)):

@@ -10,6 +10,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from solver import nlgs, residuals
+from solver.solve_records import Impulses, Velocities
 
 finite = st.floats(-10, 10, allow_nan=False)
 
@@ -115,9 +116,8 @@ def test_step_reports_the_measures_and_momentum_balances():
     # the contact impulses and gravity are the particles' momentum change (Moreau-Jean balance)
     p = sim.parameters
     problem = sim._contact_problem(sim.points, sim.velocity, sim.angular_velocity)[0]  # same a, b, normals
-    fx, fy, _ = residuals.particle_imbalance(problem.a, problem.b, problem.nx, problem.ny, problem.rax,
-                                             problem.ray, problem.rbx, problem.rby, sim.impulse[:, 0],
-                                             sim.impulse[:, 1], sim.n_particles)
+    fx, fy, _ = residuals.particle_imbalance(problem, Impulses(sim.impulse[:, 0].copy(), sim.impulse[:, 1].copy()),
+                                             sim.n_particles)
     momentum = sim.mass[:, None] * (sim.velocity[:sim.n_particles] - v_before)
     expected = np.stack([fx, fy], -1) + p.time_step * sim.mass[:, None] * np.asarray(p.gravity)
     scale = np.abs(sim.impulse).max()
@@ -174,17 +174,15 @@ def test_one_pass_measures_are_the_plain_whole_array_ones():
     pn, pt = impulse[:, 0].copy(), impulse[:, 1].copy()
     vx, vy, w = v_free[:, 0].copy(), v_free[:, 1].copy(), omega_free.copy()
     nlgs.solve_problem(problem, pn, pt, vx, vy, w, tolerance=1e-2, max_tolerance=1.0, max_iterations=3)
-    P = problem
-    geometry = (P.a, P.b, P.nx, P.ny, P.rax, P.ray, P.rbx, P.rby)
-    wnn = nlgs.delassus(*geometry, P.minv_xx, P.minv_xy, P.minv_yy, P.iinv)[0]
-    fn, ft = residuals.local_law_residuals(*geometry, P.bias, P.mu, pn, pt, vx, vy, w, wnn)
+    wnn = nlgs.delassus(problem).nn
+    fn, ft = residuals.local_law_residuals(problem, Impulses(pn, pt), Velocities(vx, vy, w), wnn)
     expected = np.sqrt(np.sum(fn * fn + ft * ft)) / np.sqrt(np.sum(pn * pn + pt * pt))
     got = residuals.local_law_residual(problem, pn, pt, vx, vy, w)
     assert got == pytest.approx(expected, rel=1e-12) and got > 1e-4
     external = 1e-4 * sim.mass[:, None] * np.array([0.0, -9.81])
     loaded = pn > 0
     mean = np.mean(np.hypot(pn[loaded], pt[loaded]))
-    fx, fy, torque = residuals.particle_imbalance(*geometry, pn, pt, sim.n_particles)
+    fx, fy, torque = residuals.particle_imbalance(problem, Impulses(pn, pt), sim.n_particles)
     force = np.hypot(fx + external[:, 0], fy + external[:, 1]).max() / mean
     moment = np.max(np.abs(torque) / sim.radius) / mean
     assert residuals.unbalanced_ratios(problem, pn, pt, external, sim.radius) == pytest.approx((force, moment),

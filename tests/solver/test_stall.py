@@ -13,6 +13,7 @@ import pytest
 
 from grainview.contract.errors import ConvergenceWarning
 from solver import acceleration, nlgs, parallel_nlgs
+from solver.solve_records import Impulses, Velocities
 
 from .conftest import compacted_problem
 
@@ -48,14 +49,13 @@ def test_plain_sweeps_stop_where_the_rule_says(problem):
     _, prob, state = problem
     # the norms of plain sweeps, one by one
     pn, pt, vx, vy, w = _copy(state)
-    geometry = (prob.a, prob.b, prob.nx, prob.ny, prob.rax, prob.ray, prob.rbx, prob.rby)
-    masses = (prob.minv_xx, prob.minv_xy, prob.minv_yy, prob.iinv)
-    wnn, wnt, wtt = nlgs.delassus(*geometry, *masses)
-    nlgs.velocities_from_impulses(*geometry, pn, pt, vx, vy, w, *masses)
+    impulses, velocities = Impulses(pn, pt), Velocities(vx, vy, w)
+    blocks = nlgs.delassus(prob)
+    nlgs.velocities_from_impulses(prob, impulses, velocities)
     order = np.arange(prob.a.size)
     norms = []
     for _ in range(6000):
-        sums = nlgs.sweep(order, *geometry, prob.bias, prob.mu, pn, pt, vx, vy, w, *masses, wnn, wnt, wtt)
+        sums = nlgs.sweep(order, prob, impulses, velocities, blocks)
         norms.append(nlgs.sweep_norms(*sums)[0])
     stop = expected_stop(norms, WINDOW, TIGHT["tolerance"])
     assert stop is not None and 2 * WINDOW <= stop < 6000 and min(norms) > TIGHT["tolerance"]
