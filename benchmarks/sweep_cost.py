@@ -48,21 +48,20 @@ MEMORY, PERIOD = 3, 2
 
 
 def _layout(caught: dict, domains: int):
-    """(problem arrays, mobility arrays, state arrays, point blocks, decomposition or None) of a
-    captured problem, laid out for ``domains`` domains (1: as captured)."""
+    """(problem, impulses, velocities, point blocks, decomposition or None) of a captured
+    problem (records of :mod:`solver.solve_records`, contiguous arrays), laid out for
+    ``domains`` domains (1: as captured)."""
     from solver import parallel_nlgs
+    from solver.solve_records import Impulses, Velocities
 
     problem = caught["problem"]
     state = [caught[k].copy() for k in ("pn", "pt", "vx", "vy", "w")]
     if domains == 1:
-        geometry = tuple(np.ascontiguousarray(getattr(problem, k)) for k in
-                         ("a", "b", "nx", "ny", "rax", "ray", "rbx", "rby", "bias", "mu"))
-        masses = tuple(np.ascontiguousarray(getattr(problem, k)) for k in ("minv_xx", "minv_xy", "minv_yy", "iinv"))
-        return geometry, masses, tuple(state), np.array([0, problem.a.size]), None
+        problem = type(problem)(*(np.ascontiguousarray(v) for v in problem))
+        return problem, Impulses(*state[:2]), Velocities(*state[2:]), np.array([0, problem.a.size]), None
     dec = parallel_nlgs.decompose(problem, caught["position"][:, 0], domains)
-    geometry, masses, state = dec.gather(problem, *state)
-    contiguous = [tuple(np.ascontiguousarray(v) for v in part) for part in (geometry, masses, state)]
-    return contiguous[0], contiguous[1], contiguous[2], dec.blocks, dec
+    renumbered, impulses, velocities = dec.gather(problem, *state)
+    return renumbered, impulses, velocities, dec.blocks, dec
 
 
 def sweep_seconds(caught: dict, domains: int, kind: str, sweeps: int, repeats: int) -> float:
@@ -70,20 +69,21 @@ def sweep_seconds(caught: dict, domains: int, kind: str, sweeps: int, repeats: i
     laid out for ``domains`` domains: the median over ``repeats`` of (time of sweeps + 2 sweeps
     minus time of 2 sweeps) / sweeps."""
     from solver import acceleration, nlgs, parallel_nlgs
+    from solver.solve_records import Limits
 
-    geometry, masses, state, blocks, dec = _layout(caught, domains)
-    work = np.empty(acceleration.scratch_size(geometry[0].size, state[2].size, MEMORY))
+    problem, impulses, velocities, blocks, dec = _layout(caught, domains)
+    work = np.empty(acceleration.scratch_size(problem.a.size, velocities.vx.size, MEMORY))
 
     def run(count):
-        s = tuple(v.copy() for v in state)
+        p, v = type(impulses)(*(x.copy() for x in impulses)), type(velocities)(*(x.copy() for x in velocities))
+        limits = Limits(0.0, 0.0, count, 0)
         start = time.perf_counter()
         if kind == "anderson":
-            acceleration.solve_anderson(blocks, *geometry, *s, *masses, 0.0, 0.0, count, MEMORY, PERIOD, 0, work)
+            acceleration.solve_anderson(blocks, problem, p, v, limits, MEMORY, PERIOD, work)
         elif dec is None:
-            nlgs.solve(*geometry, *s, *masses, 0.0, 0.0, count, False, 0, 0)
+            nlgs.solve(problem, p, v, limits, False, 0)
         else:
-            parallel_nlgs.solve_domains(dec.ptr, dec.points, dec.interface, *geometry, *s, *masses, 0.0, 0.0, count,
-                                        0)
+            parallel_nlgs.solve_domains(dec.ptr, dec.points, dec.interface, problem, p, v, limits)
         return time.perf_counter() - start
 
     run(2)  # compiled or loaded from the cache
@@ -123,19 +123,17 @@ def stage_seconds(caught: dict, sweeps: int) -> tuple:
     """
     from solver import acceleration as anderson, nlgs
 
-    geometry, masses, state, _, _ = _layout(caught, 1)
-    a, b, nx, ny, rax, ray, rbx, rby, bias, mu = geometry
-    pn, pt, vx, vy, w = (v.copy() for v in state)
-    m, n_bodies = a.size, vx.size
-    dfn, dft, dgn, dgt = (np.zeros((MEMORY, m)) for _ in range(4))
-    dvx, dvy, dw = (np.zeros((MEMORY, n_bodies)) for _ in range(3))
-    wnn, wnt, wtt, xn, xt, fn, ft, fn_prev, ft_prev, gn_prev, gt_prev = (np.zeros(m) for _ in range(11))
-    hvx, hvy, hw = (np.zeros(n_bodies) for _ in range(3))
-    nlgs.delassus_into(a, b, nx, ny, rax, ray, rbx, rby, *masses, wnn, wnt, wtt)
-    nlgs.velocities_from_impulses(a, b, nx, ny, rax, ray, rbx, rby, pn, pt, vx, vy, w, *masses)
+    problem, impulses, velocities, _, _ = _layout(caught, 1)
+    pn, pt = impulses
+    m, n_bodies = problem.a.size, velocities.vx.size
+    work = np.zeros(anderson.scratch_size(m, n_bodies, MEMORY))
+    scratch, blocks = anderson.scratch_records(work, m, n_bodies, MEMORY)
+    nlgs.delassus_into(problem, blocks)
+    nlgs.velocities_from_impulses(problem, impulses, velocities)
     order = np.arange(m)
-    gram, row, rhs = np.zeros((MEMORY, MEMORY)), np.zeros(MEMORY), np.zeros(MEMORY)
-    xn[:], xt[:] = pn, pt
+    gram, row, rhs = scratch.gram, scratch.row, scratch.rhs
+    fn, ft = scratch.fn, scratch.ft
+    scratch.xn[:], scratch.xt[:] = pn, pt
     seconds = dict.fromkeys(STAGES, 0.0)
     have_prev, count, head, last, histories, extrapolations, moved = False, 0, 0, np.inf, 0, 0, 0
 
@@ -146,16 +144,14 @@ def stage_seconds(caught: dict, sweeps: int) -> tuple:
         return out
 
     for it in range(1, sweeps + 1):
-        timed("sweep", nlgs.sweep, order, a, b, nx, ny, rax, ray, rbx, rby, bias, mu, pn, pt, vx, vy, w, *masses,
-              wnn, wnt, wtt)
+        timed("sweep", nlgs.sweep, order, problem, impulses, velocities, blocks)
         if it % PERIOD or it == sweeps:  # as solve_anderson: the last sweep's iterate is kept
             continue
         slot = head if have_prev else -1
         used = min(count + 1, MEMORY) if have_prev else 0
         row[:], rhs[:] = 0.0, 0.0
-        size = timed("point history", anderson._point_history, 0, m, slot, used, pn, pt, xn, xt, fn, ft, fn_prev,
-                     ft_prev, gn_prev, gt_prev, dfn, dft, dgn, dgt, row, rhs)
-        timed("body history", anderson._body_history, 0, n_bodies, slot, vx, vy, w, hvx, hvy, hw, dvx, dvy, dw)
+        size = timed("point history", anderson._point_history, 0, m, slot, used, impulses, scratch, row, rhs)
+        timed("body history", anderson._body_history, 0, n_bodies, slot, velocities, scratch)
         histories += 1
         have_prev = True
         if size > last or slot < 0:
@@ -168,9 +164,9 @@ def stage_seconds(caught: dict, sweeps: int) -> tuple:
         if not ok:
             count, head = 0, 0
             continue
-        timed("extrapolation, bodies", anderson._extrapolate_bodies, 0, n_bodies, gamma, count, dvx, dvy, dw, vx, vy, w)
-        timed("extrapolation, points", anderson._extrapolate_points, 0, m, gamma, count, dgn, dgt, a, b, nx, ny, rax,
-              ray, rbx, rby, mu, pn, pt, xn, xt, fn, ft, vx, vy, w, *masses)
+        timed("extrapolation, bodies", anderson._extrapolate_bodies, 0, n_bodies, gamma, count, velocities, scratch)
+        timed("extrapolation, points", anderson._extrapolate_points, 0, m, gamma, count, problem, impulses,
+              velocities, scratch)
         extrapolations += 1
         moved += int(np.count_nonzero((fn != pn) | (ft != pt)))  # fn, ft: the extrapolation before its projection
     return seconds, (histories, extrapolations), moved, (pn, pt)

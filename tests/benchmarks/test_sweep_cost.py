@@ -18,16 +18,16 @@ def test_layouts_keep_every_point(problems):
     sweep_cost = load("sweep_cost")
     c = problems[0]
     problem = c["problem"]
-    geometry, masses, state, blocks, dec = sweep_cost._layout(c, 1)
+    laid, impulses, velocities, blocks, dec = sweep_cost._layout(c, 1)
     assert dec is None and list(blocks) == [0, problem.a.size]
-    np.testing.assert_array_equal(geometry[8], problem.bias)
-    np.testing.assert_array_equal(state[0], c["pn"])
-    geometry, masses, state, blocks, dec = sweep_cost._layout(c, 2)
+    np.testing.assert_array_equal(laid.bias, problem.bias)
+    np.testing.assert_array_equal(impulses.pn, c["pn"])
+    laid, impulses, velocities, blocks, dec = sweep_cost._layout(c, 2)
     assert blocks[-1] == problem.a.size and len(blocks) == 4
     # the same points, renumbered: the same multiset of Signorini shifts and warm-start impulses
-    np.testing.assert_array_equal(np.sort(geometry[8]), np.sort(problem.bias))
-    np.testing.assert_array_equal(np.sort(state[0]), np.sort(c["pn"]))
-    assert masses[0].size >= problem.minv_xx.size  # every body, walls copied into each domain that touches them
+    np.testing.assert_array_equal(np.sort(laid.bias), np.sort(problem.bias))
+    np.testing.assert_array_equal(np.sort(impulses.pn), np.sort(c["pn"]))
+    assert laid.minv_xx.size >= problem.minv_xx.size  # every body, walls copied into each domain that touches them
 
 
 def test_costs_are_measured_for_every_kind_and_domain_count(problems):
@@ -41,19 +41,19 @@ def test_the_stages_are_the_anderson_solve_taken_apart(problems):
     """Driven kernel by kernel from Python, the solve ends on the impulses of solve_anderson
     run for as many sweeps without a tolerance, bit for bit: the stages timed are the solver's."""
     from solver import acceleration
+    from solver.solve_records import Limits
 
     sweep_cost = load("sweep_cost")
     c = problems[1]
     seconds, (histories, extrapolations), moved, (pn, pt) = sweep_cost.stage_seconds(c, 12)
     assert set(seconds) == set(sweep_cost.STAGES) and min(seconds.values()) >= 0.0
     assert histories == 5 and 1 <= extrapolations <= 5 and 0 <= moved <= extrapolations * c["problem"].a.size
-    geometry, masses, state, blocks, _ = sweep_cost._layout(c, 1)
-    s = tuple(v.copy() for v in state)
-    work = np.empty(acceleration.scratch_size(geometry[0].size, s[2].size, sweep_cost.MEMORY))
-    acceleration.solve_anderson(blocks, *geometry, *s, *masses, 0.0, 0.0, 12, sweep_cost.MEMORY, sweep_cost.PERIOD, 0,
-                                work)
-    np.testing.assert_array_equal(pn, s[0])
-    np.testing.assert_array_equal(pt, s[1])
+    problem, impulses, velocities, blocks, _ = sweep_cost._layout(c, 1)
+    work = np.empty(acceleration.scratch_size(problem.a.size, velocities.vx.size, sweep_cost.MEMORY))
+    acceleration.solve_anderson(blocks, problem, impulses, velocities, Limits(0.0, 0.0, 12, 0), sweep_cost.MEMORY,
+                                sweep_cost.PERIOD, work)
+    np.testing.assert_array_equal(pn, impulses.pn)
+    np.testing.assert_array_equal(pt, impulses.pt)
 
 
 @pytest.mark.parametrize("argv, words", [
