@@ -16,9 +16,10 @@ import xarray as xr
 from ._lift import apply, with_attrs
 from .arrays import force_pdf as _pdf
 from .contacts import kind_code, selection
+from .snapshots import select_snapshots
 from ..contract.errors import ParameterError
 
-__all__ = ["force_pdf", "pooled_force_pdf", "strong_force_exponent"]
+__all__ = ["force_pdf", "pooled_force_pdf", "strong_force_exponent", "strong_force_prefactor", "counting_error"]
 
 SCALES = ("log", "linear")
 DEFAULT_RANGE = {"linear": (0.0, 10.0), "log": (1e-4, 10.0)}
@@ -133,14 +134,14 @@ def force_pdf(ds: xr.Dataset, bins: int = 50, scale: str = "log", range=None, ki
 
 
 def pooled_force_pdf(ds: xr.Dataset, bins: int = 50, scale: str = "log", range=None, kind="all",
-                     walls: bool = False, near=None) -> xr.Dataset:
+                     walls: bool = False, near=None, time=None) -> xr.Dataset:
     """P(f_n/<f_n>) of the contacts of every snapshot of ``ds`` pooled (dims: bin).
 
     Each contact is normalised by the mean normal force of its own snapshot (as in
     :func:`force_pdf`); the counts of all snapshots are summed and the density taken from the
     sums. On dask input the result is lazy and computing it sums the counts one time-chunk at
-    a time (a dask reduction), so the file is never loaded whole. Select the snapshots to pool
-    first, e.g. ``pooled_force_pdf(ds.isel(time=slice(-20, None)))`` for the residual state.
+    a time (a dask reduction), so the file is never loaded whole. ``time`` chooses the snapshots
+    pooled, e.g. ``time="residual"`` for the residual state.
 
     Parameters
     ----------
@@ -162,6 +163,11 @@ def pooled_force_pdf(ds: xr.Dataset, bins: int = 50, scale: str = "log", range=N
         Which pairs are contacts (:func:`grainview.analysis.contacts.in_network`): None (default) the
         force-bearing ones, f_n > 0; a gap threshold in m adds the pairs with gap <= ``near``
         (they carry f_n = 0); ``np.inf`` every pair the file holds.
+    time : str, int, slice or sequence of int, optional
+        The snapshots pooled (:func:`grainview.analysis.snapshots.select_snapshots`): None or
+        ``"all"`` (default) every snapshot, ``"residual"`` the residual state, eps_q >= 0.3 (for a
+        run that stops short of it, the last part of the run; the boxes are read to find it), a
+        snapshot index, a slice or a sequence of indices.
 
     Returns
     -------
@@ -176,6 +182,7 @@ def pooled_force_pdf(ds: xr.Dataset, bins: int = 50, scale: str = "log", range=N
     Azéma, Radjai, Peyroux & Saussine, Phys. Rev. E 76, 011301 (2007),
     Sec. V.B, Figs. 14 and 23.
     """
+    ds = select_snapshots(ds, time)
     counts, n_selected, n_zero, edges, scale = _histogram(ds, bins, scale, range, kind, walls, near)
     return _pdf_dataset(counts.sum("time"), n_selected.sum("time"), n_zero.sum("time"), edges, scale,
                         {"kind": str(kind), "walls": int(walls), "pooled_snapshots": int(ds.sizes["time"])})
@@ -215,8 +222,7 @@ def strong_force_exponent(pdf: xr.Dataset, low: float = 1.0, high: float = np.in
     Azéma, Radjai, Peyroux & Saussine, Phys. Rev. E 76, 011301 (2007),
     Eq. strong (Sec. V.B), Figs. 14 and 23.
     """
-    if not isinstance(pdf, xr.Dataset) or "pdf" not in pdf or "f_over_mean" not in pdf.coords:
-        raise ParameterError("pdf: expected the Dataset returned by force_pdf or pooled_force_pdf")
+    _check_pdf(pdf)
     if not low < high:
         raise ParameterError(f"low={low!r}, high={high!r}: expected low < high")
     counts = pdf["count"] if "count" in pdf else xr.ones_like(pdf["pdf"])
@@ -224,3 +230,93 @@ def strong_force_exponent(pdf: xr.Dataset, low: float = 1.0, high: float = np.in
                            input_core_dims=[["bin"]] * 3, kwargs={"low": low, "high": high},
                            dask="parallelized", output_dtypes=[float])
     return with_attrs(alpha, "alpha", "1", "exponent of the strong-force pdf ~ exp(-alpha f_n/<f_n>)")
+
+
+def _check_pdf(pdf):
+    if not isinstance(pdf, xr.Dataset) or "pdf" not in pdf or "f_over_mean" not in pdf.coords:
+        raise ParameterError("pdf: expected the Dataset returned by force_pdf or pooled_force_pdf")
+
+
+def strong_force_prefactor(pdf: xr.Dataset, alpha=None, low: float = 1.0, high: float = np.inf) -> xr.DataArray:
+    """A of the strong-force tail pdf ~ A exp(-alpha f_n/<f_n>): the intercept of the fit of
+    :func:`strong_force_exponent`.
+
+        ln A = sum_k n_k (ln pdf_k + alpha x_k) / sum_k n_k,    x_k = f_n/<f_n> of bin k,
+
+    over the bins with ``low < x_k < high`` that hold contacts, n_k their counts (weights 1
+    when ``pdf`` has no ``count``): for the fitted alpha, the weighted least squares intercept.
+
+    Parameters
+    ----------
+    pdf : xarray.Dataset
+        The result of :func:`force_pdf` or :func:`pooled_force_pdf`.
+    alpha : float or xarray.DataArray, optional
+        The exponent, dimensionless (default: :func:`strong_force_exponent` of ``pdf`` over the
+        same bins).
+    low, high : float, default 1.0 and inf
+        The open interval of f_n/<f_n> (dimensionless) used; ``low < high``.
+
+    Returns
+    -------
+    xarray.DataArray
+        ``prefactor`` A, in the units of the pdf (dimensionless), over the remaining dims; NaN
+        without a usable bin or with a non-finite alpha.
+
+    Raises
+    ------
+    grainview.contract.errors.ParameterError
+        When ``pdf`` is not such a Dataset, or ``low >= high``.
+
+    References
+    ----------
+    Azéma, Radjai, Peyroux & Saussine, Phys. Rev. E 76, 011301 (2007),
+    Eq. strong (Sec. V.B) and Fig. 14.
+    """
+    _check_pdf(pdf)
+    if not low < high:
+        raise ParameterError(f"low={low!r}, high={high!r}: expected low < high")
+    if alpha is None:
+        alpha = strong_force_exponent(pdf, low, high)
+    counts = pdf["count"] if "count" in pdf else xr.ones_like(pdf["pdf"])
+    prefactor = xr.apply_ufunc(_pdf.exponential_prefactor, pdf["f_over_mean"], pdf["pdf"], counts, alpha,
+                               input_core_dims=[["bin"]] * 3 + [[]], kwargs={"low": low, "high": high},
+                               dask="parallelized", output_dtypes=[float])
+    return with_attrs(prefactor, "prefactor", "1", "prefactor A of the strong-force pdf ~ A exp(-alpha f_n/<f_n>)")
+
+
+def counting_error(pdf: xr.Dataset) -> xr.DataArray:
+    """One standard deviation of each bin of a pdf from counting statistics (Poisson).
+
+    A bin holding n contacts has P = n / (N width) and
+
+        sigma_P = sqrt(n) / (N width) = P / sqrt(n).
+
+    NaN where the bin is empty or the counts are not known. Contacts pooled over successive
+    snapshots are counted as independent; a contact that lasts across snapshots is counted in
+    each, so with closely spaced snapshots these errors are a lower bound.
+
+    Parameters
+    ----------
+    pdf : xarray.Dataset
+        The result of :func:`force_pdf` or :func:`pooled_force_pdf` (``pdf`` and ``count``).
+
+    Returns
+    -------
+    xarray.DataArray
+        ``pdf_error``, sigma_P per bin, in the units of the pdf (dimensionless).
+
+    Raises
+    ------
+    grainview.contract.errors.ParameterError
+        When ``pdf`` is not such a Dataset.
+
+    References
+    ----------
+    Azéma, Radjai, Peyroux & Saussine, Phys. Rev. E 76, 011301 (2007),
+    Fig. 14 (Sec. V.B).
+    """
+    _check_pdf(pdf)
+    counts = pdf["count"] if "count" in pdf else xr.zeros_like(pdf["pdf"])
+    error = xr.apply_ufunc(_pdf.counting_error, pdf["pdf"], counts, dask="parallelized", output_dtypes=[float])
+    return with_attrs(error, "pdf_error", "1", "counting error of the pdf, P / sqrt(n)")
+

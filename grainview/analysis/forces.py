@@ -14,10 +14,12 @@ from ._lift import apply, with_attrs
 from .arrays import forces as _forces
 from .arrays.tensors import principal
 from .contacts import selection
+from ..contract.errors import ParameterError
 from .fabric import check_bins, reference_direction, fabric_anisotropy, theta_coord
+from .snapshots import select_snapshots, time_mean
 from .stress import stress_invariants
 
-__all__ = ["angular_force_averages", "force_tensors", "force_anisotropies", "harmonic_prediction"]
+__all__ = ["angular_force_averages", "angular_profile", "force_tensors", "force_anisotropies", "harmonic_prediction"]
 
 
 def angular_force_averages(ds: xr.Dataset, bins: int = 36, kind="all", walls: bool = False, near=None) -> xr.Dataset:
@@ -233,3 +235,66 @@ def harmonic_prediction(ds: xr.Dataset, bins: int = 36, walls: bool = False, nea
                                             "harmonic prediction with the cross term (a' + a_n + a_t)/(2 + a' a_n)"),
         "a_prime": fab["a_prime"], "a_n": frc["a_n"], "a_t": frc["a_t"],
     })
+
+
+def angular_profile(ds: xr.Dataset, component: str = "fn", time="residual", bins: int = 36, kind="all",
+                    walls: bool = False, normalise: bool = True) -> xr.DataArray:
+    """<f_n>(theta) or <f_t>(theta) on ``bins`` sectors of [0, pi), averaged over the snapshots ``time``.
+
+    ``component="fn"`` gives <f_n>(theta), ``"ft"`` gives <f_t>(theta)
+    (:func:`angular_force_averages`, paper Eq. fnft). With ``normalise`` each snapshot's profile
+    is divided by that snapshot's mean normal force
+
+        <f_n> = sum_k N_c(theta_k) <f_n>(theta_k) / sum_k N_c(theta_k)
+
+    over the same contacts (dimensionless); otherwise in N. The snapshots' profiles are then
+    averaged (NaN-aware: a sector empty in one snapshot does not void the others).
+
+    Parameters
+    ----------
+    ds : xarray.Dataset
+        A dataset of the contract.
+    component : {"fn", "ft"}, default "fn"
+        The normal or the tangential force.
+    time : str, int, slice or sequence of int, default "residual"
+        The snapshots averaged over (:func:`grainview.analysis.snapshots.select_snapshots`):
+        ``"residual"`` the residual state, eps_q >= 0.3 (for a run that stops short of it, the
+        last part of the run), ``"all"`` or None every snapshot, a snapshot index, a slice or a
+        sequence of indices.
+    bins : int, default 36
+        Number of angular sectors of [0, pi), centred on theta_k = k pi/bins.
+    kind : {"all", "simple", "double"}, default "all"
+        The contacts used: all, simple (vertex–edge and disk contacts) or double (edge–edge)
+        ones (also 1, 2, "s", "d"; :func:`grainview.analysis.contacts.kind_code`).
+    walls : bool, default False
+        Include the particle–wall contacts (default: particle–particle only).
+    normalise : bool, default True
+        Divide each snapshot's profile by its mean normal force <f_n> over the same contacts
+        (dimensionless); otherwise in N.
+
+    Returns
+    -------
+    xarray.DataArray
+        The profile over ``theta`` (rad); dimensionless with ``normalise``, else N. Lazy on
+        dask input (``time="residual"`` reads the boxes to find the window).
+
+    Raises
+    ------
+    grainview.contract.errors.ParameterError
+        When ``component`` is neither "fn" nor "ft".
+
+    References
+    ----------
+    Azéma, Radjai, Peyroux & Saussine, Phys. Rev. E 76, 011301 (2007),
+    Eq. fnft (Sec. V.A) and Fig. 10; docs/conventions.md §3.
+    """
+    if component not in ("fn", "ft"):
+        raise ParameterError(f"component={component!r}: expected 'fn' or 'ft'")
+    avg = angular_force_averages(select_snapshots(ds, time), bins=bins, kind=kind, walls=walls)
+    profile = avg[f"{component}_mean"]
+    if normalise:
+        count = avg["count"]
+        mean_fn = (avg["fn_mean"].fillna(0) * count).sum("theta") / count.sum("theta")
+        profile = (profile / mean_fn).assign_attrs(units="1", long_name=profile.attrs["long_name"] + " / <f_n>")
+    return time_mean(profile)
+

@@ -22,7 +22,7 @@ from .contacts import check_near, n_particles, near_attr, selection, snapshot_in
 from ..contract.errors import ParameterError
 from ..contract.schema import KIND_DOUBLE, KIND_SIMPLE
 
-__all__ = ["body_count", "pair_keys", "time_blocks", "persistence", "type_transitions"]
+__all__ = ["body_count", "pair_keys", "pooled_contacts", "time_blocks", "persistence", "type_transitions"]
 
 _MAX_KEY = np.iinfo(np.int64).max // 2
 
@@ -307,3 +307,31 @@ def type_transitions(ds: xr.Dataset, walls: bool = False, near=None) -> xr.Datas
     out.attrs.update(walls=int(walls), near=near_attr(near),
                      comment="increment at t: contacts present at t-1 and t that changed kind, over N_c(t-1)")
     return out
+
+
+def pooled_contacts(ds: xr.Dataset, walls: bool = False) -> tuple[int, float]:
+    """How many different contacts the snapshots of ``ds`` hold, and how many one holds on average.
+
+    A contact is a pair of bodies (:func:`pair_keys`), force-bearing
+    (particle–particle unless ``walls``). The ratio of the two counts is how many snapshots'
+    worth of independent contacts a distribution pooled over ``ds`` rests on: 1 when every
+    snapshot holds the same contacts, the number of snapshots when none is seen twice.
+
+    Parameters
+    ----------
+    ds : xarray.Dataset
+        A dataset of the contract (e.g. its residual snapshots).
+    walls : bool, default False
+        Count the particle–wall contacts too.
+
+    Returns
+    -------
+    distinct : int
+        The number of different pairs in contact in any snapshot.
+    per_snapshot : float
+        The mean number of contacts of a snapshot.
+    """
+    order = ("time", "contact")
+    present = np.asarray(selection(ds, walls=walls).transpose(*order).values, bool)
+    keys = pair_keys(ds["i"].transpose(*order).values, ds["j"].transpose(*order).values, body_count(ds))
+    return int(np.unique(keys[present]).size), float(present.sum(axis=1).mean())

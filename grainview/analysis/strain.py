@@ -16,7 +16,7 @@ from .arrays.strain import log_strain
 from ..contract.errors import ParameterError
 from .stress import stress_invariants
 
-__all__ = ["time_derivative", "strains", "residual_window", "friction_and_dilatancy",
+__all__ = ["time_derivative", "strains", "residual_window", "friction_and_dilatancy", "friction_offset",
            "inertia_number"]
 
 RESIDUAL_STRAIN = 0.3
@@ -219,3 +219,46 @@ def inertia_number(ds: xr.Dataset) -> xr.DataArray:
     p_line = stress_invariants(ds)["p"] * sample.thickness(ds)
     total_mass = ds["mass"].sum()
     return with_attrs(rate * np.sqrt(total_mass / p_line), "inertia_number", "1", "inertia parameter I")
+
+
+EARLY_STRAIN = 0.02
+"""Snapshots below this shear strain are left out of the stress–dilatancy relation: there
+psi = arcsin(eps_p/eps_q) divides two strains that both start from zero, so it swings through
+large values that say nothing about dilatancy."""
+
+
+def friction_offset(ds: xr.Dataset, min_strain: float = EARLY_STRAIN, incremental: bool = False) -> float:
+    """phi_0 of the stress–dilatancy relation phi ~ phi_0 + psi, in rad: the median of phi - psi.
+
+        phi_0 = median over the snapshots with eps_q >= min_strain of (phi - psi),
+
+    sin phi = q/p, sin psi = eps_p/eps_q (or d eps_p/d eps_q with ``incremental``;
+    :func:`friction_and_dilatancy`). It is the friction angle at zero dilatancy of Taylor's
+    relation, which the paper's Fig. 5 shows both shapes follow. A median, not a fit: the
+    slope is 1 by assumption. It reads the whole run (computed).
+
+    Parameters
+    ----------
+    ds : xarray.Dataset
+        A dataset of the contract.
+    min_strain : float, default 0.02
+        Snapshots with a smaller eps_q are left out (:data:`EARLY_STRAIN`).
+    incremental : bool, default False
+        Use the incremental dilatancy angle.
+
+    Returns
+    -------
+    float
+        phi_0, rad (NaN when no snapshot has both angles).
+
+    References
+    ----------
+    Azéma, Radjai, Peyroux & Saussine, Phys. Rev. E 76, 011301 (2007),
+    Sec. III and Fig. 5; docs/conventions.md §6.
+    """
+    angles = friction_and_dilatancy(ds).compute()
+    early = np.asarray(strains(ds)["eps_q"].values, float) < min_strain
+    phi = np.asarray(angles["phi"].values, float)
+    psi = np.asarray(angles["psi_incremental" if incremental else "psi"].values, float)
+    both = ~early & np.isfinite(phi) & np.isfinite(psi)
+    return float(np.median(phi[both] - psi[both])) if both.any() else float("nan")

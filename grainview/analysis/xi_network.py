@@ -17,9 +17,10 @@ from .arrays import xi_network as _xi
 from .contacts import selection
 from ..contract.errors import ParameterError
 from .sample import volume
+from .snapshots import select_snapshots
 from .stress import stress_invariants
 
-__all__ = ["xi_network"]
+__all__ = ["xi_network", "xi_profile"]
 
 DEFAULT_XI = np.linspace(0.0, 5.0, 101)
 
@@ -104,3 +105,42 @@ def xi_network(ds: xr.Dataset, xi=DEFAULT_XI, walls: bool = False, near=None) ->
     out = out.assign_coords(xi=("xi", xi, {"units": "1", "long_name": "force cutoff xi (f_n < xi <f_n>)"}))
     out.attrs["walls"] = int(walls)
     return out
+
+
+def xi_profile(ds: xr.Dataset, xi=None, time="residual", near=None) -> xr.Dataset:
+    """q(xi)/p, a'(xi) and the contact fraction of the xi-network, averaged over the snapshots ``time``.
+
+    The xi-network holds the contacts with f_n < xi <f_n> (docs/conventions.md §5;
+    :func:`xi_network`, whose cutoffs are the default); each snapshot's values are averaged
+    over the snapshots ``time``.
+
+    Parameters
+    ----------
+    ds : xarray.Dataset
+        A dataset of the contract.
+    xi : array_like of float, optional
+        The cutoffs xi >= 0, multiples of <f_n>.
+    time : str, int, slice or sequence of int, default "residual"
+        The snapshots averaged over (:func:`grainview.analysis.snapshots.select_snapshots`):
+        ``"residual"`` the residual state, eps_q >= 0.3 (for a run that stops short of it, the
+        last part of the run), ``"all"`` or None every snapshot, a snapshot index, a slice or a
+        sequence of indices.
+    near : float, optional
+        None: the force-bearing contacts (f_n > 0); a gap in m: also the pairs within it,
+        which carry no force and so belong to every xi-network (the file must hold them;
+        :func:`grainview.analysis.contacts.in_network`).
+
+    Returns
+    -------
+    xarray.Dataset
+        ``q_over_p``, ``a_prime``, ``contact_fraction`` (dimensionless) and ``count`` over
+        ``xi``; lazy on dask input (``time="residual"`` reads the boxes to find the window).
+
+    References
+    ----------
+    Azéma, Radjai, Peyroux & Saussine, Phys. Rev. E 76, 011301 (2007),
+    Sec. V.C, Figs. 15 and 16; docs/conventions.md §5.
+    """
+    cutoffs = {} if xi is None else {"xi": np.asarray(xi, float)}
+    return xi_network(select_snapshots(ds, time), near=near, **cutoffs).mean("time", keep_attrs=True)
+

@@ -25,7 +25,7 @@ NOT_REACHED = "not reached"
 """Value of a residual-state row of a run that stops short of the residual window."""
 
 PHI_0_ROW = "phi_0 = median(phi - psi), eps_q >= 0.02 (rad)"
-"""Headline row of the stress–dilatancy offset of Fig. 5 (:func:`grainview.plot.macroscopic.friction_offset`),
+"""Headline row of the stress–dilatancy offset of Fig. 5 (:func:`grainview.analysis.strain.friction_offset`),
 over the whole test rather than the residual state."""
 
 # The paper's values (Azema et al. 2007, Secs. III-VI; docs/fidelity.md); strings where the
@@ -114,7 +114,7 @@ def run_summary(ds: xr.Dataset, residual_strain: float = RESIDUAL_STRAIN) -> dic
     out = describe_run(ds, window, residual_strain)
     out["solid fraction (initial)"] = float(ds.grain.solid_fraction().isel(time=0))
     out["z (initial)"] = float(ds.grain.coordination()["z"].isel(time=0))
-    from ..plot.macroscopic import EARLY_STRAIN, friction_offset
+    from ..analysis.strain import EARLY_STRAIN, friction_offset
     phi_0 = friction_offset(ds)  # Fig. 5's phi_0, over the whole test
     out[PHI_0_ROW] = phi_0 if np.isfinite(phi_0) else f"{NOT_REACHED}: eps_q < {EARLY_STRAIN:g} throughout"
     residual_rows = [key for key in PAPER["pentagons"] if key not in out and key not in INITIAL_ROWS]
@@ -392,7 +392,7 @@ def caption(label: str, ds: xr.Dataset, what: str, residual_strain: float = RESI
     """One line saying what a figure shows of run ``label``: N and shape, seed, preparation,
     and, by ``what``: "map" the snapshot drawn, "distribution" the residual window averaged
     over, anything else the range of the evolution."""
-    from ..plot._style import residual_snapshots
+    from ..analysis.snapshots import residual_snapshots
     from ..analysis.strain import strains
     from ..analysis.summary import regular_of, shape_counts
 
@@ -422,7 +422,8 @@ def write_figures(runs: dict, out: Path, time=-1, residual_strain: float = RESID
     import matplotlib.pyplot as plt  # any backend: matplotlib falls back to Agg without a display
 
     from ..plot import FIGURES, save_figure
-    from ..plot._style import Residual, add_caption
+    from ..analysis.snapshots import Residual
+    from ..plot._style import add_caption
     from ..plot.captions import describe_figure, interval_note, sampling_note
 
     out = Path(out)

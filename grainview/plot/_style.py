@@ -9,14 +9,12 @@ pairs; :func:`datasets` turns any of these into a list of ``(label, ds)``.
 from __future__ import annotations
 
 import re
-from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 import xarray as xr
 
 from ..contract.errors import ParameterError
-from ..analysis.strain import RESIDUAL_STRAIN, residual_window, strains
 
 EPS_Q_LABEL = r"$\varepsilon_q$"
 """Label of the x axis of every evolution (shear strain, dimensionless)."""
@@ -56,79 +54,11 @@ def single_dataset(data, label: str | None = None) -> tuple[str | None, xr.Datas
     return pairs[0]
 
 
-@dataclass(frozen=True)
-class Residual:
-    """A ``time`` selector for the figures: the residual state from eps_q >= ``start`` on
-    (``time="residual"`` is ``Residual(RESIDUAL_STRAIN)``)."""
-
-    start: float = RESIDUAL_STRAIN
-
-
-SHORT_RUN_FRACTION = 0.3
-"""A run short of the residual window averages the last 30% of its shear strain instead."""
-
-
-def select_snapshots(ds: xr.Dataset, time="residual", residual_strain: float = RESIDUAL_STRAIN) -> xr.Dataset:
-    """The snapshots a distribution is averaged over.
-
-    ``time``: an integer snapshot index (``-1`` the last); ``"residual"`` (or
-    :class:`Residual`, to choose where it starts) the residual state,
-    the snapshots with eps_q >= ``residual_strain`` (:func:`grainview.analysis.strain.residual_window`)
-    or, for a run that stops short of it, those with eps_q >= 0.7 max eps_q; the window used
-    is described in the result's attribute ``window``; ``"all"`` or None every snapshot; a
-    slice or a sequence of indices.
-    """
-    n = ds.sizes["time"]
-    if time is None or (isinstance(time, str) and time == "all"):
-        return ds
-    if isinstance(time, str) and time == "residual":
-        return residual_snapshots(ds, residual_strain)
-    if isinstance(time, Residual):
-        return residual_snapshots(ds, time.start)
-    if isinstance(time, (int, np.integer)) and not isinstance(time, bool):
-        if not -n <= time < n:
-            raise ParameterError(f"time={time}: expected a snapshot index in [{-n}, {n})")
-        return ds.isel(time=[int(time)])
-    if isinstance(time, slice):
-        return ds.isel(time=time)
-    try:
-        idx = np.asarray(time, dtype=int)
-    except (TypeError, ValueError):
-        idx = None
-    if idx is None or idx.ndim != 1 or idx.size == 0 or (idx < -n).any() or (idx >= n).any():
-        raise ParameterError(f"time={time!r}: expected 'residual', 'all', a snapshot index, a slice "
-                             f"or a sequence of indices in [{-n}, {n})")
-    return ds.isel(time=idx)
-
-
-def residual_snapshots(ds: xr.Dataset, residual_strain: float = RESIDUAL_STRAIN) -> xr.Dataset:
-    """The residual snapshots of ``ds`` (see :func:`select_snapshots`), with ``attrs["window"]``
-    saying which window was used and whether the residual state was reached."""
-    window = residual_window(ds, residual_strain)
-    eps_q = strains(ds)["eps_q"].compute()
-    if bool(window.any()):
-        note = f"residual: eps_q >= {residual_strain:g} ({int(window.sum())} snapshots)"
-    else:
-        top = float(eps_q.max())
-        window = eps_q >= (1 - SHORT_RUN_FRACTION) * top
-        note = (f"residual eps_q >= {residual_strain:g} NOT reached: last {SHORT_RUN_FRACTION:.0%} of the run, "
-                f"eps_q {(1 - SHORT_RUN_FRACTION) * top:.3f}-{top:.3f} ({int(window.sum())} snapshots)")
-    out = ds.isel(time=np.flatnonzero(window.values))
-    out.attrs = {**ds.attrs, "window": note}
-    return out
-
-
 def snapshot_index(ds: xr.Dataset, time=-1) -> int:
     """A single snapshot index (maps draw one snapshot); negative counts from the end."""
     from ..analysis.contacts import snapshot_index as index
 
     return index(ds, time)
-
-
-def time_mean(da: xr.DataArray) -> xr.DataArray:
-    """Average over the snapshots (NaN-aware), computed; attributes kept."""
-    out = da.mean("time", skipna=True, keep_attrs=True) if "time" in da.dims else da
-    return out.compute()
 
 
 def eps_q(ds: xr.Dataset) -> np.ndarray:

@@ -85,40 +85,9 @@ def describe_figure(number: str) -> str:
     return DESCRIPTIONS.get(number, "")
 
 
-def pooled_contacts(ds: xr.Dataset, walls: bool = False) -> tuple[int, float]:
-    """How many different contacts the snapshots of ``ds`` hold, and how many one holds on average.
-
-    A contact is a pair of bodies (:func:`grainview.analysis.persistence.pair_keys`), force-bearing
-    (particle–particle unless ``walls``). The ratio of the two counts is how many snapshots'
-    worth of independent contacts a distribution pooled over ``ds`` rests on: 1 when every
-    snapshot holds the same contacts, the number of snapshots when none is seen twice.
-
-    Parameters
-    ----------
-    ds : xarray.Dataset
-        A dataset of the contract (e.g. its residual snapshots).
-    walls : bool, default False
-        Count the particle–wall contacts too.
-
-    Returns
-    -------
-    distinct : int
-        The number of different pairs in contact in any snapshot.
-    per_snapshot : float
-        The mean number of contacts of a snapshot.
-    """
-    from ..analysis.contacts import selection
-    from ..analysis.persistence import body_count, pair_keys
-
-    order = ("time", "contact")
-    present = np.asarray(selection(ds, walls=walls).transpose(*order).values, bool)
-    keys = pair_keys(ds["i"].transpose(*order).values, ds["j"].transpose(*order).values, body_count(ds))
-    return int(np.unique(keys[present]).size), float(present.sum(axis=1).mean())
-
-
 def sampling_note(label: str, ds: xr.Dataset, residual_strain: float = RESIDUAL_STRAIN) -> str:
     """A caption line saying how independent the residual snapshots pooled by a distribution
-    are (:func:`pooled_contacts`): contacts last over many snapshots, so pooling T snapshots
+    are (:func:`grainview.analysis.persistence.pooled_contacts`): contacts last over many snapshots, so pooling T snapshots
     does not average T independent configurations, and the spikes of a finely binned
     distribution (Fig. 8) are those of a few long-lived contacts counted T times.
 
@@ -136,7 +105,8 @@ def sampling_note(label: str, ds: xr.Dataset, residual_strain: float = RESIDUAL_
     str
         The caption line.
     """
-    from ._style import residual_snapshots
+    from ..analysis.persistence import pooled_contacts
+    from ..analysis.snapshots import residual_snapshots
 
     res = residual_snapshots(ds, residual_strain)
     distinct, per_snapshot = pooled_contacts(res)
@@ -177,4 +147,4 @@ def interval_note(label: str, ds: xr.Dataset) -> str:
             "counted and Delta gamma depends on the interval")
 
 
-__all__ = ["DESCRIPTIONS", "describe_figure", "pooled_contacts", "sampling_note", "interval_note"]
+__all__ = ["DESCRIPTIONS", "describe_figure", "sampling_note", "interval_note"]

@@ -12,8 +12,9 @@ import os
 import numpy as np
 
 from ..contract.errors import ParameterError
-from ._style import (EPS_Q_LABEL, datasets, draw_evolutions, finish, get_axes, sample_colour,
-                     select_snapshots, single_dataset, snapshot_index)
+from ..analysis.snapshots import select_snapshots
+from ._style import (EPS_Q_LABEL, datasets, draw_evolutions, finish, get_axes, sample_colour, single_dataset,
+                     snapshot_index)
 
 __all__ = ["plot_chain_map", "plot_chain_fractions", "plot_chain_lengths", "plot_chain_lifetimes",
            "animate_chains", "CHAIN_COLOURS", "OUTSIDE_COLOUR"]
@@ -163,7 +164,7 @@ def plot_chain_lengths(data, ax=None, label=None, time="residual", angle: float 
     label : str, optional
         Legend label of a single dataset.
     time : "residual", "all", int, slice or sequence, default "residual"
-        The snapshots pooled (:func:`grainview.plot._style.select_snapshots`).
+        The snapshots pooled (:func:`grainview.analysis.snapshots.select_snapshots`).
     angle : float, default 45
         Alignment angle, degrees.
     min_size : int, default 3

@@ -5,19 +5,20 @@ k_s, k_d, f_s, f_d (Fig. 19), the s->d and d->s transitions (Fig. 20), pdfs per 
 (Fig. 23) and the strong/weak proportions k_s^S, k_s^W, k_d^S, k_d^W (Fig. 25).
 
 Distributions are averaged over the snapshots chosen by ``time`` (default ``"residual"``, see
-:func:`grainview.plot._style.select_snapshots`); evolutions are drawn against eps_q.
+:func:`grainview.analysis.snapshots.select_snapshots`); evolutions are drawn against eps_q.
 """
 
 from __future__ import annotations
 
 import numpy as np
-import xarray as xr
 
 from ..contract.errors import ParameterError
-from ..analysis.forces import angular_force_averages, force_anisotropies
+from ..analysis.force_pdf import counting_error, pooled_force_pdf, strong_force_exponent, strong_force_prefactor
+from ..analysis.forces import angular_profile, force_anisotropies
+from ..analysis.xi_network import xi_profile
 from ._style import (EPS_Q_LABEL, PALETTE, PI_TICK_LABELS, axis_label, datasets, draw_evolutions, finish, get_axes,
-                     legend_in_first, new_figure, sample_colour, select_snapshots, series_label, set_labels, tidy_polar,
-                     time_mean, units_of, values)
+                     legend_in_first, new_figure, sample_colour, series_label, set_labels, tidy_polar, units_of,
+                     values)
 from .texture import full_turn
 
 FORCE_RATIO_LABEL = r"$f_n/\langle f_n\rangle$"
@@ -26,71 +27,11 @@ XI_LABEL = r"$\xi$"
 
 # -- Fig. 10: angular averages -----------------------------------------------------------------
 
-def angular_profile(ds: xr.Dataset, component: str = "fn", time="residual", bins: int = 36, kind="all",
-                    walls: bool = False, normalise: bool = True) -> xr.DataArray:
-    """<f_n>(theta) or <f_t>(theta) on ``bins`` sectors of [0, pi), averaged over the snapshots ``time``.
-
-    ``component="fn"`` gives <f_n>(theta), ``"ft"`` gives <f_t>(theta)
-    (:func:`grainview.analysis.forces.angular_force_averages`, paper Eq. fnft). With ``normalise`` each
-    snapshot's profile is divided by that snapshot's mean normal force
-
-        <f_n> = sum_k N_c(theta_k) <f_n>(theta_k) / sum_k N_c(theta_k)
-
-    over the same contacts (dimensionless); otherwise in N.
-
-    Parameters
-    ----------
-    ds : xarray.Dataset
-        A dataset of the contract.
-    component : {"fn", "ft"}, default "fn"
-        The normal or the tangential force.
-    time : str, int, slice or sequence of int, default "residual"
-        The snapshots averaged over (:func:`grainview.plot._style.select_snapshots`):
-        ``"residual"`` the residual state, eps_q >= 0.3 (for a run that stops short of it, the
-        last part of the run), ``"all"`` or None every snapshot, a snapshot index, a slice or a
-        sequence of indices.
-    bins : int, default 36
-        Number of angular sectors of [0, pi), centred on theta_k = k pi/bins.
-    kind : {"all", "simple", "double"}, default "all"
-        The contacts used: all, simple (vertex–edge and disk contacts) or double (edge–edge)
-        ones (also 1, 2, "s", "d"; :func:`grainview.analysis.contacts.kind_code`).
-    walls : bool, default False
-        Include the particle–wall contacts (default: particle–particle only).
-    normalise : bool, default True
-        Divide each snapshot's profile by its mean normal force <f_n> over the same contacts
-        (dimensionless); otherwise in N.
-
-    Returns
-    -------
-    xarray.DataArray
-        The profile over ``theta`` (rad), computed; dimensionless with ``normalise``, else N.
-
-    Raises
-    ------
-    grainview.contract.errors.ParameterError
-        When ``component`` is neither "fn" nor "ft".
-
-    References
-    ----------
-    Azéma, Radjai, Peyroux & Saussine, Phys. Rev. E 76, 011301 (2007),
-    Eq. fnft (Sec. V.A) and Fig. 10; docs/conventions.md §3.
-    """
-    if component not in ("fn", "ft"):
-        raise ParameterError(f"component={component!r}: expected 'fn' or 'ft'")
-    avg = angular_force_averages(select_snapshots(ds, time), bins=bins, kind=kind, walls=walls)
-    profile = avg[f"{component}_mean"]
-    if normalise:
-        count = avg["count"]
-        mean_fn = (avg["fn_mean"].fillna(0) * count).sum("theta") / count.sum("theta")
-        profile = (profile / mean_fn).assign_attrs(units="1", long_name=profile.attrs["long_name"] + " / <f_n>")
-    return time_mean(profile)
-
-
 def plot_normal_force_polar(data, ax=None, label=None, time="residual", bins: int = 36, kind="all",
                             walls: bool = False, normalise: bool = True, **line_kw):
     """Polar plot of the angle-averaged normal force <f_n>(theta) (paper Fig. 10a).
 
-    Divided by <f_n> unless ``normalise=False`` (then N) (:func:`angular_profile`). Drawn over
+    Divided by <f_n> unless ``normalise=False`` (then N) (:func:`grainview.analysis.forces.angular_profile`). Drawn over
     the full turn (pi-periodic).
 
     Parameters
@@ -104,7 +45,7 @@ def plot_normal_force_polar(data, ax=None, label=None, time="residual", bins: in
         Legend label of a single dataset (None: no legend entry), so that successive calls on
         the same axes build a comparison.
     time : str, int, slice or sequence of int, default "residual"
-        The snapshots averaged over (:func:`grainview.plot._style.select_snapshots`):
+        The snapshots averaged over (:func:`grainview.analysis.snapshots.select_snapshots`):
         ``"residual"`` the residual state, eps_q >= 0.3 (for a run that stops short of it, the
         last part of the run), ``"all"`` or None every snapshot, a snapshot index, a slice or a
         sequence of indices.
@@ -139,7 +80,7 @@ def plot_tangential_force_polar(data, ax=None, label=None, time="residual", bins
                                 walls: bool = False, normalise: bool = True, **line_kw):
     """Polar plot of the magnitude |<f_t>(theta)| of the angle-averaged tangential force (paper Fig. 10b).
 
-    Divided by <f_n> unless ``normalise=False`` (then N) (:func:`angular_profile`). A polar
+    Divided by <f_n> unless ``normalise=False`` (then N) (:func:`grainview.analysis.forces.angular_profile`). A polar
     radius cannot be negative: the sign of <f_t>(theta), that of -sin 2(theta - theta_t), is
     dropped.
 
@@ -154,7 +95,7 @@ def plot_tangential_force_polar(data, ax=None, label=None, time="residual", bins
         Legend label of a single dataset (None: no legend entry), so that successive calls on
         the same axes build a comparison.
     time : str, int, slice or sequence of int, default "residual"
-        The snapshots averaged over (:func:`grainview.plot._style.select_snapshots`):
+        The snapshots averaged over (:func:`grainview.analysis.snapshots.select_snapshots`):
         ``"residual"`` the residual state, eps_q >= 0.3 (for a run that stops short of it, the
         last part of the run), ``"all"`` or None every snapshot, a snapshot index, a slice or a
         sequence of indices.
@@ -188,7 +129,7 @@ def plot_tangential_force_polar(data, ax=None, label=None, time="residual", bins
 def _polar(data, ax, label, component, symbol, time, bins, kind, walls, normalise, line_kw):
     ax = get_axes(ax, polar=True)
     for lab, ds in datasets(data, label):
-        profile = angular_profile(ds, component, time, bins, kind, walls, normalise)
+        profile = angular_profile(ds, component, time, bins, kind, walls, normalise).compute()
         r = values(profile)
         r = np.abs(r) if component == "ft" else r
         theta, r = full_turn(profile["theta"].values, r)
@@ -207,7 +148,7 @@ def plot_tangential_force(data, ax=None, label=None, time="residual", bins: int 
 
         <f_t>(theta) = -<f> a_t sin 2(theta - theta_t)
 
-    Divided by <f_n> unless ``normalise=False`` (then N) (:func:`angular_profile`). Cartesian
+    Divided by <f_n> unless ``normalise=False`` (then N) (:func:`grainview.analysis.forces.angular_profile`). Cartesian
     axes: a polar radius could not show the sign.
 
     Parameters
@@ -221,7 +162,7 @@ def plot_tangential_force(data, ax=None, label=None, time="residual", bins: int 
         Legend label of a single dataset (None: no legend entry), so that successive calls on
         the same axes build a comparison.
     time : str, int, slice or sequence of int, default "residual"
-        The snapshots averaged over (:func:`grainview.plot._style.select_snapshots`):
+        The snapshots averaged over (:func:`grainview.analysis.snapshots.select_snapshots`):
         ``"residual"`` the residual state, eps_q >= 0.3 (for a run that stops short of it, the
         last part of the run), ``"all"`` or None every snapshot, a snapshot index, a slice or a
         sequence of indices.
@@ -259,7 +200,7 @@ def plot_normal_force(data, ax=None, label=None, time="residual", bins: int = 36
 
         <f_n>(theta) = <f> (1 + a_n cos 2(theta - theta_n))
 
-    Divided by <f_n> unless ``normalise=False`` (then N) (:func:`angular_profile`); a grey line
+    Divided by <f_n> unless ``normalise=False`` (then N) (:func:`grainview.analysis.forces.angular_profile`); a grey line
     marks the mean (1, or nothing when not normalised). The paper draws it in polar axes
     (:func:`plot_normal_force_polar`); these axes share theta and the scale with
     :func:`plot_tangential_force`, so that a_n and a_t compare by eye (Fig. 10 of the report).
@@ -275,7 +216,7 @@ def plot_normal_force(data, ax=None, label=None, time="residual", bins: int = 36
         Legend label of a single dataset (None: no legend entry), so that successive calls on
         the same axes build a comparison.
     time : str, int, slice or sequence of int, default "residual"
-        The snapshots averaged over (:func:`grainview.plot._style.select_snapshots`):
+        The snapshots averaged over (:func:`grainview.analysis.snapshots.select_snapshots`):
         ``"residual"`` the residual state, eps_q >= 0.3 (for a run that stops short of it, the
         last part of the run), ``"all"`` or None every snapshot, a snapshot index, a slice or a
         sequence of indices.
@@ -314,7 +255,7 @@ def _cartesian_profile(data, ax, label, component, time, bins, kind, walls, norm
     the mean (<f_n>: 1 when normalised) or at zero (<f_t>)."""
     ax = get_axes(ax)
     for lab, ds in datasets(data, label):
-        profile = angular_profile(ds, component, time, bins, kind, walls, normalise)
+        profile = angular_profile(ds, component, time, bins, kind, walls, normalise).compute()
         ax.plot(profile["theta"].values, values(profile), "o-", markersize=3, color=sample_colour(ax, lab, ds),
                 label=lab, **line_kw)
     if component == "ft" or normalise:
@@ -465,104 +406,19 @@ def plot_force_anisotropies(data, label=None, **kw):
 # -- Figs. 14 and 23: force pdfs ---------------------------------------------------------------
 
 SCALES = {"log-linear": "linear", "log-log": "log"}
+"""The figures' scales and the bins of :func:`grainview.analysis.force_pdf.pooled_force_pdf` each draws."""
 
 
-def force_pdf_of(ds: xr.Dataset, scale: str = "log-linear", time="residual", bins: int = 40,
-                 range=None, kind="all", walls: bool = False) -> xr.Dataset:
-    """The pdf of f_n/<f_n> over the snapshots ``time``, contacts pooled over them.
-
-    Linear bins for ``scale="log-linear"`` and logarithmic bins for ``"log-log"``
-    (:func:`grainview.analysis.force_pdf.pooled_force_pdf`).
-
-    Parameters
-    ----------
-    ds : xarray.Dataset
-        A dataset of the contract.
-    scale : {"log-linear", "log-log"}, default "log-linear"
-        Linear bins (on [0, 6] by default) on a logarithmic P axis, or logarithmic bins on
-        log-log axes.
-    time : str, int, slice or sequence of int, default "residual"
-        The snapshots averaged over (:func:`grainview.plot._style.select_snapshots`):
-        ``"residual"`` the residual state, eps_q >= 0.3 (for a run that stops short of it, the
-        last part of the run), ``"all"`` or None every snapshot, a snapshot index, a slice or a
-        sequence of indices.
-    bins : int, default 40
-        Number of bins.
-    range : (float, float), optional
-        (low, high) of f_n/<f_n>; default (0, 6) for ``"log-linear"`` and the default of
-        :func:`grainview.analysis.force_pdf.pooled_force_pdf` for ``"log-log"``.
-    kind : {"all", "simple", "double"}, default "all"
-        The contacts used: all, simple (vertex–edge and disk contacts) or double (edge–edge)
-        ones (also 1, 2, "s", "d"; :func:`grainview.analysis.contacts.kind_code`).
-    walls : bool, default False
-        Include the particle–wall contacts (default: particle–particle only).
-
-    Returns
-    -------
-    xarray.Dataset
-        Computed; variables ``pdf`` (bin) and ``count``, coordinate ``f_over_mean`` (bin
-        centres), all dimensionless.
-
-    Raises
-    ------
-    grainview.contract.errors.ParameterError
-        When ``scale`` is neither "log-linear" nor "log-log".
-
-    References
-    ----------
-    Azéma, Radjai, Peyroux & Saussine, Phys. Rev. E 76, 011301 (2007),
-    Sec. V.B and Fig. 14 (Fig. 23 by kind).
-    """
-    from ..analysis.force_pdf import pooled_force_pdf
+def _pdf(ds, scale, time, bins, range, kind, walls):
+    """The pooled pdf a figure draws (:func:`grainview.analysis.force_pdf.pooled_force_pdf` over
+    the snapshots ``time``): linear bins on [0, 6] by default for ``"log-linear"``, log bins for
+    ``"log-log"``."""
     if scale not in SCALES:
         raise ParameterError(f"scale={scale!r}: expected 'log-linear' or 'log-log'")
     if range is None and scale == "log-linear":
         range = (0.0, 6.0)
-    pdf = pooled_force_pdf(select_snapshots(ds, time), bins=bins, scale=SCALES[scale], range=range, kind=kind,
-                           walls=walls)
-    if "time" in pdf.dims:
-        pdf = pdf.mean("time", keep_attrs=True)
-    return pdf.compute()
-
-
-def exponential_fit(pdf: xr.Dataset, alpha: float, threshold: float = 1.0) -> float:
-    """Prefactor A of P = A exp(-alpha f/<f_n>) given alpha.
-
-    The intercept of the weighted least squares fit ln P = ln A - alpha x of
-    :func:`grainview.analysis.force_pdf.strong_force_exponent`, i.e. the count-weighted mean
-
-        ln A = sum_k n_k (ln P_k + alpha x_k) / sum_k n_k
-
-    over the bins k above ``threshold`` that hold contacts (x_k = f_n/<f_n> the bin centre,
-    n_k its count).
-
-    Parameters
-    ----------
-    pdf : xarray.Dataset
-        A pdf of :func:`force_pdf_of` (or of :mod:`grainview.analysis.force_pdf`).
-    alpha : float
-        The exponent, dimensionless.
-    threshold : float, default 1.0
-        Only bins with f_n/<f_n> above it are used.
-
-    Returns
-    -------
-    float
-        A, in the units of the pdf (dimensionless); NaN without a usable bin or with a
-        non-finite ``alpha``.
-
-    References
-    ----------
-    Azéma, Radjai, Peyroux & Saussine, Phys. Rev. E 76, 011301 (2007),
-    Eq. strong (Sec. V.B) and Fig. 14.
-    """
-    x = np.asarray(pdf["f_over_mean"].values, float)
-    p = values(pdf["pdf"])
-    weight = values(pdf["count"]) if "count" in pdf else np.ones_like(p)
-    keep = (x > threshold) & (p > 0) & np.isfinite(p) & (weight > 0)
-    if not keep.any() or not np.isfinite(alpha):
-        return float("nan")
-    return float(np.exp(np.average(np.log(p[keep]) + alpha * x[keep], weights=weight[keep])))
+    return pooled_force_pdf(ds, bins=bins, scale=SCALES[scale], range=range, kind=kind, walls=walls,
+                            time=time).compute()
 
 
 def plot_force_pdf(data, ax=None, label=None, scale: str = "log-linear", time="residual", bins: int = 40,
@@ -577,7 +433,7 @@ def plot_force_pdf(data, ax=None, label=None, scale: str = "log-linear", time="r
     over the strong forces (f_n > <f_n>) is drawn after each sample's pdf, alpha from
     :func:`grainview.analysis.force_pdf.strong_force_exponent` given in the legend, over the range of
     the data. Empty bins are not drawn; each bin carries its counting error bar, P / sqrt(n) for
-    n contacts in it (:func:`counting_error`; upper bar only for n = 1). Lines per sample: the
+    n contacts in it (:func:`grainview.analysis.force_pdf.counting_error`; upper bar only for n = 1). Lines per sample: the
     pdf, then the fit when drawn.
 
     Parameters
@@ -594,7 +450,7 @@ def plot_force_pdf(data, ax=None, label=None, scale: str = "log-linear", time="r
         Linear bins (on [0, 6] by default) on a logarithmic P axis, or logarithmic bins on
         log-log axes.
     time : str, int, slice or sequence of int, default "residual"
-        The snapshots averaged over (:func:`grainview.plot._style.select_snapshots`):
+        The snapshots averaged over (:func:`grainview.analysis.snapshots.select_snapshots`):
         ``"residual"`` the residual state, eps_q >= 0.3 (for a run that stops short of it, the
         last part of the run), ``"all"`` or None every snapshot, a snapshot index, a slice or a
         sequence of indices.
@@ -623,11 +479,10 @@ def plot_force_pdf(data, ax=None, label=None, scale: str = "log-linear", time="r
     Azéma, Radjai, Peyroux & Saussine, Phys. Rev. E 76, 011301 (2007),
     Eq. strong (Sec. V.B) and Fig. 14.
     """
-    from ..analysis.force_pdf import strong_force_exponent
     ax = get_axes(ax)
     outside = []
     for lab, ds in datasets(data, label):
-        pdf = force_pdf_of(ds, scale, time, bins, range, kind, walls)
+        pdf = _pdf(ds, scale, time, bins, range, kind, walls)
         _draw_pdf(ax, pdf, lab, sample_colour(ax, lab, ds), line_kw)
         outside.append((lab, pdf))
         if fit and scale == "log-linear":
@@ -638,47 +493,13 @@ def plot_force_pdf(data, ax=None, label=None, scale: str = "log-linear", time="r
     return finish(ax, None)
 
 
-def counting_error(pdf: xr.Dataset) -> np.ndarray:
-    """One standard deviation of each bin of a pooled pdf from counting statistics.
-
-    A bin holding n contacts has P = n / (N width) and
-
-        sigma_P = sqrt(n) / (N width) = P / sqrt(n)    (Poisson).
-
-    NaN where the bin is empty or the counts are not known. Contacts pooled over successive
-    snapshots are counted as independent; a contact that lasts across snapshots is counted in
-    each, so with closely spaced snapshots these bars are a lower bound.
-
-    Parameters
-    ----------
-    pdf : xarray.Dataset
-        A pdf with ``pdf`` and, for the errors, ``count`` (:func:`force_pdf_of`).
-
-    Returns
-    -------
-    numpy.ndarray
-        sigma_P per bin, in the units of ``pdf`` (dimensionless).
-
-    References
-    ----------
-    Azéma, Radjai, Peyroux & Saussine, Phys. Rev. E 76, 011301 (2007),
-    Fig. 14 (Sec. V.B).
-    """
-    p = values(pdf["pdf"])
-    if "count" not in pdf:
-        return np.full_like(p, np.nan)
-    n = values(pdf["count"])
-    with np.errstate(divide="ignore", invalid="ignore"):
-        return np.where(n > 0, p / np.sqrt(n), np.nan)
-
-
 def _draw_pdf(ax, pdf, label, colour, line_kw, style="o-"):
-    """The non-empty bins with their counting error bars (:func:`counting_error`); a bin of a
+    """The non-empty bins with their counting error bars (:func:`grainview.analysis.force_pdf.counting_error`); a bin of a
     single contact, whose lower bar would reach zero on the log axis, gets its upper bar only."""
     x = np.asarray(pdf["f_over_mean"].values, float)
     p = values(pdf["pdf"])
     keep = p > 0
-    error = counting_error(pdf)[keep]
+    error = values(counting_error(pdf))[keep]
     lower = np.where(error < 0.999 * p[keep], error, 0.0)
     ax.errorbar(x[keep], p[keep], yerr=np.vstack([lower, error]), fmt="none", ecolor=colour, elinewidth=0.7,
                 capsize=0)
@@ -688,7 +509,7 @@ def _draw_pdf(ax, pdf, label, colour, line_kw, style="o-"):
 def _draw_fit(ax, pdf, alpha, label, colour):
     """The exponential fit over the strong forces, drawn from f_n = <f_n> to the last bin that
     holds contacts (never beyond the data)."""
-    prefactor = exponential_fit(pdf, alpha)
+    prefactor = float(strong_force_prefactor(pdf, alpha))
     x = np.asarray(pdf["f_over_mean"].values, float)
     held = x[values(pdf["pdf"]) > 0]
     x = x[(x > 1.0) & (x <= (held.max() if held.size else -np.inf))]
@@ -758,7 +579,7 @@ def plot_force_pdf_by_kind(data, ax=None, label=None, scale: str = "log-linear",
         Linear bins (on [0, 6] by default) on a logarithmic P axis, or logarithmic bins on
         log-log axes.
     time : str, int, slice or sequence of int, default "residual"
-        The snapshots averaged over (:func:`grainview.plot._style.select_snapshots`):
+        The snapshots averaged over (:func:`grainview.analysis.snapshots.select_snapshots`):
         ``"residual"`` the residual state, eps_q >= 0.3 (for a run that stops short of it, the
         last part of the run), ``"all"`` or None every snapshot, a snapshot index, a slice or a
         sequence of indices.
@@ -788,7 +609,7 @@ def plot_force_pdf_by_kind(data, ax=None, label=None, scale: str = "log-linear",
     for lab, ds in pairs:
         colour = sample_colour(ax, lab, ds)
         for kind, name, style in (("simple", "s", "o-"), ("double", "d", "s--")):
-            pdf = force_pdf_of(ds, scale, time, bins, range, kind, walls)
+            pdf = _pdf(ds, scale, time, bins, range, kind, walls)
             # one sample: the contact kinds' colours; several: the sample's, the kind by style
             _draw_pdf(ax, pdf, series_label(lab, name), PALETTE[kind] if len(pairs) == 1 else colour, line_kw,
                       style)
@@ -845,49 +666,10 @@ def plot_force_pdfs_by_kind(data, label=None, **kw):
 
 # -- Figs. 15, 16: the xi-network --------------------------------------------------------------
 
-def xi_profile(ds: xr.Dataset, xi=None, time="residual", near=None) -> xr.Dataset:
-    """q(xi)/p, a'(xi) and the contact fraction of the xi-network, averaged over the snapshots ``time``.
-
-    The xi-network holds the contacts with f_n < xi <f_n> (docs/conventions.md §5;
-    :func:`grainview.analysis.xi_network.xi_network`, whose cutoffs are the default).
-
-    Parameters
-    ----------
-    ds : xarray.Dataset
-        A dataset of the contract.
-    xi : array_like of float, optional
-        The cutoffs xi >= 0, multiples of <f_n>.
-    time : str, int, slice or sequence of int, default "residual"
-        The snapshots averaged over (:func:`grainview.plot._style.select_snapshots`):
-        ``"residual"`` the residual state, eps_q >= 0.3 (for a run that stops short of it, the
-        last part of the run), ``"all"`` or None every snapshot, a snapshot index, a slice or a
-        sequence of indices.
-    near : float, optional
-        None: the force-bearing contacts (f_n > 0); a gap in m: also the pairs within it,
-        which carry no force and so belong to every xi-network (the file must hold them;
-        :func:`grainview.analysis.contacts.in_network`).
-
-    Returns
-    -------
-    xarray.Dataset
-        Computed; ``q_over_p``, ``a_prime``, ``contact_fraction`` (dimensionless) and ``count``
-        over ``xi``.
-
-    References
-    ----------
-    Azéma, Radjai, Peyroux & Saussine, Phys. Rev. E 76, 011301 (2007),
-    Sec. V.C, Figs. 15 and 16; docs/conventions.md §5.
-    """
-    from ..analysis.xi_network import xi_network
-    subset = select_snapshots(ds, time)
-    cutoffs = {} if xi is None else {"xi": np.asarray(xi, float)}
-    return xi_network(subset, near=near, **cutoffs).mean("time", keep_attrs=True).compute()
-
-
 def plot_xi_stress(data, ax=None, label=None, xi=None, time="residual", min_contacts: float = 10, **line_kw):
     """Partial shear stress q(xi)/p of the contacts f_n < xi <f_n> against the cutoff xi (paper Fig. 15).
 
-    q(xi) is divided by the p of the whole sample (docs/conventions.md §5; :func:`xi_profile`).
+    q(xi) is divided by the p of the whole sample (docs/conventions.md §5; :func:`grainview.analysis.xi_network.xi_profile`).
     Cutoffs whose network holds fewer than ``min_contacts`` contacts per snapshot on average
     are not drawn. Dimensionless.
 
@@ -905,7 +687,7 @@ def plot_xi_stress(data, ax=None, label=None, xi=None, time="residual", min_cont
         The cutoffs xi >= 0, multiples of <f_n> (default: those of
         :func:`grainview.analysis.xi_network.xi_network`).
     time : str, int, slice or sequence of int, default "residual"
-        The snapshots averaged over (:func:`grainview.plot._style.select_snapshots`):
+        The snapshots averaged over (:func:`grainview.analysis.snapshots.select_snapshots`):
         ``"residual"`` the residual state, eps_q >= 0.3 (for a run that stops short of it, the
         last part of the run), ``"all"`` or None every snapshot, a snapshot index, a slice or a
         sequence of indices.
@@ -932,7 +714,7 @@ def plot_xi_anisotropy(data, ax=None, label=None, xi=None, time="residual", min_
     """Partial fabric anisotropy a'(xi) of the contacts f_n < xi <f_n> against the cutoff xi (paper Fig. 16).
 
     a'(xi) is signed against the whole sample's major stress direction (docs/conventions.md §5;
-    :func:`xi_profile`). Cutoffs whose network holds fewer than ``min_contacts`` contacts per
+    :func:`grainview.analysis.xi_network.xi_profile`). Cutoffs whose network holds fewer than ``min_contacts`` contacts per
     snapshot on average are not drawn: the anisotropy of a handful of contacts is noise (it
     spans [-2, 2]). Dimensionless.
 
@@ -950,7 +732,7 @@ def plot_xi_anisotropy(data, ax=None, label=None, xi=None, time="residual", min_
         The cutoffs xi >= 0, multiples of <f_n> (default: those of
         :func:`grainview.analysis.xi_network.xi_network`).
     time : str, int, slice or sequence of int, default "residual"
-        The snapshots averaged over (:func:`grainview.plot._style.select_snapshots`):
+        The snapshots averaged over (:func:`grainview.analysis.snapshots.select_snapshots`):
         ``"residual"`` the residual state, eps_q >= 0.3 (for a run that stops short of it, the
         last part of the run), ``"all"`` or None every snapshot, a snapshot index, a slice or a
         sequence of indices.
@@ -958,7 +740,7 @@ def plot_xi_anisotropy(data, ax=None, label=None, xi=None, time="residual", min_
         Cutoffs whose network holds fewer contacts per snapshot on average are not drawn.
     near : float, optional
         None: the force-bearing contacts (f_n > 0); a gap in m: also the pairs within it
-        (:func:`xi_profile`). The report counts the near pairs when the files hold them.
+        (:func:`grainview.analysis.xi_network.xi_profile`). The report counts the near pairs when the files hold them.
     log : bool, default False
         A logarithmic xi axis (the paper's inset: the very weak forces).
     **line_kw
@@ -1001,7 +783,7 @@ def plot_xi_anisotropies(data, label=None, near=None, **kw):
         Legend label of a single dataset (None: no legend entry).
     near : float, optional
         None: the force-bearing contacts (f_n > 0); a gap in m: also the pairs within it
-        (:func:`xi_profile`).
+        (:func:`grainview.analysis.xi_network.xi_profile`).
     **kw
         Keyword arguments of :func:`plot_xi_anisotropy` (``time``, ``min_contacts``, line
         keywords), passed to both panels; ``xi`` applies to (a) only.
@@ -1028,7 +810,7 @@ def plot_xi_anisotropies(data, label=None, near=None, **kw):
 def _xi(data, ax, label, xi, time, name, ylabel, min_contacts, line_kw, near=None):
     ax = get_axes(ax)
     for lab, ds in datasets(data, label):
-        prof = xi_profile(ds, xi, time, near)
+        prof = xi_profile(ds, xi, time, near).compute()
         keep = values(prof["count"]) >= min_contacts
         ax.plot(np.asarray(prof["xi"].values, float)[keep], values(prof[name])[keep], "o-", markersize=3,
                 color=sample_colour(ax, lab, ds), label=lab, **line_kw)
@@ -1213,5 +995,4 @@ __all__ = ["plot_normal_force_polar", "plot_tangential_force_polar", "plot_tange
            "plot_force_anisotropy", "plot_force_anisotropies", "plot_force_pdf", "plot_force_pdfs",
            "plot_force_pdf_by_kind", "plot_force_pdfs_by_kind", "plot_xi_stress", "plot_xi_anisotropy",
            "plot_xi_anisotropies", "plot_normal_force", "plot_strong_weak_proportion", "same_scale",
-           "plot_contact_proportions", "plot_type_transitions", "plot_strong_weak_proportions",
-           "angular_profile", "force_pdf_of", "exponential_fit", "counting_error", "xi_profile"]
+           "plot_contact_proportions", "plot_type_transitions", "plot_strong_weak_proportions"]

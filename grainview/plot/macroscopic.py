@@ -11,7 +11,8 @@ from __future__ import annotations
 import numpy as np
 import xarray as xr
 
-from ..analysis.strain import RESIDUAL_STRAIN, friction_and_dilatancy, residual_window, strains
+from ..analysis.strain import (EARLY_STRAIN, RESIDUAL_STRAIN, friction_and_dilatancy, friction_offset,
+                               residual_window, strains)
 from ..analysis.stress import stress_invariants
 from ..analysis.forces import harmonic_prediction
 from ._style import (EPS_Q_LABEL, PALETTE, axis_label, datasets, draw_evolutions, eps_q, finish, get_axes,
@@ -92,46 +93,6 @@ def plot_volumetric_strain(data, ax=None, label=None, **line_kw):
     return finish(ax, None)
 
 
-EARLY_STRAIN = 0.02
-"""Snapshots below this shear strain are left out of the stress–dilatancy diagram: there
-psi = arcsin(eps_p/eps_q) divides two strains that both start from zero, so it swings through
-large values that say nothing about dilatancy (and would set the figure's range)."""
-
-
-def friction_offset(ds: xr.Dataset, min_strain: float = EARLY_STRAIN, incremental: bool = False) -> float:
-    """phi_0 of the stress–dilatancy relation phi ~ phi_0 + psi, in rad: the median of phi - psi.
-
-        phi_0 = median over the snapshots with eps_q >= min_strain of (phi - psi),
-
-    sin phi = q/p, sin psi = eps_p/eps_q (or d eps_p/d eps_q with ``incremental``;
-    :func:`grainview.analysis.strain.friction_and_dilatancy`). It is the friction angle at zero
-    dilatancy of Taylor's relation, which the paper's Fig. 5 shows both shapes follow. A median,
-    not a fit: the slope is 1 by assumption.
-
-    Parameters
-    ----------
-    ds : xarray.Dataset
-        A dataset of the contract.
-    min_strain : float, default 0.02
-        Snapshots with a smaller eps_q are left out (:data:`EARLY_STRAIN`).
-    incremental : bool, default False
-        Use the incremental dilatancy angle.
-
-    Returns
-    -------
-    float
-        phi_0, rad (NaN when no snapshot has both angles).
-
-    References
-    ----------
-    Azéma, Radjai, Peyroux & Saussine, Phys. Rev. E 76, 011301 (2007),
-    Sec. III and Fig. 5; docs/conventions.md §6.
-    """
-    phi, psi = _angles(ds, min_strain, incremental)
-    both = np.isfinite(phi) & np.isfinite(psi)
-    return float(np.median(phi[both] - psi[both])) if both.any() else float("nan")
-
-
 def _angles(ds, min_strain, incremental):
     """phi and psi of every snapshot (rad), NaN below ``min_strain``."""
     angles = friction_and_dilatancy(ds).compute()
@@ -153,7 +114,7 @@ def plot_stress_dilatancy(data, ax=None, label=None, incremental: bool = False, 
 
     The paper's point is that both shapes follow phi ~ phi_0 + psi (Taylor's stress–dilatancy
     relation, phi_0 the friction angle at zero dilatancy): each sample gets a dotted guide of
-    slope 1 through phi_0, the median of phi - psi (:func:`friction_offset`), labelled as a
+    slope 1 through phi_0, the median of phi - psi (:func:`grainview.analysis.strain.friction_offset`), labelled as a
     guide and not a fit, with phi_0 in the legend. Its slope is parallel to phi = psi, which
     passes through the origin, away from both paths, and is not drawn.
 
@@ -170,7 +131,7 @@ def plot_stress_dilatancy(data, ax=None, label=None, incremental: bool = False, 
     incremental : bool, default False
         Draw the incremental angle, sin psi = d eps_p/d eps_q, instead of the cumulative one.
     min_strain : float, default 0.02
-        Snapshots with a smaller eps_q are not drawn (:data:`EARLY_STRAIN`); 0 draws them all.
+        Snapshots with a smaller eps_q are not drawn (:data:`grainview.analysis.strain.EARLY_STRAIN`); 0 draws them all.
     **line_kw
         Keyword arguments of ``matplotlib.axes.Axes.plot``.
 
@@ -314,5 +275,5 @@ def _partial_q_over_p(ds):
     return xr.Dataset({kind: stress_invariants(ds, kind)["q_over_p"] for kind in ("simple", "double", "all")})
 
 
-__all__ = ["plot_q_over_p", "plot_volumetric_strain", "plot_stress_dilatancy", "friction_offset",
+__all__ = ["plot_q_over_p", "plot_volumetric_strain", "plot_stress_dilatancy",
            "plot_harmonic_prediction", "plot_partial_q_over_p"]

@@ -3,7 +3,7 @@ connectivity P(c) (Fig. 7), polar P(theta) (Fig. 8), fabric anisotropy a' (Fig. 
 map of P(m_s, m_d) (Fig. 21) and the partial anisotropies a'_s, a'_d (Fig. 22).
 
 Distributions (P(c), P(theta), P(m_s, m_d)) are averaged over the snapshots chosen by ``time``
-(default ``"residual"``: the residual state; see :func:`grainview.plot._style.select_snapshots`).
+(default ``"residual"``: the residual state; see :func:`grainview.analysis.snapshots.select_snapshots`).
 """
 
 from __future__ import annotations
@@ -13,9 +13,9 @@ import xarray as xr
 
 from ..analysis.connectivity import connectivity_pdf, coordination, joint_connectivity_pdf
 from ..analysis.fabric import fabric_anisotropy, orientation_pdf
+from ..analysis.snapshots import select_snapshots, time_mean
 from ._style import (EPS_Q_LABEL, PALETTE, axis_label, datasets, draw_evolutions, finish, get_axes,
-                     sample_colour, tidy_polar, select_snapshots, set_labels, single_dataset, time_mean, units_of,
-                     values)
+                     sample_colour, tidy_polar, set_labels, single_dataset, units_of, values)
 
 
 def plot_coordination(data, ax=None, label=None, walls: bool = False, **line_kw):
@@ -121,7 +121,7 @@ def plot_connectivity_pdf(data, ax=None, label=None, time="residual", max_c: int
         Legend label of a single dataset (None: no legend entry), so that successive calls on
         the same axes build a comparison.
     time : str, int, slice or sequence of int, default "residual"
-        The snapshots averaged over (:func:`grainview.plot._style.select_snapshots`):
+        The snapshots averaged over (:func:`grainview.analysis.snapshots.select_snapshots`):
         ``"residual"`` the residual state, eps_q >= 0.3 (for a run that stops short of it, the
         last part of the run), ``"all"`` or None every snapshot, a snapshot index, a slice or a
         sequence of indices.
@@ -144,7 +144,7 @@ def plot_connectivity_pdf(data, ax=None, label=None, time="residual", max_c: int
     """
     ax = get_axes(ax)
     for lab, ds in datasets(data, label):
-        pdf = time_mean(connectivity_pdf(select_snapshots(ds, time), max_c=max_c, walls=walls)).sel(c=slice(1, None))
+        pdf = time_mean(connectivity_pdf(select_snapshots(ds, time), max_c=max_c, walls=walls)).sel(c=slice(1, None)).compute()
         ax.plot(pdf["c"].values, values(pdf), "o", linestyle="none", color=sample_colour(ax, lab, ds), label=lab,
                 **line_kw)
     ax.set_xticks(np.arange(1, max_c + 1))  # c is an integer: every value labelled
@@ -171,7 +171,7 @@ def plot_orientation_pdf(data, ax=None, label=None, time="residual", bins: int =
         Legend label of a single dataset (None: no legend entry), so that successive calls on
         the same axes build a comparison.
     time : str, int, slice or sequence of int, default "residual"
-        The snapshots averaged over (:func:`grainview.plot._style.select_snapshots`):
+        The snapshots averaged over (:func:`grainview.analysis.snapshots.select_snapshots`):
         ``"residual"`` the residual state, eps_q >= 0.3 (for a run that stops short of it, the
         last part of the run), ``"all"`` or None every snapshot, a snapshot index, a slice or a
         sequence of indices.
@@ -197,7 +197,7 @@ def plot_orientation_pdf(data, ax=None, label=None, time="residual", bins: int =
     """
     ax = get_axes(ax, polar=True)
     for lab, ds in datasets(data, label):
-        pdf = time_mean(orientation_pdf(select_snapshots(ds, time), bins=bins, kind=kind, walls=walls))
+        pdf = time_mean(orientation_pdf(select_snapshots(ds, time), bins=bins, kind=kind, walls=walls)).compute()
         theta, r = full_turn(pdf["theta"].values, values(pdf))
         ax.plot(theta, r, color=sample_colour(ax, lab, ds), label=lab, **line_kw)
     tidy_polar(ax)
@@ -329,7 +329,7 @@ def plot_joint_connectivity(data, ax=None, label=None, time="residual", max_m: i
     label : str, optional
         Title of the axes for a single dataset (a dict's or list's label otherwise).
     time : str, int, slice or sequence of int, default "residual"
-        The snapshots averaged over (:func:`grainview.plot._style.select_snapshots`):
+        The snapshots averaged over (:func:`grainview.analysis.snapshots.select_snapshots`):
         ``"residual"`` the residual state, eps_q >= 0.3 (for a run that stops short of it, the
         last part of the run), ``"all"`` or None every snapshot, a snapshot index, a slice or a
         sequence of indices.
@@ -354,7 +354,7 @@ def plot_joint_connectivity(data, ax=None, label=None, time="residual", max_m: i
     """
     lab, ds = single_dataset(data, label)
     ax = get_axes(ax)
-    pdf = time_mean(joint_connectivity_pdf(select_snapshots(ds, time), max_m=max_m, walls=walls))
+    pdf = time_mean(joint_connectivity_pdf(select_snapshots(ds, time), max_m=max_m, walls=walls)).compute()
     image = values(pdf.transpose("m_d", "m_s"))
     mesh = ax.imshow(image, origin="lower", cmap=cmap, vmin=0,
                      extent=(-0.5, max_m + 0.5, -0.5, max_m + 0.5), interpolation="nearest")

@@ -138,3 +138,39 @@ def test_lazy_equals_eager():
              ds.grain.harmonic_prediction(), ds.grain.orientation_pdf()]
     for l, e in zip(lazy, eager):
         xr.testing.assert_allclose(l.compute(), e, rtol=1e-13)
+
+
+def _angular_profile_by_loop(ds, snapshots, bins, component="fn"):
+    """<f>(theta)/<f_n> of each snapshot, one contact at a time, then averaged NaN-aware."""
+    rows = []
+    n = ds.sizes["particle"]
+    for t in snapshots:
+        sums, counts, total, m = np.zeros(bins), np.zeros(bins), 0.0, 0
+        for c in range(int(ds["contact_count"].values[t])):
+            fn = float(ds["fn"].values[t, c])
+            if fn <= 0 or ds["j"].values[t, c] >= n:
+                continue
+            nx, ny = ds["normal"].values[t, c]
+            k = int(np.floor((np.arctan2(ny, nx) % np.pi) / (np.pi / bins) + 0.5)) % bins
+            sums[k] += float(ds[component].values[t, c])
+            counts[k] += 1
+            total, m = total + fn, m + 1
+        with np.errstate(invalid="ignore"):
+            rows.append(sums / counts / (total / m))
+    return np.nanmean(rows, axis=0)
+
+
+@pytest.mark.parametrize("component", ["fn", "ft"])
+def test_angular_profile_against_a_loop_through_the_accessor(prepare, component):
+    from grainview.analysis.synthetic import harmonic_series
+
+    ds = harmonic_series(n_snapshots=4, n_contacts=150, seed=5)
+    lazy = prepare(ds)
+    with raise_if_dask_computes():
+        profile = lazy.grain.angular_profile(component, time=slice(1, 4), bins=12)
+    np.testing.assert_allclose(profile.values, _angular_profile_by_loop(ds, [1, 2, 3], 12, component), rtol=1e-12)
+    assert profile.dims == ("theta",) and profile.attrs["units"] == "1"
+    raw = ds.grain.angular_profile(component, time=-1, bins=12, normalise=False)
+    assert raw.attrs["units"] == "N"
+    with pytest.raises(ParameterError, match="component='fx'"):
+        ds.grain.angular_profile("fx")

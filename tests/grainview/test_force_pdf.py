@@ -178,3 +178,84 @@ def test_bad_exponent_input():
         strong_force_exponent(xr.Dataset({"x": ("bin", [1.0])}))
     with pytest.raises(ParameterError, match="low"):
         strong_force_exponent(force_pdf(hand_dataset()), low=2.0, high=1.0)
+
+
+# -- the strong-force prefactor and the counting errors (drawn by Fig. 14, computed here) -------
+
+def _prefactor_by_loop(x, pdf, counts, alpha, low, high):
+    """ln A as the plain weighted mean of ln P_k + alpha x_k, one bin at a time."""
+    total = weighted = 0.0
+    for xk, pk, nk in zip(x, pdf, counts):
+        if low < xk < high and nk > 0 and pk > 0 and np.isfinite(pk):
+            total += nk
+            weighted += nk * (np.log(pk) + alpha * xk)
+    return np.exp(weighted / total) if total > 0 and np.isfinite(alpha) else np.nan
+
+
+def test_exponential_prefactor_against_a_loop():
+    from grainview.analysis.arrays.force_pdf import exponential_prefactor
+
+    rng = np.random.default_rng(3)
+    x = np.linspace(0.05, 5.95, 30)
+    pdf = rng.exponential(0.3, (4, 30)) * (rng.random((4, 30)) > 0.2)  # some empty bins
+    counts = rng.integers(0, 9, (4, 30)) * (pdf > 0)
+    alpha = np.array([0.7, 1.4, np.nan, 2.0])
+    got = exponential_prefactor(x, pdf, counts, alpha, low=1.0, high=5.0)
+    want = [_prefactor_by_loop(x, pdf[r], counts[r], alpha[r], 1.0, 5.0) for r in range(4)]
+    np.testing.assert_allclose(got, want, rtol=RTOL)
+    assert np.isnan(got[2])
+    assert np.isnan(exponential_prefactor(x, pdf[0], np.zeros(30), 1.0))  # no bin holds a contact
+
+
+def test_counting_error_against_a_loop():
+    from grainview.analysis.arrays.force_pdf import counting_error as error_of
+
+    rng = np.random.default_rng(4)
+    counts = rng.integers(0, 5, (3, 12)).astype(float)
+    pdf = counts / (counts.sum(-1, keepdims=True) * 0.5)
+    want = np.array([[p / np.sqrt(n) if n > 0 else np.nan for p, n in zip(prow, nrow)]
+                     for prow, nrow in zip(pdf, counts)])
+    np.testing.assert_allclose(error_of(pdf, counts), want, rtol=RTOL)
+
+
+def test_an_exact_exponential_gives_back_its_prefactor_and_exponent():
+    """P = A exp(-alpha x) on every bin: the fit recovers alpha and A exactly, whatever the counts."""
+    from grainview.analysis.force_pdf import counting_error, strong_force_prefactor
+
+    x = np.linspace(0.1, 5.9, 30)
+    counts = np.arange(30.0) % 7  # bins with no contact are left out of both fits
+    pdf = xr.Dataset({"pdf": ("bin", 2.5 * np.exp(-0.8 * x)), "count": ("bin", counts)},
+                     coords={"f_over_mean": ("bin", x)})
+    assert float(strong_force_exponent(pdf)) == pytest.approx(0.8, rel=1e-12)
+    assert float(strong_force_prefactor(pdf)) == pytest.approx(2.5, rel=1e-12)
+    assert float(strong_force_prefactor(pdf, alpha=0.8, low=3.0)) == pytest.approx(2.5, rel=1e-12)
+    error = counting_error(pdf)
+    with np.errstate(divide="ignore"):
+        want = np.where(counts > 0, pdf["pdf"].values / np.sqrt(counts), np.nan)
+    np.testing.assert_allclose(error.values, want, rtol=RTOL)
+    assert error.name == "pdf_error" and error.attrs["units"] == "1"
+    assert np.isnan(counting_error(pdf.drop_vars("count")).values).all()  # counts unknown
+    with pytest.raises(ParameterError, match="expected the Dataset"):
+        strong_force_prefactor(pdf["pdf"])
+    with pytest.raises(ParameterError, match="low < high"):
+        strong_force_prefactor(pdf, low=2.0, high=1.0)
+
+
+def test_pooled_pdf_over_chosen_snapshots_through_the_accessor(prepare):
+    """``time=`` pools the snapshots it chooses, lazily, the same as pooling them picked by hand."""
+    from grainview.analysis.force_pdf import counting_error, strong_force_prefactor
+    from grainview.analysis.synthetic import harmonic_series
+
+    ds = harmonic_series(n_snapshots=5, n_contacts=400, seed=2)
+    lazy = prepare(ds)
+    with raise_if_dask_computes():
+        pooled = lazy.grain.pooled_force_pdf(bins=20, scale="linear", range=(0.0, 6.0), time=[1, 3, 4])
+        prefactor = strong_force_prefactor(pooled)
+        error = counting_error(pooled)
+    want = pooled_force_pdf(ds.isel(time=[1, 3, 4]), bins=20, scale="linear", range=(0.0, 6.0))
+    xr.testing.assert_allclose(pooled.compute(), want)
+    assert int(pooled["n_contacts"]) == 3 * 400
+    assert float(prefactor) == pytest.approx(_prefactor_by_loop(
+        want["f_over_mean"].values, want["pdf"].values, want["count"].values,
+        float(strong_force_exponent(want)), 1.0, np.inf), rel=1e-10)
+    np.testing.assert_allclose(error.values, counting_error(want).values, rtol=RTOL)

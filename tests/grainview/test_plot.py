@@ -21,7 +21,7 @@ from grainview.contract.errors import ParameterError  # noqa: E402
 from grainview.analysis.fabric import fabric_anisotropy, orientation_pdf  # noqa: E402
 from grainview.analysis.forces import force_anisotropies, harmonic_prediction  # noqa: E402
 from grainview.plot import PlotAccessor, save_figure  # noqa: E402
-from grainview.plot._style import select_snapshots  # noqa: E402
+from grainview.analysis.snapshots import select_snapshots  # noqa: E402
 from grainview.plot.maps import CLASS_COLOURS, KIND_COLOURS, contact_collection, newtons  # noqa: E402
 from grainview.analysis.strain import friction_and_dilatancy, strains  # noqa: E402
 from grainview.analysis.stress import stress_invariants  # noqa: E402
@@ -165,7 +165,7 @@ def test_stress_dilatancy_leaves_out_the_early_snapshots_and_labels_its_guides_a
     # phi_0: the median of phi - psi over the snapshots drawn, the same number as the headline's
     phi, psi = angles["phi"].values[eps >= cut], angles["psi"].values[eps >= cut]
     phi_0 = float(np.median(phi - psi))
-    assert gp.macroscopic.friction_offset(series, min_strain=cut) == pytest.approx(phi_0)
+    assert series.grain.friction_offset(min_strain=cut) == pytest.approx(phi_0)
     x, g = ax.lines[1].get_xdata(), ax.lines[1].get_ydata()
     np.testing.assert_allclose(x - g, phi_0)
     assert "not a fit" in legend_texts(ax)[1] and f"{phi_0:.2f} rad" in legend_texts(ax)[1]
@@ -725,7 +725,8 @@ def test_every_report_figure_says_what_it_plots_in_readable_type(series):
 
 
 def test_pooled_contacts_counts_different_pairs(series):
-    from grainview.plot.captions import pooled_contacts, sampling_note
+    from grainview.analysis.persistence import pooled_contacts
+    from grainview.plot.captions import sampling_note
 
     # the synthetic series keeps the same 300 pairs in every snapshot: 300 different contacts
     assert pooled_contacts(series) == (300, 300.0)
@@ -756,7 +757,7 @@ def test_the_transition_caption_gives_the_snapshot_interval(series):
 
 
 def test_the_headline_phi_0_is_fig5s_and_says_when_the_run_is_too_short(series):
-    from grainview.plot.macroscopic import friction_offset
+    from grainview.analysis.strain import friction_offset
     from grainview.app.report import NOT_REACHED, PHI_0_ROW, run_summary
 
     angles = friction_and_dilatancy(series)

@@ -131,3 +131,19 @@ def test_default_xi_and_scalar():
     ds = builders.square_lattice(3, 3, 2.0, 6.0)
     assert xi_network(ds).sizes["xi"] == 101
     assert xi_network(ds, xi=2.0)["count"].values.tolist() == [[12]]
+
+
+def test_xi_profile_is_the_mean_of_each_snapshots_network_through_the_accessor(prepare):
+    from grainview.analysis.synthetic import harmonic_series
+
+    from .conftest import raise_if_dask_computes
+
+    ds = harmonic_series(n_snapshots=4, n_contacts=200, seed=6)
+    xi = np.array([0.5, 1.0, 2.0, 4.0])
+    lazy = prepare(ds)
+    with raise_if_dask_computes():
+        profile = lazy.grain.xi_profile(xi=xi, time=[0, 2, 3])
+    for name in ("q_over_p", "a_prime", "contact_fraction", "count"):
+        one_by_one = [xi_network(ds.isel(time=[t]), xi=xi)[name].values[0] for t in (0, 2, 3)]
+        np.testing.assert_allclose(profile[name].values, np.mean(one_by_one, axis=0), rtol=1e-12)
+    assert profile.sizes == {"xi": 4}

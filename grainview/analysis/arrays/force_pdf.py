@@ -97,3 +97,43 @@ def exponential_fit(centres, pdf, counts, low=1.0, high=np.inf):
     with np.errstate(invalid="ignore", divide="ignore"):
         slope = (s * sxy - sx * sy) / (s * sxx - sx * sx)
     return np.where(enough, -slope, np.nan)
+
+
+def exponential_prefactor(centres, pdf, counts, alpha, low=1.0, high=np.inf):
+    """A of pdf ~ A exp(-alpha x) given alpha: the intercept of :func:`exponential_fit`'s line.
+
+        ln A = sum_k n_k (ln pdf_k + alpha x_k) / sum_k n_k
+
+    over the bins k with ``low < x_k < high`` that hold contacts (n_k > 0, pdf_k > 0): the
+    count-weighted least squares intercept of ``ln pdf = ln A - alpha x`` for that slope.
+    ``centres`` (n_bins,), ``pdf`` and ``counts`` (..., n_bins), ``alpha`` (...) or a number.
+    Returns A (...), in the units of ``pdf``; NaN without a usable bin or with a non-finite alpha.
+    """
+    x = np.asarray(centres, float)
+    pdf = np.asarray(pdf, float)
+    counts = np.asarray(counts, float)
+    alpha = np.asarray(alpha, float)
+    use = (x > low) & (x < high) & (counts > 0) & (pdf > 0) & np.isfinite(pdf)
+    w = np.where(use, counts, 0.0)
+    y = np.log(np.where(use, pdf, 1.0)) + alpha[..., None] * x
+    total = w.sum(-1)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        log_a = (w * y).sum(-1) / total
+    return np.where((total > 0) & np.isfinite(alpha), np.exp(log_a), np.nan)
+
+
+def counting_error(pdf, counts):
+    """One standard deviation of each bin of a pdf from counting statistics (Poisson).
+
+    A bin holding n contacts has P = n / (N width) and
+
+        sigma_P = sqrt(n) / (N width) = P / sqrt(n);
+
+    NaN where the bin is empty. ``pdf`` and ``counts`` (..., n_bins); returns sigma_P, in the
+    units of ``pdf``.
+    """
+    pdf = np.asarray(pdf, float)
+    counts = np.asarray(counts, float)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        return np.where(counts > 0, pdf / np.sqrt(counts), np.nan)
+
