@@ -122,12 +122,9 @@ class Method:
         return options
 
     def problems(self, parameters) -> list:
-        """What in ``parameters`` this method cannot run with, one 'name=value: expected ...'
-        string each (empty when it can)."""
+        """What in ``parameters`` (:class:`solver.parameters.Parameters`) this stepper method
+        cannot run with, one 'name=value: expected ...' string each (empty when it can)."""
         bad = []
-        if not self.in_stepper:
-            bad.append(f"solver={self.name!r}: expected one of {', '.join(stepper_methods())} ({self.name} solves "
-                       "a problem given by its matrix only, solver.contact_problem)")
         if parameters.domains != 1 and not self.domains:
             bad.append(f"domains={parameters.domains!r}: expected 1 with solver={self.name!r} (it has no "
                        "domain-decomposed sweeps)")

@@ -10,10 +10,12 @@ One step of length h (the theta-scheme, theta = 1/2 by default), each stage a me
    :mod:`solver.warm_start`);
 3. ``_free_velocities``: v_free = v- + h M^-1 F_ext (gravity, wall stresses);
 4. ``_contact_problem``: the points' geometry, Delassus data and Signorini shifts as one
-   :class:`solver.nlgs.ContactProblem`;
-5. ``_solve``: the NLGS (:mod:`solver.nlgs`; Anderson-accelerated, :mod:`solver.acceleration`,
-   and/or on several domains, :mod:`solver.parallel_nlgs`, decomposed once per step for this
-   solve and the overlap recovery's, as the parameters say) for the
+   :class:`solver.nlgs.ContactProblem` (stages 1-4 together: :meth:`Simulation.contact_problem`,
+   public, so that tests and benchmarks take the problem a step poses);
+5. ``_solve``: the contact solver that ``Parameters.solver`` names in the registry
+   :mod:`solver.contact_solvers` (the NLGS, :mod:`solver.nlgs`, or its Anderson-accelerated
+   sweeps, :mod:`solver.acceleration`; either on several domains, :mod:`solver.parallel_nlgs`,
+   decomposed once per step for this solve and the overlap recovery's) for the
    impulses p and the end-of-step velocities v+, then the solution's local-law residual and
    unbalanced force (:mod:`solver.residuals`) for the report;
 6. ``_end_velocities``: walls driven as they are (imposed, fixed, capped);
@@ -23,6 +25,9 @@ One step of length h (the theta-scheme, theta = 1/2 by default), each stage a me
 
 Forces are impulses divided by h. Nothing here loops over particles or contacts in Python:
 each stage is one numba kernel or one vectorised numpy expression.
+
+Each step adds the seconds of its stages to :attr:`Simulation.timings` (keys :data:`STAGES`),
+the documented way to see where a step's time goes (benchmarks/step_profile.py).
 """
 
 from __future__ import annotations
@@ -30,18 +35,54 @@ from __future__ import annotations
 import time
 import warnings
 from dataclasses import asdict, dataclass, replace
+from typing import NamedTuple
 
 import numpy as np
 
 from grainview.contract.errors import ConvergenceWarning, ParameterError
 
-from . import acceleration, broadphase, narrowphase, nlgs, parallel_nlgs, problem_assembly, residuals, warm_start
+from . import broadphase, contact_solvers, narrowphase, nlgs, parallel_nlgs, problem_assembly, residuals, warm_start
+from .contact_solvers import ContactState, Limits
 from .contact_points import PairIndex, force_vectors, point_keys
 from .parameters import ACCELERATIONS, MAX_FRICTION, Parameters, check_time_step  # noqa: F401 (their home)
 from .sample_history import SampleHistory
 from .shapes import Shapes
 from .solve_records import StepLaw, StepStart
 from .walls import FIXED, STRESS, VELOCITY, Walls
+
+
+STAGES = ("broad_phase", "narrow_phase", "warm_start", "contact_problem", "solve", "diagnostics",
+          "overlap_recovery", "update", "other")
+"""The stages whose seconds :attr:`Simulation.timings` accumulates, disjoint, in the order of a
+step: the broad and narrow phases of :meth:`Simulation.detect`; the warm start (the points' keys
+and the matching of the last step's impulses); the contact problem (free velocities and
+:meth:`Simulation._contact_problem`); the solve (the step's decomposition and its solver);
+the diagnostics (the solution's local-law residual and unbalanced force); the overlap recovery
+(its split-impulse solve); the update (end velocities, integration, bookkeeping); and the
+step's other work (its alert distance, its record). Their sum is the time spent in
+:meth:`Simulation.step` and :meth:`Simulation.contact_problem`."""
+
+
+class StepProblem(NamedTuple):
+    """The contact problem a step poses to its solver (:meth:`Simulation.contact_problem`).
+
+    problem : :class:`solver.nlgs.ContactProblem`; state : :class:`solver.contact_solvers.ContactState`,
+    the warm-start impulses (N s) and the free velocities (m s-1, rad s-1), fresh arrays that a
+    solver may update in place; limits : :class:`solver.solve_records.Limits` of the parameters;
+    points : the detected :class:`solver.narrowphase` points; keys : their identities
+    (:func:`solver.contact_points.point_keys`); ra, rb : (P, 2) lever arms (m); v_start (B, 2),
+    omega_start (B,): the start-of-step velocities with the imposed wall velocities.
+    """
+
+    problem: nlgs.ContactProblem
+    state: ContactState
+    limits: Limits
+    points: object
+    keys: np.ndarray
+    ra: np.ndarray
+    rb: np.ndarray
+    v_start: np.ndarray
+    omega_start: np.ndarray
 
 
 @dataclass
@@ -153,7 +194,7 @@ class Simulation:
         self.impulse = np.empty((0, 2))
         self.last = None
         self.history = SampleHistory()  # how the sample was made (solver.scenes, solver.preparation)
-        self.timings = {"broad_phase": 0.0, "narrow_phase": 0.0, "solve": 0.0, "update": 0.0}
+        self.timings = dict.fromkeys(STAGES, 0.0)  # seconds per stage (STAGES), summed over the steps
         self.counters = {"steps": 0, "broad_phase_runs": 0, "sweeps": 0, "point_sweeps": 0, "recovery_sweeps": 0,
                          "unconverged_steps": 0}
         self.unconverged = Unconverged()  # the unconverged steps since the last take_unconverged()
@@ -285,41 +326,67 @@ class Simulation:
         return point_keys(pts, self.n_particles + self.n_walls)
 
     # -- one step ---------------------------------------------------------------------------
-    def step(self) -> StepInfo:
-        """One Moreau–Jean step, in the stages of the module docstring."""
+    def contact_problem(self) -> StepProblem:
+        """The contact problem the next step will pose to its solver (stages 1-4 of the module
+        docstring: the step's alert distance, detection, warm start, free velocities and
+        problem), as a :class:`StepProblem`, without stepping. :meth:`step` poses its problem
+        by this call, so a problem taken here is the one the next step solves, bit for bit:
+        tests and benchmarks capture problems with it (detection's caches and counters move on
+        as a step's would)."""
         self.step_alert = self.alert_for_step()
         pts = self.detect()
+        start = time.perf_counter()
         keys = self._point_keys(pts)
         impulse = self._matched_impulses(keys)
+        middle = time.perf_counter()
         v_start, omega_start, v_free, omega_free = self._free_velocities()
         problem, ra, rb = self._contact_problem(pts, v_start, omega_start)
-        solve_start = time.perf_counter()
-        vx, vy, om = v_free[:, 0].copy(), v_free[:, 1].copy(), omega_free.copy()
-        pn, pt = impulse[:, 0].copy(), impulse[:, 1].copy()
+        state = ContactState(impulse[:, 0].copy(), impulse[:, 1].copy(), v_free[:, 0].copy(), v_free[:, 1].copy(),
+                             omega_free.copy())
         p = self.parameters
+        limits = Limits(float(p.tolerance), float(p.max_tolerance), int(p.max_iterations), int(p.stall_sweeps))
+        self.timings["warm_start"] += middle - start
+        self.timings["contact_problem"] += time.perf_counter() - middle
+        return StepProblem(problem, state, limits, pts, keys, ra, rb, v_start, omega_start)
+
+    def step(self) -> StepInfo:
+        """One Moreau–Jean step, in the stages of the module docstring; the seconds of each
+        stage are added to :attr:`timings` (:data:`STAGES`)."""
+        start = time.perf_counter()
+        staged = sum(self.timings.values())
+        posed = self.contact_problem()
+        problem, state, pts, keys = posed.problem, posed.state, posed.points, posed.keys
+        pn, pt, vx, vy, om = state
+        p = self.parameters
+        solve_start = time.perf_counter()
         decomposition = self._decomposition(problem)
-        result = self._solve(problem, pn, pt, vx, vy, om, p.tolerance, p.max_tolerance, p.max_iterations,
-                             shuffle=p.shuffle, stall=p.stall_sweeps, decomposition=decomposition)
-        self.timings["solve"] += time.perf_counter() - solve_start
-        update_start = time.perf_counter()
+        result = self._solve(problem, state, posed.limits, shuffle=p.shuffle, decomposition=decomposition)
+        converged_start = time.perf_counter()
+        self.timings["solve"] += converged_start - solve_start
         converged = self._count_solve(result, len(keys))
+        diagnostics_start = time.perf_counter()
         law = residuals.local_law_residual(problem, pn, pt, vx, vy, om)
         force, torque = self._unbalanced(problem, pn, pt)
+        update_start = time.perf_counter()
+        self.timings["diagnostics"] += update_start - diagnostics_start
+        recovery = self.timings["overlap_recovery"]
         v_end, om = self._end_velocities(vx, vy, om)
-        self._integrate(pts, problem, ra, rb, v_start, omega_start, v_end, om, decomposition)
+        self._integrate(pts, problem, posed.ra, posed.rb, posed.v_start, posed.omega_start, v_end, om, decomposition)
         self.points = pts
         self.impulse = np.stack([pn, pt], -1)
         self._keys, self._impulse = keys, self.impulse
         self.time += p.time_step
         self.step_index += 1
         self.counters["steps"] += 1
-        self.timings["update"] += time.perf_counter() - update_start
         overlap = float(max(0.0, -pts.gap.min())) if len(pts.gap) else 0.0
         self.last = StepInfo(result.iterations, result.residual, result.max_residual, converged, len(keys), overlap,
                              law, force, torque)
         if not converged:
             self.counters["unconverged_steps"] += 1
             self.unconverged.add(self.last)
+        end = time.perf_counter()
+        self.timings["update"] += end - update_start - (self.timings["overlap_recovery"] - recovery)
+        self.timings["other"] += (end - start) - (sum(self.timings.values()) - staged)
         return self.last
 
     def take_unconverged(self) -> Unconverged:
@@ -444,25 +511,18 @@ class Simulation:
             return None
         return parallel_nlgs.decompose(problem, self.position[:self.n_particles, 0], self.parameters.domains)
 
-    def _solve(self, problem, pn, pt, vx, vy, om, tolerance, max_tolerance, max_iterations, shuffle=False, stall=0,
-               decomposition=None):
-        """Solve a contact problem in place with the sweeps the parameters choose: Anderson-
-        accelerated (:mod:`solver.acceleration`), domain-decomposed
-        (:mod:`solver.parallel_nlgs`, on ``decomposition`` when given), or the serial NLGS
-        (:mod:`solver.nlgs`), in a random order when ``shuffle``; ``stall``: sweeps of the stall
-        test (0: none). Returns the :class:`solver.nlgs.NLGSResult`."""
+    def _solve(self, problem, state: ContactState, limits: Limits, shuffle=False, decomposition=None):
+        """Solve a contact problem in place (``state`` updated) by the method of the registry
+        :mod:`solver.contact_solvers` that ``Parameters.solver`` names, with its options from
+        the parameters (:meth:`solver.contact_solvers.Method.options`): on the step's
+        ``decomposition`` when it has domains, in a random order (seeded by the seed and the
+        step index) when ``shuffle`` and it has one. Returns its
+        :class:`solver.nlgs.NLGSResult`."""
         p = self.parameters
-        x = self.position[:self.n_particles, 0]
-        limits = dict(tolerance=tolerance, max_tolerance=max_tolerance, max_iterations=max_iterations, stall=stall)
-        if p.acceleration == "anderson":
-            return acceleration.solve_problem_anderson(problem, pn, pt, vx, vy, om, memory=p.anderson_memory,
-                                                       period=p.anderson_period, domains=p.domains, x=x,
-                                                       decomposition=decomposition, **limits)
-        if p.domains > 1:
-            return parallel_nlgs.solve_problem_domains(problem, x, pn, pt, vx, vy, om, domains=p.domains,
-                                                       decomposition=decomposition, **limits)
-        return nlgs.solve_problem(problem, pn, pt, vx, vy, om, shuffle=shuffle, seed=p.seed + self.step_index,
-                                  **limits)
+        method = contact_solvers.method(p.solver)
+        options = method.options(p, x=self.position[:self.n_particles, 0], decomposition=decomposition,
+                                 shuffle=shuffle, seed=p.seed + self.step_index)
+        return method.solve(problem, state, limits, **options)
 
     def _recover_overlaps(self, problem, g_end, decomposition=None):
         """Split-impulse removal of overlaps: pseudo-velocities that move the bodies apart at
@@ -471,17 +531,19 @@ class Simulation:
         kinetic energy) are untouched, so existing overlaps are removed gently and never
         pushed out explosively. ``decomposition``: the step's (:meth:`_decomposition`). Returns
         the pseudo-velocities (bodies, 2) and (bodies,)."""
+        start = time.perf_counter()
         p = self.parameters
         h = p.time_step
         recover = np.minimum(p.overlap_recovery_rate * np.maximum(-g_end, 0.0) / h, p.overlap_recovery_speed)
         m = len(problem.a)
         recovery = problem._replace(bias=np.where(g_end >= 0.0, g_end / h, -recover), mu=np.zeros(m))
         bodies = self.n_particles + self.n_walls
-        vx, vy, om = np.zeros(bodies), np.zeros(bodies), np.zeros(bodies)
-        result = self._solve(recovery, np.zeros(m), np.zeros(m), vx, vy, om, p.overlap_recovery_tolerance, 1.0,
-                             p.overlap_recovery_iterations, decomposition=decomposition)
+        state = ContactState(np.zeros(m), np.zeros(m), np.zeros(bodies), np.zeros(bodies), np.zeros(bodies))
+        limits = Limits(float(p.overlap_recovery_tolerance), 1.0, int(p.overlap_recovery_iterations), 0)
+        result = self._solve(recovery, state, limits, decomposition=decomposition)
         self.counters["recovery_sweeps"] += result.iterations
-        return np.stack([vx, vy], -1), om
+        self.timings["overlap_recovery"] += time.perf_counter() - start
+        return np.stack([state.vx, state.vy], -1), state.w
 
     # -- derived quantities ------------------------------------------------------------------
     def kinetic_energy(self):

@@ -25,8 +25,6 @@ def compacted_problem(seed):
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", ConvergenceWarning)
         isotropic_compaction(sim)
-    pts = sim.detect()
-    impulse = sim._matched_impulses(sim._point_keys(pts))
-    v_start, omega_start, v_free, omega_free = sim._free_velocities()
-    problem, _, _ = sim._contact_problem(pts, v_start, omega_start)
-    return sim, problem, impulse, v_free, omega_free
+    posed = sim.contact_problem()
+    pn, pt, vx, vy, w = posed.state
+    return sim, posed.problem, np.stack([pn, pt], -1), np.stack([vx, vy], -1), w

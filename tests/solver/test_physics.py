@@ -5,16 +5,18 @@ import warnings
 import numpy as np
 import pytest
 
-from solver import Parameters, Simulation, Walls
+from solver import Parameters, Simulation, Walls, contact_solvers
 from solver.shapes import mass_and_inertia
 
 G = 9.81
 R = 0.0125
 EXACT = dict(tolerance=1e-12, max_tolerance=1e-12, max_iterations=100_000)
-SOLVERS = pytest.mark.parametrize(
-    "solver", [{}, {"stall_sweeps": 200}, {"acceleration": "anderson"}, {"acceleration": "anderson", "anderson_period": 2},
-               {"domains": 2}],
-    ids=["nlgs", "nlgs-stall", "anderson", "anderson-every-2-sweeps", "domains2"])  # every solver, same answers
+VARIANTS = [({"solver": name}, name) for name in contact_solvers.stepper_methods()] + [
+    ({"solver": "nlgs", "stall_sweeps": 200}, "nlgs-stall"), ({"solver": "anderson", "anderson_period": 2},
+                                                               "anderson-every-2-sweeps"),
+    ({"solver": "nlgs", "domains": 2}, "nlgs-domains2"), ({"solver": "anderson", "domains": 2}, "anderson-domains2")]
+SOLVERS = pytest.mark.parametrize("solver", [v for v, _ in VARIANTS], ids=[i for _, i in VARIANTS])
+"""Every method of the registry the stepper can use, and their variants: the same answers."""
 PENTAGON_ON_EDGE = np.radians(-54.0)  # vertices at -54 + 72 k degrees: an edge at the bottom
 
 

@@ -1,0 +1,143 @@
+"""The registry of contact solvers (solver.contact_solvers): names, what each method can run,
+the stepper's dispatch through it, the problem a step poses and the step's stage timings."""
+
+import copy
+import pickle
+import time
+import warnings
+
+import numpy as np
+import pytest
+
+from grainview.contract.errors import ConvergenceWarning, ParameterError
+from solver import Parameters, compaction_sample, contact_solvers, isotropic_compaction
+from solver.stepper import STAGES
+
+
+def test_the_registered_methods_and_what_each_solves():
+    assert contact_solvers.stepper_methods() == ("anderson", "nlgs")
+    assert contact_solvers.matrix_methods() == ("newton", "nlgs", "pcg")
+    assert contact_solvers.method("anderson").domains and not contact_solvers.method("anderson").shuffle
+    assert contact_solvers.method("nlgs").domains and contact_solvers.method("nlgs").shuffle
+    assert not contact_solvers.method("pcg").in_stepper
+
+
+@pytest.mark.parametrize("name", ["fast", "pcg", "newton", None])
+def test_an_unknown_or_matrix_only_solver_is_refused_in_one_line_naming_the_registered_ones(name):
+    with pytest.raises(ParameterError) as caught:
+        Parameters(solver=name).validate()
+    message = str(caught.value)
+    assert "\n" not in message
+    assert f"solver={name!r}: expected one of ('anderson', 'nlgs')" in message
+    if name in ("pcg", "newton"):  # registered, for problems given by their matrix
+        assert not contact_solvers.method(name).in_stepper
+        return
+    with pytest.raises(ParameterError, match=r"expected one of anderson, nlgs \(the time stepper's\); problems "
+                                             r"given by their matrix: newton, nlgs, pcg"):
+        contact_solvers.method(name)
+
+
+def test_a_method_registers_once():
+    with pytest.raises(ValueError, match="'nlgs' is already registered"):
+        contact_solvers.register(contact_solvers.Method("nlgs", "again", solve=lambda *a: None))
+    with pytest.raises(ValueError, match="needs a stepper entry"):
+        contact_solvers.register(contact_solvers.Method("nothing", "no entry point"))
+    assert "nothing" not in contact_solvers.stepper_methods() + contact_solvers.matrix_methods()
+
+
+def test_what_a_method_cannot_run_with_is_named():
+    with pytest.raises(ParameterError, match="shuffle=True: expected False with solver='anderson'"):
+        Parameters(shuffle=True).validate()
+    with pytest.raises(ParameterError, match="domains=2: expected 1 with shuffle"):
+        Parameters(solver="nlgs", shuffle=True, domains=2).validate()
+    Parameters(solver="nlgs", shuffle=True).validate()
+    Parameters(solver="anderson", domains=2).validate()
+
+
+def test_the_options_a_method_reads_from_the_parameters():
+    p = Parameters(solver="anderson", anderson_memory=5, anderson_period=2, domains=2)
+    x = np.arange(3.0)
+    options = contact_solvers.method("anderson").options(p, x=x, decomposition="d", shuffle=True, seed=7)
+    assert options == dict(memory=5, period=2, domains=2, x=x, decomposition="d")  # no random order
+    options = contact_solvers.method("nlgs").options(Parameters(solver="nlgs"), x=x, shuffle=True, seed=7)
+    assert options == dict(domains=1, x=x, decomposition=None, shuffle=True, seed=7)
+
+
+def test_the_former_acceleration_setting_names_a_solver():
+    assert Parameters(acceleration="off").solver == "nlgs"
+    assert Parameters(acceleration="anderson").solver == "anderson"
+    p = Parameters(solver="nlgs")
+    assert p.acceleration == "off"
+    p.acceleration = "anderson"
+    assert p.solver == "anderson" and p.acceleration == "anderson"
+    with pytest.raises(ParameterError, match="acceleration='fast': expected one of off, anderson"):
+        Parameters(acceleration="fast")
+    assert "acceleration" not in {f for f in Parameters.__dataclass_fields__ if f != "acceleration"}
+    import dataclasses
+
+    assert "acceleration" not in dataclasses.asdict(p)  # a file records solver_solver only
+    assert dataclasses.replace(p, domains=2).solver == "anderson"
+    assert dataclasses.replace(p, acceleration="off").solver == "nlgs"
+
+
+def test_a_parameters_record_pickled_before_the_solver_field_unpickles_with_its_solver():
+    p = Parameters(solver="anderson")
+    assert pickle.loads(pickle.dumps(p)) == p and copy.deepcopy(p) == p
+    old = dict(p.__dict__)
+    del old["solver"]
+    old["acceleration"] = "off"  # how a Parameters was pickled before
+    restored = Parameters.__new__(Parameters)
+    restored.__setstate__(old)
+    assert restored.solver == "nlgs" and "acceleration" not in restored.__dict__
+
+
+def _sample(solver="anderson", **settings):
+    """30 pentagons 800 steps into their isotropic compaction (about 50 contact points)."""
+    sim = compaction_sample(30, "pentagon", seed=3, solver=solver, **settings)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", ConvergenceWarning)
+        isotropic_compaction(sim, max_steps=800, progress=False)
+    return sim
+
+
+@pytest.mark.parametrize("solver", ["anderson", "nlgs"])
+def test_the_problem_taken_is_the_one_the_step_solves_and_taking_it_changes_nothing(solver):
+    """contact_problem() gives the next step's problem: solved by the registry's method it gives
+    the step's impulses bit for bit, and a simulation whose problem was taken steps on exactly
+    as one whose was not."""
+    sim = _sample(solver)
+    twin = copy.deepcopy(sim)
+    posed = sim.contact_problem()
+    assert len(posed.problem.a) > 40 and np.any(posed.state.pn > 0)  # a loaded packing, warm-started
+    assert posed.limits == (sim.parameters.tolerance, sim.parameters.max_tolerance, sim.parameters.max_iterations,
+                            sim.parameters.stall_sweeps)
+    state = contact_solvers.ContactState(*(a.copy() for a in posed.state))
+    method = contact_solvers.method(solver)
+    method.solve(posed.problem, state, posed.limits,
+                 **method.options(sim.parameters, x=sim.position[:sim.n_particles, 0], seed=sim.parameters.seed
+                                  + sim.step_index))
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", ConvergenceWarning)
+        twin.step()
+        sim.step()
+    np.testing.assert_array_equal(twin.impulse, np.stack([state.pn, state.pt], -1))
+    np.testing.assert_array_equal(sim.impulse, twin.impulse)
+    np.testing.assert_array_equal(sim.position, twin.position)
+    np.testing.assert_array_equal(sim.velocity, twin.velocity)
+
+
+def test_the_stage_timings_add_up_to_the_steps():
+    sim = _sample("anderson")
+    assert tuple(sim.timings) == STAGES
+    before = dict(sim.timings)
+    start = time.perf_counter()
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", ConvergenceWarning)
+        for _ in range(20):
+            sim.step()
+    elapsed = time.perf_counter() - start
+    spent = {k: sim.timings[k] - before[k] for k in STAGES}
+    assert all(v >= 0 for v in spent.values()), spent
+    assert all(spent[k] > 0 for k in ("narrow_phase", "warm_start", "contact_problem", "solve", "diagnostics",
+                                      "update", "other")), spent
+    assert 0.95 * elapsed <= sum(spent.values()) <= elapsed
