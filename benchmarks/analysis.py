@@ -13,7 +13,7 @@ import time
 
 import numpy as np
 
-from common import in_fresh_process, markdown_table, median_time
+from benchmarks.common import in_fresh_process, markdown_table, median_time
 
 CASES = {
     "stress (sigma, p, q)": lambda ds: ds.grain.stress_invariants(),

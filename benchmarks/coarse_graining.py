@@ -18,19 +18,17 @@ with the threaded scheduler on every core, or with the synchronous scheduler on 
 (loaded into memory first, the loading not timed). The rate counts particles x snapshots and
 contacts x snapshots per second.
 
-Usage: ``python benchmarks/coarse_graining.py [--quick]``; writes benchmarks/RESULTS-coarse-graining.md.
+Usage: ``python -m benchmarks.coarse_graining [--quick]``; writes benchmarks/results/coarse-graining.md.
 """
 
 from __future__ import annotations
 
 import os
-import sys
 import time
 
 import numpy as np
 
-sys.path.insert(0, os.path.dirname(__file__))
-from common import in_fresh_process, machine_description, markdown_table, median_time, run_and_record  # noqa: E402
+from benchmarks.common import in_fresh_process, machine_description, markdown_table, median_time, run_and_record
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 TARGET_S = 60.0  # 14,400 particles x 100 snapshots on a 200 x 100 grid
@@ -143,7 +141,7 @@ def run(quick=False):
             print(rows[-1], flush=True)
     header = ["sample", "snapshots x particles", "mode", "contacts", "width (mm)", "grid: cells of (mm)", "median time (s)",
               "first run (s)", "M particle-snapshots/s", "M contacts/s", "target: < 60 s", "peak RSS (MiB)"]
-    return (f"# Coarse-grained fields throughput\n\n`python benchmarks/coarse_graining.py{' --quick' if quick else ''}`: "
+    return (f"# Coarse-grained fields throughput\n\n`python -m benchmarks.coarse_graining{' --quick' if quick else ''}`: "
             f"ds.grain.coarse_grained(x=..., y=...) computed on whole runs, the tiled sample on a {GRID[0]} x {GRID[1]} "
             f"grid over the union of the boxes, the study's runs on the default grid (cells of half a width); kernel "
             f"width the mean particle diameter, cutoff 3 widths (the defaults); every "
@@ -159,7 +157,7 @@ def run(quick=False):
 def main(argv=None):
     """Run the benchmark (all of it, or ``--quick``) and write its results
     (:func:`common.run_and_record`)."""
-    run_and_record(__doc__.split("\n\n")[0], run, "RESULTS-coarse-graining.md", argv)
+    run_and_record(__doc__.split("\n\n")[0], run, "results/coarse-graining.md", argv)
 
 
 if __name__ == "__main__":

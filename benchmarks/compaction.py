@@ -48,7 +48,7 @@ import numpy as np
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, os.path.dirname(HERE))
-from common import save_sample, way_of_solving  # noqa: E402
+from benchmarks.common import save_sample, way_of_solving  # noqa: E402
 
 ROUTES = {
     "paper": {"approach_speed": None, "until_solid_fraction": None, "loosen": 1.0, "speed": 0.05},
@@ -140,10 +140,11 @@ def compact(shape: str, particles: int, seed: int, route: str, acceleration: str
             "rattlers": int((per_particle < 2).sum()), "fabric_a": round(float(2 * (high - low)), 4)}
 
 
-def table(path) -> str:
-    """The Markdown table of a JSON-lines file written by this script: one row per route and
-    way of solving, with the mean and the spread (min-max) over seeds."""
-    rows = [json.loads(line) for line in open(path) if line.strip()]
+def table(path, rows=None) -> str:
+    """The Markdown table of a JSON-lines file written by this script (or of ``rows``, the dicts
+    of :func:`compact`): one row per route and way of solving, with the mean and the spread
+    (min-max) over seeds."""
+    rows = rows if rows is not None else [json.loads(line) for line in open(path) if line.strip()]
     out = ["| sample | route | sweeps | seeds | steps | NLGS sweeps (M) | sweeps / step median, p90 | "
            "unconverged steps | time (s) | CPU time (s) | solid fraction | z | rattlers | a |",
            "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
@@ -179,6 +180,7 @@ def main(argv=None):
     parser.add_argument("--report-every", type=int, default=0, help="a progress line every so many steps")
     parser.add_argument("--out", default=os.path.join(HERE, "_data", "compaction.jsonl"))
     parser.add_argument("--table", action="store_true", help="print the table of --out and stop")
+    parser.add_argument("--results", help="also write the table of this run's rows as a results file here")
     args = parser.parse_args(argv)
     if args.table:
         print(table(args.out))
@@ -186,6 +188,7 @@ def main(argv=None):
     os.makedirs(os.path.dirname(os.path.abspath(args.out)), exist_ok=True)
     if args.save and ("," in args.seeds or "," in args.routes):
         parser.error("--save keeps one sample: give one seed and one route")
+    rows = []
     for seed in map(int, args.seeds.split(",")):
         for route in args.routes.split(","):
             result = compact(args.shape, args.particles, seed, route, args.acceleration, args.period, args.stall,
@@ -193,6 +196,15 @@ def main(argv=None):
             with open(args.out, "a") as fh:
                 fh.write(json.dumps(result) + "\n")
             print(json.dumps(result), flush=True)
+            rows.append(result)
+    if args.results:
+        from benchmarks.common import machine_description
+
+        with open(args.results, "w") as fh:
+            fh.write("\n".join(["# Compaction routes", "", "Written by `python -m benchmarks.compaction "
+                                 + " ".join(argv if argv is not None else sys.argv[1:]) + "` (its docstring defines the "
+                                 "routes and the state measures); mean over seeds, min-max in parentheses.", "",
+                                 machine_description(), "", table(None, rows), ""]))
 
 
 if __name__ == "__main__":

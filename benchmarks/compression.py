@@ -1,7 +1,7 @@
 """What compressing a finished run costs and saves: size, time and memory to compress, and the
 analyses' throughput on the compressed file against the same data uncompressed.
 
-    python benchmarks/compression.py [FILE] [--repeats 3] [--out benchmarks/RESULTS-compression.md]
+    python -m benchmarks.compression [FILE] [--repeats 3] [--out benchmarks/results/compression.md]
 
 Without FILE, a synthetic series of 40 snapshots x 200,000 contacts (8 million contacts, every
 slot a contact; benchmarks/analysis.py's writer) is written once into benchmarks/_data. The
@@ -31,8 +31,6 @@ import warnings
 import numpy as np
 
 HERE = os.path.dirname(os.path.abspath(__file__))
-sys.path.insert(0, HERE)
-sys.path.insert(0, os.path.dirname(HERE))
 
 CASES = {
     "stress invariants": lambda ds: ds.grain.stress_invariants()["q_over_p"],
@@ -104,12 +102,12 @@ def main(argv=None):
     args = parser.parse_args(argv)
     warnings.simplefilter("ignore")
     import grainview
-    from common import machine_description
+    from benchmarks.common import machine_description
     from grainview.contract.writer import decompress_file
 
     source = args.file
     if source is None:
-        from analysis import write_series
+        from benchmarks.analysis import write_series
 
         source = os.path.join(HERE, "_data", "series_40x200000.nc")
         if not os.path.exists(source):

@@ -1,13 +1,13 @@
 """Every problem-level method of solver.contact_solvers on problems others use and on the
 stepper's own: time and iterations to a natural-map residual of 1e-4 and of 1e-8 (or the best
-each reaches), a table (RESULTS-contact-solvers.md) and a performance profile
-(contact_solvers_profile.png).
+each reaches), a table (results/contact-solvers.md) and a performance profile
+(results/contact_solvers_profile.png).
 
-    python benchmarks/contact_solvers.py --fetch-siconos MIRROR   # copy the 2D problems out of a siconos git mirror
-    nice -n 10 python benchmarks/contact_solvers.py --build 1000  # capture the stepper's problems (~3 min)
-    nice -n 10 python benchmarks/contact_solvers.py --build 4000  # (~10 min)
-    nice -n 10 python benchmarks/contact_solvers.py               # solve them all, write the table and figure
-    nice -n 10 python benchmarks/contact_solvers.py --degeneracy  # rank and spectrum of the 2020-contact W
+    python -m benchmarks.contact_solvers --fetch-siconos MIRROR   # copy the 2D problems out of a siconos git mirror
+    nice -n 10 python -m benchmarks.contact_solvers --build 1000  # capture the stepper's problems (~3 min)
+    nice -n 10 python -m benchmarks.contact_solvers --build 4000  # (~10 min)
+    nice -n 10 python -m benchmarks.contact_solvers               # solve them all, write the table and figure
+    nice -n 10 python -m benchmarks.contact_solvers --degeneracy  # rank and spectrum of the 2020-contact W
 
 The problems (benchmarks/_data/, ignored by git):
 
@@ -39,7 +39,6 @@ import argparse
 import os
 import pickle
 import subprocess
-import sys
 import time
 import warnings
 
@@ -47,13 +46,11 @@ import numpy as np
 from scipy import sparse
 
 HERE = os.path.dirname(os.path.abspath(__file__))
-sys.path.insert(0, os.path.dirname(HERE))
-sys.path.insert(0, HERE)
-from common import capture_contact_problems, markdown_table  # noqa: E402
+from benchmarks.common import capture_contact_problems, markdown_table
 
 DATA = os.path.join(HERE, "_data", "contact_solvers")
-RESULTS = os.path.join(HERE, "RESULTS-contact-solvers.md")
-FIGURE = os.path.join(HERE, "contact_solvers_profile.png")
+RESULTS = os.path.join(HERE, "results", "contact-solvers.md")
+FIGURE = os.path.join(HERE, "results", "contact_solvers_profile.png")
 SICONOS = ["fc2d_granularflowonwall_00667_00000", "fc2d_granularflowonwall_02020_00213",
            "fc2d_granularflowonwall_07002_00801"]
 SICONOS_PATH = "numerics/src/FrictionContact/test/data"
@@ -389,6 +386,7 @@ if __name__ == "__main__":
     parser.add_argument("--build", type=int, metavar="PARTICLES")
     parser.add_argument("--degeneracy", action="store_true")
     parser.add_argument("--replot", action="store_true", help="table and figure from the last run's rows")
+    parser.add_argument("--out", help="write the table as a results file here (default: printed only)")
     args = parser.parse_args()
     if args.fetch_siconos:
         fetch_siconos(args.fetch_siconos)
@@ -404,3 +402,14 @@ if __name__ == "__main__":
             found = measure()
         profile(found)
         print(table(found))
+        if args.out:
+            from benchmarks.common import machine_description
+
+            with open(args.out, "w") as fh:
+                fh.write("\n".join([
+                    "# Problem-level methods: NLGS, semi-smooth Newton, projected conjugate gradient", "",
+                    "Written by `python -m benchmarks.contact_solvers` (its docstring gives the problems and the "
+                    "method). Time and iterations of each method to a natural-map residual of 1e-4 and 1e-8, or the "
+                    "best it reaches.", "", machine_description(), "", table(found), "",
+                    f"![performance profiles]({os.path.relpath(FIGURE, os.path.dirname(os.path.abspath(args.out)))})",
+                    ""]))

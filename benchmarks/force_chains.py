@@ -12,19 +12,17 @@ with ``follow=True`` (tracks and lifetimes), and the stress invariants as a refe
 reading and dask cost any analysis); contacts = occupied slots (walls included), medians
 of ``repeats`` runs after one warm-up (which also compiles the numba kernel).
 
-Usage: ``python benchmarks/force_chains.py [--quick]``; writes benchmarks/RESULTS-force-chains.md.
+Usage: ``python -m benchmarks.force_chains [--quick]``; writes benchmarks/results/force-chains.md.
 """
 
 from __future__ import annotations
 
 import os
-import sys
 import time
 
 import numpy as np
 
-sys.path.insert(0, os.path.dirname(__file__))
-from common import in_fresh_process, machine_description, markdown_table, median_time, run_and_record  # noqa: E402
+from benchmarks.common import in_fresh_process, machine_description, markdown_table, median_time, run_and_record
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 TARGET = 1e6  # contacts per second
@@ -124,7 +122,7 @@ def run(quick=False):
     load = (f"Load average (1 min) {load_before:.1f} at the start and {os.getloadavg()[0]:.1f} at the end, on "
             f"{os.cpu_count()} cores: above the core count, other work shared the machine and the times are longer "
             f"than on free cores.")
-    return (f"# Force-chain throughput\n\n`python benchmarks/force_chains.py{' --quick' if quick else ''}`: "
+    return (f"# Force-chain throughput\n\n`python -m benchmarks.force_chains{' --quick' if quick else ''}`: "
             f"ds.grain.force_chains() computed on whole runs, medians of {repeats} runs after one warm-up, "
             f"each sample and mode in a fresh process; eager: the file loaded into memory first; dask: opened "
             f"lazily, {CHUNK} snapshots per chunk, threaded scheduler. Contacts: occupied slots, wall contacts "
@@ -137,7 +135,7 @@ def run(quick=False):
 def main(argv=None):
     """Run the benchmark (all of it, or ``--quick``) and write its results
     (:func:`common.run_and_record`)."""
-    run_and_record(__doc__.split("\n\n")[0], run, "RESULTS-force-chains.md", argv)
+    run_and_record(__doc__.split("\n\n")[0], run, "results/force-chains.md", argv)
 
 
 if __name__ == "__main__":

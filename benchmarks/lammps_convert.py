@@ -1,7 +1,7 @@
 """Throughput and memory of ``grainview convert lammps`` on a large LAMMPS run.
 
-    python benchmarks/lammps_convert.py [--width 1.2 --height 1.25 --snapshots 200 --every 50]
-                                        [--data benchmarks/_data/lammps-large] [--out RESULTS-lammps-convert.md]
+    python -m benchmarks.lammps_convert [--width 1.2 --height 1.25 --snapshots 200 --every 50]
+                                        [--data benchmarks/_data/lammps-large] [--out results/lammps-convert.md]
 
 Makes (once, when its folder is empty) a LAMMPS run of about 10,000 disks with
 ``tests/data/lammps/in.settle`` in a larger box: settled for ``--settle`` steps, then dumped
@@ -16,6 +16,7 @@ snapshots. Writes a markdown table to ``--out`` (default: print it).
 from __future__ import annotations
 
 import argparse
+import importlib.util
 import json
 import os
 import subprocess
@@ -82,8 +83,9 @@ def convert(folder: Path) -> dict:
 
 
 def make_run(folder: Path, width: float, height: float, snapshots: int, every: int, settle: int) -> None:
-    sys.path.insert(0, str(FIXTURES))
-    import make_fixtures
+    spec = importlib.util.spec_from_file_location("make_fixtures", FIXTURES / "make_fixtures.py")
+    make_fixtures = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(make_fixtures)
 
     started = time.perf_counter()
     make_fixtures.run(folder, seed=7, steps=snapshots * every, every=every, width=width, height=height,
@@ -111,7 +113,7 @@ def main(argv=None) -> int:
     lines = [
         "# `grainview convert lammps` on a large run",
         "",
-        f"Made by `python benchmarks/lammps_convert.py` on {time.strftime('%Y-%m-%d %H:%M UTC', time.gmtime())} "
+        f"Made by `python -m benchmarks.lammps_convert` on {time.strftime('%Y-%m-%d %H:%M UTC', time.gmtime())} "
         f"(machine: {os.cpu_count()} cores, shared). The run: tests/data/lammps/in.settle in a "
         f"{args.width} m x {args.height} m box, settled {args.settle} steps, then dumped every {args.every} steps; "
         "converted whole and cut after its first 50 snapshots, each in a fresh process (no warm-up: the reader "
@@ -140,7 +142,7 @@ def main(argv=None) -> int:
         "memory while the next is copied: it ends within a few MiB of the peak the validation reached, "
         "whatever the number of snapshots (compare the last two columns; on its own, in a fresh process, "
         "it takes 68 MiB for the 201 snapshots' file and 88 MiB for a 979 MB one: "
-        "benchmarks/RESULTS-compression.md). Before, blocks of up to "
+        "benchmarks/results/compression.md). Before, blocks of up to "
         "64 MiB and a 64 MiB chunk cache per variable gave 302 MiB after 50 snapshots and 674 MiB after "
         "201. What still grows with the snapshots is the validation's peak.",
     ]

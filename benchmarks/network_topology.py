@@ -11,7 +11,7 @@ Samples:
   leaves out by default, are dropped): 36 copies of a real sheared packing, so the same edges,
   triangles and loops per particle as the study's;
 * a LAMMPS run of 10,197 settled disks when present (benchmarks/_data/lammps-large/converted.nc,
-  made by ``python benchmarks/lammps_convert.py``): its last snapshot, one connected packing.
+  made by ``python -m benchmarks.lammps_convert``): its last snapshot, one connected packing.
 
 For each: the whole analysis (dimensions 0 and 1, the Betti curves on 101 thresholds, the cycle
 counts, all the project's own code) and dimension 0 alone, eager on one snapshot held in
@@ -21,20 +21,18 @@ gudhi's persistence of the same complex in dimensions 0 and 1 for comparison, wh
 installed, the cycle counts). The tiled sample is also timed lazily: 4 snapshots (the study's last 4, tiled)
 in chunks of one, computed with dask's threaded scheduler on the machine's cores.
 
-Usage: ``python benchmarks/network_topology.py [--repeats 7]``; writes
-benchmarks/RESULTS-network-topology.md.
+Usage: ``python -m benchmarks.network_topology [--repeats 7]``; writes
+benchmarks/results/network-topology.md.
 """
 
 from __future__ import annotations
 
 import importlib.util
 import os
-import sys
 
 import numpy as np
 
-sys.path.insert(0, os.path.dirname(__file__))
-from common import markdown_table, median_time, write_results  # noqa: E402
+from benchmarks.common import markdown_table, median_time, write_results
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 TARGET_S = 2.0
@@ -108,7 +106,7 @@ def measure(name, ds, repeats):
     return row, whole, stages
 
 
-def run(repeats=7):
+def run(repeats=7, out=None):
     import dask
 
     import grainview
@@ -135,7 +133,7 @@ def run(repeats=7):
     header = ["sample (one snapshot)", "particles", "contacts (edges)", "3-cycles", "beta_1 at xi = 0",
               "whole analysis (s)", "dimension 0 only (s)",
               "edges / union-find / dimension 1 / gudhi dimensions 0 and 1 / cycles (ms)"]
-    intro = (f"`python benchmarks/network_topology.py --repeats {repeats}`: ds.grain.network_persistence() on one "
+    intro = (f"`python -m benchmarks.network_topology --repeats {repeats}`: ds.grain.network_persistence() on one "
              f"snapshot held in memory, medians of {repeats} calls after one warm-up; the whole analysis is "
              "dimensions 0 and 1 with the Betti curves on 101 thresholds and the 3- and 4-cycle counts; "
              "all of it the project's own code (no gudhi). The parts are the array functions of "
@@ -153,7 +151,7 @@ def run(repeats=7):
                     + (f"{1e3 * big_parts['gudhi']:.1f} ms ({big_parts['gudhi'] / own:.0f} times as long), "
                        "so the analysis uses its own code whether gudhi is installed or not."
                        if np.isfinite(big_parts["gudhi"]) else "not measured (gudhi is not installed)."))
-    return write_results(os.path.join(HERE, "RESULTS-network-topology.md"),
+    return write_results(out or os.path.join(HERE, "results", "network-topology.md"),
                          "Topology of the force network: throughput", intro,
                          [markdown_table(header, rows), verdict_line])
 
@@ -165,10 +163,11 @@ def main(argv=None):
 
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--repeats", type=int, default=7, help="calls timed per measurement (default 7)")
+    parser.add_argument("--out", help="the results file (default benchmarks/results/network-topology.md)")
     args = parser.parse_args(argv)
     if args.repeats < 1:
         parser.error(f"--repeats {args.repeats}: expected an integer >= 1")
-    run(repeats=args.repeats)
+    run(repeats=args.repeats, out=args.out)
 
 
 if __name__ == "__main__":

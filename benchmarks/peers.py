@@ -3,7 +3,7 @@
 Run in the peers' own environment (``benchmarks/requirements-peers.txt``; they are not project
 dependencies)::
 
-    python benchmarks/peers.py PILE.npz OUT.npz --engine pymunk --steps 200 --iterations 50
+    python -m benchmarks.peers PILE.npz OUT.npz --engine pymunk --steps 200 --iterations 50
 
 The pile (``PILE.npz``: position (N, 2), angle, radius (circumscribed, m), n_vertices,
 first_vertex and local_vertices (the shape table's body-frame vertices),

@@ -1,126 +1,95 @@
-"""Run every benchmark of issue 5 and write ``benchmarks/RESULTS.md`` (tables) and plots.
+"""The solver's sections of the benchmarks (solver_bench/) and the analysis throughput, one
+section per call, each written to its own file.
 
-    python benchmarks/run.py            # full run (~25 min on 2 cores)
-    python benchmarks/run.py --quick    # tiny sizes, < 3 min: checks that the script works
-    python benchmarks/run.py --only scaling,peers   # some sections
+    python -m benchmarks.sections scaling --out benchmarks/results/scaling.md
+    python -m benchmarks.sections stress --quick --out /tmp/stress.md
 
-A full run writes benchmarks/RESULTS.md; --quick and --only write benchmarks/_data/RESULTS-*.md
-(not committed) unless --output says otherwise.
-
-Sections: scaling (solver speed on dense samples, serial and on 2 domains), work-precision, peers (pymunk, Box2D;
-needs the venv of benchmarks/requirements-peers.txt at /tmp/peervenv or $PEER_PYTHON),
-analysis throughput (benchmarks/analysis.py), skipping what a scene does not need, stress
-tests. RESULTS.md is rewritten after every section, so an interrupted run keeps what it did.
-Set NUMBA_CACHE_DIR to reuse compiled kernels between runs.
+``python -m benchmarks`` calls this once per section (benchmarks/README.md); run it directly
+to measure one section alone. Sections: scaling (solver speed on dense samples, serial and on
+2 domains), work_precision, acceleration (needs the fidelity study's 1000-particle runs, built
+on first use), peers (pymunk, Box2D; needs the venv of benchmarks/requirements-peers.txt at
+/tmp/peervenv or $PEER_PYTHON), analysis (throughput of grainview), skipping (what a scene
+does not need), stress (numerical stress tests), ensemble (dask.distributed runner and
+out-of-core analysis). Set NUMBA_CACHE_DIR to reuse compiled kernels between runs.
 """
 
 from __future__ import annotations
 
 import argparse
 import os
-import sys
 import time
-import traceback
+
+from benchmarks import solver_bench as sb
+from benchmarks.common import machine_description
 
 HERE = os.path.dirname(os.path.abspath(__file__))
-sys.path.insert(0, HERE)
-sys.path.insert(0, os.path.dirname(HERE))
-
-import analysis  # noqa: E402
-import solver_bench as sb  # noqa: E402
-from common import machine_description  # noqa: E402
-
-SECTIONS = ["scaling", "work_precision", "acceleration", "peers", "analysis", "skipping", "stress", "ensemble"]
+DATA = os.path.join(HERE, "_data")
 TITLES = {
-    "scaling": "a. Scaling on dense samples, serial and on 2 domains: time per step, per particle, per contact point "
+    "scaling": "Scaling on dense samples, serial and on 2 domains: time per step, per particle, per contact point "
                "per NLGS sweep, memory",
-    "work_precision": "b. Work-precision: run time against error",
-    "acceleration": "b2. Fewer sweeps at equal accuracy: candidates against the NLGS",
-    "peers": "c. Peers: pymunk and Box2D on the same settled piles",
-    "analysis": "e. Analysis throughput (grainview)",
-    "skipping": "d. Skipping what a scene does not need",
-    "stress": "f. Numerical stress tests at larger sizes",
-    "ensemble": "g. Ensembles on dask.distributed: runner efficiency, out-of-core analysis",
+    "work_precision": "Work-precision: run time against error",
+    "acceleration": "Fewer sweeps at equal accuracy: candidates against the NLGS",
+    "peers": "Peers: pymunk and Box2D on the same settled piles",
+    "analysis": "Analysis throughput (grainview)",
+    "skipping": "Skipping what a scene does not need",
+    "stress": "Numerical stress tests at larger sizes",
+    "ensemble": "Ensembles on dask.distributed: runner efficiency, out-of-core analysis",
 }
+"""Each section's title, in the order of benchmarks/RESULTS.md."""
+
+
+def _analysis(quick):
+    from benchmarks import analysis
+
+    snaps, contacts = (40, 3000) if quick else (1000, 30_000)
+    return analysis.run(n_snapshots=snaps, n_contacts=contacts, chunk=10 if quick else 25,
+                        n_eager=20 if quick else 50, workdir=DATA)
+
+
+def _skipping(cfg):
+    series = sorted(f for f in os.listdir(DATA) if f.startswith("series_")) if os.path.isdir(DATA) else []
+    return sb.section_skipping(cfg, series_path=os.path.join(DATA, series[0]) if series else None)[0]
+
+
+def _ensemble(quick):
+    from benchmarks import ensemble
+
+    folder = os.path.join(DATA, "ensemble_quick" if quick else "ensemble")
+    os.makedirs(folder, exist_ok=True)
+    return (ensemble.runner_efficiency(folder, **ensemble.RUNNER_SIZES[quick]) + "\n\n"
+            + ensemble.out_of_core(folder, **ensemble.OUT_OF_CORE_SIZES[quick]))
+
+
+def measure(name: str, quick: bool, plot_dir: str) -> str:
+    """Run section ``name`` (tiny sizes when ``quick``) and return its Markdown; its plots go
+    to ``plot_dir``, beside the file that links them."""
+    cfg = sb.Config(quick=quick)
+    cfg.plot_dir = plot_dir
+    if name == "analysis":
+        return _analysis(quick)
+    if name == "ensemble":
+        return _ensemble(quick)
+    if name == "skipping":
+        return _skipping(cfg)
+    return getattr(sb, f"section_{name}")(cfg)[0]
 
 
 def main(argv=None):
-    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    parser.add_argument("--quick", action="store_true", help="tiny sizes (< 3 min), to check the script")
-    parser.add_argument("--only", default=",".join(SECTIONS), help="comma-separated sections: " + ",".join(SECTIONS))
-    parser.add_argument("--output", default=None,
-                        help="where to write the tables (default: benchmarks/RESULTS.md for a full run; "
-                             "benchmarks/_data/RESULTS-<sections>.md for --quick or --only, so that the "
-                             "committed RESULTS.md always holds one complete full run)")
+    parser = argparse.ArgumentParser(prog="python -m benchmarks.sections", description=__doc__.split("\n\n")[0])
+    parser.add_argument("section", choices=list(TITLES), help="the section to measure")
+    parser.add_argument("--quick", action="store_true", help="tiny sizes: checks that the section works")
+    parser.add_argument("--out", required=True, help="the section's file (Markdown)")
     args = parser.parse_args(argv)
-    cfg = sb.Config(quick=args.quick)
-    wanted = [s.strip() for s in args.only.split(",") if s.strip()]
-    unknown = set(wanted) - set(SECTIONS)
-    if unknown:
-        parser.error(f"unknown sections {sorted(unknown)}; expected some of {SECTIONS}")
-    if args.output is None:
-        if args.quick or wanted != SECTIONS:
-            os.makedirs(os.path.join(HERE, "_data"), exist_ok=True)
-            tag = ("quick-" if args.quick else "") + "-".join(wanted)
-            args.output = os.path.join(HERE, "_data", f"RESULTS-{tag}.md")
-        else:
-            args.output = os.path.join(HERE, "RESULTS.md")
-    cfg.plot_dir = os.path.dirname(os.path.abspath(args.output))
     start = time.perf_counter()
-    header = ["# Benchmark results", "",
-              f"Generated by `python benchmarks/run.py{' --quick' if args.quick else ''}` "
-              f"({'QUICK run: tiny sizes, numbers only check that the script works' if args.quick else 'full run'}"
-              f"{'' if wanted == SECTIONS else ', sections ' + ', '.join(wanted) + ' only'}). "
-              "See docs/benchmarks.md for what each table means.", "", machine_description(), ""]
-    done = {}
-
-    def write(status):
-        body = list(header)
-        for name in SECTIONS:
-            if name in done:
-                body += [f"## {TITLES[name]}", "", done[name][0],
-                         f"\n_Section time: {done[name][1]:.0f} s._", ""]
-        body.append(status)
-        with open(args.output, "w") as fh:
-            fh.write("\n".join(body) + "\n")
-
-    series_path = None
-    for name in SECTIONS:
-        if name not in wanted:
-            continue
-        print(f"== {name}", flush=True)
-        t0 = time.perf_counter()
-        try:
-            if name == "analysis":
-                snaps, contacts = (40, 3000) if args.quick else (1000, 30_000)
-                text = analysis.run(n_snapshots=snaps, n_contacts=contacts, chunk=10 if args.quick else 25,
-                                    n_eager=20 if args.quick else 50, workdir=os.path.join(HERE, "_data"))
-                series_path = os.path.join(HERE, "_data", f"series_{snaps}x{contacts}.nc")
-                if not args.quick and snaps < 1000:
-                    text = (f"**Scaled down** from the issue's 1000 x 30,000 to {snaps} x {contacts:,} "
-                            "to fit the 25-minute run on 2 cores (contacts per second do not depend on the "
-                            "number of snapshots; memory of the dask rows is per chunk).\n\n" + text)
-            elif name == "ensemble":
-                import ensemble
-
-                folder = os.path.join(HERE, "_data", "ensemble_quick" if args.quick else "ensemble")
-                os.makedirs(folder, exist_ok=True)
-                text = ensemble.runner_efficiency(folder, **ensemble.RUNNER_SIZES[args.quick]) + "\n\n" + \
-                    ensemble.out_of_core(folder, **ensemble.OUT_OF_CORE_SIZES[args.quick])
-            elif name == "skipping":
-                if series_path is None:
-                    candidates = sorted(f for f in os.listdir(os.path.join(HERE, "_data")) if f.startswith("series_"))
-                    series_path = os.path.join(HERE, "_data", candidates[0]) if candidates else None
-                text, _ = sb.section_skipping(cfg, series_path=series_path)
-            else:
-                text, _ = getattr(sb, f"section_{name}")(cfg)
-        except Exception:
-            text = "**Section failed:**\n\n```\n" + traceback.format_exc()[-3000:] + "\n```"
-            print(text, flush=True)
-        done[name] = (text, time.perf_counter() - t0)
-        write(f"_Run in progress: {time.perf_counter() - start:.0f} s so far._")
-    write(f"_Total run time: {time.perf_counter() - start:.0f} s._")
-    print(f"wrote {args.output} in {time.perf_counter() - start:.0f} s")
+    text = measure(args.section, args.quick, os.path.dirname(os.path.abspath(args.out)))
+    run = "quick run: tiny sizes, the numbers only check that the section works" if args.quick else "full run"
+    body = [f"# {TITLES[args.section]}", "",
+            f"Written by `python -m benchmarks --only {args.section}{' --quick' if args.quick else ''}` ({run}). "
+            "See docs/benchmarks.md for what each table means.", "", machine_description(), "", text, "",
+            f"_Section time: {time.perf_counter() - start:.0f} s._"]
+    with open(args.out, "w") as fh:
+        fh.write("\n".join(body) + "\n")
+    print(f"wrote {args.out}")
 
 
 if __name__ == "__main__":

@@ -1,6 +1,6 @@
 """Does the order of the contact points in memory set the cost of an NLGS sweep at large N?
 
-    python benchmarks/point_order.py --sizes 3600,14400,28800,57600 [--shape disk]
+    python -m benchmarks.archive.point_order --sizes 3600,14400,28800,57600 [--shape disk]
 
 For each size: a deposited sample (solver.compaction_sample, no compaction: the geometric
 deposit already touches), three steps, then the contact problem of the fourth step is captured
@@ -16,15 +16,11 @@ Delassus set-up excluded; the same problem for every order.
 from __future__ import annotations
 
 import argparse
-import os
-import sys
 import time
 import warnings
 
 import numpy as np
 
-HERE = os.path.dirname(os.path.abspath(__file__))
-sys.path.insert(0, os.path.dirname(HERE))
 
 
 def _morton(ij):
@@ -40,7 +36,7 @@ def _morton(ij):
 
 def measure(n: int, shape: str, repeats: int = 200) -> dict:
     """ns per point-sweep of each order for ``n`` particles of ``shape``."""
-    from common import capture_contact_problems
+    from benchmarks.common import capture_contact_problems
     from solver import nlgs
     from solver.scenes import compaction_sample
 
@@ -86,7 +82,7 @@ def main(argv=None):
     parser.add_argument("--sizes", default="3600,14400,28800,57600")
     parser.add_argument("--shape", default="disk")
     args = parser.parse_args(argv)
-    from common import machine_description
+    from benchmarks.common import machine_description
 
     print(machine_description() + "\n")
     orders = ("as built", "by body a, b", "Morton cell of a", "random", "as built, 32-bit geometry")

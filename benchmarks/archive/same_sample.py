@@ -1,10 +1,10 @@
 """Does a way of solving change the study's physics?  The evidence for a solver default.
 
-    python benchmarks/same_sample.py --seeds 0,1,2            # shears (~25 min per seed, 2 cores)
-    python benchmarks/same_sample.py --compaction --seeds 0,1,2,3,4 --shapes disk
-    python benchmarks/same_sample.py --tighter 4 --seeds 0,1,2,3 --shapes pentagon
-    python benchmarks/same_sample.py --static --seeds 0 --shapes pentagon
-    python benchmarks/same_sample.py --table                  # RESULTS-same-sample.md's tables
+    python -m benchmarks.archive.same_sample --seeds 0,1,2            # shears (~25 min per seed, 2 cores)
+    python -m benchmarks.archive.same_sample --compaction --seeds 0,1,2,3,4 --shapes disk
+    python -m benchmarks.archive.same_sample --tighter 4 --seeds 0,1,2,3 --shapes pentagon
+    python -m benchmarks.archive.same_sample --static --seeds 0 --shapes pentagon
+    python -m benchmarks.archive.same_sample --table                  # archive/same-sample.md's tables
 
 Shears. Per seed and shape (400 particles, the 'paper' preparation, the study's defaults:
 eps_1 = 0.2 at 1 cm/s, a snapshot every 200 steps, near contacts written), the deposit is
@@ -33,7 +33,7 @@ Written to benchmarks/_data/same_sample/tolerance_<shape>_<seed>_<K>.json.
 
 Static part (``--static``). Is a tolerance's effect that of the forces solved on the same
 geometry, or of the path the grains take? Sample B is sheared with Anderson sweeps (as
-``sweep_bursts.capture`` shears: an extrapolation every 2 sweeps, the stall test over 200) to
+``benchmarks.shear.capture`` shears: an extrapolation every 2 sweeps, the stall test over 200) to
 shear step 30,000 (eps_q about 0.45 for 400 pentagons: the residual state), and every 20th
 step's contact problem up to step 30,400 is re-solved from its warm start at the default
 tolerance and 4, 10 and 100 times tighter (the shear's sweep cap, else 22,000). The q/p of each
@@ -52,15 +52,12 @@ import copy
 import glob
 import json
 import os
-import sys
 import time
 import warnings
 
 import numpy as np
 
-HERE = os.path.dirname(os.path.abspath(__file__))
-sys.path.insert(0, os.path.dirname(HERE))
-sys.path.insert(0, HERE)
+HERE = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))  # benchmarks/
 OUT = os.path.join(HERE, "_data", "same_sample")
 PARTICLES = 400
 SHEARS = {"A-off": ("A", "off"), "A-and": ("A", "anderson"), "B-and": ("B", "anderson")}
@@ -196,7 +193,7 @@ def _q_over_p(problem, pn, pt) -> float:
 def static(seed: int, shape: str) -> dict:
     """The static part of the tolerance effect for one seed and shape (module docstring)."""
     from solver import acceleration, residuals
-    from sweep_bursts import capture
+    from benchmarks.shear import capture
 
     sim = _compacted(seed, shape, "anderson")
     first, last, every = STATIC_STEPS

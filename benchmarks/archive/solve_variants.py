@@ -3,9 +3,9 @@ sweeps (memory m, extrapolated after every sweep or every k-th), serial and on t
 with and without the stall test (solver.nlgs: stop when the quadratic norm has fallen less than
 5% over W sweeps).
 
-    python benchmarks/solve_variants.py --build --particles 1000   # capture (~8 min, cached)
-    python benchmarks/solve_variants.py --build --particles 4000 --shapes pentagon   # (~30 min)
-    python benchmarks/solve_variants.py        # solve every cached set, write RESULTS-solve-variants.md
+    python -m benchmarks.archive.solve_variants --build --particles 1000   # capture (~8 min, cached)
+    python -m benchmarks.archive.solve_variants --build --particles 4000 --shapes pentagon   # (~30 min)
+    python -m benchmarks.archive.solve_variants        # solve every cached set, write archive/solve-variants.md
 
 The problems: a sample of each shape and size compacted with the 'fast' preparation, sheared
 to eps_1 = 0.03 (top wall 1 cm/s, sigma0 = 10 kPa, dt = 5e-4 s), then the contact problems of
@@ -25,18 +25,16 @@ from __future__ import annotations
 import argparse
 import os
 import pickle
-import sys
 import time
 import warnings
 
 import numpy as np
 
-HERE = os.path.dirname(os.path.abspath(__file__))
-sys.path.insert(0, os.path.dirname(HERE))
-from common import capture_contact_problems, markdown_table, sheared_sample, write_results  # noqa: E402
+HERE = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))  # benchmarks/
+from benchmarks.common import capture_contact_problems, markdown_table, sheared_sample, write_results
 
 OUT = os.path.join(HERE, "_data", "solve_variants")
-RESULTS = os.path.join(HERE, "RESULTS-solve-variants.md")
+RESULTS = os.path.join(HERE, "archive", "solve-variants.md")
 SHAPES = ("pentagon", "disk")
 SIZES = (1000, 4000)
 SHEAR = 0.03
@@ -140,7 +138,7 @@ def main(argv=None):
     sections = [measure(shape, particles, candidates) for shape, particles in sets
                 if os.path.exists(cache_path(shape, particles))]
     write_results(RESULTS, "The same contact problems, every solver candidate",
-                  "Written by `python benchmarks/solve_variants.py` (its docstring gives the method). The speed-up is "
+                  "Written by `python -m benchmarks.archive.solve_variants` (its docstring gives the method). The speed-up is "
                   "the plain NLGS's total solve time over the candidate's, from one run with the candidates "
                   "interleaved problem by problem; equal local-law residuals mean equal accuracy.", sections)
 

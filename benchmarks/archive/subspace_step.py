@@ -1,6 +1,6 @@
 """Can a Krylov step converge what the sweeps drift along?  A subspace probe on slow shear steps.
 
-    python benchmarks/subspace_step.py --sample benchmarks/_data/time_to_strain/sample_pentagon_14400_fast.pkl
+    python -m benchmarks.archive.subspace_step --sample benchmarks/_data/time_to_strain/sample_pentagon_14400_fast.pkl
 
 The slow steps of a large sheared packing are a network-wide drift of the impulses along nearly
 self-stressed paths: load moves among the contacts while the bodies hardly move
@@ -35,19 +35,17 @@ asks whether it is, on captured steps (:func:`sweep_bursts.capture`):
    linear term along a near-self-stress puts the face's minimum far out, and the step's solution
    is then set by the inequalities (p_n >= 0, the cones), not by the quadratic.
 
-Writes benchmarks/RESULTS-subspace-step-<N>.md.
+Writes benchmarks/archive/subspace-step-<N>.md.
 """
 import argparse
 import os
-import sys
 import time
 
 import numpy as np
 
-sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
-sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from common import load_sample, markdown_table, write_results  # noqa: E402
-from sweep_bursts import _cone_projections, _relative_velocity, _velocities, capture  # noqa: E402
+from benchmarks.common import load_sample, markdown_table, write_results
+from benchmarks.shear import capture
+from benchmarks.sweep_bursts import _cone_projections, _relative_velocity, _velocities
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 CHECKPOINTS = (5, 10, 20, 40)
@@ -171,7 +169,7 @@ def main(argv=None):
                         help="the shear steps captured (default 10 30)")
     parser.add_argument("--burst", type=int, default=200, help="sweeps that make a step a burst step (default 200)")
     parser.add_argument("--sweeps", type=int, default=20, help="plain sweeps that fix the face (default 20)")
-    parser.add_argument("--out", help="the results file (default benchmarks/RESULTS-subspace-step-<N>.md)")
+    parser.add_argument("--out", help="the results file (default benchmarks/archive/subspace-step-<N>.md)")
     args = parser.parse_args(argv)
     sim, _ = load_sample(args.sample)
     n = sim.n_particles
@@ -200,8 +198,8 @@ def main(argv=None):
     direction_table = markdown_table(
         ["step", "kind", "points", "closed", "sliding", "‖W d‖ / ‖D d‖", "1/2 d.W d (J)", "d.q: free velocities",
          "d.bias", "d.shift", "d.W p_0", "walls' share of ‖d‖²"], directions)
-    out = args.out or os.path.join(HERE, f"RESULTS-subspace-step-{n}.md")
-    intro = (f"Written by `python benchmarks/subspace_step.py --sample {os.path.relpath(args.sample, os.path.dirname(HERE))} "
+    out = args.out or os.path.join(HERE, f"subspace-step-{n}.md")
+    intro = (f"Written by `python -m benchmarks.archive.subspace_step --sample {os.path.relpath(args.sample, os.path.dirname(os.path.dirname(HERE)))} "
              f"--steps {args.steps[0]} {args.steps[1]}`: {n} particles, shear steps {args.steps[0]}-{args.steps[1]} "
              f"(sweeps per step with the default solve: {sweeps}), the face fixed by {args.sweeps} plain sweeps. "
              "The script's docstring defines each column; docs/solver.md (\"What the slow steps are\") reads them.")

@@ -1,7 +1,7 @@
 """Where the impulse changes of NLGS sweeps are, in dense sheared packings: could a sweep skip the
 points (or regions) that have stopped changing?
 
-    python benchmarks/sweep_changes.py pentagon      # 1000 particles, preset fast, 300 biaxial steps
+    python -m benchmarks.archive.sweep_changes pentagon      # 1000 particles, preset fast, 300 biaxial steps
 
 Compacts 1000 particles (preparation 'fast'), shears them 300 steps (top wall 1 cm/s), captures
 the contact problems of the next 20 steps and re-solves every fourth one sweep by sweep, printing
@@ -9,13 +9,10 @@ after sweeps 1, 5, 20, 50 and the last: the quadratic norm, the share of points 
 99.9% of the sum of dV_k^2 = dp_k . W_k dp_k over the sweep, and the share of points whose
 impulse changed at all. Results are quoted in docs/solver.md ("Skipping converged points").
 """
-import os
 import sys
 import warnings
 import numpy as np
-sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
-sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from common import capture_contact_problems  # noqa: E402
+from benchmarks.common import capture_contact_problems
 from solver import nlgs
 from solver.preparation import preparation, prepare_sample
 

@@ -1,14 +1,14 @@
 """How long the paper's study takes: "time to eps_q = 0.4" from measured step rates and step
 counts.
 
-    python benchmarks/time_to_strain.py --measure pentagon,disk   # shear 1000 particles (~30 min)
-    python benchmarks/time_to_strain.py --measure pentagon --acceleration anderson   # the same shear,
+    python -m benchmarks.archive.time_to_strain --measure pentagon,disk   # shear 1000 particles (~30 min)
+    python -m benchmarks.archive.time_to_strain --measure pentagon --acceleration anderson   # the same shear,
                                                                   # Anderson-accelerated sweeps
-    python benchmarks/time_to_strain.py --measure pentagon --acceleration anderson --domains 2
+    python -m benchmarks.archive.time_to_strain --measure pentagon --acceleration anderson --domains 2
                                                                   # ... on two domains, one thread each
-    python benchmarks/time_to_strain.py --measure pentagon --acceleration anderson --period 2 \
+    python -m benchmarks.archive.time_to_strain --measure pentagon --acceleration anderson --period 2 \
         --stall 200 --particles 4000 --until 0.1                  # a check of the extrapolation (~1 h)
-    python benchmarks/time_to_strain.py                           # the tables from what was measured
+    python -m benchmarks.archive.time_to_strain                           # the tables from what was measured
 
 Measured, per shape, on 1000 particles in one process on one core: the compaction of the
 'paper' preparation (steps, seconds) and a whole biaxial test from that sample to eps_q = 0.4
@@ -43,15 +43,13 @@ from __future__ import annotations
 import argparse
 import json
 import os
-import sys
 import time
 import warnings
 
 import numpy as np
 
-HERE = os.path.dirname(os.path.abspath(__file__))
-sys.path.insert(0, os.path.dirname(HERE))
-from common import load_sample, save_sample, way_of_solving  # noqa: E402
+HERE = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))  # benchmarks/
+from benchmarks.common import load_sample, save_sample, way_of_solving
 OUT = os.path.join(HERE, "_data", "time_to_strain")
 TARGET_EPS_Q = 0.4
 MEASURED_N = 1000
@@ -280,7 +278,7 @@ def main(argv=None):
     if not results:
         print("nothing measured yet: run with --measure pentagon,disk")
         return
-    from common import machine_description
+    from benchmarks.common import machine_description
 
     print(machine_description() + "\n")
     print("| shape | N | sample | sweeps | compaction steps, time | shear steps to eps_q = 0.4 (eps_1) | sweeps / step median, "

@@ -1,7 +1,7 @@
 """Cross-check: the same compacted samples sheared by the same biaxial test in three engines.
 
-    nice -n 10 python benchmarks/crosscheck/run.py --jobs 2   # the full run (~1 h on 2 shared cores)
-    python benchmarks/crosscheck/run.py --shape disk --particles 100 --strain 0.02   # a quick look
+    nice -n 10 python -m benchmarks.crosscheck --jobs 2   # the full run (~1 h on 2 shared cores)
+    python -m benchmarks.crosscheck --shape disk --particles 100 --strain 0.02   # a quick look
 
 The engines: this project's solver (``engine_project.py``, its public API), Box2D 2.3
 (``engines_box2d.py``) and pymunk (``engines_pymunk.py``); the peers run as subprocesses in their
@@ -45,11 +45,9 @@ import numpy as np
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 BENCHMARKS = os.path.dirname(HERE)
-sys.path.insert(0, HERE)
-sys.path.insert(0, BENCHMARKS)
 
-import export  # noqa: E402
-from report import write_report  # noqa: E402
+from benchmarks.crosscheck import export
+from benchmarks.crosscheck.report import write_report
 
 DATA = os.path.join(BENCHMARKS, "_data", "crosscheck")
 NETCDF_LOCK = threading.Lock()
@@ -77,7 +75,7 @@ class Job:
 
 
 def build_parser():
-    parser = argparse.ArgumentParser(prog="run.py", description=__doc__.split("\n\n")[0])
+    parser = argparse.ArgumentParser(prog="python -m benchmarks.crosscheck", description=__doc__.split("\n\n")[0])
     parser.add_argument("--shape", default=DEFAULTS["shape"], help="comma-separated: pentagon, disk (default both)")
     parser.add_argument("--particles", type=int, default=DEFAULTS["particles"],
                         help="particles per sample (default 400)")
@@ -139,7 +137,7 @@ def log(message):
 
 def fail(message):
     """Exit with a one-line error."""
-    sys.exit(f"run.py: error: {message}")
+    sys.exit(f"python -m benchmarks.crosscheck: error: {message}")
 
 
 def call(command, what):
@@ -267,7 +265,7 @@ def load_existing(job):
 def command_line(argv):
     niceness = os.nice(0)
     prefix = f"nice -n {niceness} " if niceness else ""
-    return prefix + "python benchmarks/crosscheck/run.py" + "".join(" " + shlex.quote(a) for a in argv)
+    return prefix + "python -m benchmarks.crosscheck" + "".join(" " + shlex.quote(a) for a in argv)
 
 
 def run_record(args, argv, reuse):
@@ -276,7 +274,7 @@ def run_record(args, argv, reuse):
     to ``runs/record-<settings>.json``; ``--reuse`` reads it back (the command that made the
     runs, not the one that only re-analyses them). Exits with one line if ``--reuse`` finds
     none for these settings."""
-    from common import machine_description
+    from benchmarks.common import machine_description
 
     settings = {k: getattr(args, k) for k in ("shapes", "particles", "seed", "strain", "every", "engine_list",
                                                "box2d", "pymunk_iterations", "check_iterations")}

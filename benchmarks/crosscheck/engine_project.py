@@ -1,6 +1,6 @@
 """The cross-check's biaxial test in this project's solver, through its public API.
 
-Run by ``run.py`` in the project's environment::
+Run by ``python -m benchmarks.crosscheck`` in the project's environment::
 
     python engine_project.py SAMPLE.nc OUT.nc --strain 0.25 --every 100
 

@@ -1,6 +1,6 @@
 """The cross-check's biaxial test in Box2D 2.3 (``pip install box2d``, ``import Box2D``).
 
-Run in the peers' virtual environment by ``run.py``::
+Run in the peers' virtual environment by ``python -m benchmarks.crosscheck``::
 
     python engines_box2d.py SAMPLE.npz OUT_DIR --strain 0.25 --every 100 \
         --velocity-iterations 100 --position-iterations 40

@@ -1,6 +1,6 @@
 """The cross-check's biaxial test in pymunk (Chipmunk2D; ``pip install pymunk``).
 
-Run in the peers' virtual environment by ``run.py``::
+Run in the peers' virtual environment by ``python -m benchmarks.crosscheck``::
 
     python engines_pymunk.py SAMPLE.npz OUT_DIR --strain 0.25 --every 100 --iterations 200
 

@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import os
 
-import analyse
+from benchmarks.crosscheck import analyse
 
 LABELS = {"project": "project", "box2d": "Box2D", "pymunk": "pymunk"}
 STYLES = {"project": "-", "Box2D": "--", "pymunk": ":"}
@@ -24,7 +24,7 @@ def write_report(args, jobs, sigma0, record, out_dir, reused_by=None):
     regenerated the report from existing runs (``--reuse``), if any."""
     import platform
 
-    from common import markdown_table
+    from benchmarks.common import markdown_table
 
     os.makedirs(out_dir, exist_ok=True)
     data = {job.out: analyse.series(job.out) for job in jobs}
@@ -38,7 +38,7 @@ def write_report(args, jobs, sigma0, record, out_dir, reused_by=None):
                                                    if e != "project") + ".", "",
         f"Command (wall time {record['wall_s'] / 60:.1f} min in all):", "", "```", record["command"], "```", "",
         *([f"This report was regenerated from that command's runs by `{reused_by}`.", ""] if reused_by else []),
-        "Read with `benchmarks/crosscheck/run.py`'s docstring (protocol) and `export.py` (contract conventions). "
+        "Read with `benchmarks/crosscheck/__main__.py`'s docstring (protocol) and `export.py` (contract conventions). "
         f"Samples: {args.particles} particles, seed {args.seed}, compacted by `grainview run isotropic` under "
         "sigma0 = 10 kPa; every engine starts from the same last snapshot (positions, angles, velocities, walls) "
         f"and shears it to eps_1 = {args.strain:g} with a snapshot every {args.every} steps (dt = 5e-4 s, top wall "
@@ -140,7 +140,7 @@ def write_report(args, jobs, sigma0, record, out_dir, reused_by=None):
                       "~0.02, bearing in mind that a 400-particle sample's residual q/p also moves by a few "
                       "hundredths between runs that differ by any detail (see the spread between engines).", "",
                       markdown_table(["shape", "engine", "budget", "q/p", "doubled", "q/p", "change"], rows), ""]
-    lines += [f"Written by `benchmarks/crosscheck/run.py` on {platform.node() or 'this machine'}; the runs are "
+    lines += [f"Written by `python -m benchmarks.crosscheck` on {platform.node() or 'this machine'}; the runs are "
               f"under `benchmarks/_data/crosscheck/runs/` (not committed).", ""]
     with open(os.path.join(out_dir, "RESULTS.md"), "w") as fh:
         fh.write("\n".join(lines))

@@ -11,16 +11,15 @@ from __future__ import annotations
 
 import copy
 import os
-import sys
 import time
 import warnings
 from dataclasses import replace
 
 import numpy as np
 
-from common import markdown_table
+from benchmarks.common import markdown_table
 
-from .config import HERE, Config
+from .config import Config
 from .helpers import dense_sample, fmt, reset_meters, run_steps, start_biaxial
 
 CANDIDATES = (
@@ -41,14 +40,13 @@ def _state(cfg: Config, shape, log):
         start_biaxial(sim)
         run_steps(sim, 50)
         return sim, f"N = {sim.n_particles}, compacted {steps} steps then 50 biaxial steps (quick run)"
-    sys.path.insert(0, os.path.join(HERE, "fidelity"))
-    from run import Config as FidelityConfig
-    from runs import simulate
+    from benchmarks.fidelity.__main__ import Config as FidelityConfig
+    from benchmarks.fidelity.runs import simulate
 
     run = FidelityConfig().run(shape=shape, particles=cfg.acc_particles)
     if not os.path.exists(run.path()):
         log(f"acceleration {shape}: the fidelity run {os.path.basename(run.path())} is not cached; compacting and "
-            "shearing it now (30-60 min on one core; `python benchmarks/fidelity/run.py` builds it too)")
+            "shearing it now (30-60 min on one core; `python -m benchmarks.fidelity` builds it too)")
     path = simulate(run)  # cached in benchmarks/_data/fidelity
     import grainview
 

@@ -7,7 +7,7 @@ from dataclasses import dataclass
 
 
 HERE = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-"""benchmarks/: where the plots and RESULTS.md go."""
+"""benchmarks/: the package; its _data/ holds what the benchmarks cache."""
 DATA = os.path.join(HERE, "_data")
 PEER_PYTHON = os.environ.get("PEER_PYTHON", "/tmp/peervenv/bin/python")
 

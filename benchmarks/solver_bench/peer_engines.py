@@ -9,7 +9,7 @@ import warnings
 
 import numpy as np
 
-from common import in_fresh_process, markdown_table
+from benchmarks.common import in_fresh_process, markdown_table
 
 from .config import Config, DATA, HERE, PEER_PYTHON
 from .helpers import fmt, largest_overlap, reset_meters, run_steps

@@ -5,10 +5,10 @@ Dense rows. Each sample is a compacted, equilibrated packing (the paper's prepar
 benchmarks/compaction.py's ``fast`` route, cached in ``benchmarks/_data/samples/`` and built
 here when missing). It is sheared as the shear benchmarks shear it (``solver.biaxial_test``,
 top wall at 1 cm/s, sigma_0 kept on the right wall; Anderson sweeps extrapolated every 2
-sweeps, the stall test over 200; ``sweep_bursts._shear``), serially and on 2 domains, each in
+sweeps, the stall test over 200; ``benchmarks.shear.shear``), serially and on 2 domains, each in
 a fresh process, three times in turns (a case's turns take the same steps; the row is the turn
 of median time). The first ``skip`` steps (the shear's start) are left out and the next
-``steps`` timed: a window of the shear, not the whole of it (benchmarks/RESULTS-time-to-strain.md
+``steps`` timed: a window of the shear, not the whole of it (benchmarks/archive/time-to-strain.md
 has whole shears).
 
 Loose rows. At 57,600 particles a dense sample is out of reach of a benchmark run; a sample
@@ -22,7 +22,7 @@ import time
 
 import numpy as np
 
-from common import in_fresh_process, markdown_table
+from benchmarks.common import in_fresh_process, markdown_table
 
 from .config import DATA, Config, TARGET_SWEEP_NS
 from .helpers import dense_sample, reset_meters, run_steps, start_biaxial
@@ -30,7 +30,7 @@ from .helpers import dense_sample, reset_meters, run_steps, start_biaxial
 SAMPLES = os.path.join(DATA, "samples")
 """The cached dense samples, ``<shape>_<N>_fast.pkl`` (benchmarks/compaction.py ``--save``)."""
 SHEAR = dict(acceleration="anderson", anderson_period=2, stall_sweeps=200)
-"""How the shear benchmarks solve (``sweep_bursts._shear``), so the rows compare with them."""
+"""How the shear benchmarks solve (``benchmarks.shear.shear``), so the rows compare with them."""
 
 
 def sample_path(shape: str, n: int) -> str:
@@ -41,7 +41,7 @@ def sample_path(shape: str, n: int) -> str:
 def build_sample(shape: str, n: int, domains: int = 2) -> dict:
     """Compact a dense sample along the ``fast`` route with the shear's settings on
     ``domains`` domains and cache it (benchmarks/compaction.py); returns compaction.py's row."""
-    import compaction
+    from benchmarks import compaction
 
     os.makedirs(SAMPLES, exist_ok=True)
     return compaction.compact(shape, n, 0, "fast", acceleration="anderson", period=SHEAR["anderson_period"],
@@ -52,8 +52,8 @@ def dense_case(path: str, domains: int, skip: int, steps: int) -> dict:
     """Shear the sample at ``path`` (module docstring) on ``domains`` domains; time steps
     ``skip + 1 .. skip + steps``. Returns the per-step sweeps, seconds, contact points and
     local-law residuals of the timed steps, and the simulation's timings and counters over them."""
-    from common import load_sample
-    from sweep_bursts import _Done, _shear
+    from benchmarks.common import load_sample
+    from benchmarks.shear import Done, shear
 
     sim, _ = load_sample(path)
     record = dict(sweeps=[], seconds=[], points=[], law=[], converged=[])
@@ -61,7 +61,7 @@ def dense_case(path: str, domains: int, skip: int, steps: int) -> dict:
     done = [0]
 
     def timed_step():
-        sim.parameters.domains = domains  # _shear sets one domain: the shear's settings on ``domains``
+        sim.parameters.domains = domains  # shear() sets one domain: the shear's settings on ``domains``
         if done[0] == skip:
             reset_meters(sim)
         start = time.perf_counter()
@@ -77,10 +77,10 @@ def dense_case(path: str, domains: int, skip: int, steps: int) -> dict:
     def after_step(info):
         done[0] += 1
         if done[0] == skip + steps:
-            raise _Done
+            raise Done
 
     sim.step = timed_step
-    _shear(sim, after_step)
+    shear(sim, after_step)
     return dict(n=sim.n_particles, domains=domains, timings=dict(sim.timings), counters=dict(sim.counters),
                 **{k: np.asarray(v) for k, v in record.items()})
 
@@ -179,7 +179,7 @@ def section_scaling(cfg: Config, log=print):
             "down, sigma_0 = 10 kPa on the right wall, dt = 5e-4 s, the default tolerance) with Anderson sweeps "
             "extrapolated every 2 sweeps and the stall test over 200 sweeps, as the shear benchmarks solve; each run "
             f"in a fresh process. Steps left out at the shear's start: {skips}; then timed: {timed}: a window of the "
-            "shear, not the whole (whole shears: RESULTS-time-to-strain.md). Each case ran "
+            "shear, not the whole (whole shears: archive/time-to-strain.md). Each case ran "
             f"{cfg.dense_turns} times, the domain counts in turns (the order reversed every other turn); a case's "
             "turns follow the same trajectory step for step, so they differ only by what else the machine did: the "
             "row is the turn of median time, and the range is the turns' spread. 'ns / point / sweep' = NLGS solve "

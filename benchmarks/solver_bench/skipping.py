@@ -8,7 +8,7 @@ import tempfile
 import time
 import warnings
 
-from common import markdown_table
+from benchmarks.common import markdown_table
 
 from .config import Config
 from .helpers import dense_sample, reset_meters, run_steps, start_biaxial

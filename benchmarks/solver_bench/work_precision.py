@@ -10,7 +10,7 @@ import warnings
 
 import numpy as np
 
-from common import markdown_table
+from benchmarks.common import markdown_table
 
 from .config import Config
 from .helpers import dense_sample, fmt, reset_meters, start_biaxial

@@ -1,50 +1,36 @@
-"""Loading a script of benchmarks/ as a module, as the benchmarks themselves import each other
-(their folder on sys.path while the script loads)."""
+"""Benchmarks as modules: ``benchmarks`` is a package (run with ``python -m``), so a test
+imports a current benchmark as ``benchmarks.<name>`` and an archived study as
+``benchmarks.archive.<name>``."""
 
-import importlib.util
-import os
-import sys
+import importlib
 
 import pytest
 
-BENCHMARKS = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "benchmarks")
-
 
 def load_benchmark(name):
-    """The module of ``benchmarks/<name>.py``."""
-    sys.path.insert(0, BENCHMARKS)
-    try:
-        spec = importlib.util.spec_from_file_location(f"bench_{name}", os.path.join(BENCHMARKS, f"{name}.py"))
-        module = importlib.util.module_from_spec(spec)
-        spec.loader.exec_module(module)
-    finally:
-        sys.path.remove(BENCHMARKS)
-    return module
+    """The module ``benchmarks.<name>``: ``load_benchmark("sweep_cost")``, or an archived
+    study's, ``load_benchmark("archive.same_sample")``."""
+    return importlib.import_module(f"benchmarks.{name}")
 
 
 def load_solver_bench(name):
-    """The module ``solver_bench.<name>`` of benchmarks/ (the package the sections of
-    RESULTS.md live in), imported with benchmarks/ on sys.path as ``benchmarks/run.py`` has it."""
-    sys.path.insert(0, BENCHMARKS)
-    try:
-        return importlib.import_module(f"solver_bench.{name}")
-    finally:
-        sys.path.remove(BENCHMARKS)
+    """The module ``benchmarks.solver_bench.<name>`` (the solver's sections of RESULTS.md)."""
+    return importlib.import_module(f"benchmarks.solver_bench.{name}")
 
 
 def shear_sweeps(sim, steps):
     """The NLGS sweeps of each of the first ``steps`` steps of ``sim``'s shear as the shear
-    benchmarks run it (``sweep_bursts._shear``), with nothing timed or profiled: the reference
+    benchmarks run it (``benchmarks.shear.shear``), with nothing timed or profiled: the reference
     that a measured run of the same steps must repeat."""
-    sweep_bursts = load_benchmark("sweep_bursts")
+    shear = load_benchmark("shear")
     sweeps = []
 
     def count(info):
         sweeps.append(info.iterations)
         if len(sweeps) == steps:
-            raise sweep_bursts._Done
+            raise shear.Done
 
-    sweep_bursts._shear(sim, count)
+    shear.shear(sim, count)
     return sweeps
 
 

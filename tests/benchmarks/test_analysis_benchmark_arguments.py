@@ -1,6 +1,6 @@
 """The throughput benchmarks of the force chains, coarse-grained fields and force-network topology
 refuse an argument they do not take in one line, before measuring anything or rewriting their
-results (``--help`` ran the whole benchmark and rewrote benchmarks/RESULTS-*.md)."""
+results (``--help`` ran the whole benchmark and rewrote its file under benchmarks/results/)."""
 
 import os
 import subprocess
@@ -8,20 +8,19 @@ import sys
 
 import pytest
 
-from .conftest import BENCHMARKS
-
-RESULTS = {"force_chains": "RESULTS-force-chains.md", "coarse_graining": "RESULTS-coarse-graining.md",
-           "network_topology": "RESULTS-network-topology.md"}
+ROOT = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..")
+RESULTS = {"force_chains": "force-chains.md", "coarse_graining": "coarse-graining.md",
+           "network_topology": "network-topology.md"}
 
 
 def run_script(name, *args):
-    return subprocess.run([sys.executable, os.path.join(BENCHMARKS, f"{name}.py"), *args], capture_output=True,
-                          text=True, timeout=120)
+    return subprocess.run([sys.executable, "-m", f"benchmarks.{name}", *args], capture_output=True, text=True,
+                          timeout=120, cwd=ROOT)
 
 
 @pytest.mark.parametrize("name", sorted(RESULTS))
 def test_help_and_unknown_arguments_measure_nothing(name):
-    results = os.path.join(BENCHMARKS, RESULTS[name])
+    results = os.path.join(ROOT, "benchmarks", "results", RESULTS[name])
     before = os.stat(results).st_mtime_ns
     shown = run_script(name, "--help")
     assert shown.returncode == 0 and shown.stdout.startswith("usage:") and "--" in shown.stdout

@@ -1,4 +1,4 @@
-"""benchmarks/same_sample.py: the tolerance study's table pairs the runs by seed and computes
+"""benchmarks/archive/same_sample.py: the tolerance study's table pairs the runs by seed and computes
 their differences as by hand."""
 
 import json
@@ -11,7 +11,7 @@ from .conftest import load_benchmark
 
 @pytest.fixture()
 def same_sample(tmp_path, monkeypatch):
-    module = load_benchmark("same_sample")
+    module = load_benchmark("archive.same_sample")
     monkeypatch.setattr(module, "OUT", str(tmp_path))
     return module
 
@@ -22,7 +22,7 @@ def _write(folder, seed, q_default, q_tight, tighter=4):
         runs[run] = {key: 1.0 for key in ("steps", "seconds", "sweeps median", "sweeps p90",
                                           "local-law residual median", "local-law residual p90",
                                           "unbalanced force median", "unbalanced force p90")}
-        runs[run].update({key: 0.5 for key in load_benchmark("same_sample").QUANTITIES})
+        runs[run].update({key: 0.5 for key in load_benchmark("archive.same_sample").QUANTITIES})
         runs[run]["q/p (residual)"] = q
     with open(folder / f"tolerance_pentagon_{seed}_{tighter}.json", "w") as fh:
         json.dump({"seed": seed, "shape": "pentagon", "tighter": tighter, **runs}, fh)

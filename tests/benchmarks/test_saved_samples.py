@@ -1,5 +1,5 @@
 """A sample compacted by benchmarks/compaction.py ``--save`` is the one that
-benchmarks/time_to_strain.py ``--sample`` shears: the pickle holds the compacted simulation
+benchmarks/archive/time_to_strain.py ``--sample`` shears: the pickle holds the compacted simulation
 whole (its steps, its particles, its state), the shear starts from it, and a sample of another
 size or shape is refused with one line."""
 
@@ -37,7 +37,7 @@ def test_the_saved_sample_is_the_compacted_one(saved):
 
 def test_the_shear_starts_from_the_saved_sample(saved, monkeypatch, tmp_path):
     row, path = saved
-    time_to_strain = load("time_to_strain")
+    time_to_strain = load("archive.time_to_strain")
     monkeypatch.setattr(time_to_strain, "OUT", str(tmp_path))
     result = time_to_strain.measure("pentagon", "anderson", particles=60, until=0.002, sample=path)
     steps = result.pop("per_step")
@@ -51,7 +51,7 @@ def test_the_shear_starts_from_the_saved_sample(saved, monkeypatch, tmp_path):
 
 def test_a_sample_of_another_size_is_refused(saved):
     _, path = saved
-    time_to_strain = load("time_to_strain")
+    time_to_strain = load("archive.time_to_strain")
     with pytest.raises(SystemExit, match="holds 60 particles, expected 80 pentagons"):
         time_to_strain.measure("pentagon", "anderson", particles=80, until=0.002, sample=path)
     with pytest.raises(SystemExit, match="expected 60 disks"):

@@ -1,4 +1,4 @@
-"""benchmarks/subspace_step.py: its face map is P and P^T, its conjugate gradient solves a
+"""benchmarks/archive/subspace_step.py: its face map is P and P^T, its conjugate gradient solves a
 hand-made sticking contact exactly, and on a captured shear step its energies, gradients and the
 split of the direction agree with independent recomputations."""
 
@@ -10,7 +10,7 @@ from .conftest import load_benchmark
 
 @pytest.fixture(scope="module")
 def subspace():
-    return load_benchmark("subspace_step")
+    return load_benchmark("archive.subspace_step")
 
 
 def test_lift_and_restrict_are_adjoint(subspace):

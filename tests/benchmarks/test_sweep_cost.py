@@ -9,9 +9,9 @@ from .conftest import load_benchmark as load
 
 @pytest.fixture(scope="module")
 def problems(pentagon_sample):
-    sweep_bursts = load("sweep_bursts")
+    shear = load("shear")
     sim, _ = load("common").load_sample(pentagon_sample)
-    return sweep_bursts.capture(sim, 3, 4)
+    return shear.capture(sim, 3, 4)
 
 
 def test_layouts_keep_every_point(problems):
