@@ -13,6 +13,7 @@ import numpy as np
 
 from ..contract.errors import ParameterError
 from ..analysis.snapshots import select_snapshots
+from ._docs import fill_doc
 from ._style import (EPS_Q_LABEL, datasets, draw_evolutions, finish, get_axes, sample_colour, single_dataset,
                      snapshot_index)
 
@@ -40,6 +41,7 @@ def _chains_of(ds, chains, k, angle, min_size):
     return chains.isel(time=k).compute()
 
 
+@fill_doc
 def plot_chain_map(data, ax=None, time: int = -1, angle: float = 45.0, min_size: int = 3, chains=None,
                    linewidth: float = 1.5, title: bool = True):
     """Map of the force chains of snapshot ``time``: each chain's particles in one colour, the
@@ -52,17 +54,12 @@ def plot_chain_map(data, ax=None, time: int = -1, angle: float = 45.0, min_size:
 
     Parameters
     ----------
-    data : xarray.Dataset, dict or list
-        One dataset of the contract (a dict or list must hold exactly one): this figure draws
-        one sample.
-    ax : matplotlib.axes.Axes, optional
-        The axes to draw on (default: new axes on a new figure).
-    time : int, default -1
-        Index of the snapshot drawn (negative counts from the end).
+    {data_one}
+    {ax}
+    {time_drawn}
     angle : float, default 45
         Alignment angle of :func:`grainview.analysis.force_chains.force_chains`, degrees.
-    min_size : int, default 3
-        Fewest particles of a chain.
+    {min_size}
     chains : xarray.Dataset, optional
         ``force_chains(ds, ...)`` of the whole dataset, already computed or lazy (default:
         computed here for this snapshot with ``angle`` and ``min_size``).
@@ -73,8 +70,7 @@ def plot_chain_map(data, ax=None, time: int = -1, angle: float = 45.0, min_size:
 
     Returns
     -------
-    matplotlib.axes.Axes
-        The axes drawn on.
+    {returns_axes}
 
     References
     ----------
@@ -103,6 +99,7 @@ def plot_chain_map(data, ax=None, time: int = -1, angle: float = 45.0, min_size:
     return ax
 
 
+@fill_doc
 def plot_chain_fractions(data, ax=None, label=None, angle: float = 45.0, min_size: int = 3):
     """Shares of the chains along the shear: of the particles, of the deviatoric stress and of
     the mean stress, against eps_q.
@@ -115,19 +112,15 @@ def plot_chain_fractions(data, ax=None, label=None, angle: float = 45.0, min_siz
     ----------
     data : xarray.Dataset, dict or list
         One dataset, or several as ``{label: ds}`` or ``[(label, ds), ...]``.
-    ax : matplotlib.axes.Axes, optional
-        The axes to draw on (default: new axes on a new figure).
+    {ax}
     label : str, optional
         Legend label of a single dataset.
-    angle : float, default 45
-        Alignment angle, degrees.
-    min_size : int, default 3
-        Fewest particles of a chain.
+    {angle}
+    {min_size}
 
     Returns
     -------
-    matplotlib.axes.Axes
-        The axes drawn on.
+    {returns_axes}
 
     References
     ----------
@@ -147,6 +140,7 @@ def plot_chain_fractions(data, ax=None, label=None, angle: float = 45.0, min_siz
     return finish(ax, pairs)
 
 
+@fill_doc
 def plot_chain_lengths(data, ax=None, label=None, time="residual", angle: float = 45.0, min_size: int = 3,
                        max_length: int = 50):
     """Pdf of the chains' lengths (particles per chain) over the snapshots of ``time``.
@@ -159,23 +153,19 @@ def plot_chain_lengths(data, ax=None, label=None, time="residual", angle: float 
     ----------
     data : xarray.Dataset, dict or list
         One dataset, or several as ``{label: ds}`` or ``[(label, ds), ...]``.
-    ax : matplotlib.axes.Axes, optional
-        The axes to draw on (default: new axes on a new figure).
+    {ax}
     label : str, optional
         Legend label of a single dataset.
     time : "residual", "all", int, slice or sequence, default "residual"
         The snapshots pooled (:func:`grainview.analysis.snapshots.select_snapshots`).
-    angle : float, default 45
-        Alignment angle, degrees.
-    min_size : int, default 3
-        Fewest particles of a chain.
+    {angle}
+    {min_size}
     max_length : int, default 50
         Last length bin.
 
     Returns
     -------
-    matplotlib.axes.Axes
-        The axes drawn on.
+    {returns_axes}
 
     References
     ----------
@@ -201,6 +191,7 @@ def plot_chain_lengths(data, ax=None, label=None, time="residual", angle: float 
     return finish(ax, pairs)
 
 
+@fill_doc
 def plot_chain_lifetimes(data, ax=None, label=None, angle: float = 45.0, min_size: int = 3):
     """Survival of the chains followed from snapshot to snapshot: the fraction of chains seen
     in at least n snapshots, against n, for the chains born and gone within the record
@@ -210,19 +201,15 @@ def plot_chain_lifetimes(data, ax=None, label=None, angle: float = 45.0, min_siz
     ----------
     data : xarray.Dataset, dict or list
         One dataset, or several as ``{label: ds}`` or ``[(label, ds), ...]``.
-    ax : matplotlib.axes.Axes, optional
-        The axes to draw on (default: new axes on a new figure).
+    {ax}
     label : str, optional
         Legend label of a single dataset.
-    angle : float, default 45
-        Alignment angle, degrees.
-    min_size : int, default 3
-        Fewest particles of a chain.
+    {angle}
+    {min_size}
 
     Returns
     -------
-    matplotlib.axes.Axes
-        The axes drawn on.
+    {returns_axes}
 
     References
     ----------
@@ -247,6 +234,7 @@ def plot_chain_lifetimes(data, ax=None, label=None, angle: float = 45.0, min_siz
     return finish(ax, pairs)
 
 
+@fill_doc
 def animate_chains(data, path, every: int = 1, fps: int = 8, angle: float = 45.0, min_size: int = 3,
                    dpi: int = 90, progress: bool = True, overwrite: bool = False) -> str:
     """Write a movie of the chain maps (:func:`plot_chain_map`) of every ``every``-th snapshot
@@ -263,10 +251,8 @@ def animate_chains(data, path, every: int = 1, fps: int = 8, angle: float = 45.0
         Draw every ``every``-th snapshot (the last always included).
     fps : int, default 8
         Frames per second.
-    angle : float, default 45
-        Alignment angle, degrees.
-    min_size : int, default 3
-        Fewest particles of a chain.
+    {angle}
+    {min_size}
     dpi : int, default 90
         Resolution of the frames, dots per inch.
     progress : bool, default True

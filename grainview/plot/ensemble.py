@@ -4,11 +4,13 @@ from __future__ import annotations
 
 import numpy as np
 
+from ._docs import fill_doc
 from ._style import EPS_Q_LABEL, sample_colour
 
 __all__ = ["seed_bands"]
 
 
+@fill_doc
 def seed_bands(stats, ax=None, label: str = "", units: str = "1"):
     """Draw :func:`grainview.analysis.ensemble.seed_statistics` binned on eps_q: mean and spread per group.
 
@@ -22,8 +24,7 @@ def seed_bands(stats, ax=None, label: str = "", units: str = "1"):
     stats : xarray.Dataset
         The result of :func:`grainview.analysis.ensemble.seed_statistics` with ``eps_q_bins``: ``mean``,
         ``std``, ``n`` over (group, eps_q_bin).
-    ax : matplotlib.axes.Axes, optional
-        The axes to draw on (default: new axes on a new figure).
+    {ax}
     label : str, default ""
         The quantity's symbol, the y-axis label.
     units : str, default "1"
@@ -31,8 +32,7 @@ def seed_bands(stats, ax=None, label: str = "", units: str = "1"):
 
     Returns
     -------
-    matplotlib.axes.Axes
-        The axes drawn on.
+    {returns_axes}
     """
     import matplotlib.pyplot as plt
 

@@ -9,6 +9,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..contract.errors import ParameterError
+from ._docs import fill_doc
 from ._style import axis_label, new_figure, single_dataset, snapshot_index
 
 __all__ = ["plot_field_maps", "plot_field_profiles", "plot_shear_band", "draw_band", "DEFAULT_FIELDS"]
@@ -54,6 +55,7 @@ def _label(name, units):
     return axis_label(SYMBOLS.get(name, name), units)
 
 
+@fill_doc
 def plot_field_maps(data, names=DEFAULT_FIELDS, time: int = -1, width=None, spacing=None, cutoff: float = 3.0,
                     fields=None, stress: str = "total", title: bool = True, band=None):
     """Maps of coarse-grained fields of snapshot ``time``, one panel per quantity, over the grid,
@@ -66,8 +68,7 @@ def plot_field_maps(data, names=DEFAULT_FIELDS, time: int = -1, width=None, spac
         One dataset of the contract (a dict or list must hold exactly one).
     names : sequence of str, default ("sigma_yy", "q_over_p", "solid_fraction")
         The quantities (:data:`grainview.analysis.coarse_graining.QUANTITIES`).
-    time : int, default -1
-        Index of the snapshot drawn (negative counts from the end).
+    {time_drawn}
     width, spacing, cutoff : float, optional
         The kernel width, grid spacing (m) and cutoff (widths) of
         :func:`grainview.analysis.coarse_graining.coarse_grained`, when ``fields`` is not given.

@@ -16,6 +16,7 @@ from ..contract.errors import ParameterError
 from ..analysis.force_pdf import counting_error, pooled_force_pdf, strong_force_exponent, strong_force_prefactor
 from ..analysis.forces import angular_profile, force_anisotropies
 from ..analysis.xi_network import xi_profile
+from ._docs import fill_doc
 from ._style import (EPS_Q_LABEL, PALETTE, PI_TICK_LABELS, axis_label, datasets, draw_evolutions, finish, get_axes,
                      legend_in_first, new_figure, sample_colour, series_label, set_labels, tidy_polar, units_of,
                      values)
@@ -27,6 +28,7 @@ XI_LABEL = r"$\xi$"
 
 # -- Fig. 10: angular averages -----------------------------------------------------------------
 
+@fill_doc
 def plot_normal_force_polar(data, ax=None, label=None, time="residual", bins: int = 36, kind="all",
                             walls: bool = False, normalise: bool = True, **line_kw):
     """Polar plot of the angle-averaged normal force <f_n>(theta) (paper Fig. 10a).
@@ -36,36 +38,19 @@ def plot_normal_force_polar(data, ax=None, label=None, time="residual", bins: in
 
     Parameters
     ----------
-    data : xarray.Dataset, dict or list
-        One dataset of the contract, or several to compare on the same axes as ``{label: ds}``
-        or ``[(label, ds), ...]``.
-    ax : matplotlib.axes.Axes, optional
-        Polar axes to draw on (default: new polar axes on a new figure).
-    label : str, optional
-        Legend label of a single dataset (None: no legend entry), so that successive calls on
-        the same axes build a comparison.
-    time : str, int, slice or sequence of int, default "residual"
-        The snapshots averaged over (:func:`grainview.analysis.snapshots.select_snapshots`):
-        ``"residual"`` the residual state, eps_q >= 0.3 (for a run that stops short of it, the
-        last part of the run), ``"all"`` or None every snapshot, a snapshot index, a slice or a
-        sequence of indices.
-    bins : int, default 36
-        Number of angular sectors of [0, pi), centred on theta_k = k pi/bins.
-    kind : {"all", "simple", "double"}, default "all"
-        The contacts used: all, simple (vertex–edge and disk contacts) or double (edge–edge)
-        ones (also 1, 2, "s", "d"; :func:`grainview.analysis.contacts.kind_code`).
-    walls : bool, default False
-        Include the particle–wall contacts (default: particle–particle only).
-    normalise : bool, default True
-        Divide each snapshot's profile by its mean normal force <f_n> over the same contacts
-        (dimensionless); otherwise in N.
-    **line_kw
-        Keyword arguments of ``matplotlib.axes.Axes.plot``.
+    {data}
+    {ax_polar}
+    {label}
+    {time_averaged}
+    {bins}
+    {kind}
+    {walls}
+    {normalise}
+    {line_kw}
 
     Returns
     -------
-    matplotlib.axes.Axes
-        The axes drawn on.
+    {returns_axes}
 
     References
     ----------
@@ -76,6 +61,7 @@ def plot_normal_force_polar(data, ax=None, label=None, time="residual", bins: in
                   line_kw)
 
 
+@fill_doc
 def plot_tangential_force_polar(data, ax=None, label=None, time="residual", bins: int = 36, kind="all",
                                 walls: bool = False, normalise: bool = True, **line_kw):
     """Polar plot of the magnitude |<f_t>(theta)| of the angle-averaged tangential force (paper Fig. 10b).
@@ -86,36 +72,19 @@ def plot_tangential_force_polar(data, ax=None, label=None, time="residual", bins
 
     Parameters
     ----------
-    data : xarray.Dataset, dict or list
-        One dataset of the contract, or several to compare on the same axes as ``{label: ds}``
-        or ``[(label, ds), ...]``.
-    ax : matplotlib.axes.Axes, optional
-        Polar axes to draw on (default: new polar axes on a new figure).
-    label : str, optional
-        Legend label of a single dataset (None: no legend entry), so that successive calls on
-        the same axes build a comparison.
-    time : str, int, slice or sequence of int, default "residual"
-        The snapshots averaged over (:func:`grainview.analysis.snapshots.select_snapshots`):
-        ``"residual"`` the residual state, eps_q >= 0.3 (for a run that stops short of it, the
-        last part of the run), ``"all"`` or None every snapshot, a snapshot index, a slice or a
-        sequence of indices.
-    bins : int, default 36
-        Number of angular sectors of [0, pi), centred on theta_k = k pi/bins.
-    kind : {"all", "simple", "double"}, default "all"
-        The contacts used: all, simple (vertex–edge and disk contacts) or double (edge–edge)
-        ones (also 1, 2, "s", "d"; :func:`grainview.analysis.contacts.kind_code`).
-    walls : bool, default False
-        Include the particle–wall contacts (default: particle–particle only).
-    normalise : bool, default True
-        Divide each snapshot's profile by its mean normal force <f_n> over the same contacts
-        (dimensionless); otherwise in N.
-    **line_kw
-        Keyword arguments of ``matplotlib.axes.Axes.plot``.
+    {data}
+    {ax_polar}
+    {label}
+    {time_averaged}
+    {bins}
+    {kind}
+    {walls}
+    {normalise}
+    {line_kw}
 
     Returns
     -------
-    matplotlib.axes.Axes
-        The axes drawn on.
+    {returns_axes}
 
     References
     ----------
@@ -140,6 +109,7 @@ def _polar(data, ax, label, component, symbol, time, bins, kind, walls, normalis
     return finish(ax, None, title=axis_label(title, units_of(profile)))
 
 
+@fill_doc
 def plot_tangential_force(data, ax=None, label=None, time="residual", bins: int = 36, kind="all",
                           walls: bool = False, normalise: bool = True, **line_kw):
     """The angle-averaged tangential force <f_t>(theta), with its sign, against theta (paper Fig. 10b).
@@ -153,36 +123,19 @@ def plot_tangential_force(data, ax=None, label=None, time="residual", bins: int 
 
     Parameters
     ----------
-    data : xarray.Dataset, dict or list
-        One dataset of the contract, or several to compare on the same axes as ``{label: ds}``
-        or ``[(label, ds), ...]``.
-    ax : matplotlib.axes.Axes, optional
-        The axes to draw on (default: new axes on a new figure).
-    label : str, optional
-        Legend label of a single dataset (None: no legend entry), so that successive calls on
-        the same axes build a comparison.
-    time : str, int, slice or sequence of int, default "residual"
-        The snapshots averaged over (:func:`grainview.analysis.snapshots.select_snapshots`):
-        ``"residual"`` the residual state, eps_q >= 0.3 (for a run that stops short of it, the
-        last part of the run), ``"all"`` or None every snapshot, a snapshot index, a slice or a
-        sequence of indices.
-    bins : int, default 36
-        Number of angular sectors of [0, pi), centred on theta_k = k pi/bins.
-    kind : {"all", "simple", "double"}, default "all"
-        The contacts used: all, simple (vertex–edge and disk contacts) or double (edge–edge)
-        ones (also 1, 2, "s", "d"; :func:`grainview.analysis.contacts.kind_code`).
-    walls : bool, default False
-        Include the particle–wall contacts (default: particle–particle only).
-    normalise : bool, default True
-        Divide each snapshot's profile by its mean normal force <f_n> over the same contacts
-        (dimensionless); otherwise in N.
-    **line_kw
-        Keyword arguments of ``matplotlib.axes.Axes.plot``.
+    {data}
+    {ax}
+    {label}
+    {time_averaged}
+    {bins}
+    {kind}
+    {walls}
+    {normalise}
+    {line_kw}
 
     Returns
     -------
-    matplotlib.axes.Axes
-        The axes drawn on.
+    {returns_axes}
 
     References
     ----------
@@ -192,6 +145,7 @@ def plot_tangential_force(data, ax=None, label=None, time="residual", bins: int 
     return _cartesian_profile(data, ax, label, "ft", time, bins, kind, walls, normalise, line_kw)
 
 
+@fill_doc
 def plot_normal_force(data, ax=None, label=None, time="residual", bins: int = 36, kind="all",
                       walls: bool = False, normalise: bool = True, **line_kw):
     """The angle-averaged normal force <f_n>(theta) against theta on Cartesian axes (paper Fig. 10a).
@@ -207,36 +161,19 @@ def plot_normal_force(data, ax=None, label=None, time="residual", bins: int = 36
 
     Parameters
     ----------
-    data : xarray.Dataset, dict or list
-        One dataset of the contract, or several to compare on the same axes as ``{label: ds}``
-        or ``[(label, ds), ...]``.
-    ax : matplotlib.axes.Axes, optional
-        The axes to draw on (default: new axes on a new figure).
-    label : str, optional
-        Legend label of a single dataset (None: no legend entry), so that successive calls on
-        the same axes build a comparison.
-    time : str, int, slice or sequence of int, default "residual"
-        The snapshots averaged over (:func:`grainview.analysis.snapshots.select_snapshots`):
-        ``"residual"`` the residual state, eps_q >= 0.3 (for a run that stops short of it, the
-        last part of the run), ``"all"`` or None every snapshot, a snapshot index, a slice or a
-        sequence of indices.
-    bins : int, default 36
-        Number of angular sectors of [0, pi), centred on theta_k = k pi/bins.
-    kind : {"all", "simple", "double"}, default "all"
-        The contacts used: all, simple (vertex–edge and disk contacts) or double (edge–edge)
-        ones (also 1, 2, "s", "d"; :func:`grainview.analysis.contacts.kind_code`).
-    walls : bool, default False
-        Include the particle–wall contacts (default: particle–particle only).
-    normalise : bool, default True
-        Divide each snapshot's profile by its mean normal force <f_n> over the same contacts
-        (dimensionless); otherwise in N.
-    **line_kw
-        Keyword arguments of ``matplotlib.axes.Axes.plot``.
+    {data}
+    {ax}
+    {label}
+    {time_averaged}
+    {bins}
+    {kind}
+    {walls}
+    {normalise}
+    {line_kw}
 
     Returns
     -------
-    matplotlib.axes.Axes
-        The axes drawn on.
+    {returns_axes}
 
     References
     ----------
@@ -268,6 +205,7 @@ def _cartesian_profile(data, ax, label, component, time, bins, kind, walls, norm
     return finish(ax, None)
 
 
+@fill_doc
 def plot_angular_forces(data, label=None, **kw):
     """Figure of paper Fig. 10: (a) <f_n>(theta) and (b) <f_t>(theta) with its sign, against theta.
 
@@ -278,19 +216,13 @@ def plot_angular_forces(data, label=None, **kw):
 
     Parameters
     ----------
-    data : xarray.Dataset, dict or list
-        One dataset of the contract, or several to compare on the same axes as ``{label: ds}``
-        or ``[(label, ds), ...]``.
-    label : str, optional
-        Legend label of a single dataset (None: no legend entry), so that successive calls on
-        the same axes build a comparison.
-    **kw
-        Keyword arguments of the panel function, passed to both panels.
+    {data}
+    {label}
+    {panel_kw}
 
     Returns
     -------
-    matplotlib.figure.Figure
-        The figure with panels (a) and (b).
+    {returns_panels}
 
     References
     ----------
@@ -318,6 +250,7 @@ def same_scale(*axes) -> None:
 
 # -- Fig. 11: force anisotropies ---------------------------------------------------------------
 
+@fill_doc
 def plot_force_anisotropy(data, ax=None, label=None, component: str = "a_n", bins: int = 36,
                           walls: bool = False, **line_kw):
     """Signed force anisotropy a_n or a_t against eps_q (paper Fig. 11).
@@ -329,28 +262,18 @@ def plot_force_anisotropy(data, ax=None, label=None, component: str = "a_n", bin
 
     Parameters
     ----------
-    data : xarray.Dataset, dict or list
-        One dataset of the contract, or several to compare on the same axes as ``{label: ds}``
-        or ``[(label, ds), ...]``.
-    ax : matplotlib.axes.Axes, optional
-        The axes to draw on (default: new axes on a new figure).
-    label : str, optional
-        Legend label of a single dataset (None: no legend entry), so that successive calls on
-        the same axes build a comparison.
+    {data}
+    {ax}
+    {label}
     component : {"a_n", "a_t"}, default "a_n"
         The anisotropy drawn.
-    bins : int, default 36
-        Number of angular sectors of [0, pi), centred on theta_k = k pi/bins.
-    walls : bool, default False
-        Include the particle–wall contacts (default: particle–particle only).
-    **line_kw
-        Keyword arguments of ``matplotlib.axes.Axes.plot`` (``color`` applies when a single
-        sample is drawn).
+    {bins}
+    {walls}
+    {line_kw_colour}
 
     Returns
     -------
-    matplotlib.axes.Axes
-        The axes drawn on.
+    {returns_axes}
 
     Raises
     ------
@@ -371,6 +294,7 @@ def plot_force_anisotropy(data, ax=None, label=None, component: str = "a_n", bin
     return finish(ax, None)
 
 
+@fill_doc
 def plot_force_anisotropies(data, label=None, **kw):
     """Figure of paper Fig. 11: (a) a_n and (b) a_t against eps_q.
 
@@ -378,19 +302,13 @@ def plot_force_anisotropies(data, label=None, **kw):
 
     Parameters
     ----------
-    data : xarray.Dataset, dict or list
-        One dataset of the contract, or several to compare on the same axes as ``{label: ds}``
-        or ``[(label, ds), ...]``.
-    label : str, optional
-        Legend label of a single dataset (None: no legend entry), so that successive calls on
-        the same axes build a comparison.
-    **kw
-        Keyword arguments of the panel function, passed to both panels.
+    {data}
+    {label}
+    {panel_kw}
 
     Returns
     -------
-    matplotlib.figure.Figure
-        The figure with panels (a) and (b).
+    {returns_panels}
 
     References
     ----------
@@ -421,6 +339,7 @@ def _pdf(ds, scale, time, bins, range, kind, walls):
                             time=time).compute()
 
 
+@fill_doc
 def plot_force_pdf(data, ax=None, label=None, scale: str = "log-linear", time="residual", bins: int = 40,
                    range=None, kind="all", walls: bool = False, fit: bool = True, **line_kw):
     """Pdf P of the normal forces f_n/<f_n> (paper Fig. 14), log-linear or log-log.
@@ -438,41 +357,27 @@ def plot_force_pdf(data, ax=None, label=None, scale: str = "log-linear", time="r
 
     Parameters
     ----------
-    data : xarray.Dataset, dict or list
-        One dataset of the contract, or several to compare on the same axes as ``{label: ds}``
-        or ``[(label, ds), ...]``.
-    ax : matplotlib.axes.Axes, optional
-        The axes to draw on (default: new axes on a new figure).
-    label : str, optional
-        Legend label of a single dataset (None: no legend entry), so that successive calls on
-        the same axes build a comparison.
+    {data}
+    {ax}
+    {label}
     scale : {"log-linear", "log-log"}, default "log-linear"
         Linear bins (on [0, 6] by default) on a logarithmic P axis, or logarithmic bins on
         log-log axes.
-    time : str, int, slice or sequence of int, default "residual"
-        The snapshots averaged over (:func:`grainview.analysis.snapshots.select_snapshots`):
-        ``"residual"`` the residual state, eps_q >= 0.3 (for a run that stops short of it, the
-        last part of the run), ``"all"`` or None every snapshot, a snapshot index, a slice or a
-        sequence of indices.
+    {time_averaged}
     bins : int, default 40
         Number of bins.
     range : (float, float), optional
         (low, high) of f_n/<f_n>; default (0, 6) for ``"log-linear"`` and the default of
         :func:`grainview.analysis.force_pdf.pooled_force_pdf` for ``"log-log"``.
-    kind : {"all", "simple", "double"}, default "all"
-        The contacts used: all, simple (vertex–edge and disk contacts) or double (edge–edge)
-        ones (also 1, 2, "s", "d"; :func:`grainview.analysis.contacts.kind_code`).
-    walls : bool, default False
-        Include the particle–wall contacts (default: particle–particle only).
+    {kind}
+    {walls}
     fit : bool, default True
         Draw the exponential fit of the strong forces (log-linear only).
-    **line_kw
-        Keyword arguments of ``matplotlib.axes.Axes.plot``.
+    {line_kw}
 
     Returns
     -------
-    matplotlib.axes.Axes
-        The axes drawn on.
+    {returns_axes}
 
     References
     ----------
@@ -524,6 +429,7 @@ def _pdf_axes(ax, scale):
     set_labels(ax, FORCE_RATIO_LABEL, "$P$")
 
 
+@fill_doc
 def plot_force_pdfs(data, label=None, **kw):
     """Figure of paper Fig. 14: (a) log-linear and (b) log-log pdfs of f_n/<f_n>.
 
@@ -531,19 +437,13 @@ def plot_force_pdfs(data, label=None, **kw):
 
     Parameters
     ----------
-    data : xarray.Dataset, dict or list
-        One dataset of the contract, or several to compare on the same axes as ``{label: ds}``
-        or ``[(label, ds), ...]``.
-    label : str, optional
-        Legend label of a single dataset (None: no legend entry), so that successive calls on
-        the same axes build a comparison.
-    **kw
-        Keyword arguments of the panel function, passed to both panels.
+    {data}
+    {label}
+    {panel_kw}
 
     Returns
     -------
-    matplotlib.figure.Figure
-        The figure with panels (a) and (b).
+    {returns_panels}
 
     References
     ----------
@@ -557,6 +457,7 @@ def plot_force_pdfs(data, label=None, **kw):
     return fig
 
 
+@fill_doc
 def plot_force_pdf_by_kind(data, ax=None, label=None, scale: str = "log-linear", time="residual",
                            bins: int = 40, range=None, walls: bool = False, **line_kw):
     """Pdfs of f_n/<f_n> for simple (s, solid) and double (d, dashed) contacts (paper Fig. 23).
@@ -567,36 +468,24 @@ def plot_force_pdf_by_kind(data, ax=None, label=None, scale: str = "log-linear",
 
     Parameters
     ----------
-    data : xarray.Dataset, dict or list
-        One dataset of the contract, or several to compare on the same axes as ``{label: ds}``
-        or ``[(label, ds), ...]``.
-    ax : matplotlib.axes.Axes, optional
-        The axes to draw on (default: new axes on a new figure).
-    label : str, optional
-        Legend label of a single dataset (None: no legend entry), so that successive calls on
-        the same axes build a comparison.
+    {data}
+    {ax}
+    {label}
     scale : {"log-linear", "log-log"}, default "log-linear"
         Linear bins (on [0, 6] by default) on a logarithmic P axis, or logarithmic bins on
         log-log axes.
-    time : str, int, slice or sequence of int, default "residual"
-        The snapshots averaged over (:func:`grainview.analysis.snapshots.select_snapshots`):
-        ``"residual"`` the residual state, eps_q >= 0.3 (for a run that stops short of it, the
-        last part of the run), ``"all"`` or None every snapshot, a snapshot index, a slice or a
-        sequence of indices.
+    {time_averaged}
     bins : int, default 40
         Number of bins.
     range : (float, float), optional
         (low, high) of f_n/<f_n>; default (0, 6) for ``"log-linear"`` and the default of
         :func:`grainview.analysis.force_pdf.pooled_force_pdf` for ``"log-log"``.
-    walls : bool, default False
-        Include the particle–wall contacts (default: particle–particle only).
-    **line_kw
-        Keyword arguments of ``matplotlib.axes.Axes.plot``.
+    {walls}
+    {line_kw}
 
     Returns
     -------
-    matplotlib.axes.Axes
-        The axes drawn on.
+    {returns_axes}
 
     References
     ----------
@@ -631,6 +520,7 @@ def _outside_note(ax, pdfs):
                 transform=ax.transAxes, fontsize="x-small", va="bottom", ha="left", color="0.3")
 
 
+@fill_doc
 def plot_force_pdfs_by_kind(data, label=None, **kw):
     """Figure of paper Fig. 23: pdfs per contact kind, (a) log-linear and (b) log-log.
 
@@ -638,19 +528,13 @@ def plot_force_pdfs_by_kind(data, label=None, **kw):
 
     Parameters
     ----------
-    data : xarray.Dataset, dict or list
-        One dataset of the contract, or several to compare on the same axes as ``{label: ds}``
-        or ``[(label, ds), ...]``.
-    label : str, optional
-        Legend label of a single dataset (None: no legend entry), so that successive calls on
-        the same axes build a comparison.
-    **kw
-        Keyword arguments of the panel function, passed to both panels.
+    {data}
+    {label}
+    {panel_kw}
 
     Returns
     -------
-    matplotlib.figure.Figure
-        The figure with panels (a) and (b).
+    {returns_panels}
 
     References
     ----------
@@ -666,6 +550,7 @@ def plot_force_pdfs_by_kind(data, label=None, **kw):
 
 # -- Figs. 15, 16: the xi-network --------------------------------------------------------------
 
+@fill_doc
 def plot_xi_stress(data, ax=None, label=None, xi=None, time="residual", min_contacts: float = 10, **line_kw):
     """Partial shear stress q(xi)/p of the contacts f_n < xi <f_n> against the cutoff xi (paper Fig. 15).
 
@@ -675,31 +560,20 @@ def plot_xi_stress(data, ax=None, label=None, xi=None, time="residual", min_cont
 
     Parameters
     ----------
-    data : xarray.Dataset, dict or list
-        One dataset of the contract, or several to compare on the same axes as ``{label: ds}``
-        or ``[(label, ds), ...]``.
-    ax : matplotlib.axes.Axes, optional
-        The axes to draw on (default: new axes on a new figure).
-    label : str, optional
-        Legend label of a single dataset (None: no legend entry), so that successive calls on
-        the same axes build a comparison.
+    {data}
+    {ax}
+    {label}
     xi : array_like of float, optional
         The cutoffs xi >= 0, multiples of <f_n> (default: those of
         :func:`grainview.analysis.xi_network.xi_network`).
-    time : str, int, slice or sequence of int, default "residual"
-        The snapshots averaged over (:func:`grainview.analysis.snapshots.select_snapshots`):
-        ``"residual"`` the residual state, eps_q >= 0.3 (for a run that stops short of it, the
-        last part of the run), ``"all"`` or None every snapshot, a snapshot index, a slice or a
-        sequence of indices.
+    {time_averaged}
     min_contacts : float, default 10
         Cutoffs whose network holds fewer contacts per snapshot on average are not drawn.
-    **line_kw
-        Keyword arguments of ``matplotlib.axes.Axes.plot``.
+    {line_kw}
 
     Returns
     -------
-    matplotlib.axes.Axes
-        The axes drawn on.
+    {returns_axes}
 
     References
     ----------
@@ -709,6 +583,7 @@ def plot_xi_stress(data, ax=None, label=None, xi=None, time="residual", min_cont
     return _xi(data, ax, label, xi, time, "q_over_p", r"$q(\xi)/p$", min_contacts, line_kw)
 
 
+@fill_doc
 def plot_xi_anisotropy(data, ax=None, label=None, xi=None, time="residual", min_contacts: float = 10,
                        near=None, log: bool = False, **line_kw):
     """Partial fabric anisotropy a'(xi) of the contacts f_n < xi <f_n> against the cutoff xi (paper Fig. 16).
@@ -720,22 +595,13 @@ def plot_xi_anisotropy(data, ax=None, label=None, xi=None, time="residual", min_
 
     Parameters
     ----------
-    data : xarray.Dataset, dict or list
-        One dataset of the contract, or several to compare on the same axes as ``{label: ds}``
-        or ``[(label, ds), ...]``.
-    ax : matplotlib.axes.Axes, optional
-        The axes to draw on (default: new axes on a new figure).
-    label : str, optional
-        Legend label of a single dataset (None: no legend entry), so that successive calls on
-        the same axes build a comparison.
+    {data}
+    {ax}
+    {label}
     xi : array_like of float, optional
         The cutoffs xi >= 0, multiples of <f_n> (default: those of
         :func:`grainview.analysis.xi_network.xi_network`).
-    time : str, int, slice or sequence of int, default "residual"
-        The snapshots averaged over (:func:`grainview.analysis.snapshots.select_snapshots`):
-        ``"residual"`` the residual state, eps_q >= 0.3 (for a run that stops short of it, the
-        last part of the run), ``"all"`` or None every snapshot, a snapshot index, a slice or a
-        sequence of indices.
+    {time_averaged}
     min_contacts : float, default 10
         Cutoffs whose network holds fewer contacts per snapshot on average are not drawn.
     near : float, optional
@@ -743,13 +609,11 @@ def plot_xi_anisotropy(data, ax=None, label=None, xi=None, time="residual", min_
         (:func:`grainview.analysis.xi_network.xi_profile`). The report counts the near pairs when the files hold them.
     log : bool, default False
         A logarithmic xi axis (the paper's inset: the very weak forces).
-    **line_kw
-        Keyword arguments of ``matplotlib.axes.Axes.plot``.
+    {line_kw}
 
     Returns
     -------
-    matplotlib.axes.Axes
-        The axes drawn on.
+    {returns_axes}
 
     References
     ----------
@@ -767,6 +631,7 @@ WEAK_XI = np.geomspace(1e-2, 1.0, 13)
 """The cutoffs of the paper's inset of Fig. 16, the very weak and weak forces, 0.01 to 1."""
 
 
+@fill_doc
 def plot_xi_anisotropies(data, label=None, near=None, **kw):
     """Figure of paper Fig. 16: a'(xi) over the whole range (a) and, on a logarithmic axis,
     for the weak forces, 0.01 <= xi <= 1 (b, the paper's inset).
@@ -776,9 +641,7 @@ def plot_xi_anisotropies(data, label=None, near=None, **kw):
 
     Parameters
     ----------
-    data : xarray.Dataset, dict or list
-        One dataset of the contract, or several to compare on the same axes as ``{label: ds}``
-        or ``[(label, ds), ...]``.
+    {data}
     label : str, optional
         Legend label of a single dataset (None: no legend entry).
     near : float, optional
@@ -790,8 +653,7 @@ def plot_xi_anisotropies(data, label=None, near=None, **kw):
 
     Returns
     -------
-    matplotlib.figure.Figure
-        The figure with panels (a) and (b).
+    {returns_panels}
 
     References
     ----------
@@ -821,6 +683,7 @@ def _xi(data, ax, label, xi, time, name, ylabel, min_contacts, line_kw, near=Non
 
 # -- Figs. 19, 20, 25: proportions and transitions ---------------------------------------------
 
+@fill_doc
 def plot_contact_proportions(data, ax=None, label=None, **line_kw):
     """Proportions k_s, k_d and relative force averages f_s, f_d against eps_q (paper Fig. 19).
 
@@ -832,22 +695,14 @@ def plot_contact_proportions(data, ax=None, label=None, **line_kw):
 
     Parameters
     ----------
-    data : xarray.Dataset, dict or list
-        One dataset of the contract, or several to compare on the same axes as ``{label: ds}``
-        or ``[(label, ds), ...]``.
-    ax : matplotlib.axes.Axes, optional
-        The axes to draw on (default: new axes on a new figure).
-    label : str, optional
-        Legend label of a single dataset (None: no legend entry), so that successive calls on
-        the same axes build a comparison.
-    **line_kw
-        Keyword arguments of ``matplotlib.axes.Axes.plot`` (``color`` applies when a single
-        sample is drawn).
+    {data}
+    {ax}
+    {label}
+    {line_kw_colour}
 
     Returns
     -------
-    matplotlib.axes.Axes
-        The axes drawn on.
+    {returns_axes}
 
     References
     ----------
@@ -864,6 +719,7 @@ def plot_contact_proportions(data, ax=None, label=None, **line_kw):
     return finish(ax, None)
 
 
+@fill_doc
 def plot_type_transitions(data, ax=None, label=None, **line_kw):
     """Cumulative proportions Delta gamma of s->d and d->s transitions against eps_q (paper Fig. 20).
 
@@ -873,22 +729,14 @@ def plot_type_transitions(data, ax=None, label=None, **line_kw):
 
     Parameters
     ----------
-    data : xarray.Dataset, dict or list
-        One dataset of the contract, or several to compare on the same axes as ``{label: ds}``
-        or ``[(label, ds), ...]``.
-    ax : matplotlib.axes.Axes, optional
-        The axes to draw on (default: new axes on a new figure).
-    label : str, optional
-        Legend label of a single dataset (None: no legend entry), so that successive calls on
-        the same axes build a comparison.
-    **line_kw
-        Keyword arguments of ``matplotlib.axes.Axes.plot`` (``color`` applies when a single
-        sample is drawn).
+    {data}
+    {ax}
+    {label}
+    {line_kw_colour}
 
     Returns
     -------
-    matplotlib.axes.Axes
-        The axes drawn on.
+    {returns_axes}
 
     References
     ----------
@@ -903,6 +751,7 @@ def plot_type_transitions(data, ax=None, label=None, **line_kw):
     return finish(ax, None)
 
 
+@fill_doc
 def plot_strong_weak_proportion(data, ax=None, label=None, network: str = "strong", **line_kw):
     """Fractions k_s and k_d of the strong or of the weak contacts against eps_q (a panel of paper Fig. 25).
 
@@ -915,24 +764,16 @@ def plot_strong_weak_proportion(data, ax=None, label=None, network: str = "stron
 
     Parameters
     ----------
-    data : xarray.Dataset, dict or list
-        One dataset of the contract, or several to compare on the same axes as ``{label: ds}``
-        or ``[(label, ds), ...]``.
-    ax : matplotlib.axes.Axes, optional
-        The axes to draw on (default: new axes on a new figure).
-    label : str, optional
-        Legend label of a single dataset (None: no legend entry), so that successive calls on
-        the same axes build a comparison.
+    {data}
+    {ax}
+    {label}
     network : {"strong", "weak"}, default "strong"
         Which network's fractions are drawn.
-    **line_kw
-        Keyword arguments of ``matplotlib.axes.Axes.plot`` (``color`` applies when a single
-        sample is drawn).
+    {line_kw_colour}
 
     Returns
     -------
-    matplotlib.axes.Axes
-        The axes drawn on.
+    {returns_axes}
 
     Raises
     ------
@@ -957,6 +798,7 @@ def plot_strong_weak_proportion(data, ax=None, label=None, network: str = "stron
     return finish(ax, None)
 
 
+@fill_doc
 def plot_strong_weak_proportions(data, label=None, **kw):
     """Figure of paper Fig. 25: (a) k_s^S and k_d^S, (b) k_s^W and k_d^W against eps_q.
 
@@ -966,18 +808,14 @@ def plot_strong_weak_proportions(data, label=None, **kw):
 
     Parameters
     ----------
-    data : xarray.Dataset, dict or list
-        One dataset of the contract, or several to compare on the same axes as ``{label: ds}``
-        or ``[(label, ds), ...]``.
+    {data}
     label : str, optional
         Legend label of a single dataset (None: no legend entry).
-    **kw
-        Keyword arguments of the panel function, passed to both panels.
+    {panel_kw}
 
     Returns
     -------
-    matplotlib.figure.Figure
-        The figure with panels (a) and (b).
+    {returns_panels}
 
     References
     ----------

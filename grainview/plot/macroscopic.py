@@ -15,10 +15,12 @@ from ..analysis.strain import (EARLY_STRAIN, RESIDUAL_STRAIN, friction_and_dilat
                                residual_window, strains)
 from ..analysis.stress import stress_invariants
 from ..analysis.forces import harmonic_prediction
+from ._docs import fill_doc
 from ._style import (EPS_Q_LABEL, PALETTE, axis_label, datasets, draw_evolutions, eps_q, finish, get_axes,
                      sample_colour, series_label, set_labels, values)
 
 
+@fill_doc
 def plot_q_over_p(data, ax=None, label=None, **line_kw):
     """Normalised shear stress q/p against eps_q (paper Fig. 3).
 
@@ -28,22 +30,14 @@ def plot_q_over_p(data, ax=None, label=None, **line_kw):
 
     Parameters
     ----------
-    data : xarray.Dataset, dict or list
-        One dataset of the contract, or several to compare on the same axes as ``{label: ds}``
-        or ``[(label, ds), ...]``.
-    ax : matplotlib.axes.Axes, optional
-        The axes to draw on (default: new axes on a new figure).
-    label : str, optional
-        Legend label of a single dataset (None: no legend entry), so that successive calls on
-        the same axes build a comparison.
-    **line_kw
-        Keyword arguments of ``matplotlib.axes.Axes.plot`` (``color`` applies when a single
-        sample is drawn).
+    {data}
+    {ax}
+    {label}
+    {line_kw_colour}
 
     Returns
     -------
-    matplotlib.axes.Axes
-        The axes drawn on.
+    {returns_axes}
 
     References
     ----------
@@ -56,6 +50,7 @@ def plot_q_over_p(data, ax=None, label=None, **line_kw):
     return finish(ax, None)
 
 
+@fill_doc
 def plot_volumetric_strain(data, ax=None, label=None, **line_kw):
     """Cumulative volumetric strain eps_p (dilation positive) against eps_q (paper Fig. 4).
 
@@ -65,22 +60,14 @@ def plot_volumetric_strain(data, ax=None, label=None, **line_kw):
 
     Parameters
     ----------
-    data : xarray.Dataset, dict or list
-        One dataset of the contract, or several to compare on the same axes as ``{label: ds}``
-        or ``[(label, ds), ...]``.
-    ax : matplotlib.axes.Axes, optional
-        The axes to draw on (default: new axes on a new figure).
-    label : str, optional
-        Legend label of a single dataset (None: no legend entry), so that successive calls on
-        the same axes build a comparison.
-    **line_kw
-        Keyword arguments of ``matplotlib.axes.Axes.plot`` (``color`` applies when a single
-        sample is drawn).
+    {data}
+    {ax}
+    {label}
+    {line_kw_colour}
 
     Returns
     -------
-    matplotlib.axes.Axes
-        The axes drawn on.
+    {returns_axes}
 
     References
     ----------
@@ -102,6 +89,7 @@ def _angles(ds, min_strain, incremental):
     return phi, psi
 
 
+@fill_doc
 def plot_stress_dilatancy(data, ax=None, label=None, incremental: bool = False, min_strain: float = EARLY_STRAIN,
                           **line_kw):
     """Stress–dilatancy diagram: dilatancy angle psi against friction angle phi, in rad (paper Fig. 5).
@@ -120,25 +108,18 @@ def plot_stress_dilatancy(data, ax=None, label=None, incremental: bool = False, 
 
     Parameters
     ----------
-    data : xarray.Dataset, dict or list
-        One dataset of the contract, or several to compare on the same axes as ``{label: ds}``
-        or ``[(label, ds), ...]``.
-    ax : matplotlib.axes.Axes, optional
-        The axes to draw on (default: new axes on a new figure).
-    label : str, optional
-        Legend label of a single dataset (None: no legend entry), so that successive calls on
-        the same axes build a comparison.
+    {data}
+    {ax}
+    {label}
     incremental : bool, default False
         Draw the incremental angle, sin psi = d eps_p/d eps_q, instead of the cumulative one.
     min_strain : float, default 0.02
         Snapshots with a smaller eps_q are not drawn (:data:`grainview.analysis.strain.EARLY_STRAIN`); 0 draws them all.
-    **line_kw
-        Keyword arguments of ``matplotlib.axes.Axes.plot``.
+    {line_kw}
 
     Returns
     -------
-    matplotlib.axes.Axes
-        The axes drawn on.
+    {returns_axes}
 
     References
     ----------
@@ -163,6 +144,7 @@ def plot_stress_dilatancy(data, ax=None, label=None, incremental: bool = False, 
     return finish(ax, None)
 
 
+@fill_doc
 def plot_harmonic_prediction(data, ax=None, label=None, bins: int = 36, **line_kw):
     """q/p and its harmonic predictions against eps_q (paper Eq. qa, Fig. 12).
 
@@ -180,24 +162,15 @@ def plot_harmonic_prediction(data, ax=None, label=None, bins: int = 36, **line_k
 
     Parameters
     ----------
-    data : xarray.Dataset, dict or list
-        One dataset of the contract, or several to compare on the same axes as ``{label: ds}``
-        or ``[(label, ds), ...]``.
-    ax : matplotlib.axes.Axes, optional
-        The axes to draw on (default: new axes on a new figure).
-    label : str, optional
-        Legend label of a single dataset (None: no legend entry), so that successive calls on
-        the same axes build a comparison.
-    bins : int, default 36
-        Number of angular sectors of [0, pi), centred on theta_k = k pi/bins.
-    **line_kw
-        Keyword arguments of ``matplotlib.axes.Axes.plot`` (``color`` applies when a single
-        sample is drawn).
+    {data}
+    {ax}
+    {label}
+    {bins}
+    {line_kw_colour}
 
     Returns
     -------
-    matplotlib.axes.Axes
-        The axes drawn on.
+    {returns_axes}
 
     References
     ----------
@@ -231,6 +204,7 @@ HARMONIC_STYLES = [dict(linewidth=4.0, alpha=0.35, solid_capstyle="butt"), dict(
 """Fig. 12's line styles: q/p a wide pale band, the two predictions thin lines over it."""
 
 
+@fill_doc
 def plot_partial_q_over_p(data, ax=None, label=None, **line_kw):
     """q/p of simple (s), double (d) and all (s+d) contacts against eps_q (paper Fig. 18).
 
@@ -241,22 +215,14 @@ def plot_partial_q_over_p(data, ax=None, label=None, **line_kw):
 
     Parameters
     ----------
-    data : xarray.Dataset, dict or list
-        One dataset of the contract, or several to compare on the same axes as ``{label: ds}``
-        or ``[(label, ds), ...]``.
-    ax : matplotlib.axes.Axes, optional
-        The axes to draw on (default: new axes on a new figure).
-    label : str, optional
-        Legend label of a single dataset (None: no legend entry), so that successive calls on
-        the same axes build a comparison.
-    **line_kw
-        Keyword arguments of ``matplotlib.axes.Axes.plot`` (``color`` applies when a single
-        sample is drawn).
+    {data}
+    {ax}
+    {label}
+    {line_kw_colour}
 
     Returns
     -------
-    matplotlib.axes.Axes
-        The axes drawn on.
+    {returns_axes}
 
     References
     ----------

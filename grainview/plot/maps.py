@@ -20,6 +20,7 @@ from matplotlib.collections import EllipseCollection, LineCollection, PolyCollec
 from ..analysis.contacts import selection
 from ..contract.errors import ParameterError
 from ..contract.shapes import body_vertices_of, world_vertices
+from ._docs import fill_doc
 from ._style import PALETTE, axis_label, get_axes, single_dataset, snapshot_index
 
 PARTICLE_FACE = "0.92"
@@ -35,6 +36,7 @@ in every figure (:data:`grainview.plot._style.PALETTE`), not the paper's blue an
 the pentagon sample wherever samples are compared."""
 
 
+@fill_doc
 def plot_particles(data, ax=None, time: int = -1, facecolor=PARTICLE_FACE, edgecolor=PARTICLE_EDGE,
                    linewidth: float = 0.5, values=None, cmap=None, norm=None):
     """Draw the particles of snapshot ``time``: disks and regular polygons.
@@ -47,13 +49,9 @@ def plot_particles(data, ax=None, time: int = -1, facecolor=PARTICLE_FACE, edgec
 
     Parameters
     ----------
-    data : xarray.Dataset, dict or list
-        One dataset of the contract (a dict or list must hold exactly one): this figure draws
-        one sample.
-    ax : matplotlib.axes.Axes, optional
-        The axes to draw on (default: new axes on a new figure).
-    time : int, default -1
-        Index of the snapshot drawn (negative counts from the end).
+    {data_one}
+    {ax}
+    {time_drawn}
     facecolor, edgecolor : matplotlib colour
         Face and edge colours of the particles.
     linewidth : float, default 0.5
@@ -67,8 +65,7 @@ def plot_particles(data, ax=None, time: int = -1, facecolor=PARTICLE_FACE, edgec
 
     Returns
     -------
-    matplotlib.axes.Axes
-        The axes drawn on.
+    {returns_axes}
 
     References
     ----------
@@ -111,6 +108,7 @@ PARTICLE_FIELDS = {"c": "contacts c", "m_s": "simple contacts m_s", "m_d": "doub
 """Fields a particle map can show (:func:`grainview.analysis.particle_fields.particle_fields`)."""
 
 
+@fill_doc
 def plot_particle_map(data, field: str = "c", ax=None, time: int = -1, reference: int = 0, walls: bool = True,
                       cmap: str = "cividis"):
     """Particles of snapshot ``time`` coloured by a per-particle ``field``, with a colour bar.
@@ -122,15 +120,11 @@ def plot_particle_map(data, field: str = "c", ax=None, time: int = -1, reference
 
     Parameters
     ----------
-    data : xarray.Dataset, dict or list
-        One dataset of the contract (a dict or list must hold exactly one): this figure draws
-        one sample.
+    {data_one}
     field : str, default "c"
         "c", "m_s", "m_d", "strong", "rattler", "rotation" (rad) or "displacement" (m).
-    ax : matplotlib.axes.Axes, optional
-        The axes to draw on (default: new axes on a new figure).
-    time : int, default -1
-        Index of the snapshot drawn (negative counts from the end).
+    {ax}
+    {time_drawn}
     reference : int, default 0
         Snapshot the rotation and displacement are measured from.
     walls : bool, default True
@@ -140,8 +134,7 @@ def plot_particle_map(data, field: str = "c", ax=None, time: int = -1, reference
 
     Returns
     -------
-    matplotlib.axes.Axes
-        The axes drawn on.
+    {returns_axes}
 
     Raises
     ------
@@ -178,25 +171,21 @@ def plot_particle_map(data, field: str = "c", ax=None, time: int = -1, reference
     return ax
 
 
+@fill_doc
 def plot_connectivity_map(data, ax=None, time: int = -1, **options):
     """:func:`plot_particle_map` of the contacts c of each particle.
 
     Parameters
     ----------
-    data : xarray.Dataset, dict or list
-        One dataset of the contract (a dict or list must hold exactly one): this figure draws
-        one sample.
-    ax : matplotlib.axes.Axes, optional
-        The axes to draw on (default: new axes on a new figure).
-    time : int, default -1
-        Index of the snapshot drawn (negative counts from the end).
+    {data_one}
+    {ax}
+    {time_drawn}
     **options
         Keyword arguments of :func:`plot_particle_map` (``reference``, ``walls``, ``cmap``).
 
     Returns
     -------
-    matplotlib.axes.Axes
-        The axes drawn on.
+    {returns_axes}
 
     References
     ----------
@@ -206,25 +195,21 @@ def plot_connectivity_map(data, ax=None, time: int = -1, **options):
     return plot_particle_map(data, "c", ax=ax, time=time, **options)
 
 
+@fill_doc
 def plot_rattler_map(data, ax=None, time: int = -1, **options):
     """:func:`plot_particle_map` of the rattlers (particles without force-bearing contacts).
 
     Parameters
     ----------
-    data : xarray.Dataset, dict or list
-        One dataset of the contract (a dict or list must hold exactly one): this figure draws
-        one sample.
-    ax : matplotlib.axes.Axes, optional
-        The axes to draw on (default: new axes on a new figure).
-    time : int, default -1
-        Index of the snapshot drawn (negative counts from the end).
+    {data_one}
+    {ax}
+    {time_drawn}
     **options
         Keyword arguments of :func:`plot_particle_map` (``reference``, ``walls``, ``cmap``).
 
     Returns
     -------
-    matplotlib.axes.Axes
-        The axes drawn on.
+    {returns_axes}
 
     References
     ----------
@@ -234,25 +219,21 @@ def plot_rattler_map(data, ax=None, time: int = -1, **options):
     return plot_particle_map(data, "rattler", ax=ax, time=time, **options)
 
 
+@fill_doc
 def plot_rotation_map(data, ax=None, time: int = -1, **options):
     """:func:`plot_particle_map` of each particle's rotation (rad) since the ``reference`` snapshot.
 
     Parameters
     ----------
-    data : xarray.Dataset, dict or list
-        One dataset of the contract (a dict or list must hold exactly one): this figure draws
-        one sample.
-    ax : matplotlib.axes.Axes, optional
-        The axes to draw on (default: new axes on a new figure).
-    time : int, default -1
-        Index of the snapshot drawn (negative counts from the end).
+    {data_one}
+    {ax}
+    {time_drawn}
     **options
         Keyword arguments of :func:`plot_particle_map` (``reference``, ``walls``, ``cmap``).
 
     Returns
     -------
-    matplotlib.axes.Axes
-        The axes drawn on.
+    {returns_axes}
 
     References
     ----------
@@ -484,6 +465,7 @@ def contact_collection(ax) -> LineCollection:
     raise LookupError("no contact map on these axes")
 
 
+@fill_doc
 def plot_force_chains(data, ax=None, time: int = -1, walls: bool = False, max_linewidth: float = 3.0,
                       colour="k", particles: bool = True, force_scale=None):
     """Map of the normal forces of snapshot ``time`` (paper Fig. 13).
@@ -498,28 +480,21 @@ def plot_force_chains(data, ax=None, time: int = -1, walls: bool = False, max_li
 
     Parameters
     ----------
-    data : xarray.Dataset, dict or list
-        One dataset of the contract (a dict or list must hold exactly one): this figure draws
-        one sample.
-    ax : matplotlib.axes.Axes, optional
-        The axes to draw on (default: new axes on a new figure).
-    time : int, default -1
-        Index of the snapshot drawn (negative counts from the end).
-    walls : bool, default False
-        Include the particle–wall contacts (default: particle–particle only).
+    {data_one}
+    {ax}
+    {time_drawn}
+    {walls}
     max_linewidth : float, default 3.0
         Width of the largest force (or of ``force_scale``), points.
     colour : matplotlib colour, default "k"
         Colour of the segments.
-    particles : bool, default True
-        Draw the particles under the network.
+    {particles}
     force_scale : float, optional
         The force F (N) drawn at ``max_linewidth``, to compare maps.
 
     Returns
     -------
-    matplotlib.axes.Axes
-        The axes drawn on.
+    {returns_axes}
 
     References
     ----------
@@ -535,6 +510,7 @@ def plot_force_chains(data, ax=None, time: int = -1, walls: bool = False, max_li
     return ax
 
 
+@fill_doc
 def plot_force_classes(data, ax=None, time: int = -1, walls: bool = False, very_weak: float = 0.1,
                        strong: float = 1.0, width_by_force: bool = False, linewidth: float = 1.0,
                        max_linewidth: float = 3.0, particles: bool = True):
@@ -547,15 +523,10 @@ def plot_force_classes(data, ax=None, time: int = -1, walls: bool = False, very_
 
     Parameters
     ----------
-    data : xarray.Dataset, dict or list
-        One dataset of the contract (a dict or list must hold exactly one): this figure draws
-        one sample.
-    ax : matplotlib.axes.Axes, optional
-        The axes to draw on (default: new axes on a new figure).
-    time : int, default -1
-        Index of the snapshot drawn (negative counts from the end).
-    walls : bool, default False
-        Include the particle–wall contacts (default: particle–particle only).
+    {data_one}
+    {ax}
+    {time_drawn}
+    {walls}
     very_weak : float, default 0.1
         Very weak threshold, a multiple of <f_n>.
     strong : float, default 1.0
@@ -566,13 +537,11 @@ def plot_force_classes(data, ax=None, time: int = -1, walls: bool = False, very_
         Uniform line width, points.
     max_linewidth : float, default 3.0
         Width of the largest force with ``width_by_force``, points.
-    particles : bool, default True
-        Draw the particles under the network.
+    {particles}
 
     Returns
     -------
-    matplotlib.axes.Axes
-        The axes drawn on.
+    {returns_axes}
 
     References
     ----------
@@ -596,6 +565,7 @@ def plot_force_classes(data, ax=None, time: int = -1, walls: bool = False, very_
     return ax
 
 
+@fill_doc
 def plot_contact_kinds(data, ax=None, time: int = -1, walls: bool = False, max_linewidth: float = 3.0,
                        particles: bool = True):
     """Map of the normal-force network of snapshot ``time`` by contact kind (paper Fig. 24).
@@ -605,24 +575,17 @@ def plot_contact_kinds(data, ax=None, time: int = -1, walls: bool = False, max_l
 
     Parameters
     ----------
-    data : xarray.Dataset, dict or list
-        One dataset of the contract (a dict or list must hold exactly one): this figure draws
-        one sample.
-    ax : matplotlib.axes.Axes, optional
-        The axes to draw on (default: new axes on a new figure).
-    time : int, default -1
-        Index of the snapshot drawn (negative counts from the end).
-    walls : bool, default False
-        Include the particle–wall contacts (default: particle–particle only).
+    {data_one}
+    {ax}
+    {time_drawn}
+    {walls}
     max_linewidth : float, default 3.0
         Width of the largest force, points.
-    particles : bool, default True
-        Draw the particles under the network.
+    {particles}
 
     Returns
     -------
-    matplotlib.axes.Axes
-        The axes drawn on.
+    {returns_axes}
 
     References
     ----------

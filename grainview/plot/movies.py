@@ -15,6 +15,7 @@ import numpy as np
 
 from ..analysis.contacts import selection
 from ..contract.errors import ParameterError
+from ._docs import fill_doc
 from ._style import single_dataset
 
 __all__ = ["animate"]
@@ -78,6 +79,7 @@ def save_frames(fig, path, writer, frames, draw, *, dpi, progress, overwrite, de
     return str(path)
 
 
+@fill_doc
 def animate(data, path, kind: str = "force_chains", every: int = 1, fps: int = 8, walls: bool = False,
             max_linewidth: float = 3.0, dpi: int = 90, progress: bool = True, overwrite: bool = False) -> str:
     """Write a movie of every ``every``-th snapshot (and the last) to ``path`` (.gif or .mp4).
@@ -90,9 +92,7 @@ def animate(data, path, kind: str = "force_chains", every: int = 1, fps: int = 8
 
     Parameters
     ----------
-    data : xarray.Dataset, dict or list
-        One dataset of the contract (a dict or list must hold exactly one): this figure draws
-        one sample.
+    {data_one}
     path : str or path-like
         The movie's file name: ``.gif`` (Pillow) or ``.mp4`` (needs ffmpeg).
     kind : {"force_chains", "force_classes", "connectivity"}, default "force_chains"
@@ -101,8 +101,7 @@ def animate(data, path, kind: str = "force_chains", every: int = 1, fps: int = 8
         Draw every ``every``-th snapshot (the last always included).
     fps : int, default 8
         Frames per second.
-    walls : bool, default False
-        Include the particle–wall contacts (default: particle–particle only).
+    {walls}
     max_linewidth : float, default 3.0
         Width of the movie's largest force, points (``"force_chains"``).
     dpi : int, default 90

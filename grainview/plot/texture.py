@@ -14,10 +14,12 @@ import xarray as xr
 from ..analysis.connectivity import connectivity_pdf, coordination, joint_connectivity_pdf
 from ..analysis.fabric import fabric_anisotropy, orientation_pdf
 from ..analysis.snapshots import select_snapshots, time_mean
+from ._docs import fill_doc
 from ._style import (EPS_Q_LABEL, PALETTE, axis_label, datasets, draw_evolutions, finish, get_axes,
                      sample_colour, tidy_polar, set_labels, single_dataset, units_of, values)
 
 
+@fill_doc
 def plot_coordination(data, ax=None, label=None, walls: bool = False, **line_kw):
     """Coordination number z of the force-bearing network against eps_q (paper Fig. 6a).
 
@@ -28,24 +30,15 @@ def plot_coordination(data, ax=None, label=None, walls: bool = False, **line_kw)
 
     Parameters
     ----------
-    data : xarray.Dataset, dict or list
-        One dataset of the contract, or several to compare on the same axes as ``{label: ds}``
-        or ``[(label, ds), ...]``.
-    ax : matplotlib.axes.Axes, optional
-        The axes to draw on (default: new axes on a new figure).
-    label : str, optional
-        Legend label of a single dataset (None: no legend entry), so that successive calls on
-        the same axes build a comparison.
-    walls : bool, default False
-        Include the particle–wall contacts (default: particle–particle only).
-    **line_kw
-        Keyword arguments of ``matplotlib.axes.Axes.plot`` (``color`` applies when a single
-        sample is drawn).
+    {data}
+    {ax}
+    {label}
+    {walls}
+    {line_kw_colour}
 
     Returns
     -------
-    matplotlib.axes.Axes
-        The axes drawn on.
+    {returns_axes}
 
     References
     ----------
@@ -59,6 +52,7 @@ def plot_coordination(data, ax=None, label=None, walls: bool = False, **line_kw)
     return finish(ax, None)
 
 
+@fill_doc
 def plot_persistence(data, ax=None, label=None, reference: int = 0, **line_kw):
     """Fraction gamma of the contacts of snapshot ``reference`` still present, against eps_q (paper Fig. 6b).
 
@@ -69,24 +63,16 @@ def plot_persistence(data, ax=None, label=None, reference: int = 0, **line_kw):
 
     Parameters
     ----------
-    data : xarray.Dataset, dict or list
-        One dataset of the contract, or several to compare on the same axes as ``{label: ds}``
-        or ``[(label, ds), ...]``.
-    ax : matplotlib.axes.Axes, optional
-        The axes to draw on (default: new axes on a new figure).
-    label : str, optional
-        Legend label of a single dataset (None: no legend entry), so that successive calls on
-        the same axes build a comparison.
+    {data}
+    {ax}
+    {label}
     reference : int, default 0
         The reference snapshot index (negative counts from the end).
-    **line_kw
-        Keyword arguments of ``matplotlib.axes.Axes.plot`` (``color`` applies when a single
-        sample is drawn).
+    {line_kw_colour}
 
     Returns
     -------
-    matplotlib.axes.Axes
-        The axes drawn on.
+    {returns_axes}
 
     References
     ----------
@@ -102,6 +88,7 @@ def plot_persistence(data, ax=None, label=None, reference: int = 0, **line_kw):
     return finish(ax, None)
 
 
+@fill_doc
 def plot_connectivity_pdf(data, ax=None, label=None, time="residual", max_c: int = 10, walls: bool = False,
                           **line_kw):
     """P(c) against c, averaged over the snapshots ``time`` (paper Fig. 7).
@@ -112,30 +99,18 @@ def plot_connectivity_pdf(data, ax=None, label=None, time="residual", max_c: int
 
     Parameters
     ----------
-    data : xarray.Dataset, dict or list
-        One dataset of the contract, or several to compare on the same axes as ``{label: ds}``
-        or ``[(label, ds), ...]``.
-    ax : matplotlib.axes.Axes, optional
-        The axes to draw on (default: new axes on a new figure).
-    label : str, optional
-        Legend label of a single dataset (None: no legend entry), so that successive calls on
-        the same axes build a comparison.
-    time : str, int, slice or sequence of int, default "residual"
-        The snapshots averaged over (:func:`grainview.analysis.snapshots.select_snapshots`):
-        ``"residual"`` the residual state, eps_q >= 0.3 (for a run that stops short of it, the
-        last part of the run), ``"all"`` or None every snapshot, a snapshot index, a slice or a
-        sequence of indices.
+    {data}
+    {ax}
+    {label}
+    {time_averaged}
     max_c : int, default 10
         The largest c drawn.
-    walls : bool, default False
-        Include the particle–wall contacts (default: particle–particle only).
-    **line_kw
-        Keyword arguments of ``matplotlib.axes.Axes.plot``.
+    {walls}
+    {line_kw}
 
     Returns
     -------
-    matplotlib.axes.Axes
-        The axes drawn on.
+    {returns_axes}
 
     References
     ----------
@@ -152,6 +127,7 @@ def plot_connectivity_pdf(data, ax=None, label=None, time="residual", max_c: int
     return finish(ax, None)
 
 
+@fill_doc
 def plot_orientation_pdf(data, ax=None, label=None, time="residual", bins: int = 36, kind="all",
                          walls: bool = False, **line_kw):
     """Polar plot of the density P(theta) of contact-normal orientations (rad-1) (paper Fig. 8).
@@ -162,33 +138,18 @@ def plot_orientation_pdf(data, ax=None, label=None, time="residual", bins: int =
 
     Parameters
     ----------
-    data : xarray.Dataset, dict or list
-        One dataset of the contract, or several to compare on the same axes as ``{label: ds}``
-        or ``[(label, ds), ...]``.
-    ax : matplotlib.axes.Axes, optional
-        Polar axes to draw on (default: new polar axes on a new figure).
-    label : str, optional
-        Legend label of a single dataset (None: no legend entry), so that successive calls on
-        the same axes build a comparison.
-    time : str, int, slice or sequence of int, default "residual"
-        The snapshots averaged over (:func:`grainview.analysis.snapshots.select_snapshots`):
-        ``"residual"`` the residual state, eps_q >= 0.3 (for a run that stops short of it, the
-        last part of the run), ``"all"`` or None every snapshot, a snapshot index, a slice or a
-        sequence of indices.
-    bins : int, default 36
-        Number of angular sectors of [0, pi), centred on theta_k = k pi/bins.
-    kind : {"all", "simple", "double"}, default "all"
-        The contacts used: all, simple (vertex–edge and disk contacts) or double (edge–edge)
-        ones (also 1, 2, "s", "d"; :func:`grainview.analysis.contacts.kind_code`).
-    walls : bool, default False
-        Include the particle–wall contacts (default: particle–particle only).
-    **line_kw
-        Keyword arguments of ``matplotlib.axes.Axes.plot``.
+    {data}
+    {ax_polar}
+    {label}
+    {time_averaged}
+    {bins}
+    {kind}
+    {walls}
+    {line_kw}
 
     Returns
     -------
-    matplotlib.axes.Axes
-        The axes drawn on.
+    {returns_axes}
 
     References
     ----------
@@ -226,6 +187,7 @@ def full_turn(theta, r):
     return theta, r
 
 
+@fill_doc
 def plot_fabric_anisotropy(data, ax=None, label=None, walls: bool = False, **line_kw):
     """Signed fabric anisotropy a' = a cos 2(theta_F - theta_sigma) against eps_q (paper Fig. 9).
 
@@ -235,24 +197,15 @@ def plot_fabric_anisotropy(data, ax=None, label=None, walls: bool = False, **lin
 
     Parameters
     ----------
-    data : xarray.Dataset, dict or list
-        One dataset of the contract, or several to compare on the same axes as ``{label: ds}``
-        or ``[(label, ds), ...]``.
-    ax : matplotlib.axes.Axes, optional
-        The axes to draw on (default: new axes on a new figure).
-    label : str, optional
-        Legend label of a single dataset (None: no legend entry), so that successive calls on
-        the same axes build a comparison.
-    walls : bool, default False
-        Include the particle–wall contacts (default: particle–particle only).
-    **line_kw
-        Keyword arguments of ``matplotlib.axes.Axes.plot`` (``color`` applies when a single
-        sample is drawn).
+    {data}
+    {ax}
+    {label}
+    {walls}
+    {line_kw_colour}
 
     Returns
     -------
-    matplotlib.axes.Axes
-        The axes drawn on.
+    {returns_axes}
 
     References
     ----------
@@ -266,6 +219,7 @@ def plot_fabric_anisotropy(data, ax=None, label=None, walls: bool = False, **lin
     return finish(ax, None)
 
 
+@fill_doc
 def plot_partial_fabric_anisotropy(data, ax=None, label=None, walls: bool = False, **line_kw):
     """Signed anisotropies a'_s and a'_d of the partial fabric tensors against eps_q (paper Fig. 22).
 
@@ -276,24 +230,15 @@ def plot_partial_fabric_anisotropy(data, ax=None, label=None, walls: bool = Fals
 
     Parameters
     ----------
-    data : xarray.Dataset, dict or list
-        One dataset of the contract, or several to compare on the same axes as ``{label: ds}``
-        or ``[(label, ds), ...]``.
-    ax : matplotlib.axes.Axes, optional
-        The axes to draw on (default: new axes on a new figure).
-    label : str, optional
-        Legend label of a single dataset (None: no legend entry), so that successive calls on
-        the same axes build a comparison.
-    walls : bool, default False
-        Include the particle–wall contacts (default: particle–particle only).
-    **line_kw
-        Keyword arguments of ``matplotlib.axes.Axes.plot`` (``color`` applies when a single
-        sample is drawn).
+    {data}
+    {ax}
+    {label}
+    {walls}
+    {line_kw_colour}
 
     Returns
     -------
-    matplotlib.axes.Axes
-        The axes drawn on.
+    {returns_axes}
 
     References
     ----------
@@ -311,6 +256,7 @@ def plot_partial_fabric_anisotropy(data, ax=None, label=None, walls: bool = Fals
     return finish(ax, None)
 
 
+@fill_doc
 def plot_joint_connectivity(data, ax=None, label=None, time="residual", max_m: int = 6, walls: bool = False,
                             cmap="Greys", colorbar: bool = True):
     """Grey-level map of P(m_s, m_d), averaged over the snapshots ``time`` (paper Fig. 21).
@@ -321,22 +267,14 @@ def plot_joint_connectivity(data, ax=None, label=None, time="residual", max_m: i
 
     Parameters
     ----------
-    data : xarray.Dataset, dict or list
-        One dataset of the contract (a dict or list must hold exactly one): this figure draws
-        one sample.
-    ax : matplotlib.axes.Axes, optional
-        The axes to draw on (default: new axes on a new figure).
+    {data_one}
+    {ax}
     label : str, optional
         Title of the axes for a single dataset (a dict's or list's label otherwise).
-    time : str, int, slice or sequence of int, default "residual"
-        The snapshots averaged over (:func:`grainview.analysis.snapshots.select_snapshots`):
-        ``"residual"`` the residual state, eps_q >= 0.3 (for a run that stops short of it, the
-        last part of the run), ``"all"`` or None every snapshot, a snapshot index, a slice or a
-        sequence of indices.
+    {time_averaged}
     max_m : int, default 6
         The largest m_s and m_d drawn.
-    walls : bool, default False
-        Include the particle–wall contacts (default: particle–particle only).
+    {walls}
     cmap : str or matplotlib.colors.Colormap, default "Greys"
         The colour map.
     colorbar : bool, default True
@@ -344,8 +282,7 @@ def plot_joint_connectivity(data, ax=None, label=None, time="residual", max_m: i
 
     Returns
     -------
-    matplotlib.axes.Axes
-        The axes drawn on.
+    {returns_axes}
 
     References
     ----------

@@ -14,6 +14,7 @@ import numpy as np
 import xarray as xr
 
 from ..contract.errors import ParameterError
+from ._docs import fill_doc
 from ._style import datasets, finish, get_axes, new_figure, sample_colour, single_dataset
 
 __all__ = ["plot_persistence_diagram", "plot_betti_curves", "plot_cycle_counts", "plot_network_topology"]
@@ -30,6 +31,7 @@ def _result(ds: xr.Dataset) -> xr.Dataset:
     return network_persistence(ds)
 
 
+@fill_doc
 def plot_persistence_diagram(data, time=-1, ax=None, label=None):
     """One snapshot's persistence diagram: each feature at (birth, death), in units of <f_n>.
 
@@ -45,8 +47,7 @@ def plot_persistence_diagram(data, time=-1, ax=None, label=None):
         :func:`~grainview.analysis.network_topology.network_persistence` (a single sample).
     time : int, default -1
         The snapshot (an index along ``time``).
-    ax : matplotlib.axes.Axes, optional
-        The axes to draw on (default: new axes on a new figure).
+    {ax}
     label : str, optional
         The sample's name, in the legend.
 

@@ -9,6 +9,8 @@ import ast
 import re
 from pathlib import Path
 
+from grainview.plot._docs import build_docstring
+
 PLOT = Path(__file__).resolve().parents[2] / "grainview" / "plot"
 
 DRAWING_HELPERS = {
@@ -35,14 +37,17 @@ DRAWING_HELPERS = {
     "add_caption": "a caption under a figure", "save_figure": "PNG and PDF files of a figure",
     "frame_title": "a movie frame's title", "save_frames": "a movie's frames written",
     "animate": "a movie of the maps", "animate_chains": "a movie of the force chains",
+    # the figures' own docstrings
+    "build_docstring": "shared numpydoc entries put in place", "fill_doc": "the same, as a decorator",
 }
 """The public functions of grainview/plot/ that draw, label or save without returning a
 matplotlib object, and what each is for."""
 
 
 def _returns(func: ast.FunctionDef) -> str:
-    """The first line of a function's numpydoc Returns section ('' without one)."""
-    match = re.search(r"Returns\n-------\n(.*)", ast.get_docstring(func) or "")
+    """The first line of a function's numpydoc Returns section ('' without one), its shared
+    fragments in place."""
+    match = re.search(r"Returns\n-------\n(.*)", build_docstring(ast.get_docstring(func)) or "")
     return match.group(1) if match else ""
 
 
