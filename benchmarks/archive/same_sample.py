@@ -18,7 +18,7 @@ the table gives, per quantity, the seeds' mean and standard deviation of A-off a
 the mean and standard deviation over seeds of the differences A-and - A-off and B-and - A-off.
 
 Compaction (``--compaction``). The state a compaction reaches depends on how well its steps are
-solved (docs/solver.md, "Compaction"): per seed, the deposit is compacted with plain and with
+solved (benchmarks/archive/solver-log.md, "Compaction"): per seed, the deposit is compacted with plain and with
 Anderson sweeps at the default tolerance and at a 10x tighter one (sweep cap 10x higher), and
 the compacted state's coordination z (force-bearing contacts, rattlers out;
 ``ds.grain.coordination``) and solid fraction are written to

@@ -4,7 +4,7 @@
 
 The slow steps of a large sheared packing are a network-wide drift of the impulses along nearly
 self-stressed paths: load moves among the contacts while the bodies hardly move
-(``sweep_bursts.py``; docs/solver.md, "What the slow steps are"). Gauss–Seidel converges such
+(``sweep_bursts.py``; benchmarks/archive/solver-log.md, "What the slow steps are"). Gauss–Seidel converges such
 smooth, global modes slowly, and a Krylov method converges them in far fewer iterations *if*
 the linear problem that holds once every contact's status is known is well posed. The probe
 asks whether it is, on captured steps (:func:`sweep_bursts.capture`):
@@ -202,7 +202,7 @@ def main(argv=None):
     intro = (f"Written by `python -m benchmarks.archive.subspace_step --sample {os.path.relpath(args.sample, os.path.dirname(os.path.dirname(HERE)))} "
              f"--steps {args.steps[0]} {args.steps[1]}`: {n} particles, shear steps {args.steps[0]}-{args.steps[1]} "
              f"(sweeps per step with the default solve: {sweeps}), the face fixed by {args.sweeps} plain sweeps. "
-             "The script's docstring defines each column; docs/solver.md (\"What the slow steps are\") reads them.")
+             "The script's docstring defines each column; benchmarks/archive/solver-log.md (\"What the slow steps are\") reads them.")
     write_results(out, "A Krylov step on the face the sweeps find", intro,
                   ["## The conjugate gradient on the face (row 0: the sweeps' iterate)", path_table,
                    "## The direction it takes: d = p - p_0 after the last iteration", direction_table])

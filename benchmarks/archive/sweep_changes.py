@@ -7,7 +7,7 @@ Compacts 1000 particles (preparation 'fast'), shears them 300 steps (top wall 1 
 the contact problems of the next 20 steps and re-solves every fourth one sweep by sweep, printing
 after sweeps 1, 5, 20, 50 and the last: the quadratic norm, the share of points carrying 99% and
 99.9% of the sum of dV_k^2 = dp_k . W_k dp_k over the sweep, and the share of points whose
-impulse changed at all. Results are quoted in docs/solver.md ("Skipping converged points").
+impulse changed at all. Results are quoted in benchmarks/archive/solver-log.md ("Skipping converged points").
 """
 import sys
 import warnings

@@ -24,7 +24,7 @@ Extrapolated to N = 4000 and 14,400, and to the paper's pair of samples (14,400 
 * shear steps to eps_q = 0.4 grow as the sample height, sqrt(N) (the top wall moves at a
   fixed speed; the eps_1 at which eps_q reaches 0.4 is the measured one);
 * the time per particle per step stays the measured one (sweeps per step in the quasi-static
-  shear do not grow with N: docs/solver.md; ns per point-sweep stays 16-20 up to 14,400);
+  shear do not grow with N: benchmarks/archive/solver-log.md; ns per point-sweep stays 16-20 up to 14,400);
 * compaction steps: measured where a compaction of that size was run (here or by
   benchmarks/compaction.py) or a cached dense sample exists (benchmarks/samples.py), else grown
   as sqrt(N) from the measured 1000;
