@@ -20,7 +20,9 @@ reads it to build its options without loading a numba kernel.
 
 from __future__ import annotations
 
-from dataclasses import MISSING, InitVar, dataclass, field, fields
+import functools
+import inspect
+from dataclasses import MISSING, dataclass, field, fields
 
 import numpy as np
 
@@ -187,15 +189,6 @@ class Parameters:
     overlap_recovery_tolerance: float = setting(1e-2, "NLGS tolerance of the recovery pass (a correction, not "
                                                 "physics)")
     overlap_recovery_iterations: int = setting(50, "sweep cap of the recovery pass")
-    acceleration: InitVar[str | None] = None
-    """The former name of ``solver`` (files, scripts and command lines from before it):
-    ``'off'`` is ``solver='nlgs'``, ``'anderson'`` ``solver='anderson'``
-    (:data:`solver.contact_solvers.ACCELERATIONS`); given, it sets ``solver``. Read or set
-    afterwards, it is the property :attr:`acceleration` (None for a solver it has no value for)."""
-
-    def __post_init__(self, acceleration):
-        if acceleration is not None:
-            self.solver = contact_solvers.from_acceleration(acceleration)
 
     def __setstate__(self, state):
         """Unpickle, also a record pickled before ``solver`` existed (its ``acceleration``)."""
@@ -233,6 +226,25 @@ def _set_acceleration(self, value):
     self.solver = contact_solvers.from_acceleration(value)
 
 
+def _accepting_acceleration(init):
+    """The dataclass's ``__init__`` with the keyword ``acceleration``, the former name of
+    ``solver`` (files, scripts and command lines from before it): ``'off'`` is
+    ``solver='nlgs'``, ``'anderson'`` ``solver='anderson'``
+    (:data:`solver.contact_solvers.ACCELERATIONS`); given, it sets ``solver``. It is not a field
+    (a file records ``solver``; :func:`dataclasses.replace` keeps the record's solver)."""
+    @functools.wraps(init)
+    def __init__(self, *args, acceleration=None, **kwargs):
+        init(self, *args, **kwargs)
+        if acceleration is not None:
+            self.solver = contact_solvers.from_acceleration(acceleration)
+
+    signature = inspect.signature(init)
+    __init__.__signature__ = signature.replace(parameters=[
+        *signature.parameters.values(), inspect.Parameter("acceleration", inspect.Parameter.KEYWORD_ONLY, default=None)])
+    return __init__
+
+
+Parameters.__init__ = _accepting_acceleration(Parameters.__init__)
 Parameters.acceleration = property(_acceleration, _set_acceleration, doc="The former name of ``solver``: ``'off'`` "
                                    "for 'nlgs', ``'anderson'`` for 'anderson' (None for another solver); set, it sets "
                                    "``solver`` (:data:`solver.contact_solvers.ACCELERATIONS`).")

@@ -2,6 +2,7 @@
 the stepper's dispatch through it, the problem a step poses and the step's stage timings."""
 
 import copy
+import dataclasses
 import pickle
 import time
 import warnings
@@ -72,12 +73,17 @@ def test_the_former_acceleration_setting_names_a_solver():
     assert p.solver == "anderson" and p.acceleration == "anderson"
     with pytest.raises(ParameterError, match="acceleration='fast': expected one of off, anderson"):
         Parameters(acceleration="fast")
-    assert "acceleration" not in {f for f in Parameters.__dataclass_fields__ if f != "acceleration"}
-    import dataclasses
-
+    assert "acceleration" not in Parameters.__dataclass_fields__
     assert "acceleration" not in dataclasses.asdict(p)  # a file records solver_solver only
     assert dataclasses.replace(p, domains=2).solver == "anderson"
     assert dataclasses.replace(p, acceleration="off").solver == "nlgs"
+
+
+@pytest.mark.parametrize("before, after", [("nlgs", "anderson"), ("anderson", "nlgs")])
+def test_replace_sets_the_solver_it_is_given(before, after):
+    p = Parameters(solver=before)
+    assert dataclasses.replace(p, solver=after).solver == after
+    assert dataclasses.replace(p, domains=2).solver == before
 
 
 def test_a_parameters_record_pickled_before_the_solver_field_unpickles_with_its_solver():
