@@ -83,23 +83,16 @@ def markdown_table(header, rows) -> str:
 
 
 def capture_contact_problems(sim, steps: int = 1) -> list:
-    """Step ``sim`` ``steps`` times and return each step's contact problem as the NLGS received
-    it: ``(problem, pn, pt, vx, vy, w, options)`` with copies of the warm-start impulses and the
-    free velocities, and the solver options (tolerances, sweep limit). The steps run as usual."""
-    from unittest import mock
-
-    from solver import nlgs
-
+    """Step ``sim`` ``steps`` times and return each step's contact problem as its solver
+    receives it (:meth:`solver.stepper.Simulation.contact_problem`): ``(problem, pn, pt, vx, vy,
+    w, options)`` with copies of the warm-start impulses and the free velocities, and the
+    stopping limits as keywords (tolerance, max_tolerance, max_iterations, stall). The steps
+    run as usual, whatever the solver."""
     seen = []
-    solve = nlgs.solve_problem
-
-    def capture(problem, pn, pt, vx, vy, w, **options):
-        seen.append((problem, pn.copy(), pt.copy(), vx.copy(), vy.copy(), w.copy(), options))
-        return solve(problem, pn, pt, vx, vy, w, **options)
-
-    with mock.patch.object(nlgs, "solve_problem", capture):
-        for _ in range(steps):
-            sim.step()
+    for _ in range(steps):
+        posed = sim.contact_problem()
+        seen.append((posed.problem, *(a.copy() for a in posed.state), posed.limits._asdict()))
+        sim.step()
     return seen
 
 
@@ -117,7 +110,7 @@ def sheared_sample(shape: str, particles: int, strain: float, folder: str):
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         sim = prepare_sample(preparation("fast", shape=shape, particles=particles), progress=False,
-                             acceleration="off", stall_sweeps=0)
+                             solver="nlgs", stall_sweeps=0)
         path = os.path.join(folder, f"{shape}_{particles}_shear.nc")
         solver.biaxial_test(sim, path, strain=strain, velocity=0.01, every=10**9, overwrite=True, progress=False)
     os.remove(path)
@@ -144,13 +137,16 @@ def load_sample(path: str):
 
 
 def way_of_solving(row: dict) -> str:
-    """How a benchmark row's NLGS was run, in words, from its ``acceleration``,
-    ``anderson_period``, ``stall_sweeps`` and ``domains`` (rows from before an option existed:
-    plain sweeps, an extrapolation after every sweep, no stall test, one domain)."""
-    how = row.get("acceleration", "off")
-    if how == "anderson":
-        period = row.get("anderson_period", 1)
-        how += ", every sweep" if period == 1 else f", every {period} sweeps"
+    """How a benchmark row's contact problems were solved, in words: its ``solver`` (rows from
+    before it: the method their ``acceleration`` names, :data:`solver.contact_solvers.ACCELERATIONS`,
+    plain sweeps without one) with the options the method reads that the row holds
+    (:attr:`solver.contact_solvers.Method.parameters`), ``stall_sweeps`` and ``domains`` (rows
+    from before an option existed: no stall test, one domain)."""
+    from solver import contact_solvers
+
+    name = row["solver"] if "solver" in row else contact_solvers.from_acceleration(row.get("acceleration", "off"))
+    how = name + "".join(f", {keyword} {row[field]}" for field, keyword in contact_solvers.method(name).parameters
+                         if field in row)
     stall = row.get("stall_sweeps", 0)
     domains = row.get("domains", 1)
     return how + (f", stall {stall}" if stall else "") + (f", {domains} domains" if domains > 1 else "")

@@ -41,6 +41,7 @@ import pickle
 import subprocess
 import time
 import warnings
+from dataclasses import replace
 
 import numpy as np
 from scipy import sparse
@@ -162,7 +163,7 @@ def build(particles):
         path = os.path.join(DATA, f"pentagon_{particles}_shear.nc")
         solver.biaxial_test(sim, path, strain=SHEAR, velocity=0.01, every=10**9, overwrite=True, progress=False)
         os.remove(path)
-        sim.parameters.acceleration = "off"  # the captured solve is then nlgs.solve_problem
+        sim.parameters = replace(sim.parameters, solver="nlgs")  # the steps between: plain sweeps, as first built
         captured = []
         for _ in range(CAPTURED_STEPS):
             problem, pn, pt, vx, vy, w, options = capture_contact_problems(sim, 1)[0]

@@ -19,20 +19,25 @@ class Done(Exception):
     """Raised by an ``after_step`` callback of :func:`shear` to end the shear there."""
 
 
-def shear(sim, after_step, solve=None) -> float:
+def shear(sim, after_step, solve=None, before_step=None, domains=1) -> float:
     """Run ``solver.biaxial_test`` on ``sim`` (top wall at 1 cm/s, no snapshots but the first,
-    warnings silenced) with Anderson sweeps every 2 sweeps and the stall test over 200 on one
-    domain, calling ``after_step(info)`` after every step (it raises :class:`Done` to stop),
-    with ``solve`` (if given) in place of ``solver.acceleration.solve_problem_anderson``; the
-    simulation's and the module's own functions are back afterwards. Returns the seconds."""
+    warnings silenced) with Anderson sweeps every 2 sweeps and the stall test over 200 on
+    ``domains`` domains (one by default), calling ``before_step()`` (if given) right before every
+    step and ``after_step(info)`` after it (either raises :class:`Done` to stop), with ``solve``
+    (if given) in place of ``solver.acceleration.solve_problem_anderson``; the simulation's and
+    the module's own functions are back afterwards. Returns the seconds."""
+    from dataclasses import replace
+
     import solver
     from solver import acceleration
 
-    p = sim.parameters
-    p.acceleration, p.anderson_period, p.stall_sweeps, p.domains = "anderson", 2, 200, 1
+    sim.parameters = replace(sim.parameters, solver="anderson", anderson_period=2, stall_sweeps=200,
+                             domains=domains).validate()
     original_solve, step = acceleration.solve_problem_anderson, sim.step
 
     def stepped():
+        if before_step is not None:
+            before_step()
         info = step()
         after_step(info)
         return info
@@ -57,31 +62,28 @@ def shear(sim, after_step, solve=None) -> float:
 
 def capture(sim, first: int, last: int) -> list:
     """Shear ``sim`` as :func:`shear` does until shear step ``last`` and return the main contact
-    problem of steps ``first``..``last`` as dicts: step, problem, warm-start impulses pn, pt,
-    free velocities vx, vy, w, the solver options, the particles' positions, and the sweeps the
-    step took and the local-law residual of its solution."""
-    from solver import acceleration, residuals
-
-    tolerance = sim.parameters.tolerance
+    problem of steps ``first``..``last`` (the step's own, taken with
+    :meth:`solver.stepper.Simulation.contact_problem` right before it; not the overlap
+    recovery's) as dicts: step, problem, warm-start impulses pn, pt, free velocities vx, vy, w,
+    the stopping limits as ``options`` (tolerance, max_tolerance, max_iterations, stall), the
+    particles' positions, and the sweeps the step took and the local-law residual of its
+    solution (its :class:`solver.stepper.StepInfo`)."""
     caught, done = [], [0]
-    solve = acceleration.solve_problem_anderson
 
-    def capturing(problem, pn, pt, vx, vy, w, **options):
-        main = options["tolerance"] == tolerance and first <= done[0] <= last
-        if main:
-            caught.append(dict(step=done[0], problem=problem, pn=pn.copy(), pt=pt.copy(), vx=vx.copy(),
-                               vy=vy.copy(), w=w.copy(), options=dict(options),
-                               position=sim.position[:sim.n_particles].copy()))
-        result = solve(problem, pn, pt, vx, vy, w, **options)
-        if main:
-            caught[-1]["sweeps"] = result.iterations
-            caught[-1]["law"] = residuals.local_law_residual(problem, pn, pt, vx, vy, w)
-        return result
+    def take():
+        if first <= done[0] <= last:
+            posed = sim.contact_problem()
+            pn, pt, vx, vy, w = (a.copy() for a in posed.state)
+            caught.append(dict(step=done[0], problem=posed.problem, pn=pn, pt=pt, vx=vx, vy=vy, w=w,
+                               options=posed.limits._asdict(), position=sim.position[:sim.n_particles].copy()))
 
     def count(info):
+        if first <= done[0] <= last:
+            caught[-1]["sweeps"] = info.iterations
+            caught[-1]["law"] = info.local_law_residual
         done[0] += 1
         if done[0] > last:
             raise Done
 
-    shear(sim, count, capturing)
+    shear(sim, count, before_step=take)
     return caught

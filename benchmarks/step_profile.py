@@ -4,17 +4,20 @@
 
 A sample saved by ``compaction.py --save`` is sheared as the shear benchmarks shear it
 (``solver.biaxial_test``, top wall at 1 cm/s, Anderson sweeps with an extrapolation every 2
-sweeps and the stall test over 200; ``sweep_bursts._shear``) for ``--skip`` steps, and the next
-``--steps`` steps are timed stage by stage:
+sweeps and the stall test over 200; ``benchmarks.shear.shear``) for ``--skip`` steps, and the
+next ``--steps`` steps are timed stage by stage, by the stepper itself
+(``Simulation.timings``, whose stages ``solver.stepper.STAGES`` are disjoint and add up to the
+time spent in ``Simulation.step``):
 
-- broad phase and narrow phase (the simulation's own ``timings``);
+- broad phase and narrow phase;
 - warm start: the points' keys and the matching of last step's impulses;
 - contact problem: the free velocities and the step's :class:`solver.nlgs.ContactProblem`;
-- solve: the step's NLGS (the simulation's ``timings``);
+- solve: the step's solver (``Parameters.solver``, its domain decomposition included);
 - overlap recovery: the split-impulse pass (a second, frictionless solve, when overlaps remain);
 - diagnostics: the local-law residual and the unbalanced force of every step;
 - update, other: the rest of the end of the step (end velocities, integration, bookkeeping);
-- step, other: the rest of ``Simulation.step`` (the alert distance, the step's record);
+- step, other: the rest of ``Simulation.step`` (the alert distance, the convergence count, the
+  step's record);
 - outside the step: what ``biaxial_test`` does between steps (wall control, output checks).
 
 Each domain count shears its own copy of the sample, in turns (``--repeats``: the order
@@ -43,80 +46,37 @@ from common import load_sample, write_results  # noqa: E402
 STAGES = ["broad phase", "narrow phase", "warm start", "contact problem", "solve", "overlap recovery",
           "diagnostics", "update, other", "step, other", "outside the step"]
 """The stages of the table, in the order of a step."""
-WRAPPED = {"_point_keys": "warm start", "_matched_impulses": "warm start", "_free_velocities": "contact problem",
-           "_contact_problem": "contact problem", "_recover_overlaps": "overlap recovery",
-           "_unbalanced": "diagnostics"}
-"""Methods of :class:`solver.stepper.Simulation` timed, and their stage."""
+TIMINGS = {"broad_phase": "broad phase", "narrow_phase": "narrow phase", "warm_start": "warm start",
+           "contact_problem": "contact problem", "solve": "solve", "overlap_recovery": "overlap recovery",
+           "diagnostics": "diagnostics", "update": "update, other", "other": "step, other"}
+"""The stepper's stages (``solver.stepper.STAGES``, keys of ``Simulation.timings``) and their row."""
 
 
 def profile(sim, skip: int, steps: int, domains: int = 1) -> dict:
     """Shear ``sim`` (module docstring) on ``domains`` NLGS domains ``skip`` steps, then time
-    ``steps`` steps by stage.
-    Returns ms per step per stage (``ms``), the calls of each timed piece (``calls``), the
-    sweeps and contact points per step and the wall seconds of the timed steps. The
-    simulation's methods and ``solver.residuals.local_law_residual`` are restored afterwards."""
-    from solver import residuals
-    from sweep_bursts import _Done, _shear
+    ``steps`` steps by stage, from the simulation's own stage timings (``Simulation.timings``).
+    Returns ms per step per stage (``ms``), the steps timed (``steps``), the sweeps and contact
+    points per step and the wall seconds of the timed steps."""
+    from benchmarks.shear import Done, shear
 
-    seconds = dict.fromkeys(STAGES, 0.0)
-    calls = dict.fromkeys(list(WRAPPED) + ["local_law_residual", "step"], 0)
-    state = dict(on=False, step_seconds=0.0)
-
-    def timed(function, stage, name):
-        def wrapper(*args, **kwargs):
-            if not state["on"]:
-                return function(*args, **kwargs)
-            start = time.perf_counter()
-            try:
-                return function(*args, **kwargs)
-            finally:
-                seconds[stage] += time.perf_counter() - start
-                calls[name] += 1
-        return wrapper
-
-    for name, stage in WRAPPED.items():
-        setattr(sim, name, timed(getattr(sim, name), stage, name))
-    law = residuals.local_law_residual
-    residuals.local_law_residual = timed(law, "diagnostics", "local_law_residual")
-    step = sim.step
     done = [0]
     mark = {}
 
-    def timed_step():
+    def before_step():
         if done[0] == skip:
-            state["on"] = True
             mark.update(start=time.perf_counter(), sweeps=sim.counters["sweeps"], timings=dict(sim.timings))
-        sim.parameters.domains = domains  # the shear benchmarks' settings, on ``domains``
-        start = time.perf_counter()
-        info = step()
-        if state["on"]:
-            state["step_seconds"] += time.perf_counter() - start
-            calls["step"] += 1
-        return info
 
     def after_step(info):
         done[0] += 1
         if done[0] == skip + steps:
             mark["end"] = time.perf_counter()
-            raise _Done
+            raise Done
 
-    sim.step = timed_step
-    try:
-        _shear(sim, after_step)
-    finally:
-        residuals.local_law_residual = law
-        for name in WRAPPED:
-            delattr(sim, name)
-    timings = {k: sim.timings[k] - mark["timings"][k] for k in sim.timings}
-    seconds["broad phase"] = timings["broad_phase"]
-    seconds["narrow phase"] = timings["narrow_phase"]
-    seconds["solve"] = timings["solve"]
-    seconds["update, other"] = timings["update"] - seconds["overlap recovery"] - seconds["diagnostics"]
-    inside = sum(seconds[s] for s in STAGES if s not in ("step, other", "outside the step"))
-    seconds["step, other"] = state["step_seconds"] - inside
+    shear(sim, after_step, before_step=before_step, domains=domains)
     wall = mark["end"] - mark["start"]
-    seconds["outside the step"] = wall - state["step_seconds"]
-    return dict(ms={s: 1e3 * seconds[s] / steps for s in STAGES}, calls=calls, seconds=wall,
+    seconds = {TIMINGS[k]: sim.timings[k] - mark["timings"][k] for k in TIMINGS}
+    seconds["outside the step"] = wall - sum(seconds.values())
+    return dict(ms={s: 1e3 * seconds[s] / steps for s in STAGES}, steps=done[0] - skip, seconds=wall,
                 sweeps=(sim.counters["sweeps"] - mark["sweeps"]) / steps, points=len(sim.points.gap), domains=domains)
 
 

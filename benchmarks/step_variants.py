@@ -27,6 +27,7 @@ import pickle
 import sys
 import time
 import warnings
+from dataclasses import replace
 
 import numpy as np
 
@@ -39,16 +40,17 @@ RESULTS = os.path.join(HERE, "RESULTS-step-variants.md")
 SHAPES = ("pentagon", "disk")
 SHEAR = 0.03
 CANDIDATES = [
-    ("NLGS", dict(acceleration="off", domains=1, stall_sweeps=0)),
-    ("NLGS, stall 200", dict(acceleration="off", domains=1, stall_sweeps=200)),
-    ("NLGS, 2 domains", dict(acceleration="off", domains=2, stall_sweeps=0)),
-    ("Anderson m = 3, every sweep", dict(acceleration="anderson", anderson_period=1, domains=1, stall_sweeps=0)),
-    ("Anderson m = 3, every 2 sweeps", dict(acceleration="anderson", anderson_period=2, domains=1, stall_sweeps=0)),
-    ("Anderson m = 3, every 2 sweeps, stall 200", dict(acceleration="anderson", anderson_period=2, domains=1,
+    ("NLGS", dict(solver="nlgs", domains=1, stall_sweeps=0)),
+    ("NLGS, stall 200", dict(solver="nlgs", domains=1, stall_sweeps=200)),
+    ("NLGS, 2 domains", dict(solver="nlgs", domains=2, stall_sweeps=0)),
+    ("Anderson m = 3, every sweep", dict(solver="anderson", anderson_period=1, domains=1, stall_sweeps=0)),
+    ("Anderson m = 3, every 2 sweeps", dict(solver="anderson", anderson_period=2, domains=1, stall_sweeps=0)),
+    ("Anderson m = 3, every 2 sweeps, stall 200", dict(solver="anderson", anderson_period=2, domains=1,
                                                        stall_sweeps=200)),
-    ("Anderson m = 3, every 2 sweeps, stall 200, 2 domains", dict(acceleration="anderson", anderson_period=2,
+    ("Anderson m = 3, every 2 sweeps, stall 200, 2 domains", dict(solver="anderson", anderson_period=2,
                                                                   domains=2, stall_sweeps=200)),
 ]
+"""Each candidate's name and the :class:`solver.parameters.Parameters` fields it sets."""
 
 
 def cache_path(shape, particles):
@@ -72,9 +74,7 @@ def measure(shape, particles, steps, chunk, candidates=CANDIDATES):
     sims = {}
     for name, settings in candidates:
         sim = copy.deepcopy(start_state)
-        for key, value in settings.items():
-            setattr(sim.parameters, key, value)
-        sim.parameters.validate()
+        sim.parameters = replace(sim.parameters, **settings).validate()
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
             sim.step()  # compile outside the timing

@@ -54,7 +54,6 @@ def test_a_stepper_problem_as_a_matrix(pentagon_sample):
 
     bench = load("contact_solvers")
     sim, _ = load("step_profile").load_sample(pentagon_sample)
-    sim.parameters.acceleration = "off"  # the step's solve is then nlgs.solve_problem, which is captured
     problem, pn, pt, vx, vy, w, _ = load("common").capture_contact_problems(sim, 1)[0]
     W, q, mu = bench.matrix_problem(problem, vx, vy, w)
     blocks = nlgs.delassus(problem.a, problem.b, problem.nx, problem.ny, problem.rax, problem.ray, problem.rbx,
