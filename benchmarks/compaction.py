@@ -129,7 +129,8 @@ def compact(shape: str, particles: int, seed: int, route: str, acceleration: str
     fabric = np.array([[np.mean(nx * nx), np.mean(nx * ny)], [np.mean(nx * ny), np.mean(ny * ny)]])
     low, high = np.linalg.eigvalsh(fabric)
     sweeps = np.array(counts["sweeps"])
-    return {"shape": shape, "particles": particles, "seed": seed, "route": route, "acceleration": acceleration,
+    return {"shape": shape, "particles": particles, "seed": seed, "route": route, "solver": sim.parameters.solver,
+            "acceleration": acceleration,
             "anderson_period": period, "stall_sweeps": stall, "domains": domains, "steps": int(steps),
             "switch_step": counts["switch_step"], "sweeps": int(sweeps.sum()),
             "sweeps_median": float(np.median(sweeps)), "sweeps_p90": float(np.percentile(sweeps, 90)),
@@ -167,12 +168,16 @@ def table(path, rows=None) -> str:
 
 
 def main(argv=None):
+    from solver.contact_solvers import ACCELERATIONS
+
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--shape", default="pentagon")
     parser.add_argument("--particles", type=int, default=1000)
     parser.add_argument("--seeds", default="0")
     parser.add_argument("--routes", default="paper,fast")
-    parser.add_argument("--acceleration", choices=("off", "anderson"), default="off")
+    parser.add_argument("--acceleration", choices=tuple(ACCELERATIONS), default="off",
+                        help="the solver, by the former names of solver.contact_solvers.ACCELERATIONS: "
+                        + ", ".join(f"{old} is {new}" for old, new in ACCELERATIONS.items()))
     parser.add_argument("--period", type=int, default=1, help="Anderson: sweeps between extrapolations")
     parser.add_argument("--stall", type=int, default=0, help="the stall test over this many sweeps (0: none)")
     parser.add_argument("--domains", type=int, default=1, help="NLGS domains swept at once (threads)")

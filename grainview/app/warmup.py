@@ -74,13 +74,17 @@ def _stages(folder):
     from solver import biaxial_test
 
     def solver_shape(shape):
-        def run():
-            _steps(shape)
-            _steps(shape, acceleration="off")
-            _steps(shape, acceleration="off", shuffle=True)
+        from solver import contact_solvers
+
+        def run():  # every solver of the registry the stepper can use, on its domains and in its orders
+            for name in contact_solvers.stepper_methods():
+                method = contact_solvers.method(name)
+                _steps(shape, solver=name)
+                if method.domains:
+                    _steps(shape, solver=name, domains=2)
+                if method.shuffle:
+                    _steps(shape, solver=name, shuffle=True)
             _steps(shape, stall_sweeps=2, max_iterations=20)
-            _steps(shape, domains=2)
-            _steps(shape, domains=2, acceleration="off")
         return run
 
     def written():
