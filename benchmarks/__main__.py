@@ -23,7 +23,6 @@ first when missing (benchmarks/compaction.py, the ``fast`` route; hours at 14,40
 from __future__ import annotations
 
 import argparse
-import datetime
 import os
 import re
 import subprocess
@@ -157,12 +156,13 @@ def _anchor(title: str) -> str:
     return re.sub(r"[^\w\- ]", "", title.strip().lower()).replace(" ", "-")
 
 
-def assemble(folder: str = RESULTS_DIR, output: str = RESULTS, sections=SECTIONS, note: str = "") -> str:
-    """Write ``output`` from the section files in ``folder``, in the order of ``sections``: a
+def assembled(folder: str = RESULTS_DIR, sections=SECTIONS, note: str = "", base: str = HERE) -> str:
+    """RESULTS.md's text from the section files in ``folder``, in the order of ``sections``: a
     header, a table of contents giving each section's date, then each file with its headings
-    one level down (its links made relative to ``output``'s folder). A missing file is listed
-    as not measured. Returns the text."""
-    rel = os.path.relpath(folder, os.path.dirname(os.path.abspath(output)))
+    one level down and its links made relative to ``base`` (the folder RESULTS.md is written
+    to). A missing file is listed as not measured. The text depends on the section files
+    alone, so the committed RESULTS.md can be checked against them."""
+    rel = os.path.relpath(folder, base)
     contents, bodies = [], []
     for section in sections:
         path = section.path(folder)
@@ -176,15 +176,21 @@ def assemble(folder: str = RESULTS_DIR, output: str = RESULTS, sections=SECTIONS
                       text)
         bodies.append(_demoted(text if text.startswith("# ") else f"# {section.name}\n\n{text}"))
     header = ["# Benchmark results", "",
-              f"Assembled by `python -m benchmarks` from the section files in `{os.path.relpath(folder, HERE)}/` "
-              f"on {datetime.datetime.now(datetime.timezone.utc):%Y-%m-%d %H:%M UTC}; each section is the latest "
-              "run of its benchmark and says when, on which commit and machine it was measured. "
+              f"Assembled by `python -m benchmarks` from the section files in `{rel}/`: "
+              "each section is the latest run of its benchmark and says when, on which commit and machine it was "
+              "measured (the table's last column). "
               "benchmarks/README.md says what each benchmark is and how to run it, docs/benchmarks.md how to "
               "read the tables; past studies are in benchmarks/archive/.", ""]
     if note:
         header += [note, ""]
     header += ["| section | what | measured |", "|---|---|---|"] + contents + [""]
-    text = "\n".join(header) + "\n" + "\n\n".join(bodies) + "\n"
+    return "\n".join(header) + "\n" + "\n\n".join(bodies) + "\n"
+
+
+def assemble(folder: str = RESULTS_DIR, output: str = RESULTS, sections=SECTIONS, note: str = "") -> str:
+    """Write ``output`` (RESULTS.md) from the section files in ``folder`` (:func:`assembled`);
+    returns its text."""
+    text = assembled(folder, sections, note, os.path.dirname(os.path.abspath(output)))
     with open(output, "w") as fh:
         fh.write(text)
     return text
@@ -203,17 +209,23 @@ def _ensure_samples(samples, log=print) -> None:
 def measure(section: Section, quick: bool, folder: str, log=print) -> bool:
     """Run ``section``'s benchmark into its file in ``folder``; True when it succeeded. A
     failed run leaves the section's previous file as it was."""
-    _ensure_samples(section.quick_samples if quick else section.samples, log)
+    try:
+        _ensure_samples(section.quick_samples if quick else section.samples, log)
+    except Exception as exc:  # a sample that cannot be made fails its section, not the run
+        log(f"the dense samples of {section.name} could not be made: {exc!r}")
+        return False
     command = section.command(quick, folder)
-    log("$ " + " ".join(command[1:]), flush=True)
+    log("$ python " + " ".join(command[1:]), flush=True)
     root = os.path.dirname(HERE)
     if section.out or not quick:
         return subprocess.run(command, cwd=root).returncode == 0
     done = subprocess.run(command, cwd=root, stdout=subprocess.PIPE, text=True)
     if done.returncode != 0:
         return False
+    text = done.stdout
+    title = re.search(r"^# ", text, flags=re.M)  # the Markdown starts at its title; progress lines before it
     with open(section.path(folder), "w") as fh:
-        fh.write(done.stdout.strip() + "\n")
+        fh.write((text[title.start():] if title else text).strip() + "\n")
     return True
 
 
