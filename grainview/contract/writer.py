@@ -30,7 +30,7 @@ project's netCDF4 1.7 / HDF5 2.2 can crash the interpreter when a file read befo
 same process is opened again (docs/schema.md)."""
 DEFAULT_COMPLEVEL = 1
 """zlib level (1-9) of :func:`compress_file`: level 1 makes files within 2% of level 4's size and
-inflates faster (benchmarks/RESULTS-compression.md)."""
+inflates faster (benchmarks/results/compression.md)."""
 COPY_BLOCK_BYTES = 8 * 2**20
 """At most this many bytes of one variable (whole chunks, at least one) are held in memory while
 a file is converted."""
@@ -40,7 +40,7 @@ as fit in this many bytes when one snapshot of the variable is smaller (see :fun
 MIN_SAVING = 0.4
 """A per-snapshot variable is deflated only when zlib saves at least this fraction of its bytes
 (see :func:`deflate_saving`); data that compress less are stored as they are, since inflating
-them costs the analyses more than the bytes saved (benchmarks/RESULTS-compression.md)."""
+them costs the analyses more than the bytes saved (benchmarks/results/compression.md)."""
 
 
 TEMPORARY_SUFFIXES = (".part", ".convert")
