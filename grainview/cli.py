@@ -8,7 +8,6 @@ never as a traceback.
 from __future__ import annotations
 
 import argparse
-import math
 import sys
 from pathlib import Path
 
@@ -21,9 +20,22 @@ S1S2_HELP = ("s1s2: the paper's two initial states, each shape compacted its own
              "friction 0.4 as 'paper' (the paper's S1, solid fraction 0.80), disks compacted frictionless (S2, the "
              "denser 0.82); both tested with friction 0.4; docs/fidelity.md")
 """What ``--preparation s1s2`` means, in the help of every command that takes it."""
-DEFAULT_STRAIN = 0.2
-"""Default vertical strain eps_1 of a biaxial test: eps_q reaches ~0.55-0.65, well into the
-residual state (eps_q >= 0.3)."""
+SOLVER_OPTIONS = ("wall_friction", "time_step", "tolerance", "solver", "stall_sweeps", "domains")
+"""The :class:`solver.parameters.Parameters` fields that ``run`` and ``study`` take as options;
+each option's type, choices, default and help are its field's (:func:`setting_option`)."""
+ENSEMBLE_SOLVER_OPTIONS = ("wall_friction", "time_step", "tolerance", "solver")
+"""The :class:`solver.parameters.Parameters` fields that ``ensemble`` takes as options."""
+PREPARATION_OPTIONS = ("friction", "sigma0", "compaction_friction", "max_inertia_number", "aspect", "pressure_ramp")
+"""The :class:`solver.preparation.Preparation` fields that change a named preparation on the
+command line (besides the sample: particles, shape, seed)."""
+TEST_OPTIONS = ("strain", "velocity", "every")
+"""The :class:`solver.parameters.BiaxialTest` fields: the options of the biaxial test."""
+STUDY_SAMPLES = {"pentagons": "pentagon", "disks": "disk"}
+"""The study's samples: file label -> shape."""
+ENSEMBLE_SEEDS = 3
+"""Seeds per setting of ``grainview ensemble`` when --seeds is not given."""
+DEMO_SIZE = {"snapshots": 11, "contacts": 20000}
+"""The size of the synthetic series of ``grainview demo``: large enough to show the lazy reading."""
 
 
 def _info(args) -> int:
@@ -207,35 +219,101 @@ def _warmup(args) -> int:
 
 
 def _preparation(args, shape):
-    """The :class:`solver.preparation.Preparation` the command line asks for."""
+    """The :class:`solver.preparation.Preparation` the command line asks for: the named preset
+    with the preparation's settings given on the command line (:data:`PREPARATION_OPTIONS`)."""
     from solver.preparation import preparation
 
-    return preparation(args.preparation, particles=args.particles, shape=shape, seed=args.seed,
-                       friction=args.friction, sigma0=args.sigma0,
-                       compaction_friction=args.compaction_friction, max_inertia_number=args.max_inertia_number,
-                       aspect=args.aspect, pressure_ramp=args.pressure_ramp)
+    changes = {name: getattr(args, name) for name in PREPARATION_OPTIONS if name in _given(args)}
+    return preparation(args.preparation, particles=args.particles, shape=shape, seed=args.seed, **changes)
 
 
 def _solver_parameters(args) -> dict:
-    """The :class:`solver.Parameters` the command line sets (the others keep their defaults)."""
-    from solver import Parameters
+    """The :class:`solver.Parameters` fields given on the command line (:data:`SOLVER_OPTIONS`;
+    the others keep their defaults), validated."""
+    from solver.parameters import Parameters
 
-    given = {"wall_friction": args.wall_friction, "time_step": args.time_step, "tolerance": args.tolerance,
-             "acceleration": args.acceleration, "domains": getattr(args, "domains", None),
-             "stall_sweeps": getattr(args, "stall_sweeps", None)}
-    parameters = {k: v for k, v in given.items() if v is not None}
+    parameters = {name: getattr(args, name) for name in SOLVER_OPTIONS if name in _given(args)}
+    if getattr(args, "acceleration", None) is not None:  # the former name of --solver
+        from solver.contact_solvers import from_acceleration
+
+        if "solver" in parameters:
+            raise GrainviewError("--acceleration and --solver name the same setting: expected one of them")
+        parameters["solver"] = from_acceleration(args.acceleration)
     Parameters(**parameters).validate()  # one clear line before anything is simulated
     return parameters
 
 
-def _check_test(args):
-    """Check the settings of the biaxial test before anything is simulated."""
-    if not (0 < args.strain < 1):
-        raise GrainviewError(f"--strain {args.strain}: expected a vertical strain eps_1 in (0, 1)")
-    if args.every < 1:
-        raise GrainviewError(f"--every {args.every}: expected a positive number of steps between snapshots")
-    if not (math.isfinite(args.velocity) and args.velocity > 0):
-        raise GrainviewError(f"--velocity {args.velocity:g}: expected a finite wall speed > 0 in m/s")
+def _test(args):
+    """The :class:`solver.parameters.BiaxialTest` of the command line, checked by its own
+    validator before anything is simulated; a bad value is named by its flag."""
+    from solver.parameters import BiaxialTest, problems
+
+    test = BiaxialTest(**{name: getattr(args, name) for name in TEST_OPTIONS})
+    for name, value, expected in problems(test)[:1]:
+        shown = f"{value:g}" if isinstance(value, float) else value
+        raise GrainviewError(f"{_flag(name)} {shown}: expected {expected}")
+    return test
+
+
+def _given(args) -> set:
+    """The settings given on the command line (:class:`_Given`)."""
+    return getattr(args, "given", None) or set()
+
+
+def _flag(name) -> str:
+    """The command-line flag of a setting: ``--`` and its name with dashes."""
+    return "--" + name.replace("_", "-")
+
+
+class _Given(argparse.Action):
+    """Stores an option's value and notes, in ``args.given``, that it was given: a named
+    preparation's own values hold for the settings that were not."""
+
+    def __call__(self, parser, namespace, values, option_string=None):
+        setattr(namespace, self.dest, values)
+        namespace.given = _given(namespace) | {self.dest}
+
+
+def _setting_type(f):
+    """The command-line type of a settings field: its annotation's first type (``float | None``:
+    float; ``str | int``: str, parsed further by the command)."""
+    return {"float": float, "int": int}.get(str(f.type).split("|")[0].strip(), str)
+
+
+def setting_option(parser, record, name, *, more="", flag=None, **overrides):
+    """Add the option of field ``name`` of the settings dataclass ``record``
+    (:func:`solver.parameters.setting`): flag ``--name-with-dashes``, its type, choices, default
+    and help (the field's help, unit and default), all from the field. ``more``: words added to
+    the help; ``flag``: another flag; ``overrides``: other
+    :meth:`argparse.ArgumentParser.add_argument` keywords."""
+    from dataclasses import fields
+
+    f = next(f for f in fields(record) if f.name == name)
+    meta, default = f.metadata, f.default
+    choices = meta["choices"]() if meta.get("choices") else None
+    shown = "none" if default is None else f"{default:g}" if isinstance(default, float) else default
+    unit = f" {meta['unit']}" if meta.get("unit") and default is not None else ""
+    text = f"{meta['help']}{more} (default {shown}{unit})".replace("%", "%%")
+    options = dict(dest=name, default=default, action=_Given, help=text)
+    options.update(dict(choices=choices) if choices is not None else dict(type=_setting_type(f)))
+    options.update(overrides)
+    parser.add_argument(flag or _flag(name), **options)
+
+
+def library_default(module, function, parameter):
+    """The default of ``parameter`` of grainview's ``module.function``, read from the module's
+    source (its signature, parsed; nothing imported), so that an option's default is the
+    function's and ``--help`` loads no xarray."""
+    import ast
+
+    path = Path(__file__).parent.joinpath(*module.split(".")[1:]).with_suffix(".py")
+    tree = ast.parse(path.read_text(encoding="utf-8"))
+    node = next(n for n in ast.walk(tree) if isinstance(n, ast.FunctionDef) and n.name == function)
+    args = node.args
+    positional = args.posonlyargs + args.args
+    pairs = list(zip(positional[len(positional) - len(args.defaults):], args.defaults))
+    pairs += [(a, d) for a, d in zip(args.kwonlyargs, args.kw_defaults) if d is not None]
+    return next(ast.literal_eval(d) for a, d in pairs if a.arg == parameter)
 
 
 MAX_VERTICES = 64
@@ -267,17 +345,19 @@ def _shape_of(text, option=None):
                          f"to {MAX_VERTICES}, {', '.join(FAMILIES)} or a {SHAPE_FILE_SUFFIX} file of vertex lists")
 
 
-def _simulate(prep, path, *, strain, every, velocity, near_contacts, overwrite, progress, scene="biaxial",
-              parameters=None, compress=True):
+def _simulate(prep, path, *, test, near_contacts, overwrite, progress, scene="biaxial", parameters=None,
+              compress=True, engine=None):
     """Deposit, compact isotropically (as ``prep`` says) and, for ``scene="biaxial"``, shear
-    one sample into ``path``; returns the path. An isotropic run writes its compacted state.
-    ``parameters``: solver settings (:class:`solver.Parameters` fields) other than the defaults."""
+    one sample in the biaxial ``test`` (:class:`solver.parameters.BiaxialTest`) into ``path``,
+    with the engine named ``engine`` (:mod:`solver.engine`; None: the default); returns the
+    path. An isotropic run writes its compacted state. ``parameters``: solver settings
+    (:class:`solver.Parameters` fields) other than the defaults."""
     import warnings
 
-    from solver import biaxial_test
-    from solver.output import Recorder
-    from solver.preparation import prepare_sample, record
+    from solver.engine import DEFAULT_ENGINE
+    from solver.engine import engine as engine_named
 
+    runner = engine_named(engine or DEFAULT_ENGINE)
     path = Path(path)
     if path.exists() and not overwrite:
         raise GrainviewError(f"{path} exists; pass --overwrite to replace it")
@@ -287,22 +367,21 @@ def _simulate(prep, path, *, strain, every, velocity, near_contacts, overwrite, 
     print(f"{name}: depositing {prep.particles} particles and compacting under {prep.sigma0:g} Pa ...", flush=True)
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
-        sim = prepare_sample(prep, progress=progress, **(parameters or {}))
-        settled = "settled" if sim.settled else "NOT settled (step limit reached)"
-        print(f"{name}: compaction {settled} after {sim.compaction_steps} steps; wall stresses "
-              f"{', '.join(f'{s:.0f}' for s in sim.compaction_stress)} Pa", flush=True)
-        attrs = record(sim)
+        sample = runner.prepare(prep, parameters or {}, progress=progress)
+        history = sample.history
+        settled = "settled" if history.settled else "NOT settled (step limit reached)"
+        print(f"{name}: compaction {settled} after {history.compaction_steps} steps; wall stresses "
+              f"{', '.join(f'{s:.0f}' for s in history.compaction_stress)} Pa", flush=True)
         if scene == "isotropic":
-            with Recorder(path, sim, attrs={"scene": "isotropic", **attrs}, overwrite=overwrite,
-                          near_contacts=near_contacts, compress=compress) as rec:
-                rec.write()
+            runner.write_state(sample, path, attrs={"scene": "isotropic"}, overwrite=overwrite,
+                               near_contacts=near_contacts, compress=compress)
         else:
-            print(f"{name}: biaxial compression to eps_1 = {strain} at {velocity:g} m/s ...", flush=True)
-            biaxial_test(sim, path, strain=strain, every=every, velocity=velocity, overwrite=overwrite,
-                         progress=progress, attrs=attrs, near_contacts=near_contacts, compress=compress)
+            print(f"{name}: biaxial compression to eps_1 = {test.strain} at {test.velocity:g} m/s ...", flush=True)
+            runner.shear(sample, path, test, overwrite=overwrite, progress=progress, attrs=history.attrs(),
+                         near_contacts=near_contacts, compress=compress)
     unconverged = sum(issubclass(w.category, ConvergenceWarning) for w in caught)
     if unconverged:
-        print(f"{name}: warning: {_unconverged_warning(sim, path, unconverged)}", file=sys.stderr)
+        print(f"{name}: warning: {_unconverged_warning(sample, path, unconverged)}", file=sys.stderr)
     print(f"{name}: wrote {path}", flush=True)
     return path
 
@@ -317,10 +396,10 @@ def _unconverged_warning(sim, path, unconverged) -> str:
 
     with netCDF4.Dataset(path) as nc:
         counts = unconverged_in_file(nc.variables, {k: nc.getncattr(k) for k in nc.ncattrs()})
-    compaction = sim.compaction_unconverged
+    compaction = sim.history.compaction_unconverged
     parts, law, quad = [], 0.0, 0.0
     if compaction is not None:
-        parts.append(f"{compaction.steps} of the compaction's {sim.compaction_steps}")
+        parts.append(f"{compaction.steps} of the compaction's {sim.history.compaction_steps}")
         law, quad = compaction.local_law_residual, compaction.residual
     if counts is not None and counts["of"]:
         parts.append(f"{counts['steps']} of the test's {counts['of']}")
@@ -340,9 +419,9 @@ def _progress_flag(args):
 
 
 def _simulation_kwargs(args):
-    return dict(strain=args.strain, every=args.every, velocity=args.velocity, near_contacts=args.near_contacts,
-                overwrite=args.overwrite, progress=_progress_flag(args), parameters=_solver_parameters(args),
-                compress=not args.no_compress)
+    return dict(test=_test(args), near_contacts=args.near_contacts, overwrite=args.overwrite,
+                progress=_progress_flag(args), parameters=_solver_parameters(args), compress=not args.no_compress,
+                engine=args.engine)
 
 
 TEMPORARY_NAME_EXTRA = len("..") + 7 + len(".convert")
@@ -389,23 +468,22 @@ def _check_output_file(path, overwrite):
         raise GrainviewError(f"--out {path}: the folder {folder} is not writable")
 
 
-def _check_time_step(args, prep):
-    """The time step against the walls' speeds, before any work (solver.stepper.check_time_step)."""
-    from solver import Parameters
+def _check_settings(args, prep):
+    """Every setting of a run against the others before any work: the solver parameters (a
+    time step of the wrong sign or form is named as such first), then the time step against
+    the walls' speeds and the test's length in steps, by the engine (:mod:`solver.engine`)."""
+    from solver.engine import engine
 
-    _solver_parameters(args)  # a time step of the wrong sign or form is named as such first
-    time_step = args.time_step if args.time_step is not None else Parameters().time_step
+    parameters = _solver_parameters(args)
     biaxial = getattr(args, "scene", "biaxial") == "biaxial"
-    prep.check_time_step(time_step, args.velocity if biaxial else None)
-    if biaxial:
-        prep.check_test_speed(time_step, args.velocity, args.strain)
+    engine(args.engine).check(prep, parameters, _test(args) if biaxial else None)
 
 
 def _run(args) -> int:
-    _check_test(args)
+    _test(args)
     _check_output_file(args.out, args.overwrite)
     prep = _preparation(args, _shape_of(args.shape))
-    _check_time_step(args, prep)
+    _check_settings(args, prep)
     _simulate(prep, args.out, scene=args.scene, **_simulation_kwargs(args))
     return 0
 
@@ -479,13 +557,15 @@ def _ensemble(args) -> int:
         raise GrainviewError(f"--workers {args.workers}: expected at least 1 worker process")
     if args.workers is not None and args.scheduler is not None:
         raise GrainviewError("--workers applies to the local cluster; an existing --scheduler has its own workers")
-    frictions = _split(args.friction, float, "friction") if args.friction else [None]
-    sigma0 = _split(args.sigma0, float, "sigma0") if args.sigma0 else [None]
+    test = _test(args)
+    frictions = _split(args.friction_list, float, "friction") if args.friction_list else [None]
+    sigma0 = _split(args.sigma0_list, float, "sigma0") if args.sigma0_list else [None]
+    particles = {"particles": _split(args.particles_list, int, "particles")} if args.particles_list else {}
     shapes = [_shape_of(s, f"--shapes {args.shapes}") for s in _split(args.shapes, str, "shapes")]
-    specs = grid(shapes=shapes, particles=_split(args.particles, int, "particles"),
-                 frictions=frictions, sigma0=sigma0, seeds=range(args.first_seed, args.first_seed + args.seeds),
-                 preparation=args.preparation, strain=args.strain, velocity=args.velocity, every=args.every,
-                 solver=tuple(sorted(_solver_parameters(args).items())))
+    specs = grid(shapes=shapes, **particles, frictions=frictions, sigma0=sigma0,
+                 seeds=range(args.seed, args.seed + args.seeds), preparation=args.preparation,
+                 strain=test.strain, velocity=test.velocity, every=test.every,
+                 solver=tuple(sorted(_solver_parameters(args).items())), engine=args.engine)
     out = Path(args.out)
     report = out / "report"
     if not args.no_report and (report / "headline.csv").exists() and not (args.overwrite or args.overwrite_report):
@@ -513,20 +593,20 @@ def _ensemble(args) -> int:
 def _study(args) -> int:
     from concurrent.futures import ProcessPoolExecutor
 
-    _check_test(args)
+    _test(args)
     if args.jobs < 1:
         raise GrainviewError(f"--jobs {args.jobs}: expected at least 1 process")
     import os
 
-    threads = min(args.jobs, 2) * (args.domains or 1)
+    threads = min(args.jobs, len(STUDY_SAMPLES)) * args.domains
     if threads > (os.cpu_count() or 1):
         raise GrainviewError(f"--domains {args.domains} with --jobs {args.jobs} needs {threads} cores, this machine has "
                              f"{os.cpu_count()}: a busy core stalls every parallel sweep; pass --jobs 1")
     out = Path(args.out)
-    samples = {"pentagons": "pentagon", "disks": "disk"}
+    samples = STUDY_SAMPLES
     preps = {label: _preparation(args, shape) for label, shape in samples.items()}
     for prep in preps.values():
-        _check_time_step(args, prep)
+        _check_settings(args, prep)
     paths = {label: out / f"{label}.nc" for label in samples}
     if not args.overwrite:
         for path in paths.values():
@@ -550,101 +630,111 @@ def _study(args) -> int:
     return _report(args)
 
 
-def build_parser() -> argparse.ArgumentParser:
-    parser = argparse.ArgumentParser(prog="grainview", description=(
-        "Contact dynamics of disks and polygons, and the force-transmission analyses of "
-        "Azema et al., Phys. Rev. E 76, 011301 (2007)."))
-    from . import __version__
+def _no_compress_option(p):
+    p.add_argument("--no-compress", action="store_true",
+                   help="leave the finished netCDF files uncompressed (default: zlib, about half the size; "
+                   "read the same either way)")
 
-    parser.add_argument("--version", action="version", version=f"%(prog)s {__version__}")
-    sub = parser.add_subparsers(dest="command", required=True)
 
-    def no_compress_option(p):
-        p.add_argument("--no-compress", action="store_true",
-                       help="leave the finished netCDF files uncompressed (default: zlib, about half the size; "
-                       "read the same either way)")
+def _residual_option(p):
+    p.add_argument("--residual-strain", type=float, default=RESIDUAL_STRAIN,
+                   help=f"the residual state starts at this shear strain eps_q (default {RESIDUAL_STRAIN}); "
+                   "a run short of it reports 'not reached'")
 
-    def residual_option(p):
-        p.add_argument("--residual-strain", type=float, default=RESIDUAL_STRAIN,
-                       help=f"the residual state starts at this shear strain eps_q (default {RESIDUAL_STRAIN}); "
-                       "a run short of it reports 'not reached'")
 
-    def simulation_options(p, particles=400, strain=DEFAULT_STRAIN, every=200):
-        from solver.preparation import MAX_SEED, MIN_TEST_STEPS, preset_names
+def _acceleration_option(p):
+    """``--acceleration``, the former name of ``--solver`` (command lines written before it)."""
+    from solver.contact_solvers import ACCELERATIONS
 
-        p.add_argument("--particles", type=int, default=particles, help=f"particles per sample (default {particles})")
-        p.add_argument("--strain", type=float, default=strain,
-                       help=f"vertical strain eps_1 of the biaxial test (default {strain}: eps_q ~0.6, "
-                       "into the residual state)")
-        p.add_argument("--velocity", type=float, default=0.01,
-                       help="speed of the top wall in m/s (default 0.01, the paper's): finite, > 0, and such that "
-                       f"the test takes at least {MIN_TEST_STEPS} time steps and no more than a file's 32-bit step "
-                       "counter holds")
-        p.add_argument("--every", type=int, default=every, help=f"steps between snapshots (default {every})")
-        p.add_argument("--seed", type=int, default=0, help=f"random seed of the deposit, 0 to {MAX_SEED} (default 0)")
-        physics = p.add_argument_group("physics and numerics (defaults: the paper's)")
-        physics.add_argument("--friction", type=float, default=None,
-                             help="grain-grain friction coefficient of the test (default 0.4)")
-        physics.add_argument("--wall-friction", type=float, default=None,
-                             help="grain-wall friction coefficient (default 0)")
-        physics.add_argument("--sigma0", type=float, default=None, help="confining stress in Pa (default 1e4)")
-        physics.add_argument("--time-step", type=float, default=None, help="time step in s (default 5e-4)")
-        physics.add_argument("--tolerance", type=float, default=None,
-                             help="NLGS tolerance, quadratic norm of the velocity changes over a sweep "
-                             "(default 1.7e-4; docs/solver.md)")
-        physics.add_argument("--acceleration", choices=("off", "anderson"), default=None,
-                             help="'anderson' (the default): Anderson-accelerated NLGS sweeps, the same "
-                             "local-law residual in less time per step than 'off', plain sweeps (docs/solver.md)")
-        physics.add_argument("--stall-sweeps", type=int, default=None,
-                             help="stop a step's NLGS when its quadratic norm has fallen less than 5%% over this many "
-                             "sweeps (a step that would creep to the sweep cap; default 0: never; docs/solver.md)")
-        physics.add_argument("--domains", type=int, default=None,
-                             help="NLGS domains swept at once, one per core (default 1: the serial sweep; "
-                             "deterministic for a given number; combines with --acceleration; on free cores only; "
-                             "docs/solver.md)")
-        prep = p.add_argument_group("sample preparation (docs/fidelity.md)")
-        prep.add_argument("--preparation", choices=preset_names(), default="paper",
-                          help=f"named preparation (default paper: compaction with friction 0.4, walls closing "
-                          f"at up to 5 cm/s; {S1S2_HELP}); the options below change it")
-        prep.add_argument("--compaction-friction", type=float, default=None,
-                          help="grain friction during compaction (default: the test's 0.4)")
-        prep.add_argument("--max-inertia-number", type=float, default=None,
-                          help="cap of the inertia number I = (v/L) d sqrt(rho/sigma0) of the closing walls "
-                          "(default: none, the walls close at up to 5 cm/s)")
-        prep.add_argument("--aspect", type=float, default=None, help="h/l of the sample box (default 2)")
-        prep.add_argument("--pressure-ramp", type=float, default=None,
-                          help="time in s over which sigma0 rises from 0 (default 0: applied at once)")
-        p.add_argument("--overwrite", action="store_true", help="replace existing output files")
-        p.add_argument("--progress", choices=["auto", "on", "off"], default="auto",
-                       help="progress bars (default: on in a terminal)")
-        no_compress_option(p)
+    p.add_argument("--acceleration", choices=tuple(ACCELERATIONS), default=None,
+                   help="the former name of --solver: " + ", ".join(f"{old} is {new}" for old, new in
+                                                                 ACCELERATIONS.items()) + " (default: --solver's)")
 
+
+def _engine_option(p):
+    from solver.engine import DEFAULT_ENGINE, engine_names
+
+    p.add_argument("--engine", choices=engine_names(), default=DEFAULT_ENGINE,
+                   help=f"the simulation engine (solver.engine; default {DEFAULT_ENGINE}: this package's contact "
+                   "dynamics)")
+
+
+def _test_options(p):
+    """The biaxial test's options, from :class:`solver.parameters.BiaxialTest`."""
+    from solver.parameters import BiaxialTest
+    from solver.preparation import MIN_TEST_STEPS
+
+    setting_option(p, BiaxialTest, "strain")
+    setting_option(p, BiaxialTest, "velocity", more=f": finite, > 0, and such that the test takes at least "
+                   f"{MIN_TEST_STEPS} time steps and no more than a file's 32-bit step counter holds")
+    setting_option(p, BiaxialTest, "every")
+
+
+def _simulation_options(p):
+    """The options of ``run`` and ``study``: the sample, the test, the solver's settings and
+    the preparation, each from its record's field (:func:`setting_option`)."""
+    from solver.parameters import Parameters
+    from solver.preparation import DEFAULT_PRESET, Preparation, preset_names
+
+    setting_option(p, Preparation, "particles")
+    _test_options(p)
+    setting_option(p, Preparation, "seed")
+    physics = p.add_argument_group("physics and numerics (defaults: the paper's)")
+    for name in ("friction", "sigma0"):
+        setting_option(physics, Preparation, name)
+    for name in SOLVER_OPTIONS:
+        setting_option(physics, Parameters, name)
+    _acceleration_option(physics)
+    _engine_option(physics)
+    prep = p.add_argument_group("sample preparation (docs/fidelity.md)")
+    prep.add_argument("--preparation", choices=preset_names(), default=DEFAULT_PRESET,
+                      help=f"named preparation (default {DEFAULT_PRESET}: compaction with the test's friction, "
+                      f"walls closing at up to {Preparation.max_wall_speed:g} m/s; {S1S2_HELP}); the options "
+                      "below change it")
+    for name in PREPARATION_OPTIONS:
+        if name not in ("friction", "sigma0"):
+            setting_option(prep, Preparation, name)
+    p.add_argument("--overwrite", action="store_true", help="replace existing output files")
+    p.add_argument("--progress", choices=["auto", "on", "off"], default="auto",
+                   help="progress bars (default: on in a terminal)")
+    _no_compress_option(p)
+
+
+def _study_parser(sub):
     study = sub.add_parser("study", help="the paper's study: pentagons vs disks, simulated, analysed, plotted",
                            description="Deposit, compact (10 kPa) and shear an S1-like pentagon sample and an "
                            "S2-like disk sample into the residual state, side by side, then write the report "
                            "(table vs the paper, figures). The files hold the near contacts too, so the table "
                            "also counts them (docs/fidelity.md).")
     study.add_argument("--out", default="study", help="output folder (default: study)")
-    study.add_argument("--jobs", type=int, default=2, help="processes: the two samples side by side (default 2)")
-    residual_option(study)
-    simulation_options(study)
+    study.add_argument("--jobs", type=int, default=len(STUDY_SAMPLES),
+                       help=f"processes: the {len(STUDY_SAMPLES)} samples side by side (default {len(STUDY_SAMPLES)})")
+    _residual_option(study)
+    _simulation_options(study)
     study.set_defaults(func=_study)
+
+
+def _run_parser(sub):
+    from solver.preparation import Preparation
 
     run = sub.add_parser("run", help="simulate one sample into a netCDF file",
                          description="Geometric deposit, isotropic compaction under sigma0 (10 kPa), then "
                          "(scene biaxial) compression by the top wall (1 cm/s) with sigma0 held on the right wall.")
     run.add_argument("scene", nargs="?", choices=["biaxial", "isotropic"], default="biaxial",
                      help="biaxial (default) or isotropic (writes the compacted state)")
-    run.add_argument("--shape", default="pentagon", help="pentagon (default), disk, a number of vertices from 3 to "
-                     f"{MAX_VERTICES} (6: hexagons), irregular (random convex polygons) or a .json file of "
-                     "vertex lists {\"polygons\": [[[x, y], ...], ...]} (docs/solver.md, \"Shapes\")")
+    setting_option(run, Preparation, "shape", help=f"pentagon, disk, a number of vertices from 3 to "
+                   f"{MAX_VERTICES} (6: hexagons), irregular (random convex polygons) or a .json file of vertex lists "
+                   "{\"polygons\": [[[x, y], ...], ...]} (docs/solver.md, \"Shapes\"; default "
+                   f"{Preparation.shape})")
     run.add_argument("--out", default="run.nc", help="output netCDF file (default: run.nc)")
     run.add_argument("--near-contacts", action="store_true",
                      help="also write the pairs within the alert distance that carry no force (with their "
                      "gap), for the analyses' near= counting (the study always does)")
-    simulation_options(run)
+    _simulation_options(run)
     run.set_defaults(func=_run)
 
+
+def _report_parser(sub):
     report = sub.add_parser("report", help="analyse runs: headline table vs the paper and all figures",
                             description="Analyse one or more files of the data contract: the headline table "
                             "(residual state next to the paper's values), the paper's figures, a CSV of the "
@@ -660,10 +750,16 @@ def build_parser() -> argparse.ArgumentParser:
                         "(force_chains_<label>.gif)")
     report.add_argument("--ensemble", action="store_true", help="the files are seeds and settings of one "
                         "ensemble: report mean +- spread over the seeds of each setting (docs/ensembles.md)")
-    report.add_argument("--movie-every", type=int, default=1, help="one movie frame every k snapshots (default 1)")
-    residual_option(report)
+    every = library_default("grainview.plot.movies", "animate", "every")
+    report.add_argument("--movie-every", type=int, default=every,
+                        help=f"one movie frame every k snapshots (default {every})")
+    _residual_option(report)
     report.set_defaults(func=_report)
-    from solver.preparation import MIN_TEST_STEPS
+
+
+def _ensemble_parser(sub):
+    from solver.parameters import Parameters
+    from solver.preparation import DEFAULT_PRESET, Preparation
 
     ens = sub.add_parser("ensemble", help="many runs (settings x seeds) on a dask cluster, then their report",
                          description="One biaxial test per (shape, particles, friction, sigma0, seed) on a "
@@ -672,24 +768,21 @@ def build_parser() -> argparse.ArgumentParser:
                          "skips finished runs and resumes the others. Then the ensemble report: mean +- spread over "
                          "seeds (docs/ensembles.md).")
     ens.add_argument("--out", default="ensemble", help="output folder (default: ensemble)")
-    ens.add_argument("--shapes", default="pentagon", help="comma-separated shapes: pentagon, disk or numbers of vertices "
-                     f"from 3 to {MAX_VERTICES} (default pentagon; e.g. pentagon,disk,6)")
-    ens.add_argument("--particles", default="400", help="comma-separated particle counts (default 400)")
-    ens.add_argument("--friction", default=None, help="comma-separated grain friction values (default: 0.4)")
-    ens.add_argument("--sigma0", default=None, help="comma-separated confining stresses in Pa (default: 1e4)")
-    ens.add_argument("--seeds", type=int, default=3, help="seeds per setting (default 3)")
-    ens.add_argument("--first-seed", type=int, default=0, help="first seed (default 0)")
-    ens.add_argument("--strain", type=float, default=DEFAULT_STRAIN, help=f"vertical strain eps_1 (default {DEFAULT_STRAIN})")
-    ens.add_argument("--velocity", type=float, default=0.01, help="speed of the top wall in m/s (default 0.01): "
-                     f"finite, > 0, and such that the test takes at least {MIN_TEST_STEPS} time steps and no more than "
-                     "a file's 32-bit step counter holds")
-    ens.add_argument("--every", type=int, default=200, help="steps between snapshots (default 200)")
-    ens.add_argument("--preparation", default="paper", help=f"named preparation (default paper; {S1S2_HELP})")
-    ens.add_argument("--wall-friction", type=float, default=None, help="grain-wall friction (default 0)")
-    ens.add_argument("--time-step", type=float, default=None, help="time step in s (default 5e-4)")
-    ens.add_argument("--tolerance", type=float, default=None, help="NLGS tolerance (default 1.7e-4)")
-    ens.add_argument("--acceleration", choices=("off", "anderson"), default=None, help="NLGS acceleration: 'anderson' (default) or "
-                     "'off', plain sweeps (docs/solver.md)")
+    ens.add_argument("--shapes", default=Preparation.shape, help="comma-separated shapes: pentagon, disk or numbers "
+                     f"of vertices from 3 to {MAX_VERTICES} (default {Preparation.shape}; e.g. pentagon,disk,6)")
+    for name, unit in (("particles", ""), ("friction", ""), ("sigma0", " in Pa")):
+        default = getattr(Preparation, name)
+        ens.add_argument(_flag(name), dest=f"{name}_list", default=None,
+                         help=f"comma-separated values of {name}{unit} (default {default:g}, the preparation's)")
+    ens.add_argument("--seeds", type=int, default=ENSEMBLE_SEEDS, help=f"seeds per setting (default {ENSEMBLE_SEEDS})")
+    setting_option(ens, Preparation, "seed", flag="--first-seed", help=f"first seed (default {Preparation.seed})")
+    _test_options(ens)
+    ens.add_argument("--preparation", default=DEFAULT_PRESET, help=f"named preparation (default {DEFAULT_PRESET}; "
+                     f"{S1S2_HELP})")
+    for name in ENSEMBLE_SOLVER_OPTIONS:
+        setting_option(ens, Parameters, name)
+    _acceleration_option(ens)
+    _engine_option(ens)
     ens.add_argument("--workers", type=int, default=None, help="worker processes of the local cluster "
                      "(default: one per core; each single-threaded)")
     ens.add_argument("--scheduler", default=None, help="address of an existing dask scheduler (tcp://host:8786); "
@@ -698,11 +791,14 @@ def build_parser() -> argparse.ArgumentParser:
     ens.add_argument("--overwrite", action="store_true", help="redo every run, replacing its file (and the report)")
     ens.add_argument("--overwrite-report", action="store_true", help="replace an existing report in OUT/report; "
                      "finished runs are kept")
-    no_compress_option(ens)
-    ens.add_argument("--progress", choices=["auto", "on", "off"], default="auto", help="a progress bar per run (default auto: on "
-                     "in a terminal)")
-    residual_option(ens)
+    _no_compress_option(ens)
+    ens.add_argument("--progress", choices=["auto", "on", "off"], default="auto", help="a progress bar per run "
+                     "(default auto: on in a terminal)")
+    _residual_option(ens)
     ens.set_defaults(func=_ensemble)
+
+
+def _info_parser(sub):
     info = sub.add_parser("info", help="validate a grainview netCDF file and print its summary",
                           description="Print a file's size, snapshots, strain and q/p reached and settings, "
                           "in under a second, checking its structure and units against the data contract "
@@ -714,6 +810,9 @@ def build_parser() -> argparse.ArgumentParser:
                       help="also check every value against the contract (ids, kinds, finite forces, unit "
                       "normals...: reads the whole file; without it only the structure and units are checked)")
     info.set_defaults(func=_info)
+
+
+def _export_parser(sub):
     export = sub.add_parser("export", help="write snapshots as VTK (ParaView, OVITO) or CSV",
                             description="Export a file of the data contract: --to vtk writes, per snapshot, "
                             "the particles (points with a radius) and the contacts (lines with fn, ft, kind, "
@@ -723,21 +822,32 @@ def build_parser() -> argparse.ArgumentParser:
     export.add_argument("file", help="netCDF file of the grainview contract")
     export.add_argument("--to", choices=("vtk", "csv"), required=True, help="output format")
     export.add_argument("--out", required=True, help="output folder (created if needed)")
-    export.add_argument("--every", type=int, default=1, help="export every k-th snapshot (and the last; default 1)")
+    every = library_default("grainview.formats.export", "write_vtk", "every")
+    export.add_argument("--every", type=int, default=every,
+                        help=f"export every k-th snapshot (and the last; default {every})")
     export.add_argument("--overwrite", action="store_true", help="replace existing files in --out")
     export.add_argument("--progress", choices=("on", "off"), default="on", help="progress bar (default on)")
     export.set_defaults(func=_export)
+
+
+def _demo_parser(sub):
     demo = sub.add_parser("demo", help="write a synthetic harmonic-model series and analyse it lazily",
                           description="Write a synthetic series drawn from the harmonic model (no simulation, "
                           "seconds) and compare q/p with the prediction (a' + a_n + a_t)/2 computed lazily "
                           "from the file.")
     demo.add_argument("--out", default="demo-out", help="output folder (default: demo-out)")
-    demo.add_argument("--snapshots", type=int, default=11, help="number of snapshots (default 11)")
-    demo.add_argument("--contacts", type=int, default=20000, help="contacts per snapshot (default 20000)")
-    demo.add_argument("--seed", type=int, default=0, help="random seed (default 0)")
+    demo.add_argument("--snapshots", type=int, default=DEMO_SIZE["snapshots"],
+                      help=f"number of snapshots (default {DEMO_SIZE['snapshots']})")
+    demo.add_argument("--contacts", type=int, default=DEMO_SIZE["contacts"],
+                      help=f"contacts per snapshot (default {DEMO_SIZE['contacts']})")
+    seed = library_default("grainview.analysis.synthetic", "harmonic_series", "seed")
+    demo.add_argument("--seed", type=int, default=seed, help=f"random seed (default {seed})")
     demo.add_argument("--overwrite", action="store_true", help="replace existing output files")
-    no_compress_option(demo)
+    _no_compress_option(demo)
     demo.set_defaults(func=_demo)
+
+
+def _warmup_parser(sub):
     warmup = sub.add_parser("warmup", help="compile every numba kernel into the cache, so that runs start at once",
                             description="Compile (or load) every numba kernel of the solver and the analysis into "
                             "numba's cache (NUMBA_CACHE_DIR when set, else __pycache__ beside the modules) with a "
@@ -745,6 +855,9 @@ def build_parser() -> argparse.ArgumentParser:
                             "its first step compiling, and acts on SIGTERM only after that step: warm the cache "
                             "once per installation, e.g. before submitting batch jobs (docs/solver.md).")
     warmup.set_defaults(func=_warmup)
+
+
+def _convert_parser(sub):
     convert = sub.add_parser("convert", help="turn another code's output into a file of the contract",
                              description="Read another code's output and write a validated, compressed file of "
                              "the grainview contract (docs/formats.md); an existing file is kept unless "
@@ -773,7 +886,7 @@ def build_parser() -> argparse.ArgumentParser:
     lammps.add_argument("--out", required=True, help="the netCDF file to write")
     lammps.add_argument("--overwrite", action="store_true", help="replace an existing --out")
     lammps.add_argument("--progress", choices=("on", "off"), default="on", help="progress bar (default: on)")
-    no_compress_option(lammps)
+    _no_compress_option(lammps)
     lammps.set_defaults(func=_convert)
     lmgc90 = formats.add_parser("lmgc90", help="an LMGC90 2D rigid run (DATBOX + OUTBOX text files)",
                                 description="An LMGC90 2D rigid run: its folder holding DATBOX/BODIES.DAT and "
@@ -785,7 +898,7 @@ def build_parser() -> argparse.ArgumentParser:
     lmgc90.add_argument("--out", required=True, help="the netCDF file to write")
     lmgc90.add_argument("--overwrite", action="store_true", help="replace an existing --out")
     lmgc90.add_argument("--progress", choices=("on", "off"), default="on", help="progress bar (default: on)")
-    no_compress_option(lmgc90)
+    _no_compress_option(lmgc90)
     lmgc90.set_defaults(func=_convert_lmgc90)
     mercury = formats.add_parser("mercurydpm", help="a MercuryDPM 2D run (.data + .fstat + .restart)",
                                  description="A MercuryDPM 2D run: its .data (particles), .fstat (contacts, each "
@@ -800,7 +913,7 @@ def build_parser() -> argparse.ArgumentParser:
     mercury.add_argument("--out", required=True, help="the netCDF file to write")
     mercury.add_argument("--overwrite", action="store_true", help="replace an existing --out")
     mercury.add_argument("--progress", choices=("on", "off"), default="on", help="progress bar (default: on)")
-    no_compress_option(mercury)
+    _no_compress_option(mercury)
     mercury.set_defaults(func=_convert_mercurydpm)
     pegs = formats.add_parser("pegs", help="a photoelastic experiment solved by PeGS2 (adjacency list + positions)",
                               description="A photoelastic experiment solved by PeGS2: its adjacency lists (rows "
@@ -814,15 +927,17 @@ def build_parser() -> argparse.ArgumentParser:
                       "(PeGS2's metersperpixel)")
     pegs.add_argument("--force-unit-n", type=float, required=True, help="newtons per force unit of the adjacency "
                       "list (1 when PeGS2's fsigma is calibrated in N)")
-    pegs.add_argument("--frame-interval", type=float, default=1.0, help="time between frames, s (default: 1)")
-    pegs.add_argument("--thickness", type=float, default=1.0, help="the disks' thickness, m (default: 1; stresses "
-                      "are per this thickness)")
-    pegs.add_argument("--density", type=float, default=1000.0, help="the disks' density for their masses, kg/m^3 "
-                      "(not measured; default: 1000)")
+    for flag, parameter, text in (("--frame-interval", "frame_interval_s", "time between frames, s (default: {:g})"),
+                                  ("--thickness", "thickness_m", "the disks' thickness, m (default: {:g}; stresses "
+                                   "are per this thickness)"),
+                                  ("--density", "density_kg_m3", "the disks' density for their masses, kg/m^3 (not "
+                                   "measured; default: {:g})")):
+        default = library_default("grainview.formats.pegs", "convert_pegs", parameter)
+        pegs.add_argument(flag, type=float, default=default, help=text.format(default))
     pegs.add_argument("--out", required=True, help="the netCDF file to write")
     pegs.add_argument("--overwrite", action="store_true", help="replace an existing --out")
     pegs.add_argument("--progress", choices=("on", "off"), default="on", help="progress bar (default: on)")
-    no_compress_option(pegs)
+    _no_compress_option(pegs)
     pegs.set_defaults(func=_convert_pegs)
     for engine, version in (("box2d", "Box2D 2.3"), ("pymunk", "pymunk")):
         peer = formats.add_parser(engine, help=f"a {version} run of the cross-check (raw snapshots)",
@@ -833,8 +948,23 @@ def build_parser() -> argparse.ArgumentParser:
         peer.add_argument("--sample", required=True, help="the cross-check sample's .npz the engine started from")
         peer.add_argument("--out", required=True, help="the netCDF file to write")
         peer.add_argument("--overwrite", action="store_true", help="replace an existing --out")
-        no_compress_option(peer)
+        _no_compress_option(peer)
         peer.set_defaults(func=_convert_peer)
+
+
+def build_parser() -> argparse.ArgumentParser:
+    """The command line: one subcommand per ``_<name>_parser``; the simulation's options are
+    derived from the settings records (:func:`setting_option`)."""
+    parser = argparse.ArgumentParser(prog="grainview", description=(
+        "Contact dynamics of disks and polygons, and the force-transmission analyses of "
+        "Azema et al., Phys. Rev. E 76, 011301 (2007)."))
+    from . import __version__
+
+    parser.add_argument("--version", action="version", version=f"%(prog)s {__version__}")
+    sub = parser.add_subparsers(dest="command", required=True)
+    for add in (_study_parser, _run_parser, _report_parser, _ensemble_parser, _info_parser, _export_parser,
+                _demo_parser, _warmup_parser, _convert_parser):
+        add(sub)
     return parser
 
 

@@ -42,7 +42,9 @@ import numpy as np
 
 from grainview.contract.errors import ConvergenceWarning, FileFormatError, ParameterError
 
+from .engine import DEFAULT_ENGINE, engine
 from .parameters import BiaxialTest
+from .preparation import DEFAULT_PRESET, Preparation
 
 EVENT_TOPIC = "grainview-ensemble"
 """Topic of the progress events the workers send to the client (``Worker.log_event``)."""
@@ -57,19 +59,21 @@ class RunSpec:
     """One biaxial test of an ensemble: the sample (shape, particles, seed, grain friction,
     named preparation, confining stress sigma0 in Pa) and the test (vertical strain eps_1, top
     wall speed in m s-1, steps between snapshots). ``solver``: further :class:`solver.Parameters`
-    as sorted (name, value) pairs. ``None`` keeps the preparation's default."""
+    as sorted (name, value) pairs. ``None`` keeps the preparation's default. ``engine``: the
+    name of the :mod:`solver.engine` that simulates it."""
 
-    shape: str | int = "pentagon"  # a name of solver.shapes.SHAPES, a number of vertices, a family or a file
-    particles: int = 400
-    seed: int = 0
+    shape: str | int = Preparation.shape  # a name of solver.shapes.SHAPES, a number of vertices, a family or a file
+    particles: int = Preparation.particles
+    seed: int = Preparation.seed
     friction: float | None = None
-    preparation: str = "paper"
+    preparation: str = DEFAULT_PRESET
     sigma0: float | None = None
     strain: float = BiaxialTest.strain
     velocity: float = BiaxialTest.velocity
     every: int = BiaxialTest.every
     near_contacts: bool = True
     solver: tuple = field(default=())
+    engine: str = DEFAULT_ENGINE
 
     @property
     def name(self) -> str:
@@ -92,16 +96,15 @@ class RunSpec:
         BiaxialTest(self.strain, self.velocity, self.every).validate()
         if isinstance(self.seed, bool) or int(self.seed) != self.seed or self.seed < 0:
             raise ParameterError(f"seed={self.seed!r}: expected a whole number >= 0")
-        from .parameters import Parameters
-
         try:
-            parameters = Parameters(**dict(self.solver)).validate()
+            engine(self.engine).check(self.sample(), dict(self.solver), self.test())
         except TypeError as exc:
             raise ParameterError(f"solver={self.solver!r}: {exc}; expected fields of solver.Parameters") from None
-        sample = self.sample()  # the preparation's own checks
-        sample.check_time_step(parameters.time_step, self.velocity)
-        sample.check_test_speed(parameters.time_step, self.velocity, self.strain)
         return self
+
+    def test(self) -> BiaxialTest:
+        """The :class:`solver.parameters.BiaxialTest` of the run."""
+        return BiaxialTest(self.strain, self.velocity, self.every)
 
     def sample(self):
         """The :class:`solver.preparation.Preparation` of the run's sample."""
@@ -123,7 +126,8 @@ class RunSpec:
         return expected
 
 
-def grid(*, shapes=("pentagon",), frictions=(None,), seeds=1, particles=(400,), sigma0=(None,), **common):
+def grid(*, shapes=(RunSpec.shape,), frictions=(None,), seeds=1, particles=(RunSpec.particles,), sigma0=(None,),
+         **common):
     """Every combination of the values given, with ``seeds`` seeds each (a count: seeds 0 ..
     seeds-1, or a sequence of seeds): a list of :class:`RunSpec`, validated. ``common``: the
     other :class:`RunSpec` fields, the same for every run."""
@@ -139,21 +143,10 @@ def grid(*, shapes=("pentagon",), frictions=(None,), seeds=1, particles=(400,), 
 
 
 def file_state(path) -> str:
-    """What the file of a run holds: "missing", "empty" (no complete snapshot: the run died
-    before its test began), "partial" (an unfinished test) or "finished"."""
-    from .restart import load_state
+    """What the file of a run holds (:func:`solver.restart.file_state`)."""
+    from .restart import file_state
 
-    path = Path(path)
-    if not path.exists():
-        return "missing"
-    try:
-        sim, test = load_state(path)
-    except FileFormatError as exc:
-        if "no complete snapshot" in str(exc):
-            return "empty"
-        raise
-    done = sim.step_index - test["first_step"]
-    return "finished" if done >= test["n_steps"] else "partial"
+    return file_state(path)
 
 
 def _check_settings(path, spec: RunSpec):
@@ -180,29 +173,26 @@ def run_one(spec: RunSpec, folder, *, overwrite=False, progress=None, compress=T
     "finished already"), ``steps`` (steps taken now), ``seconds``, ``unconverged`` (steps
     where NLGS stopped unconverged: sweep cap or stall test). ``progress`` and ``compress`` (the finished file kept
     compressed): as for :func:`solver.biaxial_test`."""
-    from .preparation import prepare_sample, record
-    from .restart import resume
-    from .scenes import biaxial_test
-
     spec = spec.validate()
+    runner = engine(spec.engine)
     path = Path(folder) / f"{spec.name}.nc"
     start = time.perf_counter()
-    state = "missing" if overwrite else file_state(path)
+    state = "missing" if overwrite else runner.file_state(path)
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
         if state == "finished":
             _check_settings(path, spec)
             # resume() of a finished test takes nothing further: it compresses a file whose
             # compression was stopped and removes what killed writers left beside it
-            action, steps = "finished already", resume(path, progress=progress, compress=compress)
+            action, steps = "finished already", runner.resume(path, progress=progress, compress=compress)
         elif state == "partial":
             _check_settings(path, spec)
-            action, steps = "resumed", resume(path, progress=progress, compress=compress)
+            action, steps = "resumed", runner.resume(path, progress=progress, compress=compress)
         else:
-            sim = prepare_sample(spec.sample(), progress=progress, **dict(spec.solver))
-            steps = biaxial_test(sim, path, strain=spec.strain, velocity=spec.velocity, every=int(spec.every),
-                                 overwrite=True, attrs={**record(sim), "ensemble_run": spec.name},
-                                 progress=progress, near_contacts=spec.near_contacts, compress=compress)
+            sample = runner.prepare(spec.sample(), dict(spec.solver), progress=progress)
+            steps = runner.shear(sample, path, spec.test(), overwrite=True,
+                                 attrs={**sample.history.attrs(), "ensemble_run": spec.name}, progress=progress,
+                                 near_contacts=spec.near_contacts, compress=compress)
             action = "ran"
     unconverged = sum(issubclass(w.category, ConvergenceWarning) for w in caught)
     others = list(dict.fromkeys(str(w.message).splitlines()[0] for w in caught
@@ -333,7 +323,7 @@ def run_ensemble(specs, folder, *, scheduler=None, workers=None, client=None, ov
                 path.unlink()
             continue
         try:  # a changed command line must not resume, or skip, another run's file
-            if file_state(path) in ("partial", "finished"):
+            if engine(spec.engine).file_state(path) in ("partial", "finished"):
                 _check_settings(path, spec)
         except FileFormatError as exc:
             raise FileFormatError(f"{exc}; remove the file to run {spec.name} again, or pass overwrite=True to "

@@ -144,12 +144,17 @@ class Preparation:
         return self
 
     def attrs(self) -> dict:
-        """The preparation as file attributes ``preparation_<name>`` ("none" for None)."""
-        return {f"preparation_{k}": ("none" if v is None else v) for k, v in asdict(self).items()}
+        """The preparation as file attributes ``preparation_<name>`` ("none" for None), and
+        ``preparation_name``, the preset it is (:func:`preset_name`)."""
+        return {**{f"preparation_{k}": ("none" if v is None else v) for k, v in asdict(self).items()},
+                "preparation_name": preset_name(self)}
 
+
+DEFAULT_PRESET = "paper"
+"""The preparation used when none is named."""
 
 PRESETS = {
-    "paper": Preparation(),
+    DEFAULT_PRESET: Preparation(),
     "frictionless": Preparation(compaction_friction=0.0),
     "quasistatic": Preparation(max_inertia_number=2e-4, max_steps=200000),
     "fast": Preparation(max_wall_speed=0.2),
@@ -188,7 +193,7 @@ def preset_names():
     return sorted(PRESETS) + sorted(BY_SHAPE)
 
 
-def preparation(name_or_prep="paper", **changes) -> Preparation:
+def preparation(name_or_prep=DEFAULT_PRESET, **changes) -> Preparation:
     """A :class:`Preparation` from a preset name (or an instance) with ``changes`` applied.
     A preset of :data:`BY_SHAPE` needs ``shape`` among the changes."""
     if isinstance(name_or_prep, Preparation):

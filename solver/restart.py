@@ -199,6 +199,21 @@ def load_state(path):
     return sim, test
 
 
+def file_state(path) -> str:
+    """What the file of a run holds: "missing", "empty" (no complete snapshot: the run died
+    before its test began), "partial" (an unfinished test) or "finished"."""
+    if not os.path.exists(path):
+        return "missing"
+    try:
+        sim, test = load_state(path)
+    except FileFormatError as exc:
+        if "no complete snapshot" in str(exc):
+            return "empty"
+        raise
+    done = sim.step_index - test["first_step"]
+    return "finished" if done >= test["n_steps"] else "partial"
+
+
 def resume(path, progress=None, compress=True) -> int:
     """Continue the biaxial test written to ``path`` from its last complete snapshot until its
     strain target, appending the snapshots to the same file. Returns the number of steps

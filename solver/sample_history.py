@@ -63,10 +63,8 @@ class SampleHistory:
         made."""
         if self.preparation is None:
             return dict(self.recorded)
-        from .preparation import preset_name
-
         prep = self.preparation
-        out = {**prep.attrs(), "preparation_name": preset_name(prep), "sigma0_Pa": prep.sigma0,
+        out = {**prep.attrs(), "sigma0_Pa": prep.sigma0,
                "compaction_steps": self.compaction_steps, "compaction_settled": int(bool(self.settled)),
                "compaction_inertia_number": self.compaction_inertia_number}
         if self.compaction_unconverged is not None:  # steps whose NLGS stopped before its tolerances

@@ -73,7 +73,7 @@ def test_physics_options_reach_the_solver_and_act(tmp_path, capsys):
         assert attrs["solver_friction"] == 0.2 and attrs["preparation_friction"] == 0.2
         assert attrs["solver_wall_friction"] == 0.1
         assert attrs["solver_time_step"] == 4e-4 and attrs["solver_tolerance"] == 1e-5
-        assert attrs["solver_acceleration"] == "anderson" and attrs["solver_stall_sweeps"] == 300
+        assert attrs["solver_solver"] == "anderson" and attrs["solver_stall_sweeps"] == 300  # --acceleration: its old name
         assert attrs["sigma0_Pa"] == 5000.0
         used = ds.kind.values > 0
         wall = ds.j.values >= ds.sizes["particle"]

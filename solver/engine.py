@@ -1,0 +1,142 @@
+"""Simulation engines behind one interface: what the command line's ``run``, ``study`` and
+``ensemble`` (and :mod:`solver.ensemble`) ask of the code that simulates.
+
+An engine makes a sample as a :class:`solver.preparation.Preparation` says (``prepare``),
+shears it in the biaxial test a :class:`solver.parameters.BiaxialTest` describes into a file
+of the grainview data contract (``shear``), and carries on an interrupted test from its file
+(``resume``); ``check`` refuses bad settings before any work, ``write_state`` writes a
+prepared sample as it is, ``file_state`` says how far the test in a file got. The settings
+are the records of :mod:`solver.parameters` and :mod:`solver.preparation`, whatever the
+engine; numerical settings of an engine's own go in ``parameters``, a dict of
+:class:`solver.parameters.Parameters` fields.
+
+:data:`ENGINES` names the engines (``"module:attribute"`` of a class whose instances follow
+:class:`Engine`); packages add theirs through the entry-point group ``grainview.engines``
+(``name = "package.module:Class"``), so that a new engine needs no edit of the command line.
+The one engine here is :class:`ContactDynamics`, this package's Moreau–Jean solver.
+
+Loading this module, or listing the engines, imports no numba kernel.
+"""
+
+from __future__ import annotations
+
+import importlib
+from typing import Protocol, runtime_checkable
+
+from grainview.contract.errors import ParameterError
+
+ENTRY_POINT_GROUP = "grainview.engines"
+"""Entry-point group through which installed packages register engines."""
+
+ENGINES = {"solver": "solver.engine:ContactDynamics"}
+"""Engine name -> ``"module:attribute"`` of its class."""
+
+DEFAULT_ENGINE = "solver"
+"""The engine used when none is named."""
+
+
+@runtime_checkable
+class Engine(Protocol):
+    """What an engine does. A *sample* is the engine's own object for a prepared packing; the
+    command line reads ``sample.history`` (:class:`solver.sample_history.SampleHistory`: how it
+    was made, whether its compaction settled) and ``sample.parameters`` (the numerical
+    settings it ran with, for the warning on unconverged steps)."""
+
+    name: str
+
+    def check(self, preparation, parameters: dict, test=None):
+        """Refuse, before any work and in one :class:`ParameterError` line, settings with
+        which the sample could not be made or tested (``test``: a
+        :class:`solver.parameters.BiaxialTest`, or None for a preparation only)."""
+
+    def prepare(self, preparation, parameters: dict, progress=None):
+        """Deposit and compact the sample ``preparation`` describes; returns it."""
+
+    def shear(self, sample, path, test, *, attrs=None, near_contacts=False, overwrite=False, progress=None,
+              compress=True) -> int:
+        """Shear ``sample`` in the biaxial ``test``, written to ``path``; returns the steps."""
+
+    def write_state(self, sample, path, *, attrs=None, near_contacts=False, overwrite=False, compress=True):
+        """Write ``sample`` as it is (one snapshot) to ``path``."""
+
+    def resume(self, path, progress=None, compress=True) -> int:
+        """Carry on the test written to ``path`` until its end; returns the steps taken."""
+
+    def file_state(self, path) -> str:
+        """How far the test in ``path`` got: "missing", "empty", "partial" or "finished"."""
+
+
+class ContactDynamics:
+    """This package's engine: Moreau–Jean contact dynamics of rigid disks and polygons
+    (:mod:`solver.stepper`), the paper's preparation (:func:`solver.preparation.prepare_sample`)
+    and biaxial test (:func:`solver.scenes.biaxial_test`), resumed by :mod:`solver.restart`."""
+
+    name = "solver"
+
+    def check(self, preparation, parameters: dict, test=None):
+        from .parameters import Parameters
+
+        time_step = Parameters(**parameters).validate().time_step
+        preparation.validate()
+        if test is None:
+            preparation.check_time_step(time_step)
+            return
+        test.validate()
+        preparation.check_time_step(time_step, test.velocity)
+        preparation.check_test_speed(time_step, test.velocity, test.strain)
+
+    def prepare(self, preparation, parameters: dict, progress=None):
+        from .preparation import prepare_sample
+
+        return prepare_sample(preparation, progress=progress, **parameters)
+
+    def shear(self, sample, path, test, *, attrs=None, near_contacts=False, overwrite=False, progress=None,
+              compress=True) -> int:
+        from .scenes import biaxial_test
+
+        return biaxial_test(sample, path, strain=test.strain, velocity=test.velocity, every=int(test.every),
+                            overwrite=overwrite, attrs=attrs, progress=progress, near_contacts=near_contacts,
+                            compress=compress)
+
+    def write_state(self, sample, path, *, attrs=None, near_contacts=False, overwrite=False, compress=True):
+        from .output import Recorder
+
+        with Recorder(path, sample, attrs={**sample.history.attrs(), **(attrs or {})}, overwrite=overwrite,
+                      near_contacts=near_contacts, compress=compress) as rec:
+            rec.write()
+
+    def resume(self, path, progress=None, compress=True) -> int:
+        from .restart import resume
+
+        return resume(path, progress=progress, compress=compress)
+
+    def file_state(self, path) -> str:
+        from .restart import file_state
+
+        return file_state(path)
+
+
+def _registered() -> dict:
+    """:data:`ENGINES` and the engines of the entry-point group, by name."""
+    from importlib.metadata import entry_points
+
+    found = dict(ENGINES)
+    for point in entry_points(group=ENTRY_POINT_GROUP):
+        found.setdefault(point.name, point.value)
+    return found
+
+
+def engine_names() -> list[str]:
+    """Every engine's name, the default first."""
+    names = sorted(_registered())
+    return [DEFAULT_ENGINE] + [name for name in names if name != DEFAULT_ENGINE]
+
+
+def engine(name: str = DEFAULT_ENGINE) -> Engine:
+    """An instance of the engine registered as ``name``; a :class:`ParameterError` naming the
+    known ones otherwise."""
+    target = _registered().get(name)
+    if target is None:
+        raise ParameterError(f"engine={name!r}: expected one of {', '.join(engine_names())}")
+    module, _, attribute = target.partition(":")
+    return getattr(importlib.import_module(module), attribute)()

@@ -1,0 +1,207 @@
+"""The command line's simulation options are derived from the settings records (their flags,
+types, choices, defaults and help), a named preparation's own values hold for the options not
+given, and run, study and ensemble reach the simulation through an engine of the registry."""
+
+import ast
+import argparse
+from dataclasses import fields
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import grainview.cli as cli
+from grainview.cli import build_parser, main
+from solver.parameters import BiaxialTest, Parameters
+from solver.preparation import Preparation
+from solver.sample_history import SampleHistory
+
+RECORDS = (Parameters, Preparation, BiaxialTest)
+SIMULATING = ("run", "study", "ensemble")
+
+
+def _subparser(name):
+    return build_parser()._subparsers._group_actions[0].choices[name]
+
+
+def _field(name):
+    return next(f for record in RECORDS for f in fields(record) if f.name == name)
+
+
+def test_every_derived_option_has_its_fields_default_type_and_help():
+    seen = set()
+    for command in SIMULATING:
+        for action in _subparser(command)._actions:
+            if not isinstance(action, cli._Given):
+                continue
+            f = _field(action.dest)
+            seen.add(action.dest)
+            assert action.default == f.default, (command, action.dest)
+            shown = "none" if f.default is None else f"{f.default:g}" if isinstance(f.default, float) else f.default
+            assert f"default {shown}" in action.help, action.help
+            if f.metadata.get("choices"):
+                assert tuple(action.choices) == tuple(f.metadata["choices"]())
+            else:
+                first = str(f.type).split("|")[0].strip()  # float | None: float
+                assert action.type is {"float": float, "int": int, "str": str}[first]
+    expected = set(cli.SOLVER_OPTIONS) | set(cli.PREPARATION_OPTIONS) | set(cli.TEST_OPTIONS) | {"particles", "seed",
+                                                                                                 "shape"}
+    assert seen == expected
+
+
+def test_no_option_of_a_simulating_command_bypasses_the_records():
+    """An option whose destination is a field of the records is the field's own option."""
+    names = {f.name for record in RECORDS for f in fields(record)}
+    for command in SIMULATING:
+        for action in _subparser(command)._actions:
+            if action.dest in names:
+                assert isinstance(action, cli._Given), (command, action.option_strings)
+
+
+def _numeric_defaults(source):
+    """The ``default=`` keywords of ``source`` whose value is a number written out."""
+    found = []
+    for node in ast.walk(ast.parse(source)):
+        if isinstance(node, ast.keyword) and node.arg == "default":
+            sign = -1 if isinstance(node.value, ast.UnaryOp) and isinstance(node.value.op, ast.USub) else 1
+            value = node.value.operand if isinstance(node.value, ast.UnaryOp) else node.value
+            if isinstance(value, ast.Constant) and isinstance(value.value, (int, float)) \
+                    and not isinstance(value.value, bool):
+                found.append((node.lineno, sign * value.value))
+    return found
+
+
+def test_the_command_line_holds_no_numeric_default_of_its_own():
+    assert _numeric_defaults("p.add_argument('--x', default=-0.5)\np.add_argument('--y', default=3)") \
+        == [(1, -0.5), (2, 3)]  # the scan sees them
+    assert _numeric_defaults(Path(cli.__file__).read_text(encoding="utf-8")) == []
+
+
+def test_options_of_other_functions_take_those_functions_defaults():
+    from grainview.analysis.synthetic import harmonic_series
+    from grainview.formats.pegs import convert_pegs
+    import inspect
+
+    assert cli.library_default("grainview.formats.pegs", "convert_pegs", "density_kg_m3") \
+        == inspect.signature(convert_pegs).parameters["density_kg_m3"].default
+    assert cli.library_default("grainview.analysis.synthetic", "harmonic_series", "seed") \
+        == inspect.signature(harmonic_series).parameters["seed"].default
+    pegs = build_parser().parse_args(["convert", "pegs", "a.txt", "--positions", "p.txt", "--metres-per-pixel", "1",
+                                      "--force-unit-n", "1", "--out", "x.nc"])
+    assert (pegs.frame_interval, pegs.thickness, pegs.density) == tuple(
+        inspect.signature(convert_pegs).parameters[name].default
+        for name in ("frame_interval_s", "thickness_m", "density_kg_m3"))
+
+
+@pytest.mark.parametrize("argv, expected", [
+    ([], {"max_inertia_number": None, "compaction_friction": None, "friction": 0.4}),
+    (["--preparation", "quasistatic"], {"max_inertia_number": 2e-4, "max_steps": 200000}),
+    (["--preparation", "quasistatic", "--max-inertia-number", "1e-3"], {"max_inertia_number": 1e-3}),
+    (["--preparation", "frictionless"], {"compaction_friction": 0.0, "friction": 0.4}),
+    (["--preparation", "frictionless", "--friction", "0.3", "--aspect", "1.5"],
+     {"compaction_friction": 0.0, "friction": 0.3, "aspect": 1.5}),
+])
+def test_a_named_preparation_holds_where_no_option_is_given(argv, expected):
+    args = build_parser().parse_args(["run", *argv])
+    prep = cli._preparation(args, "pentagon")
+    for name, value in expected.items():
+        assert getattr(prep, name) == value, name
+
+
+def test_only_the_solver_settings_given_are_passed_on():
+    args = build_parser().parse_args(["run", "--time-step", "4e-4", "--solver", "nlgs"])
+    assert cli._solver_parameters(args) == {"time_step": 4e-4, "solver": "nlgs"}
+    assert cli._solver_parameters(build_parser().parse_args(["run"])) == {}
+    old = build_parser().parse_args(["run", "--acceleration", "off"])
+    assert cli._solver_parameters(old) == {"solver": "nlgs"}
+
+
+@pytest.mark.parametrize("argv, line", [
+    (["--every", "0"], "--every 0: expected a positive whole number of steps between snapshots"),
+    (["--strain", "1.5"], "--strain 1.5: expected a vertical strain eps_1 in (0, 1)"),
+    (["--acceleration", "off", "--solver", "nlgs"], "--acceleration and --solver name the same setting"),
+])
+def test_bad_test_settings_are_named_by_their_flag(tmp_path, capsys, argv, line):
+    assert main(["run", *argv, "--out", str(tmp_path / "x.nc")]) == 2
+    err = capsys.readouterr().err.strip()
+    assert err.count("\n") == 0 and line in err
+    assert list(tmp_path.iterdir()) == []
+
+
+# -- engines -------------------------------------------------------------------------------
+CALLS = []
+
+
+class FakeEngine:
+    """An engine that simulates nothing: it records what it is asked."""
+
+    name = "fake"
+
+    def check(self, preparation, parameters, test=None):
+        CALLS.append(("check", preparation, dict(parameters), test))
+
+    def prepare(self, preparation, parameters, progress=None):
+        CALLS.append(("prepare", preparation, dict(parameters)))
+        sample = type("Sample", (), {})()
+        sample.history = SampleHistory(sigma0=preparation.sigma0, preparation=preparation, settled=True,
+                                       compaction_steps=0, compaction_stress=np.full(2, preparation.sigma0))
+        sample.parameters = Parameters(**parameters)
+        return sample
+
+    def shear(self, sample, path, test, *, attrs=None, near_contacts=False, overwrite=False, progress=None,
+              compress=True):
+        CALLS.append(("shear", Path(path).name, test, attrs["preparation_name"]))
+        return 0
+
+    def write_state(self, sample, path, *, attrs=None, near_contacts=False, overwrite=False, compress=True):
+        CALLS.append(("write_state", Path(path).name, attrs))
+
+    def resume(self, path, progress=None, compress=True):
+        CALLS.append(("resume", Path(path).name))
+        return 0
+
+    def file_state(self, path):
+        return "missing"
+
+
+@pytest.fixture
+def fake_engine(monkeypatch):
+    import solver.engine
+
+    monkeypatch.setitem(solver.engine.ENGINES, "fake", f"{__name__}:FakeEngine")
+    CALLS.clear()
+    yield CALLS
+
+
+def test_the_engines_are_a_registry():
+    from grainview.contract.errors import ParameterError
+    from solver.engine import DEFAULT_ENGINE, ContactDynamics, Engine, engine, engine_names
+
+    assert engine_names()[0] == DEFAULT_ENGINE and isinstance(engine(), ContactDynamics)
+    assert isinstance(engine(), Engine) and isinstance(FakeEngine(), Engine)
+    with pytest.raises(ParameterError, match="engine='lammps': expected one of solver"):
+        engine("lammps")
+
+
+def test_run_reaches_the_simulation_through_the_chosen_engine(tmp_path, fake_engine, capsys):
+    """Another engine plugs in through the registry alone: ``run --engine fake`` hands it the
+    records the command line made."""
+    assert main(["run", "--engine", "fake", "--particles", "12", "--friction", "0.3", "--time-step", "4e-4",
+                 "--strain", "0.05", "--every", "7", "--out", str(tmp_path / "r.nc"), "--progress", "off"]) == 0
+    (check, prep, parameters, test), prepare, shear = fake_engine
+    assert check == "check" and prepare[0] == "prepare" and shear[0] == "shear"
+    assert prep.particles == 12 and prep.friction == 0.3 and parameters == {"time_step": 4e-4}
+    assert test == BiaxialTest(strain=0.05, velocity=BiaxialTest.velocity, every=7)
+    assert shear[1:] == ("r.nc", test, "custom")  # the paper's preparation with another friction
+    main(["run", "isotropic", "--engine", "fake", "--out", str(tmp_path / "i.nc"), "--progress", "off"])
+    assert fake_engine[-1] == ("write_state", "i.nc", {"scene": "isotropic"})
+    assert fake_engine[-3][3] is None  # an isotropic run checks the preparation without a test
+
+
+def test_ensemble_runs_go_through_their_engine(tmp_path, fake_engine):
+    from solver.ensemble import grid, run_one
+
+    spec, = grid(shapes=("disk",), particles=(12,), seeds=1, engine="fake", strain=0.05, every=5)
+    result = run_one(spec, tmp_path)
+    assert result["action"] == "ran" and [c[0] for c in fake_engine] == ["check", "check", "prepare", "shear"]
+    assert fake_engine[-1][1] == f"{spec.name}.nc" and fake_engine[-1][2] == spec.test()
