@@ -157,6 +157,8 @@ class GrainAccessor:
     xi_profile = _Delegate("xi_network")
     network_persistence = _Delegate("network_topology")
     force_chains = _Delegate("force_chains")
+    chain_length_pdf = _Delegate("force_chains")
+    chain_survival = _Delegate("force_chains")
     # contact history (these compute, one time-chunk at a time)
     persistence = _Delegate("persistence")
     type_transitions = _Delegate("persistence")

@@ -18,8 +18,9 @@ from .contacts import selection
 from ..contract.errors import ParameterError
 from ..contract.shapes import particle_area
 from .sample import thickness
+from .snapshots import select_snapshots
 
-__all__ = ["force_chains", "particle_volume", "DEFAULT_ANGLE"]
+__all__ = ["force_chains", "chain_length_pdf", "chain_survival", "particle_volume", "DEFAULT_ANGLE"]
 
 DEFAULT_ANGLE = 45.0
 """Largest angle (degrees) between a link's branch vector and the major stress direction of
@@ -177,6 +178,87 @@ def force_chains(ds: xr.Dataset, angle: float = DEFAULT_ANGLE, min_size: int = 3
         out = out.compute()
         out = out.merge(_tracks(out["chain"], ds["time"]))
     return out
+
+
+def chain_length_pdf(ds: xr.Dataset, time="residual", angle: float = DEFAULT_ANGLE, min_size: int = 3,
+                     max_length: int = 50) -> xr.Dataset:
+    """P(L): the chains of the snapshots ``time`` pooled, by their length L in particles.
+
+        P(L) = n(L) / sum_L' n(L'),
+
+    n(L) the number of chains of L particles over the snapshots (``length_count`` of
+    :func:`force_chains` summed over them; the last bin counts every chain of ``max_length``
+    particles or more).
+
+    Parameters
+    ----------
+    ds : xarray.Dataset
+        A dataset of the contract, eager or chunked along ``time``.
+    time : str, int, slice or sequence of int, default "residual"
+        The snapshots pooled (:func:`grainview.analysis.snapshots.select_snapshots`):
+        ``"residual"`` the residual state, eps_q >= 0.3 (for a run that stops short of it, the
+        last part of the run), ``"all"`` or None every snapshot, a snapshot index, a slice or a
+        sequence of indices.
+    angle, min_size, max_length
+        As in :func:`force_chains`.
+
+    Returns
+    -------
+    xarray.Dataset
+        Over ``length``: ``length_count`` (chains) and ``length_pdf`` (dimensionless; NaN
+        without any chain). Lazy on dask input (``time="residual"`` reads the boxes to find
+        the window).
+
+    References
+    ----------
+    Peters, Muthuswamy, Wibowo & Tordesillas, Phys. Rev. E 72, 041307 (2005);
+    docs/analysis.md, "Force chains".
+    """
+    out = force_chains(select_snapshots(ds, time), angle=angle, min_size=min_size, max_length=max_length)
+    count = out["length_count"].sum("time")
+    total = count.sum("length")
+    return xr.Dataset({
+        "length_count": with_attrs(count, "length_count", "1", "number of chains of each length, pooled"),
+        "length_pdf": with_attrs(count / total.where(total > 0), "length_pdf", "1",
+                                 "fraction of the pooled chains of each length"),
+    }, attrs=dict(out.attrs, pooled_snapshots=int(out.sizes["time"])))
+
+
+def chain_survival(ds: xr.Dataset, angle: float = DEFAULT_ANGLE, min_size: int = 3) -> xr.DataArray:
+    """The fraction of the chains seen in at least n snapshots, for n = 1, 2, ..., of the chains
+    born and gone within the record.
+
+        S(n) = #{tracks k uncensored : lifetime_k >= n} / #{tracks k uncensored},
+
+    the tracks and their lifetimes (snapshots seen) those of :func:`force_chains` with
+    ``follow=True``; a censored track (seen in the first or the last snapshot) may live longer
+    than seen and is left out. Computed (the tracks need every snapshot).
+
+    Parameters
+    ----------
+    ds : xarray.Dataset
+        A dataset of the contract.
+    angle, min_size
+        As in :func:`force_chains`.
+
+    Returns
+    -------
+    xarray.DataArray
+        ``survival`` over ``lifetime`` n = 1 ... the longest uncensored lifetime (snapshots),
+        dimensionless; empty without an uncensored chain.
+
+    References
+    ----------
+    Peters, Muthuswamy, Wibowo & Tordesillas, Phys. Rev. E 72, 041307 (2005);
+    docs/analysis.md, "Force chains".
+    """
+    out = force_chains(ds, angle=angle, min_size=min_size, follow=True)
+    lives = np.asarray(out["lifetime"].values)[~np.asarray(out["censored"].values, bool)]
+    n = np.arange(1, (lives.max() if lives.size else 0) + 1)
+    surviving = (lives[None, :] >= n[:, None]).mean(1) if lives.size else np.zeros(0)
+    return with_attrs(xr.DataArray(surviving, dims="lifetime", coords={"lifetime": n}), "survival", "1",
+                      "fraction of the uncensored chains seen in at least n snapshots",
+                      angle_deg=float(angle), min_size=int(min_size), chains=int(lives.size))
 
 
 def _tracks(chain: xr.DataArray, time: xr.DataArray) -> xr.Dataset:

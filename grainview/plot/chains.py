@@ -12,7 +12,6 @@ import os
 import numpy as np
 
 from ..contract.errors import ParameterError
-from ..analysis.snapshots import select_snapshots
 from ._docs import fill_doc
 from ._style import (EPS_Q_LABEL, datasets, draw_evolutions, finish, get_axes, sample_colour, single_dataset,
                      snapshot_index)
@@ -147,7 +146,8 @@ def plot_chain_lengths(data, ax=None, label=None, time="residual", angle: float 
 
         P(L) = (chains of L particles) / (chains), pooled over the snapshots,
 
-    on a logarithmic axis; the last bin counts the chains of ``max_length`` particles or more.
+    on a logarithmic axis (:func:`grainview.analysis.force_chains.chain_length_pdf`); the last bin counts the
+    chains of ``max_length`` particles or more.
 
     Parameters
     ----------
@@ -172,19 +172,17 @@ def plot_chain_lengths(data, ax=None, label=None, time="residual", angle: float 
     Peters, Muthuswamy, Wibowo & Tordesillas, Phys. Rev. E 72, 041307 (2005);
     docs/analysis.md, "Force chains".
     """
-    from ..analysis.force_chains import force_chains
+    from ..analysis.force_chains import chain_length_pdf
 
     ax = get_axes(ax)
     pairs = datasets(data, label)
     for name, ds in pairs:
-        out = force_chains(select_snapshots(ds, time), angle=angle, min_size=min_size, max_length=max_length)
-        counts = np.asarray(out["length_count"].sum("time").values, float)
-        if counts.sum() == 0:
+        pdf = chain_length_pdf(ds, time, angle=angle, min_size=min_size, max_length=max_length).compute()
+        shown = np.asarray(pdf["length_count"].values) > 0
+        if not shown.any():
             continue
-        lengths = np.asarray(out["length"].values)
-        shown = counts > 0
-        ax.plot(lengths[shown], counts[shown] / counts.sum(), marker="o", markersize=3,
-                color=sample_colour(ax, name, ds), label=name)
+        ax.plot(np.asarray(pdf["length"].values)[shown], np.asarray(pdf["length_pdf"].values, float)[shown],
+                marker="o", markersize=3, color=sample_colour(ax, name, ds), label=name)
     ax.set_yscale("log")
     ax.set_xlabel("chain length $L$ (particles)")
     ax.set_ylabel("$P(L)$")
@@ -195,7 +193,7 @@ def plot_chain_lengths(data, ax=None, label=None, time="residual", angle: float 
 def plot_chain_lifetimes(data, ax=None, label=None, angle: float = 45.0, min_size: int = 3):
     """Survival of the chains followed from snapshot to snapshot: the fraction of chains seen
     in at least n snapshots, against n, for the chains born and gone within the record
-    (uncensored).
+    (uncensored; :func:`grainview.analysis.force_chains.chain_survival`).
 
     Parameters
     ----------
@@ -216,18 +214,16 @@ def plot_chain_lifetimes(data, ax=None, label=None, angle: float = 45.0, min_siz
     Peters, Muthuswamy, Wibowo & Tordesillas, Phys. Rev. E 72, 041307 (2005);
     docs/analysis.md, "Force chains".
     """
-    from ..analysis.force_chains import force_chains
+    from ..analysis.force_chains import chain_survival
 
     ax = get_axes(ax)
     pairs = datasets(data, label)
     for name, ds in pairs:
-        out = force_chains(ds, angle=angle, min_size=min_size, follow=True)
-        lives = np.sort(np.asarray(out["lifetime"].values)[~np.asarray(out["censored"].values, bool)])
-        if lives.size == 0:
+        survival = chain_survival(ds, angle=angle, min_size=min_size)
+        if survival.size == 0:
             continue
-        n = np.arange(1, lives.max() + 1)
-        surviving = (lives[None, :] >= n[:, None]).mean(1)
-        ax.step(n, surviving, where="post", color=sample_colour(ax, name, ds), label=name)
+        ax.step(survival["lifetime"].values, survival.values, where="post", color=sample_colour(ax, name, ds),
+                label=name)
     ax.set_yscale("log")
     ax.set_xlabel("lifetime $n$ (snapshots)")
     ax.set_ylabel("fraction of chains seen in $\\geq n$ snapshots")

@@ -481,3 +481,30 @@ def test_an_ensemble_gives_each_run_its_chains_and_tracks(tmp_path):
     np.testing.assert_array_equal(out.lifetime.values[0, :1], [2])
     np.testing.assert_array_equal(out.lifetime.values[1, :1], [1])
     np.testing.assert_array_equal(out.chain_track.values[0, :, 0], [0, 0, -1])
+
+
+# -- pooled over snapshots: P(L) and the chains' survival (drawn by plot/chains.py) -------------
+
+def test_the_length_pdf_pools_the_chosen_snapshots_through_the_accessor(prepare):
+    from grainview.analysis.force_chains import chain_length_pdf
+
+    three = series(column_among_pairs(), column_among_pairs(rotation=0.4), column_among_pairs(load=0.2))
+    lazy = prepare(three)
+    with raise_if_dask_computes():
+        pooled = lazy.grain.chain_length_pdf(time="all", max_length=8)
+        none = chain_length_pdf(lazy, time=[2], max_length=8)
+    count = pooled["length_count"].values
+    assert count[list(pooled["length"].values).index(5)] == 2 and count.sum() == 2  # the column, twice
+    np.testing.assert_array_equal(pooled["length_pdf"].values, np.where(pooled["length"].values == 5, 1.0, 0.0))
+    assert pooled.attrs["pooled_snapshots"] == 3
+    assert none["length_count"].values.sum() == 0 and np.isnan(none["length_pdf"].values).all()
+
+
+def test_the_survival_counts_only_the_chains_born_and_gone_within_the_record():
+    light, column = column_among_pairs(load=0.2), column_among_pairs()
+    survival = series(light, column, light, column, column, light).grain.chain_survival()
+    np.testing.assert_array_equal(survival["lifetime"].values, [1, 2])  # one chain of 1 snapshot, one of 2
+    np.testing.assert_allclose(survival.values, [1.0, 0.5])
+    assert survival.attrs["chains"] == 2
+    censored = series(column, column, light).grain.chain_survival()  # seen in the first snapshot
+    assert censored.size == 0 and censored.attrs["chains"] == 0
