@@ -80,16 +80,13 @@ def _parameters(attrs, source) -> Parameters:
         if key not in attrs:
             raise FileFormatError(f"{source}: cannot resume, global attribute {key!r} is missing")
         value = attrs[key]
+        kind = str(field.type).split("|")[0].strip()  # the field's declared type (float | None: float)
         if isinstance(value, str):
             value = None if value == "none" else value
-        elif field.name == "gravity":
+        elif kind == "tuple":
             value = tuple(float(g) for g in np.atleast_1d(value))
-        elif field.name == "shuffle":
-            value = bool(value)
-        elif field.name in ("seed", "max_iterations", "stall_sweeps", "anderson_memory", "anderson_period", "domains"):
-            value = int(value)
         else:
-            value = float(value)
+            value = {"bool": bool, "int": int}.get(kind, float)(value)
         values[field.name] = value
     acceleration = attrs.get("solver_acceleration") if "solver_solver" not in attrs else None
     return Parameters(**values, acceleration=acceleration)

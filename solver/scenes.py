@@ -39,15 +39,17 @@ def gravity_scene(position, angle, radius, n_vertices, *, gravity=9.81, tilt=0.0
     return Simulation(position, angle, radius, n_vertices, Walls.floor(sides=sides), params, shapes=shapes)
 
 
-def compaction_sample(n=400, shape="pentagon", *, sigma0=1e4, friction=0.4, wall_friction=0.0,
-                      time_step=5e-4, seed=0, diameters=PAPER_DIAMETERS, fractions=PAPER_FRACTIONS,
-                      aspect=2.0, wall_mass=None, max_wall_speed=0.05, **parameters) -> Simulation:
+def compaction_sample(n=400, shape="pentagon", *, sigma0=1e4, seed=0, diameters=PAPER_DIAMETERS,
+                      fractions=PAPER_FRACTIONS, aspect=2.0, wall_mass=None, max_wall_speed=0.05,
+                      **parameters) -> Simulation:
     """A deposited sample in its box, ready for isotropic compaction: bottom and left walls
     fixed, right and top walls pushed by ``sigma0`` (Pa), zero gravity. ``wall_mass``
     defaults to the total particle mass (kg); the pushed walls move inwards at most at
     ``max_wall_speed`` (m s-1) while they close the loose deposit. ``shape``: a regular shape,
     a family of random convex polygons or a file of them (:mod:`solver.shape_families`); the
-    deposit places the circumscribed disks of the size mix either way."""
+    deposit places the circumscribed disks of the size mix either way. ``parameters`` go to
+    :class:`Parameters` (friction, wall_friction, time_step...: their defaults are its own);
+    ``seed`` is also the NLGS's."""
     if not (np.isfinite(sigma0) and sigma0 > 0):
         raise ParameterError(f"sigma0={sigma0!r}: expected a positive stress in Pa")
     nv = regular_vertex_count(shape)
@@ -56,7 +58,7 @@ def compaction_sample(n=400, shape="pentagon", *, sigma0=1e4, friction=0.4, wall
     shapes, turned = sample_shapes(shape, radius, seed)
     angle = angle if turned is None else turned
     walls = Walls.box(width, height + 0.5 * float(radius.min()))
-    params = Parameters(time_step=time_step, friction=friction, wall_friction=wall_friction, seed=seed, **parameters)
+    params = Parameters(seed=seed, **parameters)
     sim = Simulation(position, angle, walls=walls, parameters=params, shapes=shapes)
     mass = float(sim.mass.sum()) if wall_mass is None else float(wall_mass)
     walls.drive_stress("right", sigma0, mass, max_wall_speed)
