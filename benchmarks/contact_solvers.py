@@ -107,29 +107,11 @@ def read_siconos_fc2d(path):
 
 def matrix_problem(problem, vx, vy, w):
     """(W CSR, q, mu) of a captured :class:`solver.nlgs.ContactProblem` with the free body
-    velocities ``vx, vy, w`` (module docstring)."""
-    m, bodies = problem.a.size, problem.minv_xx.size
-    rows, cols, vals = [], [], []
-    for e, (ex, ey) in enumerate([(problem.nx, problem.ny), (-problem.ny, problem.nx)]):
-        for body, rx, ry, sign in ((problem.b, problem.rbx, problem.rby, 1.0),
-                                   (problem.a, problem.rax, problem.ray, -1.0)):
-            for dof, value in enumerate([ex, ey, rx * ey - ry * ex]):
-                rows.append(2 * np.arange(m) + e)
-                cols.append(3 * body + dof)
-                vals.append(sign * value)
-    H = sparse.csr_matrix((np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))),
-                          shape=(2 * m, 3 * bodies))
-    blocks = np.zeros((bodies, 3, 3))
-    blocks[:, 0, 0], blocks[:, 0, 1], blocks[:, 1, 0] = problem.minv_xx, problem.minv_xy, problem.minv_xy
-    blocks[:, 1, 1], blocks[:, 2, 2] = problem.minv_yy, problem.iinv
-    minv = sparse.block_diag(list(blocks), format="csr")
-    W = (H @ minv @ H.T).tocsr()
-    W.eliminate_zeros()
-    W.sort_indices()
-    free = np.stack([vx, vy, w], -1).reshape(-1)
-    q = H @ free
-    q[0::2] += problem.bias
-    return W, q, problem.mu.copy()
+    velocities ``vx, vy, w``: :func:`solver.matrix_form.matrix_problem`, the stepper's own
+    assembly (the one its ``pcg`` solver uses)."""
+    from solver.matrix_form import matrix_problem as assemble
+
+    return assemble(problem, vx, vy, w)
 
 
 def check_assembly(problem, W, q, pn, pt, vx, vy, w):

@@ -5,9 +5,11 @@ quality of a result is the natural-map residual of :mod:`solver.residuals` (FCLI
 for frictional contact): per point F_k = r_k - proj_K(r_k - rho_k u^_k), rho_k = 1 / W_nn,k
 (kg), u^ = (u_n + mu |u_t|, u_t) De Saxcé's modified velocity, and over the problem
 
-    local-law residual = |F| / |r|      (|F| itself when r = 0),
+    local-law residual = |F| / |r|      (infinite when r = 0 and F != 0; 0 when both are 0),
 
-zero exactly at a solution of Signorini's condition and Coulomb's law, whatever method found it.
+zero exactly at a solution of Signorini's condition and Coulomb's law, whatever method found it
+(at r = 0, F = 0 only at a solution, every point open and separating), and the same measure as
+the time stepper's (:func:`solver.residuals.local_law_residual`).
 """
 
 from __future__ import annotations
@@ -59,12 +61,15 @@ def natural_map_at(impulse, velocity, mu, rho):
 
 
 def local_law_residual(violation, impulse) -> float:
-    """|F| / |r| over all points; |F| when r = 0 (module docstring). (Sums of squares rather
+    """|F| / |r| over all points; at r = 0, 0 if F = 0 and infinite otherwise (module
+    docstring). (Sums of squares rather
     than np.linalg.norm: its BLAS dot can take milliseconds on a loaded machine whose threads
     wait for cores.)"""
     size = float(np.sqrt(np.sum(impulse * impulse)))
     law = float(np.sqrt(np.sum(violation * violation)))
-    return law / size if size > 0 else law
+    if size > 0:
+        return law / size
+    return 0.0 if law == 0.0 else float("inf")
 
 
 def largest_point_residual(violation, impulse) -> float:

@@ -37,17 +37,28 @@ The methods registered here:
     (:mod:`solver.contact_solution`). Matrix only.
 ``pcg``
     Projected conjugate gradient after Renouf & Alart (:mod:`solver.projected_cg`);
-    ``tolerance`` is the local-law residual. Matrix only.
+    ``tolerance`` is the local-law residual. In the stepper it solves the step's problem in
+    matrix form (:mod:`solver.matrix_form`: W and q assembled every step, the velocities
+    updated from the impulses), from the warm start, until the local-law residual
+    (:mod:`solver.residuals`) is within ``Parameters.tolerance`` or ``max_iterations``
+    iterations; both norms of its result are that residual. One domain, no random order, no
+    stall test of the NLGS's (its own: :data:`solver.projected_cg.STALL_ITERATIONS`). A known
+    limit: where W is singular (more points than the bodies' degrees of freedom, as in a
+    compacted packing with frictionless walls) its projections can stall far from the
+    tolerance on steps that the NLGS solves in a few sweeps; such a step is reported
+    unconverged (a ConvergenceWarning) with its true residual. An alternative to study, not
+    a default.
 
 :data:`ACCELERATIONS` maps the values of the former ``acceleration`` setting (``off``,
 ``anderson``; files and scripts written before ``Parameters.solver``) to the methods they name.
 
 Adding a method: write its entry point(s) with the signatures above in a module of its own,
 and add one ``register(Method(...))`` below, saying which ``Parameters`` fields it reads as
-options (``parameters``), whether it runs on several domains (``domains``) and whether it
-visits points in a random order (``shuffle``). The stepper, ``Parameters.validate``, the command
-line's choices and restart read the registry and need no edit; a test should show the new
-method on the analytic scenes of tests/solver/test_physics.py.
+options (``parameters``), whether it runs on several domains (``domains``), whether it visits
+points in a random order (``shuffle``) and whether it applies the NLGS's stall test
+(``stall``). The stepper, ``Parameters.validate``, the command line's choices and restart read
+the registry and need no edit; tests/solver/test_physics.py runs every stepper method on its
+analytic scenes.
 
 This module imports numpy and the contract's errors only (each entry point imports its
 solver's module when called), so the command line and :mod:`solver.parameters` read the
@@ -94,6 +105,8 @@ class Method:
         particles' abscissae in m, ``decomposition``: :func:`solver.parallel_nlgs.decompose`).
     shuffle : whether ``solve`` can visit the points in a random order (options ``shuffle``,
         ``seed``).
+    stall : whether ``solve`` applies the NLGS's stall test (``limits.stall``,
+        ``Parameters.stall_sweeps``).
     """
 
     name: str
@@ -103,6 +116,7 @@ class Method:
     parameters: tuple = ()
     domains: bool = False
     shuffle: bool = False
+    stall: bool = True
 
     @property
     def in_stepper(self) -> bool:
@@ -131,6 +145,9 @@ class Method:
         if parameters.shuffle and not self.shuffle:
             bad.append(f"shuffle={parameters.shuffle!r}: expected False with solver={self.name!r} (the random order "
                        f"is an option of {', '.join(n for n, m in _METHODS.items() if m.shuffle)})")
+        if parameters.stall_sweeps and not self.stall:
+            bad.append(f"stall_sweeps={parameters.stall_sweeps!r}: expected 0 with solver={self.name!r} (it has no "
+                       "stall test of the NLGS's)")
         if parameters.shuffle and parameters.domains != 1:
             bad.append(f"domains={parameters.domains!r}: expected 1 with shuffle (the domain-decomposed sweep has "
                        "its own order)")
@@ -258,9 +275,32 @@ def solve_pcg(W, q, mu, tolerance, max_iterations, initial) -> ContactSolution:
     return projected_cg.solve(W, q, mu, tolerance, max_iterations, initial)
 
 
+def solve_stepper_pcg(problem, state: ContactState, limits: Limits) -> NLGSResult:
+    """The stepper's problem by projected conjugate gradient (:func:`solver.projected_cg.solve`)
+    on its matrix form (:mod:`solver.matrix_form`), from the warm-start impulses, until the
+    local-law residual is within ``limits.tolerance`` or ``limits.max_iterations`` iterations;
+    ``state`` updated in place (the impulses, and the velocities V_free + M^-1 H^T r). The
+    result's two norms are both the local-law residual |F|/|r|."""
+    from . import matrix_form, projected_cg
+    from .nlgs import NLGSResult
+
+    pn, pt, vx, vy, w = state
+    if pn.size == 0:
+        return NLGSResult(0, 0.0, 0.0)
+    H, minv = matrix_form.local_map(problem), matrix_form.inverse_mass(problem)
+    W, q, mu = matrix_form.matrix_problem(problem, vx, vy, w, H, minv)
+    solution = projected_cg.solve(W, q, mu, float(limits.tolerance), int(limits.max_iterations),
+                                  np.stack([pn, pt], -1))
+    pn[:], pt[:] = solution.impulse[:, 0], solution.impulse[:, 1]
+    matrix_form.body_velocities(H, minv, solution.impulse, vx, vy, w)
+    return NLGSResult(int(solution.iterations), float(solution.local_law_residual),
+                      float(solution.local_law_residual))
+
+
 register(Method("nlgs", "nonlinear Gauss-Seidel sweeps (serial, shuffled or on domains)", solve=solve_stepper_nlgs,
                 solve_matrix=solve_nlgs, parameters=(), domains=True, shuffle=True))
 register(Method("anderson", "Anderson-accelerated NLGS sweeps (the default)", solve=solve_stepper_anderson,
                 parameters=(("anderson_memory", "memory"), ("anderson_period", "period")), domains=True))
 register(Method("newton", "semi-smooth Newton on Alart-Curnier's function", solve_matrix=solve_newton))
-register(Method("pcg", "projected conjugate gradient (Renouf & Alart)", solve_matrix=solve_pcg))
+register(Method("pcg", "projected conjugate gradient (Renouf & Alart) on the step's matrix", solve=solve_stepper_pcg,
+                solve_matrix=solve_pcg, stall=False))

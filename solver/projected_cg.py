@@ -75,5 +75,8 @@ def solve(W, q, mu, tolerance, max_iterations, initial) -> ContactSolution:
 
 
 def _law(violation, size):
-    """|F| / |r| from their squares (|F| when r = 0)."""
-    return float(np.sqrt(violation / size)) if size > 0 else float(np.sqrt(violation))
+    """|F| / |r| from their squares (at r = 0: 0 if F = 0, infinite otherwise;
+    :func:`solver.contact_solution.local_law_residual`)."""
+    if size > 0:
+        return float(np.sqrt(violation / size))
+    return 0.0 if violation == 0.0 else float("inf")
