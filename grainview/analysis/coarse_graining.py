@@ -14,6 +14,7 @@ from ._lift import apply, with_attrs
 from .arrays import coarse_graining as _cg
 from .arrays.tensors import principal
 from .contacts import selection
+from ._docs import fill_doc
 from ..contract.errors import ParameterError
 from ..contract.shapes import particle_area
 
@@ -72,13 +73,13 @@ def _areas(ds: xr.Dataset) -> xr.DataArray:
     return xr.apply_ufunc(particle_area, *args, input_core_dims=core, dask="parallelized", output_dtypes=[float])
 
 
+@fill_doc
 def mean_diameter(ds: xr.Dataset) -> float:
     """The particles' mean diameter 2 <R> (m), R the circumscribed radius: the default kernel width.
 
     Parameters
     ----------
-    ds : xarray.Dataset
-        A dataset of the contract.
+    {ds_short}
 
     Returns
     -------
@@ -88,6 +89,7 @@ def mean_diameter(ds: xr.Dataset) -> float:
     return 2.0 * float(ds["radius"].mean())
 
 
+@fill_doc
 def coarse_grained(ds: xr.Dataset, width=None, spacing=None, kernel: str = "gaussian", cutoff: float = 3.0,
                    x=None, y=None) -> xr.Dataset:
     """Coarse-grained fields of every snapshot on a regular grid (time, y, x).
@@ -117,8 +119,7 @@ def coarse_grained(ds: xr.Dataset, width=None, spacing=None, kernel: str = "gaus
 
     Parameters
     ----------
-    ds : xarray.Dataset
-        A dataset of the contract (docs/schema.md), eager or chunked along ``time``.
+    {ds}
     width : float, optional
         Kernel width w (standard deviation of the Gaussian), m; about a particle diameter
         resolves the packing's structure, a few diameters its continuum fields. Default: the

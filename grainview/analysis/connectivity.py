@@ -15,12 +15,14 @@ import xarray as xr
 from ._lift import apply, with_attrs
 from .arrays import connectivity as _conn
 from .contacts import selection
+from ._docs import fill_doc
 from ..contract.errors import ParameterError
 
 __all__ = ["contact_numbers", "counts_of", "coordination", "connectivity_pdf",
            "joint_connectivity_pdf"]
 
 
+@fill_doc
 def contact_numbers(ds: xr.Dataset, kind="all", walls: bool = False, near=None) -> xr.DataArray:
     """c_i (time, particle): number of contacts of each particle, force-bearing ones by default.
 
@@ -29,17 +31,10 @@ def contact_numbers(ds: xr.Dataset, kind="all", walls: bool = False, near=None) 
 
     Parameters
     ----------
-    ds : xarray.Dataset
-        A dataset of the contract (docs/schema.md), eager or chunked along ``time``.
-    kind : {"all", "simple", "double"}, default "all"
-        The contacts used: all, simple (vertex–edge and disk contacts) or double (edge–edge)
-        ones (also 1, 2, "s", "d"; :func:`grainview.analysis.contacts.kind_code`).
-    walls : bool, default False
-        Include the particle–wall contacts (default: particle–particle only).
-    near : float, optional
-        Which pairs are contacts (:func:`grainview.analysis.contacts.in_network`): None (default) the
-        force-bearing ones, f_n > 0; a gap threshold in m adds the pairs with gap <= ``near``
-        (they carry f_n = 0); ``np.inf`` every pair the file holds.
+    {ds}
+    {kind}
+    {walls}
+    {near}
 
     Returns
     -------
@@ -56,6 +51,7 @@ def contact_numbers(ds: xr.Dataset, kind="all", walls: bool = False, near=None) 
                       f"number of {which} per particle")
 
 
+@fill_doc
 def counts_of(ds: xr.Dataset, mask: xr.DataArray) -> xr.DataArray:
     """Per particle, how many of the slots selected by ``mask`` touch it (time, particle).
 
@@ -64,8 +60,7 @@ def counts_of(ds: xr.Dataset, mask: xr.DataArray) -> xr.DataArray:
 
     Parameters
     ----------
-    ds : xarray.Dataset
-        A dataset of the contract (docs/schema.md), eager or chunked along ``time``.
+    {ds}
     mask : xarray.DataArray
         Boolean (time, contact), e.g. :func:`grainview.analysis.contacts.selection`.
 
@@ -88,6 +83,7 @@ def _check_min(min_contacts):
         raise ParameterError(f"min_contacts={min_contacts!r}: expected an integer >= 1")
 
 
+@fill_doc
 def coordination(ds: xr.Dataset, walls: bool = False, min_contacts: int = 1, near=None) -> xr.Dataset:
     """Coordination number z (time) over the N' non-rattler particles, and N'.
 
@@ -99,16 +95,11 @@ def coordination(ds: xr.Dataset, walls: bool = False, min_contacts: int = 1, nea
 
     Parameters
     ----------
-    ds : xarray.Dataset
-        A dataset of the contract (docs/schema.md), eager or chunked along ``time``.
-    walls : bool, default False
-        Include the particle–wall contacts (default: particle–particle only).
+    {ds}
+    {walls}
     min_contacts : int, default 1
         A particle with fewer such contacts is a rattler, left out (default 1: none at all).
-    near : float, optional
-        Which pairs are contacts (:func:`grainview.analysis.contacts.in_network`): None (default) the
-        force-bearing ones, f_n > 0; a gap threshold in m adds the pairs with gap <= ``near``
-        (they carry f_n = 0); ``np.inf`` every pair the file holds.
+    {near}
 
     Returns
     -------
@@ -135,6 +126,7 @@ def coordination(ds: xr.Dataset, walls: bool = False, min_contacts: int = 1, nea
     })
 
 
+@fill_doc
 def connectivity_pdf(ds: xr.Dataset, max_c: int = 10, walls: bool = False, min_contacts: int = 1,
                      near=None) -> xr.DataArray:
     """P(c) (time, c): fraction of non-rattler particles with exactly c contacts (Fig. 7).
@@ -146,18 +138,13 @@ def connectivity_pdf(ds: xr.Dataset, max_c: int = 10, walls: bool = False, min_c
 
     Parameters
     ----------
-    ds : xarray.Dataset
-        A dataset of the contract (docs/schema.md), eager or chunked along ``time``.
+    {ds}
     max_c : int, default 10
         The largest c of the result (c = 0 .. max_c).
-    walls : bool, default False
-        Include the particle–wall contacts (default: particle–particle only).
+    {walls}
     min_contacts : int, default 1
         A particle with fewer such contacts is a rattler, left out (default 1: none at all).
-    near : float, optional
-        Which pairs are contacts (:func:`grainview.analysis.contacts.in_network`): None (default) the
-        force-bearing ones, f_n > 0; a gap threshold in m adds the pairs with gap <= ``near``
-        (they carry f_n = 0); ``np.inf`` every pair the file holds.
+    {near}
 
     Returns
     -------
@@ -181,6 +168,7 @@ def connectivity_pdf(ds: xr.Dataset, max_c: int = 10, walls: bool = False, min_c
     return with_attrs(da, "P_c", "1", "fraction of particles with exactly c contacts P(c)")
 
 
+@fill_doc
 def joint_connectivity_pdf(ds: xr.Dataset, max_m: int = 8, walls: bool = False, min_contacts: int = 1,
                            near=None) -> xr.DataArray:
     """P(m_s, m_d): fraction of non-rattler particles with m_s simple and m_d double contacts.
@@ -195,18 +183,13 @@ def joint_connectivity_pdf(ds: xr.Dataset, max_m: int = 8, walls: bool = False, 
 
     Parameters
     ----------
-    ds : xarray.Dataset
-        A dataset of the contract (docs/schema.md), eager or chunked along ``time``.
+    {ds}
     max_m : int, default 8
         The largest m_s and m_d of the result (0 .. max_m each).
-    walls : bool, default False
-        Include the particle–wall contacts (default: particle–particle only).
+    {walls}
     min_contacts : int, default 1
         A particle with fewer such contacts is a rattler, left out (default 1: none at all).
-    near : float, optional
-        Which pairs are contacts (:func:`grainview.analysis.contacts.in_network`): None (default) the
-        force-bearing ones, f_n > 0; a gap threshold in m adds the pairs with gap <= ``near``
-        (they carry f_n = 0); ``np.inf`` every pair the file holds.
+    {near}
 
     Returns
     -------

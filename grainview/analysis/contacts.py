@@ -16,6 +16,7 @@ import xarray as xr
 from ..contract.errors import ParameterError
 from ..contract.schema import KIND_DOUBLE, KIND_SIMPLE
 from ..contract.validation import occupied
+from ._docs import fill_doc
 
 __all__ = ["n_particles", "snapshot_index", "occupied", "is_wall_contact", "kind_code",
            "check_near", "in_network", "near_attr", "selection"]
@@ -23,13 +24,13 @@ __all__ = ["n_particles", "snapshot_index", "occupied", "is_wall_contact", "kind
 KINDS = {"all": None, "simple": KIND_SIMPLE, "double": KIND_DOUBLE, "s": KIND_SIMPLE, "d": KIND_DOUBLE}
 
 
+@fill_doc
 def n_particles(ds: xr.Dataset) -> int:
     """Number of particles N (walls are bodies N, N+1, ...).
 
     Parameters
     ----------
-    ds : xarray.Dataset
-        A dataset of the contract.
+    {ds_short}
 
     Returns
     -------
@@ -39,6 +40,7 @@ def n_particles(ds: xr.Dataset) -> int:
     return ds.sizes["particle"]
 
 
+@fill_doc
 def snapshot_index(ds: xr.Dataset, value, name: str = "time") -> int:
     """``value`` as a snapshot index in [0, T) (negative counts from the end).
 
@@ -46,8 +48,7 @@ def snapshot_index(ds: xr.Dataset, value, name: str = "time") -> int:
 
     Parameters
     ----------
-    ds : xarray.Dataset
-        A dataset of the contract.
+    {ds_short}
     value : int
         A snapshot index in [-T, T), T the number of snapshots.
     name : str, default "time"
@@ -69,13 +70,13 @@ def snapshot_index(ds: xr.Dataset, value, name: str = "time") -> int:
     return int(value) % n
 
 
+@fill_doc
 def is_wall_contact(ds: xr.Dataset) -> xr.DataArray:
     """Boolean (time, contact): True where body j is a wall (j >= N).
 
     Parameters
     ----------
-    ds : xarray.Dataset
-        A dataset of the contract (docs/schema.md), eager or chunked along ``time``.
+    {ds}
 
     Returns
     -------
@@ -120,13 +121,13 @@ def kind_code(kind) -> int | None:
     raise ParameterError(f"kind={kind!r}: expected 'all', 'simple' or 'double'")
 
 
+@fill_doc
 def check_near(ds: xr.Dataset, near) -> float | None:
     """Validate the ``near`` argument of the analyses (see :func:`in_network`).
 
     Parameters
     ----------
-    ds : xarray.Dataset
-        A dataset of the contract.
+    {ds_short}
     near : float or None
         None, a gap threshold >= 0 in m, or ``np.inf``.
 
@@ -167,6 +168,7 @@ def check_near(ds: xr.Dataset, near) -> float | None:
     return near
 
 
+@fill_doc
 def in_network(ds: xr.Dataset, near=None) -> xr.DataArray:
     """Boolean (time, contact): the slots counted as contacts of the packing.
 
@@ -179,8 +181,7 @@ def in_network(ds: xr.Dataset, near=None) -> xr.DataArray:
 
     Parameters
     ----------
-    ds : xarray.Dataset
-        A dataset of the contract (docs/schema.md), eager or chunked along ``time``.
+    {ds}
     near : float, optional
         None, a gap threshold g >= 0 in m (at most the file's ``near_contacts_m``), or
         ``np.inf`` (:func:`check_near`).
@@ -220,6 +221,7 @@ def near_attr(near) -> str | float:
     return "none" if near is None else float(near)
 
 
+@fill_doc
 def selection(ds: xr.Dataset, *, walls: bool = False, kind="all", near=None) -> xr.DataArray:
     """Boolean (time, contact) mask of the contacts an analysis uses.
 
@@ -228,8 +230,7 @@ def selection(ds: xr.Dataset, *, walls: bool = False, kind="all", near=None) -> 
 
     Parameters
     ----------
-    ds : xarray.Dataset
-        A dataset of the contract (docs/schema.md), eager or chunked along ``time``.
+    {ds}
     walls : bool, default False
         Include particle–wall contacts (default: particle–particle only).
     kind : {"all", "simple", "double"}, default "all"

@@ -15,11 +15,13 @@ from .arrays.tensors import principal, signed_anisotropy
 from .contacts import kind_code, selection
 from ..contract.errors import ParameterError
 from .stress import stress_direction
+from ._docs import fill_doc
 
 __all__ = ["fabric_tensor", "reference_direction", "fabric_anisotropy", "orientation_pdf",
            "theta_coord", "check_bins"]
 
 
+@fill_doc
 def fabric_tensor(ds: xr.Dataset, kind="all", walls: bool = False, near=None) -> xr.DataArray:
     """Fabric tensor F (time, xy_a, xy_b), dimensionless, tr F = 1 (paper Eq. F).
 
@@ -31,17 +33,10 @@ def fabric_tensor(ds: xr.Dataset, kind="all", walls: bool = False, near=None) ->
 
     Parameters
     ----------
-    ds : xarray.Dataset
-        A dataset of the contract (docs/schema.md), eager or chunked along ``time``.
-    kind : {"all", "simple", "double"}, default "all"
-        The contacts used: all, simple (vertex–edge and disk contacts) or double (edge–edge)
-        ones (also 1, 2, "s", "d"; :func:`grainview.analysis.contacts.kind_code`).
-    walls : bool, default False
-        Include the particle–wall contacts (default: particle–particle only).
-    near : float, optional
-        Which pairs are contacts (:func:`grainview.analysis.contacts.in_network`): None (default) the
-        force-bearing ones, f_n > 0; a gap threshold in m adds the pairs with gap <= ``near``
-        (they carry f_n = 0); ``np.inf`` every pair the file holds.
+    {ds}
+    {kind}
+    {walls}
+    {near}
 
     Returns
     -------
@@ -59,6 +54,7 @@ def fabric_tensor(ds: xr.Dataset, kind="all", walls: bool = False, near=None) ->
     return apply(_fabric.fabric_tensor, ds["normal"], mask, mask_all, names=["fabric"], attrs={"units": "1", "long_name": f"fabric tensor{label}"})
 
 
+@fill_doc
 def reference_direction(ds, reference):
     """The reference direction theta' of a signed anisotropy (rad).
 
@@ -67,8 +63,7 @@ def reference_direction(ds, reference):
 
     Parameters
     ----------
-    ds : xarray.Dataset
-        A dataset of the contract (docs/schema.md), eager or chunked along ``time``.
+    {ds}
     reference : "stress", None, float or xarray.DataArray
         ``"stress"`` or None: :func:`grainview.analysis.stress.stress_direction`; a number: a fixed angle
         in rad; a DataArray: the direction over time, rad.
@@ -97,6 +92,7 @@ def reference_direction(ds, reference):
     raise ParameterError(f"reference={reference!r}: expected 'stress', an angle in rad or a DataArray")
 
 
+@fill_doc
 def fabric_anisotropy(ds: xr.Dataset, kind="all", walls: bool = False, reference="stress", near=None) -> xr.Dataset:
     """Fabric anisotropy a = 2 (F_1 - F_2), theta_F and the signed a' (paper Eq. a').
 
@@ -110,21 +106,14 @@ def fabric_anisotropy(ds: xr.Dataset, kind="all", walls: bool = False, reference
 
     Parameters
     ----------
-    ds : xarray.Dataset
-        A dataset of the contract (docs/schema.md), eager or chunked along ``time``.
-    kind : {"all", "simple", "double"}, default "all"
-        The contacts used: all, simple (vertex–edge and disk contacts) or double (edge–edge)
-        ones (also 1, 2, "s", "d"; :func:`grainview.analysis.contacts.kind_code`).
-    walls : bool, default False
-        Include the particle–wall contacts (default: particle–particle only).
+    {ds}
+    {kind}
+    {walls}
     reference : "stress", float or xarray.DataArray, default "stress"
         The reference direction theta' (rad): ``"stress"`` (or None) the major principal stress
         direction of the whole sample (docs/conventions.md §3, "Signs"), a fixed angle in rad,
         or a DataArray over time.
-    near : float, optional
-        Which pairs are contacts (:func:`grainview.analysis.contacts.in_network`): None (default) the
-        force-bearing ones, f_n > 0; a gap threshold in m adds the pairs with gap <= ``near``
-        (they carry f_n = 0); ``np.inf`` every pair the file holds.
+    {near}
 
     Returns
     -------
@@ -148,6 +137,7 @@ def fabric_anisotropy(ds: xr.Dataset, kind="all", walls: bool = False, reference
     })
 
 
+@fill_doc
 def orientation_pdf(ds: xr.Dataset, bins: int = 36, kind="all", walls: bool = False, near=None) -> xr.DataArray:
     """P(theta) (time, theta): density of contact-normal orientations on [0, pi), rad-1.
 
@@ -158,19 +148,11 @@ def orientation_pdf(ds: xr.Dataset, bins: int = 36, kind="all", walls: bool = Fa
 
     Parameters
     ----------
-    ds : xarray.Dataset
-        A dataset of the contract (docs/schema.md), eager or chunked along ``time``.
-    bins : int, default 36
-        Number of angular sectors of [0, pi), centred on theta_k = k pi/bins.
-    kind : {"all", "simple", "double"}, default "all"
-        The contacts used: all, simple (vertex–edge and disk contacts) or double (edge–edge)
-        ones (also 1, 2, "s", "d"; :func:`grainview.analysis.contacts.kind_code`).
-    walls : bool, default False
-        Include the particle–wall contacts (default: particle–particle only).
-    near : float, optional
-        Which pairs are contacts (:func:`grainview.analysis.contacts.in_network`): None (default) the
-        force-bearing ones, f_n > 0; a gap threshold in m adds the pairs with gap <= ``near``
-        (they carry f_n = 0); ``np.inf`` every pair the file holds.
+    {ds}
+    {bins}
+    {kind}
+    {walls}
+    {near}
 
     Returns
     -------

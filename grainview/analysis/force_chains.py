@@ -19,6 +19,7 @@ from ..contract.errors import ParameterError
 from ..contract.shapes import particle_area
 from .sample import thickness
 from .snapshots import select_snapshots
+from ._docs import fill_doc
 
 __all__ = ["force_chains", "chain_length_pdf", "chain_survival", "particle_volume", "DEFAULT_ANGLE"]
 
@@ -66,6 +67,7 @@ def _check(angle, min_size, max_length):
             raise ParameterError(f"{name}={value!r}: expected an integer >= {low}")
 
 
+@fill_doc
 def force_chains(ds: xr.Dataset, angle: float = DEFAULT_ANGLE, min_size: int = 3, max_length: int = 50,
                  follow: bool = False) -> xr.Dataset:
     """Force chains of every snapshot (time, particle), their statistics and, with ``follow``,
@@ -91,8 +93,7 @@ def force_chains(ds: xr.Dataset, angle: float = DEFAULT_ANGLE, min_size: int = 3
 
     Parameters
     ----------
-    ds : xarray.Dataset
-        A dataset of the contract (docs/schema.md), eager or chunked along ``time``.
+    {ds}
     angle : float, default 45
         Largest angle between a link's branch vector and each particle's major direction,
         degrees, in (0, 90].
@@ -224,6 +225,7 @@ def chain_length_pdf(ds: xr.Dataset, time="residual", angle: float = DEFAULT_ANG
     }, attrs=dict(out.attrs, pooled_snapshots=int(out.sizes["time"])))
 
 
+@fill_doc
 def chain_survival(ds: xr.Dataset, angle: float = DEFAULT_ANGLE, min_size: int = 3) -> xr.DataArray:
     """The fraction of the chains seen in at least n snapshots, for n = 1, 2, ..., of the chains
     born and gone within the record.
@@ -236,8 +238,7 @@ def chain_survival(ds: xr.Dataset, angle: float = DEFAULT_ANGLE, min_size: int =
 
     Parameters
     ----------
-    ds : xarray.Dataset
-        A dataset of the contract.
+    {ds_short}
     angle, min_size
         As in :func:`force_chains`.
 

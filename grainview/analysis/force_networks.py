@@ -14,6 +14,7 @@ from ._lift import apply, with_attrs
 from .arrays import force_networks as _net
 from .contacts import near_attr, selection
 from ..contract.errors import ParameterError
+from ._docs import fill_doc
 
 __all__ = ["force_class", "contact_proportions"]
 
@@ -28,6 +29,7 @@ def _check_thresholds(very_weak, strong):
     return float(very_weak), float(strong)
 
 
+@fill_doc
 def force_class(ds: xr.Dataset, very_weak: float = 0.1, strong: float = 1.0, walls: bool = False,
                 near=None) -> xr.DataArray:
     """Force class of each contact slot (time, contact), int8 (paper Fig. 17's tricolor map).
@@ -44,18 +46,13 @@ def force_class(ds: xr.Dataset, very_weak: float = 0.1, strong: float = 1.0, wal
 
     Parameters
     ----------
-    ds : xarray.Dataset
-        A dataset of the contract (docs/schema.md), eager or chunked along ``time``.
+    {ds}
     very_weak : float, default 0.1
         Very weak threshold, a multiple of <f_n> (finite, >= 0, <= ``strong``).
     strong : float, default 1.0
         Strong threshold, a multiple of <f_n> (finite, >= 0).
-    walls : bool, default False
-        Include the particle–wall contacts (default: particle–particle only).
-    near : float, optional
-        Which pairs are contacts (:func:`grainview.analysis.contacts.in_network`): None (default) the
-        force-bearing ones, f_n > 0; a gap threshold in m adds the pairs with gap <= ``near``
-        (they carry f_n = 0); ``np.inf`` every pair the file holds.
+    {walls}
+    {near}
 
     Returns
     -------
@@ -104,6 +101,7 @@ _ATTRS = {
 }
 
 
+@fill_doc
 def contact_proportions(ds: xr.Dataset, walls: bool = False, very_weak: float = 0.1,
                         strong: float = 1.0, near=None) -> xr.Dataset:
     """Proportions of simple/double and weak/strong contacts per snapshot (time,) (docs/conventions.md §4).
@@ -127,18 +125,13 @@ def contact_proportions(ds: xr.Dataset, walls: bool = False, very_weak: float = 
 
     Parameters
     ----------
-    ds : xarray.Dataset
-        A dataset of the contract (docs/schema.md), eager or chunked along ``time``.
-    walls : bool, default False
-        Include the particle–wall contacts (default: particle–particle only).
+    {ds}
+    {walls}
     very_weak : float, default 0.1
         Very weak threshold, a multiple of <f_n> (finite, >= 0, <= ``strong``).
     strong : float, default 1.0
         Strong threshold, a multiple of <f_n> (finite, >= 0).
-    near : float, optional
-        Which pairs are contacts (:func:`grainview.analysis.contacts.in_network`): None (default) the
-        force-bearing ones, f_n > 0; a gap threshold in m adds the pairs with gap <= ``near``
-        (they carry f_n = 0); ``np.inf`` every pair the file holds.
+    {near}
 
     Returns
     -------

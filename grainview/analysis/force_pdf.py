@@ -18,6 +18,7 @@ from .arrays import force_pdf as _pdf
 from .contacts import kind_code, selection
 from .snapshots import select_snapshots
 from ..contract.errors import ParameterError
+from ._docs import fill_doc
 
 __all__ = ["force_pdf", "pooled_force_pdf", "strong_force_exponent", "strong_force_prefactor", "counting_error"]
 
@@ -85,6 +86,7 @@ def _pdf_dataset(counts, n_selected, n_zero, edges, scale, attrs):
     return ds
 
 
+@fill_doc
 def force_pdf(ds: xr.Dataset, bins: int = 50, scale: str = "log", range=None, kind="all",
               walls: bool = False, near=None) -> xr.Dataset:
     """P(f_n/<f_n>) per snapshot (time, bin), dimensionless (paper Fig. 14; Fig. 23 by kind).
@@ -98,8 +100,7 @@ def force_pdf(ds: xr.Dataset, bins: int = 50, scale: str = "log", range=None, ki
 
     Parameters
     ----------
-    ds : xarray.Dataset
-        A dataset of the contract (docs/schema.md), eager or chunked along ``time``.
+    {ds}
     bins : int, default 50
         Number of bins (>= 1).
     scale : {"log", "linear"}, default "log"
@@ -110,12 +111,8 @@ def force_pdf(ds: xr.Dataset, bins: int = 50, scale: str = "log", range=None, ki
         linear bins.
     kind : {"all", "simple", "double"}, default "all"
         The contacts counted (the mean <f_n> is always that of every kind).
-    walls : bool, default False
-        Include the particle–wall contacts (default: particle–particle only).
-    near : float, optional
-        Which pairs are contacts (:func:`grainview.analysis.contacts.in_network`): None (default) the
-        force-bearing ones, f_n > 0; a gap threshold in m adds the pairs with gap <= ``near``
-        (they carry f_n = 0); ``np.inf`` every pair the file holds.
+    {walls}
+    {near}
 
     Returns
     -------
@@ -133,6 +130,7 @@ def force_pdf(ds: xr.Dataset, bins: int = 50, scale: str = "log", range=None, ki
     return _pdf_dataset(counts, n_selected, n_zero, edges, scale, {"kind": str(kind), "walls": int(walls)})
 
 
+@fill_doc
 def pooled_force_pdf(ds: xr.Dataset, bins: int = 50, scale: str = "log", range=None, kind="all",
                      walls: bool = False, near=None, time=None) -> xr.Dataset:
     """P(f_n/<f_n>) of the contacts of every snapshot of ``ds`` pooled (dims: bin).
@@ -145,8 +143,7 @@ def pooled_force_pdf(ds: xr.Dataset, bins: int = 50, scale: str = "log", range=N
 
     Parameters
     ----------
-    ds : xarray.Dataset
-        A dataset of the contract (docs/schema.md), eager or chunked along ``time``.
+    {ds}
     bins : int, default 50
         Number of bins (>= 1).
     scale : {"log", "linear"}, default "log"
@@ -157,12 +154,8 @@ def pooled_force_pdf(ds: xr.Dataset, bins: int = 50, scale: str = "log", range=N
         linear bins.
     kind : {"all", "simple", "double"}, default "all"
         The contacts counted (the mean <f_n> is always that of every kind).
-    walls : bool, default False
-        Include the particle–wall contacts (default: particle–particle only).
-    near : float, optional
-        Which pairs are contacts (:func:`grainview.analysis.contacts.in_network`): None (default) the
-        force-bearing ones, f_n > 0; a gap threshold in m adds the pairs with gap <= ``near``
-        (they carry f_n = 0); ``np.inf`` every pair the file holds.
+    {walls}
+    {near}
     time : str, int, slice or sequence of int, optional
         The snapshots pooled (:func:`grainview.analysis.snapshots.select_snapshots`): None or
         ``"all"`` (default) every snapshot, ``"residual"`` the residual state, eps_q >= 0.3 (for a

@@ -18,10 +18,12 @@ from ..contract.errors import ParameterError
 from .fabric import check_bins, reference_direction, fabric_anisotropy, theta_coord
 from .snapshots import select_snapshots, time_mean
 from .stress import stress_invariants
+from ._docs import fill_doc
 
 __all__ = ["angular_force_averages", "angular_profile", "force_tensors", "force_anisotropies", "harmonic_prediction"]
 
 
+@fill_doc
 def angular_force_averages(ds: xr.Dataset, bins: int = 36, kind="all", walls: bool = False, near=None) -> xr.Dataset:
     """<f_n>(theta), <f_t>(theta) (N) and N_c(theta) on ``bins`` sectors of [0, pi) (paper Eq. fnft).
 
@@ -35,19 +37,11 @@ def angular_force_averages(ds: xr.Dataset, bins: int = 36, kind="all", walls: bo
 
     Parameters
     ----------
-    ds : xarray.Dataset
-        A dataset of the contract (docs/schema.md), eager or chunked along ``time``.
-    bins : int, default 36
-        Number of angular sectors of [0, pi), centred on theta_k = k pi/bins.
-    kind : {"all", "simple", "double"}, default "all"
-        The contacts used: all, simple (vertex–edge and disk contacts) or double (edge–edge)
-        ones (also 1, 2, "s", "d"; :func:`grainview.analysis.contacts.kind_code`).
-    walls : bool, default False
-        Include the particle–wall contacts (default: particle–particle only).
-    near : float, optional
-        Which pairs are contacts (:func:`grainview.analysis.contacts.in_network`): None (default) the
-        force-bearing ones, f_n > 0; a gap threshold in m adds the pairs with gap <= ``near``
-        (they carry f_n = 0); ``np.inf`` every pair the file holds.
+    {ds}
+    {bins}
+    {kind}
+    {walls}
+    {near}
 
     Returns
     -------
@@ -71,6 +65,7 @@ def angular_force_averages(ds: xr.Dataset, bins: int = 36, kind="all", walls: bo
     }).assign_coords(theta=theta_coord(bins))
 
 
+@fill_doc
 def force_tensors(ds: xr.Dataset, bins: int = 36, kind="all", walls: bool = False, near=None) -> xr.Dataset:
     """Force tensors H^(n) and H^(t) (time, xy_a, xy_b) in N (docs/conventions.md §3).
 
@@ -84,19 +79,11 @@ def force_tensors(ds: xr.Dataset, bins: int = 36, kind="all", walls: bool = Fals
 
     Parameters
     ----------
-    ds : xarray.Dataset
-        A dataset of the contract (docs/schema.md), eager or chunked along ``time``.
-    bins : int, default 36
-        Number of angular sectors of [0, pi), centred on theta_k = k pi/bins.
-    kind : {"all", "simple", "double"}, default "all"
-        The contacts used: all, simple (vertex–edge and disk contacts) or double (edge–edge)
-        ones (also 1, 2, "s", "d"; :func:`grainview.analysis.contacts.kind_code`).
-    walls : bool, default False
-        Include the particle–wall contacts (default: particle–particle only).
-    near : float, optional
-        Which pairs are contacts (:func:`grainview.analysis.contacts.in_network`): None (default) the
-        force-bearing ones, f_n > 0; a gap threshold in m adds the pairs with gap <= ``near``
-        (they carry f_n = 0); ``np.inf`` every pair the file holds.
+    {ds}
+    {bins}
+    {kind}
+    {walls}
+    {near}
 
     Returns
     -------
@@ -118,6 +105,7 @@ def force_tensors(ds: xr.Dataset, bins: int = 36, kind="all", walls: bool = Fals
     })
 
 
+@fill_doc
 def force_anisotropies(ds: xr.Dataset, bins: int = 36, kind="all", walls: bool = False,
                        reference="stress", near=None) -> xr.Dataset:
     """Signed normal and tangential force anisotropies a_n, a_t (docs/conventions.md §3).
@@ -132,23 +120,15 @@ def force_anisotropies(ds: xr.Dataset, bins: int = 36, kind="all", walls: bool =
 
     Parameters
     ----------
-    ds : xarray.Dataset
-        A dataset of the contract (docs/schema.md), eager or chunked along ``time``.
-    bins : int, default 36
-        Number of angular sectors of [0, pi), centred on theta_k = k pi/bins.
-    kind : {"all", "simple", "double"}, default "all"
-        The contacts used: all, simple (vertex–edge and disk contacts) or double (edge–edge)
-        ones (also 1, 2, "s", "d"; :func:`grainview.analysis.contacts.kind_code`).
-    walls : bool, default False
-        Include the particle–wall contacts (default: particle–particle only).
+    {ds}
+    {bins}
+    {kind}
+    {walls}
     reference : "stress", float or xarray.DataArray, default "stress"
         The reference direction theta' of the signs (rad): ``"stress"`` the major principal
         stress direction of the whole sample, a fixed angle in rad, or a DataArray over time
         (:func:`grainview.analysis.fabric.reference_direction`).
-    near : float, optional
-        Which pairs are contacts (:func:`grainview.analysis.contacts.in_network`): None (default) the
-        force-bearing ones, f_n > 0; a gap threshold in m adds the pairs with gap <= ``near``
-        (they carry f_n = 0); ``np.inf`` every pair the file holds.
+    {near}
 
     Returns
     -------
@@ -178,6 +158,7 @@ def force_anisotropies(ds: xr.Dataset, bins: int = 36, kind="all", walls: bool =
     })
 
 
+@fill_doc
 def harmonic_prediction(ds: xr.Dataset, bins: int = 36, walls: bool = False, near=None) -> xr.Dataset:
     """q/p and its harmonic predictions (paper Eq. qa, Fig. 12; docs/conventions.md §3).
 
@@ -201,16 +182,10 @@ def harmonic_prediction(ds: xr.Dataset, bins: int = 36, walls: bool = False, nea
 
     Parameters
     ----------
-    ds : xarray.Dataset
-        A dataset of the contract (docs/schema.md), eager or chunked along ``time``.
-    bins : int, default 36
-        Number of angular sectors of [0, pi), centred on theta_k = k pi/bins.
-    walls : bool, default False
-        Include the particle–wall contacts (default: particle–particle only).
-    near : float, optional
-        Which pairs are contacts (:func:`grainview.analysis.contacts.in_network`): None (default) the
-        force-bearing ones, f_n > 0; a gap threshold in m adds the pairs with gap <= ``near``
-        (they carry f_n = 0); ``np.inf`` every pair the file holds.
+    {ds}
+    {bins}
+    {walls}
+    {near}
 
     Returns
     -------
@@ -237,6 +212,7 @@ def harmonic_prediction(ds: xr.Dataset, bins: int = 36, walls: bool = False, nea
     })
 
 
+@fill_doc
 def angular_profile(ds: xr.Dataset, component: str = "fn", time="residual", bins: int = 36, kind="all",
                     walls: bool = False, normalise: bool = True) -> xr.DataArray:
     """<f_n>(theta) or <f_t>(theta) on ``bins`` sectors of [0, pi), averaged over the snapshots ``time``.
@@ -252,22 +228,13 @@ def angular_profile(ds: xr.Dataset, component: str = "fn", time="residual", bins
 
     Parameters
     ----------
-    ds : xarray.Dataset
-        A dataset of the contract.
+    {ds_short}
     component : {"fn", "ft"}, default "fn"
         The normal or the tangential force.
-    time : str, int, slice or sequence of int, default "residual"
-        The snapshots averaged over (:func:`grainview.analysis.snapshots.select_snapshots`):
-        ``"residual"`` the residual state, eps_q >= 0.3 (for a run that stops short of it, the
-        last part of the run), ``"all"`` or None every snapshot, a snapshot index, a slice or a
-        sequence of indices.
-    bins : int, default 36
-        Number of angular sectors of [0, pi), centred on theta_k = k pi/bins.
-    kind : {"all", "simple", "double"}, default "all"
-        The contacts used: all, simple (vertex–edge and disk contacts) or double (edge–edge)
-        ones (also 1, 2, "s", "d"; :func:`grainview.analysis.contacts.kind_code`).
-    walls : bool, default False
-        Include the particle–wall contacts (default: particle–particle only).
+    {time_averaged}
+    {bins}
+    {kind}
+    {walls}
     normalise : bool, default True
         Divide each snapshot's profile by its mean normal force <f_n> over the same contacts
         (dimensionless); otherwise in N.

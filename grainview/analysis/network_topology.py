@@ -16,6 +16,7 @@ from .contacts import near_attr, selection
 from ..contract.errors import ParameterError
 from .persistence import body_count
 from .xi_network import DEFAULT_XI, _check_xi
+from ._docs import fill_doc
 
 __all__ = ["network_persistence"]
 
@@ -36,6 +37,7 @@ def _check_options(dimensions, strong, max_features):
     return dims
 
 
+@fill_doc
 def network_persistence(ds: xr.Dataset, xi=DEFAULT_XI, dimensions=(0, 1), strong: float = 1.0,
                         walls: bool = False, near=None, max_features: int | None = None) -> xr.Dataset:
     """Persistent homology of each snapshot's force network, its Betti curves and its 3- and
@@ -76,8 +78,7 @@ def network_persistence(ds: xr.Dataset, xi=DEFAULT_XI, dimensions=(0, 1), strong
 
     Parameters
     ----------
-    ds : xarray.Dataset
-        A dataset of the contract (docs/schema.md), eager or chunked along ``time``.
+    {ds}
     xi : array_like of float, default 0, 0.05, ..., 5
         Thresholds of the Betti curves, multiples of <f_n> (dimensionless).
     dimensions : (0,) or (0, 1), default (0, 1)

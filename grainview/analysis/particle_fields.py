@@ -18,10 +18,12 @@ import xarray as xr
 from ._lift import with_attrs
 from .connectivity import _check_min, counts_of
 from .contacts import selection, snapshot_index
+from ._docs import fill_doc
 
 __all__ = ["particle_fields"]
 
 
+@fill_doc
 def particle_fields(ds: xr.Dataset, reference: int = 0, walls: bool = True, near=None,
                     min_contacts: int = 1) -> xr.Dataset:
     """The per-particle fields of every snapshot as a Dataset (time, particle).
@@ -37,17 +39,13 @@ def particle_fields(ds: xr.Dataset, reference: int = 0, walls: bool = True, near
 
     Parameters
     ----------
-    ds : xarray.Dataset
-        A dataset of the contract (docs/schema.md), eager or chunked along ``time``.
+    {ds}
     reference : int, default 0
         Snapshot index the rotation and displacement are measured from (negative counts from
         the end).
     walls : bool, default True
         Include the particle–wall contacts; ``False`` leaves them out.
-    near : float, optional
-        Which pairs are contacts (:func:`grainview.analysis.contacts.in_network`): None (default) the
-        force-bearing ones, f_n > 0; a gap threshold in m adds the pairs with gap <= ``near``
-        (they carry f_n = 0); ``np.inf`` every pair the file holds.
+    {near}
     min_contacts : int, default 1
         A particle with fewer contacts c is a rattler.
 

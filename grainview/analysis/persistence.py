@@ -21,12 +21,14 @@ from ._lift import with_attrs
 from .contacts import check_near, n_particles, near_attr, selection, snapshot_index
 from ..contract.errors import ParameterError
 from ..contract.schema import KIND_DOUBLE, KIND_SIMPLE
+from ._docs import fill_doc
 
 __all__ = ["body_count", "pair_keys", "pooled_contacts", "time_blocks", "persistence", "type_transitions"]
 
 _MAX_KEY = np.iinfo(np.int64).max // 2
 
 
+@fill_doc
 def body_count(ds: xr.Dataset) -> int:
     """N + W: particles plus walls, the stride of the pair keys.
 
@@ -34,8 +36,7 @@ def body_count(ds: xr.Dataset) -> int:
 
     Parameters
     ----------
-    ds : xarray.Dataset
-        A dataset of the contract.
+    {ds_short}
 
     Returns
     -------
@@ -73,13 +74,13 @@ def pair_keys(i, j, n_bodies):
     return np.minimum(i, j) * n_bodies + np.maximum(i, j)
 
 
+@fill_doc
 def time_blocks(ds: xr.Dataset):
     """Slices of ``time`` following the dataset's dask chunks (one slice when eager).
 
     Parameters
     ----------
-    ds : xarray.Dataset
-        A dataset of the contract.
+    {ds_short}
 
     Yields
     ------
@@ -120,6 +121,7 @@ def _check_flag(name, value):
         raise ParameterError(f"{name}={value!r}: expected True or False")
 
 
+@fill_doc
 def persistence(ds: xr.Dataset, reference: int = 0, uninterrupted: bool = False, walls: bool = False,
                 near=None) -> xr.DataArray:
     """gamma(t): fraction of the contacts of the reference snapshot still present at t.
@@ -135,18 +137,13 @@ def persistence(ds: xr.Dataset, reference: int = 0, uninterrupted: bool = False,
 
     Parameters
     ----------
-    ds : xarray.Dataset
-        A dataset of the contract (docs/schema.md), eager or chunked along ``time``.
+    {ds}
     reference : int, default 0
         The reference snapshot index (negative counts from the end).
     uninterrupted : bool, default False
         Count a contact only if present at every snapshot from the reference to t.
-    walls : bool, default False
-        Include the particle–wall contacts (default: particle–particle only).
-    near : float, optional
-        Which pairs are contacts (:func:`grainview.analysis.contacts.in_network`): None (default) the
-        force-bearing ones, f_n > 0; a gap threshold in m adds the pairs with gap <= ``near``
-        (they carry f_n = 0); ``np.inf`` every pair the file holds.
+    {walls}
+    {near}
 
     Returns
     -------
@@ -228,6 +225,7 @@ def _pair_transitions(prev_keys, prev_kind, prev_present, keys, kind, present, s
     return s_to_d, d_to_s, prev_present.sum(axis=1)
 
 
+@fill_doc
 def type_transitions(ds: xr.Dataset, walls: bool = False, near=None) -> xr.Dataset:
     """Cumulative fractions Delta gamma_{s->d}(t) and Delta gamma_{d->s}(t) of contacts that changed type.
 
@@ -249,14 +247,9 @@ def type_transitions(ds: xr.Dataset, walls: bool = False, near=None) -> xr.Datas
 
     Parameters
     ----------
-    ds : xarray.Dataset
-        A dataset of the contract (docs/schema.md), eager or chunked along ``time``.
-    walls : bool, default False
-        Include the particle–wall contacts (default: particle–particle only).
-    near : float, optional
-        Which pairs are contacts (:func:`grainview.analysis.contacts.in_network`): None (default) the
-        force-bearing ones, f_n > 0; a gap threshold in m adds the pairs with gap <= ``near``
-        (they carry f_n = 0); ``np.inf`` every pair the file holds.
+    {ds}
+    {walls}
+    {near}
 
     Returns
     -------

@@ -6,17 +6,18 @@ import xarray as xr
 
 from ._lift import with_attrs
 from ..contract.shapes import particle_area_of
+from ._docs import fill_doc
 
 __all__ = ["thickness", "width", "height", "volume", "solid_fraction", "area"]
 
 
+@fill_doc
 def thickness(ds: xr.Dataset) -> float:
     """Slab thickness of the 2D sample in m (global attribute ``thickness_m``, default 1).
 
     Parameters
     ----------
-    ds : xarray.Dataset
-        A dataset of the contract.
+    {ds_short}
 
     Returns
     -------
@@ -31,13 +32,13 @@ def thickness(ds: xr.Dataset) -> float:
     return float(ds.attrs.get("thickness_m", 1.0))
 
 
+@fill_doc
 def width(ds: xr.Dataset) -> xr.DataArray:
     """Box width l = x_max - x_min (m).
 
     Parameters
     ----------
-    ds : xarray.Dataset
-        A dataset of the contract (docs/schema.md), eager or chunked along ``time``.
+    {ds}
 
     Returns
     -------
@@ -53,13 +54,13 @@ def width(ds: xr.Dataset) -> xr.DataArray:
     return with_attrs(l.drop_vars("xy"), "width", "m", "sample width l")
 
 
+@fill_doc
 def height(ds: xr.Dataset) -> xr.DataArray:
     """Box height h = y_max - y_min (m).
 
     Parameters
     ----------
-    ds : xarray.Dataset
-        A dataset of the contract (docs/schema.md), eager or chunked along ``time``.
+    {ds}
 
     Returns
     -------
@@ -75,6 +76,7 @@ def height(ds: xr.Dataset) -> xr.DataArray:
     return with_attrs(h.drop_vars("xy"), "height", "m", "sample height h")
 
 
+@fill_doc
 def volume(ds: xr.Dataset) -> xr.DataArray:
     """Sample volume V = l h times the slab thickness (m3); the V of the stress (docs/conventions.md §1).
 
@@ -82,8 +84,7 @@ def volume(ds: xr.Dataset) -> xr.DataArray:
 
     Parameters
     ----------
-    ds : xarray.Dataset
-        A dataset of the contract (docs/schema.md), eager or chunked along ``time``.
+    {ds}
 
     Returns
     -------
@@ -98,6 +99,7 @@ def volume(ds: xr.Dataset) -> xr.DataArray:
     return with_attrs(width(ds) * height(ds) * thickness(ds), "volume", "m3", "sample volume V")
 
 
+@fill_doc
 def solid_fraction(ds: xr.Dataset) -> xr.DataArray:
     """Solid fraction (time,): total particle area / box area l h.
 
@@ -110,8 +112,7 @@ def solid_fraction(ds: xr.Dataset) -> xr.DataArray:
 
     Parameters
     ----------
-    ds : xarray.Dataset
-        A dataset of the contract (docs/schema.md), eager or chunked along ``time``.
+    {ds}
 
     Returns
     -------
@@ -127,6 +128,7 @@ def solid_fraction(ds: xr.Dataset) -> xr.DataArray:
     return with_attrs(solid / area(ds), "solid_fraction", "1", "solid fraction")
 
 
+@fill_doc
 def area(ds: xr.Dataset) -> xr.DataArray:
     """Sample area l h (m2).
 
@@ -134,8 +136,7 @@ def area(ds: xr.Dataset) -> xr.DataArray:
 
     Parameters
     ----------
-    ds : xarray.Dataset
-        A dataset of the contract (docs/schema.md), eager or chunked along ``time``.
+    {ds}
 
     Returns
     -------

@@ -16,6 +16,7 @@ import xarray as xr
 
 from ..contract.errors import ParameterError
 from .strain import RESIDUAL_STRAIN, residual_window, strains
+from ._docs import fill_doc
 
 
 @dataclass(frozen=True)
@@ -30,6 +31,7 @@ SHORT_RUN_FRACTION = 0.3
 """A run short of the residual window averages the last 30% of its shear strain instead."""
 
 
+@fill_doc
 def select_snapshots(ds: xr.Dataset, time="residual", residual_strain: float = RESIDUAL_STRAIN) -> xr.Dataset:
     """The snapshots a distribution is averaged over.
 
@@ -42,8 +44,7 @@ def select_snapshots(ds: xr.Dataset, time="residual", residual_strain: float = R
 
     Parameters
     ----------
-    ds : xarray.Dataset
-        A dataset of the contract.
+    {ds_short}
     time : str, int, slice, sequence of int or Residual, default "residual"
         The snapshots, as above.
     residual_strain : float, default 0.3

@@ -15,6 +15,7 @@ from ._lift import with_attrs
 from .arrays.strain import log_strain
 from ..contract.errors import ParameterError
 from .stress import stress_invariants
+from ._docs import fill_doc
 
 __all__ = ["time_derivative", "strains", "residual_window", "friction_and_dilatancy", "friction_offset",
            "inertia_number"]
@@ -68,6 +69,7 @@ def _log_strain(size, reference):
     return log_strain(size, size.isel(time=reference))
 
 
+@fill_doc
 def strains(ds: xr.Dataset, reference: int = 0) -> xr.Dataset:
     """eps_1, eps_2, eps_p, eps_q (dimensionless) of every snapshot.
 
@@ -81,8 +83,7 @@ def strains(ds: xr.Dataset, reference: int = 0) -> xr.Dataset:
 
     Parameters
     ----------
-    ds : xarray.Dataset
-        A dataset of the contract (docs/schema.md), eager or chunked along ``time``.
+    {ds}
     reference : int, default 0
         Index of the reference snapshot (h0, l0, V0) along ``time``.
 
@@ -111,6 +112,7 @@ def strains(ds: xr.Dataset, reference: int = 0) -> xr.Dataset:
     return out.drop_vars([c for c in out.coords if c != "time"])
 
 
+@fill_doc
 def residual_window(ds: xr.Dataset, start: float = RESIDUAL_STRAIN) -> xr.DataArray:
     """Boolean (time,): the snapshots of the residual state, eps_q >= ``start`` (computed).
 
@@ -119,8 +121,7 @@ def residual_window(ds: xr.Dataset, start: float = RESIDUAL_STRAIN) -> xr.DataAr
 
     Parameters
     ----------
-    ds : xarray.Dataset
-        A dataset of the contract (docs/schema.md), eager or chunked along ``time``.
+    {ds}
     start : float, default 0.3
         Shear strain eps_q (dimensionless, >= 0) from which the state is residual
         (:data:`RESIDUAL_STRAIN`).
@@ -148,6 +149,7 @@ def residual_window(ds: xr.Dataset, start: float = RESIDUAL_STRAIN) -> xr.DataAr
     return window.rename("residual").assign_attrs(long_name=f"residual state, eps_q >= {start:g}", units="1")
 
 
+@fill_doc
 def friction_and_dilatancy(ds: xr.Dataset, reference: int = 0) -> xr.Dataset:
     """Friction angle phi, cumulative and incremental dilatancy angles psi (rad).
 
@@ -160,8 +162,7 @@ def friction_and_dilatancy(ds: xr.Dataset, reference: int = 0) -> xr.Dataset:
 
     Parameters
     ----------
-    ds : xarray.Dataset
-        A dataset of the contract (docs/schema.md), eager or chunked along ``time``.
+    {ds}
     reference : int, default 0
         Index of the reference snapshot (h0, l0, V0) along ``time``.
 
@@ -227,6 +228,7 @@ psi = arcsin(eps_p/eps_q) divides two strains that both start from zero, so it s
 large values that say nothing about dilatancy."""
 
 
+@fill_doc
 def friction_offset(ds: xr.Dataset, min_strain: float = EARLY_STRAIN, incremental: bool = False) -> float:
     """phi_0 of the stress–dilatancy relation phi ~ phi_0 + psi, in rad: the median of phi - psi.
 
@@ -239,8 +241,7 @@ def friction_offset(ds: xr.Dataset, min_strain: float = EARLY_STRAIN, incrementa
 
     Parameters
     ----------
-    ds : xarray.Dataset
-        A dataset of the contract.
+    {ds_short}
     min_strain : float, default 0.02
         Snapshots with a smaller eps_q are left out (:data:`EARLY_STRAIN`).
     incremental : bool, default False

@@ -16,10 +16,12 @@ from ._lift import apply, with_attrs
 from .arrays import stress as _stress
 from .arrays.tensors import principal
 from .contacts import kind_code, selection
+from ._docs import fill_doc
 
 __all__ = ["stress_tensor", "stress_invariants", "stress_direction"]
 
 
+@fill_doc
 def stress_tensor(ds: xr.Dataset, kind="all", walls: bool = True) -> xr.DataArray:
     """Stress tensor sigma of every snapshot, in Pa.
 
@@ -37,11 +39,8 @@ def stress_tensor(ds: xr.Dataset, kind="all", walls: bool = True) -> xr.DataArra
 
     Parameters
     ----------
-    ds : xarray.Dataset
-        A dataset of the contract (docs/schema.md), eager or chunked along ``time``.
-    kind : {"all", "simple", "double"}, default "all"
-        The contacts used: all, simple (vertex–edge and disk contacts) or double (edge–edge)
-        ones (also 1, 2, "s", "d"; :func:`grainview.analysis.contacts.kind_code`).
+    {ds}
+    {kind}
     walls : bool, default True
         Include the particle–wall contacts; ``False`` leaves them out.
 
@@ -69,6 +68,7 @@ def _principal_parts(sigma: xr.DataArray):
     return apply(principal, sigma)
 
 
+@fill_doc
 def stress_invariants(ds: xr.Dataset, kind="all", walls: bool = True,
                       sigma: xr.DataArray | None = None) -> xr.Dataset:
     """p, q, q/p and theta_sigma of the stress tensor (paper Sec. III).
@@ -82,11 +82,8 @@ def stress_invariants(ds: xr.Dataset, kind="all", walls: bool = True,
 
     Parameters
     ----------
-    ds : xarray.Dataset
-        A dataset of the contract (docs/schema.md), eager or chunked along ``time``.
-    kind : {"all", "simple", "double"}, default "all"
-        The contacts used: all, simple (vertex–edge and disk contacts) or double (edge–edge)
-        ones (also 1, 2, "s", "d"; :func:`grainview.analysis.contacts.kind_code`).
+    {ds}
+    {kind}
     walls : bool, default True
         Include the particle–wall contacts; ``False`` leaves them out.
     sigma : xarray.DataArray, optional
@@ -124,6 +121,7 @@ def stress_invariants(ds: xr.Dataset, kind="all", walls: bool = True,
     })
 
 
+@fill_doc
 def stress_direction(ds: xr.Dataset, walls: bool = True) -> xr.DataArray:
     """Major principal stress direction theta_sigma (time,), rad.
 
@@ -132,8 +130,7 @@ def stress_direction(ds: xr.Dataset, walls: bool = True) -> xr.DataArray:
 
     Parameters
     ----------
-    ds : xarray.Dataset
-        A dataset of the contract (docs/schema.md), eager or chunked along ``time``.
+    {ds}
     walls : bool, default True
         Include the particle–wall contacts; ``False`` leaves them out.
 

@@ -19,6 +19,7 @@ from ..contract.errors import ParameterError
 from .sample import volume
 from .snapshots import select_snapshots
 from .stress import stress_invariants
+from ._docs import fill_doc
 
 __all__ = ["xi_network", "xi_profile"]
 
@@ -39,6 +40,7 @@ def _check_xi(xi):
     return values
 
 
+@fill_doc
 def xi_network(ds: xr.Dataset, xi=DEFAULT_XI, walls: bool = False, near=None) -> xr.Dataset:
     """q(xi)/p, a'(xi) and the contact fraction of the xi-networks (time, xi) (docs/conventions.md §5).
 
@@ -59,12 +61,10 @@ def xi_network(ds: xr.Dataset, xi=DEFAULT_XI, walls: bool = False, near=None) ->
 
     Parameters
     ----------
-    ds : xarray.Dataset
-        A dataset of the contract (docs/schema.md), eager or chunked along ``time``.
+    {ds}
     xi : array_like of float, default 0, 0.05, ..., 5
         Any 1-D sequence of cutoffs >= 0, multiples of <f_n> (dimensionless).
-    walls : bool, default False
-        Include the particle–wall contacts (default: particle–particle only).
+    {walls}
     near : float, optional
         Which pairs are contacts (:func:`grainview.analysis.contacts.in_network`): None (default) the
         force-bearing ones, f_n > 0; a gap threshold in m adds the pairs with gap <= ``near``
@@ -107,6 +107,7 @@ def xi_network(ds: xr.Dataset, xi=DEFAULT_XI, walls: bool = False, near=None) ->
     return out
 
 
+@fill_doc
 def xi_profile(ds: xr.Dataset, xi=None, time="residual", near=None) -> xr.Dataset:
     """q(xi)/p, a'(xi) and the contact fraction of the xi-network, averaged over the snapshots ``time``.
 
@@ -116,15 +117,10 @@ def xi_profile(ds: xr.Dataset, xi=None, time="residual", near=None) -> xr.Datase
 
     Parameters
     ----------
-    ds : xarray.Dataset
-        A dataset of the contract.
+    {ds_short}
     xi : array_like of float, optional
         The cutoffs xi >= 0, multiples of <f_n>.
-    time : str, int, slice or sequence of int, default "residual"
-        The snapshots averaged over (:func:`grainview.analysis.snapshots.select_snapshots`):
-        ``"residual"`` the residual state, eps_q >= 0.3 (for a run that stops short of it, the
-        last part of the run), ``"all"`` or None every snapshot, a snapshot index, a slice or a
-        sequence of indices.
+    {time_averaged}
     near : float, optional
         None: the force-bearing contacts (f_n > 0); a gap in m: also the pairs within it,
         which carry no force and so belong to every xi-network (the file must hold them;

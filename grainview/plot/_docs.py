@@ -1,18 +1,19 @@
-"""The docstring fragments the figure functions share, and the step that puts them in place.
+"""The docstring entries the figure functions share, and the step that puts them in place.
 
 Most figure functions take the same ``data``, ``ax``, ``label``, ``time``, ``walls``... and
-return the axes they drew on; the numpydoc entry of each is written once here, in
-:data:`FRAGMENTS`. A docstring names one by a line holding only ``{name}``, indented as the
-entry should be; :func:`fill_doc` (a decorator) replaces that line by the fragment, indented
-alike, when the module is imported, so ``help()``, IDEs and the documentation read the whole
-entry (as cf_xarray's ``_build_docstring`` does).
+return the axes they drew on; the numpydoc entry of each is written once: the analysis's
+(:data:`grainview.analysis._docs.FRAGMENTS`: ``ds``, ``walls``, ``kind``, ``near``...) and the
+figures' own here. A docstring names one by a line holding only ``{name}``, indented as the
+entry should be; :func:`fill_doc` puts the entry in place when the module is imported
+(:func:`grainview.analysis._docs.build_docstring`).
 """
 
 from __future__ import annotations
 
-import re
+from ..analysis import _docs as _analysis_docs
 
 FRAGMENTS = {
+    **_analysis_docs.FRAGMENTS,
     "data": """\
 data : xarray.Dataset, dict or list
     One dataset of the contract, or several to compare on the same axes as ``{label: ds}``
@@ -31,25 +32,9 @@ ax : matplotlib.axes.Axes, optional
 label : str, optional
     Legend label of a single dataset (None: no legend entry), so that successive calls on
     the same axes build a comparison.""",
-    "time_averaged": """\
-time : str, int, slice or sequence of int, default "residual"
-    The snapshots averaged over (:func:`grainview.analysis.snapshots.select_snapshots`):
-    ``"residual"`` the residual state, eps_q >= 0.3 (for a run that stops short of it, the
-    last part of the run), ``"all"`` or None every snapshot, a snapshot index, a slice or a
-    sequence of indices.""",
     "time_drawn": """\
 time : int, default -1
     Index of the snapshot drawn (negative counts from the end).""",
-    "bins": """\
-bins : int, default 36
-    Number of angular sectors of [0, pi), centred on theta_k = k pi/bins.""",
-    "kind": """\
-kind : {"all", "simple", "double"}, default "all"
-    The contacts used: all, simple (vertex–edge and disk contacts) or double (edge–edge)
-    ones (also 1, 2, "s", "d"; :func:`grainview.analysis.contacts.kind_code`).""",
-    "walls": """\
-walls : bool, default False
-    Include the particle–wall contacts (default: particle–particle only).""",
     "normalise": """\
 normalise : bool, default True
     Divide each snapshot's profile by its mean normal force <f_n> over the same contacts
@@ -80,30 +65,14 @@ matplotlib.axes.Axes
 matplotlib.figure.Figure
     The figure with panels (a) and (b).""",
 }
-"""Numpydoc entries by name, unindented (the description four spaces in)."""
-
-_PLACE = re.compile(r"^([ \t]*)\{(\w+)\}[ \t]*$", re.M)
+"""Numpydoc entries by name, unindented (the description four spaces in): the analysis's and
+the figures' own."""
 
 
 def build_docstring(doc: str | None) -> str | None:
-    """``doc`` with every line holding only ``{name}`` replaced by ``FRAGMENTS[name]``, each
-    line of the fragment indented as the placeholder was.
-
-    Raises
-    ------
-    KeyError
-        When a placeholder names no fragment (a typo must not reach the rendered help).
-    """
-    if doc is None:  # python -OO
-        return None
-
-    def fragment(match):
-        indent, name = match.groups()
-        if name not in FRAGMENTS:
-            raise KeyError(f"docstring fragment {{{name}}}: none of that name in grainview.plot._docs.FRAGMENTS")
-        return "\n".join(indent + line if line else line for line in FRAGMENTS[name].split("\n"))
-
-    return _PLACE.sub(fragment, doc)
+    """``doc`` with its ``{name}`` lines replaced by :data:`FRAGMENTS`
+    (:func:`grainview.analysis._docs.build_docstring`)."""
+    return _analysis_docs.build_docstring(doc, FRAGMENTS)
 
 
 def fill_doc(func):

@@ -37,6 +37,7 @@ the pentagon sample wherever samples are compared."""
 
 
 @fill_doc
+@fill_doc
 def plot_particles(data, ax=None, time: int = -1, facecolor=PARTICLE_FACE, edgecolor=PARTICLE_EDGE,
                    linewidth: float = 0.5, values=None, cmap=None, norm=None):
     """Draw the particles of snapshot ``time``: disks and regular polygons.
@@ -109,6 +110,7 @@ PARTICLE_FIELDS = {"c": "contacts c", "m_s": "simple contacts m_s", "m_d": "doub
 
 
 @fill_doc
+@fill_doc
 def plot_particle_map(data, field: str = "c", ax=None, time: int = -1, reference: int = 0, walls: bool = True,
                       cmap: str = "cividis"):
     """Particles of snapshot ``time`` coloured by a per-particle ``field``, with a colour bar.
@@ -172,6 +174,7 @@ def plot_particle_map(data, field: str = "c", ax=None, time: int = -1, reference
 
 
 @fill_doc
+@fill_doc
 def plot_connectivity_map(data, ax=None, time: int = -1, **options):
     """:func:`plot_particle_map` of the contacts c of each particle.
 
@@ -196,6 +199,7 @@ def plot_connectivity_map(data, ax=None, time: int = -1, **options):
 
 
 @fill_doc
+@fill_doc
 def plot_rattler_map(data, ax=None, time: int = -1, **options):
     """:func:`plot_particle_map` of the rattlers (particles without force-bearing contacts).
 
@@ -219,6 +223,7 @@ def plot_rattler_map(data, ax=None, time: int = -1, **options):
     return plot_particle_map(data, "rattler", ax=ax, time=time, **options)
 
 
+@fill_doc
 @fill_doc
 def plot_rotation_map(data, ax=None, time: int = -1, **options):
     """:func:`plot_particle_map` of each particle's rotation (rad) since the ``reference`` snapshot.
@@ -247,6 +252,7 @@ MAP_HEIGHT = 5.0
 """Height of a new map's figure, inches; its width follows the box's aspect."""
 
 
+@fill_doc
 def map_axes(ax, ds: xr.Dataset, k: int):
     """``ax`` itself, or new axes on a figure shaped like the box of snapshot ``k``.
 
@@ -258,8 +264,7 @@ def map_axes(ax, ds: xr.Dataset, k: int):
     ----------
     ax : matplotlib.axes.Axes or None
         Axes to draw on.
-    ds : xarray.Dataset
-        A dataset of the contract.
+    {ds_short}
     k : int
         The snapshot drawn.
 
@@ -289,6 +294,7 @@ def _frame(ax, ds, k):
     ax.set_ylabel(axis_label("$y$", ds["position"].attrs.get("units", "m")))
 
 
+@fill_doc
 def contact_segments(ds: xr.Dataset, k: int, mask) -> tuple[np.ndarray, np.ndarray]:
     """Segments from the centre of i along the branch vector of the contacts selected by ``mask``.
 
@@ -298,8 +304,7 @@ def contact_segments(ds: xr.Dataset, k: int, mask) -> tuple[np.ndarray, np.ndarr
 
     Parameters
     ----------
-    ds : xarray.Dataset
-        A dataset of the contract.
+    {ds_short}
     k : int
         Snapshot index.
     mask : array_like of bool
@@ -466,6 +471,7 @@ def contact_collection(ax) -> LineCollection:
 
 
 @fill_doc
+@fill_doc
 def plot_force_chains(data, ax=None, time: int = -1, walls: bool = False, max_linewidth: float = 3.0,
                       colour="k", particles: bool = True, force_scale=None):
     """Map of the normal forces of snapshot ``time`` (paper Fig. 13).
@@ -510,6 +516,7 @@ def plot_force_chains(data, ax=None, time: int = -1, walls: bool = False, max_li
     return ax
 
 
+@fill_doc
 @fill_doc
 def plot_force_classes(data, ax=None, time: int = -1, walls: bool = False, very_weak: float = 0.1,
                        strong: float = 1.0, width_by_force: bool = False, linewidth: float = 1.0,
@@ -565,6 +572,7 @@ def plot_force_classes(data, ax=None, time: int = -1, walls: bool = False, very_
     return ax
 
 
+@fill_doc
 @fill_doc
 def plot_contact_kinds(data, ax=None, time: int = -1, walls: bool = False, max_linewidth: float = 3.0,
                        particles: bool = True):

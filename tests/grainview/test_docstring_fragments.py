@@ -1,5 +1,5 @@
-"""The figures' shared docstring fragments (grainview/plot/_docs.py) render into whole numpydoc
-entries, indented as the placeholder was."""
+"""The shared docstring fragments (grainview/analysis/_docs.py, grainview/plot/_docs.py) render
+into whole numpydoc entries, indented as the placeholder was, in the functions and in ds.grain."""
 
 import pytest
 
@@ -64,3 +64,25 @@ def test_placeholders_take_their_indentation_and_only_whole_lines():
 def test_an_unknown_fragment_is_an_error():
     with pytest.raises(KeyError, match="docstring fragment {wals}"):
         build_docstring("Draws.\n\n    {wals}\n")
+
+
+def test_the_analysis_entries_render_in_the_function_and_in_the_accessor():
+    import xarray as xr
+
+    from grainview.analysis import _docs
+    from grainview.analysis.force_pdf import pooled_force_pdf
+
+    near = """
+    near : float, optional
+        Which pairs are contacts (:func:`grainview.analysis.contacts.in_network`): None (default) the
+        force-bearing ones, f_n > 0; a gap threshold in m adds the pairs with gap <= ``near``
+        (they carry f_n = 0); ``np.inf`` every pair the file holds.
+"""
+    ds = """
+    ds : xarray.Dataset
+        A dataset of the contract (docs/schema.md), eager or chunked along ``time``.
+"""
+    assert near in pooled_force_pdf.__doc__ and ds in pooled_force_pdf.__doc__
+    assert xr.Dataset.grain.pooled_force_pdf.__doc__ == pooled_force_pdf.__doc__
+    assert "{" + "near}" not in pooled_force_pdf.__doc__
+    assert set(_docs.FRAGMENTS) <= set(FRAGMENTS)  # the figures use the analysis's entries too
