@@ -444,20 +444,23 @@ class Simulation:
         return problem, ra, rb
 
     def _count_solve(self, result, n_points):
-        """Count the sweeps; warn (ConvergenceWarning) when the sweep cap or the stall test
-        stopped the NLGS before both norms were met. Returns whether it converged."""
+        """Count the sweeps (a solver's iterations); warn (ConvergenceWarning) when the iteration
+        cap or a stall test stopped the solver before both norms were met. Returns whether it
+        converged."""
         p = self.parameters
         self.counters["sweeps"] += result.iterations
         self.counters["point_sweeps"] += result.iterations * n_points
         converged = result.residual <= p.tolerance and result.max_residual <= p.max_tolerance
         if not converged:
-            stop = ("the sweep cap" if result.iterations >= p.max_iterations else
+            nlgs_stall = contact_solvers.method(p.solver).stall
+            stop = ("the iteration cap" if result.iterations >= p.max_iterations else
                     f"a stall (the best quadratic norm fell < {100 * nlgs.STALL_IMPROVEMENT:g}% over "
-                    f"{p.stall_sweeps} sweeps)")
-            warnings.warn(f"NLGS did not converge at step {self.step_index} (t = {self.time:.6g} s): stopped by "
-                          f"{stop} after {result.iterations} iterations, quadratic residual {result.residual:.3g} "
-                          f"(tolerance {p.tolerance:g}), max residual {result.max_residual:.3g} (tolerance "
-                          f"{p.max_tolerance:g})", ConvergenceWarning, stacklevel=3)
+                    f"{p.stall_sweeps} sweeps)" if nlgs_stall else "its own stall test")
+            warnings.warn(f"the contact solver ({p.solver}) did not converge at step {self.step_index} (t = "
+                          f"{self.time:.6g} s): stopped by {stop} after {result.iterations} iterations, residual "
+                          f"{result.residual:.3g} (tolerance {p.tolerance:g}), max residual "
+                          f"{result.max_residual:.3g} (tolerance {p.max_tolerance:g})", ConvergenceWarning,
+                          stacklevel=3)
         return converged
 
     def _end_velocities(self, vx, vy, om):

@@ -169,9 +169,12 @@ def test_a_run_with_the_projected_conjugate_gradient_reaches_the_residual_it_cla
         return infos[-1]
 
     sim.step = recorded
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore", ConvergenceWarning)
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always", ConvergenceWarning)
         isotropic_compaction(sim, max_steps=800, progress=False)
+    said = [str(w.message) for w in caught if issubclass(w.category, ConvergenceWarning)]
+    assert said and all(m.startswith("the contact solver (pcg) did not converge") for m in said)
+    assert any("stopped by its own stall test" in m for m in said)
     claimed = np.array([i.residual for i in infos])
     measured = np.array([i.local_law_residual for i in infos])
     converged = np.array([i.converged for i in infos])
