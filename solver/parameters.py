@@ -5,7 +5,8 @@ defaults, units, help texts and validators.
   solver's tolerances and caps...); defaults are the paper's (Azema et al. 2007, Sec. II.B);
 * :class:`BiaxialTest`: the biaxial test of a prepared sample (strain, top wall speed,
   snapshots);
-* :class:`solver.preparation.Preparation`: how a sample is made (its own module).
+* :class:`Preparation`: how a sample is made, and :data:`PRESETS`, the named ones
+  (:mod:`solver.preparation` says what each setting means and prepares samples).
 
 Each field is declared with :func:`setting`: its default, a one-line help, its unit, and the
 check of its value with what is expected of it. The records validate themselves from these
@@ -22,14 +23,16 @@ from __future__ import annotations
 
 import functools
 import inspect
-from dataclasses import MISSING, dataclass, field, fields
+from dataclasses import MISSING, asdict, dataclass, field, fields
 
 import numpy as np
 
 from grainview.contract.errors import ParameterError
+from grainview.contract.schema import MAX_STEP_INDEX
 
 from . import contact_solvers
 from .contact_solvers import ACCELERATIONS  # noqa: F401 (the former acceleration's values, read from the registry)
+from .shape_families import check_shape
 
 MAX_FRICTION = 10.0
 """Largest accepted friction coefficient: measured ones lie below ~1.5, and 10 already makes
@@ -86,6 +89,15 @@ def problems(record) -> list[tuple[str, object, str]]:
         if not ok:
             out.append((f.name, value, expected))
     return out
+
+
+def check_values(record_type, **values):
+    """Refuse, in one :class:`ParameterError` line, the ``values`` of fields of the dataclass
+    ``record_type`` that fail their own checks (:func:`setting`): for functions that take some
+    of a record's settings as arguments."""
+    bad = problems(record_type(**values))
+    if bad:
+        raise ParameterError("; ".join(refusal(*p) for p in bad))
 
 
 def refusal(name, value, expected) -> str:
@@ -273,3 +285,140 @@ class BiaxialTest:
         if bad:
             raise ParameterError("; ".join(refusal(*p) for p in bad))
         return self
+
+
+MAX_SEED = 2**31 - 1
+"""Largest seed: files store the seed as a 32-bit integer attribute (netCDF-3 has no wider one)."""
+MIN_TEST_STEPS = 10
+"""Fewest time steps a biaxial test may take to reach its strain (a test of fewer is no test)."""
+
+
+def _integer(value) -> bool:
+    return isinstance(value, (int, np.integer)) and not isinstance(value, bool)
+
+
+@dataclass(frozen=True)
+class Preparation:
+    """How a sample is prepared (see the module docstring); every default is the paper's or,
+    where the paper is silent, this project's historical default (:mod:`solver.preparation`
+    says what each means, names presets and prepares samples). Each field's help, unit and check
+    are its :func:`setting`; :meth:`validate` is the one validator."""
+
+    particles: int = setting(400, "particles per sample", check=lambda v: _integer(v) and v >= 2,
+                             expected="an integer >= 2")
+    shape: str | int = setting("pentagon", "a name of solver.shapes.SHAPES, a number of vertices, a family or "
+                               "a file (solver.shape_families.check_shape)")
+    seed: int = setting(0, "random seed of the deposit", check=lambda v: _integer(v) and 0 <= v <= MAX_SEED,
+                        expected=f"an integer in 0 .. {MAX_SEED} (files store it as a 32-bit integer)")
+    aspect: float = setting(2.0, "h/l of the sample box", check=lambda v: np.isfinite(v) and 0.2 <= v <= 20,
+                            expected="h/l in [0.2, 20]")
+    sigma0: float = setting(1e4, "confining stress", unit="Pa", check=positive, expected="a positive stress in Pa")
+    friction: float = setting(default_of(Parameters, "friction"), "grain-grain friction coefficient of the test",
+                              check=coulomb, expected=FRICTION_EXPECTED)
+    compaction_friction: float | None = setting(None, "grain friction during compaction (None: the test's)",
+                                                check=coulomb, expected=FRICTION_EXPECTED + " or None",
+                                                optional=True)
+    max_wall_speed: float = setting(0.05, "cap of the closing speed of the pushed walls", unit="m s-1",
+                                    check=lambda v: v > 0, expected="a positive speed in m s-1 (inf: no cap)")
+    max_inertia_number: float | None = setting(None, "cap of the inertia number I = (v/L) d sqrt(rho/sigma0) of "
+                                               "the closing walls (None: the walls close at up to max_wall_speed)",
+                                               check=positive, expected="a positive number or None", optional=True)
+    pressure_ramp: float = setting(0.0, "time over which sigma0 rises from 0 (0: applied at once)", unit="s",
+                                   check=lambda v: np.isfinite(v) and v >= 0, expected="a duration >= 0 in s")
+    max_steps: int = setting(40000, "compaction step limit", check=lambda v: _integer(v) and v >= 1,
+                             expected="an integer >= 1")
+
+    def validate(self):
+        """The preparation itself, checked: each field's own check, then the shape
+        (:func:`solver.shape_families.check_shape`); one :class:`ParameterError` naming every
+        bad value."""
+        bad = [refusal(*p) for p in problems(self)]
+        try:
+            check_shape(self.shape)
+        except ParameterError as exc:
+            bad.append(str(exc))
+        if bad:
+            raise ParameterError("invalid preparation: " + "; ".join(bad))
+        return self
+
+    def check_time_step(self, time_step, test_velocity=None):
+        """Refuse, before any work, a time step in which the closing walls of the compaction
+        (at most ``max_wall_speed``) or the top wall of the test (``test_velocity``, m s-1)
+        travel farther than the smallest particle radius of the paper's size mix
+        (:func:`check_time_step`)."""
+        from .packing import PAPER_DIAMETERS
+
+        smallest = 0.5 * min(PAPER_DIAMETERS)
+        check_time_step(time_step, self.max_wall_speed, smallest, "a closing wall of the compaction")
+        if test_velocity is not None:
+            check_time_step(time_step, test_velocity, smallest, "the top wall of the test")
+        return self
+
+    def test_steps(self, time_step, velocity, strain) -> float:
+        """About how many time steps the biaxial test takes to reach ``strain``: the top wall,
+        at ``velocity`` (m s-1), travels h (e^strain - 1) at ``time_step`` (s) per step, where
+        h is the deposit's height, aspect x :func:`solver.packing.box_width_for` (m): the
+        compacted sample is lower, so its test takes somewhat fewer steps."""
+        with np.errstate(over="ignore", divide="ignore"):
+            return float(self.deposit_height() * np.expm1(strain) / (float(velocity) * float(time_step)))
+
+    def deposit_height(self) -> float:
+        """The deposit's height in m: aspect x :func:`solver.packing.box_width_for`."""
+        from .packing import box_width_for
+
+        return self.aspect * box_width_for(self.particles, aspect_ratio=self.aspect)
+
+    def check_test_speed(self, time_step, velocity, strain):
+        """Refuse, before any work, a top-wall speed of the biaxial test that is not finite and
+        positive, with which the test would reach ``strain`` in fewer than
+        :data:`MIN_TEST_STEPS` steps, or would take more steps than a file's step counter
+        holds (:data:`MAX_STEP_INDEX`, less the compaction's :attr:`max_steps`); the count is
+        :meth:`test_steps`. Raises :class:`ParameterError` naming the speeds allowed (m s-1)."""
+        velocity = float(velocity)
+        if not (np.isfinite(velocity) and velocity > 0):
+            raise ParameterError(f"velocity={velocity:g}: expected a finite wall speed > 0 in m/s")
+        steps = self.test_steps(time_step, velocity, strain)
+        at_unit_speed = self.test_steps(time_step, 1.0, strain)  # steps x velocity
+        most = MAX_STEP_INDEX - self.max_steps
+        if steps < MIN_TEST_STEPS:
+            raise ParameterError(
+                f"velocity={velocity:g}: the test would reach eps_1 = {strain:g} in about {steps:.2g} steps of "
+                f"{time_step:g} s ({self.particles} particles deposited about {self.deposit_height():.2g} m high); "
+                f"expected at most {at_unit_speed / MIN_TEST_STEPS:.3g} m/s, for at least "
+                f"{MIN_TEST_STEPS} steps")
+        if steps > most:
+            raise ParameterError(
+                f"velocity={velocity:g}: the test would take about {steps:.3g} steps of {time_step:g} s to reach "
+                f"eps_1 = {strain:g}, more than a file's 32-bit step counter leaves for the test ({most} after the "
+                f"compaction's {self.max_steps}); expected at least {at_unit_speed / most:.3g} m/s")
+        return self
+
+    def attrs(self) -> dict:
+        """The preparation as file attributes ``preparation_<name>`` ("none" for None), and
+        ``preparation_name``, the preset it is (:func:`preset_name`)."""
+        return {**{f"preparation_{k}": ("none" if v is None else v) for k, v in asdict(self).items()},
+                "preparation_name": preset_name(self)}
+
+
+DEFAULT_PRESET = "paper"
+"""The preparation used when none is named."""
+
+PRESETS = {
+    DEFAULT_PRESET: Preparation(),
+    "frictionless": Preparation(compaction_friction=0.0),
+    "quasistatic": Preparation(max_inertia_number=2e-4, max_steps=200000),
+    "fast": Preparation(max_wall_speed=0.2),
+}
+"""Named preparations (docs/fidelity.md): ``paper`` compacts with the test's friction 0.4
+and walls closing at up to 5 cm/s (this project's default); ``frictionless`` compacts with
+friction 0 (then 0.4 for the test); ``quasistatic`` caps the closing walls at I = 2e-4
+(about 6 mm/s for 400 particles, ten times slower than ``paper``); ``fast`` as ``paper`` with
+the walls closing at up to 20 cm/s: half the NLGS sweeps of ``paper`` for the same solid
+fraction and coordination within the scatter between seeds (docs/solver.md, "Compaction")."""
+
+
+def preset_name(prep: Preparation) -> str:
+    """The first preset ``prep`` is (whatever its particles, shape and seed), or "custom"."""
+    def core(p):
+        return {k: v for k, v in asdict(p).items() if k not in ("particles", "shape", "seed")}
+    return next((name for name, preset in PRESETS.items() if core(preset) == core(prep)), "custom")

@@ -16,7 +16,7 @@ from .interrupt import interruptible, progress_bar, resume_instructions, stop_ex
 from .output import Recorder
 from .packing import PAPER_DIAMETERS, PAPER_FRACTIONS, box_width_for, deposit
 from .shape_families import regular_vertex_count, sample_shapes
-from .parameters import BiaxialTest, Parameters, check_time_step
+from .parameters import BiaxialTest, Parameters, Preparation, check_time_step, check_values
 from .stepper import Simulation
 from .walls import STRESS, Walls
 
@@ -39,8 +39,9 @@ def gravity_scene(position, angle, radius, n_vertices, *, gravity=9.81, tilt=0.0
     return Simulation(position, angle, radius, n_vertices, Walls.floor(sides=sides), params, shapes=shapes)
 
 
-def compaction_sample(n=400, shape="pentagon", *, sigma0=1e4, seed=0, diameters=PAPER_DIAMETERS,
-                      fractions=PAPER_FRACTIONS, aspect=2.0, wall_mass=None, max_wall_speed=0.05,
+def compaction_sample(n=Preparation.particles, shape=Preparation.shape, *, sigma0=Preparation.sigma0,
+                      seed=Preparation.seed, diameters=PAPER_DIAMETERS, fractions=PAPER_FRACTIONS,
+                      aspect=Preparation.aspect, wall_mass=None, max_wall_speed=Preparation.max_wall_speed,
                       **parameters) -> Simulation:
     """A deposited sample in its box, ready for isotropic compaction: bottom and left walls
     fixed, right and top walls pushed by ``sigma0`` (Pa), zero gravity. ``wall_mass``
@@ -50,8 +51,7 @@ def compaction_sample(n=400, shape="pentagon", *, sigma0=1e4, seed=0, diameters=
     deposit places the circumscribed disks of the size mix either way. ``parameters`` go to
     :class:`Parameters` (friction, wall_friction, time_step...: their defaults are its own);
     ``seed`` is also the NLGS's."""
-    if not (np.isfinite(sigma0) and sigma0 > 0):
-        raise ParameterError(f"sigma0={sigma0!r}: expected a positive stress in Pa")
+    check_values(Preparation, sigma0=sigma0)
     nv = regular_vertex_count(shape)
     width = box_width_for(n, diameters, fractions, aspect_ratio=aspect)
     position, angle, radius, n_vertices, height = deposit(n, diameters, fractions, nvert=nv, width=width, seed=seed)
@@ -96,9 +96,9 @@ def inertia_number_speed(inertia_number, size, mean_diameter, density, sigma0):
     return inertia_number * size / (mean_diameter * np.sqrt(density / sigma0))
 
 
-def isotropic_compaction(sim: Simulation, *, max_steps=40000, window=200, stress_tolerance=0.01,
-                         strain_rate_tolerance=1e-3, max_inertia_number=None, pressure_ramp=0.0,
-                         progress=None):
+def isotropic_compaction(sim: Simulation, *, max_steps=Preparation.max_steps, window=200, stress_tolerance=0.01,
+                         strain_rate_tolerance=1e-3, max_inertia_number=Preparation.max_inertia_number,
+                         pressure_ramp=Preparation.pressure_ramp, progress=None):
     """Step ``sim`` until the last ``window`` steps are at equilibrium (:func:`is_equilibrium`)
     or for ``max_steps``. Returns the number of steps taken and records in ``sim.history``
     (:class:`solver.sample_history.SampleHistory`) ``settled`` (False when ``max_steps`` ran
@@ -116,10 +116,7 @@ def isotropic_compaction(sim: Simulation, *, max_steps=40000, window=200, stress
     """
     from collections import deque
 
-    if max_inertia_number is not None and not (np.isfinite(max_inertia_number) and max_inertia_number > 0):
-        raise ParameterError(f"max_inertia_number={max_inertia_number!r}: expected a positive number (or None)")
-    if not (np.isfinite(pressure_ramp) and pressure_ramp >= 0):
-        raise ParameterError(f"pressure_ramp={pressure_ramp!r}: expected a duration >= 0 in s")
+    check_values(Preparation, max_inertia_number=max_inertia_number, pressure_ramp=pressure_ramp)
     sigma0 = sim.history.sigma0
     h = sim.parameters.time_step
     driven = np.flatnonzero(sim.walls.mode == STRESS)
@@ -171,7 +168,8 @@ def biaxial_test(sim: Simulation, path, *, strain=BiaxialTest.strain, velocity=B
     """Biaxial compression of a compacted sample, written to ``path`` every ``every`` steps.
 
     The top wall moves down at ``velocity`` (m s-1) until eps_1 = ln(1 + dh/h0) reaches
-    ``strain`` (defaults and checks: :class:`solver.parameters.BiaxialTest`); the right wall keeps the confining stress sigma0; bottom and left are fixed.
+    ``strain`` (defaults and checks: :class:`solver.parameters.BiaxialTest`); the right wall
+    keeps the confining stress sigma0; bottom and left are fixed.
     The snapshot at the start of the test is written first. Ctrl-C stops after the current
     step, with every written snapshot kept. ``near_contacts``: also write the pairs within the
     alert distance that carry no force (:class:`solver.output.Recorder`). The file records the
