@@ -13,9 +13,6 @@ from pathlib import Path
 
 from .contract.errors import ConvergenceWarning, GrainviewError, SchemaError
 
-RESIDUAL_STRAIN = 0.3
-"""Default start of the residual window (eps_q); the same as grainview.analysis.strain.RESIDUAL_STRAIN,
-repeated here so that ``--help`` does not import xarray."""
 S1S2_HELP = ("s1s2: the paper's two initial states, each shape compacted its own way: pentagons with "
              "friction 0.4 as 'paper' (the paper's S1, solid fraction 0.80), disks compacted frictionless (S2, the "
              "denser 0.82); both tested with friction 0.4; docs/fidelity.md")
@@ -300,15 +297,31 @@ def setting_option(parser, record, name, *, more="", flag=None, **overrides):
     parser.add_argument(flag or _flag(name), **options)
 
 
+def _module_tree(module):
+    """The parsed source of grainview's ``module`` (nothing imported)."""
+    import ast
+
+    path = Path(__file__).parent.joinpath(*module.split(".")[1:]).with_suffix(".py")
+    return ast.parse(path.read_text(encoding="utf-8"))
+
+
+def library_constant(module, name):
+    """The value of the constant ``name`` of grainview's ``module``, read from its source, so
+    that ``--help`` loads no xarray."""
+    import ast
+
+    node = next(n for n in _module_tree(module).body if isinstance(n, ast.Assign)
+                and any(isinstance(t, ast.Name) and t.id == name for t in n.targets))
+    return ast.literal_eval(node.value)
+
+
 def library_default(module, function, parameter):
     """The default of ``parameter`` of grainview's ``module.function``, read from the module's
     source (its signature, parsed; nothing imported), so that an option's default is the
     function's and ``--help`` loads no xarray."""
     import ast
 
-    path = Path(__file__).parent.joinpath(*module.split(".")[1:]).with_suffix(".py")
-    tree = ast.parse(path.read_text(encoding="utf-8"))
-    node = next(n for n in ast.walk(tree) if isinstance(n, ast.FunctionDef) and n.name == function)
+    node = next(n for n in ast.walk(_module_tree(module)) if isinstance(n, ast.FunctionDef) and n.name == function)
     args = node.args
     positional = args.posonlyargs + args.args
     pairs = list(zip(positional[len(positional) - len(args.defaults):], args.defaults))
@@ -549,7 +562,7 @@ def _split(text, kind, name):
 
 
 def _ensemble(args) -> int:
-    from solver.ensemble import describe_result, grid, run_ensemble
+    from solver.ensemble import grid, run_ensemble
 
     if args.seeds < 1:
         raise GrainviewError(f"--seeds {args.seeds}: expected at least 1 seed")
@@ -637,8 +650,9 @@ def _no_compress_option(p):
 
 
 def _residual_option(p):
-    p.add_argument("--residual-strain", type=float, default=RESIDUAL_STRAIN,
-                   help=f"the residual state starts at this shear strain eps_q (default {RESIDUAL_STRAIN}); "
+    residual = library_constant("grainview.analysis.strain", "RESIDUAL_STRAIN")
+    p.add_argument("--residual-strain", type=float, default=residual,
+                   help=f"the residual state starts at this shear strain eps_q (default {residual}); "
                    "a run short of it reports 'not reached'")
 
 

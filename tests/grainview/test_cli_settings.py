@@ -86,6 +86,10 @@ def test_options_of_other_functions_take_those_functions_defaults():
         == inspect.signature(convert_pegs).parameters["density_kg_m3"].default
     assert cli.library_default("grainview.analysis.synthetic", "harmonic_series", "seed") \
         == inspect.signature(harmonic_series).parameters["seed"].default
+    from grainview.analysis.strain import RESIDUAL_STRAIN
+
+    assert cli.library_constant("grainview.analysis.strain", "RESIDUAL_STRAIN") == RESIDUAL_STRAIN
+    assert build_parser().parse_args(["report", "x.nc"]).residual_strain == RESIDUAL_STRAIN
     pegs = build_parser().parse_args(["convert", "pegs", "a.txt", "--positions", "p.txt", "--metres-per-pixel", "1",
                                       "--force-unit-n", "1", "--out", "x.nc"])
     assert (pegs.frame_interval, pegs.thickness, pegs.density) == tuple(
