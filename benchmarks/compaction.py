@@ -118,7 +118,7 @@ def compact(shape: str, particles: int, seed: int, route: str, acceleration: str
             steps += isotropic_compaction(sim, max_steps=prep.max_steps, progress=False)
     seconds, cpu = time.perf_counter() - start, time.process_time() - cpu
     del sim.step  # the class's step again: the counting wrapper is not part of the sample
-    sim.compaction_steps = int(steps)
+    sim.history.compaction_steps = int(steps)
     if save:
         save_sample(save, sim, seconds)
     contacts = pair_contacts(sim, None, 10**6)

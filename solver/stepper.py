@@ -579,10 +579,11 @@ class Simulation:
 
 
 def _history_alias(name):
-    """``sim.<name>``: the same as ``sim.history.<name>`` (:class:`SampleHistory`), for the
-    scripts that read the sample's history from the simulation."""
-    return property(lambda self: getattr(self.history, name), lambda self, value: setattr(self.history, name, value),
-                    doc=f"``history.{name}`` (:class:`solver.sample_history.SampleHistory`).")
+    """``sim.<name>``: ``sim.history.<name>`` (:class:`SampleHistory`), read-only, for the scripts
+    that read the sample's history from the simulation; the history is written in
+    ``sim.history`` alone."""
+    return property(lambda self: getattr(self.history, name),
+                    doc=f"``history.{name}`` (:class:`solver.sample_history.SampleHistory`), read-only.")
 
 
 for _name in ("sigma0", "settled", "compaction_steps", "compaction_stress", "compaction_inertia_number",

@@ -36,8 +36,8 @@ def main(argv=None):
     from grainview.contract.errors import ConvergenceWarning
 
     sim = solver.load_sample(args.sample)
-    if not math.isfinite(sim.sigma0):  # samples written before isotropic files recorded sigma0_Pa
-        sim.sigma0 = float(sim.walls.stress[sim.walls.index("right")])
+    if not math.isfinite(sim.history.sigma0):  # samples written before isotropic files recorded sigma0_Pa
+        sim.history.sigma0 = float(sim.walls.stress[sim.walls.index("right")])
     start = time.perf_counter()
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")

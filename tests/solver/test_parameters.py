@@ -138,5 +138,8 @@ def test_a_sample_no_preparation_made_has_an_empty_history():
 
     sim = compaction_sample(6, "disk", sigma0=2e4)
     assert sim.history.sigma0 == 2e4 and sim.history.attrs() == {} and sim.history.settled is None
+    with pytest.raises(AttributeError):  # the history is written in one place, sim.history
+        sim.sigma0 = 1e3
+    assert sim.sigma0 == 2e4
     assert SampleHistory.from_attrs({"title": "x"}).attrs() == {}
     assert np.isnan(SampleHistory.from_attrs({}).sigma0)
