@@ -131,8 +131,11 @@ class ContactPoints(NamedTuple):
 
 
 # ----------------------------------------------------------------------------------------
-# the records the kernels pass: one per concept, each a named tuple of arrays (numba reads a
-# field as it reads a loose argument)
+# the records the kernels pass: one per concept, each a named tuple of arrays. A kernel that
+# calls another (not inlined) one takes a reference to every array of the records it receives,
+# on entry, and drops them at each return (atomic counts that LLVM keeps): the per-pair kernels
+# therefore receive only what they read (Outlines, Slots), the bookkeeping stays in Tally, and
+# _best_edge is inlined so that _polygon_polygon calls nothing and keeps no counts.
 # ----------------------------------------------------------------------------------------
 
 class PlacedShapes(NamedTuple):
@@ -204,23 +207,42 @@ class Candidates(NamedTuple):
     ww: np.ndarray
 
 
-class Slots(NamedTuple):
-    """Scratch of :func:`_detect_kernel`: one slot per candidate c (M + K of them), written
-    only by c in pass 1 and read in pass 2; the normal points from the first body to the second.
+class Alerts(NamedTuple):
+    """The distances of :func:`detect`, m.
 
-    count : int64 (M + K,) — the points kept of c: 1 or 2, 0 when its nearest gap exceeds alert.
-    normal : float64 (M + K, 2) — unit normal of c.
+    alert : float — a contact is kept when its nearest point's gap is <= alert (>= 0).
+    double_alert : float — the tolerance of the double-contact criterion (module doc, >= 0).
+    """
+
+    alert: float
+    double_alert: float
+
+
+class Slots(NamedTuple):
+    """Scratch of :func:`_detect_kernel`, what the geometry of a pair writes: one slot per
+    candidate c (M + K of them), written only by c in pass 1 and read in pass 2.
+
+    normal : float64 (M + K, 2) — unit normal of c, from its first body to its second.
     point : float64 (M + K, 2, 2) — its one or two points, m.
     gap : float64 (M + K, 2) — their gaps, m (negative = interpenetration).
+    """
+
+    normal: np.ndarray
+    point: np.ndarray
+    gap: np.ndarray
+
+
+class Tally(NamedTuple):
+    """Scratch of :func:`_detect_kernel`, which slots are kept and where their points go
+    (M + K candidates).
+
+    count : int64 (M + K,) — the points kept of c: 1 or 2, 0 when its nearest gap exceeds alert.
     kind : int8 (M + K,) — KIND_SIMPLE or KIND_DOUBLE.
     offsets : int64 (M + K + 1,) — the output row of c's first point (prefix sum of count).
     pair_offsets : int64 (M + K + 1,) — the contact index of c (prefix sum of count > 0).
     """
 
     count: np.ndarray
-    normal: np.ndarray
-    point: np.ndarray
-    gap: np.ndarray
     kind: np.ndarray
     offsets: np.ndarray
     pair_offsets: np.ndarray
@@ -234,12 +256,14 @@ class Slots(NamedTuple):
 @njit(cache=True)
 def _disk_disk(a, b, bodies, c, slots):
     """Contact of disks a and b (module doc); normal from a to b."""
-    xa = bodies.pos[a, 0]
-    ya = bodies.pos[a, 1]
-    ra = bodies.radius[a]
-    xb = bodies.pos[b, 0]
-    yb = bodies.pos[b, 1]
-    rb = bodies.radius[b]
+    pos = bodies.pos
+    radius = bodies.radius
+    xa = pos[a, 0]
+    ya = pos[a, 1]
+    ra = radius[a]
+    xb = pos[b, 0]
+    yb = pos[b, 1]
+    rb = radius[b]
     normal = slots.normal
     point = slots.point
     gap = slots.gap
@@ -264,13 +288,16 @@ def _disk_disk(a, b, bodies, c, slots):
 @njit(cache=True)
 def _disk_wall(p, w, bodies, walls, c, slots):
     """Contact of disk p with wall w (module doc); normal from the disk to the wall."""
-    x = bodies.pos[p, 0]
-    y = bodies.pos[p, 1]
+    pos = bodies.pos
+    wall_point = walls.point
+    wall_normal = walls.normal
+    x = pos[p, 0]
+    y = pos[p, 1]
     r = bodies.radius[p]
-    px = walls.point[w, 0]
-    py = walls.point[w, 1]
-    wnx = walls.normal[w, 0]
-    wny = walls.normal[w, 1]
+    px = wall_point[w, 0]
+    py = wall_point[w, 1]
+    wnx = wall_normal[w, 0]
+    wny = wall_normal[w, 1]
     normal = slots.normal
     point = slots.point
     gap = slots.gap
@@ -335,7 +362,7 @@ def _polygon_geometry(placed, chunks=1):
     return Outlines(placed.pos, placed.radius, nvert, verts, norms)
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _best_edge(p, q, bodies):
     """Separating-axis search over the edges of polygon p: returns (s, e, k) with
     s = max_e min_k (v_q,k - v_p,e) . n_p,e, e the maximising edge, k the vertex of q
@@ -543,10 +570,12 @@ def _polygon_wall(p, w, bodies, walls, double_alert, c, slots):
     verts = bodies.verts
     nvert = bodies.nvert
     radius = bodies.radius
-    px = walls.point[w, 0]
-    py = walls.point[w, 1]
-    wnx = walls.normal[w, 0]
-    wny = walls.normal[w, 1]
+    wall_point = walls.point
+    wall_normal = walls.normal
+    px = wall_point[w, 0]
+    py = wall_point[w, 1]
+    wnx = wall_normal[w, 0]
+    wny = wall_normal[w, 1]
     normal = slots.normal
     point = slots.point
     gap = slots.gap
@@ -599,8 +628,9 @@ def _polygon_wall(p, w, bodies, walls, double_alert, c, slots):
 @njit(cache=True)
 def _pair_points(a, b, bodies, double_alert, c, slots):
     """Contact points between particles a < b, normal from a to b. Returns the count (1 or 2)."""
-    na = bodies.nvert[a]
-    nb = bodies.nvert[b]
+    nvert = bodies.nvert
+    na = nvert[a]
+    nb = nvert[b]
     if na == 0 and nb == 0:
         return _disk_disk(a, b, bodies, c, slots)
     if na == 0:
@@ -611,20 +641,22 @@ def _pair_points(a, b, bodies, double_alert, c, slots):
 
 
 @njit(cache=True)
-def _candidate_block(lo, hi, bodies, walls, candidates, alert, double_alert, slots):
+def _candidate_block(lo, hi, bodies, walls, candidates, alerts, slots, tally):
     """Pass 1 for candidates lo..hi-1: up to two points of candidate c into its own slot
-    (slots.normal[c], .point[c], .gap[c], .kind[c]) and slots.count[c] = their number if the
-    nearest is within ``alert``, else 0."""
+    (slots.normal[c], .point[c], .gap[c]), tally.kind[c] and tally.count[c] = their number if
+    the nearest is within ``alerts.alert``, else 0."""
+    alert = alerts.alert
+    double_alert = alerts.double_alert
     pi = candidates.pi
     pj = candidates.pj
     wp = candidates.wp
     ww = candidates.ww
     m_pairs = pi.shape[0]
     nvert = bodies.nvert
-    count = slots.count
+    count = tally.count
     normal = slots.normal
     gap = slots.gap
-    kind = slots.kind
+    kind = tally.kind
     for c in range(lo, hi):
         if c < m_pairs:
             i = pi[c]
@@ -651,21 +683,21 @@ def _candidate_block(lo, hi, bodies, walls, candidates, alert, double_alert, slo
 
 
 @njit(cache=True)
-def _compact_block(lo, hi, n_particles, candidates, slots, out):
+def _compact_block(lo, hi, n_particles, candidates, slots, tally, out):
     """Pass 2 for candidates lo..hi-1: the kept points of candidate c to rows
-    slots.offsets[c]... of ``out`` (:class:`ContactPoints`), wall w as body n_particles + w."""
+    tally.offsets[c]... of ``out`` (:class:`ContactPoints`), wall w as body n_particles + w."""
     pi = candidates.pi
     pj = candidates.pj
     wp = candidates.wp
     ww = candidates.ww
     m_pairs = pi.shape[0]
-    count = slots.count
-    offsets = slots.offsets
-    pair_offsets = slots.pair_offsets
+    count = tally.count
+    offsets = tally.offsets
+    pair_offsets = tally.pair_offsets
     normal = slots.normal
     point = slots.point
     gap = slots.gap
-    kind = slots.kind
+    kind = tally.kind
     o_i = out.body_i
     o_j = out.body_j
     o_normal = out.normal
@@ -694,24 +726,23 @@ def _compact_block(lo, hi, n_particles, candidates, slots, out):
 
 
 @njit(cache=True, parallel=True)
-def _candidate_blocks(chunks, bodies, walls, candidates, alert, double_alert, slots):
+def _candidate_blocks(chunks, bodies, walls, candidates, alerts, slots, tally):
     """:func:`_candidate_block` over ``chunks`` consecutive blocks of candidates at once (a thread each)."""
-    m = slots.count.size
+    m = tally.count.size
     for d in prange(chunks):
-        _candidate_block(m * d // chunks, m * (d + 1) // chunks, bodies, walls, candidates, alert, double_alert,
-                         slots)
+        _candidate_block(m * d // chunks, m * (d + 1) // chunks, bodies, walls, candidates, alerts, slots, tally)
 
 
 @njit(cache=True, parallel=True)
-def _compact_blocks(chunks, n_particles, candidates, slots, out):
+def _compact_blocks(chunks, n_particles, candidates, slots, tally, out):
     """:func:`_compact_block` over ``chunks`` consecutive blocks of candidates at once (a thread each)."""
-    m = slots.count.size
+    m = tally.count.size
     for d in prange(chunks):
-        _compact_block(m * d // chunks, m * (d + 1) // chunks, n_particles, candidates, slots, out)
+        _compact_block(m * d // chunks, m * (d + 1) // chunks, n_particles, candidates, slots, tally, out)
 
 
 @njit(cache=True)
-def _detect_kernel(placed, walls, candidates, alert, double_alert, chunks):
+def _detect_kernel(placed, walls, candidates, alerts, chunks):
     """Pass 1: up to two points per candidate into fixed slots (each candidate writes only its
     own slot); pass 2: compaction of the kept ones at prefix-sum offsets. With ``chunks`` > 1
     both passes split the candidates into that many consecutive blocks done at once (a thread
@@ -720,20 +751,19 @@ def _detect_kernel(placed, walls, candidates, alert, double_alert, chunks):
     the parallel functions (numba would make each one a parallel region).
 
     ``placed`` : :class:`PlacedShapes`; ``walls`` : :class:`WallLines`; ``candidates`` :
-    :class:`Candidates`; ``alert``, ``double_alert`` : m (:func:`detect`). Returns the
-    :class:`ContactPoints`."""
+    :class:`Candidates`; ``alerts`` : :class:`Alerts`. Returns the :class:`ContactPoints`."""
     n_particles = placed.pos.shape[0]
     m = candidates.pi.shape[0] + candidates.wp.shape[0]
-    slots = Slots(np.zeros(m, np.int64), np.empty((m, 2)), np.empty((m, 2, 2)), np.empty((m, 2)),
-                  np.empty(m, np.int8), np.zeros(m + 1, np.int64), np.zeros(m + 1, np.int64))
+    slots = Slots(np.empty((m, 2)), np.empty((m, 2, 2)), np.empty((m, 2)))
+    tally = Tally(np.zeros(m, np.int64), np.empty(m, np.int8), np.zeros(m + 1, np.int64), np.zeros(m + 1, np.int64))
     bodies = _polygon_geometry(placed, chunks)
     if chunks == 1:
-        _candidate_block(0, m, bodies, walls, candidates, alert, double_alert, slots)
+        _candidate_block(0, m, bodies, walls, candidates, alerts, slots, tally)
     else:
-        _candidate_blocks(chunks, bodies, walls, candidates, alert, double_alert, slots)
-    count = slots.count
-    offsets = slots.offsets
-    pair_offsets = slots.pair_offsets
+        _candidate_blocks(chunks, bodies, walls, candidates, alerts, slots, tally)
+    count = tally.count
+    offsets = tally.offsets
+    pair_offsets = tally.pair_offsets
     for c in range(m):
         offsets[c + 1] = offsets[c] + count[c]
         pair_offsets[c + 1] = pair_offsets[c] + (1 if count[c] > 0 else 0)
@@ -742,9 +772,9 @@ def _detect_kernel(placed, walls, candidates, alert, double_alert, chunks):
                         np.empty((total, 2)), np.empty(total), np.empty(total, np.int8), np.empty(total, np.int32),
                         pair_offsets[m])
     if chunks == 1:
-        _compact_block(0, m, n_particles, candidates, slots, out)
+        _compact_block(0, m, n_particles, candidates, slots, tally, out)
     else:
-        _compact_blocks(chunks, n_particles, candidates, slots, out)
+        _compact_blocks(chunks, n_particles, candidates, slots, tally, out)
     return out
 
 
@@ -812,5 +842,5 @@ def detect(pos, angle, shapes, wall_point, wall_normal, alert, pi, pj, wp, ww, d
         raise ParameterError(f"threads={threads!r}: expected an integer >= 1")
     placed = PlacedShapes(pos, angle, shapes.radius, shapes.n_vertices, shapes.first_vertex, shapes.vertex_radius,
                           shapes.vertex_angle, shapes.normal_angle)
-    return _detect_kernel(placed, WallLines(wall_point, wall_normal), Candidates(pi, pj, wp, ww), alert,
-                          double_alert, int(threads))
+    return _detect_kernel(placed, WallLines(wall_point, wall_normal), Candidates(pi, pj, wp, ww),
+                          Alerts(alert, double_alert), int(threads))
