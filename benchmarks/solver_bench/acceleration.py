@@ -23,11 +23,11 @@ from .config import Config
 from .helpers import dense_sample, fmt, reset_meters, run_steps, start_biaxial
 
 CANDIDATES = (
-    ("NLGS", dict(acceleration="off")),
-    ("NLGS, random order each sweep", dict(acceleration="off", shuffle=True)),
-    ("Anderson, m = 3", dict(acceleration="anderson", anderson_memory=3)),
-    ("Anderson, m = 5", dict(acceleration="anderson", anderson_memory=5)),
-    ("Anderson, m = 8", dict(acceleration="anderson", anderson_memory=8)),
+    ("NLGS", dict(solver="nlgs")),
+    ("NLGS, random order each sweep", dict(solver="nlgs", shuffle=True)),
+    ("Anderson, m = 3", dict(solver="anderson", anderson_memory=3)),
+    ("Anderson, m = 5", dict(solver="anderson", anderson_memory=5)),
+    ("Anderson, m = 8", dict(solver="anderson", anderson_memory=8)),
 )
 
 

@@ -29,7 +29,7 @@ from .helpers import dense_sample, reset_meters, run_steps, start_biaxial
 
 SAMPLES = os.path.join(DATA, "samples")
 """The cached dense samples, ``<shape>_<N>_fast.pkl`` (benchmarks/compaction.py ``--save``)."""
-SHEAR = dict(acceleration="anderson", anderson_period=2, stall_sweeps=200)
+SHEAR = dict(solver="anderson", anderson_period=2, stall_sweeps=200)
 """How the shear benchmarks solve (``benchmarks.shear.shear``), so the rows compare with them."""
 
 
