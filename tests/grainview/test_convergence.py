@@ -13,6 +13,7 @@ import grainview
 from grainview.cli import _simulate
 from grainview.app.convergence import unconverged_in_file, unconverged_text
 from grainview.app.report import convergence_notes, convergence_text
+from solver.parameters import BiaxialTest
 from solver.preparation import preparation
 
 ATTRS = {"solver_tolerance": 1.7e-4, "solver_max_tolerance": 1e-2, "solver_max_iterations": 2000,
@@ -69,8 +70,8 @@ def test_the_run_command_warns_with_the_counts_its_file_and_report_hold(tmp_path
     report's text states the same numbers."""
     path = tmp_path / "run.nc"
     prep = preparation("paper", particles=30, shape="pentagon", seed=0)
-    _simulate(prep, path, strain=0.004, every=10, velocity=0.01, near_contacts=False, overwrite=False,
-              progress=False, parameters={"max_iterations": 10})
+    _simulate(prep, path, test=BiaxialTest(strain=0.004, every=10, velocity=0.01), near_contacts=False,
+              overwrite=False, progress=False, parameters={"max_iterations": 10})
     err = capsys.readouterr().err
     total, compaction, compaction_steps, test, test_steps = map(int, re.search(
         r"did not converge in (\d+) step\(s\) \((\d+) of the compaction's (\d+), (\d+) of the test's (\d+)\)",
