@@ -3,6 +3,14 @@
 
 Errors a user can cause are printed as one line (``grainview: error: ...``) with exit code 2,
 never as a traceback.
+
+The simulation's options (``run``, ``study``, ``ensemble``) are the fields of the settings
+records of :mod:`solver.parameters` (``Parameters``, ``Preparation``, ``BiaxialTest``): each
+option's flag, type, choices, default and help come from its field (:func:`setting_option`),
+and its value is checked by the record's validator. The command line holds no default of its
+own for them; options of other functions take those functions' defaults
+(:func:`library_default`). The simulation itself goes through an engine of
+:mod:`solver.engine` (``--engine``), so another engine needs no edit here.
 """
 
 from __future__ import annotations
