@@ -143,3 +143,27 @@ def test_a_sample_no_preparation_made_has_an_empty_history():
     assert sim.sigma0 == 2e4
     assert SampleHistory.from_attrs({"title": "x"}).attrs() == {}
     assert np.isnan(SampleHistory.from_attrs({}).sigma0)
+
+
+def test_the_scenes_take_their_defaults_from_the_records():
+    import inspect
+
+    from solver.ensemble import RunSpec
+    from solver.scenes import biaxial_test, compaction_sample, isotropic_compaction
+
+    def defaults(func):
+        return {k: p.default for k, p in inspect.signature(func).parameters.items()}
+
+    sample, compaction, test = defaults(compaction_sample), defaults(isotropic_compaction), defaults(biaxial_test)
+    prep = Preparation()
+    assert (sample["n"], sample["shape"], sample["sigma0"], sample["seed"], sample["aspect"],
+            sample["max_wall_speed"]) == (prep.particles, prep.shape, prep.sigma0, prep.seed, prep.aspect,
+                                          prep.max_wall_speed)
+    assert "friction" not in sample and "time_step" not in sample  # Parameters' own, through **parameters
+    assert (compaction["max_steps"], compaction["max_inertia_number"], compaction["pressure_ramp"]) == (
+        prep.max_steps, prep.max_inertia_number, prep.pressure_ramp)
+    assert (test["strain"], test["velocity"], test["every"]) == (BiaxialTest.strain, BiaxialTest.velocity,
+                                                                 BiaxialTest.every)
+    spec = RunSpec()
+    assert (spec.shape, spec.particles, spec.seed) == (prep.shape, prep.particles, prep.seed)
+    assert spec.test() == BiaxialTest()
