@@ -1,23 +1,20 @@
 """solver.problem_assembly: the one-pass kernel against the whole-array numpy reference, bit for
 bit, and one point's lever arms, shift and friction by hand."""
 
-from typing import NamedTuple
-
 import numpy as np
 import pytest
 
+from solver.narrowphase import ContactPoints
 from solver.problem_assembly import assemble, assemble_reference, end_gaps
 from solver.solve_records import ContactProblem, StepLaw, StepStart
 
 
-class Points(NamedTuple):
-    """What the kernels read of :class:`solver.narrowphase.ContactPoints`."""
-
-    point: np.ndarray
-    normal: np.ndarray
-    gap: np.ndarray
-    body_i: np.ndarray
-    body_j: np.ndarray
+def Points(point, normal, gap, body_i, body_j):
+    """Contact points as the narrow phase returns them (the kernel's cache holds the types it was
+    called with: a record type of the tests' own would be looked up by every later run)."""
+    m = len(gap)
+    return ContactPoints(np.asarray(body_i, np.int32), np.asarray(body_j, np.int32), normal, point, gap,
+                         np.ones(m, np.int8), np.arange(m, dtype=np.int32), m)
 
 
 def _random_points(seed, n=30, walls=4, m=200):
