@@ -146,15 +146,16 @@ def anatomy(case: dict, bounds, n_particles: int, sweeps: int = 400, drift_from:
     (module docstring, items 1-3), and the quadratic norm and local-law residual after sweeps
     20, ``drift_from`` and ``sweeps``."""
     from solver import nlgs, residuals
+    from solver.solve_records import Impulses, Velocities
 
     P = case["problem"]
     m = P.a.size
     pn, pt = case["pn"].copy(), case["pt"].copy()
     vx, vy, w = case["vx"].copy(), case["vy"].copy(), case["w"].copy()
-    wnn, wnt, wtt = nlgs.delassus(P.a, P.b, P.nx, P.ny, P.rax, P.ray, P.rbx, P.rby, P.minv_xx, P.minv_xy,
-                                  P.minv_yy, P.iinv)
-    nlgs.velocities_from_impulses(P.a, P.b, P.nx, P.ny, P.rax, P.ray, P.rbx, P.rby, pn, pt, vx, vy, w,
-                                  P.minv_xx, P.minv_xy, P.minv_yy, P.iinv)
+    impulses, velocities = Impulses(pn, pt), Velocities(vx, vy, w)
+    blocks = nlgs.delassus(P)
+    wnn, wnt, wtt = blocks
+    nlgs.velocities_from_impulses(P, impulses, velocities)
     lo, hi = bounds
     pos = case["position"]
     on_a = P.a < n_particles
@@ -170,8 +171,7 @@ def anatomy(case: dict, bounds, n_particles: int, sweeps: int = 400, drift_from:
     checkpoints = {}
     for it in range(1, sweeps + 1):
         pn0, pt0 = pn.copy(), pt.copy()
-        total, largest, _, _ = nlgs.sweep(order, P.a, P.b, P.nx, P.ny, P.rax, P.ray, P.rbx, P.rby, P.bias, P.mu, pn,
-                                          pt, vx, vy, w, P.minv_xx, P.minv_xy, P.minv_yy, P.iinv, wnn, wnt, wtt)
+        total, largest, _, _ = nlgs.sweep(order, P, impulses, velocities, blocks)
         dv = _w_norm(pn - pn0, pt - pt0, wnn, wnt, wtt)
         if it > 20:
             change += dv ** 2
@@ -180,7 +180,7 @@ def anatomy(case: dict, bounds, n_particles: int, sweeps: int = 400, drift_from:
         if it == drift_from:
             start = (pn.copy(), pt.copy(), *_relative_velocity(P, vx, vy, w))
         if it in (20, drift_from, sweeps):
-            quad, _ = nlgs.norms(total, largest, pn, pt, wnn, wnt, wtt)
+            quad, _ = nlgs.norms(total, largest, impulses, blocks)
             checkpoints[it] = (float(quad), residuals.local_law_residual(P, pn, pt, vx, vy, w))
     per_cell = np.sort(np.bincount(cell, change, GRID * GRID))[::-1]
     cells90 = (np.searchsorted(np.cumsum(per_cell) / per_cell.sum(), 0.9) + 1) / GRID ** 2
@@ -196,12 +196,11 @@ def anatomy(case: dict, bounds, n_particles: int, sweeps: int = 400, drift_from:
 def _velocities(problem, free, pn, pt):
     """Body velocities (vx, vy, w) = free + M^-1 H p (the NLGS's own kernel)."""
     from solver import nlgs
+    from solver.solve_records import Impulses, Velocities
 
-    P = problem
-    vx, vy, w = (v.copy() for v in free)
-    nlgs.velocities_from_impulses(P.a, P.b, P.nx, P.ny, P.rax, P.ray, P.rbx, P.rby, pn, pt, vx, vy, w, P.minv_xx,
-                                  P.minv_xy, P.minv_yy, P.iinv)
-    return vx, vy, w
+    velocities = Velocities(*(v.copy() for v in free))
+    nlgs.velocities_from_impulses(problem, Impulses(np.ascontiguousarray(pn), np.ascontiguousarray(pt)), velocities)
+    return tuple(velocities)
 
 
 def _cone_projections(zn, zt, mu):
@@ -236,8 +235,7 @@ def apgd_probe(case: dict, target: float, iterations: int = 400, check_every: in
 
     P = case["problem"]
     free = (case["vx"], case["vy"], case["w"])
-    wnn, _, _ = nlgs.delassus(P.a, P.b, P.nx, P.ny, P.rax, P.ray, P.rbx, P.rby, P.minv_xx, P.minv_xy, P.minv_yy,
-                              P.iinv)
+    wnn = nlgs.delassus(P).nn
     scale = 1.0 / wnn
     root = np.sqrt(scale)
     rest = tuple(np.zeros_like(v) for v in free)
