@@ -67,17 +67,13 @@ def _one_sweep(path, repeats):
     import numba
 
     from solver import load_sample, nlgs, parallel_nlgs
+    from solver.solve_records import DelassusBlocks, Impulses, Velocities
 
     warnings.simplefilter("ignore")
     sim = load_sample(path, -1)
     sim.walls.drive_velocity("top", (0.0, -0.032))
     problem, *state, _ = capture_contact_problems(sim)[0]
-    wnn, wnt, wtt = nlgs.delassus(problem.a, problem.b, problem.nx, problem.ny, problem.rax, problem.ray,
-                                  problem.rbx, problem.rby, problem.minv_xx, problem.minv_xy, problem.minv_yy,
-                                  problem.iinv)
-    geometry = (problem.a, problem.b, problem.nx, problem.ny, problem.rax, problem.ray, problem.rbx, problem.rby,
-                problem.bias, problem.mu)
-    masses = (problem.minv_xx, problem.minv_xy, problem.minv_yy, problem.iinv)
+    blocks = nlgs.delassus(problem)
 
     def timed(call):
         call()
@@ -86,18 +82,19 @@ def _one_sweep(path, repeats):
             call()
         return (time.perf_counter() - start) / repeats
 
-    serial_state = [a.copy() for a in state]
+    serial_impulses = Impulses(*(a.copy() for a in state[:2]))
+    serial_velocities = Velocities(*(a.copy() for a in state[2:]))
     order = np.arange(problem.a.size)
-    out = {"serial": timed(lambda: nlgs.sweep(order, *geometry, *serial_state, *masses, wnn, wnt, wtt)),
+    out = {"serial": timed(lambda: nlgs.sweep(order, problem, serial_impulses, serial_velocities, blocks)),
            "points": problem.a.size}
     dec = parallel_nlgs.decompose(problem, sim.position[:sim.n_particles, 0], 2)
-    new_geometry, new_masses, new_state = dec.gather(problem, *[a.copy() for a in state])
-    o = dec.point_order
+    renumbered, new_impulses, new_velocities = dec.gather(problem, *[a.copy() for a in state])
+    new_blocks = DelassusBlocks(*(x[dec.point_order] for x in blocks))
     out["interface"] = dec.interface.size
     for threads in (1, 2):
         numba.set_num_threads(threads)
-        out[threads] = timed(lambda: parallel_nlgs.sweep_domains(dec.ptr, dec.points, dec.interface, *new_geometry,
-                                                                 *new_state, *new_masses, wnn[o], wnt[o], wtt[o]))
+        out[threads] = timed(lambda: parallel_nlgs.sweep_domains(dec.ptr, dec.points, dec.interface, renumbered,
+                                                                 new_impulses, new_velocities, new_blocks))
     return out
 
 
