@@ -118,12 +118,12 @@ def check_assembly(problem, W, q, pn, pt, vx, vy, w):
     """Raise unless W r + q equals the stepper's own local velocities (its kernels, Signorini
     shift added) for the impulses of 20 NLGS sweeps from the warm start."""
     from solver import nlgs
+    from solver.solve_records import Velocities
 
     pn, pt, vx, vy, w = pn.copy(), pt.copy(), vx.copy(), vy.copy(), w.copy()
     nlgs.solve_problem(problem, pn, pt, vx, vy, w, tolerance=1e-30, max_tolerance=1e-30, max_iterations=20)
-    local = np.array([nlgs._relative_velocity(k, problem.a, problem.b, problem.nx, problem.ny, problem.rax,
-                                              problem.ray, problem.rbx, problem.rby, vx, vy, w)
-                      for k in range(problem.a.size)])
+    velocities = Velocities(vx, vy, w)
+    local = np.array([nlgs._relative_velocity(k, problem, velocities) for k in range(problem.a.size)])
     local[:, 0] += problem.bias
     assembled = (W @ np.stack([pn, pt], -1).reshape(-1) + q).reshape(-1, 2)
     error = np.abs(assembled - local).max() / np.abs(local).max()
@@ -187,18 +187,32 @@ def law(W, q, mu, impulse):
     return local_law_residual(natural_map(W, q, mu, impulse)[0], impulse)
 
 
+def nlgs_sweeps(matrix, rn, rt, sweeps):
+    """Run ``sweeps`` NLGS sweeps (no tolerance) on ``matrix`` (:func:`as_matrix_problem`) from the
+    impulses ``rn, rt`` (n,), updated in place (:func:`solver.nlgs.solve_matrix`)."""
+    from solver import nlgs
+    from solver.solve_records import Impulses, Limits
+
+    nlgs.solve_matrix(matrix, Impulses(rn, rt), Limits(1e-300, 1e-300, int(sweeps), 0))
+
+
+def as_matrix_problem(W, q, mu):
+    """The :class:`solver.solve_records.MatrixProblem` of W (CSR), q and mu."""
+    from solver.solve_records import MatrixProblem
+
+    return MatrixProblem(W.indptr.astype(np.int64), W.indices.astype(np.int64), W.data, q, mu)
+
+
 def nlgs_trajectory(W, q, mu, initial, stop=TARGETS[-1]):
     """[(sweeps, seconds, residual)] of NLGS sweeps from ``initial`` (module docstring), until the
     residual is within ``stop``, CAPS['nlgs'] sweeps or SECONDS."""
-    from solver import nlgs
-
-    indptr, indices = W.indptr.astype(np.int64), W.indices.astype(np.int64)
+    matrix = as_matrix_problem(W, q, mu)
     rn, rt = initial[:, 0].copy(), initial[:, 1].copy()
     sweeps, seconds, points = 0, 0.0, [(0, 0.0, law(W, q, mu, initial))]
     while points[-1][2] > stop and sweeps < CAPS["nlgs"] and seconds < SECONDS:
         chunk = max(2, sweeps // 20)
         start = time.perf_counter()
-        nlgs.solve_matrix(indptr, indices, W.data, q, mu, rn, rt, 1e-300, 1e-300, chunk)
+        nlgs_sweeps(matrix, rn, rt, chunk)
         seconds += time.perf_counter() - start
         sweeps += chunk
         points.append((sweeps, seconds, law(W, q, mu, np.stack([rn, rt], -1))))
@@ -323,7 +337,6 @@ def degeneracy(name=SICONOS[1]):
     NLGS's natural-map residual sits after CAPS['nlgs'] sweeps, and how far 3000 sweeps get on
     the stored W and on W with its negative modes removed (entries below 1e-12 of the largest
     dropped)."""
-    from solver import nlgs
     from solver.contact_solution import natural_map
 
     W, q, mu = read_siconos_fc2d(os.path.join(DATA, name + ".dat"))
@@ -343,8 +356,7 @@ def degeneracy(name=SICONOS[1]):
         modes.update(top.tolist())
         print(f"  mode {values[j]:.3g}: points {top.tolist()} carry {weight[top].sum():.2f} of it")
     rn, rt = np.zeros(mu.size), np.zeros(mu.size)
-    nlgs.solve_matrix(W.indptr.astype(np.int64), W.indices.astype(np.int64), W.data, q, mu, rn, rt, 1e-300, 1e-300,
-                      CAPS["nlgs"])
+    nlgs_sweeps(as_matrix_problem(W, q, mu), rn, rt, CAPS["nlgs"])
     impulse = np.stack([rn, rt], -1)
     violation = natural_map(W, q, mu, impulse)[0]
     share = np.sum(violation ** 2, axis=1) / np.sum(violation ** 2)
@@ -358,8 +370,7 @@ def degeneracy(name=SICONOS[1]):
     repaired = sparse.csr_matrix(np.where(np.abs(repaired) > 1e-12 * np.abs(repaired).max(), repaired, 0.0))
     for label, matrix in (("stored W", W), ("W without its negative modes", repaired)):
         rn, rt = np.zeros(mu.size), np.zeros(mu.size)
-        nlgs.solve_matrix(matrix.indptr.astype(np.int64), matrix.indices.astype(np.int64), matrix.data, q, mu, rn, rt,
-                          1e-300, 1e-300, 3000)
+        nlgs_sweeps(as_matrix_problem(matrix, q, mu), rn, rt, 3000)
         print(f"NLGS, 3000 sweeps, {label}: residual {law(matrix, q, mu, np.stack([rn, rt], -1)):.2e}")
 
 

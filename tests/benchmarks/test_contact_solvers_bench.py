@@ -56,8 +56,7 @@ def test_a_stepper_problem_as_a_matrix(pentagon_sample):
     sim, _ = load("step_profile").load_sample(pentagon_sample)
     problem, pn, pt, vx, vy, w, _ = load("common").capture_contact_problems(sim, 1)[0]
     W, q, mu = bench.matrix_problem(problem, vx, vy, w)
-    blocks = nlgs.delassus(problem.a, problem.b, problem.nx, problem.ny, problem.rax, problem.ray, problem.rbx,
-                           problem.rby, problem.minv_xx, problem.minv_xy, problem.minv_yy, problem.iinv)
+    blocks = nlgs.delassus(problem)
     diagonal = W.diagonal()
     np.testing.assert_allclose(diagonal[0::2], blocks[0], rtol=1e-12)
     np.testing.assert_allclose(diagonal[1::2], blocks[2], rtol=1e-12)
