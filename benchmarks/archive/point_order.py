@@ -39,6 +39,7 @@ def measure(n: int, shape: str, repeats: int = 200) -> dict:
     from benchmarks.common import capture_contact_problems
     from solver import nlgs
     from solver.scenes import compaction_sample
+    from solver.solve_records import ContactProblem, DelassusBlocks, Impulses, Velocities
 
     warnings.simplefilter("ignore")
     sim = compaction_sample(n, shape, seed=0)
@@ -48,15 +49,17 @@ def measure(n: int, shape: str, repeats: int = 200) -> dict:
     m = p.a.size
 
     def per_sweep(perm, narrow=False):
-        g = [np.ascontiguousarray(x[perm]) for x in (p.a, p.b, p.nx, p.ny, p.rax, p.ray, p.rbx, p.rby, p.bias, p.mu)]
-        wnn, wnt, wtt = nlgs.delassus(*g[:8], p.minv_xx, p.minv_xy, p.minv_yy, p.iinv)
+        g = [np.ascontiguousarray(x[perm]) for x in p[:10]]  # the point arrays, a .. mu
+        problem = ContactProblem(*g, *p[10:])
+        blocks = nlgs.delassus(problem)
         order = np.arange(m)
         if narrow:  # half the bytes: int32 ids, float32 normals, lever arms and Delassus blocks
             order, g[0], g[1] = order.astype(np.int32), g[0].astype(np.int32), g[1].astype(np.int32)
             g[2:8] = [x.astype(np.float32) for x in g[2:8]]
-            wnn, wnt, wtt = (x.astype(np.float32) for x in (wnn, wnt, wtt))
-        args = (order, *g, pn[perm].copy(), pt[perm].copy(), vx.copy(), vy.copy(), w.copy(),
-                p.minv_xx, p.minv_xy, p.minv_yy, p.iinv, wnn, wnt, wtt)
+            problem = ContactProblem(*g, *p[10:])
+            blocks = DelassusBlocks(*(x.astype(np.float32) for x in blocks))
+        args = (order, problem, Impulses(pn[perm].copy(), pt[perm].copy()), Velocities(vx.copy(), vy.copy(), w.copy()),
+                blocks)
         nlgs.sweep(*args)
         runs = []
         for _ in range(5):

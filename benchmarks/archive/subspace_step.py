@@ -100,17 +100,17 @@ def probe(case: dict, n_particles: int, sweeps: int = 20, checkpoints=CHECKPOINT
     checkpoint, the direction's split, the face, the impulses before and after the CG (``start``,
     ``end``) and the frozen shift."""
     from solver import nlgs, residuals
+    from solver.solve_records import Impulses, Velocities
 
     P = case["problem"]
     free = (case["vx"], case["vy"], case["w"])
     pn, pt = case["pn"].copy(), case["pt"].copy()
     vx, vy, w = _velocities(P, free, pn, pt)
-    wnn, wnt, wtt = nlgs.delassus(P.a, P.b, P.nx, P.ny, P.rax, P.ray, P.rbx, P.rby, P.minv_xx, P.minv_xy,
-                                  P.minv_yy, P.iinv)
+    blocks = nlgs.delassus(P)
+    wnn, wnt, wtt = blocks
     order = np.arange(P.a.size)
     for _ in range(sweeps):
-        nlgs.sweep(order, P.a, P.b, P.nx, P.ny, P.rax, P.ray, P.rbx, P.rby, P.bias, P.mu, pn, pt, vx, vy, w,
-                   P.minv_xx, P.minv_xy, P.minv_yy, P.iinv, wnn, wnt, wtt)
+        nlgs.sweep(order, P, Impulses(pn, pt), Velocities(vx, vy, w), blocks)
     face = Face(P.mu, pn, pt)
     un, ut = _relative_velocity(P, vx, vy, w)
     qn, qt = _relative_velocity(P, *free)

@@ -15,6 +15,7 @@ import numpy as np
 from benchmarks.common import capture_contact_problems
 from solver import nlgs
 from solver.preparation import preparation, prepare_sample
+from solver.solve_records import Impulses, Velocities
 
 
 def main():
@@ -28,15 +29,16 @@ def main():
     problems = capture_contact_problems(sim, 20)
     for P, pn, pt, vx, vy, w, opt in problems[:20:4]:
         m = P.a.size
-        wnn, wnt, wtt = nlgs.delassus(P.a, P.b, P.nx, P.ny, P.rax, P.ray, P.rbx, P.rby, P.minv_xx, P.minv_xy, P.minv_yy, P.iinv)
-        nlgs.velocities_from_impulses(P.a, P.b, P.nx, P.ny, P.rax, P.ray, P.rbx, P.rby, pn, pt, vx, vy, w, P.minv_xx, P.minv_xy, P.minv_yy, P.iinv)
+        blocks = nlgs.delassus(P)
+        wnn, wnt, wtt = blocks
+        impulses, velocities = Impulses(pn, pt), Velocities(vx, vy, w)
+        nlgs.velocities_from_impulses(P, impulses, velocities)
         order = np.arange(m)
         rows = []
         for it in range(1, 2001):
             pn0, pt0 = pn.copy(), pt.copy()
-            s, mx, _, _ = nlgs.sweep(order, P.a, P.b, P.nx, P.ny, P.rax, P.ray, P.rbx, P.rby, P.bias, P.mu, pn, pt, vx, vy, w,
-                               P.minv_xx, P.minv_xy, P.minv_yy, P.iinv, wnn, wnt, wtt)
-            q, worst = nlgs.norms(s, mx, pn, pt, wnn, wnt, wtt)
+            s, mx, _, _ = nlgs.sweep(order, P, impulses, velocities, blocks)
+            q, worst = nlgs.norms(s, mx, impulses, blocks)
             dpn, dpt = pn - pn0, pt - pt0
             dv2 = dpn * (wnn * dpn + wnt * dpt) + dpt * (wnt * dpn + wtt * dpt)
             if it in (1, 5, 20, 50) or (q <= opt["tolerance"] and worst <= opt["max_tolerance"]):
