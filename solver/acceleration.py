@@ -385,7 +385,7 @@ def solve_anderson(blocks, problem, impulses, velocities, limits, memory, period
 
 def solve_problem_anderson(problem, pn, pt, vx, vy, w, *, tolerance, max_tolerance, max_iterations,
                            memory=3, domains=1, x=None, period=1, stall=0, decomposition=None) -> NLGSResult:
-    """Solve ``problem`` (:class:`solver.nlgs.ContactProblem`) by Anderson-accelerated NLGS
+    """Solve ``problem`` (:class:`solver.solve_records.ContactProblem`) by Anderson-accelerated NLGS
     sweeps (module docstring); same arguments, in-place updates and result as
     :func:`solver.nlgs.solve_problem`. ``memory`` is m, the number of past sweeps combined.
     With ``domains`` > 1 the sweeps are the domain-decomposed ones of

@@ -50,7 +50,7 @@ from typing import NamedTuple
 import numpy as np
 from numba import njit
 
-from .solve_records import ContactProblem, DelassusBlocks, Impulses, Limits, MatrixProblem, Velocities
+from .solve_records import ContactProblem, DelassusBlocks, Impulses, Limits, Velocities
 
 __all__ = ["ContactProblem", "NLGSResult", "STALL_IMPROVEMENT", "delassus", "delassus_block", "delassus_into",
            "local_solve", "norms", "solve", "solve_matrix", "solve_problem", "stalled", "sweep", "sweep_norms",

@@ -404,7 +404,7 @@ def decompose(problem, x, domains) -> Decomposition:
 
 def solve_problem_domains(problem, x, pn, pt, vx, vy, w, *, domains, tolerance, max_tolerance,
                           max_iterations, stall=0, decomposition=None) -> NLGSResult:
-    """Solve ``problem`` (:class:`solver.nlgs.ContactProblem`) by domain-decomposed sweeps
+    """Solve ``problem`` (:class:`solver.solve_records.ContactProblem`) by domain-decomposed sweeps
     (module docstring) with ``domains`` slabs of the particles whose centres have abscissae
     ``x`` (m, the first ``x.size`` bodies); arguments and result otherwise as
     :func:`solver.nlgs.solve_problem`. ``decomposition``: the problem's :func:`decompose`, when

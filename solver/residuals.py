@@ -136,7 +136,7 @@ def _law_sums(problem, impulses, velocities):
 
 def local_law_residual(problem, pn, pt, vx, vy, w) -> float:
     """The step's local-law residual |F| / |r| (module docstring) for a
-    :class:`solver.nlgs.ContactProblem` and its impulses and end velocities; 0 for no points."""
+    :class:`solver.solve_records.ContactProblem` and its impulses and end velocities; 0 for no points."""
     if problem.a.size == 0:
         return 0.0
     violation, scale = _law_sums(problem, Impulses(pn, pt), Velocities(vx, vy, w))
