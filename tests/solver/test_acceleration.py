@@ -231,3 +231,22 @@ def test_a_short_work_array_is_refused(problem):
         pn, pt, vx, vy, w = _copy(state)
         acceleration.solve_anderson(np.array([0, m]), prob, Impulses(pn, pt), Velocities(vx, vy, w),
                                     Limits(1e-4, 1e-2, 5, 0), 3, 2, work)
+
+
+def test_the_scratch_records_cut_the_work_array_without_overlap():
+    """Every array of the Anderson scratch and the Delassus blocks is a view of its own stretch of
+    the work array, and together they fill exactly scratch_size floats of it: each view written
+    with its own number is found in as many entries as it holds, and nothing past the end is
+    touched; the small normal equations are memory of their own."""
+    points, bodies, memory = 7, 5, 3
+    size = acceleration.scratch_size(points, bodies, memory)
+    assert size == (4 * memory + 11) * points + (3 * memory + 3) * bodies
+    work = np.full(size + 4, -1.0)
+    scratch, blocks = acceleration.scratch_records(work, points, bodies, memory)
+    views = [*blocks, *scratch[:18]]
+    for number, view in enumerate(views):
+        view[...] = number
+    assert np.bincount(work[:size].astype(np.int64)).tolist() == [v.size for v in views]
+    assert np.all(work[size:] == -1.0)
+    assert scratch.dfn.shape == (memory, points) and scratch.dw.shape == (memory, bodies)
+    assert not any(np.shares_memory(x, work) for x in (scratch.gram, scratch.row, scratch.rhs))
