@@ -11,7 +11,7 @@ defaults, units, help texts and validators.
 Each field is declared with :func:`setting`: its default, a one-line help, its unit, and the
 check of its value with what is expected of it. The records validate themselves from these
 declarations (:func:`problems`, then the checks that relate several fields), and the command
-line (:mod:`grainview.cli`) derives its options, defaults and help from them
+line (:mod:`grainview.app.cli`) derives its options, defaults and help from them
 (:func:`dataclasses.fields`), so that a setting is declared, defaulted and checked once.
 
 This module imports numpy, the contract's errors and the solver registry

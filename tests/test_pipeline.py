@@ -6,7 +6,7 @@ import pandas as pd
 import pytest
 
 import grainview
-from grainview.cli import main
+from grainview.app.cli import main
 from grainview.plot import FIGURES
 from grainview.app.report import FIGURE_NAMES, NOT_REACHED, PER_RUN_FIGURES, POLYGON_FIGURES, convergence_text
 from grainview.analysis.strain import residual_window

@@ -110,7 +110,7 @@ def test_differences_name_each_changed_row():
 
 @pytest.mark.slow
 def test_the_committed_headline_is_what_the_study_gives(tmp_path):
-    from grainview.cli import main
+    from grainview.app.cli import main
 
     import json
 

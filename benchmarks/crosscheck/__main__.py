@@ -178,7 +178,7 @@ def sample_files(shape, args):
     nc, npz = stem + ".nc", stem + ".npz"
     if not os.path.exists(nc):
         log(f"{shape}: compacting a {args.particles}-particle sample (grainview run isotropic) -> {nc}")
-        call([sys.executable, "-m", "grainview.cli", "run", "isotropic", "--shape", shape, "--particles",
+        call([sys.executable, "-m", "grainview", "run", "isotropic", "--shape", shape, "--particles",
               str(args.particles), "--seed", str(args.seed), "--out", nc, "--progress", "off"],
              f"compacting the {shape} sample")
     if not os.path.exists(npz) or os.path.getmtime(npz) < os.path.getmtime(nc):

@@ -6,7 +6,7 @@ import pytest
 import xarray as xr
 
 import grainview
-from grainview.cli import main
+from grainview.app.cli import main
 from grainview.analysis.synthetic import harmonic_series
 from grainview.contract.writer import is_compressed
 
@@ -112,7 +112,7 @@ def test_version(capsys):
 
 def test_interruptions_exit_with_the_shells_codes(monkeypatch, capsys):
     """Ctrl-C -> 130, SIGTERM (solver.interrupt.Terminated, raised after a whole step) -> 143."""
-    import grainview.cli as cli
+    import grainview.app.cli as cli
     from solver.interrupt import Terminated
 
     for exc, code, text in ((KeyboardInterrupt(), 130, "interrupted"), (Terminated(), 143, "terminated (SIGTERM)")):
@@ -152,7 +152,7 @@ def test_ordinary_mistakes_get_one_line_at_once(tmp_path, capsys, argv, fragment
 def test_system_errors_are_one_line_and_a_closed_pipe_is_quiet(monkeypatch, capsys):
     import errno
 
-    import grainview.cli as cli
+    import grainview.app.cli as cli
 
     def full(args):
         raise OSError(errno.ENOSPC, "No space left on device", "run.nc")
@@ -168,7 +168,7 @@ def test_system_errors_are_one_line_and_a_closed_pipe_is_quiet(monkeypatch, caps
 
 
 def test_library_advice_is_given_as_the_flag(monkeypatch, capsys):
-    import grainview.cli as cli
+    import grainview.app.cli as cli
 
     def lost_race(args):
         raise FileExistsError("run.nc exists; pass overwrite=True to replace it")
@@ -210,7 +210,7 @@ def test_info_reports_variables_without_units(tmp_path, capsys):
 
 INFO_IMPORTS = """
 import sys
-from grainview.cli import main
+from grainview.app.cli import main
 assert main(["info", sys.argv[1]]) == 0
 print(sorted(m for m in ("xarray", "dask", "pandas", "scipy") if m in sys.modules))
 """

@@ -7,7 +7,7 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from grainview.cli import main
+from grainview.app.cli import main
 
 TOKENS = ["--to", "vtk", "csv", "--out", "--every", "0", "-1", "2.5", "--labels", "a,b", "--attrs",
           "--overwrite", "--movie", "--residual-strain", "nan", "", "--", "FILE"]

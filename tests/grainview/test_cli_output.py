@@ -14,7 +14,7 @@ import pandas as pd
 import pytest
 
 import grainview
-from grainview.cli import build_parser, main
+from grainview.app.cli import build_parser, main
 from grainview.contract.dataset import netcdf_encoding
 from grainview.analysis.synthetic import harmonic_series
 
@@ -309,7 +309,7 @@ def test_warmup_refuses_a_cache_folder_it_cannot_write_in_one_line(tmp_path, mon
 @pytest.mark.slow
 def test_warmup_fills_a_cold_cache_that_the_next_process_loads(tmp_path):
     env = {**os.environ, "NUMBA_CACHE_DIR": str(tmp_path / "cache"), "MPLBACKEND": "Agg"}
-    command = [sys.executable, "-m", "grainview.cli", "warmup"]
+    command = [sys.executable, "-m", "grainview", "warmup"]
     times, outputs = [], []
     for _ in range(2):
         started = time.perf_counter()

@@ -10,8 +10,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-import grainview.cli as cli
-from grainview.cli import build_parser, main
+import grainview.app.cli as cli
+from grainview.app.cli import build_parser, main
 from solver.parameters import BiaxialTest, Parameters
 from solver.preparation import Preparation
 from solver.sample_history import SampleHistory

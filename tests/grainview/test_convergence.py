@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 import grainview
-from grainview.cli import _simulate
+from grainview.app.cli import _simulate
 from grainview.app.convergence import unconverged_in_file, unconverged_text
 from grainview.app.report import convergence_notes, convergence_text
 from solver.parameters import BiaxialTest

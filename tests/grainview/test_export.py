@@ -167,7 +167,7 @@ def test_csv_is_the_tidy_table_of_every_snapshot(tmp_path):
 
 
 def test_export_command(tmp_path, capsys):
-    from grainview.cli import main
+    from grainview.app.cli import main
 
     ds = polygons_and_disks()
     source = tmp_path / "run.nc"

@@ -187,7 +187,7 @@ def test_an_out_that_is_a_folder_is_refused_first(tmp_path):
     folder = tmp_path / "results"
     folder.mkdir()
     (folder / "keep.txt").write_text("mine")
-    done = subprocess.run([sys.executable, "-m", "grainview.cli", "convert", "lammps", "--particles",
+    done = subprocess.run([sys.executable, "-m", "grainview", "convert", "lammps", "--particles",
                            str(files["particles"]), "--contacts", str(files["contacts"]), "--log", str(files["log"]),
                            "--out", str(folder), "--overwrite", "--progress", "off"], capture_output=True, text=True)
     assert done.returncode != 0 and len(done.stderr.strip().splitlines()) == 1, done.stderr
@@ -276,12 +276,12 @@ def test_a_fresh_lammps_run_converts_and_checks(tmp_path):
     folder = _lammps().run(tmp_path / "run", seed=97)
     files = dump_files(folder)
     out = tmp_path / "fresh.nc"
-    done = subprocess.run([sys.executable, "-m", "grainview.cli", "convert", "lammps", "--particles",
+    done = subprocess.run([sys.executable, "-m", "grainview", "convert", "lammps", "--particles",
                            str(files["particles"]), "--contacts", str(files["contacts"]), "--walls",
                            str(files["walls"]), "--log", str(files["log"]), "--out", str(out)],
                           capture_output=True, text=True)
     assert done.returncode == 0, done.stderr
-    check = subprocess.run([sys.executable, "-m", "grainview.cli", "info", str(out), "--check"], capture_output=True,
+    check = subprocess.run([sys.executable, "-m", "grainview", "info", str(out), "--check"], capture_output=True,
                            text=True)
     assert check.returncode == 0 and "valid" in check.stdout, check.stdout + check.stderr
     fresh = grainview.open_dataset(out, chunks=None)

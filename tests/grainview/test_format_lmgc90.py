@@ -525,12 +525,12 @@ def test_bad_input_gets_one_line_and_writes_nothing(tmp_path, name, edit, match)
 
 def test_the_command_line_converts_and_refuses_in_one_line(tmp_path):
     out = tmp_path / "run.nc"
-    done = subprocess.run([sys.executable, "-m", "grainview.cli", "convert", "lmgc90", str(HANDMADE), "--out",
+    done = subprocess.run([sys.executable, "-m", "grainview", "convert", "lmgc90", str(HANDMADE), "--out",
                            str(out), "--progress", "off"], capture_output=True, text=True)
     assert done.returncode == 0, done.stderr
     assert "2 snapshots from LMGC90" in done.stdout
     folder = _copy(tmp_path, "bad", ("DATBOX/BODIES.DAT", None))
-    bad = subprocess.run([sys.executable, "-m", "grainview.cli", "convert", "lmgc90", str(folder), "--out",
+    bad = subprocess.run([sys.executable, "-m", "grainview", "convert", "lmgc90", str(folder), "--out",
                           str(tmp_path / "bad.nc")], capture_output=True, text=True)
     assert bad.returncode != 0 and len(bad.stderr.strip().splitlines()) == 1, bad.stderr
     assert "no DATBOX/BODIES.DAT" in bad.stderr and not (tmp_path / "bad.nc").exists()
@@ -553,10 +553,10 @@ def test_a_fresh_lmgc90_run_converts_and_checks(tmp_path):
     step. The hand-made run, made again, reads as the committed one."""
     folder = _lmgc90().run(tmp_path / "run", "sample", seed=97)
     out = tmp_path / "fresh.nc"
-    done = subprocess.run([sys.executable, "-m", "grainview.cli", "convert", "lmgc90", str(folder), "--out", str(out),
+    done = subprocess.run([sys.executable, "-m", "grainview", "convert", "lmgc90", str(folder), "--out", str(out),
                            "--progress", "off"], capture_output=True, text=True)
     assert done.returncode == 0, done.stderr
-    check = subprocess.run([sys.executable, "-m", "grainview.cli", "info", str(out), "--check"], capture_output=True,
+    check = subprocess.run([sys.executable, "-m", "grainview", "info", str(out), "--check"], capture_output=True,
                            text=True)
     assert check.returncode == 0 and "valid" in check.stdout, check.stdout + check.stderr
     fresh = grainview.open_dataset(out, chunks=None)

@@ -346,7 +346,7 @@ def test_bad_input_gets_one_line_and_writes_nothing(tmp_path, name, which, edit,
 
 def test_the_command_line_converts_and_refuses_in_one_line(tmp_path):
     out = tmp_path / "run.nc"
-    command = [sys.executable, "-m", "grainview.cli", "convert", "mercurydpm", str(files()[0]), "--out", str(out),
+    command = [sys.executable, "-m", "grainview", "convert", "mercurydpm", str(files()[0]), "--out", str(out),
                "--progress", "off"]
     done = subprocess.run(command + ["--units", "si"], capture_output=True, text=True)
     assert done.returncode == 0, done.stderr
@@ -383,11 +383,11 @@ def test_a_fresh_mercurydpm_run_converts_and_checks(tmp_path):
         np.testing.assert_allclose(*np.array(numbers).T, rtol=1e-9, atol=1e-12)
     folder = make.run(tmp_path / "run", seed=97)
     out = tmp_path / "fresh.nc"
-    done = subprocess.run([sys.executable, "-m", "grainview.cli", "convert", "mercurydpm",
+    done = subprocess.run([sys.executable, "-m", "grainview", "convert", "mercurydpm",
                            str(folder / "Settle2D.data"), "--units", "si", "--out", str(out), "--progress", "off"],
                           capture_output=True, text=True)
     assert done.returncode == 0, done.stderr
-    check = subprocess.run([sys.executable, "-m", "grainview.cli", "info", str(out), "--check"], capture_output=True,
+    check = subprocess.run([sys.executable, "-m", "grainview", "info", str(out), "--check"], capture_output=True,
                            text=True)
     assert check.returncode == 0 and "valid" in check.stdout, check.stdout + check.stderr
     fresh = grainview.open_dataset(out, chunks=None)

@@ -295,7 +295,7 @@ def test_bad_input_gets_one_line_and_writes_nothing(tmp_path, name, which, edit,
 
 def test_the_command_line_converts_and_refuses_in_one_line(tmp_path):
     out = tmp_path / "run.nc"
-    command = [sys.executable, "-m", "grainview.cli", "convert", "pegs", str(ADJACENCY), "--positions",
+    command = [sys.executable, "-m", "grainview", "convert", "pegs", str(ADJACENCY), "--positions",
                str(POSITIONS), "--out", str(out), "--progress", "off", "--force-unit-n", "1"]
     done = subprocess.run(command + ["--metres-per-pixel", str(SCALE)], capture_output=True, text=True)
     assert done.returncode == 0, done.stderr

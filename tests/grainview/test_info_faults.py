@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 import grainview
-from grainview.cli import main
+from grainview.app.cli import main
 from grainview.contract.dataset import netcdf_options
 from grainview.contract.errors import FileFormatError, SchemaError
 from grainview.analysis.synthetic import harmonic_series

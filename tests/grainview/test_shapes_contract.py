@@ -16,7 +16,7 @@ from matplotlib.collections import PolyCollection
 
 import grainview
 import grainview.plot as gp
-from grainview.cli import main
+from grainview.app.cli import main
 from grainview.contract.dataset import make_dataset
 from grainview.contract.errors import ParameterError, SchemaError
 from grainview.contract.shapes import (body_vertices, body_vertices_of, inertia_per_mass, particle_area,

@@ -23,7 +23,7 @@ limit = int(sys.argv[1])
 if limit:
     resource.setrlimit(resource.RLIMIT_FSIZE, (limit, limit))
 sys.argv = ["grainview", *sys.argv[2:]]
-from grainview.cli import main
+from grainview.app.cli import main
 sys.exit(main())
 """
 RUN = ["run", "isotropic", "--shape", "disk", "--particles", "12", "--preparation", "fast", "--progress", "off"]

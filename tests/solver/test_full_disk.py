@@ -39,7 +39,7 @@ def tiny_disk(tmp_path):
 def test_full_disk_is_one_line_and_the_file_resumes_exactly(tiny_disk, tmp_path):
     env = {**os.environ, "MPLBACKEND": "Agg"}
     target = tiny_disk / "run.nc"
-    done = subprocess.run([sys.executable, "-m", "grainview.cli", *RUN, "--out", str(target)],
+    done = subprocess.run([sys.executable, "-m", "grainview", *RUN, "--out", str(target)],
                           capture_output=True, text=True, env=env, timeout=600)
     assert done.returncode == 2, done.stderr[-2000:]  # not 139 (a segmentation fault)
     errors = [line for line in done.stderr.splitlines() if line.strip()]
@@ -52,7 +52,7 @@ def test_full_disk_is_one_line_and_the_file_resumes_exactly(tiny_disk, tmp_path)
                              capture_output=True, text=True, env=env, timeout=600)
     assert resumed.returncode == 0, resumed.stderr[-2000:]
     whole = tmp_path / "whole.nc"
-    subprocess.run([sys.executable, "-m", "grainview.cli", *RUN, "--out", str(whole)], check=True,
+    subprocess.run([sys.executable, "-m", "grainview", *RUN, "--out", str(whole)], check=True,
                    capture_output=True, env=env, timeout=600)
     a, b = grainview.open_dataset(target, chunks=None), grainview.open_dataset(whole, chunks=None)
     assert a.sizes == b.sizes and a.sizes["time"] > kept.sizes["time"]

@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 import grainview
-from grainview.cli import main
+from grainview.app.cli import main
 from grainview.contract import shapes as contract
 from grainview.contract.errors import ParameterError
 from grainview.contract.reader import ContractFile

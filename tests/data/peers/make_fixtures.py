@@ -33,7 +33,7 @@ def main(argv=None) -> int:
     args.out.mkdir(parents=True, exist_ok=True)
     with tempfile.TemporaryDirectory() as scratch:
         nc = Path(scratch) / "sample.nc"
-        subprocess.run([sys.executable, "-m", "grainview.cli", "run", "isotropic", "--shape", "pentagon",
+        subprocess.run([sys.executable, "-m", "grainview", "run", "isotropic", "--shape", "pentagon",
                         "--particles", "30", "--seed", "3", "--out", str(nc), "--progress", "off"], check=True)
         sys.path.insert(0, str(CROSSCHECK))
         import export

@@ -19,7 +19,7 @@ import argparse
 import sys
 from pathlib import Path
 
-from .contract.errors import ConvergenceWarning, GrainviewError, SchemaError
+from ..contract.errors import ConvergenceWarning, GrainviewError, SchemaError
 
 S1S2_HELP = ("s1s2: the paper's two initial states, each shape compacted its own way: pentagons with "
              "friction 0.4 as 'paper' (the paper's S1, solid fraction 0.80), disks compacted frictionless (S2, the "
@@ -44,11 +44,11 @@ DEMO_SIZE = {"snapshots": 11, "contacts": 20000}
 
 
 def _info(args) -> int:
-    from .app.file_summary import describe_file
+    from .file_summary import describe_file
 
     if args.check:  # first, so that every problem is listed: the summary's own and every value's
-        from .contract.io import open_dataset
-        from .contract.validation import validate
+        from ..contract.io import open_dataset
+        from ..contract.validation import validate
 
         problems = []
         try:
@@ -78,9 +78,9 @@ def _info(args) -> int:
 
 
 def _export(args) -> int:
-    from .formats.export import write_csv, write_vtk
-    from .contract.io import open_dataset
-    from .contract.validation import validate
+    from ..formats.export import write_csv, write_vtk
+    from ..contract.io import open_dataset
+    from ..contract.validation import validate
 
     ds = open_dataset(args.file)
     validate(ds, source=str(args.file))
@@ -96,7 +96,7 @@ def _export(args) -> int:
 
 
 def _convert_peer(args) -> int:
-    from .formats.peers import convert_peer
+    from ..formats.peers import convert_peer
 
     count = convert_peer(args.out, args.raw, args.sample, engine=args.format, overwrite=args.overwrite,
                          compress=not args.no_compress)
@@ -105,7 +105,7 @@ def _convert_peer(args) -> int:
 
 
 def _convert(args) -> int:
-    from .formats.lammps import convert_lammps
+    from ..formats.lammps import convert_lammps
 
     columns = None
     if args.columns:
@@ -123,7 +123,7 @@ def _convert(args) -> int:
 
 
 def _convert_lmgc90(args) -> int:
-    from .formats.lmgc90 import convert_lmgc90
+    from ..formats.lmgc90 import convert_lmgc90
 
     count = convert_lmgc90(args.out, args.run, overwrite=args.overwrite, compress=not args.no_compress,
                            progress=args.progress != "off")
@@ -145,7 +145,7 @@ def _mercurydpm_units(text):
 def _convert_mercurydpm(args) -> int:
     import warnings
 
-    from .formats.mercurydpm import convert_mercurydpm
+    from ..formats.mercurydpm import convert_mercurydpm
 
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
@@ -161,7 +161,7 @@ def _convert_mercurydpm(args) -> int:
 def _convert_pegs(args) -> int:
     import warnings
 
-    from .formats.pegs import convert_pegs
+    from ..formats.pegs import convert_pegs
 
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
@@ -176,9 +176,9 @@ def _convert_pegs(args) -> int:
 
 
 def _demo(args) -> int:
-    from . import open_dataset
-    from .contract.dataset import netcdf_options
-    from .analysis.synthetic import harmonic_series
+    from ..formats.opening import open_dataset
+    from ..contract.dataset import netcdf_options
+    from ..analysis.synthetic import harmonic_series
 
     if args.snapshots < 2 or args.contacts < 1:
         raise GrainviewError(f"--snapshots {args.snapshots} --contacts {args.contacts}: expected at least 2 "
@@ -205,7 +205,7 @@ def _demo(args) -> int:
 def _warmup(args) -> int:
     import os
 
-    from .app.warmup import cache_location, warm_up
+    from .warmup import cache_location, warm_up
 
     folder = os.environ.get("NUMBA_CACHE_DIR")
     if folder:
@@ -309,7 +309,7 @@ def _module_tree(module):
     """The parsed source of grainview's ``module`` (nothing imported)."""
     import ast
 
-    path = Path(__file__).parent.joinpath(*module.split(".")[1:]).with_suffix(".py")
+    path = Path(__file__).parents[1].joinpath(*module.split(".")[1:]).with_suffix(".py")  # the grainview package
     return ast.parse(path.read_text(encoding="utf-8"))
 
 
@@ -413,7 +413,7 @@ def _unconverged_warning(sim, path, unconverged) -> str:
     were from a solution (grainview.app.convergence), read from the written file."""
     import netCDF4
 
-    from .app.convergence import residual_comparison, stop_rule, tolerances, unconverged_in_file
+    from .convergence import residual_comparison, stop_rule, tolerances, unconverged_in_file
 
     with netCDF4.Dataset(path) as nc:
         counts = unconverged_in_file(nc.variables, {k: nc.getncattr(k) for k in nc.ncattrs()})
@@ -510,8 +510,8 @@ def _run(args) -> int:
 
 
 def _report(args) -> int:
-    from .contract.io import open_dataset
-    from .app.report import write_report
+    from ..contract.io import open_dataset
+    from .report import write_report
 
     if getattr(args, "ensemble", False):
         if args.labels or args.movie:
@@ -526,7 +526,7 @@ def _report(args) -> int:
                           log=lambda line: print(f"report: {line}", flush=True))
     files = list(result["files"])
     if getattr(args, "movie", False):  # the study reports without movies
-        from .plot.movies import animate
+        from ..plot.movies import animate
 
         for label, ds in runs.items():
             path = Path(args.out) / f"force_chains_{label}.gif"
@@ -541,14 +541,14 @@ def _report(args) -> int:
 def _terminal_table(table) -> str:
     """A report's table fitted to the terminal's width, rounded as the Markdown
     (grainview.app.report.terminal_table)."""
-    from .app.report import terminal_table
+    from .report import terminal_table
 
     return terminal_table(table)
 
 
 def _ensemble_report(args) -> int:
-    from .analysis.ensemble import open_ensemble
-    from .app.ensemble_report import write_ensemble_report
+    from ..analysis.ensemble import open_ensemble
+    from .ensemble_report import write_ensemble_report
 
     ens = open_ensemble(args.files, validate=True)
     result = write_ensemble_report(ens, args.out, residual_strain=args.residual_strain, overwrite=args.overwrite,
@@ -980,7 +980,12 @@ def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(prog="grainview", description=(
         "Contact dynamics of disks and polygons, and the force-transmission analyses of "
         "Azema et al., Phys. Rev. E 76, 011301 (2007)."))
-    from . import __version__
+    from importlib.metadata import PackageNotFoundError, version
+
+    try:
+        __version__ = version("grainview")
+    except PackageNotFoundError:  # run from a source tree that was not installed
+        __version__ = "(not installed)"
 
     parser.add_argument("--version", action="version", version=f"%(prog)s {__version__}")
     sub = parser.add_subparsers(dest="command", required=True)
