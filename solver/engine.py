@@ -49,8 +49,11 @@ class Engine(Protocol):
         which the sample could not be made or tested (``test``: a
         :class:`solver.parameters.BiaxialTest`, or None for a preparation only)."""
 
-    def prepare(self, preparation, parameters: dict, progress=None):
-        """Deposit and compact the sample ``preparation`` describes; returns it."""
+    def prepare(self, preparation, parameters: dict, progress=None, checkpoint=None):
+        """Deposit and compact the sample ``preparation`` describes; returns it. ``checkpoint``:
+        a file where the compaction saves its state as it goes and from which it resumes (an
+        engine without checkpoints may leave the argument out; the command line then starts
+        its compaction afresh)."""
 
     def shear(self, sample, path, test, *, attrs=None, near_contacts=False, overwrite=False, progress=None,
               compress=True) -> int:
@@ -85,10 +88,10 @@ class ContactDynamics:
         preparation.check_time_step(time_step, test.velocity)
         preparation.check_test_speed(time_step, test.velocity, test.strain)
 
-    def prepare(self, preparation, parameters: dict, progress=None):
+    def prepare(self, preparation, parameters: dict, progress=None, checkpoint=None):
         from .preparation import prepare_sample
 
-        return prepare_sample(preparation, progress=progress, **parameters)
+        return prepare_sample(preparation, progress=progress, checkpoint=checkpoint, **parameters)
 
     def shear(self, sample, path, test, *, attrs=None, near_contacts=False, overwrite=False, progress=None,
               compress=True) -> int:
@@ -114,6 +117,16 @@ class ContactDynamics:
         from .restart import file_state
 
         return file_state(path)
+
+
+def prepare(runner, preparation, parameters: dict, progress=None, checkpoint=None):
+    """``runner.prepare``, with the compaction's ``checkpoint`` when the engine takes one
+    (an engine of the entry-point group may not)."""
+    import inspect
+
+    if checkpoint is not None and "checkpoint" in inspect.signature(runner.prepare).parameters:
+        return runner.prepare(preparation, parameters, progress=progress, checkpoint=checkpoint)
+    return runner.prepare(preparation, parameters, progress=progress)
 
 
 def _registered() -> dict:

@@ -72,30 +72,46 @@ def preparation(name_or_prep=DEFAULT_PRESET, **changes) -> Preparation:
     return replace(prep, **{k: v for k, v in changes.items() if v is not None}).validate()
 
 
-def prepare_sample(prep: Preparation, progress=None, **parameters):
+def prepare_sample(prep: Preparation, progress=None, checkpoint=None, **parameters):
     """Deposit and compact a sample as ``prep`` says; returns the compacted :class:`Simulation`
     with the test's friction set, and the sample's history in ``sim.history``
     (:class:`solver.sample_history.SampleHistory`: the preparation, whether the compaction
     settled, its wall stresses, largest inertia number, steps and unconverged steps).
     ``parameters`` go to :class:`solver.Parameters` (time step, tolerances...); the grains'
     friction is the preparation's (``prep.friction``, ``prep.compaction_friction``), not one of
-    them."""
+    them.
+
+    ``checkpoint``: a path (or a :class:`solver.compaction_checkpoint.CompactionCheckpoint`)
+    where the compaction writes its state every ten minutes of wall time and when Ctrl-C or
+    SIGTERM stops it; when that file holds a checkpoint of this sample (the same preparation
+    and parameters), the compaction goes on from it instead of from the deposit, and ends on
+    the state an uninterrupted one reaches, bit for bit. A checkpoint of another sample is
+    refused (:class:`grainview.contract.errors.FileFormatError`). The file is left in place:
+    the caller removes it once the sample is written elsewhere."""
     prep = prep.validate()
     if "friction" in parameters:
         raise ParameterError(f"friction={parameters['friction']!r} among the solver parameters: the grains' "
                              "friction is the preparation's; expected Preparation(friction=..., "
                              "compaction_friction=...)")
     compaction_friction = prep.friction if prep.compaction_friction is None else prep.compaction_friction
+    from .compaction_checkpoint import CompactionCheckpoint, describe
     from .scenes import compaction_sample, isotropic_compaction  # the solver proper, on first use
 
-    sim = compaction_sample(prep.particles, prep.shape, sigma0=prep.sigma0, friction=compaction_friction,
-                            seed=prep.seed, aspect=prep.aspect, max_wall_speed=prep.max_wall_speed, **parameters)
+    if checkpoint is not None and not isinstance(checkpoint, CompactionCheckpoint):
+        checkpoint = CompactionCheckpoint(checkpoint, of=describe(prep, parameters))
+    resumed = None
+    if checkpoint is not None and checkpoint.exists():
+        sim, resumed = checkpoint.load()
+    else:
+        sim = compaction_sample(prep.particles, prep.shape, sigma0=prep.sigma0, friction=compaction_friction,
+                                seed=prep.seed, aspect=prep.aspect, max_wall_speed=prep.max_wall_speed, **parameters)
     from .parameters import check_time_step
 
     check_time_step(sim.parameters.time_step, prep.max_wall_speed, float(sim.radius.min()),
                     "a closing wall of the compaction")
     steps = isotropic_compaction(sim, max_steps=prep.max_steps, max_inertia_number=prep.max_inertia_number,
-                                 pressure_ramp=prep.pressure_ramp, progress=progress)
+                                 pressure_ramp=prep.pressure_ramp, progress=progress, checkpoint=checkpoint,
+                                 resume=resumed)
     sim.history.compaction_steps = steps
     sim.history.compaction_unconverged = sim.take_unconverged()
     sim.set_parameters(friction=prep.friction)

@@ -98,7 +98,7 @@ def inertia_number_speed(inertia_number, size, mean_diameter, density, sigma0):
 
 def isotropic_compaction(sim: Simulation, *, max_steps=Preparation.max_steps, window=200, stress_tolerance=0.01,
                          strain_rate_tolerance=1e-3, max_inertia_number=Preparation.max_inertia_number,
-                         pressure_ramp=Preparation.pressure_ramp, progress=None):
+                         pressure_ramp=Preparation.pressure_ramp, progress=None, checkpoint=None, resume=None):
     """Step ``sim`` until the last ``window`` steps are at equilibrium (:func:`is_equilibrium`)
     or for ``max_steps``. Returns the number of steps taken and records in ``sim.history``
     (:class:`solver.sample_history.SampleHistory`) ``settled`` (False when ``max_steps`` ran
@@ -113,47 +113,61 @@ def isotropic_compaction(sim: Simulation, *, max_steps=Preparation.max_steps, wi
     the wall, d the mean diameter), on top of the walls' own ``max_speed``. With
     ``pressure_ramp`` (s) the stress on the pushed walls rises linearly from 0 to its target
     over that time; equilibrium is only looked for once the ramp is over.
+
+    Checkpoints: ``checkpoint`` (a :class:`solver.compaction_checkpoint.CompactionCheckpoint`)
+    writes the compaction's state when it is due and when Ctrl-C or SIGTERM stops the loop;
+    ``resume`` (the :class:`solver.compaction_checkpoint.CompactionProgress` that
+    :meth:`~solver.compaction_checkpoint.CompactionCheckpoint.load` returns with ``sim``) goes on
+    from it, so that the steps taken are those of an uninterrupted compaction, bit for bit, and
+    the number returned counts the steps before the checkpoint too.
     """
-    from collections import deque
+    from .compaction_checkpoint import CompactionProgress
 
     check_values(Preparation, max_inertia_number=max_inertia_number, pressure_ramp=pressure_ramp)
     sigma0 = sim.history.sigma0
     h = sim.parameters.time_step
     driven = np.flatnonzero(sim.walls.mode == STRESS)
-    target = sim.walls.stress[driven].copy()
-    own_cap = sim.walls.max_speed[driven].copy()
+    state = CompactionProgress.start(sim.walls, driven, window) if resume is None else resume
     mean_diameter = 2.0 * float(sim.radius.mean())
     scale = mean_diameter * np.sqrt(sim.parameters.density / sigma0)
     ramp_steps = int(np.ceil(pressure_ramp / h))
-    stresses, rates = deque(maxlen=window), deque(maxlen=window)
-    largest_inertia = 0.0
+    stresses, rates = state.stresses, state.rates
     sim.history.settled = False
     with interruptible() as flag, progress_bar(max_steps, "isotropic compaction", progress) as bar:
-        for k in range(max_steps):
+        bar.update(state.steps)
+        for k in range(state.steps, max_steps):
             if k < ramp_steps:
-                sim.walls.stress[driven] = target * (k + 1) / ramp_steps
+                sim.walls.stress[driven] = state.target * (k + 1) / ramp_steps
             if max_inertia_number is not None:
                 size = _box_size_across(sim)[driven]
                 sim.walls.max_speed[driven] = np.minimum(
-                    own_cap, inertia_number_speed(max_inertia_number, size, mean_diameter,
-                                                  sim.parameters.density, sigma0))
+                    state.own_cap, inertia_number_speed(max_inertia_number, size, mean_diameter,
+                                                        sim.parameters.density, sigma0))
             sim.step()
             bar.update(1)
             stress, rate = wall_state(sim)
-            largest_inertia = max(largest_inertia, float(np.max(np.abs(rate[driven]), initial=0.0)) * scale)
+            state.largest_inertia = max(state.largest_inertia,
+                                        float(np.max(np.abs(rate[driven]), initial=0.0)) * scale)
             stresses.append(stress[driven])
             rates.append(rate[driven])
+            state.steps = k + 1
             if k >= ramp_steps and len(stresses) == window and k % 10 == 0 and is_equilibrium(
                     stresses, rates, sigma0, stress_tolerance, strain_rate_tolerance):
                 sim.history.settled = True
                 break
             if flag["stop"]:
+                if checkpoint is not None:
+                    checkpoint.write(sim, state)
+                    print(f"{stop_reason(flag)} after compaction step {state.steps}: {checkpoint.path} holds the "
+                          "compaction so far; the same command resumes it", file=sys.stderr)
                 raise stop_exception(flag)
-    sim.walls.stress[driven] = target
+            if checkpoint is not None and state.steps < max_steps and checkpoint.due(state.steps):
+                checkpoint.write(sim, state)
+    sim.walls.stress[driven] = state.target
     sim.history.compaction_stress = np.mean(stresses, axis=0) if stresses else np.zeros(len(driven))
-    sim.history.compaction_inertia_number = largest_inertia
+    sim.history.compaction_inertia_number = state.largest_inertia
     sim.walls.max_speed[:] = np.inf
-    return k + 1
+    return state.steps
 
 
 def _box_size_across(sim):
