@@ -31,14 +31,12 @@ from __future__ import annotations
 
 import itertools
 import logging
-import math
 import os
 import time
 import warnings
 from dataclasses import dataclass, field
 from pathlib import Path
 
-import numpy as np
 
 from grainview.contract.errors import ConvergenceWarning, FileFormatError, ParameterError
 
@@ -150,21 +148,11 @@ def file_state(path) -> str:
 
 
 def _check_settings(path, spec: RunSpec):
-    """Refuse to resume a file written with other settings than ``spec``."""
-    from grainview.contract.reader import ContractFile
+    """Refuse to resume a file written with other settings than ``spec``
+    (:func:`solver.restart.check_settings`)."""
+    from .restart import check_settings
 
-    with ContractFile(path) as ds:
-        attrs = dict(ds.attrs)
-    for key, want in spec.expected_attrs().items():
-        have = attrs.get(key)
-        if isinstance(want, bool):
-            want = int(want)
-        numeric = isinstance(want, (int, float, np.integer, np.floating)) and not isinstance(have, str)
-        same = have is not None and (math.isclose(float(have), float(want), rel_tol=1e-12) if numeric
-                                     else str(have) == str(want))
-        if not same:
-            raise FileExistsError(f"{path} holds another run ({key} = {have}, this run's is {want}); "
-                                  "pass overwrite=True to replace it")
+    check_settings(path, spec.expected_attrs())
 
 
 def run_one(spec: RunSpec, folder, *, overwrite=False, progress=None, compress=True) -> dict:

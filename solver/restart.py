@@ -211,6 +211,28 @@ def file_state(path) -> str:
     return "finished" if done >= test["n_steps"] else "partial"
 
 
+def check_settings(path, expected, advice="pass overwrite=True to replace it"):
+    """Refuse, in one :class:`FileExistsError` line naming the first difference and ``advice``,
+    to resume or keep the run in ``path`` when its global attributes differ from ``expected``
+    (name -> value: numbers equal to 1e-12 relative, other values as text; a bool as 0/1): a
+    run of other settings than the ones asked for is neither resumed nor taken as finished."""
+    import math
+
+    with ContractFile(os.fspath(path)) as ds:
+        attrs = dict(ds.attrs)
+    for key, want in expected.items():
+        have = attrs.get(key)
+        if isinstance(want, bool):
+            want = int(want)
+        if want is None:
+            want = "none"
+        numeric = isinstance(want, (int, float, np.integer, np.floating)) and not isinstance(have, str)
+        same = have is not None and (math.isclose(float(have), float(want), rel_tol=1e-12) if numeric
+                                     else str(have) == str(want))
+        if not same:
+            raise FileExistsError(f"{path} holds another run ({key} = {have}, this run's is {want}); {advice}")
+
+
 def resume(path, progress=None, compress=True) -> int:
     """Continue the biaxial test written to ``path`` from its last complete snapshot until its
     strain target, appending the snapshots to the same file. Returns the number of steps
