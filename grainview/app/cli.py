@@ -223,13 +223,15 @@ def _warmup(args) -> int:
     return 0
 
 
-def _preparation(args, shape):
+def _preparation(args, shape, particles=None):
     """The :class:`solver.preparation.Preparation` the command line asks for: the named preset
-    with the preparation's settings given on the command line (:data:`PREPARATION_OPTIONS`)."""
+    with the preparation's settings given on the command line (:data:`PREPARATION_OPTIONS`);
+    ``particles``: the sample's size (default ``--particles``)."""
     from solver.preparation import preparation
 
     changes = {name: getattr(args, name) for name in PREPARATION_OPTIONS if name in _given(args)}
-    return preparation(args.preparation, particles=args.particles, shape=shape, seed=args.seed, **changes)
+    particles = args.particles if particles is None else particles
+    return preparation(args.preparation, particles=particles, shape=shape, seed=args.seed, **changes)
 
 
 def _solver_parameters(args) -> dict:
@@ -367,16 +369,19 @@ def _shape_of(text, option=None):
 
 
 def _simulate(prep, path, *, test, near_contacts, overwrite, progress, scene="biaxial", parameters=None,
-              compress=True, engine=None):
+              compress=True, engine=None, checkpoint=None, label=None):
     """Deposit, compact isotropically (as ``prep`` says) and, for ``scene="biaxial"``, shear
     one sample in the biaxial ``test`` (:class:`solver.parameters.BiaxialTest`) into ``path``,
     with the engine named ``engine`` (:mod:`solver.engine`; None: the default); returns the
     path. An isotropic run writes its compacted state. ``parameters``: solver settings
-    (:class:`solver.Parameters` fields) other than the defaults."""
+    (:class:`solver.Parameters` fields) other than the defaults. ``checkpoint``: the file where
+    the compaction saves its state as it goes and resumes from (:func:`solver.engine.prepare`).
+    ``label``: the sample's name in the messages (default: its shape's)."""
     import warnings
 
     from solver.engine import DEFAULT_ENGINE
     from solver.engine import engine as engine_named
+    from solver.engine import prepare
 
     runner = engine_named(engine or DEFAULT_ENGINE)
     path = Path(path)
@@ -384,11 +389,11 @@ def _simulate(prep, path, *, test, near_contacts, overwrite, progress, scene="bi
         raise GrainviewError(f"{path} exists; pass --overwrite to replace it")
     from solver.shape_families import shape_label
 
-    name = shape_label(prep.shape)
+    name = label or shape_label(prep.shape)
     print(f"{name}: depositing {prep.particles} particles and compacting under {prep.sigma0:g} Pa ...", flush=True)
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
-        sample = runner.prepare(prep, parameters or {}, progress=progress)
+        sample = prepare(runner, prep, parameters or {}, progress=progress, checkpoint=checkpoint)
         history = sample.history
         settled = "settled" if history.settled else "NOT settled (step limit reached)"
         print(f"{name}: compaction {settled} after {history.compaction_steps} steps; wall stresses "
@@ -397,7 +402,8 @@ def _simulate(prep, path, *, test, near_contacts, overwrite, progress, scene="bi
             runner.write_state(sample, path, attrs={"scene": "isotropic"}, overwrite=overwrite,
                                near_contacts=near_contacts, compress=compress)
         else:
-            print(f"{name}: biaxial compression to eps_1 = {test.strain} at {test.velocity:g} m/s ...", flush=True)
+            print(f"{name}: biaxial compression to eps_1 = {test.strain} at {test.velocity:g} m/s{_inertia(sample, test)}"
+                  " ...", flush=True)
             runner.shear(sample, path, test, overwrite=overwrite, progress=progress, attrs=history.attrs(),
                          near_contacts=near_contacts, compress=compress)
     unconverged = sum(issubclass(w.category, ConvergenceWarning) for w in caught)
@@ -405,6 +411,18 @@ def _simulate(prep, path, *, test, near_contacts, overwrite, progress, scene="bi
         print(f"{name}: warning: {_unconverged_warning(sample, path, unconverged)}", file=sys.stderr)
     print(f"{name}: wrote {path}", flush=True)
     return path
+
+
+def _inertia(sample, test) -> str:
+    """The test's inertia numbers at its start, in words (:func:`solver.paper_size.inertia_numbers`),
+    or "" for a sample that is not this package's simulation."""
+    from solver.paper_size import inertia_numbers
+
+    try:
+        paper, grain = inertia_numbers(sample, test.velocity)
+    except AttributeError:  # another engine's sample
+        return ""
+    return f" (inertia number I = {paper:.1e}, the paper's eps_dot sqrt(m/p); grain-scale {grain:.1e})"
 
 
 def _unconverged_warning(sim, path, unconverged) -> str:
@@ -611,8 +629,118 @@ def _ensemble(args) -> int:
     return _ensemble_report(args)
 
 
+def _study_particles(args) -> dict:
+    """The study's sample sizes, label -> particles: ``--particles N`` for both samples,
+    ``--particles N1,N2`` for the pentagons and the disks, ``--paper-size`` the paper's
+    (:data:`solver.paper_size.PAPER_PARTICLES`)."""
+    from solver.paper_size import PAPER_PARTICLES
+
+    if args.paper_size:
+        if "particles" in _given(args):
+            raise GrainviewError(f"--paper-size sets --particles ({PAPER_PARTICLES['pentagon']},"
+                                 f"{PAPER_PARTICLES['disk']}); expected one of them")
+        return {label: PAPER_PARTICLES[shape] for label, shape in STUDY_SAMPLES.items()}
+    text = str(args.particles)
+    try:
+        values = [int(v) for v in text.split(",")]
+    except ValueError:
+        values = []
+    if len(values) not in (1, len(STUDY_SAMPLES)):
+        raise GrainviewError(f"--particles {text}: expected one whole number for both samples or "
+                             f"{len(STUDY_SAMPLES)}, comma-separated ({','.join(STUDY_SAMPLES)}), e.g. 14400,10000")
+    values = values * len(STUDY_SAMPLES) if len(values) == 1 else values
+    return dict(zip(STUDY_SAMPLES, values))
+
+
+def _study_tests(args, particles) -> dict:
+    """The study's biaxial test of each sample, label -> :class:`solver.parameters.BiaxialTest`:
+    the command line's; with ``--paper-size`` and no ``--velocity``, each sample's top wall at
+    the strain rate of 400 particles at 1 cm/s (:func:`solver.paper_size.velocity_for`)."""
+    from dataclasses import replace
+
+    from solver.paper_size import velocity_for
+
+    test = _test(args)
+    if not args.paper_size or "velocity" in _given(args):
+        return dict.fromkeys(particles, test)
+    return {label: replace(test, velocity=velocity_for(n)) for label, n in particles.items()}
+
+
+def _study_state(runner, label, path, checkpoint, expected, overwrite) -> str:
+    """What is to be done for one sample of the study: "finished" (its file complete),
+    "partial" (its test to be resumed) or "start" (from its compaction's checkpoint when there
+    is one, else from its deposit). A file or checkpoint of other settings is refused in one
+    line, unless ``overwrite`` (then both are removed and the sample starts afresh)."""
+    from solver.restart import check_settings
+
+    if overwrite:
+        checkpoint.unlink(missing_ok=True)
+        return "start"
+    state = runner.file_state(path)
+    if state in ("finished", "partial"):
+        check_settings(path, expected, "pass --overwrite to replace it, or give the settings it was made with")
+        checkpoint.unlink(missing_ok=True)  # the compaction is in the test's file now
+        return state
+    return "start"
+
+
+def _expected_attrs(prep, test, parameters) -> dict:
+    """File attributes a study file of ``prep`` sheared in ``test`` with the solver settings
+    ``parameters`` (the command line's :data:`SOLVER_OPTIONS`, given or default) holds."""
+    return {"strain_target": test.strain, "wall_velocity_m_s": test.velocity, "snapshot_every": test.every,
+            "solver_friction": prep.friction, "sigma0_Pa": prep.sigma0, **prep.attrs(),
+            **{f"solver_{k}": v for k, v in parameters.items()}}
+
+
+def _study_sample(label, prep, path, state, checkpoint, *, test, near_contacts, overwrite, progress,
+                  parameters=None, compress=True, engine=None):
+    """One sample of the study: skipped when finished (a file whose compression was stopped is
+    compressed), its test resumed when partial, else prepared (from the compaction's
+    checkpoint ``checkpoint`` when it holds one) and sheared into ``path``; the checkpoint is
+    removed once the test's file is complete."""
+    from solver.engine import DEFAULT_ENGINE
+    from solver.engine import engine as engine_named
+
+    runner = engine_named(engine or DEFAULT_ENGINE)
+    if state == "finished":
+        runner.resume(path, progress=progress, compress=compress)
+        print(f"{label}: {path} is complete (skipped)", flush=True)
+        return path
+    if state == "partial":
+        print(f"{label}: resuming the test in {path} ...", flush=True)
+        steps = runner.resume(path, progress=progress, compress=compress)
+        print(f"{label}: resumed for {steps} steps; wrote {path}", flush=True)
+        return path
+    _simulate(prep, path, test=test, near_contacts=near_contacts, overwrite=True, progress=progress,
+              parameters=parameters, compress=compress, engine=engine, checkpoint=checkpoint, label=label)
+    Path(checkpoint).unlink(missing_ok=True)
+    return path
+
+
+def _print_estimate(preps, tests, parameters, jobs):
+    """Print the expected steps and wall time of each stage of each sample, and of the study,
+    with where the costs come from (:func:`solver.paper_size.estimate`)."""
+    from solver.paper_size import estimate, hours
+    from solver.parameters import Parameters
+
+    p = Parameters(**parameters)
+    totals = {}
+    for label, prep in preps.items():
+        stages = estimate(prep, tests[label], p.time_step, p.domains)
+        totals[label] = sum(stage[2] for stage in stages.values())
+        for stage, (steps, cost, seconds, source) in stages.items():
+            print(f"estimate: {label} ({prep.particles}), {stage}: ~{steps} steps x {cost:.3g} us per particle and "
+                  f"step = ~{hours(seconds)} ({source})", flush=True)
+    whole = max(totals.values()) if jobs > 1 else sum(totals.values())
+    print(f"estimate: the study ~{hours(whole)} of wall time ({'side by side' if jobs > 1 else 'one after the other'}"
+          f", {'serial sweeps' if p.domains <= 1 else f'{p.domains} domains'}), within a factor of about 2; a "
+          "stopped or killed run resumes with the same command", flush=True)
+
+
 def _study(args) -> int:
     from concurrent.futures import ProcessPoolExecutor
+
+    from solver.engine import engine
 
     _test(args)
     if args.jobs < 1:
@@ -625,30 +753,112 @@ def _study(args) -> int:
                              f"{os.cpu_count()}: a busy core stalls every parallel sweep; pass --jobs 1")
     out = Path(args.out)
     samples = STUDY_SAMPLES
-    preps = {label: _preparation(args, shape) for label, shape in samples.items()}
-    for prep in preps.values():
-        _check_settings(args, prep)
+    particles = _study_particles(args)
+    tests = _study_tests(args, particles)
+    preps = {label: _preparation(args, shape, particles[label]) for label, shape in samples.items()}
+    parameters = _solver_parameters(args)
+    runner = engine(args.engine)
+    for label, prep in preps.items():
+        runner.check(prep, parameters, tests[label])
     paths = {label: out / f"{label}.nc" for label in samples}
-    if not args.overwrite:
-        for path in paths.values():
-            if path.exists():
-                raise GrainviewError(f"{path} exists; pass --overwrite to replace it")
+    checkpoints = {label: out / f"{label}.compaction.nc" for label in samples}
+    if out.is_file():
+        raise GrainviewError(f"--out {out} is a file; expected a folder")
+    from solver.parameters import Parameters, default_of
+
+    recorded = {name: parameters.get(name, default_of(Parameters, name)) for name in SOLVER_OPTIONS}
+    states = {label: _study_state(runner, label, paths[label], checkpoints[label],
+                                  _expected_attrs(preps[label], tests[label], recorded), args.overwrite)
+              for label in samples}
     out.mkdir(parents=True, exist_ok=True)
+    for label, state in states.items():
+        if state == "start" and checkpoints[label].exists():
+            print(f"{label}: resuming the compaction from {checkpoints[label]}", flush=True)
+    if any(state != "finished" for state in states.values()):
+        _print_estimate(preps, tests, parameters, args.jobs)
     args.near_contacts = True  # the report counts near pairs as well (docs/fidelity.md)
     kwargs = _simulation_kwargs(args)
+    kwargs.pop("test")
+    kwargs["overwrite"] = args.overwrite
     if args.jobs == 1:
         for label in samples:
-            _simulate(preps[label], paths[label], **kwargs)
+            _study_sample(label, preps[label], paths[label], states[label], checkpoints[label], test=tests[label],
+                          **kwargs)
     else:  # one process per sample: the two samples run side by side on two cores
-        kwargs["progress"] = False
+        kwargs["progress"] = _SampleProgress.for_jobs(kwargs["progress"])
         with ProcessPoolExecutor(max_workers=min(args.jobs, len(samples))) as pool:
-            futures = [pool.submit(_simulate, preps[label], paths[label], **kwargs) for label in samples]
+            futures = [pool.submit(_study_sample, label, preps[label], paths[label], states[label],
+                                   checkpoints[label], test=tests[label],
+                                   **{**kwargs, "progress": kwargs["progress"] and kwargs["progress"].at(i, label)})
+                       for i, label in enumerate(samples)]
             for future in futures:
                 future.result()
+    report = out / "report"
+    if all(state == "finished" for state in states.values()) and (report / "headline.csv").exists():
+        print(f"study: every sample was complete already and {report} holds their report; nothing to do "
+              "(--overwrite runs the study again)", flush=True)
+        return 0
     args.files = [str(p) for p in paths.values()]
     args.labels = ",".join(paths)
-    args.out = str(out / "report")
+    args.out = str(report)
+    args.overwrite = True  # the report of the files just completed replaces an older one of the same folder
     return _report(args)
+
+
+class _SampleProgress:
+    """The progress of one sample of a study run side by side with the others: a tqdm bar at
+    its own line in a terminal, else a line every :attr:`every` seconds (steps done, elapsed,
+    expected to go). Called as ``progress(total, desc)`` (:func:`solver.interrupt.progress_bar`);
+    picklable, for the worker processes."""
+
+    every = 60.0
+
+    def __init__(self, terminal, position=0, label=""):
+        self.terminal, self.position, self.label = terminal, position, label
+
+    @classmethod
+    def for_jobs(cls, flag):
+        """The progress of side-by-side samples for the command line's ``--progress`` (None:
+        auto, True: on, False: off): None when off."""
+        if flag is False:
+            return False
+        return cls(terminal=sys.stderr.isatty() or flag is True)
+
+    def at(self, position, label):
+        return _SampleProgress(self.terminal, position, label)
+
+    def __call__(self, total, desc):
+        if self.terminal:
+            from tqdm.std import tqdm
+
+            return tqdm(total=total, desc=f"{self.label}: {desc}", unit="step", position=self.position, leave=False)
+        return _ProgressLines(total, f"{self.label}: {desc}", self.every)
+
+
+class _ProgressLines:
+    """A progress bar as lines on stdout, one every ``every`` seconds (a log file's progress)."""
+
+    def __init__(self, total, desc, every):
+        import time
+
+        self.total, self.desc, self.every, self.done = total, desc, every, 0
+        self.start = self.last = time.monotonic()
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc):
+        return False
+
+    def update(self, n):
+        import time
+
+        self.done += n
+        now = time.monotonic()
+        if now - self.last >= self.every:
+            self.last = now
+            elapsed = now - self.start
+            print(f"{self.desc}: step {self.done} of at most {self.total}, {elapsed / 60:.0f} min", flush=True)
 
 
 def _no_compress_option(p):
@@ -692,13 +902,18 @@ def _test_options(p):
     setting_option(p, BiaxialTest, "every")
 
 
-def _simulation_options(p):
+def _simulation_options(p, samples=1):
     """The options of ``run`` and ``study``: the sample, the test, the solver's settings and
-    the preparation, each from its record's field (:func:`setting_option`)."""
+    the preparation, each from its record's field (:func:`setting_option`). ``samples``: the
+    samples a command makes (the study's ``--particles`` takes one size or one per sample)."""
     from solver.parameters import Parameters
     from solver.preparation import DEFAULT_PRESET, Preparation, preset_names
 
-    setting_option(p, Preparation, "particles")
+    if samples > 1:
+        setting_option(p, Preparation, "particles", type=str, more=f"; or {samples}, comma-separated, one per "
+                       f"sample ({','.join(STUDY_SAMPLES)}), e.g. 14400,10000")
+    else:
+        setting_option(p, Preparation, "particles")
     _test_options(p)
     setting_option(p, Preparation, "seed")
     physics = p.add_argument_group("physics and numerics (defaults: the paper's)")
@@ -727,12 +942,24 @@ def _study_parser(sub):
                            description="Deposit, compact (10 kPa) and shear an S1-like pentagon sample and an "
                            "S2-like disk sample into the residual state, side by side, then write the report "
                            "(table vs the paper, figures). The files hold the near contacts too, so the table "
-                           "also counts them (docs/fidelity.md).")
+                           "also counts them (docs/fidelity.md). The same command again, after a stop (Ctrl-C, "
+                           "SIGTERM) or a kill, skips the finished samples and resumes the others where they were: "
+                           "a test from its file, a compaction from its checkpoint OUT/<sample>.compaction.nc "
+                           "(written every ten minutes and when stopped); files of other settings are refused "
+                           "unless --overwrite.")
     study.add_argument("--out", default="study", help="output folder (default: study)")
     study.add_argument("--jobs", type=int, default=len(STUDY_SAMPLES),
                        help=f"processes: the {len(STUDY_SAMPLES)} samples side by side (default {len(STUDY_SAMPLES)})")
+    from solver.paper_size import PAPER_PARTICLES, REFERENCE_PARTICLES, REFERENCE_VELOCITY
+
+    study.add_argument("--paper-size", action="store_true",
+                       help=f"the paper's sizes: {PAPER_PARTICLES['pentagon']} pentagons and {PAPER_PARTICLES['disk']} "
+                       f"disks, each top wall at the strain rate of {REFERENCE_PARTICLES} particles at "
+                       f"{REFERENCE_VELOCITY:g} m/s (speed x sqrt(N/{REFERENCE_PARTICLES}): 0.06 and 0.05 m/s; "
+                       "--velocity V shears both at V); hours on two cores, resumable: the same command again "
+                       "goes on where a stopped or killed run was (docs/fidelity.md, section 4)")
     _residual_option(study)
-    _simulation_options(study)
+    _simulation_options(study, samples=len(STUDY_SAMPLES))
     study.set_defaults(func=_study)
 
 
