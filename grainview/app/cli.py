@@ -794,6 +794,8 @@ def _study(args) -> int:
             for future in futures:
                 future.result()
     report = out / "report"
+    if args.no_report:
+        return 0
     if all(state == "finished" for state in states.values()) and (report / "headline.csv").exists():
         print(f"study: every sample was complete already and {report} holds their report; nothing to do "
               "(--overwrite runs the study again)", flush=True)
@@ -958,6 +960,8 @@ def _study_parser(sub):
                        f"{REFERENCE_VELOCITY:g} m/s (speed x sqrt(N/{REFERENCE_PARTICLES}): 0.06 and 0.05 m/s; "
                        "--velocity V shears both at V); hours on two cores, resumable: the same command again "
                        "goes on where a stopped or killed run was (docs/fidelity.md, section 4)")
+    study.add_argument("--no-report", action="store_true",
+                       help="simulate only (grainview report OUT/pentagons.nc OUT/disks.nc --out DIR reports later)")
     _residual_option(study)
     _simulation_options(study, samples=len(STUDY_SAMPLES))
     study.set_defaults(func=_study)
