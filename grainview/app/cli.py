@@ -390,7 +390,10 @@ def _simulate(prep, path, *, test, near_contacts, overwrite, progress, scene="bi
     from solver.shape_families import shape_label
 
     name = label or shape_label(prep.shape)
-    print(f"{name}: depositing {prep.particles} particles and compacting under {prep.sigma0:g} Pa ...", flush=True)
+    if checkpoint is not None and Path(checkpoint).exists():
+        print(f"{name}: resuming the compaction of {prep.particles} particles from {checkpoint} ...", flush=True)
+    else:
+        print(f"{name}: depositing {prep.particles} particles and compacting under {prep.sigma0:g} Pa ...", flush=True)
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
         sample = prepare(runner, prep, parameters or {}, progress=progress, checkpoint=checkpoint)
@@ -771,9 +774,6 @@ def _study(args) -> int:
                                   _expected_attrs(preps[label], tests[label], recorded), args.overwrite)
               for label in samples}
     out.mkdir(parents=True, exist_ok=True)
-    for label, state in states.items():
-        if state == "start" and checkpoints[label].exists():
-            print(f"{label}: resuming the compaction from {checkpoints[label]}", flush=True)
     if any(state != "finished" for state in states.values()):
         _print_estimate(preps, tests, parameters, args.jobs)
     args.near_contacts = True  # the report counts near pairs as well (docs/fidelity.md)
