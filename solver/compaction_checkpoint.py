@@ -2,10 +2,11 @@
 resumes where it was, bit for bit, instead of starting again from its deposit.
 
 A compaction's state is the simulation's (particles, walls, the warm start of the next step,
-time, step index: what a snapshot of the data contract holds, :mod:`solver.restart`) and the
-loop's own (:class:`CompactionProgress`: steps taken, the equilibrium test's window of wall
-stresses and strain rates, the largest inertia number so far, the walls' target stress and
-own speed cap, the unconverged steps so far). :class:`CompactionCheckpoint` writes both into
+time, step index: what a snapshot of the data contract holds, :mod:`solver.restart`; the
+unconverged steps so far) and the loop's own
+(:class:`solver.compaction_progress.CompactionProgress`: steps taken, the equilibrium test's
+window of wall stresses and strain rates, the largest inertia number so far, the walls' target
+stress and own speed cap). :class:`CompactionCheckpoint` writes both into
 one file of the contract (one snapshot, ``scene = "compaction"``; the loop's state as global
 attributes ``checkpoint_*``) every ``every_steps`` steps or ``every_seconds`` of wall time, and
 when Ctrl-C or SIGTERM stops the compaction. Each checkpoint is written whole under a hidden
@@ -23,12 +24,11 @@ from __future__ import annotations
 import json
 import os
 import time
-from collections import deque
-from dataclasses import asdict, dataclass, field
-
-import numpy as np
+from dataclasses import asdict
 
 from grainview.contract.errors import FileFormatError
+
+from .compaction_progress import CompactionProgress
 
 CHECKPOINT_SECONDS = 600.0
 """Default wall time between two checkpoints, s: at most ten minutes of a compaction is redone
@@ -36,65 +36,6 @@ after a kill (a 14,400-pentagon step takes about 0.1-0.4 s, a checkpoint file a 
 
 SCENE = "compaction"
 """The ``scene`` attribute of a checkpoint file."""
-
-
-@dataclass
-class CompactionProgress:
-    """The state of :func:`solver.scenes.isotropic_compaction`'s loop besides the simulation.
-
-    Attributes
-    ----------
-    steps : int
-        Compaction steps taken.
-    target : ndarray
-        The stress-driven walls' target stress, Pa (the pressure ramp rises to it).
-    own_cap : ndarray
-        The stress-driven walls' own cap of their inward speed, m s-1 (the inertia-number cap is
-        applied below it).
-    stresses, rates : deque of ndarray
-        The last ``window`` steps' stresses on (Pa) and strain rates of (s-1) the driven walls,
-        for the equilibrium test (:func:`solver.scenes.is_equilibrium`).
-    largest_inertia : float
-        The largest inertia number of a driven wall so far.
-    """
-
-    steps: int
-    target: np.ndarray
-    own_cap: np.ndarray
-    stresses: deque = field(default_factory=deque)
-    rates: deque = field(default_factory=deque)
-    largest_inertia: float = 0.0
-
-    @classmethod
-    def start(cls, walls, driven, window) -> CompactionProgress:
-        """The state before the first step: the driven walls' stresses and speed caps as set."""
-        return cls(0, walls.stress[driven].copy(), walls.max_speed[driven].copy(), deque(maxlen=window),
-                   deque(maxlen=window))
-
-    def attrs(self) -> dict:
-        """The state as ``checkpoint_*`` file attributes (the windows as flat arrays)."""
-        width = len(self.target)
-        return {"checkpoint_steps": int(self.steps), "checkpoint_window": int(self.stresses.maxlen),
-                "checkpoint_target_stress_Pa": self.target.astype("f8"),
-                "checkpoint_own_cap_m_s": self.own_cap.astype("f8"),
-                "checkpoint_stresses_Pa": np.asarray(list(self.stresses), "f8").reshape(-1, width).ravel(),
-                "checkpoint_rates_s": np.asarray(list(self.rates), "f8").reshape(-1, width).ravel(),
-                "checkpoint_largest_inertia": float(self.largest_inertia)}
-
-    @classmethod
-    def from_attrs(cls, attrs) -> CompactionProgress:
-        """The state :meth:`attrs` wrote."""
-        target = np.atleast_1d(np.asarray(attrs["checkpoint_target_stress_Pa"], float))
-        window = int(attrs["checkpoint_window"])
-
-        def rows(name):
-            flat = np.atleast_1d(np.asarray(attrs[name], float))
-            return deque(list(flat.reshape(-1, len(target))), maxlen=window)
-
-        return cls(int(attrs["checkpoint_steps"]), target,
-                   np.atleast_1d(np.asarray(attrs["checkpoint_own_cap_m_s"], float)),
-                   rows("checkpoint_stresses_Pa"), rows("checkpoint_rates_s"),
-                   float(attrs["checkpoint_largest_inertia"]))
 
 
 def describe(preparation, parameters) -> str:

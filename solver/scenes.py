@@ -116,12 +116,12 @@ def isotropic_compaction(sim: Simulation, *, max_steps=Preparation.max_steps, wi
 
     Checkpoints: ``checkpoint`` (a :class:`solver.compaction_checkpoint.CompactionCheckpoint`)
     writes the compaction's state when it is due and when Ctrl-C or SIGTERM stops the loop;
-    ``resume`` (the :class:`solver.compaction_checkpoint.CompactionProgress` that
+    ``resume`` (the :class:`solver.compaction_progress.CompactionProgress` that
     :meth:`~solver.compaction_checkpoint.CompactionCheckpoint.load` returns with ``sim``) goes on
     from it, so that the steps taken are those of an uninterrupted compaction, bit for bit, and
     the number returned counts the steps before the checkpoint too.
     """
-    from .compaction_checkpoint import CompactionProgress
+    from .compaction_progress import CompactionProgress
 
     check_values(Preparation, max_inertia_number=max_inertia_number, pressure_ramp=pressure_ramp)
     sigma0 = sim.history.sigma0

@@ -41,6 +41,8 @@ def test_every_derived_option_has_its_fields_default_type_and_help():
             assert f"default {shown}" in action.help, action.help
             if f.metadata.get("choices"):
                 assert tuple(action.choices) == tuple(f.metadata["choices"]())
+            elif command == "study" and action.dest == "particles":  # one size, or one per sample: parsed by the study
+                assert action.type is str and "comma-separated, one per sample" in action.help
             else:
                 first = str(f.type).split("|")[0].strip()  # float | None: float
                 assert action.type is {"float": float, "int": int, "str": str}[first]
