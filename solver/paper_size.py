@@ -12,11 +12,12 @@ speed between 0.5 and 8 cm/s at 400 particles).
 Wall time. A stage's time is its steps x N x the measured microseconds per particle and step
 (:data:`COSTS`, each with its source). The test's steps are
 :meth:`solver.parameters.Preparation.test_steps` (the deposit's height: a slight
-overestimate); the compaction's are the measured steps at the measured size scaled as sqrt(N)
+overestimate); the compaction's are the steps at the size of :data:`COSTS` scaled as sqrt(N)
 (the 'fast' route's 14,400 pentagons took 6991 steps where sqrt(N) from 4000 predicted 7231).
-The costs were measured at the start of a shear or over a compaction on a shared 2-core VM;
-the sweeps per step, and with them the cost, vary by a factor of about 2 along a shear at
-14,400 (docs/solver.md, "Known limits"): read an estimate as within a factor of 2.
+The costs come from benchmarks on a shared 2-core VM, measured over part of a shear and
+extrapolated for the compaction; the sweeps per step, and with them the cost, vary by a factor
+of about 2 along a shear at 14,400 (docs/solver.md, "Known limits"): read an estimate as
+within a factor of 2.
 """
 
 from __future__ import annotations
@@ -71,16 +72,21 @@ class Cost:
 
 
 COSTS = {
-    # 4000 pentagons, 'paper' route, Anderson sweeps: 730 s of CPU for 11,591 steps; on 2 domains the 1.54x of
-    # the 'fast' route. The cost per particle grew from 8.7 to 15.8 us between 1000 and 4000: a lower bound.
-    ("pentagon", "compaction"): Cost(4000, 15.8, 15.8 / 1.54, 11591,
-                                     "benchmarks/results/compaction.md, 4000 pentagons, 'paper' route; more at larger N"),
-    # no disk compaction was measured at this size: the pentagons', an upper bound (a disk step costs half a
-    # pentagon's in the shear)
-    ("disk", "compaction"): Cost(4000, 15.8, 15.8 / 1.54, 11591,
-                                 "the pentagons' (no disk compaction measured at this size), an upper bound"),
-    # 200 biaxial steps early in the shear of dense samples (the sweeps per step vary along a shear)
-    ("pentagon", "test"): Cost(14400, 9.15, 6.58, None, "benchmarks/RESULTS.md section a, 14,400 dense pentagons"),
+    # the 'paper' route with Anderson sweeps: 22,923 steps at 14,400 pentagons, 2.52 h serially, the time per
+    # particle and step grown from the compactions measured at 1000 and 4000 (8.6 and 15.8 us) as N^0.43;
+    # on 2 domains the 1.54x measured on the 4000-pentagon 'fast' route (benchmarks/results/compaction.md)
+    ("pentagon", "compaction"): Cost(14400, 27.5, 27.5 / 1.54, 22923,
+                                     "benchmarks/archive/time-to-strain.md, 14,400 pentagons, 'paper' route, "
+                                     "extrapolated from 1000 and 4000"),
+    # disks settle in far fewer steps: 2001 measured at 14,400; the time per step as the pentagons'
+    ("disk", "compaction"): Cost(14400, 27.5, 27.5 / 1.54, 2001,
+                                 "benchmarks/archive/time-to-strain.md, 14,400 disks: steps measured, time per "
+                                 "step extrapolated"),
+    # the first 0.01 of eps_q of a 14,400-pentagon shear, 6651 steps (2026-11-25, commit 80ed2db), where the
+    # sweeps per step are the shear's highest (a 200-step window of benchmarks/RESULTS.md section a: 9.15 / 6.58)
+    ("pentagon", "test"): Cost(14400, 14.9, 7.1, None,
+                               "benchmarks/archive/time-to-strain.md, 14,400 pentagons sheared to eps_q = 0.01"),
+    # 200 biaxial steps early in the shear of 14,400 dense disks
     ("disk", "test"): Cost(14400, 4.05, 2.02, None, "benchmarks/RESULTS.md section a, 14,400 dense disks"),
 }
 """Measured microseconds per particle and step, by (shape, stage)."""

@@ -160,9 +160,9 @@ def test_estimate_from_measured_costs():
     compaction = COSTS[("pentagon", "compaction")]
     steps = compaction.steps * np.sqrt(14400 / compaction.particles)  # steps as sqrt(N) from the measured size
     assert stages["compaction"][0] == round(steps)
-    assert stages["compaction"][2] == pytest.approx(steps * 14400 * 15.8e-6)
-    # the test: the deposit's height h times (e^0.2 - 1) at 0.06 m/s, 5e-4 s a step, 9.15 us per particle-step
-    h = prep.deposit_height()
+    assert stages["compaction"][2] == pytest.approx(steps * 14400 * compaction.serial * 1e-6)
+    # the test: the deposit's height h times (e^0.2 - 1) at 0.06 m/s, 5e-4 s a step, at the measured cost
+    h, cost = prep.deposit_height(), COSTS[("pentagon", "test")]
     assert stages["test"][0] == round(h * np.expm1(0.2) / (0.06 * 5e-4))
-    assert stages["test"][2] == pytest.approx(h * np.expm1(0.2) / (0.06 * 5e-4) * 14400 * 9.15e-6)
-    assert estimate(prep, test, 5e-4, domains=2)["test"][1] == 6.58
+    assert stages["test"][2] == pytest.approx(h * np.expm1(0.2) / (0.06 * 5e-4) * 14400 * cost.serial * 1e-6)
+    assert estimate(prep, test, 5e-4, domains=2)["test"][1] == cost.two_domains
