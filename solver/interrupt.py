@@ -16,8 +16,8 @@ class Terminated(SystemExit):
     143, so that a script ends quietly with that code once every ``with`` block has closed its
     file (a Ctrl-C raises KeyboardInterrupt instead)."""
 
-    def __init__(self):
-        super().__init__(143)
+    def __init__(self, code=143):  # the code as an argument: unpickled from a worker process as Terminated(143)
+        super().__init__(code)
 
 
 STOP_SIGNALS = (signal.SIGINT, signal.SIGTERM)

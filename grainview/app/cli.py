@@ -16,6 +16,8 @@ own for them; options of other functions take those functions' defaults
 from __future__ import annotations
 
 import argparse
+import contextlib
+import signal
 import sys
 from pathlib import Path
 
@@ -786,13 +788,22 @@ def _study(args) -> int:
                           **kwargs)
     else:  # one process per sample: the two samples run side by side on two cores
         kwargs["progress"] = _SampleProgress.for_jobs(kwargs["progress"])
-        with ProcessPoolExecutor(max_workers=min(args.jobs, len(samples))) as pool:
+        with ProcessPoolExecutor(max_workers=min(args.jobs, len(samples))) as pool, _workers_stop_with_me() as stop:
             futures = [pool.submit(_study_sample, label, preps[label], paths[label], states[label],
                                    checkpoints[label], test=tests[label],
                                    **{**kwargs, "progress": kwargs["progress"] and kwargs["progress"].at(i, label)})
                        for i, label in enumerate(samples)]
+            stopped = []
             for future in futures:
-                future.result()
+                try:
+                    future.result()
+                except (KeyboardInterrupt, SystemExit) as exc:  # a worker stopped by Ctrl-C or SIGTERM
+                    stopped.append(exc)
+            if stop["signal"] is not None or stopped:
+                from solver.interrupt import Terminated
+
+                raise (Terminated() if stop["signal"] == signal.SIGTERM or any(
+                    isinstance(exc, SystemExit) for exc in stopped) else KeyboardInterrupt())
     report = out / "report"
     if args.no_report:
         return 0
@@ -805,6 +816,35 @@ def _study(args) -> int:
     args.out = str(report)
     args.overwrite = True  # the report of the files just completed replaces an older one of the same folder
     return _report(args)
+
+
+@contextlib.contextmanager
+def _workers_stop_with_me():
+    """While the study's samples run in worker processes: Ctrl-C or SIGTERM sent to this
+    process alone (not to its process group, as a terminal or a batch scheduler sends them)
+    stops the workers too, after their current step, as Ctrl-C does (a compaction writes its
+    checkpoint, a test keeps its snapshots); this process then waits for them and stops.
+    Yields ``{"signal": the signal received, or None}``. Only in the main thread."""
+    import multiprocessing
+    import os
+
+    state = {"signal": None}
+
+    def handler(signum, _frame):
+        state["signal"] = signum
+        for child in multiprocessing.active_children():
+            os.kill(child.pid, signal.SIGINT)
+
+    try:
+        previous = {signum: signal.signal(signum, handler) for signum in (signal.SIGINT, signal.SIGTERM)}
+    except ValueError:  # not the main thread
+        yield state
+        return
+    try:
+        yield state
+    finally:
+        for signum, old in previous.items():
+            signal.signal(signum, old)
 
 
 class _SampleProgress:
