@@ -11,8 +11,10 @@ by default, or any scheduler by its address (``tcp://...``, a dask-jobqueue clus
 
 Resuming is the files' business, not the scheduler's: :func:`run_one` looks at the file first.
 
-* no file, or one without a complete snapshot (a run killed during its compaction, which is not
-  written): the run starts from its deposit;
+* no file, or one without a complete snapshot (a run killed during its compaction): the run
+  starts from its compaction's checkpoint ``<folder>/.<spec.name>.compaction.nc`` when there is
+  one (written every ten minutes of the compaction, :mod:`solver.compaction_checkpoint`; removed
+  once the test's file is complete), else from its deposit;
 * a file whose test is unfinished (a run killed mid-test, by a lost worker, a wall-time limit
   or Ctrl-C): the test goes on from its last complete snapshot (:func:`solver.restart.resume`:
   the same snapshots, bit for bit, as an uninterrupted run);
@@ -40,7 +42,7 @@ from pathlib import Path
 
 from grainview.contract.errors import ConvergenceWarning, FileFormatError, ParameterError
 
-from .engine import DEFAULT_ENGINE, engine
+from .engine import DEFAULT_ENGINE, engine, prepare
 from .parameters import BiaxialTest
 from .preparation import DEFAULT_PRESET, Preparation
 
@@ -164,7 +166,10 @@ def run_one(spec: RunSpec, folder, *, overwrite=False, progress=None, compress=T
     spec = spec.validate()
     runner = engine(spec.engine)
     path = Path(folder) / f"{spec.name}.nc"
+    checkpoint = Path(folder) / f".{spec.name}.compaction.nc"
     start = time.perf_counter()
+    if overwrite:
+        checkpoint.unlink(missing_ok=True)
     state = "missing" if overwrite else runner.file_state(path)
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
@@ -177,11 +182,12 @@ def run_one(spec: RunSpec, folder, *, overwrite=False, progress=None, compress=T
             _check_settings(path, spec)
             action, steps = "resumed", runner.resume(path, progress=progress, compress=compress)
         else:
-            sample = runner.prepare(spec.sample(), dict(spec.solver), progress=progress)
+            sample = prepare(runner, spec.sample(), dict(spec.solver), progress=progress, checkpoint=checkpoint)
             steps = runner.shear(sample, path, spec.test(), overwrite=True,
                                  attrs={**sample.history.attrs(), "ensemble_run": spec.name}, progress=progress,
                                  near_contacts=spec.near_contacts, compress=compress)
             action = "ran"
+    checkpoint.unlink(missing_ok=True)  # the compaction is in the test's file now
     unconverged = sum(issubclass(w.category, ConvergenceWarning) for w in caught)
     others = list(dict.fromkeys(str(w.message).splitlines()[0] for w in caught
                                 if not issubclass(w.category, (ConvergenceWarning, DeprecationWarning))))

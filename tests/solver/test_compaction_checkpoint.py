@@ -118,3 +118,28 @@ def test_a_kill_while_a_checkpoint_is_written_keeps_the_previous_one(tmp_path, m
         prepare_sample(PREP, checkpoint=checkpoint)
     assert checkpoint.written == 1 and _checkpoint(path).load()[1].steps == 100
     assert os.listdir(tmp_path) == [path.name]
+
+
+def test_an_ensemble_run_killed_in_its_compaction_resumes_from_its_checkpoint(tmp_path, monkeypatch):
+    import netCDF4
+
+    from solver.ensemble import RunSpec, run_one
+
+    spec = RunSpec(shape="pentagon", particles=30, seed=1, strain=0.004, every=10)
+    (tmp_path / "reference").mkdir()
+    reference = run_one(spec, tmp_path / "reference", progress=False)
+    folder = tmp_path / "runs"
+    folder.mkdir()
+    monkeypatch.setattr(CompactionCheckpoint, "due", lambda self, steps: steps % 100 == 0)
+    with monkeypatch.context() as m:
+        _act_at(m, 250, _kill)
+        with pytest.raises(Killed):
+            run_one(spec, folder, progress=False)
+    checkpoint = folder / f".{spec.name}.compaction.nc"
+    assert CompactionCheckpoint(checkpoint).load()[1].steps == 200 and not (folder / f"{spec.name}.nc").exists()
+    result = run_one(spec, folder, progress=False)
+    assert result["action"] == "ran" and os.listdir(folder) == [f"{spec.name}.nc"]
+    with netCDF4.Dataset(result["path"]) as a, netCDF4.Dataset(reference["path"]) as b:
+        for name in ("position", "angle", "velocity", "normal_impulse", "time", "step"):
+            assert np.array_equal(a[name][...], b[name][...]), name
+        assert a.getncattr("compaction_steps") == b.getncattr("compaction_steps") > 250
