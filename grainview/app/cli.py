@@ -867,7 +867,10 @@ class _SampleProgress:
         return cls(terminal=sys.stderr.isatty() or flag is True)
 
     def at(self, position, label):
-        return _SampleProgress(self.terminal, position, label)
+        """The progress of the sample ``label``, shown at line ``position``."""
+        sample = _SampleProgress(self.terminal, position, label)
+        sample.every = self.every
+        return sample
 
     def __call__(self, total, desc):
         if self.terminal:

@@ -166,3 +166,16 @@ def test_estimate_from_measured_costs():
     assert stages["test"][0] == round(h * np.expm1(0.2) / (0.06 * 5e-4))
     assert stages["test"][2] == pytest.approx(h * np.expm1(0.2) / (0.06 * 5e-4) * 14400 * cost.serial * 1e-6)
     assert estimate(prep, test, 5e-4, domains=2)["test"][1] == cost.two_domains
+
+
+def test_side_by_side_progress_without_a_terminal_prints_lines(capsys):
+    from grainview.app.cli import _SampleProgress
+
+    progress = _SampleProgress.for_jobs(None)
+    assert _SampleProgress.for_jobs(False) is False and _SampleProgress.for_jobs(True).terminal
+    if progress.terminal:  # stderr is a terminal here: nothing to check
+        return
+    progress.every = 0.0
+    with progress.at(1, "disks")(300, "biaxial test") as bar:
+        bar.update(120)
+    assert capsys.readouterr().out.startswith("disks: biaxial test: step 120 of at most 300, 0 min")
