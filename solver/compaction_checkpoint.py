@@ -40,9 +40,13 @@ SCENE = "compaction"
 
 def describe(preparation, parameters) -> str:
     """What a compaction is of, as the JSON a checkpoint records: the preparation's fields and
-    the solver parameters asked for (sorted)."""
+    every solver parameter, those asked for (``parameters``, a dict of
+    :class:`solver.parameters.Parameters` fields) and the defaults of the others, so that a
+    default given explicitly is the same compaction."""
+    from .parameters import Parameters
+
     prep = asdict(preparation) if preparation is not None else {}
-    return json.dumps({"preparation": prep, "parameters": dict(sorted((parameters or {}).items()))},
+    return json.dumps({"preparation": prep, "parameters": asdict(Parameters(**(parameters or {})))},
                       sort_keys=True, default=str)
 
 
@@ -128,14 +132,7 @@ class CompactionCheckpoint:
         from .stepper import Unconverged
 
         with ContractFile(self.path) as ds:
-            attrs = dict(ds.attrs)
-            if attrs.get("scene") != SCENE or "checkpoint_steps" not in attrs or ds.n_snapshots != 1:
-                raise FileFormatError(f"{self.path}: not a compaction checkpoint (expected one snapshot and "
-                                      "checkpoint_* attributes); remove it or pass --overwrite")
-            if self.of and attrs.get("checkpoint_of") != self.of:
-                raise FileFormatError(f"{self.path} holds the compaction of another sample or with other "
-                                      "settings; pass --overwrite to start this one again, or give the settings "
-                                      "it was made with")
+            attrs = self._checked(ds)
             state = _snapshot_state(ds, 0, self.path)
         sim = _simulation(state, self.path)
         sim.history = SampleHistory(sigma0=float(attrs["sigma0_Pa"]))
@@ -143,6 +140,25 @@ class CompactionCheckpoint:
                                       float(attrs["checkpoint_unconverged_residual"]),
                                       float(attrs["checkpoint_unconverged_local_law_residual"]))
         return sim, CompactionProgress.from_attrs(attrs)
+
+    def check(self):
+        """Refuse, as :meth:`load` does and without loading it, a file that is not a compaction
+        checkpoint of this sample (:class:`FileFormatError`, one line)."""
+        from grainview.contract.reader import ContractFile
+
+        with ContractFile(self.path) as ds:
+            self._checked(ds)
+
+    def _checked(self, ds) -> dict:
+        attrs = dict(ds.attrs)
+        if attrs.get("scene") != SCENE or "checkpoint_steps" not in attrs or ds.n_snapshots != 1:
+            raise FileFormatError(f"{self.path}: not a compaction checkpoint (expected one snapshot and "
+                                  "checkpoint_* attributes); remove it or pass --overwrite")
+        if self.of and attrs.get("checkpoint_of") != self.of:
+            raise FileFormatError(f"{self.path} holds the compaction of another sample or with other "
+                                  "settings; pass --overwrite to start this one again, or give the settings "
+                                  "it was made with")
+        return attrs
 
     def remove(self):
         """Remove the checkpoint (its compaction's sample is written elsewhere now)."""

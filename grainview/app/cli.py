@@ -671,11 +671,13 @@ def _study_tests(args, particles) -> dict:
     return {label: replace(test, velocity=velocity_for(n)) for label, n in particles.items()}
 
 
-def _study_state(runner, label, path, checkpoint, expected, overwrite) -> str:
+def _study_state(runner, prep, parameters, path, checkpoint, expected, overwrite) -> str:
     """What is to be done for one sample of the study: "finished" (its file complete),
     "partial" (its test to be resumed) or "start" (from its compaction's checkpoint when there
-    is one, else from its deposit). A file or checkpoint of other settings is refused in one
-    line, unless ``overwrite`` (then both are removed and the sample starts afresh)."""
+    is one, else from its deposit). A file or checkpoint of other settings (``expected``: the
+    file's attributes; ``prep`` and ``parameters``: what the checkpoint is of) is refused in one
+    line before any work, unless ``overwrite`` (then the checkpoint is removed and the sample
+    starts afresh)."""
     from solver.restart import check_settings
 
     if overwrite:
@@ -686,6 +688,10 @@ def _study_state(runner, label, path, checkpoint, expected, overwrite) -> str:
         check_settings(path, expected, "pass --overwrite to replace it, or give the settings it was made with")
         checkpoint.unlink(missing_ok=True)  # the compaction is in the test's file now
         return state
+    if checkpoint.exists() and runner.name == "solver":  # this package's checkpoints
+        from solver.compaction_checkpoint import CompactionCheckpoint, describe
+
+        CompactionCheckpoint(checkpoint, of=describe(prep, parameters)).check()
     return "start"
 
 
@@ -772,7 +778,7 @@ def _study(args) -> int:
     from solver.parameters import Parameters, default_of
 
     recorded = {name: parameters.get(name, default_of(Parameters, name)) for name in SOLVER_OPTIONS}
-    states = {label: _study_state(runner, label, paths[label], checkpoints[label],
+    states = {label: _study_state(runner, preps[label], parameters, paths[label], checkpoints[label],
                                   _expected_attrs(preps[label], tests[label], recorded), args.overwrite)
               for label in samples}
     out.mkdir(parents=True, exist_ok=True)

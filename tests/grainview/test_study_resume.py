@@ -118,6 +118,11 @@ def test_a_checkpoint_of_other_settings_is_refused(tmp_path, monkeypatch, capsys
     assert main([*STUDY, "--out", str(out), "--tolerance", "1e-4"]) == 2
     assert "holds the compaction of another sample or with other settings" in capsys.readouterr().err
     assert (out / "pentagons.compaction.nc").read_bytes() == before
+    (out / "disks.compaction.nc").write_bytes(b"keep")  # not a checkpoint: refused before any work too
+    assert main([*STUDY, "--out", str(out)]) == 2
+    assert "disks.compaction.nc: not a readable netCDF file" in capsys.readouterr().err
+    assert sorted(os.listdir(out)) == ["disks.compaction.nc", "pentagons.compaction.nc"]
+    assert (out / "pentagons.compaction.nc").read_bytes() == before
 
 
 def _parsed(*argv):

@@ -143,3 +143,11 @@ def test_an_ensemble_run_killed_in_its_compaction_resumes_from_its_checkpoint(tm
         for name in ("position", "angle", "velocity", "normal_impulse", "time", "step"):
             assert np.array_equal(a[name][...], b[name][...]), name
         assert a.getncattr("compaction_steps") == b.getncattr("compaction_steps") > 250
+
+
+def test_what_a_checkpoint_is_of():
+    from solver.parameters import Parameters
+
+    assert describe(PREP, {}) == describe(PREP, {"tolerance": Parameters().tolerance})  # a default given
+    assert describe(PREP, {}) != describe(PREP, {"tolerance": 1e-4})
+    assert describe(PREP, {}) != describe(preparation(PREP, seed=4), {})
