@@ -392,17 +392,25 @@ def _simulate(prep, path, *, test, near_contacts, overwrite, progress, scene="bi
     from solver.shape_families import shape_label
 
     name = label or shape_label(prep.shape)
-    if checkpoint is not None and Path(checkpoint).exists():
+    resumed = checkpoint is not None and Path(checkpoint).exists()
+    if resumed:
         print(f"{name}: resuming the compaction of {prep.particles} particles from {checkpoint} ...", flush=True)
     else:
         print(f"{name}: depositing {prep.particles} particles and compacting under {prep.sigma0:g} Pa ...", flush=True)
+    from time import monotonic
+
+    from solver.paper_size import hours
+
+    start = monotonic()
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
         sample = prepare(runner, prep, parameters or {}, progress=progress, checkpoint=checkpoint)
         history = sample.history
         settled = "settled" if history.settled else "NOT settled (step limit reached)"
-        print(f"{name}: compaction {settled} after {history.compaction_steps} steps; wall stresses "
+        print(f"{name}: compaction {settled} after {history.compaction_steps} steps ({hours(monotonic() - start)} "
+              f"of wall time{' since the checkpoint' if resumed else ''}); wall stresses "
               f"{', '.join(f'{s:.0f}' for s in history.compaction_stress)} Pa", flush=True)
+        start = monotonic()
         if scene == "isotropic":
             runner.write_state(sample, path, attrs={"scene": "isotropic"}, overwrite=overwrite,
                                near_contacts=near_contacts, compress=compress)
@@ -414,7 +422,8 @@ def _simulate(prep, path, *, test, near_contacts, overwrite, progress, scene="bi
     unconverged = sum(issubclass(w.category, ConvergenceWarning) for w in caught)
     if unconverged:
         print(f"{name}: warning: {_unconverged_warning(sample, path, unconverged)}", file=sys.stderr)
-    print(f"{name}: wrote {path}", flush=True)
+    print(f"{name}: wrote {path}" + ("" if scene == "isotropic" else f" (the test: {hours(monotonic() - start)} of wall "
+                                      "time)"), flush=True)
     return path
 
 
@@ -718,9 +727,15 @@ def _study_sample(label, prep, path, state, checkpoint, *, test, near_contacts, 
         print(f"{label}: {path} is complete (skipped)", flush=True)
         return path
     if state == "partial":
+        from time import monotonic
+
+        from solver.paper_size import hours
+
         print(f"{label}: resuming the test in {path} ...", flush=True)
+        start = monotonic()
         steps = runner.resume(path, progress=progress, compress=compress)
-        print(f"{label}: resumed for {steps} steps; wrote {path}", flush=True)
+        print(f"{label}: resumed for {steps} steps ({hours(monotonic() - start)} of wall time); wrote {path}",
+              flush=True)
         return path
     _simulate(prep, path, test=test, near_contacts=near_contacts, overwrite=True, progress=progress,
               parameters=parameters, compress=compress, engine=engine, checkpoint=checkpoint, label=label)
