@@ -1,11 +1,11 @@
 """Routes to a compacted sample: steps, NLGS sweeps and time of the isotropic compaction, and
 the state it reaches, for routes that differ in how fast the walls close.
 
-    python benchmarks/compaction.py --shape pentagon --particles 1000 --seeds 0,1,2 \
+    python -m benchmarks.compaction --shape pentagon --particles 1000 --seeds 0,1,2 \
         --routes paper,approach,fast [--out benchmarks/_data/compaction.jsonl]
-    python benchmarks/compaction.py --particles 4000 --routes paper --acceleration anderson \
+    python -m benchmarks.compaction --particles 4000 --routes paper --acceleration anderson \
         --stall 200                                    # the same route, solved another way
-    python benchmarks/compaction.py --particles 14400 --routes fast --acceleration anderson \
+    python -m benchmarks.compaction --particles 14400 --routes fast --acceleration anderson \
         --domains 2 --report-every 250 --save sample.pkl  # on both cores; keep the sample
 
 Every route deposits the sample of the 'paper' preparation (friction 0.4, sigma0 = 10 kPa on
@@ -47,8 +47,7 @@ import warnings
 import numpy as np
 
 HERE = os.path.dirname(os.path.abspath(__file__))
-sys.path.insert(0, os.path.dirname(HERE))
-from benchmarks.common import save_sample, way_of_solving  # noqa: E402
+from benchmarks.common import save_sample, way_of_solving
 
 ROUTES = {
     "paper": {"approach_speed": None, "until_solid_fraction": None, "loosen": 1.0, "speed": 0.05},

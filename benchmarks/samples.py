@@ -3,8 +3,8 @@ pentagons and disks under the paper's preparation, built once and cached as file
 contract (benchmarks/_data/fidelity/samples/, the fidelity study's cache), so that every speed
 figure can start from a dense packing (``solver.load_sample(path)``, then ``biaxial_test``).
 
-    python benchmarks/samples.py                       # list: cached or missing, with cost
-    python benchmarks/samples.py --build --sizes 1000,4000 [--jobs 2]
+    python -m benchmarks.samples                       # list: cached or missing, with cost
+    python -m benchmarks.samples --build --sizes 1000,4000 [--jobs 2]
 
 Listing reads only the files' attributes: particles, compaction steps and wall-clock time,
 whether the compaction settled, solid fraction. A missing sample is listed with an estimate of
@@ -16,13 +16,10 @@ from __future__ import annotations
 
 import argparse
 import os
-import sys
 
 HERE = os.path.dirname(os.path.abspath(__file__))
-sys.path.insert(0, os.path.join(HERE, "fidelity"))
-sys.path.insert(0, os.path.dirname(HERE))
 
-from runs import Run, make_sample  # noqa: E402
+from benchmarks.fidelity.runs import Run, make_sample
 
 SIZES = (1000, 4000, 14_400)
 SHAPES = ("pentagon", "disk")

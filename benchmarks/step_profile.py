@@ -1,6 +1,6 @@
 """Where a biaxial step's time goes, on one domain and on several: the whole-step speed-up's account.
 
-    python benchmarks/step_profile.py --sample benchmarks/_data/samples/pentagon_4000_fast.pkl --domains 1,2
+    python -m benchmarks.step_profile --sample benchmarks/_data/samples/pentagon_4000_fast.pkl --domains 1,2
 
 A sample saved by ``compaction.py --save`` is sheared as the shear benchmarks shear it
 (``solver.biaxial_test``, top wall at 1 cm/s, Anderson sweeps with an extrapolation every 2
@@ -25,23 +25,20 @@ reversed every other turn, so that the machine's drift falls on each alike). Dom
 above 1 follow another trajectory (a domain-decomposed sweep is another Gauss–Seidel order),
 so their sweeps per step differ a little; the table gives them. Stages that only numpy and
 Python do run on one core whatever the domains: with the solve's and the narrow phase's
-speed-ups they bound the whole step's (Amdahl). Writes benchmarks/RESULTS-step-profile-<N>.md.
+speed-ups they bound the whole step's (Amdahl). Writes benchmarks/results/step-profile-<N>.md.
 """
 
 from __future__ import annotations
 
 import argparse
 import os
-import sys
 import time
 
 import numpy as np
 
 HERE = os.path.dirname(os.path.abspath(__file__))
-sys.path.insert(0, os.path.dirname(HERE))
-sys.path.insert(0, HERE)
 
-from common import load_sample, write_results  # noqa: E402
+from benchmarks.common import load_sample, write_results
 
 STAGES = ["broad phase", "narrow phase", "warm start", "contact problem", "solve", "overlap recovery",
           "diagnostics", "update, other", "step, other", "outside the step"]
@@ -120,7 +117,7 @@ def main(argv=None):
     parser.add_argument("--skip", type=int, default=300, help="shear steps before the timed ones (default 300)")
     parser.add_argument("--steps", type=int, default=300, help="shear steps timed (default 300)")
     parser.add_argument("--repeats", type=int, default=2, help="turns over the domain counts (default 2)")
-    parser.add_argument("--out", help="the results file (default benchmarks/RESULTS-step-profile-<N>.md)")
+    parser.add_argument("--out", help="the results file (default benchmarks/results/step-profile-<N>.md)")
     args = parser.parse_args(argv)
     counts = [int(d) for d in args.domains.split(",")]
     if not os.path.exists(args.sample):
@@ -131,8 +128,8 @@ def main(argv=None):
             runs.append(_run(args.sample, d, args.skip, args.steps))
             print(f"turn {turn}, {d} domain(s): {sum(runs[-1]['ms'].values()):.2f} ms per step", flush=True)
     n = load_sample(args.sample)[0].n_particles
-    out = args.out or os.path.join(HERE, f"RESULTS-step-profile-{n}.md")
-    intro = (f"Written by `python benchmarks/step_profile.py --sample {os.path.basename(args.sample)} --domains "
+    out = args.out or os.path.join(HERE, "results", f"step-profile-{n}.md")
+    intro = (f"Written by `python -m benchmarks.step_profile --sample {os.path.basename(args.sample)} --domains "
              f"{args.domains} --skip {args.skip} --steps {args.steps} --repeats {args.repeats}` (its docstring gives "
              f"the method): {n} particles, shear steps {args.skip + 1}-{args.skip + args.steps}, the median of the "
              "turns. Read with docs/solver.md, \"Both cores\".")

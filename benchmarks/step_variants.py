@@ -1,8 +1,8 @@
 """Whole biaxial steps, every way of solving, interleaved: the same sheared sample stepped on
 by each candidate in turn, a chunk of steps at a time.
 
-    python benchmarks/step_variants.py --build --particles 1000     # the samples (~3 min, cached)
-    python benchmarks/step_variants.py --particles 1000 --steps 3000  # write RESULTS-step-variants.md
+    python -m benchmarks.step_variants --build --particles 1000     # the samples (~3 min, cached)
+    python -m benchmarks.step_variants --particles 1000 --steps 3000  # write results/step-variants.md
 
 The sample: the shape compacted with the 'fast' preparation and sheared to eps_1 = 0.03 (top
 wall 1 cm/s, sigma0 = 10 kPa, dt = 5e-4 s), pickled in benchmarks/_data/step_variants/. Each
@@ -24,7 +24,6 @@ import argparse
 import copy
 import os
 import pickle
-import sys
 import time
 import warnings
 from dataclasses import replace
@@ -32,11 +31,10 @@ from dataclasses import replace
 import numpy as np
 
 HERE = os.path.dirname(os.path.abspath(__file__))
-sys.path.insert(0, os.path.dirname(HERE))
-from common import markdown_table, sheared_sample, write_results  # noqa: E402
+from benchmarks.common import markdown_table, sheared_sample, write_results
 
 OUT = os.path.join(HERE, "_data", "step_variants")
-RESULTS = os.path.join(HERE, "RESULTS-step-variants.md")
+RESULTS = os.path.join(HERE, "results", "step-variants.md")
 SHAPES = ("pentagon", "disk")
 SHEAR = 0.03
 CANDIDATES = [
@@ -115,6 +113,7 @@ def main(argv=None):
     parser.add_argument("--particles", default="1000", help="sample sizes, comma-separated")
     parser.add_argument("--steps", type=int, default=3000, help="steps per candidate")
     parser.add_argument("--chunk", type=int, default=100, help="steps per turn")
+    parser.add_argument("--out", default=RESULTS, help="the results file (default benchmarks/results/step-variants.md)")
     parser.add_argument("--serial", action="store_true", help="leave out the candidates on two domains (for a "
                         "machine whose other core is busy)")
     args = parser.parse_args(argv)
@@ -127,8 +126,8 @@ def main(argv=None):
             build(shape, particles)
     sections = [measure(shape, particles, args.steps, args.chunk, candidates) for shape, particles in sets
                 if os.path.exists(cache_path(shape, particles))]
-    write_results(RESULTS, "Whole steps, every way of solving",
-                  "Written by `python benchmarks/step_variants.py` (its docstring gives the method). Each candidate "
+    write_results(args.out, "Whole steps, every way of solving",
+                  "Written by `python -m benchmarks.step_variants` (its docstring gives the method). Each candidate "
                   "follows its own trajectory from the same sheared sample; the candidates take turns, so the "
                   "speed-up (the plain NLGS's total time over the candidate's) is from one run under the same drift.",
                   sections)

@@ -1,10 +1,10 @@
 """What one NLGS sweep costs per contact point, serially and on domains, on captured problems.
 
-    python benchmarks/sweep_cost.py --sample benchmarks/_data/samples/pentagon_14400_fast.pkl
-    python benchmarks/sweep_cost.py --sample ... --strips 1,2,4,8,16 --threads 1   # the domains' order, one thread
+    python -m benchmarks.sweep_cost --sample benchmarks/_data/samples/pentagon_14400_fast.pkl
+    python -m benchmarks.sweep_cost --sample ... --strips 1,2,4,8,16 --threads 1   # the domains' order, one thread
 
 A sample saved by ``compaction.py --save`` is sheared as the shear benchmarks shear it
-(``sweep_bursts.capture``) and the main contact problems of steps ``--first`` onwards are
+(``benchmarks.shear.capture``) and the main contact problems of steps ``--first`` onwards are
 captured with their warm starts. Each problem is then solved from its warm start for a fixed
 number of sweeps (no tolerance) by the plain NLGS and by Anderson-accelerated sweeps (memory 3,
 an extrapolation every 2 sweeps, as the shear benchmarks solve), serially and on each count of
@@ -32,16 +32,13 @@ from __future__ import annotations
 
 import argparse
 import os
-import sys
 import time
 
 import numpy as np
 
 HERE = os.path.dirname(os.path.abspath(__file__))
-sys.path.insert(0, os.path.dirname(HERE))
-sys.path.insert(0, HERE)
 
-from common import load_sample, markdown_table, write_results  # noqa: E402
+from benchmarks.common import load_sample, markdown_table, write_results
 
 KINDS = ("plain", "anderson")
 MEMORY, PERIOD = 3, 2
@@ -104,7 +101,7 @@ def stage_seconds(caught: dict, sweeps: int) -> tuple:
     Parameters
     ----------
     caught : dict
-        A problem of ``sweep_bursts.capture``.
+        A problem of ``benchmarks.shear.capture``.
     sweeps : int
         Sweeps of the solve (no tolerance).
 
@@ -242,7 +239,7 @@ def main(argv=None):
         parser.error(f"--threads {args.threads}: expected 1 to {numba.config.NUMBA_NUM_THREADS} (numba's threads)")
     if not os.path.exists(args.sample):
         raise SystemExit(f"sweep_cost.py: no sample at {args.sample}: make one with compaction.py --save")
-    from sweep_bursts import capture
+    from benchmarks.shear import capture
 
     numba.set_num_threads(args.threads)
     sim, _ = load_sample(args.sample)
@@ -251,7 +248,7 @@ def main(argv=None):
     if args.stages:
         numba.set_num_threads(1)
         table = stages_table(problems, args.sweeps)
-        intro = (f"`python benchmarks/sweep_cost.py --sample {os.path.basename(args.sample)} --first {args.first} "
+        intro = (f"`python -m benchmarks.sweep_cost --sample {os.path.basename(args.sample)} --first {args.first} "
                  f"--count {args.count} --sweeps {args.sweeps} --stages`: {n} particles, the serial Anderson solve "
                  "(memory 3, an extrapolation every 2 sweeps) taken apart.")
         _report(args.out, f"Stages of an Anderson solve: {n} particles", intro, table)
@@ -267,7 +264,7 @@ def main(argv=None):
         rows.append(row)
     table = markdown_table(["domains", "plain NLGS: ns per point-sweep", "Anderson (m = 3, every 2 sweeps): "
                             "ns per point-sweep"], rows)
-    intro = (f"`python benchmarks/sweep_cost.py --sample {os.path.basename(args.sample)} --first {args.first} "
+    intro = (f"`python -m benchmarks.sweep_cost --sample {os.path.basename(args.sample)} --first {args.first} "
              f"--count {args.count} --sweeps {args.sweeps} --repeats {args.repeats} --strips {args.strips} "
              f"--threads {args.threads}`: "
              f"{n} particles, {len(problems)} problems of about {points} points, {args.threads} thread(s); "

@@ -45,7 +45,7 @@ import numpy as np
 
 from benchmarks.common import load_sample, markdown_table, write_results
 from benchmarks.shear import capture
-from benchmarks.sweep_bursts import _cone_projections, _relative_velocity, _velocities
+from benchmarks.archive.sweep_bursts import _cone_projections, _relative_velocity, _velocities
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 CHECKPOINTS = (5, 10, 20, 40)

@@ -1,4 +1,4 @@
-"""benchmarks/sweep_bursts.py: its point keys match the stepper's, its extrapolated warm start
+"""benchmarks/archive/sweep_bursts.py: its point keys match the stepper's, its extrapolated warm start
 follows the rule by hand, and its anatomy of a captured step obeys the triangle inequality and
 agrees with the solver's own residuals."""
 
@@ -10,7 +10,7 @@ from .conftest import load_benchmark
 
 @pytest.fixture(scope="module")
 def bursts():
-    return load_benchmark("sweep_bursts")
+    return load_benchmark("archive.sweep_bursts")
 
 
 @pytest.fixture(scope="module")

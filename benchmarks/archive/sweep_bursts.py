@@ -1,10 +1,10 @@
 """Why a large sheared packing needs more sweeps per step: the anatomy of its slow steps.
 
-    python benchmarks/sweep_bursts.py --sample benchmarks/_data/time_to_strain/sample_pentagon_14400_fast.pkl
+    python -m benchmarks.archive.sweep_bursts --sample benchmarks/_data/time_to_strain/sample_pentagon_14400_fast.pkl
 
 A 14,400-pentagon shear needs three times the sweeps per step of a 4000-pentagon one, in bursts
-of consecutive steps that end at the stall test (docs/solver.md, "At 14,400 pentagons"). This
-script shears a saved sample (``benchmarks/compaction.py --save``) as time_to_strain.py does
+of consecutive steps that end at the stall test (benchmarks/archive/solver-log.md, "At 14,400 pentagons"). This
+script shears a saved sample (``benchmarks/compaction.py --save``) as archive/time_to_strain.py does
 (Anderson sweeps extrapolated every 2 sweeps, stall test over 200 sweeps, one domain), captures
 the contact problem of shear steps ``--steps A B`` with its warm start, and asks of each
 *burst* step (at least ``--burst`` sweeps) and of the quiet steps:
@@ -26,104 +26,27 @@ the contact problem of shear steps ``--steps A B`` with its warm start, and asks
    12, and the warm start extrapolated from the last two steps' impulses,
    p_k + f (p_k - p_(k-1)) projected onto the Coulomb cone, for f = 0, 0.5, 1 (each step
    re-solved from the captured trajectory; a real run's own trajectory responds to it, and
-   docs/solver.md reports what that did).
+   benchmarks/archive/solver-log.md reports what that did).
 6. **A lead**: on the steps of items 1-4, the iterations a Jacobi-scaled accelerated projected
    gradient (:func:`apgd_probe`, numpy) needs to reach the local-law residual that the default
    NLGS reached on the same step. ``--apgd-shear EPS_Q`` then shears the sample to that eps_q
    twice, with the default solve and with the probe as the step's solve (:func:`shear`), and
    adds a table of the two runs.
 
-Writes benchmarks/RESULTS-sweep-bursts-<N>.md.
+Writes benchmarks/archive/sweep-bursts-<N>.md.
 """
 import argparse
 import os
-import shutil
-import sys
-import tempfile
 import time
-import warnings
 
 import numpy as np
 
-sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
-sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from common import load_sample, markdown_table, write_results  # noqa: E402
+from benchmarks.common import load_sample, markdown_table, write_results
+from benchmarks.shear import Done as _Done, capture, shear as _shear
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 GRID = 24
 """Cells per side of the grid over the box in which the changes are binned."""
-
-
-class _Done(Exception):
-    pass
-
-
-def _shear(sim, after_step, solve=None) -> float:
-    """Run ``solver.biaxial_test`` on ``sim`` (top wall at 1 cm/s, no snapshots but the first,
-    warnings silenced) with Anderson sweeps every 2 sweeps and the stall test over 200 on one
-    domain, calling ``after_step(info)`` after every step (it raises :class:`_Done` to stop),
-    with ``solve`` (if given) in place of ``solver.acceleration.solve_problem_anderson``; the
-    simulation's and the module's own functions are back afterwards. Returns the seconds."""
-    import solver
-    from solver import acceleration
-
-    p = sim.parameters
-    p.acceleration, p.anderson_period, p.stall_sweeps, p.domains = "anderson", 2, 200, 1
-    original_solve, step = acceleration.solve_problem_anderson, sim.step
-
-    def stepped():
-        info = step()
-        after_step(info)
-        return info
-
-    sim.step = stepped
-    acceleration.solve_problem_anderson = solve or original_solve
-    folder = tempfile.mkdtemp(prefix="sweep_bursts_")  # a file of its own: runs side by side do not meet
-    path = os.path.join(folder, "shear.nc")
-    start = time.perf_counter()
-    try:
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore")
-            solver.biaxial_test(sim, path, strain=0.5, velocity=0.01, every=10**9, overwrite=True, progress=False)
-    except _Done:
-        pass
-    finally:
-        acceleration.solve_problem_anderson = original_solve
-        del sim.step  # the class's method again
-        shutil.rmtree(folder, ignore_errors=True)
-    return time.perf_counter() - start
-
-
-def capture(sim, first: int, last: int) -> list:
-    """Shear ``sim`` as :func:`_shear` does until shear step ``last`` and return the main contact
-    problem of steps ``first``..``last`` as dicts: step, problem, warm-start impulses pn, pt,
-    free velocities vx, vy, w, the solver options, the particles' positions, and the sweeps the
-    step took and the local-law residual of its solution."""
-    from solver import acceleration, residuals
-
-    tolerance = sim.parameters.tolerance
-    caught, done = [], [0]
-    solve = acceleration.solve_problem_anderson
-
-    def capturing(problem, pn, pt, vx, vy, w, **options):
-        main = options["tolerance"] == tolerance and first <= done[0] <= last
-        if main:
-            caught.append(dict(step=done[0], problem=problem, pn=pn.copy(), pt=pt.copy(), vx=vx.copy(),
-                               vy=vy.copy(), w=w.copy(), options=dict(options),
-                               position=sim.position[:sim.n_particles].copy()))
-        result = solve(problem, pn, pt, vx, vy, w, **options)
-        if main:
-            caught[-1]["sweeps"] = result.iterations
-            caught[-1]["law"] = residuals.local_law_residual(problem, pn, pt, vx, vy, w)
-        return result
-
-    def count(info):
-        done[0] += 1
-        if done[0] > last:
-            raise _Done
-
-    _shear(sim, count, capturing)
-    return caught
 
 
 def _w_norm(dpn, dpt, wnn, wnt, wtt):
@@ -375,11 +298,11 @@ def main(argv=None):
                         help="also shear to this eps_q with the default solve and with the APGD probe (item 6)")
     parser.add_argument("--apgd-target", type=float, default=1.3e-4,
                         help="the local-law residual at which the probe stops in --apgd-shear (default 1.3e-4)")
-    parser.add_argument("--out", help="the results file (default benchmarks/RESULTS-sweep-bursts-<N>.md)")
+    parser.add_argument("--out", help="the results file (default benchmarks/archive/sweep-bursts-<N>.md)")
     args = parser.parse_args(argv)
     sim, _ = load_sample(args.sample)
     n = sim.n_particles
-    out = args.out or os.path.join(HERE, f"RESULTS-sweep-bursts-{n}.md")
+    out = args.out or os.path.join(HERE, f"sweep-bursts-{n}.md")
     bounds = sim.walls.box_bounds()
     caught = capture(sim, *args.steps)
     sweeps = [c["sweeps"] for c in caught]
@@ -431,10 +354,10 @@ def main(argv=None):
                                     "fallbacks to the NLGS", "local-law residual median", "p90",
                                     "unbalanced force median", "top wall's q/p over the second half of the steps: mean, sd",
                                     "seconds (the probe is numpy)"], shears)]
-    intro = (f"Written by `python benchmarks/sweep_bursts.py --sample {os.path.relpath(args.sample, os.path.dirname(HERE))} "
+    intro = (f"Written by `python -m benchmarks.archive.sweep_bursts --sample {os.path.relpath(args.sample, os.path.dirname(os.path.dirname(HERE)))} "
              f"--steps {args.steps[0]} {args.steps[1]}"
              + (f" --apgd-shear {args.apgd_shear:g}" if args.apgd_shear else "") + f"`: {n} particles, shear steps {args.steps[0]}-{args.steps[1]} "
-             f"(sweeps per step: {sweeps}). The script's docstring defines each column; docs/solver.md "
+             f"(sweeps per step: {sweeps}). The script's docstring defines each column; benchmarks/archive/solver-log.md "
              "(\"At 14,400 pentagons\") reads them.")
     write_results(out, "The anatomy of slow shear steps", intro,
                   ["## Where the changes are, and what they are (plain NLGS sweeps from the step's warm start)",
