@@ -18,7 +18,7 @@ so that the solver, which writes files of the contract, does not load them.
 
 import importlib
 
-from . import _register
+from . import _moved, _register
 from .contract.errors import ConvergenceWarning, FileFormatError, GrainviewError, OutputError, ParameterError, SchemaError
 from .contract.schema import SCHEMA_VERSION
 
@@ -36,6 +36,7 @@ __all__ = [
 ]
 
 _register.register()
+_moved.install()  # the modules' former names (grainview.strain, ...) still import
 
 
 def __getattr__(name):

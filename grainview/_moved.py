@@ -1,0 +1,63 @@
+"""The modules' former names, still importable: ``import grainview.strain`` gives
+:mod:`grainview.analysis.strain` (the same module object) with a ``DeprecationWarning`` naming
+the new place.
+
+grainview's modules live in rooms by concern (docs/map.md): the analysis in
+``grainview/analysis/`` (its pure array functions in ``analysis/arrays/``, its numba kernels in
+``analysis/_kernels/``), other formats and the export in ``grainview/formats/``, the report and
+the command line in ``grainview/app/``. Scripts and notebooks written against the former flat
+layout keep working through the finder below, which serves each former name by importing the
+module at its new place and registering that module under the former name as well, so that
+both names give one module (its functions, classes and state are shared, nothing is copied).
+"""
+
+from __future__ import annotations
+
+import importlib
+import importlib.abc
+import importlib.util
+import sys
+import warnings
+
+MOVED = {
+    **{f"grainview.{name}": f"grainview.analysis.{name}" for name in (
+        "_kernels", "_lift", "arrays", "coarse_graining", "connectivity", "contacts", "ensemble", "fabric",
+        "force_chains", "force_networks", "force_pdf", "forces", "lifetimes", "network_topology",
+        "particle_fields", "persistence", "sample", "shear_bands", "strain", "stress", "summary", "synthetic",
+        "tables", "xi_network")},
+    **{f"grainview.{name}": f"grainview.app.{name}" for name in (
+        "cli", "convergence", "ensemble_report", "file_summary", "report", "warmup")},
+    **{f"grainview.{name}": f"grainview.formats.{name}" for name in ("export", "opening", "vtk_xml")},
+}
+"""Former module name -> its place now; a former package's submodules follow it."""
+
+
+def new_name(name: str) -> str | None:
+    """The present name of the former module ``name`` (None when ``name`` did not move)."""
+    for old, new in MOVED.items():
+        if name == old or name.startswith(old + "."):
+            return new + name[len(old):]
+    return None
+
+
+class MovedModules(importlib.abc.MetaPathFinder, importlib.abc.Loader):
+    """Serves the former names of :data:`MOVED` (module docstring)."""
+
+    def find_spec(self, fullname, path=None, target=None):
+        if new_name(fullname) is None:
+            return None
+        return importlib.util.spec_from_loader(fullname, self)
+
+    def create_module(self, spec):
+        return None  # a placeholder, replaced in sys.modules by the real module in exec_module
+
+    def exec_module(self, module):
+        new = new_name(module.__name__)
+        warnings.warn(f"{module.__name__} is now {new}: import it from there", DeprecationWarning, stacklevel=2)
+        sys.modules[module.__name__] = importlib.import_module(new)
+
+
+def install():
+    """Put the finder first on ``sys.meta_path`` (once)."""
+    if not any(isinstance(f, MovedModules) for f in sys.meta_path):
+        sys.meta_path.insert(0, MovedModules())
