@@ -178,8 +178,10 @@ class Parameters:
                                   check=positive, expected="a positive length in m", optional=True)
     skin: float | None = setting(None, "broad-phase skin (None: 10% of the smallest diameter)", unit="m",
                                  check=positive, expected="a positive length in m", optional=True)
-    shuffle: bool = setting(False, "random NLGS ordering (a solver that has one: 'nlgs')")
-    seed: int = setting(0, "seed of the random NLGS ordering")
+    shuffle: bool = setting(False, "random NLGS ordering (a solver that has one: 'nlgs')",
+                            check=lambda v: isinstance(v, (bool, np.bool_)), expected="True or False")
+    seed: int = setting(0, "seed of the random NLGS ordering", check=lambda v: whole(v) and 0 <= v <= MAX_SEED,
+                        expected="a whole number in 0..2147483647")
     solver: str = setting("anderson", "the contact solver of each step, a method of the registry "
                           "solver.contact_solvers: 'anderson' (the default), Anderson-accelerated NLGS sweeps, the "
                           "same local-law residual in less time per step than 'nlgs', plain sweeps (docs/solver.md)",
@@ -197,10 +199,12 @@ class Parameters:
                                             check=lambda v: v >= 0, expected=">= 0 m s-1")
     overlap_recovery_rate: float = setting(0.2, "fraction of an overlap removed per step, below the cap",
                                            check=lambda v: 0 <= v <= 1, expected="in [0, 1]")
-    overlap_recovery_threshold: float = setting(1e-4, "fraction of the smallest diameter: smaller overlaps are left")
+    overlap_recovery_threshold: float = setting(1e-4, "fraction of the smallest diameter: smaller overlaps are left",
+                                                check=lambda v: bool(np.isfinite(v) and v >= 0), expected=">= 0")
     overlap_recovery_tolerance: float = setting(1e-2, "NLGS tolerance of the recovery pass (a correction, not "
-                                                "physics)")
-    overlap_recovery_iterations: int = setting(50, "sweep cap of the recovery pass")
+                                                "physics)", check=positive, expected="> 0")
+    overlap_recovery_iterations: int = setting(50, "sweep cap of the recovery pass",
+                                               check=lambda v: whole(v) and v >= 1, expected="a whole number >= 1")
 
     def __setstate__(self, state):
         """Unpickle, also a record pickled before ``solver`` existed (its ``acceleration``)."""

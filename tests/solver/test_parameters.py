@@ -2,6 +2,7 @@
 friction has one validator and one way into a running simulation, and the sample's history is
 one record whose file attributes are those files have always carried."""
 
+import re
 import warnings
 from dataclasses import fields, replace
 
@@ -167,3 +168,18 @@ def test_the_scenes_take_their_defaults_from_the_records():
     spec = RunSpec()
     assert (spec.shape, spec.particles, spec.seed) == (prep.shape, prep.particles, prep.seed)
     assert spec.test() == BiaxialTest()
+
+
+@pytest.mark.parametrize("change, named", [
+    (dict(overlap_recovery_iterations="abc"), "overlap_recovery_iterations='abc'"),
+    (dict(overlap_recovery_iterations=0), "overlap_recovery_iterations=0"),
+    (dict(overlap_recovery_tolerance=-1.0), "overlap_recovery_tolerance=-1.0"),
+    (dict(overlap_recovery_threshold=float("nan")), "overlap_recovery_threshold=nan"),
+    (dict(seed=-1), "seed=-1"),
+    (dict(solver="nlgs", shuffle="yes"), "shuffle='yes'"),
+])
+def test_every_numerical_setting_has_its_check(change, named):
+    from solver.parameters import Parameters
+
+    with pytest.raises(ParameterError, match=re.escape(named)):
+        Parameters(**change).validate()
