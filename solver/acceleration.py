@@ -46,7 +46,8 @@ import numpy as np
 from numba import njit, prange
 
 from . import scratch
-from .nlgs import NLGSResult, _apply, delassus_into, stalled, sweep, sweep_norms, velocities_from_impulses
+from .nlgs import (NLGSResult, apply_impulse_change, delassus_into, stalled, sweep, sweep_norms,
+                   velocities_from_impulses)
 from .parallel_nlgs import solve_decomposed, start_domains, sweep_domains
 from .residuals import cone_projection
 from .solve_records import AndersonScratch, DelassusBlocks, Impulses, Limits, Velocities
@@ -209,7 +210,7 @@ def _extrapolate_points(lo, hi, gamma, count, problem, impulses, velocities, scr
     for q in range(e_n.size):
         qn, qt = cone_projection(e_n[q], e_t[q], friction[q])
         if qn != e_n[q] or qt != e_t[q]:
-            _apply(lo + q, qn - e_n[q], qt - e_t[q], problem, velocities)
+            apply_impulse_change(lo + q, qn - e_n[q], qt - e_t[q], problem, velocities)
         p_n[q], p_t[q] = qn, qt
         x_n[q], x_t[q] = qn, qt
 

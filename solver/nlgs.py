@@ -159,7 +159,7 @@ def _relative_velocity(k, problem, velocities):
 
 
 @njit(cache=True)
-def _apply(k, dpn, dpt, problem, velocities):
+def apply_impulse_change(k, dpn, dpt, problem, velocities):
     """Add the impulse change (dpn, dpt) of point k to the velocities of its two bodies. A body
     that cannot move (zero inverse mass and inertia) is written too, with a zero change: a
     branch around it compiles into a several times slower sweep."""
@@ -267,7 +267,7 @@ def sweep(order, problem, impulses, velocities, blocks):
         new_n, new_t = local_solve(ufn, uft, bias[k], wnn[k], wnt[k], wtt[k], mu[k])
         dpn, dpt = new_n - pn[k], new_t - pt[k]
         if dpn != 0.0 or dpt != 0.0:
-            _apply(k, dpn, dpt, problem, velocities)
+            apply_impulse_change(k, dpn, dpt, problem, velocities)
             dv2 = dpn * (wnn[k] * dpn + wnt[k] * dpt) + dpt * (wnt[k] * dpn + wtt[k] * dpt)
             sum_dv2 += dv2
             if dv2 > max_dv2:
@@ -310,7 +310,7 @@ def velocities_from_impulses(problem, impulses, velocities):
     v = v_free + M^-1 H p when called on the free velocities."""
     pn, pt = impulses
     for k in range(problem.a.size):
-        _apply(k, pn[k], pt[k], problem, velocities)
+        apply_impulse_change(k, pn[k], pt[k], problem, velocities)
 
 
 def solve_problem(problem: ContactProblem, pn, pt, vx, vy, w, *, tolerance, max_tolerance, max_iterations,

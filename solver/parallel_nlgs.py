@@ -13,7 +13,7 @@ point. One sweep is then:
 2. the interface points swept serially after them.
 
 The copies exist because the sweep writes every body of a point, a wall that cannot move with
-a zero change (:func:`solver.nlgs._apply`: guarding that write makes the sweep several times
+a zero change (:func:`solver.nlgs.apply_impulse_change`: guarding that write makes the sweep several times
 slower); a copy's velocity is the wall's imposed one before and after the solve. The problem is
 also renumbered so that each domain's points and bodies are contiguous in memory
 (:class:`Decomposition`): with the bodies interleaved, the two threads kept writing the same

@@ -84,7 +84,7 @@ def test_same_solution_as_the_time_steppers_nlgs_on_a_random_system():
     def local_velocity(pn, pt):
         velocities = Velocities(v0[:, 0].copy(), v0[:, 1].copy(), v0[:, 2].copy())
         for k in range(points):
-            nlgs._apply(k, pn[k], pt[k], problem, velocities)
+            nlgs.apply_impulse_change(k, pn[k], pt[k], problem, velocities)
         return np.array([nlgs._relative_velocity(k, problem, velocities) for k in range(points)]).reshape(-1)
 
     q = local_velocity(np.zeros(points), np.zeros(points))
