@@ -144,6 +144,10 @@ def read_polygons(path) -> list:
     return out
 
 
+MAX_VERTICES = 64
+"""Most vertices a regular polygon of a scene may have (a polygon of more is a disk for every purpose)."""
+
+
 def _kind(shape):
     """("regular", n), ("family", IrregularFamily) or ("file", path) for a ``shape``."""
     if isinstance(shape, (str, os.PathLike)):
@@ -156,7 +160,11 @@ def _kind(shape):
             raise ParameterError(f"shape={text!r}: expected 'disk', 'pentagon', a number of vertices >= 3, "
                                  f"{', '.join(repr(name) for name in FAMILIES)} or a {SHAPE_FILE_SUFFIX} file of "
                                  "vertex lists")
-    return "regular", n_vertices_of(shape)
+    n = n_vertices_of(shape)
+    if n > MAX_VERTICES:
+        raise ParameterError(f"shape={shape!r}: expected at most {MAX_VERTICES} vertices (a polygon of more is a "
+                             "disk for every purpose)")
+    return "regular", n
 
 
 def check_shape(shape):

@@ -341,16 +341,12 @@ def library_default(module, function, parameter):
     return next(ast.literal_eval(d) for a, d in pairs if a.arg == parameter)
 
 
-MAX_VERTICES = 64
-"""Most vertices a ``--shape`` polygon may have (a polygon of more is a disk for every purpose)."""
-
-
 def _shape_of(text, option=None):
     """A shape of the command line: a name of :data:`solver.shapes.SHAPES` (disk, pentagon...),
     a number of vertices from 3 to :data:`MAX_VERTICES` (as an integer), a family of random
     convex polygons (:data:`solver.shape_families.FAMILIES`: irregular) or a .json file of vertex
     lists (read and checked here, given on as an absolute path)."""
-    from solver.shape_families import FAMILIES, SHAPE_FILE_SUFFIX, check_shape
+    from solver.shape_families import FAMILIES, MAX_VERTICES, SHAPE_FILE_SUFFIX, check_shape
     from solver.shapes import SHAPES
 
     text = str(text).strip()
@@ -1033,6 +1029,7 @@ def _study_parser(sub):
 
 def _run_parser(sub):
     from solver.preparation import Preparation
+    from solver.shape_families import MAX_VERTICES
 
     run = sub.add_parser("run", help="simulate one sample into a netCDF file",
                          description="Geometric deposit, isotropic compaction under sigma0 (10 kPa), then "
@@ -1076,6 +1073,7 @@ def _report_parser(sub):
 
 def _ensemble_parser(sub):
     from solver.parameters import Parameters
+    from solver.shape_families import MAX_VERTICES
     from solver.preparation import DEFAULT_PRESET, Preparation
 
     ens = sub.add_parser("ensemble", help="many runs (settings x seeds) on a dask cluster, then their report",

@@ -183,3 +183,11 @@ def test_every_numerical_setting_has_its_check(change, named):
 
     with pytest.raises(ParameterError, match=re.escape(named)):
         Parameters(**change).validate()
+
+
+def test_the_shape_is_checked_by_the_preparation_as_by_the_command_line():
+    from solver.shape_families import MAX_VERTICES
+
+    Preparation(shape=MAX_VERTICES).validate()
+    with pytest.raises(ParameterError, match=f"shape=100: expected at most {MAX_VERTICES} vertices"):
+        Preparation(shape=100).validate()
