@@ -19,43 +19,28 @@ class Done(Exception):
     """Raised by an ``after_step`` callback of :func:`shear` to end the shear there."""
 
 
-def shear(sim, after_step, solve=None, before_step=None, domains=1) -> float:
+def shear(sim, after_step, before_step=None, domains=1) -> float:
     """Run ``solver.biaxial_test`` on ``sim`` (top wall at 1 cm/s, no snapshots but the first,
     warnings silenced) with Anderson sweeps every 2 sweeps and the stall test over 200 on
     ``domains`` domains (one by default), calling ``before_step()`` (if given) right before every
-    step and ``after_step(info)`` after it (either raises :class:`Done` to stop), with ``solve``
-    (if given) in place of ``solver.acceleration.solve_problem_anderson``; the simulation's and
-    the module's own functions are back afterwards. Returns the seconds."""
+    step and ``after_step(info)`` after it (either raises :class:`Done` to stop), through
+    :meth:`solver.stepper.Simulation.watch`. Returns the seconds."""
     from dataclasses import replace
 
     import solver
-    from solver import acceleration
 
     sim.parameters = replace(sim.parameters, solver="anderson", anderson_period=2, stall_sweeps=200,
                              domains=domains).validate()
-    original_solve, step = acceleration.solve_problem_anderson, sim.step
-
-    def stepped():
-        if before_step is not None:
-            before_step()
-        info = step()
-        after_step(info)
-        return info
-
-    sim.step = stepped
-    acceleration.solve_problem_anderson = solve or original_solve
     folder = tempfile.mkdtemp(prefix="shear_")  # a file of its own: runs side by side do not meet
     path = os.path.join(folder, "shear.nc")
     start = time.perf_counter()
     try:
-        with warnings.catch_warnings():
+        with warnings.catch_warnings(), sim.watch(after=after_step, before=before_step):
             warnings.simplefilter("ignore")
             solver.biaxial_test(sim, path, strain=0.5, velocity=0.01, every=10**9, overwrite=True, progress=False)
     except Done:
         pass
     finally:
-        acceleration.solve_problem_anderson = original_solve
-        del sim.step  # the class's method again
         shutil.rmtree(folder, ignore_errors=True)
     return time.perf_counter() - start
 

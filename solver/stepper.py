@@ -126,6 +126,27 @@ class Unconverged:
             self.local_law_residual = float(info.local_law_residual)
 
 
+class StepWatch:
+    """Hooks of :meth:`Simulation.watch`, called around every step until :meth:`close` (or the
+    end of a ``with`` block)."""
+
+    def __init__(self, simulation, hook):
+        self.simulation, self.hook = simulation, hook
+        simulation._step_hooks = (*simulation._step_hooks, hook)
+
+    def close(self):
+        """Stop calling the hooks (a second call does nothing)."""
+        hooks = self.simulation._step_hooks
+        self.simulation._step_hooks = tuple(h for h in hooks if h is not self.hook)
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc):
+        self.close()
+        return False
+
+
 class Simulation:
     """State of a packing (particles and walls) and its time stepping.
 
@@ -349,9 +370,39 @@ class Simulation:
         self.timings["contact_problem"] += time.perf_counter() - middle
         return StepProblem(problem, state, limits, pts, keys, ra, rb, v_start, omega_start)
 
+    _step_hooks = ()  # (before, after) pairs of the open StepWatch-es; see watch()
+
+    def watch(self, after=None, before=None) -> StepWatch:
+        """Call ``before()`` right before every step and ``after(info)`` right after it, with the
+        step's :class:`StepInfo`, until the returned :class:`StepWatch` is closed (or its
+        ``with`` block ends): the documented way to observe, time or stop a run from outside
+        (a benchmark counts sweeps, captures the contact problem a step is about to solve, or
+        raises to end a scene there). The hooks' own time is not in :attr:`timings`. A hook that
+        raises stops the run: ``before`` before the step changes anything, ``after`` once the
+        step is complete. Hooks are called in the order they were added."""
+        if before is None and after is None:
+            raise ParameterError("watch(): expected a before() or an after(info) callable")
+        for name, hook in (("before", before), ("after", after)):
+            if hook is not None and not callable(hook):
+                raise ParameterError(f"watch({name}={hook!r}): expected a callable")
+        return StepWatch(self, (before, after))
+
     def step(self) -> StepInfo:
         """One Moreau–Jean step, in the stages of the module docstring; the seconds of each
-        stage are added to :attr:`timings` (:data:`STAGES`)."""
+        stage are added to :attr:`timings` (:data:`STAGES`). The hooks of :meth:`watch` are
+        called around it."""
+        hooks = self._step_hooks
+        for before, _ in hooks:
+            if before is not None:
+                before()
+        info = self._advance()
+        for _, after in hooks:
+            if after is not None:
+                after(info)
+        return info
+
+    def _advance(self) -> StepInfo:
+        """The step itself (:meth:`step` without the hooks)."""
         start = time.perf_counter()
         staged = sum(self.timings.values())
         posed = self.contact_problem()

@@ -113,22 +113,15 @@ def _shear_summary(sim, attrs: dict, path: str) -> dict:
     from grainview.app.report import run_summary
 
     steps = []
-    step = sim.step
 
-    def recorded():
-        info = step()
+    def recorded(info):
         steps.append((info.iterations, info.local_law_residual, info.unbalanced_force))
-        return info
 
-    sim.step = recorded
     start = time.perf_counter()
-    try:
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore")
-            solver.biaxial_test(sim, path, strain=0.2, velocity=0.01, every=200, overwrite=True, progress=False,
-                                attrs=attrs, near_contacts=True)
-    finally:
-        del sim.step
+    with warnings.catch_warnings(), sim.watch(after=recorded):
+        warnings.simplefilter("ignore")
+        solver.biaxial_test(sim, path, strain=0.2, velocity=0.01, every=200, overwrite=True, progress=False,
+                            attrs=attrs, near_contacts=True)
     seconds = time.perf_counter() - start
     with grainview.open_dataset(path) as ds:
         summary = run_summary(ds, 0.3)

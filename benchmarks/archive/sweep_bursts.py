@@ -238,7 +238,14 @@ def shear(sim, until: float, apgd_target: float = 0.0, apgd_iterations: int = 30
         if np.log(h0 / float(hi[1] - lo[1])) - np.log(l0 / float(hi[0] - lo[0])) >= until:
             raise _Done
 
-    record["seconds"] = _shear(sim, record_step, probed if apgd_target > 0 else None)
+    if apgd_target <= 0:
+        record["seconds"] = _shear(sim, record_step)
+    else:  # the probe is no solver of the registry: it takes the place of the Anderson sweeps' function here only
+        acceleration.solve_problem_anderson = probed
+        try:
+            record["seconds"] = _shear(sim, record_step)
+        finally:
+            acceleration.solve_problem_anderson = solve
     return {k: (np.array(v) if isinstance(v, list) else v) for k, v in record.items()}
 
 

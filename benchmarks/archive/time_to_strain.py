@@ -116,12 +116,13 @@ def measure(shape: str, acceleration: str = "off", domains: int = 1, particles: 
     lo, hi = sim.walls.box_bounds()
     h0, l0 = float(hi[1] - lo[1]), float(hi[0] - lo[0])
     sweeps, points, seconds, strains = [], [], [], []
-    step = sim.step
+    started = [0.0]
 
-    def timed_step():
-        t = time.perf_counter()
-        info = step()
-        seconds.append(time.perf_counter() - t)
+    def start_clock():
+        started[0] = time.perf_counter()
+
+    def timed_step(info):
+        seconds.append(time.perf_counter() - started[0])
         sweeps.append(info.iterations)
         points.append(info.n_points)
         residuals.append(info.local_law_residual)
@@ -130,12 +131,10 @@ def measure(shape: str, acceleration: str = "off", domains: int = 1, particles: 
         strains.append(eps_q)
         if eps_q >= until:
             raise TargetReached
-        return info
 
-    sim.step = timed_step
     path = os.path.join(OUT, f"{shape}_{particles}_{acceleration}_{domains}_{stall}_shear.nc")
     try:
-        with warnings.catch_warnings():
+        with warnings.catch_warnings(), sim.watch(after=timed_step, before=start_clock):
             warnings.simplefilter("ignore")
             solver.biaxial_test(sim, path, strain=0.5, velocity=0.01, every=10**9, overwrite=True, progress=False)
     except TargetReached:

@@ -47,14 +47,8 @@ def test_pressure_ramp_raises_the_stress_linearly_to_sigma0():
     h = sim.parameters.time_step
     ramp = 40 * h
     seen = []
-    step = sim.step
-
-    def recording_step():
-        seen.append(sim.walls.stress[[1, 2]].copy())
-        return step()
-
-    sim.step = recording_step
-    _quiet(isotropic_compaction, sim, max_steps=60, pressure_ramp=ramp, progress=False)
+    with sim.watch(before=lambda: seen.append(sim.walls.stress[[1, 2]].copy())):
+        _quiet(isotropic_compaction, sim, max_steps=60, pressure_ramp=ramp, progress=False)
     seen = np.array(seen)
     np.testing.assert_allclose(seen[:40, 0], 1e4 * np.arange(1, 41) / 40, rtol=1e-12)
     np.testing.assert_allclose(seen[40:], 1e4, rtol=0)

@@ -162,14 +162,7 @@ def test_a_run_with_the_projected_conjugate_gradient_reaches_the_residual_it_cla
     singular W, solver.contact_solvers)."""
     sim = compaction_sample(30, "pentagon", seed=3, solver="pcg")
     infos = []
-    step = sim.step
-
-    def recorded():
-        infos.append(step())
-        return infos[-1]
-
-    sim.step = recorded
-    with warnings.catch_warnings(record=True) as caught:
+    with warnings.catch_warnings(record=True) as caught, sim.watch(after=infos.append):
         warnings.simplefilter("always", ConvergenceWarning)
         isotropic_compaction(sim, max_steps=800, progress=False)
     said = [str(w.message) for w in caught if issubclass(w.category, ConvergenceWarning)]
