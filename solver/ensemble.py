@@ -39,6 +39,7 @@ import warnings
 from dataclasses import dataclass, field
 from pathlib import Path
 
+import numpy as np
 
 from grainview.contract.errors import ConvergenceWarning, FileFormatError, ParameterError
 
@@ -127,13 +128,19 @@ class RunSpec:
 
 
 def grid(*, shapes=(RunSpec.shape,), frictions=(None,), seeds=1, particles=(RunSpec.particles,), sigma0=(None,),
-         **common):
-    """Every combination of the values given, with ``seeds`` seeds each (a count: seeds 0 ..
-    seeds-1, or a sequence of seeds): a list of :class:`RunSpec`, validated. ``common``: the
-    other :class:`RunSpec` fields, the same for every run."""
-    seed_list = range(int(seeds)) if isinstance(seeds, (int,)) else tuple(seeds)
-    if len(seed_list) == 0:
-        raise ParameterError(f"seeds={seeds!r}: expected at least one seed")
+         first_seed=0, **common):
+    """Every combination of the values given, with ``seeds`` seeds each (a count: seeds
+    ``first_seed`` .. ``first_seed + seeds - 1``, or a sequence of seeds): a list of
+    :class:`RunSpec`, validated. ``common``: the other :class:`RunSpec` fields, the same for
+    every run."""
+    if isinstance(seeds, (int, np.integer)):
+        if seeds < 1:
+            raise ParameterError(f"seeds={seeds}: expected at least 1 seed")
+        seed_list = range(int(first_seed), int(first_seed) + int(seeds))
+    else:
+        seed_list = tuple(seeds)
+        if len(seed_list) == 0:
+            raise ParameterError(f"seeds={seeds!r}: expected at least 1 seed")
     specs = [RunSpec(shape=shape, particles=int(n), seed=int(seed), friction=mu, sigma0=p0, **common).validate()
              for shape, n, mu, p0, seed in itertools.product(shapes, particles, frictions, sigma0, seed_list)]
     names = [s.name for s in specs]
@@ -256,14 +263,26 @@ class _Display:
             bar.close()
 
 
+def check_cluster(scheduler=None, workers=None):
+    """Refuse, in one line, a cluster that cannot be had: ``workers`` (processes of a new local
+    cluster) not a whole number >= 1, or given with the address of an existing ``scheduler``,
+    which has its own workers. The one check of these settings, for the library and the
+    command line."""
+    if workers is not None:
+        if isinstance(workers, bool) or not isinstance(workers, (int, np.integer)) or workers < 1:
+            raise ParameterError(f"workers={workers!r}: expected at least 1 worker process (a whole number)")
+        if scheduler is not None:
+            raise ParameterError("workers= applies to the local cluster only; an existing scheduler has its own "
+                                 "workers")
+
+
 def local_cluster(workers=None, memory_limit="auto"):
     """A :class:`distributed.LocalCluster` of ``workers`` single-threaded processes (default:
     one per core), each with :data:`SINGLE_THREAD_ENV`."""
     from distributed import LocalCluster
 
+    check_cluster(None, workers)
     workers = (os.cpu_count() or 1) if workers is None else int(workers)
-    if workers < 1:
-        raise ParameterError(f"workers={workers!r}: expected at least 1 worker process")
     return LocalCluster(n_workers=workers, threads_per_worker=1, processes=True, memory_limit=memory_limit,
                         env=dict(SINGLE_THREAD_ENV), dashboard_address=None, silence_logs=logging.CRITICAL)
 
@@ -276,8 +295,6 @@ def _client(scheduler, workers):
     if scheduler is None:
         cluster = local_cluster(workers)
         return Client(cluster), cluster
-    if workers is not None:
-        raise ParameterError("workers= applies to the local cluster only; an existing scheduler has its own")
     return Client(scheduler), None
 
 
@@ -305,6 +322,8 @@ def run_ensemble(specs, folder, *, scheduler=None, workers=None, client=None, ov
 
     from distributed import as_completed
 
+    if client is None:
+        check_cluster(scheduler, workers)
     specs = [s.validate() for s in specs]
     names = [s.name for s in specs]
     if len(set(names)) != len(names):

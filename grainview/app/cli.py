@@ -598,21 +598,16 @@ def _split(text, kind, name):
 
 
 def _ensemble(args) -> int:
-    from solver.ensemble import grid, run_ensemble
+    from solver.ensemble import check_cluster, grid, run_ensemble
 
-    if args.seeds < 1:
-        raise GrainviewError(f"--seeds {args.seeds}: expected at least 1 seed")
-    if args.workers is not None and args.workers < 1:
-        raise GrainviewError(f"--workers {args.workers}: expected at least 1 worker process")
-    if args.workers is not None and args.scheduler is not None:
-        raise GrainviewError("--workers applies to the local cluster; an existing --scheduler has its own workers")
+    check_cluster(args.scheduler, args.workers)  # before any line is printed; the library's one check
     test = _test(args)
     frictions = _split(args.friction_list, float, "friction") if args.friction_list else [None]
     sigma0 = _split(args.sigma0_list, float, "sigma0") if args.sigma0_list else [None]
     particles = {"particles": _split(args.particles_list, int, "particles")} if args.particles_list else {}
     shapes = [_shape_of(s, f"--shapes {args.shapes}") for s in _split(args.shapes, str, "shapes")]
     specs = grid(shapes=shapes, **particles, frictions=frictions, sigma0=sigma0,
-                 seeds=range(args.seed, args.seed + args.seeds), preparation=args.preparation,
+                 seeds=args.seeds, first_seed=args.seed, preparation=args.preparation,
                  strain=test.strain, velocity=test.velocity, every=test.every,
                  solver=tuple(sorted(_solver_parameters(args).items())), engine=args.engine)
     out = Path(args.out)

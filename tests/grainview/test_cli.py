@@ -134,7 +134,7 @@ def test_interruptions_exit_with_the_shells_codes(monkeypatch, capsys):
     (["ensemble", "--seeds", "0", "--out", "{tmp}/e"], "at least 1 seed"),
     (["ensemble", "--friction", "0.2,high", "--out", "{tmp}/e"], "comma-separated list of float"),
     (["ensemble", "--workers", "0", "--out", "{tmp}/e"], "at least 1 worker"),
-    (["ensemble", "--workers", "2", "--scheduler", "tcp://x:1", "--out", "{tmp}/e"], "--workers applies"),
+    (["ensemble", "--workers", "2", "--scheduler", "tcp://x:1", "--out", "{tmp}/e"], "workers= applies to the local cluster"),
     (["ensemble", "--strain", "2", "--out", "{tmp}/e"], "vertical strain"),
     (["ensemble", "--shapes", "cube", "--out", "{tmp}/e"], "cube"),
     (["report", "--ensemble", "{tmp}/none*.nc", "--out", "{tmp}/r"], "no such file"),

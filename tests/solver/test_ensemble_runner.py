@@ -6,6 +6,7 @@ while the others finish; a changed command line refused before anything runs."""
 from __future__ import annotations
 
 import os
+import re
 import signal
 
 import numpy as np
@@ -135,6 +136,33 @@ def test_specs_are_checked():
     with pytest.raises(ParameterError, match="workers"):
         ensemble.local_cluster(workers=0)
     assert RunSpec(shape="disk", particles=40, friction=0.2, seed=3).name == "disk_n40_mu0.2_s3"
+
+
+def test_seeds_count_from_the_first_seed_and_none_is_refused():
+    specs = grid(seeds=3, first_seed=5, shapes=("disk",), particles=(12,))
+    assert [s.seed for s in specs] == [5, 6, 7]
+    assert [s.seed for s in grid(seeds=(2, 9), shapes=("disk",), particles=(12,))] == [2, 9]
+    for seeds in (0, -2, ()):
+        with pytest.raises(ParameterError, match=r"^seeds=.*: expected at least 1 seed$"):
+            grid(seeds=seeds)
+
+
+@pytest.mark.parametrize("scheduler, workers, words", [
+    (None, 0, "workers=0: expected at least 1 worker process"),
+    (None, 1.5, "workers=1.5: expected at least 1 worker process"),
+    ("tcp://x:1", 2, "workers= applies to the local cluster only"),
+])
+def test_the_cluster_is_checked_once_before_any_work(tmp_path, scheduler, workers, words):
+    """run_ensemble refuses an impossible cluster before it touches the folder (the command
+    line calls the same check before it prints anything)."""
+    folder = tmp_path / "runs"
+    with pytest.raises(ParameterError, match=re.escape(words)):
+        ensemble.check_cluster(scheduler, workers)
+    with pytest.raises(ParameterError, match=re.escape(words)):
+        ensemble.run_ensemble(grid(seeds=1, **TINY), folder, scheduler=scheduler, workers=workers)
+    assert not folder.exists()
+    ensemble.check_cluster("tcp://x:1", None)
+    ensemble.check_cluster(None, 2)
 
 
 def test_a_finished_run_whose_compression_was_stopped_is_compressed_on_rerun(killed, tmp_path):
