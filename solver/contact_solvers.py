@@ -74,6 +74,7 @@ import numpy as np
 
 from grainview.contract.errors import ParameterError
 
+from . import projected_cg
 from .solve_records import Impulses, Limits, MatrixProblem
 
 __all__ = ["ACCELERATIONS", "ContactState", "Limits", "Method", "matrix_methods", "method", "register",
@@ -107,6 +108,10 @@ class Method:
         ``seed``).
     stall : whether ``solve`` applies the NLGS's stall test (``limits.stall``,
         ``Parameters.stall_sweeps``).
+    label : its short name in reports' prose ("NLGS convergence: ...").
+    iteration : what one of its iterations is called ("sweep", "iteration").
+    norms : what its tolerances apply to, as the words after "before" in a report.
+    own_stall : the words for its own stall test, for a method without the NLGS's ("" for none).
     """
 
     name: str
@@ -117,6 +122,10 @@ class Method:
     domains: bool = False
     shuffle: bool = False
     stall: bool = True
+    label: str = "NLGS"
+    iteration: str = "sweep"
+    norms: str = "both stopping norms (the impulses' change over a sweep) met their tolerances"
+    own_stall: str = ""
 
     @property
     def in_stepper(self) -> bool:
@@ -188,6 +197,29 @@ def method(name: str) -> Method:
     except (KeyError, TypeError):
         raise ParameterError(f"solver={name!r}: expected one of {', '.join(stepper_methods())} (the time "
                              f"stepper's); problems given by their matrix: {', '.join(matrix_methods())}") from None
+
+
+def stall_rule(name: str, stall_sweeps=None) -> str:
+    """The stall test that stops the method ``name``, in words ("" for none): the NLGS's when the
+    method applies it and ``stall_sweeps`` > 0 (the best quadratic norm down by less than 5% over
+    that many sweeps), otherwise the method's own, if it has one."""
+    from .nlgs import STALL_IMPROVEMENT
+
+    m = method(name)
+    if m.stall:
+        return (f"the stall test (quadratic norm down by < {100 * STALL_IMPROVEMENT:g}% over {stall_sweeps:.0f} "
+                "sweeps)") if stall_sweeps else ""
+    return m.own_stall
+
+
+def stop_rule(name: str, max_iterations=None, stall_sweeps=None) -> str:
+    """What stops the method ``name`` short of its tolerances, in words: its iteration cap
+    (``max_iterations`` of them, where given) and its stall test (:func:`stall_rule`). Reports
+    and warnings take the words from here."""
+    m = method(name)
+    cap = f"the {m.iteration} cap" + (f" ({max_iterations:.0f} {m.iteration}s)" if max_iterations else "")
+    stall = stall_rule(name, stall_sweeps)
+    return f"{cap} or {stall}" if stall else cap
 
 
 def from_acceleration(value: str) -> str:
@@ -270,8 +302,6 @@ def solve_newton(W, q, mu, tolerance, max_iterations, initial) -> ContactSolutio
 
 def solve_pcg(W, q, mu, tolerance, max_iterations, initial) -> ContactSolution:
     """Projected conjugate gradient (:func:`solver.projected_cg.solve`)."""
-    from . import projected_cg
-
     return projected_cg.solve(W, q, mu, tolerance, max_iterations, initial)
 
 
@@ -281,7 +311,7 @@ def solve_stepper_pcg(problem, state: ContactState, limits: Limits) -> NLGSResul
     local-law residual is within ``limits.tolerance`` or ``limits.max_iterations`` iterations;
     ``state`` updated in place (the impulses, and the velocities V_free + M^-1 H^T r). The
     result's two norms are both the local-law residual |F|/|r|."""
-    from . import matrix_form, projected_cg
+    from . import matrix_form
     from .nlgs import NLGSResult
 
     pn, pt, vx, vy, w = state
@@ -301,6 +331,10 @@ register(Method("nlgs", "nonlinear Gauss-Seidel sweeps (serial, shuffled or on d
                 solve_matrix=solve_nlgs, parameters=(), domains=True, shuffle=True))
 register(Method("anderson", "Anderson-accelerated NLGS sweeps (the default)", solve=solve_stepper_anderson,
                 parameters=(("anderson_memory", "memory"), ("anderson_period", "period")), domains=True))
-register(Method("newton", "semi-smooth Newton on Alart-Curnier's function", solve_matrix=solve_newton))
+register(Method("newton", "semi-smooth Newton on Alart-Curnier's function", solve_matrix=solve_newton,
+                label="Newton", iteration="Newton step"))
 register(Method("pcg", "projected conjugate gradient (Renouf & Alart) on the step's matrix", solve=solve_stepper_pcg,
-                solve_matrix=solve_pcg, stall=False))
+                solve_matrix=solve_pcg, stall=False, label="Projected-CG", iteration="iteration",
+                norms="its local-law residual |F|/|r| met the tolerance (both of its norms are that residual)",
+                own_stall=f"its own stall test (the best local-law residual down by < "
+                          f"{100 * projected_cg.STALL_IMPROVEMENT:g}% over {projected_cg.STALL_ITERATIONS} iterations)"))

@@ -36,11 +36,15 @@ from .contact_solution import ContactSolution, contact_solution
 from .projected_cg_kernels import iteration, start
 from .solve_records import MatrixProblem
 
-__all__ = ["STALL_ITERATIONS", "solve"]
+__all__ = ["STALL_IMPROVEMENT", "STALL_ITERATIONS", "solve"]
 
 STALL_ITERATIONS = 500
-"""The iterations stop when the smallest local-law residual has fallen by less than 5% over
-this many iterations."""
+"""The iterations stop when the smallest local-law residual has fallen by less than
+``STALL_IMPROVEMENT`` over this many iterations."""
+
+STALL_IMPROVEMENT = 0.05
+"""The relative fall of the smallest local-law residual over ``STALL_ITERATIONS`` iterations
+below which the iterations stop."""
 
 
 def solve(W, q, mu, tolerance, max_iterations, initial) -> ContactSolution:
@@ -68,7 +72,7 @@ def solve(W, q, mu, tolerance, max_iterations, initial) -> ContactSolution:
         law = _law(violation, size)
         best = min(best, law)
         if iterations % STALL_ITERATIONS == 0:
-            if best > 0.95 * checked:
+            if best > (1.0 - STALL_IMPROVEMENT) * checked:
                 break
             checked = best
     return contact_solution(W, q, mu, r.reshape(n, 2), iterations, law <= tolerance)

@@ -307,8 +307,9 @@ def main(argv=None) -> int:
             warnings.showwarning(w.message, w.category, w.filename, w.lineno)
     unconverged = sum(issubclass(w.category, ConvergenceWarning) for w in caught)
     if unconverged:
-        print(f"warning: NLGS did not converge (sweep cap or stall test) in {unconverged} step(s); the file counts "
-              "them per snapshot (nlgs_unconverged_steps) with their largest residuals", file=sys.stderr)
+        print(f"warning: the contact solver did not converge in {unconverged} step(s) (stopped at its iteration cap "
+              "or stall test); the file counts them per snapshot (nlgs_unconverged_steps) with their largest "
+              "residuals", file=sys.stderr)
     print(f"{args.path}: {'already complete' if steps == 0 else f'resumed for {steps} steps, complete'}")
     return 0
 

@@ -503,12 +503,13 @@ class Simulation:
         self.counters["point_sweeps"] += result.iterations * n_points
         converged = result.residual <= p.tolerance and result.max_residual <= p.max_tolerance
         if not converged:
-            nlgs_stall = contact_solvers.method(p.solver).stall
-            stop = ("the iteration cap" if result.iterations >= p.max_iterations else
-                    f"a stall (the best quadratic norm fell < {100 * nlgs.STALL_IMPROVEMENT:g}% over "
-                    f"{p.stall_sweeps} sweeps)" if nlgs_stall else "its own stall test")
+            m = contact_solvers.method(p.solver)
+            if result.iterations >= p.max_iterations:
+                stop = f"the {m.iteration} cap"
+            else:
+                stop = contact_solvers.stall_rule(p.solver, p.stall_sweeps) or "a stall"
             warnings.warn(f"the contact solver ({p.solver}) did not converge at step {self.step_index} (t = "
-                          f"{self.time:.6g} s): stopped by {stop} after {result.iterations} iterations, residual "
+                          f"{self.time:.6g} s): stopped by {stop} after {result.iterations} {m.iteration}s, residual "
                           f"{result.residual:.3g} (tolerance {p.tolerance:g}), max residual "
                           f"{result.max_residual:.3g} (tolerance {p.max_tolerance:g})", ConvergenceWarning,
                           stacklevel=3)

@@ -437,11 +437,12 @@ def _inertia(sample, test) -> str:
 
 def _unconverged_warning(sim, path, unconverged) -> str:
     """What the warning on a run's unconverged steps says: how many of the compaction's and of
-    the test's steps stopped at the sweep cap or the stall test, and how far their impulses
-    were from a solution (grainview.app.convergence), read from the written file."""
+    the test's steps stopped at their contact solver's iteration cap or stall test, in that
+    solver's words, and how far their impulses were from a solution (grainview.app.convergence),
+    read from the written file."""
     import netCDF4
 
-    from .convergence import residual_comparison, stop_rule, tolerances, unconverged_in_file
+    from .convergence import norms_phrase, residual_comparison, stop_rule, tolerances, unconverged_in_file
 
     with netCDF4.Dataset(path) as nc:
         counts = unconverged_in_file(nc.variables, {k: nc.getncattr(k) for k in nc.ncattrs()})
@@ -456,10 +457,12 @@ def _unconverged_warning(sim, path, unconverged) -> str:
     else:
         counts = {"tolerance": sim.parameters.tolerance, "typical_local_law_residual": None}
     counts.update(residual=quad, local_law_residual=law, max_iterations=sim.parameters.max_iterations,
-                  max_tolerance=sim.parameters.max_tolerance, stall_sweeps=sim.parameters.stall_sweeps)
+                  max_tolerance=sim.parameters.max_tolerance, stall_sweeps=sim.parameters.stall_sweeps,
+                  solver=sim.parameters.solver)
     where = f" ({', '.join(parts)})" if parts else ""
-    return (f"the NLGS did not converge in {unconverged} step(s){where}: stopped at {stop_rule(counts)} before "
-            f"both stopping norms met their tolerances ({tolerances(counts)}); {residual_comparison(counts)}. "
+    return (f"the contact solver ({sim.parameters.solver}) did not converge in {unconverged} step(s){where}: "
+            f"stopped at {stop_rule(counts)} before {norms_phrase(counts)} ({tolerances(counts)}); "
+            f"{residual_comparison(counts)}. "
             f"{path} records the test's per snapshot (nlgs_unconverged_steps), and its report states them")
 
 

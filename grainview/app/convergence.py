@@ -84,16 +84,45 @@ def unconverged_in_file(variables, attrs) -> dict | None:
         "max_tolerance": _number(attrs, "solver_max_tolerance"),
         "max_iterations": _number(attrs, "solver_max_iterations"),
         "stall_sweeps": _number(attrs, "solver_stall_sweeps"),
+        "solver": solver_name(attrs),
     }
 
 
+def solver_name(attrs) -> str:
+    """The contact solver a file's steps were solved with: its ``solver_solver``, or for a file
+    written before that attribute its ``solver_acceleration`` ("anderson" or the plain NLGS)."""
+    if "solver_solver" in attrs:
+        return str(attrs["solver_solver"])
+    return "anderson" if str(attrs.get("solver_acceleration", "off")) == "anderson" else "nlgs"
+
+
+def _method(counts: dict):
+    """The registered method of ``counts['solver']`` (default the NLGS), or None for a name this
+    package does not know."""
+    from solver import contact_solvers
+
+    try:
+        return contact_solvers.method(counts.get("solver") or "nlgs")
+    except ValueError:
+        return None
+
+
 def stop_rule(counts: dict) -> str:
-    """What stopped the unconverged steps: the sweep cap and, when it was on, the stall test."""
-    cap = f"the sweep cap ({counts['max_iterations']:.0f} sweeps)" if counts.get("max_iterations") else "the sweep cap"
-    stall = counts.get("stall_sweeps")
-    if stall:
-        return f"{cap} or the stall test (quadratic norm down by < 5% over {stall:.0f} sweeps)"
-    return cap
+    """What stopped the unconverged steps, in the words of their contact solver
+    (:func:`solver.contact_solvers.stop_rule`): its iteration cap and, when it was on, its stall
+    test."""
+    from solver import contact_solvers
+
+    m = _method(counts)
+    if m is None:
+        return "the iteration cap or a stall test"
+    return contact_solvers.stop_rule(m.name, counts.get("max_iterations"), counts.get("stall_sweeps"))
+
+
+def norms_phrase(counts: dict) -> str:
+    """What the solver's tolerances apply to, as the words after "before"."""
+    m = _method(counts)
+    return m.norms if m is not None else "its stopping norms met their tolerances"
 
 
 def tolerances(counts: dict) -> str:
@@ -127,11 +156,13 @@ def unconverged_text(counts: dict | None, what: str = "the test") -> str:
         return ("NLGS convergence: not recorded in this file (no nlgs_unconverged_steps: written by another code "
                 "or an older solver).")
     of = f" of {what}'s {counts['of']}" if counts["of"] is not None else f" of {what}"
+    m = _method(counts)
+    heading = f"{m.label if m is not None else 'Contact-solver'} convergence"
     if counts["steps"] == 0:
-        return (f"NLGS convergence: every step{of} met both stopping tolerances ({tolerances(counts)}).")
+        return (f"{heading}: every step{of} met both stopping tolerances ({tolerances(counts)}).")
     share = f" ({100 * counts['steps'] / counts['of']:.2g}%)" if counts["of"] else ""
-    return (f"NLGS convergence: {counts['steps']}{of} steps{share}, in {counts['snapshots']} of the intervals "
-            f"between snapshots, stopped at {stop_rule(counts)} before both stopping norms (the impulses' change "
-            f"over a sweep) met their tolerances ({tolerances(counts)}); their forces are kept as they are. "
+    return (f"{heading}: {counts['steps']}{of} steps{share}, in {counts['snapshots']} of the intervals "
+            f"between snapshots, stopped at {stop_rule(counts)} before {norms_phrase(counts)} "
+            f"({tolerances(counts)}); their forces are kept as they are. "
             f"{residual_comparison(counts)[0].upper()}{residual_comparison(counts)[1:]}. Recorded per snapshot in "
             f"the file's {COUNT} (docs/schema.md).")

@@ -54,6 +54,23 @@ def test_the_text_states_the_counts_the_rule_and_the_residuals_against_the_toler
     assert "or the stall test (quadratic norm down by < 5% over 200 sweeps)" in stalled
 
 
+def test_the_text_speaks_of_the_solver_the_file_names():
+    """A file made with the projected CG says iterations, its own stall test and its one norm;
+    a file from before ``solver_solver`` is read as its ``solver_acceleration`` says; a name this
+    package does not know gets neutral words."""
+    pcg = unconverged_text(unconverged_in_file(_variables(), {**ATTRS, "solver_solver": "pcg"}))
+    assert pcg.startswith("Projected-CG convergence: 3 of the test's 600 steps")
+    assert ("stopped at the iteration cap (2000 iterations) or its own stall test (the best local-law residual "
+            "down by < 5% over 500 iterations) before its local-law residual |F|/|r| met the tolerance") in pcg
+    assert "sweep" not in pcg
+    anderson = unconverged_text(unconverged_in_file(_variables(), {**ATTRS, "solver_solver": "anderson"}))
+    older = unconverged_text(unconverged_in_file(_variables(), {**ATTRS, "solver_acceleration": "anderson"}))
+    assert anderson == older == unconverged_text(unconverged_in_file(_variables(), ATTRS))
+    assert anderson.startswith("NLGS convergence: ") and "the sweep cap (2000 sweeps) before both" in anderson
+    other = unconverged_text(unconverged_in_file(_variables(), {**ATTRS, "solver_solver": "interior-point"}))
+    assert other.startswith("Contact-solver convergence: ") and "the iteration cap or a stall test" in other
+
+
 def test_no_unconverged_step_and_no_record_are_said_so():
     variables = _variables()
     variables["nlgs_unconverged_steps"] = np.zeros(5, int)
@@ -84,6 +101,8 @@ def test_the_run_command_warns_with_the_counts_its_file_and_report_hold(tmp_path
         largest = max(float(nc["nlgs_unconverged_local_law_residual"][:].max()),
                       float(nc.getncattr("compaction_unconverged_local_law_residual")))
     assert test == stored > 0 and total == compaction + test
+    assert "the contact solver (anderson) did not converge in" in err
+    assert "stopped at the sweep cap (10 sweeps) before both stopping norms" in err
     assert f"largest local-law residual |F|/|r| {largest:.2g}" in err
     with grainview.open_dataset(path, chunks=None) as ds:
         text = convergence_text(ds)

@@ -133,6 +133,6 @@ def test_non_convergence_warns():
     sim = Simulation(np.stack([np.zeros(n), y], -1), np.zeros(n), np.full(n, R), np.zeros(n), Walls.floor(),
                      Parameters(gravity=(0, -G), tolerance=1e-14, max_tolerance=1e-14, max_iterations=2))
     with pytest.warns(Warning, match=r"the contact solver \(anderson\) did not converge at step 0 \(t = 0 s\): "
-                                    r"stopped by the iteration cap after 2 iterations"):
+                                    r"stopped by the sweep cap after 2 sweeps"):
         sim.step()
     assert not sim.last.converged and sim.last.iterations == 2

@@ -177,3 +177,21 @@ def test_a_run_with_the_projected_conjugate_gradient_reaches_the_residual_it_cla
     assert np.all(measured[~converged] > sim.parameters.tolerance)
     assert converged.mean() > 0.8
     assert sim.counters["unconverged_steps"] == (~converged).sum()
+
+
+def test_each_method_states_what_stops_it_in_its_own_words():
+    """The words the stepper's warnings and the reports use (contact_solvers.stop_rule): the
+    NLGS family counts sweeps and its stall test only when it is on; the projected CG counts
+    iterations and always has its own stall test, with the numbers its code uses."""
+    from solver import nlgs, projected_cg
+
+    assert contact_solvers.stop_rule("nlgs", 2000, 0) == "the sweep cap (2000 sweeps)"
+    assert contact_solvers.stop_rule("anderson", 2000, 200) == (
+        f"the sweep cap (2000 sweeps) or the stall test (quadratic norm down by < "
+        f"{100 * nlgs.STALL_IMPROVEMENT:g}% over 200 sweeps)")
+    assert contact_solvers.stop_rule("pcg", 100, 200) == (
+        f"the iteration cap (100 iterations) or its own stall test (the best local-law residual down by < "
+        f"{100 * projected_cg.STALL_IMPROVEMENT:g}% over {projected_cg.STALL_ITERATIONS} iterations)")
+    assert contact_solvers.stall_rule("nlgs", 0) == "" and contact_solvers.stop_rule("newton") == "the Newton step cap"
+    with pytest.raises(ParameterError, match="solver='apgd': expected one of"):
+        contact_solvers.stop_rule("apgd")
