@@ -74,7 +74,6 @@ import numpy as np
 
 from grainview.contract.errors import ParameterError
 
-from . import projected_cg
 from .solve_records import Impulses, Limits, MatrixProblem
 
 __all__ = ["ACCELERATIONS", "ContactState", "Limits", "Method", "matrix_methods", "method", "register",
@@ -111,7 +110,9 @@ class Method:
     label : its short name in reports' prose ("NLGS convergence: ...").
     iteration : what one of its iterations is called ("sweep", "iteration").
     norms : what its tolerances apply to, as the words after "before" in a report.
-    own_stall : the words for its own stall test, for a method without the NLGS's ("" for none).
+    own_stall : a function of no argument returning the words for its own stall test, for a
+        method without the NLGS's (None for none); called when the words are needed, so that
+        the registry imports no method's module.
     """
 
     name: str
@@ -125,7 +126,7 @@ class Method:
     label: str = "NLGS"
     iteration: str = "sweep"
     norms: str = "both stopping norms (the impulses' change over a sweep) met their tolerances"
-    own_stall: str = ""
+    own_stall: Callable | None = None
 
     @property
     def in_stepper(self) -> bool:
@@ -209,7 +210,7 @@ def stall_rule(name: str, stall_sweeps=None) -> str:
     if m.stall:
         return (f"the stall test (quadratic norm down by < {100 * STALL_IMPROVEMENT:g}% over {stall_sweeps:.0f} "
                 "sweeps)") if stall_sweeps else ""
-    return m.own_stall
+    return m.own_stall() if m.own_stall is not None else ""
 
 
 def stop_rule(name: str, max_iterations=None, stall_sweeps=None) -> str:
@@ -302,6 +303,8 @@ def solve_newton(W, q, mu, tolerance, max_iterations, initial) -> ContactSolutio
 
 def solve_pcg(W, q, mu, tolerance, max_iterations, initial) -> ContactSolution:
     """Projected conjugate gradient (:func:`solver.projected_cg.solve`)."""
+    from . import projected_cg
+
     return projected_cg.solve(W, q, mu, tolerance, max_iterations, initial)
 
 
@@ -311,7 +314,7 @@ def solve_stepper_pcg(problem, state: ContactState, limits: Limits) -> NLGSResul
     local-law residual is within ``limits.tolerance`` or ``limits.max_iterations`` iterations;
     ``state`` updated in place (the impulses, and the velocities V_free + M^-1 H^T r). The
     result's two norms are both the local-law residual |F|/|r|."""
-    from . import matrix_form
+    from . import matrix_form, projected_cg
     from .nlgs import NLGSResult
 
     pn, pt, vx, vy, w = state
@@ -327,6 +330,13 @@ def solve_stepper_pcg(problem, state: ContactState, limits: Limits) -> NLGSResul
                       float(solution.local_law_residual))
 
 
+def _pcg_stall() -> str:
+    from .projected_cg import STALL_IMPROVEMENT, STALL_ITERATIONS
+
+    return (f"its own stall test (the best local-law residual down by < {100 * STALL_IMPROVEMENT:g}% over "
+            f"{STALL_ITERATIONS} iterations)")
+
+
 register(Method("nlgs", "nonlinear Gauss-Seidel sweeps (serial, shuffled or on domains)", solve=solve_stepper_nlgs,
                 solve_matrix=solve_nlgs, parameters=(), domains=True, shuffle=True))
 register(Method("anderson", "Anderson-accelerated NLGS sweeps (the default)", solve=solve_stepper_anderson,
@@ -336,5 +346,4 @@ register(Method("newton", "semi-smooth Newton on Alart-Curnier's function", solv
 register(Method("pcg", "projected conjugate gradient (Renouf & Alart) on the step's matrix", solve=solve_stepper_pcg,
                 solve_matrix=solve_pcg, stall=False, label="Projected-CG", iteration="iteration",
                 norms="its local-law residual |F|/|r| met the tolerance (both of its norms are that residual)",
-                own_stall=f"its own stall test (the best local-law residual down by < "
-                          f"{100 * projected_cg.STALL_IMPROVEMENT:g}% over {projected_cg.STALL_ITERATIONS} iterations)"))
+                own_stall=_pcg_stall))

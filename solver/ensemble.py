@@ -127,7 +127,12 @@ class RunSpec:
         return expected
 
 
-def grid(*, shapes=(RunSpec.shape,), frictions=(None,), seeds=1, particles=(RunSpec.particles,), sigma0=(None,),
+SEEDS_PER_SETTING = 3
+"""Seeds per setting of an ensemble when none are named (:func:`grid`, ``grainview ensemble``):
+the fewest that give a spread over seeds beside each mean."""
+
+
+def grid(*, shapes=(RunSpec.shape,), frictions=(None,), seeds=SEEDS_PER_SETTING, particles=(RunSpec.particles,), sigma0=(None,),
          first_seed=0, **common):
     """Every combination of the values given, with ``seeds`` seeds each (a count: seeds
     ``first_seed`` .. ``first_seed + seeds - 1``, or a sequence of seeds): a list of

@@ -39,10 +39,6 @@ TEST_OPTIONS = ("strain", "velocity", "every")
 """The :class:`solver.parameters.BiaxialTest` fields: the options of the biaxial test."""
 STUDY_SAMPLES = {"pentagons": "pentagon", "disks": "disk"}
 """The study's samples: file label -> shape."""
-ENSEMBLE_SEEDS = 3
-"""Seeds per setting of ``grainview ensemble`` when --seeds is not given."""
-DEMO_SIZE = {"snapshots": 11, "contacts": 20000}
-"""The size of the synthetic series of ``grainview demo``: large enough to show the lazy reading."""
 
 
 def _info(args) -> int:
@@ -178,29 +174,12 @@ def _convert_pegs(args) -> int:
 
 
 def _demo(args) -> int:
-    from ..formats.opening import open_dataset
-    from ..contract.dataset import netcdf_options
-    from ..analysis.synthetic import harmonic_series
+    from .demo import run_demo
 
-    if args.snapshots < 2 or args.contacts < 1:
-        raise GrainviewError(f"--snapshots {args.snapshots} --contacts {args.contacts}: expected at least 2 "
-                             "snapshots and 1 contact")
-    out = Path(args.out)
-    out.mkdir(parents=True, exist_ok=True)
-    path = out / "synthetic.nc"
-    if path.exists() and not args.overwrite:
-        raise GrainviewError(f"{path} exists; pass --overwrite to replace it")
-    ds = harmonic_series(n_snapshots=args.snapshots, n_contacts=args.contacts, seed=args.seed)
-    tmp = path.with_suffix(".nc.part")
-    ds.to_netcdf(tmp, **netcdf_options(ds, compress=not args.no_compress))
-    tmp.replace(path)
-    lazy = open_dataset(path, chunks=5, validate=True)
-    table = lazy.grain.harmonic_prediction().compute()
-    table["a"] = lazy.grain.fabric_anisotropy()["a"].compute()
-    frame = table.to_dataframe()[["q_over_p", "prediction", "a_prime", "a_n", "a_t"]]
+    path, frame = run_demo(args.out, snapshots=args.snapshots, contacts=args.contacts, seed=args.seed,
+                           overwrite=args.overwrite, compress=not args.no_compress)
     print(f"wrote {path}; q/p against the harmonic prediction (a' + a_n + a_t)/2:")
     print(frame.round(4).to_string())
-    frame.to_csv(out / "harmonic_prediction.csv")
     return 0
 
 
@@ -310,16 +289,16 @@ def setting_option(parser, record, name, *, more="", flag=None, **overrides):
 
 
 def _module_tree(module):
-    """The parsed source of grainview's ``module`` (nothing imported)."""
+    """The parsed source of ``module`` of grainview or solver (nothing imported)."""
     import ast
 
-    path = Path(__file__).parents[1].joinpath(*module.split(".")[1:]).with_suffix(".py")  # the grainview package
+    path = Path(__file__).parents[2].joinpath(*module.split(".")).with_suffix(".py")  # beside the grainview package
     return ast.parse(path.read_text(encoding="utf-8"))
 
 
 def library_constant(module, name):
-    """The value of the constant ``name`` of grainview's ``module``, read from its source, so
-    that ``--help`` loads no xarray."""
+    """The value of the constant ``name`` of ``module`` (grainview's or solver's), read from its
+    source, so that ``--help`` loads no xarray or scipy."""
     import ast
 
     node = next(n for n in _module_tree(module).body if isinstance(n, ast.Assign)
@@ -1087,7 +1066,8 @@ def _ensemble_parser(sub):
         default = getattr(Preparation, name)
         ens.add_argument(_flag(name), dest=f"{name}_list", default=None,
                          help=f"comma-separated values of {name}{unit} (default {default:g}, the preparation's)")
-    ens.add_argument("--seeds", type=int, default=ENSEMBLE_SEEDS, help=f"seeds per setting (default {ENSEMBLE_SEEDS})")
+    seeds = library_constant("solver.ensemble", "SEEDS_PER_SETTING")
+    ens.add_argument("--seeds", type=int, default=seeds, help=f"seeds per setting (default {seeds})")
     setting_option(ens, Preparation, "seed", flag="--first-seed", help=f"first seed (default {Preparation.seed})")
     _test_options(ens)
     ens.add_argument("--preparation", default=DEFAULT_PRESET, help=f"named preparation (default {DEFAULT_PRESET}; "
@@ -1149,10 +1129,9 @@ def _demo_parser(sub):
                           "seconds) and compare q/p with the prediction (a' + a_n + a_t)/2 computed lazily "
                           "from the file.")
     demo.add_argument("--out", default="demo-out", help="output folder (default: demo-out)")
-    demo.add_argument("--snapshots", type=int, default=DEMO_SIZE["snapshots"],
-                      help=f"number of snapshots (default {DEMO_SIZE['snapshots']})")
-    demo.add_argument("--contacts", type=int, default=DEMO_SIZE["contacts"],
-                      help=f"contacts per snapshot (default {DEMO_SIZE['contacts']})")
+    snapshots, contacts = (library_default("grainview.app.demo", "run_demo", k) for k in ("snapshots", "contacts"))
+    demo.add_argument("--snapshots", type=int, default=snapshots, help=f"number of snapshots (default {snapshots})")
+    demo.add_argument("--contacts", type=int, default=contacts, help=f"contacts per snapshot (default {contacts})")
     seed = library_default("grainview.analysis.synthetic", "harmonic_series", "seed")
     demo.add_argument("--seed", type=int, default=seed, help=f"random seed (default {seed})")
     demo.add_argument("--overwrite", action="store_true", help="replace existing output files")

@@ -73,10 +73,36 @@ def _numeric_defaults(source):
     return found
 
 
+def _numeric_constants(source, allowed=()):
+    """The module-level assignments of ``source`` whose value holds a number written out (a
+    default kept under a name of its own), except the names ``allowed``."""
+    found = []
+    for node in ast.parse(source).body:
+        if isinstance(node, (ast.Assign, ast.AnnAssign)) and node.value is not None:
+            targets = node.targets if isinstance(node, ast.Assign) else [node.target]
+            names = {t.id for t in targets if isinstance(t, ast.Name)}
+            numbers = [c.value for c in ast.walk(node.value) if isinstance(c, ast.Constant)
+                       and isinstance(c.value, (int, float)) and not isinstance(c.value, bool)]
+            if numbers and not names <= set(allowed):
+                found.append((node.lineno, sorted(names), numbers))
+    return found
+
+
+NOT_SETTINGS = {"TEMPORARY_NAME_EXTRA"}
+"""Module-level numbers of cli.py that are no setting: the length a temporary file's name adds."""
+
+
 def test_the_command_line_holds_no_numeric_default_of_its_own():
+    """Neither an option's ``default=`` nor a module-level constant of cli.py holds a number:
+    defaults come from the settings records (solver.parameters) or the library function the
+    option feeds (library_default, library_constant, solver.ensemble.SEEDS_PER_SETTING)."""
     assert _numeric_defaults("p.add_argument('--x', default=-0.5)\np.add_argument('--y', default=3)") \
         == [(1, -0.5), (2, 3)]  # the scan sees them
-    assert _numeric_defaults(Path(cli.__file__).read_text(encoding="utf-8")) == []
+    assert _numeric_constants("SEEDS = 3\nSIZE = {'n': 11}\nNAMES = ('a',)\nX = len('..') + 7", {"X"}) \
+        == [(1, ["SEEDS"], [3]), (2, ["SIZE"], [11])]
+    source = Path(cli.__file__).read_text(encoding="utf-8")
+    assert _numeric_defaults(source) == []
+    assert _numeric_constants(source, NOT_SETTINGS) == []
 
 
 def test_options_of_other_functions_take_those_functions_defaults():
@@ -88,6 +114,14 @@ def test_options_of_other_functions_take_those_functions_defaults():
         == inspect.signature(convert_pegs).parameters["density_kg_m3"].default
     assert cli.library_default("grainview.analysis.synthetic", "harmonic_series", "seed") \
         == inspect.signature(harmonic_series).parameters["seed"].default
+    from grainview.app.demo import run_demo
+    from solver.ensemble import SEEDS_PER_SETTING, grid
+
+    demo = build_parser().parse_args(["demo"])
+    assert (demo.snapshots, demo.contacts) == tuple(inspect.signature(run_demo).parameters[k].default
+                                                    for k in ("snapshots", "contacts"))
+    assert build_parser().parse_args(["ensemble"]).seeds == SEEDS_PER_SETTING \
+        == inspect.signature(grid).parameters["seeds"].default
     from grainview.analysis.strain import RESIDUAL_STRAIN
 
     assert cli.library_constant("grainview.analysis.strain", "RESIDUAL_STRAIN") == RESIDUAL_STRAIN
