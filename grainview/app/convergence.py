@@ -91,9 +91,14 @@ def unconverged_in_file(variables, attrs) -> dict | None:
 def solver_name(attrs) -> str:
     """The contact solver a file's steps were solved with: its ``solver_solver``, or for a file
     written before that attribute its ``solver_acceleration`` ("anderson" or the plain NLGS)."""
+    from solver.contact_solvers import from_acceleration
+
     if "solver_solver" in attrs:
         return str(attrs["solver_solver"])
-    return "anderson" if str(attrs.get("solver_acceleration", "off")) == "anderson" else "nlgs"
+    try:
+        return from_acceleration(str(attrs.get("solver_acceleration", "off")))
+    except ValueError:  # a value no version of the solver wrote
+        return "nlgs"
 
 
 def _method(counts: dict):
