@@ -60,6 +60,8 @@ CAPS = {"nlgs": 20_000, "newton": 200, "pcg": 20_000}
 SECONDS = 120.0
 SHEAR = 0.002
 CAPTURED_STEPS, STEPS_APART = 3, 20
+PARTICLES = (1000, 4000, 14400)
+STRETCH_STEPS, STRETCH_METHODS = 100, ("nlgs", "anderson", "pcg")
 
 
 def fetch_siconos(mirror):
@@ -132,33 +134,60 @@ def check_assembly(problem, W, q, pn, pt, vx, vy, w):
 
 
 def build(particles):
-    """Capture the stepper's problems at ``particles`` pentagons (module docstring)."""
+    """Capture the stepper's problems at ``particles`` pentagons of the 'fast' preparation
+    (module docstring)."""
     import solver
     from solver.preparation import prepare_sample, preparation
 
-    os.makedirs(DATA, exist_ok=True)
     start = time.perf_counter()
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         sim = prepare_sample(preparation("fast", shape="pentagon", particles=particles), progress=False)
         print(f"compacted {particles} in {time.perf_counter() - start:.0f} s", flush=True)
         path = os.path.join(DATA, f"pentagon_{particles}_shear.nc")
+        os.makedirs(DATA, exist_ok=True)
         solver.biaxial_test(sim, path, strain=SHEAR, velocity=0.01, every=10**9, overwrite=True, progress=False)
         os.remove(path)
-        sim.parameters = replace(sim.parameters, solver="nlgs")  # the steps between: plain sweeps, as first built
-        captured = []
-        for _ in range(CAPTURED_STEPS):
+    capture(sim, os.path.join(DATA, f"pentagon_{particles}.pkl"), start=start)
+
+
+def build_from(source, index, captured=CAPTURED_STEPS, apart=STEPS_APART, out=None):
+    """Capture the stepper's problems from snapshot ``index`` of a biaxial test's file ``source``
+    (a copy: :func:`solver.load_sample` reads complete snapshots only), as :func:`build` does
+    after its shear: ``captured`` problems ``apart`` steps apart, plain serial NLGS sweeps on
+    one domain. Saved as ``pentagon_<particles>.pkl`` in DATA (or ``out``); returns its path."""
+    from solver import load_sample
+
+    start = time.perf_counter()
+    sim = load_sample(source, index)
+    print(f"{source}, snapshot {index}: step {sim.step_index}, {sim.x.shape[0]} particles", flush=True)
+    out = out or os.path.join(DATA, f"pentagon_{sim.x.shape[0]}.pkl")
+    capture(sim, out, captured, apart, start)
+    return out
+
+
+def capture(sim, path, captured=CAPTURED_STEPS, apart=STEPS_APART, start=None):
+    """Step ``sim`` with plain serial NLGS sweeps (one domain) and pickle the contact problems
+    of ``captured`` steps, ``apart`` steps apart, as (W, q, mu, warm start) to ``path`` (written
+    beside it, then renamed), each checked against the stepper's velocities
+    (:func:`check_assembly`)."""
+    start = time.perf_counter() if start is None else start
+    sim.parameters = replace(sim.parameters, solver="nlgs", domains=1)  # plain sweeps, as first built
+    problems_ = []
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        for k in range(captured):
             problem, pn, pt, vx, vy, w, options = capture_contact_problems(sim, 1)[0]
             W, q, mu = matrix_problem(problem, vx, vy, w)
             check_assembly(problem, W, q, pn, pt, vx, vy, w)
-            captured.append((W, q, mu, np.stack([pn, pt], -1)))
-            for _ in range(STEPS_APART - 1):
+            problems_.append((W, q, mu, np.stack([pn, pt], -1)))
+            for _ in range(apart - 1 if k < captured - 1 else 0):
                 sim.step()
-    path = os.path.join(DATA, f"pentagon_{particles}.pkl")
+    os.makedirs(os.path.dirname(os.path.abspath(path)), exist_ok=True)
     with open(path + ".part", "wb") as fh:
-        pickle.dump(captured, fh)
+        pickle.dump(problems_, fh)
     os.replace(path + ".part", path)
-    print(f"pentagon, {particles}: {len(captured)} problems ({[c[2].size for c in captured]} points) in "
+    print(f"{path}: {len(problems_)} problems ({[c[2].size for c in problems_]} points) in "
           f"{time.perf_counter() - start:.0f} s", flush=True)
 
 
@@ -171,7 +200,7 @@ def problems():
         if os.path.exists(path):
             W, q, mu = read_siconos_fc2d(path)
             found.append((f"Siconos {int(name.split('_')[2])}", W, q, mu, np.zeros((mu.size, 2))))
-    for particles in (1000, 4000):
+    for particles in PARTICLES:
         path = os.path.join(DATA, f"pentagon_{particles}.pkl")
         if os.path.exists(path):
             with open(path, "rb") as fh:
@@ -233,16 +262,18 @@ def timed(method, W, q, mu, initial, target):
     return s.iterations, time.perf_counter() - start, s.local_law_residual, s.converged
 
 
-def measure():
+def measure(found=None):
     """Rows {problem, points, method, target, iterations, seconds, residual, reached} for every
-    problem, method and target (module docstring)."""
-    from solver.contact_solvers import SOLVERS
+    problem of ``found`` ([(label, W, q, mu, initial)], default :func:`problems`), every method
+    of the registry that solves a matrix problem and every target (module docstring)."""
+    from solver.contact_solvers import matrix_methods
 
+    methods = matrix_methods()
     rows = []
     coupled = sparse.csr_matrix(np.array([[2.0, 0, 1, 0], [0, 2, 0, 0], [1, 0, 2, 0], [0, 0, 0, 2]]))
-    for method in SOLVERS:  # compile or load every kernel outside the timing, on a problem that iterates
+    for method in methods:  # compile or load every kernel outside the timing, on a problem that iterates
         timed(method, coupled, np.array([-3.0, 0.5, -3.0, -0.5]), np.full(2, 0.3), np.zeros((2, 2)), 1e-12)
-    for label, W, q, mu, initial in problems():
+    for label, W, q, mu, initial in (problems() if found is None else found):
         trajectory = nlgs_trajectory(W, q, mu, initial)
         best = min(res for _, _, res in trajectory)
         print(f"{label}: {mu.size} points, NLGS best {best:.2e} after {trajectory[-1][0]} sweeps, "
@@ -254,7 +285,7 @@ def measure():
                              iterations=hit[0] if hit else trajectory[-1][0],
                              seconds=hit[1] if hit else trajectory[-1][1],
                              residual=effective if hit else best, reached=hit is not None))
-            for method in SOLVERS:
+            for method in methods:
                 if method == "nlgs":
                     continue
                 earlier = [r for r in rows if r["problem"] == label and r["method"] == method]
@@ -266,9 +297,23 @@ def measure():
                                  iterations=iterations, seconds=seconds, residual=residual, reached=reached))
                 print(f"  {method} to {effective:.1e}: {iterations} iterations, {seconds:.2f} s, "
                       f"residual {residual:.2e}", flush=True)
-    with open(os.path.join(DATA, "rows.pkl"), "wb") as fh:
-        pickle.dump(rows, fh)
     return rows
+
+
+def merge_rows(kept, fresh):
+    """The rows of ``kept`` with those of every problem measured in ``fresh`` replaced by
+    ``fresh``'s: in ``kept``'s order of problems, a problem new to it appended."""
+    measured = {r["problem"] for r in fresh}
+    order = list(dict.fromkeys([r["problem"] for r in kept] + [r["problem"] for r in fresh]))
+    return [r for label in order for r in (fresh if label in measured else kept) if r["problem"] == label]
+
+
+def save_rows(rows, path=None):
+    """Pickle ``rows`` to ``path`` (default DATA/rows.pkl), written beside it, then renamed."""
+    path = path or os.path.join(DATA, "rows.pkl")
+    with open(path + ".part", "wb") as fh:
+        pickle.dump(rows, fh)
+    os.replace(path + ".part", path)
 
 
 def profile(rows, path=FIGURE):
@@ -331,6 +376,74 @@ def table(rows):
     return markdown_table(header, lines)
 
 
+def stepper_stretch(source, index, steps=STRETCH_STEPS, methods=STRETCH_METHODS):
+    """Rows {method, step, iterations, seconds, solve_seconds, residual, local_law_residual,
+    converged} of ``steps`` consecutive steps of the biaxial test in ``source`` from its snapshot
+    ``index``, once per stepper method of ``methods``, each from the same state (loaded again by
+    :func:`solver.load_sample`) on one domain, the file's other settings kept; ``seconds`` the
+    whole step's, ``solve_seconds`` its solve stage's (:data:`solver.stepper.STAGES`). One step
+    of each method runs first on a copy loaded apart, to load its compiled kernels off the
+    record."""
+    from solver import load_sample
+
+    rows = []
+    for name in methods:
+        for warm in (True, False):
+            sim = load_sample(source, index)
+            sim.parameters = replace(sim.parameters, solver=name, domains=1)
+            clock = {}
+
+            def before():
+                clock.update(start=time.perf_counter(), solve=sim.timings["solve"])
+
+            def after(info):
+                rows.append(dict(method=name, step=sim.step_index, iterations=info.iterations,
+                                 seconds=time.perf_counter() - clock["start"],
+                                 solve_seconds=sim.timings["solve"] - clock["solve"], residual=info.residual,
+                                 local_law_residual=info.local_law_residual, converged=bool(info.converged)))
+
+            with warnings.catch_warnings():
+                warnings.simplefilter("ignore")
+                if warm:
+                    sim.step()
+                    continue
+                with sim.watch(before=before, after=after):
+                    for _ in range(steps):
+                        sim.step()
+        mine = stretch_summary([r for r in rows if r["method"] == name])[0]
+        print(f"{name}: {steps} steps, iterations median {mine['median']:g}, mean {mine['mean']:.1f}, "
+              f"p90 {mine['p90']:g}; {mine['seconds']:.2f} s a step", flush=True)
+    return rows
+
+
+def stretch_summary(rows):
+    """Per method of ``rows`` (:func:`stepper_stretch`): {method, steps, median, mean, p90, max
+    (iterations), seconds, solve_seconds (means per step), unconverged (steps), law_median,
+    law_max (local-law residuals)}."""
+    out = []
+    for name in dict.fromkeys(r["method"] for r in rows):
+        mine = [r for r in rows if r["method"] == name]
+        it = np.array([r["iterations"] for r in mine], float)
+        law = np.array([r["local_law_residual"] for r in mine])
+        out.append(dict(method=name, steps=len(mine), median=float(np.median(it)), mean=float(it.mean()),
+                        p90=float(np.percentile(it, 90)), max=int(it.max()),
+                        seconds=float(np.mean([r["seconds"] for r in mine])),
+                        solve_seconds=float(np.mean([r["solve_seconds"] for r in mine])),
+                        unconverged=sum(not r["converged"] for r in mine),
+                        law_median=float(np.median(law)), law_max=float(law.max())))
+    return out
+
+
+def stretch_table(rows):
+    """The Markdown table of :func:`stretch_summary`."""
+    header = ["solver", "steps", "iterations: median, mean, p90, max", "s per step (solve)", "unconverged steps",
+              "local-law residual: median, max"]
+    return markdown_table(header, [[s["method"], s["steps"], f"{s['median']:g}, {s['mean']:.1f}, {s['p90']:g}, "
+                                    f"{s['max']}", f"{s['seconds']:.3g} ({s['solve_seconds']:.3g})",
+                                    s["unconverged"], f"{s['law_median']:.2e}, {s['law_max']:.2e}"]
+                                   for s in stretch_summary(rows)])
+
+
 def degeneracy(name=SICONOS[1]):
     """Print what makes the 2020-contact problem stall: the spectrum of its stored W (symmetric,
     but printed to six significant digits), the points its negative modes live on, where the
@@ -378,6 +491,14 @@ if __name__ == "__main__":
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--fetch-siconos", metavar="MIRROR")
     parser.add_argument("--build", type=int, metavar="PARTICLES")
+    parser.add_argument("--build-from", metavar="FILE", help="capture the problems from a biaxial test's file "
+                        "(a copy of it) at snapshot --index")
+    parser.add_argument("--stepper", metavar="FILE", help="run --steps steps of each of nlgs, anderson and pcg from "
+                        "snapshot --index of a biaxial test's file (a copy of it)")
+    parser.add_argument("--index", type=int, default=2, help="the snapshot of --build-from and --stepper (default 2)")
+    parser.add_argument("--steps", type=int, default=STRETCH_STEPS, help="steps of --stepper (default %(default)s)")
+    parser.add_argument("--only", metavar="LABELS", help="measure only the problems whose label starts with one of "
+                        "these (comma-separated, e.g. 'pentagons 14400'); the other rows come from the last run's")
     parser.add_argument("--degeneracy", action="store_true")
     parser.add_argument("--replot", action="store_true", help="table and figure from the last run's rows")
     parser.add_argument("--out", help="write the table as a results file here (default: printed only)")
@@ -386,14 +507,32 @@ if __name__ == "__main__":
         fetch_siconos(args.fetch_siconos)
     elif args.build:
         build(args.build)
+    elif args.build_from:
+        build_from(args.build_from, args.index)
+    elif args.stepper:
+        stretch = stepper_stretch(args.stepper, args.index, args.steps)
+        path = os.path.join(DATA, f"stepper_{args.stepper.rsplit('/', 1)[-1].rsplit('.', 1)[0]}_{args.index}.pkl")
+        save_rows(stretch, path)
+        print(stretch_table(stretch))
     elif args.degeneracy:
         degeneracy()
     else:
+        rows_path = os.path.join(DATA, "rows.pkl")
         if args.replot:
-            with open(os.path.join(DATA, "rows.pkl"), "rb") as fh:
+            with open(rows_path, "rb") as fh:
                 found = pickle.load(fh)
+        elif args.only:
+            prefixes = tuple(p.strip() for p in args.only.split(","))
+            chosen = [p for p in problems() if p[0].startswith(prefixes)]
+            if not chosen:
+                raise SystemExit(f"--only {args.only}: no problem's label starts with it (labels: "
+                                 f"{', '.join(p[0] for p in problems())})")
+            with open(rows_path, "rb") as fh:
+                found = merge_rows(pickle.load(fh), measure(chosen))
+            save_rows(found, rows_path)
         else:
             found = measure()
+            save_rows(found, rows_path)
         profile(found)
         print(table(found))
         if args.out:

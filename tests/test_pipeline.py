@@ -124,3 +124,21 @@ def test_report_refuses_to_overwrite_an_existing_report(study, capsys):
     assert main(["report", *files, "--out", str(study / "report")]) == 2
     assert "--overwrite" in capsys.readouterr().err
     assert (study / "report" / "headline.csv").read_bytes() == before
+
+
+def test_report_draws_only_the_figures_asked_for_and_the_index_lists_those(study, tmp_path, capsys):
+    files = [str(study / "pentagons.nc"), str(study / "disks.nc")]
+    out = tmp_path / "some"
+    assert main(["report", *files, "--labels", "pentagons,disks", "--out", str(out), "--figures", "3,13,6a",
+                 "--residual-strain", str(WINDOW)]) == 0
+    drawn = sorted(p.name for p in (out / "figures").glob("*.png"))
+    assert drawn == ["fig03_q_over_p.png", "fig06a_coordination.png", "fig13_force_chains_disks.png",
+                     "fig13_force_chains_pentagons.png"]
+    index = (out / "index.md").read_text()
+    assert index.count("**Fig. ") == 4 and "fig14_" not in index
+    # the whole report's Fig. 3 and this one come from the same data: the same headline table
+    assert (out / "headline.csv").read_text() == (study / "report" / "headline.csv").read_text()
+    capsys.readouterr()
+    assert main(["report", *files, "--out", str(tmp_path / "bad"), "--figures", "3,99"]) == 2
+    assert "figures='99': expected paper figure numbers among 02, 03" in capsys.readouterr().err
+    assert not (tmp_path / "bad").exists()

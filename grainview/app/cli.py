@@ -532,8 +532,9 @@ def _report(args) -> int:
     if len(labels) != len(args.files):
         raise GrainviewError(f"--labels has {len(labels)} names for {len(args.files)} files")
     runs = {label: open_dataset(f, validate=True) for label, f in zip(labels, args.files)}
+    figures = _split(args.figures, str, "figures") if getattr(args, "figures", None) else None
     result = write_report(runs, args.out, residual_strain=args.residual_strain, overwrite=args.overwrite,
-                          log=lambda line: print(f"report: {line}", flush=True))
+                          log=lambda line: print(f"report: {line}", flush=True), figures=figures)
     files = list(result["files"])
     if getattr(args, "movie", False):  # the study reports without movies
         from ..plot.movies import animate
@@ -1041,6 +1042,8 @@ def _report_parser(sub):
                         "(force_chains_<label>.gif)")
     report.add_argument("--ensemble", action="store_true", help="the files are seeds and settings of one "
                         "ensemble: report mean +- spread over the seeds of each setting (docs/ensembles.md)")
+    report.add_argument("--figures", default=None, help="comma-separated paper figure numbers to draw, e.g. "
+                        "03,08,13,14 (default: every figure the runs support; a large run takes minutes a figure)")
     every = library_default("grainview.plot.movies", "animate", "every")
     report.add_argument("--movie-every", type=int, default=every,
                         help=f"one movie frame every k snapshots (default {every})")

@@ -410,9 +410,31 @@ def caption(label: str, ds: xr.Dataset, what: str, residual_strain: float = RESI
     return f"{label}: {shape}, seed {seed}, preparation '{preparation}'; {shown}"
 
 
+def check_figures(numbers) -> tuple:
+    """The paper figure numbers ``numbers`` (e.g. ``("03", "13")``; ``3`` and ``"3"`` are read as
+    ``"03"``) as the report names them, refused in one line when one is not a figure it draws;
+    None: every figure."""
+    from ..plot import FIGURES
+
+    if numbers is None:
+        return tuple(FIGURES)
+    chosen = []
+    for number in numbers:
+        text = str(number).strip().lower()
+        name = next((n for n in FIGURES if n.lstrip("0") == text.lstrip("0")), None) if text else None
+        if name is None:
+            raise ParameterError(f"figures={text!r}: expected paper figure numbers among {', '.join(FIGURES)}")
+        chosen.append(name)
+    if not chosen:
+        raise ParameterError(f"figures=(): expected at least one of {', '.join(FIGURES)}")
+    return tuple(dict.fromkeys(chosen))
+
+
 def write_figures(runs: dict, out: Path, time=-1, residual_strain: float = RESIDUAL_STRAIN, log=None,
-                  captions: dict | None = None) -> list[Path]:
-    """Draw every figure of the paper the runs support into ``out`` (PNG and PDF).
+                  captions: dict | None = None, figures=None) -> list[Path]:
+    """Draw every figure of the paper the runs support into ``out`` (PNG and PDF), or only the
+    paper figure numbers ``figures`` (:func:`check_figures`; for large runs, where each figure
+    takes minutes).
 
     Comparative figures get all runs on one axes; the maps and P(m_s, m_d) one file per run
     (snapshot ``time``, default the last); the simple-versus-double figures only the runs
@@ -429,8 +451,11 @@ def write_figures(runs: dict, out: Path, time=-1, residual_strain: float = RESID
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
     polygon_runs = {k: v for k, v in runs.items() if int(v["n_vertices"].max()) > 0}
+    drawn = check_figures(figures)
     written = []
     for number, func in FIGURES.items():
+        if number not in drawn:
+            continue
         chosen = polygon_runs if number in POLYGON_FIGURES else runs
         if not chosen:
             continue
@@ -508,15 +533,17 @@ def xi_contacts(runs: dict):
 
 
 def write_report(runs: dict, out, residual_strain: float = RESIDUAL_STRAIN, overwrite: bool = False,
-                 log=None) -> dict:
+                 log=None, figures=None) -> dict:
     """The whole report of ``runs`` ({label: dataset}) in folder ``out``: the headline table
-    (CSV, Markdown), every figure, and ``index.md`` (each run's settings, the table, every
-    figure with its caption). Returns {"table": DataFrame, "files": [paths]}. ``log``: called
-    with a line per stage and figure (the command line prints them).
+    (CSV, Markdown), every figure (or the paper figure numbers ``figures``,
+    :func:`check_figures`), and ``index.md`` (each run's settings, the table, every figure with
+    its caption). Returns {"table": DataFrame, "files": [paths]}. ``log``: called with a line
+    per stage and figure (the command line prints them).
 
     A folder that already holds a report is refused unless ``overwrite`` is True, so that
     nothing a user owns is replaced by accident."""
     out = Path(out)
+    figures = check_figures(figures)  # before any work
     if not overwrite and (out / "headline.csv").exists():
         raise FileExistsError(f"{out} already holds a report; pass overwrite=True to replace it")
     if log is not None:
@@ -524,7 +551,8 @@ def write_report(runs: dict, out, residual_strain: float = RESIDUAL_STRAIN, over
     table = headline_table(runs, residual_strain)
     files = write_table(table, out, notes=convergence_notes(runs))
     captions = {}
-    files += write_figures(runs, out / "figures", residual_strain=residual_strain, log=log, captions=captions)
+    files += write_figures(runs, out / "figures", residual_strain=residual_strain, log=log, captions=captions,
+                           figures=figures)
     files.append(write_index(runs, out, captions, residual_strain))
     return {"table": table, "files": files}
 
