@@ -68,13 +68,17 @@ registry's names without loading a compiled kernel.
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Callable, NamedTuple
+from typing import TYPE_CHECKING, Callable, NamedTuple
 
 import numpy as np
 
 from grainview.contract.errors import ParameterError
 
 from .solve_records import Impulses, Limits, MatrixProblem
+
+if TYPE_CHECKING:  # the results' types, named in the signatures only
+    from .contact_solution import ContactSolution
+    from .nlgs import NLGSResult
 
 __all__ = ["ACCELERATIONS", "ContactState", "Limits", "Method", "matrix_methods", "method", "register",
            "solver", "solve_nlgs", "stepper_methods"]

@@ -539,7 +539,7 @@ class Simulation:
         the end velocities."""
         p = self.parameters
         h, theta, n = p.time_step, p.theta, self.n_particles
-        a, b = problem.a, problem.b
+        a = problem.a
         step_v = (1 - theta) * v_start + theta * v_end
         step_om = (1 - theta) * omega_start + theta * om
         if p.overlap_recovery_speed > 0 and len(a):

@@ -2,8 +2,6 @@
 
 from __future__ import annotations
 
-import numpy as np
-
 from ._docs import fill_doc
 from ._style import EPS_Q_LABEL, sample_colour
 

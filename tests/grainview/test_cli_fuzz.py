@@ -3,7 +3,6 @@ one line, never a traceback, a hang or a changed input."""
 
 import hashlib
 
-import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 

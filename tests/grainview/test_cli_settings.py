@@ -3,7 +3,6 @@ types, choices, defaults and help), a named preparation's own values hold for th
 given, and run, study and ensemble reach the simulation through an engine of the registry."""
 
 import ast
-import argparse
 from dataclasses import fields
 from pathlib import Path
 

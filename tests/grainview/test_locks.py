@@ -2,10 +2,8 @@
 killed writer leaves no lock behind."""
 
 import os
-import signal
 import subprocess
 import sys
-import time
 from pathlib import Path
 
 import numpy as np

@@ -1,7 +1,5 @@
 """The solver against analytic answers: resting bodies, a column, a tilted plane, a collision."""
 
-import warnings
-
 import numpy as np
 import pytest
 
