@@ -6,8 +6,12 @@ each reaches), a table (results/contact-solvers.md) and a performance profile
     python -m benchmarks.contact_solvers --fetch-siconos MIRROR   # copy the 2D problems out of a siconos git mirror
     nice -n 10 python -m benchmarks.contact_solvers --build 1000  # capture the stepper's problems (~3 min)
     nice -n 10 python -m benchmarks.contact_solvers --build 4000  # (~10 min)
+    cp /work/runs/paper_size/pentagons.nc /tmp/p14400.nc          # a copy of the paper-size study's shear
+    nice -n 10 python -m benchmarks.contact_solvers --build-from /tmp/p14400.nc --index 2   # 14,400 (~1 min)
     nice -n 10 python -m benchmarks.contact_solvers               # solve them all, write the table and figure
+    nice -n 10 python -m benchmarks.contact_solvers --only "pentagons 14400"   # these again, other rows kept
     nice -n 10 python -m benchmarks.contact_solvers --degeneracy  # rank and spectrum of the 2020-contact W
+    nice -n 10 python -m benchmarks.contact_solvers --stepper /tmp/p14400.nc --index 2 --steps 100
 
 The problems (benchmarks/_data/, ignored by git):
 
@@ -21,6 +25,17 @@ The problems (benchmarks/_data/, ignored by git):
   captured as the NLGS received them (plain sweeps), assembled here into u = W r + q with
   W = H M^-1 H^T (H the points' local velocities from the bodies' (vx, vy, w)) and
   q = H v_free + (bias, 0).
+* The stepper's problems at 14,400 pentagons (``--build-from``): not prepared here but read
+  from a snapshot of a biaxial test's file, the paper-size study's (``grainview study
+  --paper-size``: the 'paper' preparation, compacted by the study, sheared with the top wall
+  at 6 cm/s, two domains), snapshot 2 (eps_1 = 0.0023); from there the same 3 steps, 20 apart,
+  plain sweeps on one domain between them, the first from the snapshot's warm start.
+
+The stepper itself (``--stepper FILE --index K``): ``--steps`` consecutive steps of the biaxial
+test from the snapshot, once with each of nlgs, anderson and pcg, each from the same loaded
+state on one domain (the file's other settings kept: its tolerance, caps, time step), recording
+per step the iterations, seconds, local-law residual and converged flag
+(``Simulation.watch``); rows in DATA/stepper_<file>_<index>.pkl, a table printed.
 
 Each method starts a Siconos problem from r = 0 and a captured problem from the warm start the
 stepper gave its NLGS (last step's impulses, matched point by point). Time to a target: NLGS
@@ -160,8 +175,8 @@ def build_from(source, index, captured=CAPTURED_STEPS, apart=STEPS_APART, out=No
 
     start = time.perf_counter()
     sim = load_sample(source, index)
-    print(f"{source}, snapshot {index}: step {sim.step_index}, {sim.x.shape[0]} particles", flush=True)
-    out = out or os.path.join(DATA, f"pentagon_{sim.x.shape[0]}.pkl")
+    print(f"{source}, snapshot {index}: step {sim.step_index}, {sim.mass.size} particles", flush=True)
+    out = out or os.path.join(DATA, f"pentagon_{sim.mass.size}.pkl")
     capture(sim, out, captured, apart, start)
     return out
 
