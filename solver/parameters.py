@@ -334,16 +334,34 @@ class Preparation:
 
     def validate(self):
         """The preparation itself, checked: each field's own check, then the shape
-        (:func:`solver.shape_families.check_shape`); one :class:`ParameterError` naming every
+        (:func:`solver.shape_families.check_shape`) and whether the deposit's box is wide enough
+        for its largest particle (:meth:`box_problem`); one :class:`ParameterError` naming every
         bad value."""
         bad = [refusal(*p) for p in problems(self)]
         try:
             check_shape(self.shape)
         except ParameterError as exc:
             bad.append(str(exc))
+        if not bad and self.box_problem():
+            bad.append(self.box_problem())
         if bad:
             raise ParameterError("invalid preparation: " + "; ".join(bad))
         return self
+
+    def box_problem(self) -> str:
+        """What is wrong with the deposit's box, in words, or "": its width,
+        :func:`solver.packing.box_width_for` at this ``aspect``, must hold the largest particle
+        of the size mix that ``particles`` draws (too few particles, or too tall a box, and the
+        deposit could not place it)."""
+        from .packing import PAPER_DIAMETERS, PAPER_FRACTIONS, box_width_for, size_classes
+
+        width = box_width_for(self.particles, aspect_ratio=self.aspect)
+        counts = size_classes(self.particles, PAPER_DIAMETERS, PAPER_FRACTIONS)
+        largest = float(np.asarray(PAPER_DIAMETERS)[counts > 0].max())
+        if width >= largest:
+            return ""
+        return (f"particles={self.particles}, aspect={self.aspect:g}: the deposit's box would be {width:.3g} m wide, "
+                f"narrower than its largest particle ({largest:.3g} m); expected more particles or a smaller aspect")
 
     def check_time_step(self, time_step, test_velocity=None):
         """Refuse, before any work, a time step in which the closing walls of the compaction
@@ -378,9 +396,8 @@ class Preparation:
         :data:`MIN_TEST_STEPS` steps, or would take more steps than a file's step counter
         holds (:data:`MAX_STEP_INDEX`, less the compaction's :attr:`max_steps`); the count is
         :meth:`test_steps`. Raises :class:`ParameterError` naming the speeds allowed (m s-1)."""
+        check_values(BiaxialTest, velocity=velocity)  # the field's own check, then what this sample adds
         velocity = float(velocity)
-        if not (np.isfinite(velocity) and velocity > 0):
-            raise ParameterError(f"velocity={velocity:g}: expected a finite wall speed > 0 in m/s")
         steps = self.test_steps(time_step, velocity, strain)
         at_unit_speed = self.test_steps(time_step, 1.0, strain)  # steps x velocity
         most = MAX_STEP_INDEX - self.max_steps

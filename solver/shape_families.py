@@ -157,7 +157,8 @@ def _kind(shape):
         if text.lower().endswith(SHAPE_FILE_SUFFIX):
             return "file", text
         if text not in SHAPES:
-            raise ParameterError(f"shape={text!r}: expected 'disk', 'pentagon', a number of vertices >= 3, "
+            raise ParameterError(f"shape={text!r}: expected 'disk', 'pentagon', a number of vertices from 3 to "
+                                 f"{MAX_VERTICES}, "
                                  f"{', '.join(repr(name) for name in FAMILIES)} or a {SHAPE_FILE_SUFFIX} file of "
                                  "vertex lists")
     n = n_vertices_of(shape)

@@ -325,24 +325,21 @@ def _shape_of(text, option=None):
     a number of vertices from 3 to :data:`MAX_VERTICES` (as an integer), a family of random
     convex polygons (:data:`solver.shape_families.FAMILIES`: irregular) or a .json file of vertex
     lists (read and checked here, given on as an absolute path)."""
-    from solver.shape_families import FAMILIES, MAX_VERTICES, SHAPE_FILE_SUFFIX, check_shape
-    from solver.shapes import SHAPES
+    import os
+
+    from solver.shape_families import SHAPE_FILE_SUFFIX, check_shape
 
     text = str(text).strip()
-    if text in SHAPES or text in FAMILIES:
-        return text
-    if text.isdigit() and 3 <= int(text) <= MAX_VERTICES:
-        return int(text)
-    if text.lower().endswith(SHAPE_FILE_SUFFIX):
-        import os
-
-        try:
-            check_shape(text)
-        except GrainviewError as exc:  # its message starts with the file's name
-            raise GrainviewError(f"{option or '--shape'} {exc}") from None
-        return os.path.abspath(text)
-    raise GrainviewError(f"{option or f'--shape {text}'}: expected disk, pentagon, a number of vertices from 3 "
-                         f"to {MAX_VERTICES}, {', '.join(FAMILIES)} or a {SHAPE_FILE_SUFFIX} file of vertex lists")
+    shape = int(text) if text.isdigit() else text
+    try:
+        check_shape(shape)  # the library's one check
+    except GrainviewError as exc:  # "shape=...: what was expected", or a file's name and what is wrong with it
+        words = str(exc)
+        if words.startswith("shape="):
+            words = words.split(": ", 1)[1]
+            raise GrainviewError(f"{option or f'--shape {text}'}: {words}") from None
+        raise GrainviewError(f"{option or '--shape'} {words}") from None
+    return os.path.abspath(text) if text.lower().endswith(SHAPE_FILE_SUFFIX) else shape
 
 
 def _simulate(prep, path, *, test, near_contacts, overwrite, progress, scene="biaxial", parameters=None,

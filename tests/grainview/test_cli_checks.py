@@ -33,9 +33,10 @@ def _one_line_at_once(argv, capsys):
     (["--velocity", "20"], "velocity=20: the test would reach eps_1 = 0.2 in about 3.4 steps"),
     (["--time-step", "-1e-4"], "time_step=-0.0001: expected a positive number of seconds"),
     (["--friction", "-0.5"], "friction=-0.5: expected in [0, 10]"),
-    (["--shape", "hexagonal"], "--shape hexagonal: expected disk, pentagon, a number of vertices from 3 to 64, irregular or a .json file of vertex lists"),
-    (["--shape", "2"], "--shape 2: expected disk, pentagon, a number of vertices from 3 to 64, irregular or a .json file of vertex lists"),
-    (["--shape", "6.5"], "--shape 6.5: expected disk, pentagon, a number of vertices from 3 to 64, irregular or a .json file of vertex lists"),
+    (["--shape", "hexagonal"], "--shape hexagonal: expected 'disk', 'pentagon', a number of vertices from 3 to 64, 'irregular' or a .json file of vertex lists"),
+    (["--shape", "2"], "--shape 2: a polygon needs at least 3 vertices"),
+    (["--shape", "65"], "--shape 65: expected at most 64 vertices"),
+    (["--shape", "6.5"], "--shape 6.5: expected 'disk', 'pentagon', a number of vertices from 3 to 64, 'irregular' or a .json file of vertex lists"),
 ])
 def test_run_settings_are_refused_before_any_work(tmp_path, capsys, argv, fragment):
     out = tmp_path / "run.nc"
@@ -97,7 +98,7 @@ def test_a_dangling_symlink_output_is_refused(tmp_path, capsys):
 
 
 @pytest.mark.parametrize("argv, fragment", [
-    (["ensemble", "--shapes", "pentagon,2"], "--shapes pentagon,2: expected disk, pentagon, a number of vertices"),
+    (["ensemble", "--shapes", "pentagon,2"], "--shapes pentagon,2: a polygon needs at least 3 vertices"),
     (["ensemble", "--velocity", "inf"], "expected a finite wall speed > 0 in m/s"),
     (["ensemble", "--velocity", "1e-300"], "the test would take about"),
     (["ensemble", "--first-seed", str(2**40)], "expected an integer in 0 .. 2147483647"),

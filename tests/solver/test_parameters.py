@@ -191,3 +191,23 @@ def test_the_shape_is_checked_by_the_preparation_as_by_the_command_line():
     Preparation(shape=MAX_VERTICES).validate()
     with pytest.raises(ParameterError, match=f"shape=100: expected at most {MAX_VERTICES} vertices"):
         Preparation(shape=100).validate()
+
+
+def test_a_box_too_narrow_for_its_largest_particle_is_refused_before_the_deposit():
+    """Preparation.validate refuses the sizes whose deposit would fail (the deposit's own
+    check, packing.deposit, is the independent computation): 4 particles at aspect 2 or 43 at
+    aspect 20 make a box narrower than the largest diameter; 5 and 44 deposit."""
+    from solver.packing import box_width_for, deposit
+
+    for particles, aspect, fits in ((4, 2.0, False), (5, 2.0, True), (43, 20.0, False), (44, 20.0, True)):
+        prep = Preparation(particles=particles, aspect=aspect)
+        width = box_width_for(particles, aspect_ratio=aspect)
+        if fits:
+            prep.validate()
+            assert len(deposit(particles, nvert=0, width=width, seed=0).pos) == particles
+        else:
+            with pytest.raises(ParameterError, match=rf"particles={particles}, aspect={aspect:g}: the deposit's box "
+                                                     rf"would be {width:.3g} m wide, narrower than its largest"):
+                prep.validate()
+            with pytest.raises(ParameterError, match="expected a box width"):
+                deposit(particles, nvert=0, width=width, seed=0)

@@ -116,4 +116,4 @@ def test_a_stalled_step_warns_that_it_stalled(problem):
         info = sim.step()
     messages = [str(w.message) for w in caught if issubclass(w.category, ConvergenceWarning)]
     assert not info.converged and info.iterations % WINDOW == 0 and info.iterations < TIGHT["max_iterations"]
-    assert len(messages) == 1 and "stall" in messages[0] and f"after {info.iterations} iterations" in messages[0]
+    assert len(messages) == 1 and "stall" in messages[0] and f"after {info.iterations} sweeps" in messages[0]
