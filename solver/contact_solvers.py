@@ -334,6 +334,17 @@ def solve_stepper_pcg(problem, state: ContactState, limits: Limits) -> NLGSResul
                       float(solution.local_law_residual))
 
 
+LOCAL_LAW_NORMS = "its local-law residual |F|/|r| met the tolerance (both of its norms are that residual)"
+"""What the tolerance of a method stopped by the local-law residual applies to (pcg, newton)."""
+
+
+def _newton_stall() -> str:
+    from .nonsmooth_newton import STALL_IMPROVEMENT, STALL_STEPS
+
+    return (f"its own stall test (the best local-law residual down by < {100 * STALL_IMPROVEMENT:g}% over "
+            f"{STALL_STEPS} Newton steps)")
+
+
 def _pcg_stall() -> str:
     from .projected_cg import STALL_IMPROVEMENT, STALL_ITERATIONS
 
@@ -346,8 +357,7 @@ register(Method("nlgs", "nonlinear Gauss-Seidel sweeps (serial, shuffled or on d
 register(Method("anderson", "Anderson-accelerated NLGS sweeps (the default)", solve=solve_stepper_anderson,
                 parameters=(("anderson_memory", "memory"), ("anderson_period", "period")), domains=True))
 register(Method("newton", "semi-smooth Newton on Alart-Curnier's function", solve_matrix=solve_newton,
-                label="Newton", iteration="Newton step"))
+                stall=False, label="Newton", iteration="Newton step", norms=LOCAL_LAW_NORMS, own_stall=_newton_stall))
 register(Method("pcg", "projected conjugate gradient (Renouf & Alart) on the step's matrix", solve=solve_stepper_pcg,
-                solve_matrix=solve_pcg, stall=False, label="Projected-CG", iteration="iteration",
-                norms="its local-law residual |F|/|r| met the tolerance (both of its norms are that residual)",
+                solve_matrix=solve_pcg, stall=False, label="Projected-CG", iteration="iteration", norms=LOCAL_LAW_NORMS,
                 own_stall=_pcg_stall))

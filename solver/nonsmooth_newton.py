@@ -35,7 +35,7 @@ from scipy.sparse import linalg as splinalg
 
 from .contact_solution import ContactSolution, contact_solution, local_law_residual, natural_map
 
-__all__ = ["alart_curnier", "jacobian", "solve"]
+__all__ = ["STALL_IMPROVEMENT", "STALL_STEPS", "alart_curnier", "jacobian", "solve"]
 
 REGULARISATIONS = (0.0, 1e-10, 1e-8, 1e-6, 1e-4, 1e-2)
 """The regularisations eps of the Newton matrix tried in turn (module docstring)."""
@@ -44,9 +44,12 @@ ARMIJO = 1e-4
 HALVINGS = 30
 """Largest number of step halvings in one line search."""
 STALL_STEPS = 10
-"""The iterations stop when the smallest local-law residual has fallen by less than 5% over
-this many steps (the merit can creep down by tiny steps for ever on a packing whose points sit
-on the kinks of F)."""
+"""The iterations stop when the smallest local-law residual has fallen by less than
+``STALL_IMPROVEMENT`` over this many steps (the merit can creep down by tiny steps for ever on
+a packing whose points sit on the kinks of F)."""
+STALL_IMPROVEMENT = 0.05
+"""The relative fall of the smallest local-law residual over ``STALL_STEPS`` steps below which
+the iterations stop."""
 
 
 def alart_curnier(W, q, mu, impulse, rho_n, rho_t):
@@ -123,7 +126,7 @@ def solve(W, q, mu, tolerance, max_iterations, initial) -> ContactSolution:
         law = local_law_residual(natural_map(W, q, mu, r)[0], r)
         best = min(best, law)
         if iterations % STALL_STEPS == 0:
-            if best > 0.95 * checked:
+            if best > (1.0 - STALL_IMPROVEMENT) * checked:
                 break
             checked = best
     return contact_solution(W, q, mu, r, iterations, law <= tolerance)

@@ -192,6 +192,13 @@ def test_each_method_states_what_stops_it_in_its_own_words():
     assert contact_solvers.stop_rule("pcg", 100, 200) == (
         f"the iteration cap (100 iterations) or its own stall test (the best local-law residual down by < "
         f"{100 * projected_cg.STALL_IMPROVEMENT:g}% over {projected_cg.STALL_ITERATIONS} iterations)")
-    assert contact_solvers.stall_rule("nlgs", 0) == "" and contact_solvers.stop_rule("newton") == "the Newton step cap"
+    from solver import nonsmooth_newton
+
+    assert contact_solvers.stall_rule("nlgs", 0) == ""
+    assert contact_solvers.stop_rule("newton", 200, 20) == (
+        f"the Newton step cap (200 Newton steps) or its own stall test (the best local-law residual down by < "
+        f"{100 * nonsmooth_newton.STALL_IMPROVEMENT:g}% over {nonsmooth_newton.STALL_STEPS} Newton steps)")
+    assert contact_solvers.method("newton").norms == contact_solvers.method("pcg").norms
+    assert "local-law residual" in contact_solvers.method("newton").norms
     with pytest.raises(ParameterError, match="solver='apgd': expected one of"):
         contact_solvers.stop_rule("apgd")
