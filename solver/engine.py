@@ -40,7 +40,12 @@ class Engine(Protocol):
     """What an engine does. A *sample* is the engine's own object for a prepared packing; the
     command line reads ``sample.history`` (:class:`solver.sample_history.SampleHistory`: how it
     was made, whether its compaction settled) and ``sample.parameters`` (the numerical
-    settings it ran with, for the warning on unconverged steps)."""
+    settings it ran with, for the warning on unconverged steps).
+
+    An engine that keeps compaction checkpoints (``prepare(..., checkpoint=)``) also has
+    ``check_checkpoint(checkpoint, preparation, parameters)``, which refuses in one line a
+    checkpoint file made with other settings (:func:`check_checkpoint`); one without them
+    leaves both out."""
 
     name: str
 
@@ -93,6 +98,11 @@ class ContactDynamics:
 
         return prepare_sample(preparation, progress=progress, checkpoint=checkpoint, **parameters)
 
+    def check_checkpoint(self, checkpoint, preparation, parameters: dict):
+        from .compaction_checkpoint import CompactionCheckpoint, describe
+
+        CompactionCheckpoint(checkpoint, of=describe(preparation, parameters)).check()
+
     def shear(self, sample, path, test, *, attrs=None, near_contacts=False, overwrite=False, progress=None,
               compress=True) -> int:
         from .scenes import biaxial_test
@@ -117,6 +127,14 @@ class ContactDynamics:
         from .restart import file_state
 
         return file_state(path)
+
+
+def check_checkpoint(runner, checkpoint, preparation, parameters: dict):
+    """``runner.check_checkpoint`` where the engine keeps checkpoints (an engine of the
+    entry-point group may not, and then starts its compactions afresh)."""
+    check = getattr(runner, "check_checkpoint", None)
+    if check is not None:
+        check(checkpoint, preparation, parameters)
 
 
 def prepare(runner, preparation, parameters: dict, progress=None, checkpoint=None):

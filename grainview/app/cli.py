@@ -668,10 +668,10 @@ def _study_state(runner, prep, parameters, path, checkpoint, expected, overwrite
         check_settings(path, expected, "pass --overwrite to replace it, or give the settings it was made with")
         checkpoint.unlink(missing_ok=True)  # the compaction is in the test's file now
         return state
-    if checkpoint.exists() and runner.name == "solver":  # this package's checkpoints
-        from solver.compaction_checkpoint import CompactionCheckpoint, describe
+    if checkpoint.exists():
+        from solver.engine import check_checkpoint
 
-        CompactionCheckpoint(checkpoint, of=describe(prep, parameters)).check()
+        check_checkpoint(runner, checkpoint, prep, parameters)
     return "start"
 
 

@@ -244,3 +244,32 @@ def test_ensemble_runs_go_through_their_engine(tmp_path, fake_engine):
     result = run_one(spec, tmp_path)
     assert result["action"] == "ran" and [c[0] for c in fake_engine] == ["check", "check", "prepare", "shear"]
     assert fake_engine[-1][1] == f"{spec.name}.nc" and fake_engine[-1][2] == spec.test()
+
+
+class CheckpointingEngine(FakeEngine):
+    """A fake engine that keeps compaction checkpoints: the study asks it to check one."""
+
+    name = "fake-checkpoints"
+
+    def check_checkpoint(self, checkpoint, preparation, parameters):
+        CALLS.append(("check_checkpoint", Path(checkpoint).name, preparation.shape))
+
+
+def test_the_study_asks_the_engine_to_check_a_checkpoint_it_finds(tmp_path, fake_engine, monkeypatch):
+    """A compaction checkpoint left by an earlier run is checked by the engine that keeps such
+    files (through solver.engine.check_checkpoint), whatever its name; an engine without
+    checkpoints is not asked and starts afresh."""
+    import solver.engine
+
+    monkeypatch.setitem(solver.engine.ENGINES, "fake-checkpoints", f"{__name__}:CheckpointingEngine")
+    out = tmp_path / "study"
+    out.mkdir()
+    (out / "pentagons.compaction.nc").write_bytes(b"left by an earlier run")
+    argv = ["study", "--particles", "12", "--strain", "0.05", "--every", "5", "--no-report", "--progress", "off",
+            "--out", str(out), "--jobs", "1"]
+    assert main([*argv, "--engine", "fake-checkpoints"]) == 0
+    assert ("check_checkpoint", "pentagons.compaction.nc", "pentagon") in fake_engine
+    assert not any(c[0] == "check_checkpoint" and c[1].startswith("disks") for c in fake_engine)
+    fake_engine.clear()
+    assert main([*argv, "--engine", "fake"]) == 0
+    assert not any(c[0] == "check_checkpoint" for c in fake_engine) and any(c[0] == "prepare" for c in fake_engine)
