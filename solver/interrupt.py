@@ -22,6 +22,10 @@ class Terminated(SystemExit):
 
 STOP_SIGNALS = (signal.SIGINT, signal.SIGTERM)
 
+PROGRESS_LINE_SECONDS = 60.0
+"""Seconds between two progress lines of a run whose progress goes to a log, not a terminal
+(the command line's side-by-side samples)."""
+
 
 @contextlib.contextmanager
 def interruptible():

@@ -57,8 +57,7 @@ __all__ = ["ContactProblem", "NLGSResult", "STALL_IMPROVEMENT", "delassus", "del
            "velocities_from_impulses"]
 
 
-STALL_IMPROVEMENT = 0.05
-"""Least relative fall of the best quadratic norm over ``stall`` sweeps (module docstring)."""
+from .solve_records import STALL_IMPROVEMENT  # noqa: E402 (defined beside Limits, read here by the kernels)
 
 
 class NLGSResult(NamedTuple):

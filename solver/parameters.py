@@ -33,6 +33,7 @@ from grainview.contract.schema import MAX_STEP_INDEX
 from . import contact_solvers
 from .contact_solvers import ACCELERATIONS  # noqa: F401 (the former acceleration's values, read from the registry)
 from .shape_families import check_shape
+from .solve_records import STALL_IMPROVEMENT
 
 MAX_FRICTION = 10.0
 """Largest accepted friction coefficient: measured ones lie below ~1.5, and 10 already makes
@@ -170,8 +171,9 @@ class Parameters:
                                    expected="> 0")
     max_iterations: int = setting(2000, "cap of the NLGS sweeps of a step", check=lambda v: whole(v) and v >= 1,
                                   expected=">= 1")
-    stall_sweeps: int = setting(0, "stop a step's NLGS when its quadratic norm has fallen less than 5% over this "
-                                "many sweeps (a step that would creep to the sweep cap; 0: never; docs/solver.md)",
+    stall_sweeps: int = setting(0, f"stop a step's NLGS when its quadratic norm has fallen less than "
+                                f"{100 * STALL_IMPROVEMENT:g}% over this many sweeps (a step that would creep to the "
+                                "sweep cap; 0: never; docs/solver.md)",
                                 check=lambda v: whole(v) and v >= 0,
                                 expected="a whole number of sweeps >= 0 (0: no stall test)")
     alert: float | None = setting(None, "alert distance (None: 2% of the smallest diameter)", unit="m",

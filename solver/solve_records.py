@@ -105,6 +105,12 @@ class DelassusBlocks(NamedTuple):
     tt: np.ndarray
 
 
+STALL_IMPROVEMENT = 0.05
+"""Least relative fall of the best quadratic norm over ``Limits.stall`` sweeps below which the
+NLGS's stall test stops the sweeps (:func:`solver.nlgs.stalled`; kept here, beside the limits and
+away from the kernels, so that the settings can quote it without loading numba)."""
+
+
 class Limits(NamedTuple):
     """When the sweeps stop (:mod:`solver.nlgs`).
 

@@ -452,16 +452,13 @@ def _simulation_kwargs(args):
                 engine=args.engine)
 
 
-TEMPORARY_NAME_EXTRA = len("..") + 7 + len(".convert")
-"""Bytes the writer's temporary names add to a file's name: ``.<name>.<pid>.part`` and
-``.<name>.<pid>.convert`` (grainview.contract.writer; a process id has at most 7 digits) and the lock's
-``.<name>.writer`` (grainview.contract.locks)."""
-
-
 def longest_output_name(folder) -> int:
     """The longest file name, in bytes, that ``--out`` may have in ``folder``: the folder's
-    name limit (``PC_NAME_MAX``, 255 on common file systems) less :data:`TEMPORARY_NAME_EXTRA`."""
+    name limit (``PC_NAME_MAX``, 255 on common file systems) less what the writer's temporary
+    names add (:data:`grainview.contract.writer.TEMPORARY_NAME_EXTRA`)."""
     import os
+
+    from ..contract.writer import TEMPORARY_NAME_EXTRA
 
     try:
         limit = os.pathconf(folder, "PC_NAME_MAX")
@@ -475,6 +472,8 @@ def _check_output_file(path, overwrite):
     folder, short enough for the writer's temporary names, not a folder, not a link to
     nowhere, not an existing file without --overwrite."""
     import os
+
+    from ..contract.writer import TEMPORARY_NAME_EXTRA
 
     path = Path(path)
     folder = path.parent if str(path.parent) else Path(".")
@@ -845,7 +844,7 @@ class _SampleProgress:
     expected to go). Called as ``progress(total, desc)`` (:func:`solver.interrupt.progress_bar`);
     picklable, for the worker processes."""
 
-    every = 60.0
+    every = library_constant("solver.interrupt", "PROGRESS_LINE_SECONDS")
 
     def __init__(self, terminal, position=0, label=""):
         self.terminal, self.position, self.label = terminal, position, label
@@ -975,24 +974,28 @@ def _simulation_options(p, samples=1):
 
 
 def _study_parser(sub):
+    from solver.paper_size import PAPER_PARTICLES, REFERENCE_PARTICLES, REFERENCE_VELOCITY, velocity_for
+    from solver.preparation import Preparation
+
+    minutes = library_constant("solver.compaction_checkpoint", "CHECKPOINT_SECONDS") / 60
     study = sub.add_parser("study", help="the paper's study: pentagons vs disks, simulated, analysed, plotted",
-                           description="Deposit, compact (10 kPa) and shear an S1-like pentagon sample and an "
+                           description=f"Deposit, compact ({Preparation.sigma0 / 1e3:g} kPa) and shear an S1-like "
+                           "pentagon sample and an "
                            "S2-like disk sample into the residual state, side by side, then write the report "
                            "(table vs the paper, figures). The files hold the near contacts too, so the table "
                            "also counts them (docs/fidelity.md). The same command again, after a stop (Ctrl-C, "
                            "SIGTERM) or a kill, skips the finished samples and resumes the others where they were: "
                            "a test from its file, a compaction from its checkpoint OUT/<sample>.compaction.nc "
-                           "(written every ten minutes and when stopped); files of other settings are refused "
+                           f"(written every {minutes:g} minutes and when stopped); files of other settings are refused "
                            "unless --overwrite.")
     study.add_argument("--out", default="study", help="output folder (default: study)")
     study.add_argument("--jobs", type=int, default=len(STUDY_SAMPLES),
                        help=f"processes: the {len(STUDY_SAMPLES)} samples side by side (default {len(STUDY_SAMPLES)})")
-    from solver.paper_size import PAPER_PARTICLES, REFERENCE_PARTICLES, REFERENCE_VELOCITY
-
+    speeds = " and ".join(f"{velocity_for(PAPER_PARTICLES[shape]):g}" for shape in ("pentagon", "disk"))
     study.add_argument("--paper-size", action="store_true",
                        help=f"the paper's sizes: {PAPER_PARTICLES['pentagon']} pentagons and {PAPER_PARTICLES['disk']} "
                        f"disks, each top wall at the strain rate of {REFERENCE_PARTICLES} particles at "
-                       f"{REFERENCE_VELOCITY:g} m/s (speed x sqrt(N/{REFERENCE_PARTICLES}): 0.06 and 0.05 m/s; "
+                       f"{REFERENCE_VELOCITY:g} m/s (speed x sqrt(N/{REFERENCE_PARTICLES}): {speeds} m/s; "
                        "--velocity V shears both at V); hours on two cores, resumable: the same command again "
                        "goes on where a stopped or killed run was (docs/fidelity.md, section 4)")
     study.add_argument("--no-report", action="store_true",
@@ -1003,12 +1006,14 @@ def _study_parser(sub):
 
 
 def _run_parser(sub):
+    from solver.parameters import BiaxialTest
     from solver.preparation import Preparation
     from solver.shape_families import MAX_VERTICES
 
     run = sub.add_parser("run", help="simulate one sample into a netCDF file",
-                         description="Geometric deposit, isotropic compaction under sigma0 (10 kPa), then "
-                         "(scene biaxial) compression by the top wall (1 cm/s) with sigma0 held on the right wall.")
+                         description=f"Geometric deposit, isotropic compaction under sigma0 ({Preparation.sigma0 / 1e3:g} "
+                         f"kPa), then (scene biaxial) compression by the top wall ({BiaxialTest.velocity * 100:g} cm/s) "
+                         "with sigma0 held on the right wall.")
     run.add_argument("scene", nargs="?", choices=["biaxial", "isotropic"], default="biaxial",
                      help="biaxial (default) or isotropic (writes the compacted state)")
     setting_option(run, Preparation, "shape", help=f"pentagon, disk, a number of vertices from 3 to "

@@ -47,6 +47,13 @@ TEMPORARY_SUFFIXES = (".part", ".convert")
 """The hidden files ``.<name>.<pid><suffix>`` a file is written under before it is renamed
 into place (:meth:`SnapshotWriter.create`, :func:`compress_file`, :func:`decompress_file`)."""
 
+PID_DIGITS = 7
+"""The most digits a process id has (Linux's pid_max is at most 2^22)."""
+
+TEMPORARY_NAME_EXTRA = len("..") + PID_DIGITS + max(len(suffix) for suffix in TEMPORARY_SUFFIXES)
+"""Bytes the temporary names add to a file's name: ``.<name>.<pid><suffix>`` (the lock's
+``.<name>.writer``, grainview.contract.locks, adds fewer)."""
+
 
 def _fsync(path: str) -> None:
     """Flush ``path`` (a file or a folder) to disk; a file system that cannot sync a folder is
