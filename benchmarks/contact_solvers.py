@@ -140,7 +140,7 @@ def check_assembly(problem, W, q, pn, pt, vx, vy, w):
     pn, pt, vx, vy, w = pn.copy(), pt.copy(), vx.copy(), vy.copy(), w.copy()
     nlgs.solve_problem(problem, pn, pt, vx, vy, w, tolerance=1e-30, max_tolerance=1e-30, max_iterations=20)
     velocities = Velocities(vx, vy, w)
-    local = np.array([nlgs._relative_velocity(k, problem, velocities) for k in range(problem.a.size)])
+    local = np.array([nlgs.relative_velocity(k, problem, velocities) for k in range(problem.a.size)])
     local[:, 0] += problem.bias
     assembled = (W @ np.stack([pn, pt], -1).reshape(-1) + q).reshape(-1, 2)
     error = np.abs(assembled - local).max() / np.abs(local).max()

@@ -127,14 +127,14 @@ class CompactionCheckpoint:
         of another sample (``of``)."""
         from grainview.contract.reader import ContractFile
 
-        from .restart import _simulation, _snapshot_state
+        from .restart import simulation_from_state, snapshot_state
         from .sample_history import SampleHistory
         from .stepper import Unconverged
 
         with ContractFile(self.path) as ds:
             attrs = self._checked(ds)
-            state = _snapshot_state(ds, 0, self.path)
-        sim = _simulation(state, self.path)
+            state = snapshot_state(ds, 0, self.path)
+        sim = simulation_from_state(state, self.path)
         sim.history = SampleHistory(sigma0=float(attrs["sigma0_Pa"]))
         sim.unconverged = Unconverged(int(attrs["checkpoint_unconverged_steps"]),
                                       float(attrs["checkpoint_unconverged_residual"]),

@@ -208,7 +208,7 @@ def stall_rule(name: str, stall_sweeps=None) -> str:
     """The stall test that stops the method ``name``, in words ("" for none): the NLGS's when the
     method applies it and ``stall_sweeps`` > 0 (the best quadratic norm down by less than 5% over
     that many sweeps), otherwise the method's own, if it has one."""
-    from .nlgs import STALL_IMPROVEMENT
+    from .solve_records import STALL_IMPROVEMENT
 
     m = method(name)
     if m.stall:

@@ -53,7 +53,8 @@ from numba import njit
 from .solve_records import ContactProblem, DelassusBlocks, Impulses, Limits, Velocities
 
 __all__ = ["ContactProblem", "NLGSResult", "STALL_IMPROVEMENT", "delassus", "delassus_block", "delassus_into",
-           "local_solve", "norms", "solve", "solve_matrix", "solve_problem", "stalled", "sweep", "sweep_norms",
+           "local_solve", "norms", "relative_velocity", "solve", "solve_matrix", "solve_problem", "stalled", "sweep",
+           "sweep_norms",
            "velocities_from_impulses"]
 
 
@@ -144,7 +145,7 @@ def local_solve(ufn, uft, bias, wnn, wnt, wtt, mu):
 
 
 @njit(cache=True)
-def _relative_velocity(k, problem, velocities):
+def relative_velocity(k, problem, velocities):
     """Relative velocity (u_n, u_t) of body b with respect to body a at point k (m s-1)."""
     vx, vy, w = velocities
     bb, aa = np.uint64(problem.b[k]), np.uint64(problem.a[k])
@@ -260,7 +261,7 @@ def sweep(order, problem, impulses, velocities, blocks):
     n_active = 0
     for q in range(order.size):
         k = np.uint64(order[q])
-        un, ut = _relative_velocity(k, problem, velocities)
+        un, ut = relative_velocity(k, problem, velocities)
         ufn = un - wnn[k] * pn[k] - wnt[k] * pt[k]
         uft = ut - wnt[k] * pn[k] - wtt[k] * pt[k]
         new_n, new_t = local_solve(ufn, uft, bias[k], wnn[k], wnt[k], wtt[k], mu[k])

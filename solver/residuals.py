@@ -34,7 +34,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from .nlgs import _relative_velocity, delassus_block
+from .nlgs import relative_velocity, delassus_block
 from .solve_records import Impulses, Velocities
 
 __all__ = ["cone_projection", "natural_map", "natural_maps", "local_law_residuals", "particle_imbalance",
@@ -77,7 +77,7 @@ def natural_maps(pn, pt, un, ut, mu, rho):
 def _point_natural_map(k, problem, impulses, velocities, wnn_k):
     """:func:`natural_map` of point k, its velocity from the bodies' (Signorini shift added)
     and rho = 1 / W_nn."""
-    un, ut = _relative_velocity(k, problem, velocities)
+    un, ut = relative_velocity(k, problem, velocities)
     return natural_map(impulses.pn[k], impulses.pt[k], un + problem.bias[k], ut, problem.mu[k], 1.0 / wnn_k)
 
 

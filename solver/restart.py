@@ -106,7 +106,7 @@ def _check_resumable(ds, source):
                               "stopped before its first one): start the run again")
 
 
-def _snapshot_state(ds, index, source):
+def snapshot_state(ds, index, source):
     """The whole solver state at snapshot ``index`` of an open :class:`ContractFile` (plain numpy arrays)."""
     count = int(ds.snapshot("contact_count", index))
     state = {name: ds.snapshot(name, index).copy() for name in (
@@ -123,8 +123,8 @@ def _snapshot_state(ds, index, source):
     return state
 
 
-def _simulation(state, source) -> Simulation:
-    """Rebuild a :class:`Simulation` (walls, parameters, warm start) from :func:`_snapshot_state`."""
+def simulation_from_state(state, source) -> Simulation:
+    """Rebuild a :class:`Simulation` (walls, parameters, warm start) from :func:`snapshot_state`."""
     attrs = state["attrs"]
     walls = Walls(state["wall_position"], state["wall_normal"], state["names"],
                   mode=np.asarray(attrs["wall_mode"], np.int64), velocity=state["wall_velocity"],
@@ -169,8 +169,8 @@ def load_sample(path, index=-1) -> Simulation:
             raise FileFormatError(f"{source}: the file holds no complete snapshot")
         if not -ds.n_snapshots <= int(index) < ds.n_snapshots:
             raise FileFormatError(f"{source}: index={index!r} is outside its {ds.n_snapshots} snapshots")
-        state = _snapshot_state(ds, int(index), source)
-    sim = _simulation(state, source)
+        state = snapshot_state(ds, int(index), source)
+    sim = simulation_from_state(state, source)
     sim.show_warm_start()  # a test's first snapshot shows the sample's contacts and forces
     return sim
 
@@ -187,9 +187,9 @@ def load_state(path):
     source = os.fspath(path)
     with ContractFile(source) as ds:
         _check_resumable(ds, source)
-        state = _snapshot_state(ds, -1, source)
+        state = snapshot_state(ds, -1, source)
         snapshots = ds.n_snapshots
-    sim = _simulation(state, source)
+    sim = simulation_from_state(state, source)
     attrs = state["attrs"]
     test = {"first_step": state["first_step"], "n_steps": int(attrs["biaxial_steps"]),
             "every": int(attrs["snapshot_every"]), "snapshots": snapshots}

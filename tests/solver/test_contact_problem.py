@@ -85,7 +85,7 @@ def test_same_solution_as_the_time_steppers_nlgs_on_a_random_system():
         velocities = Velocities(v0[:, 0].copy(), v0[:, 1].copy(), v0[:, 2].copy())
         for k in range(points):
             nlgs.apply_impulse_change(k, pn[k], pt[k], problem, velocities)
-        return np.array([nlgs._relative_velocity(k, problem, velocities) for k in range(points)]).reshape(-1)
+        return np.array([nlgs.relative_velocity(k, problem, velocities) for k in range(points)]).reshape(-1)
 
     q = local_velocity(np.zeros(points), np.zeros(points))
     W = np.column_stack([local_velocity(*np.eye(2 * points)[c].reshape(points, 2).T) - q for c in range(2 * points)])
