@@ -74,7 +74,17 @@ def wall_state(sim):
     return sim.wall_stresses(), rate
 
 
-def is_equilibrium(stresses, rates, sigma0, stress_tolerance=0.01, strain_rate_tolerance=1e-3):
+EQUILIBRIUM_WINDOW = 200
+"""Steps over which a compaction's wall stresses and strain rates are averaged to judge
+equilibrium (:func:`isotropic_compaction`)."""
+STRESS_TOLERANCE = 0.01
+"""Largest relative departure of a stress-driven wall's mean stress from sigma0 at equilibrium."""
+STRAIN_RATE_TOLERANCE = 1e-3
+"""Largest mean strain rate (s-1) of a stress-driven wall at equilibrium."""
+
+
+def is_equilibrium(stresses, rates, sigma0, stress_tolerance=STRESS_TOLERANCE,
+                   strain_rate_tolerance=STRAIN_RATE_TOLERANCE):
     """Equilibrium over a window of steps: on every stress-driven wall, the mean stress is
     within ``stress_tolerance`` (relative) of sigma0 and the mean strain rate below
     ``strain_rate_tolerance`` s-1. ``stresses`` and ``rates`` are (steps, driven walls).
@@ -96,8 +106,9 @@ def inertia_number_speed(inertia_number, size, mean_diameter, density, sigma0):
     return inertia_number * size / (mean_diameter * np.sqrt(density / sigma0))
 
 
-def isotropic_compaction(sim: Simulation, *, max_steps=Preparation.max_steps, window=200, stress_tolerance=0.01,
-                         strain_rate_tolerance=1e-3, max_inertia_number=Preparation.max_inertia_number,
+def isotropic_compaction(sim: Simulation, *, max_steps=Preparation.max_steps, window=EQUILIBRIUM_WINDOW,
+                         stress_tolerance=STRESS_TOLERANCE, strain_rate_tolerance=STRAIN_RATE_TOLERANCE,
+                         max_inertia_number=Preparation.max_inertia_number,
                          pressure_ramp=Preparation.pressure_ramp, progress=None, checkpoint=None, resume=None):
     """Step ``sim`` until the last ``window`` steps are at equilibrium (:func:`is_equilibrium`)
     or for ``max_steps``. Returns the number of steps taken and records in ``sim.history``
