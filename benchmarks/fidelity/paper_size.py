@@ -97,23 +97,22 @@ def main(argv=None):
     studies = {"paper size": args.folder}
     if args.reference:
         studies = {"400": args.reference, **studies}
-    for name, folder in studies.items():
-        for shape, file in SAMPLES.items():
-            if not os.path.isfile(os.path.join(folder, file)):
-                raise SystemExit(f"{os.path.join(folder, file)}: no such file (expected a study's output folder)")
+    present = {(name, shape): os.path.join(folder, file) for name, folder in studies.items()
+               for shape, file in SAMPLES.items() if os.path.isfile(os.path.join(folder, file))}
+    if not present:
+        raise SystemExit(f"{args.folder}: no {' or '.join(SAMPLES.values())} (expected a study's output folder)")
+    missing = [f"{name} {shape}s" for name in studies for shape in SAMPLES if (name, shape) not in present]
     start = time.perf_counter()
     facts, sizes, states, curves = [], [], {}, []
-    for name, folder in studies.items():
-        for shape, file in SAMPLES.items():
-            path = os.path.join(folder, file)
-            f = run_facts(path)
-            label = f"{shape}s {f['particles']}"
-            print(f"{label}: {f['snapshots']} snapshots, eps_q up to {f['eps_q max']:.3f} ...", flush=True)
-            facts.append([label, f["compaction steps"], f["steps"], f["snapshots"], f"{f['velocity'] * 100:g}",
-                          f"{f['inertia']:.1e}", _f(f["eps_q max"])])
-            sizes += size_rows(label, path)
-            states[(name, shape)] = residual_states(path)
-            curves.append((f"{shape}s, N = {f['particles']}", shape, measure.strain_series(path)))
+    for (name, shape), path in present.items():
+        f = run_facts(path)
+        label = f"{shape}s {f['particles']}"
+        print(f"{label}: {f['snapshots']} snapshots, eps_q up to {f['eps_q max']:.3f} ...", flush=True)
+        facts.append([label, f["compaction steps"], f["steps"], f["snapshots"], f"{f['velocity'] * 100:g}",
+                      f"{f['inertia']:.1e}", _f(f["eps_q max"])])
+        sizes += size_rows(label, path)
+        states[(name, shape)] = residual_states(path)
+        curves.append((f"{shape}s, N = {f['particles']}", shape, measure.strain_series(path)))
     state_rows = []
     for (name, shape), counted in states.items():
         for how, s in counted.items():
@@ -122,6 +121,8 @@ def main(argv=None):
     relation_columns = []
     for name in studies:
         for how in ("force-bearing", "near"):
+            if (name, "pentagon") not in states or (name, "disk") not in states:
+                continue
             p, d = states[(name, "pentagon")][how], states[(name, "disk")][how]
             if p.get("snapshots") and d.get("snapshots"):
                 relation_columns.append((f"{name}, {how}", relations.evaluate([p], [d])))
@@ -141,7 +142,8 @@ def main(argv=None):
         "",
         f"Made by `python -m benchmarks.fidelity.paper_size {' '.join(argv)}` (its docstring), "
         f"{time.strftime('%Y-%m-%d %H:%M UTC', time.gmtime())}, in {time.perf_counter() - start:.0f} s. "
-        "Read with docs/fidelity.md, sections 4, 7 and 8. One seed per size.",
+        "Read with docs/fidelity.md, sections 4, 7 and 8. One seed per size."
+        + (f" Not there (yet): {', '.join(missing)}." if missing else ""),
         "",
         "## The runs",
         "",
