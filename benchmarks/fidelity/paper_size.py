@@ -41,17 +41,21 @@ WINDOWS = ((0.3, 0.4), RESIDUAL)
 
 
 def run_facts(path) -> dict:
-    """Particles, steps, the last eps_q and the median inertia numbers of a test's file."""
+    """Particles, steps, the last eps_q, the median inertia number and the mean stress p (Pa)
+    over eps_q >= 0.3 (median, 10th percentile, least and largest: how steady the test's stress
+    level is) of a test's file."""
     import grainview
 
     with grainview.open_dataset(path, chunks=None) as ds:
         eps_q = ds.grain.strains()["eps_q"].values
         inertia = float(ds.grain.inertia_number().median())
+        p = ds.grain.stress_invariants()["p"].values[eps_q >= 0.3]
+        levels = np.percentile(p, [50, 10, 0, 100]) if p.size else np.full(4, np.nan)
         steps = int(ds["step"].values[-1] - ds["step"].values[0]) if "step" in ds else -1
         return {"particles": int(ds.sizes["particle"]), "snapshots": int(ds.sizes["time"]), "steps": steps,
                 "eps_q max": float(eps_q.max()), "inertia": inertia,
                 "velocity": float(ds.attrs.get("wall_velocity_m_s", np.nan)),
-                "compaction steps": int(ds.attrs.get("compaction_steps", -1))}
+                "compaction steps": int(ds.attrs.get("compaction_steps", -1)), "p levels": levels}
 
 
 def size_rows(label, path) -> list:
@@ -108,8 +112,10 @@ def main(argv=None):
         f = run_facts(path)
         label = f"{shape}s {f['particles']}"
         print(f"{label}: {f['snapshots']} snapshots, eps_q up to {f['eps_q max']:.3f} ...", flush=True)
+        median, tenth, least, largest = f["p levels"] / 1e3
         facts.append([label, f["compaction steps"], f["steps"], f["snapshots"], f"{f['velocity'] * 100:g}",
-                      f"{f['inertia']:.1e}", _f(f["eps_q max"])])
+                      f"{f['inertia']:.1e}", _f(f["eps_q max"]),
+                      f"{median:.1f}, {tenth:.1f}, {least:.1f}-{largest:.1f}"])
         sizes += size_rows(label, path)
         states[(name, shape)] = residual_states(path)
         curves.append((f"{shape}s, N = {f['particles']}", shape, measure.strain_series(path)))
@@ -148,7 +154,8 @@ def main(argv=None):
         "## The runs",
         "",
         _table(["sample", "compaction steps", "test steps", "snapshots", "top wall (cm/s)",
-                "inertia number I (median)", "eps_q reached"], facts),
+                "inertia number I (median)", "eps_q reached",
+                "p over eps_q >= 0.3 (kPa): median, 10th percentile, range"], facts),
         "",
         f"![q/p, a and z against eps_q]({os.path.basename(figure)})",
         "",
