@@ -1,0 +1,96 @@
+"""Shear a study's compacted samples again at another top-wall speed, without compacting them again.
+
+The paper-size study (``grainview study --paper-size``) spends most of its pentagons' time in
+the compaction (about 1.5 h of 3.4 h at 14,400 pentagons). To ask whether the residual state
+depends on the strain rate at that size, this script takes the compacted sample of each
+finished study file -- its first snapshot, the state the test started from, with its warm
+start (:func:`solver.load_sample`) -- and shears it again to the same strain at ``--velocity``::
+
+    python -m benchmarks.fidelity.reshear /work/runs/paper_size /work/runs/paper_size_1cm \\
+        --velocity 0.01 --every 1200 --domains 1 --samples pentagons
+
+``--every`` keeps the snapshots at the same strain spacing as the original file when it is
+scaled with the speed (200 steps at 6 cm/s -> 1200 at 1 cm/s). ``--domains`` sets the sweeps'
+domains for the new test (the compaction's stay what they were; the file records both).
+
+**It resumes**: the same command again skips a finished file and carries on a partial one from
+its last snapshot (:func:`solver.restart.resume`, bit for bit); ``python -m solver.restart FILE``
+does the same for one file. The output files are those of the study's (the data contract,
+with near pairs), so ``python -m benchmarks.fidelity.paper_size OUT --reference STUDY400`` and
+``grainview report`` read them. Nothing in the source folder is written.
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+import time
+from pathlib import Path
+
+SAMPLES = ("pentagons", "disks")
+
+
+def reshear(source: Path, out: Path, label: str, *, velocity: float, every: int, domains: int | None,
+            strain: float | None = None, progress: bool = False) -> str:
+    """Shear the compacted sample of ``source/label.nc`` into ``out/label.nc`` (or resume it).
+
+    Returns what was done: "finished" (skipped), "resumed" or "started".
+    """
+    from solver import load_sample
+    from solver.restart import file_state, resume
+    from solver.scenes import biaxial_test
+
+    path = out / f"{label}.nc"
+    state = file_state(path)
+    if state == "finished":
+        resume(path, compress=True)  # compresses a file whose compression was stopped; else nothing
+        return "finished"
+    if state == "partial":
+        resume(path, progress=progress)
+        return "resumed"
+    original = source / f"{label}.nc"
+    if file_state(original) != "finished":
+        raise SystemExit(f"reshear: {original} is not a finished test; expected a study's complete file")
+    sim = load_sample(original, 0)
+    if domains is not None:
+        sim.set_parameters(domains=domains)
+    import netCDF4
+
+    with netCDF4.Dataset(original) as ds:
+        target = float(ds.getncattr("strain_target")) if strain is None else strain
+        attrs = {"resheared_from": str(original), "resheared_from_velocity_m_s": float(ds.getncattr(
+            "wall_velocity_m_s"))}
+    out.mkdir(parents=True, exist_ok=True)
+    biaxial_test(sim, path, strain=target, velocity=velocity, every=every, near_contacts=True, attrs=attrs,
+                 progress=progress)
+    return "started"
+
+
+def main(argv=None) -> int:
+    parser = argparse.ArgumentParser(prog="python -m benchmarks.fidelity.reshear", description=__doc__.split("\n")[0])
+    parser.add_argument("source", type=Path, help="folder of a finished study (pentagons.nc, disks.nc)")
+    parser.add_argument("out", type=Path, help="folder for the new tests (created)")
+    parser.add_argument("--velocity", type=float, required=True, help="top-wall speed of the new tests (m/s)")
+    parser.add_argument("--every", type=int, required=True, help="steps between snapshots")
+    parser.add_argument("--domains", type=int, default=None, help="domains of the new tests' sweeps")
+    parser.add_argument("--strain", type=float, default=None, help="eps_1 to reach (default: the original's)")
+    parser.add_argument("--samples", default=",".join(SAMPLES), help="which samples, comma-separated")
+    parser.add_argument("--progress", action="store_true", help="show a progress bar")
+    args = parser.parse_args(argv)
+    labels = [s for s in args.samples.split(",") if s]
+    unknown = sorted(set(labels) - set(SAMPLES))
+    if unknown:
+        parser.error(f"--samples: {unknown} unknown; expected some of {', '.join(SAMPLES)}")
+    if args.source.resolve() == args.out.resolve():
+        parser.error("out is the source folder; expected another folder (the study's files are only read)")
+    for label in labels:
+        start = time.monotonic()
+        print(f"{label}: ...", flush=True)
+        done = reshear(args.source, args.out, label, velocity=args.velocity, every=args.every, domains=args.domains,
+                       strain=args.strain, progress=args.progress)
+        print(f"{label}: {done} ({(time.monotonic() - start) / 3600:.2f} h of wall time)", flush=True)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
