@@ -67,6 +67,7 @@ registry's names without loading a compiled kernel.
 
 from __future__ import annotations
 
+import importlib
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Callable, NamedTuple
 
@@ -338,18 +339,17 @@ LOCAL_LAW_NORMS = "its local-law residual |F|/|r| met the tolerance (both of its
 """What the tolerance of a method stopped by the local-law residual applies to (pcg, newton)."""
 
 
-def _newton_stall() -> str:
-    from .nonsmooth_newton import STALL_IMPROVEMENT, STALL_STEPS
+def _own_stall_words(module: str, count: str, unit: str) -> Callable[[], str]:
+    """The words of a method's own stall test (:attr:`Method.own_stall`), read when called from
+    its module's ``STALL_IMPROVEMENT`` and its count named ``count`` (of ``unit``), so that the
+    registry imports the module only when the words are needed."""
 
-    return (f"its own stall test (the best local-law residual down by < {100 * STALL_IMPROVEMENT:g}% over "
-            f"{STALL_STEPS} Newton steps)")
+    def words() -> str:
+        solver_module = importlib.import_module(f"{__package__}.{module}")
+        return (f"its own stall test (the best local-law residual down by < "
+                f"{100 * solver_module.STALL_IMPROVEMENT:g}% over {getattr(solver_module, count)} {unit})")
 
-
-def _pcg_stall() -> str:
-    from .projected_cg import STALL_IMPROVEMENT, STALL_ITERATIONS
-
-    return (f"its own stall test (the best local-law residual down by < {100 * STALL_IMPROVEMENT:g}% over "
-            f"{STALL_ITERATIONS} iterations)")
+    return words
 
 
 register(Method("nlgs", "nonlinear Gauss-Seidel sweeps (serial, shuffled or on domains)", solve=solve_stepper_nlgs,
@@ -357,7 +357,8 @@ register(Method("nlgs", "nonlinear Gauss-Seidel sweeps (serial, shuffled or on d
 register(Method("anderson", "Anderson-accelerated NLGS sweeps (the default)", solve=solve_stepper_anderson,
                 parameters=(("anderson_memory", "memory"), ("anderson_period", "period")), domains=True))
 register(Method("newton", "semi-smooth Newton on Alart-Curnier's function", solve_matrix=solve_newton,
-                stall=False, label="Newton", iteration="Newton step", norms=LOCAL_LAW_NORMS, own_stall=_newton_stall))
+                stall=False, label="Newton", iteration="Newton step", norms=LOCAL_LAW_NORMS,
+                own_stall=_own_stall_words("nonsmooth_newton", "STALL_STEPS", "Newton steps")))
 register(Method("pcg", "projected conjugate gradient (Renouf & Alart) on the step's matrix", solve=solve_stepper_pcg,
                 solve_matrix=solve_pcg, stall=False, label="Projected-CG", iteration="iteration", norms=LOCAL_LAW_NORMS,
-                own_stall=_pcg_stall))
+                own_stall=_own_stall_words("projected_cg", "STALL_ITERATIONS", "iterations")))

@@ -164,7 +164,7 @@ def unconverged_text(counts: dict | None, what: str = "the test") -> str:
     m = _method(counts)
     heading = f"{m.label if m is not None else 'Contact-solver'} convergence"
     if counts["steps"] == 0:
-        return (f"{heading}: every step{of} met both stopping tolerances ({tolerances(counts)}).")
+        return f"{heading}: every step{of} stopped once {norms_phrase(counts)} ({tolerances(counts)})."
     share = f" ({100 * counts['steps'] / counts['of']:.2g}%)" if counts["of"] else ""
     return (f"{heading}: {counts['steps']}{of} steps{share}, in {counts['snapshots']} of the intervals "
             f"between snapshots, stopped at {stop_rule(counts)} before {norms_phrase(counts)} "

@@ -75,7 +75,11 @@ def test_no_unconverged_step_and_no_record_are_said_so():
     variables = _variables()
     variables["nlgs_unconverged_steps"] = np.zeros(5, int)
     text = unconverged_text(unconverged_in_file(variables, ATTRS))
-    assert text.startswith("NLGS convergence: every step of the test's 600 met both stopping tolerances")
+    assert text.startswith("NLGS convergence: every step of the test's 600 stopped once both stopping norms "
+                           "(the impulses' change over a sweep) met their tolerances")
+    pcg = unconverged_text(unconverged_in_file(variables, {**ATTRS, "solver_solver": "pcg"}))
+    assert pcg.startswith("Projected-CG convergence: every step of the test's 600 stopped once its local-law "
+                          "residual |F|/|r| met the tolerance") and "both stopping" not in pcg
     del variables["nlgs_unconverged_steps"]
     assert unconverged_in_file(variables, ATTRS) is None
     assert "not recorded in this file" in unconverged_text(None)
