@@ -1,0 +1,66 @@
+"""benchmarks/fidelity/reshear.py: a study's compacted sample sheared again from its file.
+
+The independent check: resheared at the study's own speed and snapshot interval, the new
+file is the study's file again, bit for bit (the sample, its warm start and the test are all
+restored from snapshot 0); resheared at another speed, it starts from the same state and
+records the new speed and where it came from."""
+
+from __future__ import annotations
+
+import netCDF4
+import numpy as np
+import pytest
+
+from grainview.app.cli import _simulate
+from solver.parameters import BiaxialTest
+from solver.preparation import preparation
+
+from .conftest import load_benchmark
+
+VARIABLES = ("position", "angle", "velocity", "fn", "ft", "normal_impulse", "wall_position", "wall_force", "step")
+
+
+@pytest.fixture(scope="module")
+def study(tmp_path_factory):
+    """A finished study folder holding one small test, pentagons.nc (30 pentagons)."""
+    folder = tmp_path_factory.mktemp("study")
+    prep = preparation("paper", particles=30, shape="pentagon", seed=0)
+    _simulate(prep, folder / "pentagons.nc", test=BiaxialTest(strain=0.004, every=10, velocity=0.01),
+              near_contacts=True, overwrite=False, progress=False, parameters={})
+    return folder
+
+
+def _values(path, name):
+    with netCDF4.Dataset(path) as nc:
+        values = nc[name][:]
+    return np.ma.filled(values, np.nan) if values.dtype.kind == "f" else np.ma.filled(values, -1)
+
+
+def test_resheared_at_the_same_speed_is_the_study_file_again(study, tmp_path):
+    reshear = load_benchmark("fidelity.reshear")
+    assert reshear.reshear(study, tmp_path, "pentagons", velocity=0.01, every=10, domains=None) == "started"
+    for name in VARIABLES:
+        assert np.array_equal(_values(study / "pentagons.nc", name), _values(tmp_path / "pentagons.nc", name),
+                              equal_nan=True), name
+    assert reshear.reshear(study, tmp_path, "pentagons", velocity=0.01, every=10, domains=None) == "finished"
+
+
+def test_resheared_at_another_speed_starts_from_the_same_state(study, tmp_path):
+    reshear = load_benchmark("fidelity.reshear")
+    reshear.reshear(study, tmp_path, "pentagons", velocity=0.02, every=5, domains=None)
+    new, old = tmp_path / "pentagons.nc", study / "pentagons.nc"
+    for name in ("position", "normal_impulse", "wall_position"):
+        assert np.array_equal(_values(new, name)[0], _values(old, name)[0], equal_nan=True), name
+    with netCDF4.Dataset(new) as nc:
+        assert nc.getncattr("wall_velocity_m_s") == 0.02
+        assert nc.getncattr("resheared_from_velocity_m_s") == 0.01
+        assert nc.getncattr("resheared_from") == str(old)
+        steps = nc["step"][:]
+    # twice the speed, the same strain: half the steps of the study's test
+    assert steps[-1] - steps[0] == (_values(old, "step")[-1] - _values(old, "step")[0] + 1) // 2
+
+
+def test_an_unfinished_source_is_refused(tmp_path):
+    reshear = load_benchmark("fidelity.reshear")
+    with pytest.raises(SystemExit, match="is not a finished test"):
+        reshear.reshear(tmp_path, tmp_path / "out", "pentagons", velocity=0.01, every=10, domains=None)
