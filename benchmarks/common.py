@@ -152,13 +152,35 @@ def way_of_solving(row: dict) -> str:
     return how + (f", stall {stall}" if stall else "") + (f", {domains} domains" if domains > 1 else "")
 
 
+NOTES_MARKER = "<!-- notes: written by hand, kept when the benchmark rewrites this file -->"
+"""The line of a results file below which its text is a person's (what the numbers say, a
+second run by hand, the targets): :func:`write_text_keeping_notes` keeps it."""
+
+
+def write_text_keeping_notes(path: str, text: str) -> str:
+    """Write a results file's generated ``text`` to ``path``, keeping what the file it replaces
+    holds from :data:`NOTES_MARKER` on (a person's notes; they may now speak of older numbers,
+    so a line on stdout says so). Returns what was written."""
+    notes = ""
+    if os.path.exists(path):
+        with open(path) as fh:
+            old = fh.read()
+        if NOTES_MARKER in old:
+            notes = old[old.index(NOTES_MARKER):]
+            print(f"{path}: the notes below its marker were kept; check that they still match the new numbers")
+    whole = text.rstrip("\n") + "\n\n" + notes if notes else text
+    with open(path, "w") as fh:
+        fh.write(whole)
+    return whole
+
+
 def write_results(path: str, title: str, intro: str, sections: list) -> str:
     """Write a RESULTS-*.md file: the ``title``, the ``intro`` paragraph, the machine
-    description and the ``sections``, each followed by a blank line; print it and return it."""
+    description and the ``sections``, each followed by a blank line, then the notes of the file
+    it replaces (:func:`write_text_keeping_notes`); print the generated text and return it."""
     text = "\n".join([f"# {title}", "", intro, "", machine_description(), ""] + [line for section in sections
                                                                                for line in (section, "")])
-    with open(path, "w") as f:
-        f.write(text)
+    write_text_keeping_notes(path, text)
     print(text)
     return text
 
@@ -177,5 +199,4 @@ def run_and_record(description: str, run, results_name: str, argv=None) -> None:
     text = run(quick=quick)
     print(text)
     if not quick:
-        with open(os.path.join(os.path.dirname(os.path.abspath(__file__)), results_name), "w") as fh:
-            fh.write(text)
+        write_text_keeping_notes(os.path.join(os.path.dirname(os.path.abspath(__file__)), results_name), text)

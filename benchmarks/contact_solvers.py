@@ -551,13 +551,14 @@ if __name__ == "__main__":
         profile(found)
         print(table(found))
         if args.out:
-            from benchmarks.common import machine_description
+            from benchmarks.common import machine_description, write_text_keeping_notes
 
-            with open(args.out, "w") as fh:
-                fh.write("\n".join([
-                    "# Problem-level methods: NLGS, semi-smooth Newton, projected conjugate gradient", "",
-                    "Written by `python -m benchmarks.contact_solvers` (its docstring gives the problems and the "
-                    "method). Time and iterations of each method to a natural-map residual of 1e-4 and 1e-8, or the "
-                    "best it reaches.", "", machine_description(), "", table(found), "",
-                    f"![performance profiles]({os.path.relpath(FIGURE, os.path.dirname(os.path.abspath(args.out)))})",
-                    ""]))
+            write_text_keeping_notes(args.out, "\n".join([
+                "# Problem-level methods: NLGS, semi-smooth Newton, projected conjugate gradient", "",
+                "Written by `python -m benchmarks.contact_solvers` (its docstring gives the problems and the "
+                "method). Time and iterations of each method to a natural-map residual of 1e-4 and 1e-8, or the "
+                "best it reaches. Each cell: iterations (NLGS sweeps, Newton steps, CG iterations), seconds. \"not "
+                "reached\": where the method stopped (its cap or its stall test), with the residual it ended at.", "",
+                machine_description(), "", table(found), "",
+                f"![performance profiles]({os.path.relpath(FIGURE, os.path.dirname(os.path.abspath(args.out)))})",
+                ""]))

@@ -65,3 +65,18 @@ def test_an_unknown_section_is_refused_in_one_line():
     assert done.returncode == 2 and done.stdout == ""
     last = done.stderr.strip().splitlines()[-1]
     assert "unknown section(s) nope" in last and "scaling" in last
+
+
+def test_a_rewritten_results_file_keeps_the_notes_below_its_marker(tmp_path, capsys):
+    """What a person wrote below the notes marker survives the benchmark's rewrite; a file
+    without the marker is replaced whole; a new file is just the generated text."""
+    from benchmarks.common import NOTES_MARKER, write_text_keeping_notes
+
+    path = tmp_path / "results.md"
+    assert write_text_keeping_notes(str(path), "# new\n\n| a |\n") == "# new\n\n| a |\n"
+    path.write_text(f"# old\n\n| b |\n\n{NOTES_MARKER}\n\n## What the numbers say\n\nhand-written\n")
+    whole = write_text_keeping_notes(str(path), "# new\n\n| c |\n")
+    assert whole == path.read_text() == f"# new\n\n| c |\n\n{NOTES_MARKER}\n\n## What the numbers say\n\nhand-written\n"
+    assert "notes below its marker were kept" in capsys.readouterr().out
+    path.write_text("# old, no marker\n\nnot kept\n")
+    assert write_text_keeping_notes(str(path), "# new\n") == path.read_text() == "# new\n"
