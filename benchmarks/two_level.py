@@ -7,6 +7,9 @@ the problems of benchmarks/contact_solvers.py: cycles and seconds to a local-law
     nice -n 10 python -m benchmarks.two_level --out benchmarks/results/two-level.md   # every problem (~15 min)
     nice -n 10 python -m benchmarks.two_level --only "pentagons 1000"                # some, printed only
 
+``--out`` rewrites the generated part of the results file and keeps the notes below its marker
+(benchmarks.common.NOTES_MARKER).
+
 Needs pyamg (``pip install pyamg``) and the problems of benchmarks/contact_solvers.py in
 benchmarks/_data/contact_solvers/ (its docstring says how they are made): Siconos' three 2D
 granular-flow problems from r = 0, and the stepper's pentagon problems at 1000, 4000 and 14,400
@@ -49,9 +52,14 @@ import time
 
 import numpy as np
 
-from benchmarks.common import machine_description, markdown_table
+from benchmarks.common import machine_description, markdown_table, write_text_keeping_notes
 from benchmarks.contact_solvers import problems
 
+TITLE = "A two-level method (TNNMG-style) on the stored contact problems"
+INTRO = ("Written by `python -m benchmarks.two_level --out benchmarks/results/two-level.md` (its docstring gives the "
+         "methods, the caps and how each cell is timed): cycles (NLGS: sweeps) and seconds to a local-law residual of "
+         "1e-4 and 1e-6 from the stored starts, one run per cell; then what the first coarse step is made of on each "
+         "pentagon problem.")
 TARGETS = (1e-4, 1e-6)
 CYCLES = 300
 CONTROL_CYCLES = 2500
@@ -247,9 +255,8 @@ if __name__ == "__main__":
     print(text)
     if args.out:
         head = subprocess.run(["git", "log", "-1", "--format=%h %s"], capture_output=True, text=True).stdout[:80]
-        with open(args.out + ".part", "w") as fh:
-            fh.write("\n".join([machine_description(), "",
-                                f"Load average (1, 5, 15 min) at the start {load[0]:.2f}, {load[1]:.2f}, "
-                                f"{load[2]:.2f}; at the end {load_end[0]:.2f}, {load_end[1]:.2f}, {load_end[2]:.2f}; "
-                                f"{elapsed:.0f} s of wall time. HEAD: {head.strip()}", "", text, ""]))
-        os.replace(args.out + ".part", args.out)
+        write_text_keeping_notes(args.out, "\n".join([
+            f"# {TITLE}", "", INTRO, "", machine_description(), "",
+            f"Load average (1, 5, 15 min) at the start {load[0]:.2f}, {load[1]:.2f}, {load[2]:.2f}; at the end "
+            f"{load_end[0]:.2f}, {load_end[1]:.2f}, {load_end[2]:.2f}; {elapsed:.0f} s of wall time. HEAD: "
+            f"{head.strip()}", "", text, ""]))
