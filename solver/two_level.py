@@ -1,9 +1,9 @@
 """A two-level method for u = W r + q: NLGS sweeps and one multigrid step on the current face.
 
-A truncated nonsmooth Newton multigrid cycle (TNNMG: Gräser & Kornhuber, *Multigrid methods
-for obstacle problems*, J. Comput. Math. 27 (2009) 1-44; Gräser & Sander, *Truncated nonsmooth
-Newton multigrid methods for block-separable minimization problems*, IMA J. Numer. Anal. 39
-(2019) 454-481) inside De Saxcé's fixed point on the shift s, for the 2D frictional contact
+A truncated nonsmooth Newton multigrid cycle (TNNMG: Gräser & Kornhuber, *Truncated nonsmooth
+Newton multigrid methods for convex minimization problems*, Domain Decomposition Methods in
+Science and Engineering XVIII, 2009; Gräser & Sander, arXiv:1709.04992, for block-separable
+problems) inside De Saxcé's fixed point on the shift s, for the 2D frictional contact
 problem of :mod:`solver.contact_problem` (n points, impulses r_k = (r_n, r_t) in N s, W the
 2n x 2n Delassus matrix in s kg-1, q the free velocities in m s-1, Coulomb cones
 K_k = {|r_t| <= mu_k r_n}).
@@ -16,7 +16,8 @@ minimise the convex
 e_n the normal rows (De Saxcé's bipotential: u^ = u + s e_n, K* ∋ u^ ⊥ r ∈ K). One cycle, with
 s from the end of the previous cycle (from the starting impulses for the first):
 
-1. ``pre_sweeps`` NLGS sweeps (:func:`solver.nlgs.solve_matrix`, the exact Coulomb local solve);
+1. ``pre_sweeps`` NLGS sweeps (:func:`solver.nlgs.solve_matrix`, the exact Coulomb local solve;
+   with ``smoother="convex"``, :func:`convex_sweeps`, J's exact local minimiser);
 2. every point classified on the face of K it sits on: *open* (r_n = 0: no free direction),
    *sticking* (|r_t| < mu r_n: both components free), *sliding* (|r_t| = mu r_n: one free
    direction, the cone's edge e = (1, sigma mu), sigma = sign r_t). The free directions are the
@@ -38,7 +39,8 @@ s from the end of the previous cycle (from the starting impulses for the first):
 
 The cycles stop when the local-law residual is within ``tolerance`` or after
 ``max_iterations`` cycles. With ``coarse=False`` steps 2-4 are skipped: a cycle is then
-``pre_sweeps + post_sweeps`` plain sweeps (the control of the experiment).
+``pre_sweeps + post_sweeps`` plain sweeps (the control of the experiment). How it does on the
+stepper's problems, and why: benchmarks/results/two-level.md (``python -m benchmarks.two_level``).
 """
 
 from __future__ import annotations
