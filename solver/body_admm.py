@@ -64,6 +64,13 @@ from grainview.contract.errors import ParameterError
 from .contact_solution import ContactSolution, largest_point_residual, local_law_residual, natural_map_at
 from .residuals import cone_projection
 
+STALL_WINDOW = 100
+"""Iterations over which ``stall_growth`` looks for progress of the best local-law residual."""
+STALL_IMPROVEMENT = 0.1
+"""The fraction by which the best residual must fall over STALL_WINDOW iterations."""
+RHO_RANGE = 1e4
+"""``stall_growth`` takes rho to at most this many times its first value."""
+
 __all__ = ["BodyProblem", "body_problem", "delassus_diagonal", "dual_cone_projection", "local_velocities", "solve"]
 
 
@@ -177,8 +184,8 @@ def _factor(D, A, rho):
 
 
 def solve(H, minv, v_free, bias, mu, tolerance=1e-6, max_iterations=1000, initial=None, *, rho=None,
-          scaling="none", acceleration=True, eta=0.999, shift_every=1, check_every=5, balance_every=10, refactor_ratio=10.0,
-          record=None) -> ContactSolution:
+          scaling="none", acceleration=True, eta=0.999, shift_every=1, check_every=5, balance_every=10,
+          refactor_ratio=10.0, fixed_shift=None, stall_growth=0.0, record=None) -> ContactSolution:
     """Body-space ADMM (module docstring) from the impulses ``initial`` (P, 2) (default 0).
 
     Parameters
@@ -195,6 +202,11 @@ def solve(H, minv, v_free, bias, mu, tolerance=1e-6, max_iterations=1000, initia
     shift_every, check_every, balance_every : how often (iterations) the shift is updated, the
         local-law residual computed and rho balanced (0: never balanced).
     refactor_ratio : rho changes (and D + rho A^T A is factored again) only by more than this factor.
+    fixed_shift : (P,) m s-1, a shift s held for the whole solve instead of mu |u_t| (a probe of
+        the shift's fixed point: s from a solution makes the problem the convex one it solves).
+    stall_growth : when > 0, rho is multiplied by it (and factored again) whenever the best
+        local-law residual has fallen by less than STALL_IMPROVEMENT over STALL_WINDOW iterations
+        since rho last changed, up to RHO_RANGE times its first value (0: never).
     record : a dict to fill with ``checks`` [(iteration, residual, rho, seconds since the call)],
         ``factorisations``,
         ``factor_seconds``, ``rho`` (every value used), ``seconds``.
@@ -240,13 +252,27 @@ def solve(H, minv, v_free, bias, mu, tolerance=1e-6, max_iterations=1000, initia
     # the start: r and the velocities it implies
     u, _ = local_velocities(problem, r)
     shift = np.zeros(2 * points)
-    shift[0::2] = mu * np.abs(u[:, 1])
+    shift[0::2] = root[0::2] * (mu * np.abs(u[:, 1]) if fixed_shift is None else fixed_shift)
     xi = r.reshape(-1) / (rho * root)
     z = root * u.reshape(-1) + shift
     zn, zt = np.empty(points), np.empty(points)
     z_hat, xi_hat, z_prev, xi_prev = z.copy(), xi.copy(), z.copy(), xi.copy()
     tau, e_prev = 1.0, np.inf
-    iterations = 0
+    iterations, changed, bests = 0, 0, []
+
+    def _new_rho(value):
+        """rho = value, D + rho A^T A factored again, xi rescaled (r unchanged), momentum reset."""
+        nonlocal xi, xi_hat, xi_prev, tau, e_prev
+        factor = rho / value
+        xi, xi_hat, xi_prev = xi * factor, xi_hat * factor, xi_prev * factor
+        clock = time.perf_counter()
+        factored = _factor(D, A, value)
+        record["factor_seconds"] += time.perf_counter() - clock
+        record["factorisations"] += 1
+        record["rho"].append(float(value))
+        tau, e_prev = 1.0, np.inf
+        return float(value), factored
+
     for iterations in range(1, int(max_iterations) + 1):
         y = lu.solve(rho * (A.T @ (z_hat + xi_hat - c - shift)))
         Ay = A @ y
@@ -272,7 +298,7 @@ def solve(H, minv, v_free, bias, mu, tolerance=1e-6, max_iterations=1000, initia
         else:
             z_prev, xi_prev, z, xi = z, xi, z_new, xi_new
             z_hat, xi_hat = z, xi
-        if shift_every and iterations % shift_every == 0:
+        if fixed_shift is None and shift_every and iterations % shift_every == 0:
             shift[0::2] = mu * np.abs(z[1::2])
         if check_every and iterations % check_every == 0:
             impulse = (rho * root * xi).reshape(points, 2)
@@ -284,6 +310,12 @@ def solve(H, minv, v_free, bias, mu, tolerance=1e-6, max_iterations=1000, initia
                 best, best_r = law, impulse
             if best <= tolerance:
                 break
+            bests.append((iterations, best))
+            earlier = [b for it, b in bests if it <= iterations - STALL_WINDOW and it >= changed]
+            if (stall_growth and earlier and best > (1.0 - STALL_IMPROVEMENT) * earlier[-1]
+                    and rho * stall_growth <= RHO_RANGE * record["rho"][0]):
+                rho, lu = _new_rho(rho * stall_growth)
+                changed = iterations
         if balance_every and iterations % balance_every == 0:
             scale_primal = max(np.linalg.norm(Ay), np.linalg.norm(z_new), np.linalg.norm(c + shift), 1e-300)
             dual = rho * (A.T @ (z_new - z_prev))
@@ -293,15 +325,8 @@ def solve(H, minv, v_free, bias, mu, tolerance=1e-6, max_iterations=1000, initia
             ratio = 1.0 if max(primal_rel, dual_rel) < 1e-13 else primal_rel / max(dual_rel, 1e-300)
             suggested = rho * float(np.clip(np.sqrt(ratio), 1e-2, 1e2))
             if suggested > refactor_ratio * rho or suggested < rho / refactor_ratio:
-                for vector in (xi, xi_hat, xi_prev):
-                    vector *= rho / suggested
-                rho = float(suggested)
-                clock = time.perf_counter()
-                lu = _factor(D, A, rho)
-                record["factor_seconds"] += time.perf_counter() - clock
-                record["factorisations"] += 1
-                record["rho"].append(rho)
-                tau, e_prev = 1.0, np.inf
+                rho, lu = _new_rho(suggested)
+                changed = iterations
     return _solution(problem, best_r, iterations, best <= tolerance, record, start)
 
 
