@@ -115,6 +115,8 @@ SECTIONS = (
             ("--build", "--particles", "1000", "--serial", "--steps", "3000")),
     Section("contact-solvers", "contact_solvers", "the problem-level methods (nlgs, newton, pcg) on Siconos' and "
             "the stepper's problems", ()),
+    Section("proximal", "proximal", "a proximal-point loop around the semi-smooth Newton, and ADMM and interior-point "
+            "probes, on the same problems", ()),
     Section("parallel", "parallel", "one sweep and 300 steps of a fixed problem on 2 domains", (), ("--quick",)),
     Section("compaction", "compaction", "the compaction routes: steps, sweeps, time and the state reached",
             ("--particles", "1000", "--seeds", "0,1,2", "--routes", "paper,fast", "--acceleration", "anderson",

@@ -1,7 +1,8 @@
 """Proximal-point steps around the semi-smooth Newton (solver.proximal_newton, Siconos' PROX) on
 the problems of benchmarks/contact_solvers.py, and two zero-code probes of other families on
 the pentagon problems: ADMM (OSQP) and an interior point method (Clarabel) on the convex
-problem of De Saxcé's fixed point. Written to results/proximal.md (its prose by hand).
+problem of De Saxcé's fixed point. Written to results/proximal.md; the notes below its marker
+(benchmarks.common.NOTES_MARKER) are by hand and kept when the file is rewritten.
 
     nice -n 10 python -m benchmarks.proximal --out benchmarks/results/proximal.md   # everything (~15 min)
     nice -n 10 python -m benchmarks.proximal --only "pentagons 1000" --no-probes    # some problems, printed
@@ -214,7 +215,7 @@ def probe(name, W, q, mu, initial):
                 solver_.warm_start(x=x)
             else:
                 solver_.update(q=c)
-            result = solver_.solve()
+            result = solver_.solve(raise_error=False)  # a time limit reached is a status, not an error
             x, iterations, status = np.asarray(result.x), int(result.info.iter), str(result.info.status)
         else:
             settings = module.DefaultSettings()
@@ -310,7 +311,9 @@ def probe_table(rows):
 
 
 def write(rows, path):
-    from benchmarks.common import machine_description
+    """The results file of ``rows`` at ``path``, the notes below its marker kept
+    (benchmarks.common.NOTES_MARKER)."""
+    from benchmarks.common import machine_description, write_text_keeping_notes
 
     prox = [r for r in rows if r.get("kind") == "prox"]
     probes = [r for r in rows if r.get("kind") == "probe"]
@@ -319,9 +322,7 @@ def write(rows, path):
             "measured).", "", machine_description(), "", "## PROX", "", prox_table(prox), "", nlgs_table(prox), "",
             "Residual of every centre (`*`: the inner Newton did not converge):", "", histories(prox), "",
             "## Probes", "", probe_table(probes), ""]
-    with open(path + ".part", "w") as fh:
-        fh.write("\n".join(text))
-    os.replace(path + ".part", path)
+    write_text_keeping_notes(path, "\n".join(text))
 
 
 def warm_up():
