@@ -108,7 +108,9 @@ class _CountingLinalg:
 @contextmanager
 def _counted_factorisations():
     """Within the block, :mod:`solver.nonsmooth_newton` factorises through a
-    :class:`_CountingLinalg` (yielded); its own module restored after."""
+    :class:`_CountingLinalg` (yielded); its own module restored after. The module attribute is
+    swapped for the block, so a Newton solve run at the same time in another thread of the
+    process would be counted too (the solvers here run one at a time)."""
     counter, saved = _CountingLinalg(), nonsmooth_newton.splinalg
     nonsmooth_newton.splinalg = counter
     try:
