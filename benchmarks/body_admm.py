@@ -8,6 +8,8 @@ rho each used.
     nice -n 10 python -m benchmarks.body_admm --build-from /tmp/p4000.nc --index 2   # --particles 4000 --velocity 0.032 --strain 0.004
     nice -n 10 python -m benchmarks.body_admm --build-from /work/runs/paper_size/pentagons.nc --index 2   # only read
     nice -n 10 python -m benchmarks.body_admm --out benchmarks/results/body-admm.md
+    nice -n 10 python -m benchmarks.body_admm --spectrum   # W's spectrum on the closed face, 1000 #1
+    nice -n 10 python -m benchmarks.body_admm --spectrum "pentagons 4000 #1"   # (a minute, 2 GiB)
 
 The problems (benchmarks/_data/body_space/pentagon_<particles>.pkl, ignored by git): from
 snapshot ``--index`` of a biaxial test's file (:func:`solver.load_sample`, the file only read),
@@ -261,6 +263,29 @@ def probe(label, entry, reference):
     return out
 
 
+def spectrum(label="pentagons 1000 #1"):
+    """Print the eigenvalues sigma of W on the closed face of the NLGS's best solution of the
+    problem ``label`` (the normal rows of its loaded points, the tangential rows of its sticking
+    ones; dense, so for the 1000-particle problems), as rho sigma with rho the ADMM's default:
+    near a solution the ADMM's multipliers on that face contract by 1 / (1 + rho sigma) per
+    iteration (on a face of equalities the ADMM is the augmented-Lagrangian, proximal-point
+    iteration on the impulses, and A (D + rho A^T A)^-1 rho A^T = rho W (I + rho W)^-1)."""
+    entry = dict(problems())[label]
+    W, q, mu = entry["W"], entry["q"], entry["mu"]
+    _, reference = nlgs_run(W, q, mu, entry["initial"])
+    loaded = reference[:, 0] > 0
+    sticking = loaded & (np.abs(reference[:, 1]) < mu * reference[:, 0] * (1 - 1e-9))
+    rows = np.sort(np.concatenate([2 * np.nonzero(loaded)[0], 2 * np.nonzero(sticking)[0] + 1]))
+    sigma = np.linalg.eigvalsh(W[rows][:, rows].toarray())
+    rho = float(np.median(1.0 / W.diagonal()[0::2]))
+    print(f"{label}: {mu.size} points, {loaded.sum()} loaded ({sticking.sum()} sticking), "
+          f"{entry['H'].shape[1] // 3} bodies; face rows {rows.size}; rho {rho:.3g} kg; rho sigma_max "
+          f"{rho * sigma[-1]:.3g}; smallest rho sigma above 1e-12: {rho * sigma[rho * sigma > 1e-12][:3]}")
+    for bound in (1e-12, 1e-6, 1e-4, 1e-3, 1e-2, 1e-1):
+        print(f"  rho sigma < {bound:g}: {int(np.sum(rho * sigma < bound))} eigenvalues "
+              f"(a mode at {bound:g} loses a decade in {np.log(10) / np.log1p(bound):.3g} iterations)")
+
+
 def _cell(reach, cap_words):
     return f"{reach[0]}, {reach[1]:.3g} s" if reach else f"not reached ({cap_words})"
 
@@ -327,9 +352,15 @@ if __name__ == "__main__":
     parser.add_argument("--only", metavar="LABELS", help="the problems whose label starts with one of these "
                         "(comma-separated, e.g. 'pentagons 1000')")
     parser.add_argument("--out", help="write the tables here (Markdown)")
+    parser.add_argument("--spectrum", nargs="?", const="pentagons 1000 #1", metavar="LABEL",
+                        help="print W's spectrum on the closed face of one problem (spectrum(); default "
+                        "%(const)s; dense: 4000 takes a minute and 2 GiB)")
     args = parser.parse_args()
     if args.build_from:
         capture(args.build_from, args.index)
+        raise SystemExit(0)
+    if args.spectrum:
+        spectrum(args.spectrum)
         raise SystemExit(0)
     from benchmarks.common import machine_description, write_text_keeping_notes
 
