@@ -207,15 +207,16 @@ def solve(H, minv, v_free, bias, mu, tolerance=1e-6, max_iterations=1000, initia
     stall_growth : when > 0, rho is multiplied by it (and factored again) whenever the best
         local-law residual has fallen by less than STALL_IMPROVEMENT over STALL_WINDOW iterations
         since rho last changed, up to RHO_RANGE times its first value (0: never).
-    record : a dict to fill with ``checks`` [(iteration, residual, rho, seconds since the call)],
-        ``factorisations``,
-        ``factor_seconds``, ``rho`` (every value used), ``seconds``.
+    record : a dict to fill with ``checks`` [(iteration, local-law residual, rho, seconds since
+        the call)], ``admm`` [(iteration, |A y + c + s e_n - z| / |c + s e_n|, |z - z_prev| / |z|)]
+        at the same iterations, ``factorisations``, ``factor_seconds``, ``rho`` (every value
+        used), ``seconds``.
 
     Returns
     -------
     ContactSolution: the impulses (best residual seen), their local velocities W r + q,
-    iterations, residual and local_law_residual both the local-law residual, converged when
-    within ``tolerance``.
+    iterations, residual and local_law_residual both the local-law residual, max_residual
+    :func:`solver.contact_solution.largest_point_residual`, converged when within ``tolerance``.
     """
     from scipy import sparse
 

@@ -122,14 +122,13 @@ def test_the_warm_start_is_kept_when_it_solves_the_problem():
 
 
 def test_the_dual_cone_projection_is_moreaus_complement_of_the_cones():
-    # K* of mu = 0.5 is {|t| <= 2 n}: a point inside stays, one in -K goes to 0, one beyond
-    # the edge goes to its nearest point on the edge (1, 2)/sqrt(5) direction.
+    # K* of mu = 0.5 is {|t| <= 2 n}, its edges along e = (1, +-2) / sqrt(5): (1, 1) is inside and
+    # stays; (-1, 0.1) is in -K (|t| <= 0.5 |n|) and goes to 0; (0, 1) goes to (w . e) e =
+    # (2 / 5) (1, 2); (1, -3) to (7 / 5) (1, -2).
     wn, wt, mu = np.array([1.0, -1.0, 0.0, 1.0]), np.array([1.0, 0.1, 1.0, -3.0]), np.full(4, 0.5)
     zn, zt = np.empty(4), np.empty(4)
     body_admm.dual_cone_projection(wn, wt, mu, zn, zt)
-    edge = np.array([1.0, 2.0]) / np.sqrt(5.0)
-    expected = [[1.0, 1.0], [0.0, 0.0], edge * (np.array([0.0, 1.0]) @ edge),
-                [1.0, -2.0] * np.array([1.0, 1.0]) / 5.0 * (1.0 + 6.0)]
+    expected = [[1.0, 1.0], [0.0, 0.0], [0.4, 0.8], [1.4, -2.8]]
     np.testing.assert_allclose(np.stack([zn, zt], -1), expected, atol=1e-12)
 
 
