@@ -211,7 +211,7 @@ def measure(found):
     and every ADMM variant on every problem of ``found``; probes {problem, kind, setting, reach,
     best} on the first problem of each size."""
     rows, probes = [], []
-    admm_run(problems()[0][1] if problems() else found[0][1], cap=5)  # compile the projection off the record
+    admm_run(found[0][1], cap=5)  # compile or load the projection's kernel off the record
     for label, entry in found:
         W, q, mu = entry["W"], entry["q"], entry["mu"]
         trajectory, best_impulse = nlgs_run(W, q, mu, entry["initial"])
