@@ -117,6 +117,8 @@ SECTIONS = (
             "the stepper's problems", ()),
     Section("proximal", "proximal", "a proximal-point loop around the semi-smooth Newton, and ADMM and interior-point "
             "probes, on the same problems", ()),
+    Section("body-admm", "body_admm", "ADMM in body space (M + rho H^T H) against the NLGS on the stepper's problems "
+            "at 1000, 4000, 14,400 pentagons", ()),
     Section("parallel", "parallel", "one sweep and 300 steps of a fixed problem on 2 domains", (), ("--quick",)),
     Section("compaction", "compaction", "the compaction routes: steps, sweeps, time and the state reached",
             ("--particles", "1000", "--seeds", "0,1,2", "--routes", "paper,fast", "--acceleration", "anderson",
