@@ -115,6 +115,8 @@ SECTIONS = (
             ("--build", "--particles", "1000", "--serial", "--steps", "3000")),
     Section("contact-solvers", "contact_solvers", "the problem-level methods (nlgs, newton, pcg) on Siconos' and "
             "the stepper's problems", ()),
+    Section("two-level", "two_level", "a two-level method (NLGS sweeps + an AMG V-cycle on the truncated face, "
+            "TNNMG-style; needs pyamg) against the NLGS on the same problems", ()),
     Section("proximal", "proximal", "a proximal-point loop around the semi-smooth Newton, and ADMM and interior-point "
             "probes, on the same problems", ()),
     Section("body-admm", "body_admm", "ADMM in body space (M + rho H^T H) against the NLGS on the stepper's problems "
