@@ -85,9 +85,11 @@ def jacobian(W, mu, zn, zt, rho_n, rho_t):
     return (dr + du @ W).tocsc()
 
 
-def solve(W, q, mu, tolerance, max_iterations, initial) -> ContactSolution:
+def solve(W, q, mu, tolerance, max_iterations, initial, counts: dict | None = None) -> ContactSolution:
     """Semi-smooth Newton iterations (module docstring) from the impulses ``initial`` (n, 2)
-    until the local-law residual is within ``tolerance`` or ``max_iterations`` Newton steps."""
+    until the local-law residual is within ``tolerance`` or ``max_iterations`` Newton steps.
+    ``counts``: a dict whose ``"factorisations"`` entry is increased by each sparse LU
+    factorisation made (one a step, more where the Jacobian had to be regularised)."""
     diagonal = W.diagonal()
     rho_n, rho_t = 1.0 / diagonal[0::2], 1.0 / np.where(diagonal[1::2] > 0, diagonal[1::2], diagonal[0::2])
     r = np.array(initial, dtype=np.float64).reshape(-1, 2)
@@ -101,6 +103,8 @@ def solve(W, q, mu, tolerance, max_iterations, initial) -> ContactSolution:
         step = None
         while step is None and level < len(REGULARISATIONS):
             regularised = W + REGULARISATIONS[level] * sparse.diags(diagonal) if level else W
+            if counts is not None:
+                counts["factorisations"] = counts.get("factorisations", 0) + 1
             try:
                 direction = splinalg.splu(jacobian(regularised, mu, zn, zt, rho_n, rho_t)).solve(-F.reshape(-1))
             except RuntimeError:  # exactly singular: regularise more

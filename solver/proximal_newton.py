@@ -32,12 +32,10 @@ algorithm*, SIAM J. Control Optim. 14 (1976) 877-898.
 from __future__ import annotations
 
 import time
-from contextlib import contextmanager
 from typing import NamedTuple
 
 import numpy as np
 from scipy import sparse
-from scipy.sparse import linalg as splinalg
 
 from grainview.contract.errors import ParameterError
 
@@ -89,34 +87,6 @@ class ProximalHistory(NamedTuple):
     def total_factorisations(self) -> int:
         """The sparse LU factorisations of the whole solve."""
         return int(sum(self.factorisations))
-
-
-class _CountingLinalg:
-    """``scipy.sparse.linalg`` whose ``splu`` counts its calls (the inner Newton's factorisations)."""
-
-    def __init__(self):
-        self.factorisations = 0
-
-    def splu(self, *args, **kwargs):
-        self.factorisations += 1
-        return splinalg.splu(*args, **kwargs)
-
-    def __getattr__(self, name):
-        return getattr(splinalg, name)
-
-
-@contextmanager
-def _counted_factorisations():
-    """Within the block, :mod:`solver.nonsmooth_newton` factorises through a
-    :class:`_CountingLinalg` (yielded); its own module restored after. The module attribute is
-    swapped for the block, so a Newton solve run at the same time in another thread of the
-    process would be counted too (the solvers here run one at a time)."""
-    counter, saved = _CountingLinalg(), nonsmooth_newton.splinalg
-    nonsmooth_newton.splinalg = counter
-    try:
-        yield counter
-    finally:
-        nonsmooth_newton.splinalg = saved
 
 
 def _check(alpha, grow, shrink, inner_steps, max_factorisations):
@@ -176,11 +146,11 @@ def solve_recorded(W, q, mu, tolerance, max_iterations, initial, *, alpha=ALPHA,
         W_k = (W + alpha * D).tocsr()
         W_k.sort_indices()
         q_k = q - alpha * (weights * r.reshape(-1))
-        with _counted_factorisations() as counter:
-            inner = nonsmooth_newton.solve(W_k, q_k, mu, inner_tolerance, int(inner_steps), r)
+        counts = {"factorisations": 0}
+        inner = nonsmooth_newton.solve(W_k, q_k, mu, inner_tolerance, int(inner_steps), r, counts=counts)
         alphas.append(alpha)
         steps.append(inner.iterations)
-        lus.append(counter.factorisations)
+        lus.append(counts["factorisations"])
         converged.append(inner.converged)
         tolerances.append(inner_tolerance)
         r = inner.impulse
