@@ -157,17 +157,22 @@ def local_measures(W, q, mu, impulse, previous):
             "velocity change": np.sqrt(max(change, 0.0) / spent) if spent > 0 else float("inf")}
 
 
+def _ratio(value, scale):
+    """value / scale; at scale 0, 0 for a value 0 and infinite otherwise."""
+    return value / scale if scale > 0 else (0.0 if value == 0 else float("inf"))
+
+
 def errors(W, impulse, reference, scales, split):
     """{velocity, velocity / speed, impulse, moving part, self-stress part} of impulses
     ``impulse`` (P, 2) against ``reference`` (module docstring), each over its scale
     (:class:`Scales`)."""
     dr = (impulse - reference).reshape(-1)
     moving = split.moving(dr)
-    velocity = np.sqrt(max(energy(W, dr), 0.0))  # |v - v_ref|_M
-    return {"velocity": velocity / scales.change, "velocity / speed": velocity / scales.speed,
-            "impulse": float(np.linalg.norm(dr)) / scales.impulse,
-            "moving part": float(np.linalg.norm(moving)) / scales.impulse,
-            "self-stress part": float(np.linalg.norm(dr - moving)) / scales.impulse}
+    velocity = float(np.sqrt(max(energy(W, dr), 0.0)))  # |v - v_ref|_M
+    return {"velocity": _ratio(velocity, scales.change), "velocity / speed": _ratio(velocity, scales.speed),
+            "impulse": _ratio(float(np.linalg.norm(dr)), scales.impulse),
+            "moving part": _ratio(float(np.linalg.norm(moving)), scales.impulse),
+            "self-stress part": _ratio(float(np.linalg.norm(dr - moving)), scales.impulse)}
 
 
 def _sweeps(matrix, impulse, count):
