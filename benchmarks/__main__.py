@@ -121,6 +121,8 @@ SECTIONS = (
             "probes, on the same problems", ()),
     Section("body-admm", "body_admm", "ADMM in body space (M + rho H^T H) against the NLGS on the stepper's problems "
             "at 1000, 4000, 14,400 pentagons", ()),
+    Section("compliance", "compliance", "a compliant contact law (W + eps diag W): NLGS and pcg to 1e-4 on the stepper's "
+            "problems, and what it changes against the rigid answer", ()),
     Section("parallel", "parallel", "one sweep and 300 steps of a fixed problem on 2 domains", (), ("--quick",)),
     Section("compaction", "compaction", "the compaction routes: steps, sweeps, time and the state reached",
             ("--particles", "1000", "--seeds", "0,1,2", "--routes", "paper,fast", "--acceleration", "anderson",

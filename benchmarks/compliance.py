@@ -4,6 +4,7 @@ compliance changes in the answer against the rigid one (eps = 0).
 
     nice -n 10 python -m benchmarks.compliance --out benchmarks/results/compliance.md
     nice -n 10 python -m benchmarks.compliance --only "pentagons 1000"   # a few problems, printed
+    nice -n 10 python -m benchmarks.compliance --rigid-sinks   # eps W_nn r_n at the rigid answer's impulses
 
 The problems: benchmarks/_data/body_space/pentagon_<particles>.pkl (1000, 4000, 14,400
 pentagons, three steps each; captured by benchmarks/body_admm.py, its docstring), which hold
@@ -319,6 +320,36 @@ def verdict(rows):
     return "\n".join(f"* {w}" for w in words)
 
 
+def energy_share(W, impulse):
+    """r^T W r / r^T D r of the impulses ``impulse`` (n, 2), D = diag(W): the share of W's
+    energy an answer has against the compliance energy per unit eps; an answer whose share is
+    below eps is mostly a self-stress that the law of compliance eps drains."""
+    r = impulse.reshape(-1)
+    return float((r @ (W @ r)) / (r @ (W.diagonal() * r)))
+
+
+def rigid_sinks(found, epsilons=EPSILONS[1:]):
+    """Print, per problem of ``found``, the sink speeds eps W_nn r_n the compliant law would admit
+    at the rigid answer's normal impulses (the NLGS from the warm start to TARGET): the
+    interpenetration per step once the walls have brought the load back (median, 99th
+    percentile and largest over the closed points, m/s, and times TIME_STEP, m), and the rigid
+    answer's share of W's energy r^T W r / r^T D r (D = diag W; a share below eps is a
+    self-stress the compliant law drains)."""
+    warm_up()
+    for label, entry in found:
+        W, q, mu = entry["W"], entry["q"], entry["mu"]
+        _, _, rigid = nlgs_run(W, q, mu, entry["initial"], stop=TARGET)
+        share = energy_share(W, rigid)
+        rn = rigid[:, 0]
+        speed = W.diagonal()[0::2][rn > 0] * rn[rn > 0]
+        quantiles = np.quantile(speed, [0.5, 0.99, 1.0])
+        print(f"{label}: r^T W r / r^T D r = {share:.2e}; W_nn r_n over {speed.size} closed points: median, 99%, max "
+              f"{', '.join(f'{x:.3g}' for x in quantiles)} m/s", flush=True)
+        for eps in epsilons:
+            print(f"  eps {eps:g}: sink {', '.join(f'{eps * x:.2e}' for x in quantiles)} m/s, per step "
+                  f"{', '.join(f'{eps * x * TIME_STEP:.2e}' for x in quantiles)} m", flush=True)
+
+
 TITLE = "A compliant contact law (W + eps diag W) on the stepper's pentagon problems: speed and what it changes"
 INTRO = ("Written by `python -m benchmarks.compliance --out benchmarks/results/compliance.md` (its docstring gives "
          "the problems, the caps and every measure): for each eps, the NLGS (sweeps) and the projected conjugate "
@@ -333,6 +364,8 @@ if __name__ == "__main__":
     parser.add_argument("--only", metavar="LABELS", help="the problems whose label starts with one of these "
                         "(comma-separated, e.g. 'pentagons 1000')")
     parser.add_argument("--out", help="write the tables here (Markdown)")
+    parser.add_argument("--rigid-sinks", action="store_true", help="print the sink speeds at the rigid answer's "
+                        "impulses (rigid_sinks()) and stop")
     args = parser.parse_args()
     from benchmarks.common import machine_description, write_text_keeping_notes
 
@@ -343,6 +376,9 @@ if __name__ == "__main__":
     if not found:
         raise SystemExit(f"no problem in {DATA} (capture them first: python -m benchmarks.body_admm --build-from FILE)"
                          + (f" whose label starts with {args.only}" if args.only else ""))
+    if args.rigid_sinks:
+        rigid_sinks(found)
+        raise SystemExit(0)
     load = os.getloadavg()
     start = time.perf_counter()
     rows = measure(found)

@@ -76,6 +76,9 @@ def test_two_stacked_bodies_match_the_hand_computed_impulses_and_changes():
     assert got["ks"] == 0.5
     # rigid law: F_k = rho_k (-u_k) = rho_k eps W_nn,k r_n,k = eps r_n,k on each closed, sticking point
     assert got["rigid_law"] == pytest.approx(EPS, rel=1e-9)
+    # share of W's energy of the rigid answer (3, 0, 2, 0): normal block [[1, -1], [-1, 1.5]] gives
+    # r^T W r = 9 - 12 + 6 = 3 and r^T D r = 9 + 1.5 x 4 = 15
+    assert bench.energy_share(entry["W"], reference) == pytest.approx(3.0 / 15.0, rel=1e-9)
 
 
 def test_the_verdict_names_the_smallest_eps_that_is_flat_and_few():
