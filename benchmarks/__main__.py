@@ -123,6 +123,8 @@ SECTIONS = (
             "at 1000, 4000, 14,400 pentagons", ()),
     Section("compliance", "compliance", "a compliant contact law (W + eps diag W): NLGS and pcg to 1e-4 on the stepper's "
             "problems, and what it changes against the rigid answer", ()),
+    Section("stopping-rule", "stopping_rule", "what a step needs (body velocities, sign conditions) against what the "
+            "NLGS's stopping test tracks, sweep by sweep, on the stepper's problems at 1000, 4000, 14,400 pentagons", ()),
     Section("parallel", "parallel", "one sweep and 300 steps of a fixed problem on 2 domains", (), ("--quick",)),
     Section("compaction", "compaction", "the compaction routes: steps, sweeps, time and the state reached",
             ("--particles", "1000", "--seeds", "0,1,2", "--routes", "paper,fast", "--acceleration", "anderson",
