@@ -8,7 +8,7 @@ solutions of the same problem are.
 
     nice -n 10 python -m benchmarks.stopping_rule --only "pentagons 1000"      # 2 minutes
     nice -n 10 python -m benchmarks.stopping_rule --only "pentagons 1000 #1" --sweeps 4000   # seconds
-    nice -n 10 python -m benchmarks.stopping_rule --out benchmarks/results/stopping-rule.md  # ~35 min, 1 GiB
+    nice -n 10 python -m benchmarks.stopping_rule --out benchmarks/results/stopping-rule.md  # ~35 min
 
 The problems: benchmarks/_data/body_space/pentagon_<N>.pkl (``python -m benchmarks.body_admm
 --build-from ...`` captures them: H, M^-1, v_free, the Signorini shifts, mu, the warm start the
