@@ -200,7 +200,8 @@ def solve(H, minv, v_free, bias, mu, tolerance=1e-6, max_iterations=1000, initia
         (the cones are unchanged by a positive factor per point; r = rho sqrt(omega) xi).
     acceleration : Nesterov extrapolation with restart (step 5), ``eta`` its restart factor.
     shift_every, check_every, balance_every : how often (iterations) the shift is updated, the
-        local-law residual computed and rho balanced (0: never balanced).
+        local-law residual computed (>= 1: it is the stopping test) and rho balanced (0: never
+        updated, never balanced).
     refactor_ratio : rho changes (and D + rho A^T A is factored again) only by more than this factor.
     fixed_shift : (P,) m s-1, a shift s held for the whole solve instead of mu |u_t| (a probe of
         the shift's fixed point: s from a solution makes the problem the convex one it solves).
@@ -226,7 +227,21 @@ def solve(H, minv, v_free, bias, mu, tolerance=1e-6, max_iterations=1000, initia
     if not (np.isfinite(tolerance) and tolerance > 0) or int(max_iterations) < 1:
         raise ParameterError(f"tolerance={tolerance!r}, max_iterations={max_iterations!r}: expected a positive "
                              "tolerance and at least one iteration")
-    r = np.zeros((points, 2)) if initial is None else np.array(initial, dtype=np.float64).reshape(points, 2)
+    if rho is not None and not (np.isfinite(rho) and rho > 0):
+        raise ParameterError(f"rho={rho!r}: expected a finite penalty > 0 (kg), or None for the default")
+    if int(check_every) < 1 or int(shift_every) < 0 or int(balance_every) < 0:
+        raise ParameterError(f"check_every={check_every!r}, shift_every={shift_every!r}, "
+                             f"balance_every={balance_every!r}: expected check_every >= 1 (the residual is the "
+                             "stopping test) and the others >= 0")
+    r = np.zeros((points, 2)) if initial is None else np.array(initial, dtype=np.float64)
+    if r.size != 2 * points or not np.all(np.isfinite(r)):
+        raise ParameterError(f"initial must hold 2 finite impulses per point ({2 * points} values), got {r.size}")
+    r = r.reshape(points, 2)
+    if fixed_shift is not None:
+        fixed_shift = np.asarray(fixed_shift, dtype=np.float64).reshape(-1)
+        if fixed_shift.size != points or not np.all(np.isfinite(fixed_shift)):
+            raise ParameterError(f"fixed_shift must hold one finite shift per point ({points} values), got "
+                                 f"{fixed_shift.size}")
     record = {} if record is None else record
     record.update(checks=[], admm=[], factorisations=0, factor_seconds=0.0, rho=[])
     best, best_r = _law(problem, r)[0], r.copy()

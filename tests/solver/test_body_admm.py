@@ -136,6 +136,11 @@ def test_the_dual_cone_projection_is_moreaus_complement_of_the_cones():
     (dict(minv=sparse.eye(5).tocsr()), "minv has shape (5, 5): expected (6, 6)"),
     (dict(bias=np.zeros(2)), "bias 2: expected 6 (3 per body) and 1 (1 per point)"),
     (dict(minv=sparse.csr_matrix(np.eye(6) + 0.5 * (np.eye(6, k=3) + np.eye(6, k=-3)))), "block diagonal"),
+    (dict(rho=0.0), "rho=0.0: expected a finite penalty > 0"),  # was: no error, the start returned
+    (dict(rho=-1.0), "rho=-1.0: expected a finite penalty > 0"),  # was: SuperLU's 'exactly singular'
+    (dict(initial=np.zeros(3)), "initial must hold 2 finite impulses per point (2 values), got 3"),
+    (dict(fixed_shift=np.zeros(3)), "fixed_shift must hold one finite shift per point (1 values), got 3"),
+    (dict(check_every=0), "expected check_every >= 1"),  # was: never checked, the start returned
 ])
 def test_bad_input_is_refused_in_one_line(change, words):
     arguments = dict(H=H_ONE, minv=MINV_ONE, v_free=np.zeros(6), bias=np.zeros(1), mu=0.5)
