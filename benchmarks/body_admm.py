@@ -201,7 +201,7 @@ def factor_fill(entry, rho=None):
     problem = body_admm.body_problem(entry["H"], entry["minv"], entry["v_free"], entry["bias"], entry["mu"])
     rho = float(np.median(1.0 / problem.wnn)) if rho is None else rho
     start = time.perf_counter()
-    lu = body_admm._factor(problem.D, problem.A, rho)
+    lu = body_admm.factorise(problem.D, problem.A, rho)
     return time.perf_counter() - start, lu.L.nnz + lu.U.nnz, problem.D.size
 
 

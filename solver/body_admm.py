@@ -71,7 +71,8 @@ STALL_IMPROVEMENT = 0.1
 RHO_RANGE = 1e4
 """``stall_growth`` takes rho to at most this many times its first value."""
 
-__all__ = ["BodyProblem", "body_problem", "delassus_diagonal", "dual_cone_projection", "local_velocities", "solve"]
+__all__ = ["BodyProblem", "body_problem", "delassus_diagonal", "dual_cone_projection", "factorise", "local_velocities",
+           "solve"]
 
 
 @njit(cache=True)
@@ -174,8 +175,9 @@ def _law(problem, impulse):
     return local_law_residual(violation, impulse), violation, u
 
 
-def _factor(D, A, rho):
-    """The sparse LU of diag(D) + rho A^T A (scipy's SuperLU, a fill-reducing order of A + A^T)."""
+def factorise(D, A, rho):
+    """The sparse LU of the v-step's matrix diag(D) + rho A^T A (step 1 of the module docstring;
+    D (n,) kg or kg m2, A (2P x n), rho kg): scipy's SuperLU, a fill-reducing order of A + A^T."""
     from scipy import sparse
     from scipy.sparse.linalg import splu
 
@@ -260,7 +262,7 @@ def solve(H, minv, v_free, bias, mu, tolerance=1e-6, max_iterations=1000, initia
         return _solution(problem, best_r, 0, best <= tolerance, record, start)
     rho = float(np.median(1.0 / problem.wnn)) if rho is None else float(rho)
     clock = time.perf_counter()
-    lu = _factor(D, A, rho)
+    lu = factorise(D, A, rho)
     record["factor_seconds"] += time.perf_counter() - clock
     record["factorisations"] += 1
     record["rho"].append(rho)
@@ -282,7 +284,7 @@ def solve(H, minv, v_free, bias, mu, tolerance=1e-6, max_iterations=1000, initia
         factor = rho / value
         xi, xi_hat, xi_prev = xi * factor, xi_hat * factor, xi_prev * factor
         clock = time.perf_counter()
-        factored = _factor(D, A, value)
+        factored = factorise(D, A, value)
         record["factor_seconds"] += time.perf_counter() - clock
         record["factorisations"] += 1
         record["rho"].append(float(value))
