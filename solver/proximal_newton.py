@@ -131,7 +131,13 @@ def solve_recorded(W, q, mu, tolerance, max_iterations, initial, *, alpha=ALPHA,
     weights = diagonal.copy()
     weights[1::2] = np.where(diagonal[1::2] > 0, diagonal[1::2], diagonal[0::2])
     D = sparse.diags(weights, format="csr")
-    r = np.array(initial, dtype=np.float64).reshape(-1, 2)
+    if not (np.isfinite(tolerance) and tolerance > 0) or int(max_iterations) < 1:
+        raise ParameterError(f"tolerance={tolerance!r}, max_iterations={max_iterations!r}: expected a positive "
+                             "tolerance and at least one outer step")
+    r = np.array(initial, dtype=np.float64)
+    if r.size != q.size or not np.all(np.isfinite(r)):
+        raise ParameterError(f"initial must hold 2 finite impulses per point ({q.size} values), got {r.size}")
+    r = r.reshape(-1, 2)
 
     def error(impulse):
         return local_law_residual(natural_map(W, q, mu, impulse)[0], impulse)

@@ -172,3 +172,16 @@ def test_bad_options_are_named(option, value, words):
     W, q, _ = stacked()
     with pytest.raises(ParameterError, match=words):
         prox(W, q, 0.4, **{option: value})
+
+
+@pytest.mark.parametrize("tolerance, max_iterations, initial, words", [
+    (-1.0, 20, np.zeros((2, 2)), "tolerance=-1.0, max_iterations=20: expected a positive tolerance"),  # was: 20 steps
+    (1e-10, 0, np.zeros((2, 2)), "max_iterations=0: expected a positive tolerance and at least one outer step"),
+    (1e-10, 20, np.zeros(3), r"initial must hold 2 finite impulses per point \(4 values\), got 3"),  # was: numpy's
+])
+def test_bad_arguments_are_refused_in_one_line(tolerance, max_iterations, initial, words):
+    W, q, _ = stacked()
+    with pytest.raises(ParameterError, match=words) as caught:
+        proximal_newton.solve(sparse.csr_matrix(np.asarray(W, float)), np.asarray(q, float), np.full(2, 0.4),
+                              tolerance, max_iterations, initial)
+    assert "\n" not in str(caught.value)
