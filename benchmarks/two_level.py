@@ -148,7 +148,7 @@ def diagnose(W, q, mu, initial):
     u = (W @ r.reshape(-1) + q).reshape(n, 2)
     classes = two_level.classify(r, mu)
     basis = two_level.face_basis(classes, mu)
-    A, frozen = two_level._Face(W, 1e-8).matrix(basis)
+    A, frozen = two_level.Face(W, 1e-8).matrix(basis)
     hierarchy = pyamg.smoothed_aggregation_solver(A, B=np.kron(np.ones((n, 1)), np.eye(2)), max_coarse=50)
     gradient = u + np.stack([shift, np.zeros(n)], -1)
     g = np.einsum("kji,kj->ki", basis, gradient).reshape(-1)

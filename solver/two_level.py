@@ -57,7 +57,7 @@ from .contact_solution import ContactSolution, contact_solution, local_law_resid
 from .residuals import cone_projection
 from .solve_records import Impulses, Limits, MatrixProblem
 
-__all__ = ["OPEN", "STICKING", "SLIDING", "CycleRecord", "TwoLevelResult", "classify", "face_basis",
+__all__ = ["OPEN", "STICKING", "SLIDING", "CycleRecord", "Face", "TwoLevelResult", "classify", "face_basis",
            "project_on_cones", "cone_minimiser", "convex_sweeps", "solve", "solve_recorded"]
 
 OPEN, STICKING, SLIDING = 0, 1, 2
@@ -143,9 +143,9 @@ def project_on_cones(z, mu):
     return np.stack([zn, zt], -1)
 
 
-class _Face:
+class Face:
     """W as 2x2 blocks and the truncated matrix T^T W T + D_0 + eps diag of a face (module
-    docstring, step 3), built block by block from W's blocks."""
+    docstring, step 3; s kg-1), built block by block from W's blocks; eps = ``regularisation``."""
 
     def __init__(self, W, regularisation):
         from scipy import sparse
@@ -317,7 +317,7 @@ def solve_recorded(W, q, mu, tolerance, max_iterations, initial, *, coarse=True,
     law = initial_law = residual(u)
     shift = np.zeros(2 * n)
     shift[0::2] = mu * np.abs(u[1::2])
-    face = _Face(W, regularisation) if coarse else None
+    face = Face(W, regularisation) if coarse else None
     near_null = np.kron(np.ones((n, 1)), np.eye(2))
     hierarchy, built_on, builds = None, None, 0
     records = []
