@@ -44,9 +44,9 @@ The quantities, each over its scale:
   orthogonal projection onto range(W) = range(H M^-1/2) (:class:`Split`): (I - P) dr is the part
   of the impulse error that moves no body (null(M^-1 H^T): self-equilibrated, or on a wall held
   fixed); the two add up in squares to ``impulse``;
-* ``penetration``: the largest approaching velocity max_k max(0, -(u_n + b_k)) over all points,
-  u = W r + q, in units of U = the root mean square over the points of |W r_ref| (the relative
-  velocity the reference impulses make);
+* ``penetration``: the largest approaching velocity max_k max(0, -u_n,k) over all points,
+  u = W r + q (the Signorini shift b_k already in q_n), in units of U = the root mean square over
+  the points of |W r_ref| (the relative velocity the reference impulses make);
 * ``misdirected slip``: the largest |u_t| / U over the loaded points with friction (r_n > 0,
   mu > 0) whose friction does not oppose their slip (r_t u_t >= 0, u_t != 0);
 * ``velocity change``: a stopping norm the stepper could compute, the change of the body
