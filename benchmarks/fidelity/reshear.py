@@ -1,7 +1,7 @@
 """Shear a study's compacted samples again at another top-wall speed, without compacting them again.
 
-The paper-size study (``grainview study --paper-size``) spends most of its pentagons' time in
-the compaction (about 1.5 h of 3.4 h at 14,400 pentagons). To ask whether the residual state
+The paper-size study (``grainview study --paper-size``) spends a large part of its pentagons'
+time in the compaction (docs/fidelity.md, section 4: 1.5 h of their 3.4 h). To ask whether the residual state
 depends on the strain rate at that size, this script takes the compacted sample of each
 finished study file -- its first snapshot, the state the test started from, with its warm
 start (:func:`solver.load_sample`) -- and shears it again to the same strain at ``--velocity``::
