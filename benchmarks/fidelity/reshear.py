@@ -34,14 +34,24 @@ def reshear(source: Path, out: Path, label: str, *, velocity: float, every: int,
             strain: float | None = None, progress: bool = False) -> str:
     """Shear the compacted sample of ``source/label.nc`` into ``out/label.nc`` (or resume it).
 
-    Returns what was done: "finished" (skipped), "resumed" or "started".
+    Returns what was done: "finished" (skipped), "resumed" or "started". An existing
+    ``out/label.nc`` of another ``velocity``, ``every`` or ``strain`` is refused (SystemExit, one
+    line) rather than resumed or kept as if it were the test asked for.
     """
     from solver import load_sample
-    from solver.restart import file_state, resume
+    from solver.restart import check_settings, file_state, resume
     from solver.scenes import biaxial_test
 
     path = out / f"{label}.nc"
     state = file_state(path)
+    if state in ("finished", "partial"):  # only a test of the speed and snapshots asked for is kept or resumed
+        expected = {"wall_velocity_m_s": velocity, "snapshot_every": every}
+        if strain is not None:
+            expected["strain_target"] = strain
+        try:
+            check_settings(path, expected, "give another out folder, or the settings it was started with")
+        except FileExistsError as exc:
+            raise SystemExit(f"reshear: {exc}") from None
     if state == "finished":
         resume(path, compress=True)  # compresses a file whose compression was stopped; else nothing
         return "finished"
