@@ -174,8 +174,9 @@ def cone_constraints(mu):
 
 
 def scaled(W, q):
-    """(P, c, R): the problem in numbers of order one (module docstring): P = W / w, c = q / (R w)
-    with w the mean of diag W and R = rms(q) / w, so that r = R r'."""
+    """(P, R w, R): the problem in numbers of order one (module docstring): P = W / w (CSC) and the
+    scale R w (m s-1) that divides the linear term, c = (q + s e_n) / (R w), with w the mean of
+    diag W (s kg-1) and R = rms(q) / w (N s), so that r = R r'."""
     w = float(np.mean(W.diagonal()))
     R = float(np.sqrt(np.mean(q * q))) / w
     return (W / w).tocsc(), R * w, R
