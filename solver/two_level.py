@@ -291,7 +291,7 @@ def solve_recorded(W, q, mu, tolerance, max_iterations, initial, *, coarse=True,
         raise ParameterError(f"smoother={smoother!r}: expected 'coulomb' or 'convex'")
     if not (0.0 <= regularisation < 1.0) or not (0.0 <= rebuild_fraction <= 1.0):
         raise ParameterError(f"regularisation={regularisation}, rebuild_fraction={rebuild_fraction}: expected "
-                             "numbers in [0, 1)")
+                             "regularisation in [0, 1) and rebuild_fraction in [0, 1]")
     rn = np.ascontiguousarray(initial[:, 0], dtype=np.float64).copy()
     rt = np.ascontiguousarray(initial[:, 1], dtype=np.float64).copy()
     matrix = MatrixProblem(W.indptr.astype(np.int64), W.indices.astype(np.int64), W.data, q, mu)

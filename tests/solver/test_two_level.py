@@ -144,6 +144,9 @@ def test_bad_input_and_a_missing_pyamg_are_one_line_errors(monkeypatch):
     W, q, mu = _column()
     with pytest.raises(ParameterError, match="smoother='gauss'"):
         _solve(W, q, mu, smoother="gauss")
+    with pytest.raises(ParameterError, match=r"rebuild_fraction=1.5: expected regularisation in \[0, 1\) and "
+                       r"rebuild_fraction in \[0, 1\]"):
+        _solve(W, q, mu, rebuild_fraction=1.5)
     with pytest.raises(ParameterError, match="initial must hold 2 finite impulses per point"):
         two_level.solve(sparse.csr_matrix(W), q, mu, 1e-8, 10, np.zeros(3))
     monkeypatch.setitem(sys.modules, "pyamg", None)
