@@ -40,8 +40,9 @@ convention):
    Math. Prog. Comp. 12 (2020) 637-672, section 5.2): the primal residual
    |A y + c + s e_n - z| over max(|A y|, |z|, |c + s e_n|) and the dual residual
    |rho A^T (z - z_prev)| over max(|D y|, |rho A^T xi|) suggest rho sqrt(primal / dual) (at
-   most 100 times larger or smaller); rho takes it, and the LU is made again, only when it differs by more than ``refactor_ratio``
-   from the current rho (xi rescaled so that r is unchanged).
+   most 100 times larger or smaller); rho takes it, and the LU is made again, only when it
+   differs by more than ``refactor_ratio`` from the current rho (xi rescaled so that r is
+   unchanged).
 
 Convergence is judged by nothing of the ADMM's own: every ``check_every`` iterations the
 impulses r = rho xi give the end velocities v = v_free + M^-1 H^T r and u = H v + b e_n, and the
