@@ -18,8 +18,9 @@ modes of W on the closed contacts (results/body-admm.md) become stiff. What is m
 problem and eps in EPSILONS:
 
 * speed: sweeps (NLGS, from the stored warm start and from r = 0 (cap COLD_SECONDS s), as the
-  rigid warm start holds the rigid answer's self-stress, which the compliant answer drops, sweeps in chunks of ~5% of those done, the
-  residual off the clock: benchmarks.contact_solvers.nlgs_trajectory's scheme) and iterations
+  rigid warm start holds the rigid answer's self-stress, which the compliant answer drops;
+  sweeps in chunks of ~5% of those done, the residual off the clock:
+  benchmarks.contact_solvers.nlgs_trajectory's scheme) and iterations
   (``solve_contact_problem(method='pcg')``, tolerance TARGET, cap 20,000, its own stall test)
   and seconds to the regularised problem's own local-law residual |F|/|r| of TARGET
   (solver.contact_solution with W + eps D: rho_k = 1 / ((1 + eps) W_nn,k));
