@@ -32,7 +32,12 @@ from .contact_solvers import solver
 __all__ = ["ContactSolution", "solve_contact_problem"]
 
 
-def _validate(W, q, mu):
+def check_problem(W, q, mu):
+    """The matrix problem u = W r + q checked and normalised, or one ParameterError line naming
+    what is wrong: returns ``(W, q, mu, n)`` with W a (2n, 2n) CSR matrix of sorted indices and no
+    duplicates, finite, with W_nn > 0 at every point; q (2n,) finite; mu (n,) finite and >= 0
+    (a scalar is broadcast); n the number of points. Every entry point that takes (W, q, mu)
+    checks them here."""
     from scipy import sparse
 
     q = np.asarray(q, dtype=np.float64).reshape(-1)
@@ -82,7 +87,7 @@ def solve_contact_problem(W, q, mu, *, method="nlgs", tolerance=1e-10, max_itera
     ContactSolution (:mod:`solver.contact_solution`).
     """
     solve = solver(method)
-    W, q, mu, n = _validate(W, q, mu)
+    W, q, mu, n = check_problem(W, q, mu)
     if not (np.isfinite(tolerance) and tolerance > 0):
         raise ParameterError(f"tolerance={tolerance!r}: expected a positive number")
     if int(max_iterations) < 1:

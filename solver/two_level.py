@@ -274,9 +274,9 @@ def solve_recorded(W, q, mu, tolerance, max_iterations, initial, *, coarse=True,
     one :class:`CycleRecord` per cycle.
     """
     from . import nlgs
-    from .contact_problem import _validate
+    from .contact_problem import check_problem
 
-    W, q, mu, n = _validate(W, q, mu)
+    W, q, mu, n = check_problem(W, q, mu)
     initial = np.asarray(initial, dtype=np.float64).reshape(-1)
     if initial.size != 2 * n or not np.all(np.isfinite(initial)):
         raise ParameterError(f"initial must hold 2 finite impulses per point ({2 * n} values), got {initial.size}")
