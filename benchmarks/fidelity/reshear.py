@@ -27,6 +27,8 @@ import sys
 import time
 from pathlib import Path
 
+from grainview.contract.errors import ParameterError
+
 SAMPLES = ("pentagons", "disks")
 
 
@@ -35,7 +37,7 @@ def reshear(source: Path, out: Path, label: str, *, velocity: float, every: int,
     """Shear the compacted sample of ``source/label.nc`` into ``out/label.nc`` (or resume it).
 
     Returns what was done: "finished" (skipped), "resumed" or "started". An existing
-    ``out/label.nc`` of another ``velocity``, ``every`` or ``strain`` is refused (SystemExit, one
+    ``out/label.nc`` of another ``velocity``, ``every`` or ``strain`` is refused (ParameterError, one
     line) rather than resumed or kept as if it were the test asked for.
     """
     from solver import load_sample
@@ -51,7 +53,7 @@ def reshear(source: Path, out: Path, label: str, *, velocity: float, every: int,
         try:
             check_settings(path, expected, "give another out folder, or the settings it was started with")
         except FileExistsError as exc:
-            raise SystemExit(f"reshear: {exc}") from None
+            raise ParameterError(str(exc)) from None
     if state == "finished":
         resume(path, compress=True)  # compresses a file whose compression was stopped; else nothing
         return "finished"
@@ -60,7 +62,7 @@ def reshear(source: Path, out: Path, label: str, *, velocity: float, every: int,
         return "resumed"
     original = source / f"{label}.nc"
     if file_state(original) != "finished":
-        raise SystemExit(f"reshear: {original} is not a finished test; expected a study's complete file")
+        raise ParameterError(f"{original} is not a finished test; expected a study's complete file")
     sim = load_sample(original, 0)
     if domains is not None:
         sim.set_parameters(domains=domains)
@@ -96,8 +98,12 @@ def main(argv=None) -> int:
     for label in labels:
         start = time.monotonic()
         print(f"{label}: ...", flush=True)
-        done = reshear(args.source, args.out, label, velocity=args.velocity, every=args.every, domains=args.domains,
-                       strain=args.strain, progress=args.progress)
+        try:
+            done = reshear(args.source, args.out, label, velocity=args.velocity, every=args.every,
+                           domains=args.domains, strain=args.strain, progress=args.progress)
+        except ParameterError as exc:
+            print(f"reshear: error: {exc}", file=sys.stderr)
+            return 2
         print(f"{label}: {done} ({(time.monotonic() - start) / 3600:.2f} h of wall time)", flush=True)
     return 0
 

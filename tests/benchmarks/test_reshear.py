@@ -12,6 +12,7 @@ import numpy as np
 import pytest
 
 from grainview.app.cli import _simulate
+from grainview.contract.errors import ParameterError
 from solver.parameters import BiaxialTest
 from solver.preparation import preparation
 
@@ -59,13 +60,13 @@ def test_resheared_at_another_speed_starts_from_the_same_state(study, tmp_path):
     # twice the speed, the same strain: half the steps of the study's test
     assert steps[-1] - steps[0] == (_values(old, "step")[-1] - _values(old, "step")[0] + 1) // 2
     # the same folder asked for another speed or snapshot interval: refused, not taken as finished
-    with pytest.raises(SystemExit, match=r"wall_velocity_m_s = 0\.02, this run's is 0\.01"):
+    with pytest.raises(ParameterError, match=r"wall_velocity_m_s = 0\.02, this run's is 0\.01"):
         reshear.reshear(study, tmp_path, "pentagons", velocity=0.01, every=5, domains=None)
-    with pytest.raises(SystemExit, match=r"snapshot_every = 5, this run's is 10"):
+    with pytest.raises(ParameterError, match=r"snapshot_every = 5, this run's is 10"):
         reshear.reshear(study, tmp_path, "pentagons", velocity=0.02, every=10, domains=None)
 
 
 def test_an_unfinished_source_is_refused(tmp_path):
     reshear = load_benchmark("fidelity.reshear")
-    with pytest.raises(SystemExit, match="is not a finished test"):
+    with pytest.raises(ParameterError, match="is not a finished test"):
         reshear.reshear(tmp_path, tmp_path / "out", "pentagons", velocity=0.01, every=10, domains=None)
