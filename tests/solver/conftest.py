@@ -28,3 +28,24 @@ def compacted_problem(seed):
     posed = sim.contact_problem()
     pn, pt, vx, vy, w = posed.state
     return sim, posed.problem, np.stack([pn, pt], -1), np.stack([vx, vy], -1), w
+
+
+def random_body_problem(seed, *, bodies, points, friction):
+    """(W, q, mu): ``points`` contact points between ``bodies`` random rigid bodies (x, y,
+    rotation; each point joins two different bodies at random lever arms, its normal at a random
+    angle), W = H M^-1 H^T with random masses and inertias, q = H v0 for random body velocities
+    v0, mu = ``friction`` at every point. W is singular where 2 ``points`` > 3 ``bodies``."""
+    rng = np.random.default_rng(seed)
+    a = rng.integers(0, bodies, points)
+    b = (a + rng.integers(1, bodies, points)) % bodies
+    angle = rng.uniform(0, 2 * np.pi, points)
+    nx, ny = np.cos(angle), np.sin(angle)
+    ra, rb = rng.uniform(-0.5, 0.5, (points, 2)), rng.uniform(-0.5, 0.5, (points, 2))
+    H = np.zeros((2 * points, 3 * bodies))
+    for k in range(points):
+        for e, (ex, ey) in enumerate([(nx[k], ny[k]), (-ny[k], nx[k])]):
+            for body, lever, sign in ((b[k], rb[k], 1.0), (a[k], ra[k], -1.0)):
+                H[2 * k + e, 3 * body:3 * body + 3] += sign * np.array([ex, ey, lever[0] * ey - lever[1] * ex])
+    minv = np.repeat(rng.uniform(0.5, 2.0, bodies), 3)
+    minv[2::3] = rng.uniform(1.0, 4.0, bodies)
+    return H @ np.diag(minv) @ H.T, H @ rng.normal(size=3 * bodies), np.full(points, float(friction))

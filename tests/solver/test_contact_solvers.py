@@ -13,6 +13,8 @@ from grainview.contract.errors import ParameterError
 from solver import contact_solvers, residuals
 from solver.contact_problem import solve_contact_problem
 
+from .conftest import random_body_problem
+
 NEW_METHODS = ["newton", "pcg"]
 
 
@@ -120,22 +122,8 @@ def test_newton_steps_do_not_grow_with_the_column_while_sweeps_do():
 
 
 def random_bodies(seed):
-    """(W, q, mu) of 12 points between 6 random bodies: W = H M^-1 H^T, q = H v0."""
-    rng = np.random.default_rng(seed)
-    bodies, points = 6, 12
-    a = rng.integers(0, bodies, points)
-    b = (a + rng.integers(1, bodies, points)) % bodies
-    angle = rng.uniform(0, 2 * np.pi, points)
-    nx, ny = np.cos(angle), np.sin(angle)
-    ra, rb = rng.uniform(-0.5, 0.5, (points, 2)), rng.uniform(-0.5, 0.5, (points, 2))
-    H = np.zeros((2 * points, 3 * bodies))
-    for k in range(points):
-        for e, (ex, ey) in enumerate([(nx[k], ny[k]), (-ny[k], nx[k])]):
-            for body, lever, sign in ((b[k], rb[k], 1.0), (a[k], ra[k], -1.0)):
-                H[2 * k + e, 3 * body:3 * body + 3] += sign * np.array([ex, ey, lever[0] * ey - lever[1] * ex])
-    minv = np.repeat(rng.uniform(0.5, 2.0, bodies), 3)
-    minv[2::3] = rng.uniform(1.0, 4.0, bodies)
-    return H @ np.diag(minv) @ H.T, H @ rng.normal(size=3 * bodies), np.full(points, 0.4)
+    """(W, q, mu) of 12 points between 6 random bodies, mu 0.4 (:func:`conftest.random_body_problem`)."""
+    return random_body_problem(seed, bodies=6, points=12, friction=0.4)
 
 
 @pytest.mark.parametrize("method", NEW_METHODS)

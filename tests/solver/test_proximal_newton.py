@@ -12,6 +12,8 @@ from grainview.contract.errors import ParameterError
 from solver import proximal_newton, residuals
 from solver.contact_problem import solve_contact_problem
 
+from .conftest import random_body_problem
+
 
 def independent_residual(W, q, mu, impulse):
     """|F| / |r| of the natural map from the impulses alone (dense algebra, rho = 1 / W_nn)."""
@@ -109,22 +111,9 @@ def test_the_weight_follows_the_inner_solves():
 
 
 def random_bodies(seed, bodies, points):
-    """(W, q, mu): ``points`` random points between ``bodies`` random rigid bodies (x, y,
-    rotation), W = H M^-1 H^T, q = H v0, mu 0.3."""
-    rng = np.random.default_rng(seed)
-    a = rng.integers(0, bodies, points)
-    b = (a + rng.integers(1, bodies, points)) % bodies
-    angle = rng.uniform(0, 2 * np.pi, points)
-    nx, ny = np.cos(angle), np.sin(angle)
-    ra, rb = rng.uniform(-0.5, 0.5, (points, 2)), rng.uniform(-0.5, 0.5, (points, 2))
-    H = np.zeros((2 * points, 3 * bodies))
-    for k in range(points):
-        for e, (ex, ey) in enumerate([(nx[k], ny[k]), (-ny[k], nx[k])]):
-            for body, lever, sign in ((b[k], rb[k], 1.0), (a[k], ra[k], -1.0)):
-                H[2 * k + e, 3 * body:3 * body + 3] += sign * np.array([ex, ey, lever[0] * ey - lever[1] * ex])
-    minv = np.repeat(rng.uniform(0.5, 2.0, bodies), 3)
-    minv[2::3] = rng.uniform(1.0, 4.0, bodies)
-    return H @ np.diag(minv) @ H.T, H @ rng.normal(size=3 * bodies), np.full(points, 0.3)
+    """(W, q, mu): ``points`` random points between ``bodies`` random rigid bodies, mu 0.3
+    (:func:`conftest.random_body_problem`)."""
+    return random_body_problem(seed, bodies=bodies, points=points, friction=0.3)
 
 
 @pytest.mark.parametrize("seed", [1, 2, 3])
