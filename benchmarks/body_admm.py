@@ -37,10 +37,7 @@ from __future__ import annotations
 import argparse
 import os
 import pickle
-import subprocess
 import time
-import warnings
-from dataclasses import replace
 
 import numpy as np
 
@@ -59,38 +56,27 @@ def capture(source, index, captured=CAPTURED_STEPS, apart=STEPS_APART, out=None)
     """Capture ``captured`` problems ``apart`` steps apart from snapshot ``index`` of ``source``
     in body space (module docstring), checked; saved to DATA/pentagon_<particles>.pkl (or
     ``out``), written beside it then renamed. Returns the path."""
-    from benchmarks.common import capture_contact_problems
-    from benchmarks.contact_solvers import check_assembly
+    from benchmarks.contact_solvers import captured_problems, check_assembly, save_problems
     from solver import load_sample
     from solver.matrix_form import inverse_mass, local_map, matrix_problem
 
     start = time.perf_counter()
     sim = load_sample(source, index)
     print(f"{source}, snapshot {index}: step {sim.step_index}, {sim.mass.size} particles", flush=True)
-    sim.parameters = replace(sim.parameters, solver="nlgs", domains=1)  # plain sweeps, as contact_solvers captures
-    found = []
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore")
-        for k in range(captured):
-            problem, pn, pt, vx, vy, w, _ = capture_contact_problems(sim, 1)[0]
-            H, minv = local_map(problem), inverse_mass(problem)
-            W, q, mu = matrix_problem(problem, vx, vy, w, H, minv)
-            check_assembly(problem, W, q, pn, pt, vx, vy, w)
-            v_free = np.stack([vx, vy, w], -1).reshape(-1)
-            entry = dict(H=H, minv=minv, v_free=v_free, bias=problem.bias.copy(), mu=mu, W=W, q=q,
-                         initial=np.stack([pn, pt], -1))
-            check_body_form(entry)
-            found.append(entry)
-            for _ in range(apart - 1 if k < captured - 1 else 0):
-                sim.step()
+
+    def body_entry(problem, pn, pt, vx, vy, w):
+        H, minv = local_map(problem), inverse_mass(problem)
+        W, q, mu = matrix_problem(problem, vx, vy, w, H, minv)
+        check_assembly(problem, W, q, pn, pt, vx, vy, w)
+        entry = dict(H=H, minv=minv, v_free=np.stack([vx, vy, w], -1).reshape(-1), bias=problem.bias.copy(), mu=mu,
+                     W=W, q=q, initial=np.stack([pn, pt], -1))
+        check_body_form(entry)
+        return entry
+
+    found = captured_problems(sim, body_entry, captured, apart)  # plain sweeps, as contact_solvers captures
     compare_with_stored(found, sim.mass.size)
     out = out or os.path.join(DATA, f"pentagon_{sim.mass.size}.pkl")
-    os.makedirs(os.path.dirname(os.path.abspath(out)), exist_ok=True)
-    with open(out + ".part", "wb") as fh:
-        pickle.dump(found, fh)
-    os.replace(out + ".part", out)
-    print(f"{out}: {len(found)} problems ({[e['mu'].size for e in found]} points) in "
-          f"{time.perf_counter() - start:.0f} s", flush=True)
+    save_problems(out, found, [e["mu"].size for e in found], start)
     return out
 
 
@@ -156,25 +142,11 @@ PROBE_CAP = 300
 
 def nlgs_run(W, q, mu, initial, stop=TARGETS[-1]):
     """(trajectory [(sweeps, seconds, residual)], best impulses) of NLGS sweeps from ``initial``
-    (benchmarks.contact_solvers.nlgs_trajectory's chunks and clock), until ``stop``, NLGS_CAP
-    sweeps or NLGS_SECONDS."""
-    from benchmarks.contact_solvers import as_matrix_problem, law, nlgs_sweeps
+    (benchmarks.contact_solvers.nlgs_run's chunks and clock), until ``stop``, NLGS_CAP sweeps or
+    NLGS_SECONDS."""
+    from benchmarks.contact_solvers import nlgs_run as chunked_nlgs
 
-    matrix = as_matrix_problem(W, q, mu)
-    rn, rt = initial[:, 0].copy(), initial[:, 1].copy()
-    sweeps, seconds, points = 0, 0.0, [(0, 0.0, law(W, q, mu, initial))]
-    best = (points[0][2], initial.copy())
-    while points[-1][2] > stop and sweeps < NLGS_CAP and seconds < NLGS_SECONDS:
-        chunk = max(2, sweeps // 20)
-        start = time.perf_counter()
-        nlgs_sweeps(matrix, rn, rt, chunk)
-        seconds += time.perf_counter() - start
-        sweeps += chunk
-        impulse = np.stack([rn, rt], -1)
-        points.append((sweeps, seconds, law(W, q, mu, impulse)))
-        if points[-1][2] < best[0]:
-            best = (points[-1][2], impulse.copy())
-    return points, best[1]
+    return chunked_nlgs(W, q, mu, initial, stop, NLGS_CAP, NLGS_SECONDS)[:2]
 
 
 def admm_run(entry, cap=ADMM_CAP, **options):
@@ -362,7 +334,7 @@ if __name__ == "__main__":
     if args.spectrum:
         spectrum(args.spectrum)
         raise SystemExit(0)
-    from benchmarks.common import machine_description, write_text_keeping_notes
+    from benchmarks.common import measured, results_text, write_text_keeping_notes
 
     found = problems()
     if args.only:
@@ -371,19 +343,10 @@ if __name__ == "__main__":
     if not found:
         raise SystemExit(f"no problem in {DATA} (build them first: --build-from FILE)" +
                          (f" whose label starts with {args.only}" if args.only else ""))
-    load = os.getloadavg()
-    start = time.perf_counter()
-    rows, probes = measure(found)
-    elapsed = time.perf_counter() - start
-    load_end = os.getloadavg()
+    (rows, probes), run_line = measured(lambda: measure(found), "one thread (nice)")
     text = "\n\n".join([verdict(rows), tables(rows, probes)])
     print(text)
     with open(os.path.join(DATA, "rows.pkl"), "wb") as fh:
         pickle.dump((rows, probes), fh)
     if args.out:
-        head = subprocess.run(["git", "log", "-1", "--format=%h %s"], capture_output=True, text=True).stdout[:80]
-        write_text_keeping_notes(args.out, "\n".join([
-            f"# {TITLE}", "", INTRO, "", machine_description(), "",
-            f"Load average (1, 5, 15 min) at the start {load[0]:.2f}, {load[1]:.2f}, {load[2]:.2f}; at the end "
-            f"{load_end[0]:.2f}, {load_end[1]:.2f}, {load_end[2]:.2f}; {elapsed:.0f} s of wall time; one thread "
-            f"(nice). HEAD: {head.strip()}", "", text, ""]))
+        write_text_keeping_notes(args.out, results_text(TITLE, INTRO, [run_line, text]))

@@ -174,12 +174,32 @@ def write_text_keeping_notes(path: str, text: str) -> str:
     return whole
 
 
+def results_text(title: str, intro: str, sections: list) -> str:
+    """A results file's generated text: the ``title``, the ``intro`` paragraph, the machine
+    description and the ``sections``, each followed by a blank line."""
+    return "\n".join([f"# {title}", "", intro, "", machine_description(), ""] + [line for section in sections
+                                                                              for line in (section, "")])
+
+
+def measured(run, how: str = ""):
+    """Call ``run()`` and say how it ran: returns (its result, one sentence with the load
+    averages at the start and the end, the wall time, ``how`` (e.g. "one thread (nice)") and the
+    git HEAD after the run), for a results file's header."""
+    load = os.getloadavg()
+    start = time.perf_counter()
+    result = run()
+    elapsed = time.perf_counter() - start
+    load_end = os.getloadavg()
+    head = subprocess.run(["git", "log", "-1", "--format=%h %s"], capture_output=True, text=True).stdout[:80]
+    return result, (f"Load average (1, 5, 15 min) at the start {load[0]:.2f}, {load[1]:.2f}, {load[2]:.2f}; at the "
+                    f"end {load_end[0]:.2f}, {load_end[1]:.2f}, {load_end[2]:.2f}; {elapsed:.0f} s of wall time"
+                    + (f"; {how}" if how else "") + f". HEAD: {head.strip()}")
+
+
 def write_results(path: str, title: str, intro: str, sections: list) -> str:
-    """Write a RESULTS-*.md file: the ``title``, the ``intro`` paragraph, the machine
-    description and the ``sections``, each followed by a blank line, then the notes of the file
-    it replaces (:func:`write_text_keeping_notes`); print the generated text and return it."""
-    text = "\n".join([f"# {title}", "", intro, "", machine_description(), ""] + [line for section in sections
-                                                                               for line in (section, "")])
+    """Write a RESULTS-*.md file (:func:`results_text`), then the notes of the file it replaces
+    (:func:`write_text_keeping_notes`); print the generated text and return it."""
+    text = results_text(title, intro, sections)
     write_text_keeping_notes(path, text)
     print(text)
     return text

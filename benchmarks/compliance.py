@@ -47,7 +47,6 @@ from __future__ import annotations
 import argparse
 import os
 import pickle
-import subprocess
 import time
 
 import numpy as np
@@ -89,30 +88,13 @@ def problems(particles=PARTICLES):
 
 def nlgs_run(W, q, mu, initial, stop=FAR_STOP, cap=NLGS_CAP, seconds_cap=NLGS_SECONDS, target=TARGET):
     """NLGS sweeps on (W, q, mu) from ``initial`` (n, 2) in chunks of ~5% of the sweeps done
-    (benchmarks.contact_solvers.nlgs_trajectory), the local-law residual off the clock, until
+    (benchmarks.contact_solvers.nlgs_run), the local-law residual off the clock, until
     ``stop``, ``cap`` sweeps or ``seconds_cap`` s of sweeping. Returns (trajectory [(sweeps,
     seconds, residual)], best impulses (n, 2), impulses at the first point within ``target``
     or None)."""
-    from benchmarks.contact_solvers import as_matrix_problem, law, nlgs_sweeps
+    from benchmarks.contact_solvers import nlgs_run as chunked_nlgs
 
-    matrix = as_matrix_problem(W, q, mu)
-    rn, rt = initial[:, 0].copy(), initial[:, 1].copy()
-    sweeps, seconds, points = 0, 0.0, [(0, 0.0, law(W, q, mu, initial))]
-    best = (points[0][2], initial.copy())
-    at_target = initial.copy() if points[0][2] <= target else None
-    while points[-1][2] > stop and sweeps < cap and seconds < seconds_cap:
-        chunk = max(2, sweeps // 20)
-        start = time.perf_counter()
-        nlgs_sweeps(matrix, rn, rt, chunk)
-        seconds += time.perf_counter() - start
-        sweeps += chunk
-        impulse = np.stack([rn, rt], -1)
-        points.append((sweeps, seconds, law(W, q, mu, impulse)))
-        if points[-1][2] < best[0]:
-            best = (points[-1][2], impulse.copy())
-        if at_target is None and points[-1][2] <= target:
-            at_target = impulse.copy()
-    return points, best[1], at_target
+    return chunked_nlgs(W, q, mu, initial, stop, cap, seconds_cap, target)
 
 
 def reached(trajectory, target=TARGET):
@@ -368,7 +350,7 @@ if __name__ == "__main__":
     parser.add_argument("--rigid-sinks", action="store_true", help="print the sink speeds at the rigid answer's "
                         "impulses (rigid_sinks()) and stop")
     args = parser.parse_args()
-    from benchmarks.common import machine_description, write_text_keeping_notes
+    from benchmarks.common import measured, results_text, write_text_keeping_notes
 
     found = problems()
     if args.only:
@@ -380,19 +362,10 @@ if __name__ == "__main__":
     if args.rigid_sinks:
         rigid_sinks(found)
         raise SystemExit(0)
-    load = os.getloadavg()
-    start = time.perf_counter()
-    rows = measure(found)
-    elapsed = time.perf_counter() - start
-    load_end = os.getloadavg()
+    rows, run_line = measured(lambda: measure(found), "one thread (nice)")
     text = "\n\n".join([verdict(rows), speed_table(rows), physics_table(rows)])
     print(text)
     with open(os.path.join(DATA, "compliance_rows.pkl"), "wb") as fh:
         pickle.dump(rows, fh)
     if args.out:
-        head = subprocess.run(["git", "log", "-1", "--format=%h %s"], capture_output=True, text=True).stdout[:80]
-        write_text_keeping_notes(args.out, "\n".join([
-            f"# {TITLE}", "", INTRO, "", machine_description(), "",
-            f"Load average (1, 5, 15 min) at the start {load[0]:.2f}, {load[1]:.2f}, {load[2]:.2f}; at the end "
-            f"{load_end[0]:.2f}, {load_end[1]:.2f}, {load_end[2]:.2f}; {elapsed:.0f} s of wall time; one thread "
-            f"(nice). HEAD: {head.strip()}", "", text, ""]))
+        write_text_keeping_notes(args.out, results_text(TITLE, INTRO, [run_line, text]))

@@ -181,29 +181,46 @@ def build_from(source, index, captured=CAPTURED_STEPS, apart=STEPS_APART, out=No
     return out
 
 
-def capture(sim, path, captured=CAPTURED_STEPS, apart=STEPS_APART, start=None):
-    """Step ``sim`` with plain serial NLGS sweeps (one domain) and pickle the contact problems
-    of ``captured`` steps, ``apart`` steps apart, as (W, q, mu, warm start) to ``path`` (written
-    beside it, then renamed), each checked against the stepper's velocities
-    (:func:`check_assembly`)."""
-    start = time.perf_counter() if start is None else start
+def captured_problems(sim, make_entry, captured=CAPTURED_STEPS, apart=STEPS_APART) -> list:
+    """Step ``sim`` with plain serial NLGS sweeps (one domain) and return ``make_entry(problem,
+    pn, pt, vx, vy, w)`` of the contact problems of ``captured`` steps, ``apart`` steps apart
+    (the step's problem, its warm-start impulses and free velocities:
+    :func:`benchmarks.common.capture_contact_problems`)."""
     sim.parameters = replace(sim.parameters, solver="nlgs", domains=1)  # plain sweeps, as first built
-    problems_ = []
+    found = []
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         for k in range(captured):
-            problem, pn, pt, vx, vy, w, options = capture_contact_problems(sim, 1)[0]
-            W, q, mu = matrix_problem(problem, vx, vy, w)
-            check_assembly(problem, W, q, pn, pt, vx, vy, w)
-            problems_.append((W, q, mu, np.stack([pn, pt], -1)))
+            problem, pn, pt, vx, vy, w, _ = capture_contact_problems(sim, 1)[0]
+            found.append(make_entry(problem, pn, pt, vx, vy, w))
             for _ in range(apart - 1 if k < captured - 1 else 0):
                 sim.step()
+    return found
+
+
+def save_problems(path, found, points, start):
+    """Pickle the captured problems ``found`` to ``path`` (written beside it, then renamed) and
+    say so with their ``points`` and the seconds since ``start``."""
     os.makedirs(os.path.dirname(os.path.abspath(path)), exist_ok=True)
     with open(path + ".part", "wb") as fh:
-        pickle.dump(problems_, fh)
+        pickle.dump(found, fh)
     os.replace(path + ".part", path)
-    print(f"{path}: {len(problems_)} problems ({[c[2].size for c in problems_]} points) in "
-          f"{time.perf_counter() - start:.0f} s", flush=True)
+    print(f"{path}: {len(found)} problems ({points} points) in {time.perf_counter() - start:.0f} s", flush=True)
+
+
+def capture(sim, path, captured=CAPTURED_STEPS, apart=STEPS_APART, start=None):
+    """Step ``sim`` (:func:`captured_problems`) and pickle the contact problems of ``captured``
+    steps, ``apart`` steps apart, as (W, q, mu, warm start) to ``path``, each checked against the
+    stepper's velocities (:func:`check_assembly`)."""
+    start = time.perf_counter() if start is None else start
+
+    def matrix_entry(problem, pn, pt, vx, vy, w):
+        W, q, mu = matrix_problem(problem, vx, vy, w)
+        check_assembly(problem, W, q, pn, pt, vx, vy, w)
+        return W, q, mu, np.stack([pn, pt], -1)
+
+    found = captured_problems(sim, matrix_entry, captured, apart)
+    save_problems(path, found, [c[2].size for c in found], start)
 
 
 def problems():
@@ -247,20 +264,37 @@ def as_matrix_problem(W, q, mu):
     return MatrixProblem(W.indptr.astype(np.int64), W.indices.astype(np.int64), W.data, q, mu)
 
 
-def nlgs_trajectory(W, q, mu, initial, stop=TARGETS[-1]):
-    """[(sweeps, seconds, residual)] of NLGS sweeps from ``initial`` (module docstring), until the
-    residual is within ``stop``, CAPS['nlgs'] sweeps or SECONDS."""
+def nlgs_run(W, q, mu, initial, stop, cap, seconds_cap, target=None):
+    """NLGS sweeps on (W, q, mu) from ``initial`` (n, 2) in chunks of ~5% of the sweeps done
+    (module docstring), the local-law residual computed off the clock, until the residual is
+    within ``stop``, ``cap`` sweeps or ``seconds_cap`` s of sweeping. Returns (trajectory
+    [(sweeps, seconds, residual)], best impulses (n, 2), impulses at the first point within
+    ``target``, or None where ``target`` is None or not reached)."""
     matrix = as_matrix_problem(W, q, mu)
     rn, rt = initial[:, 0].copy(), initial[:, 1].copy()
     sweeps, seconds, points = 0, 0.0, [(0, 0.0, law(W, q, mu, initial))]
-    while points[-1][2] > stop and sweeps < CAPS["nlgs"] and seconds < SECONDS:
+    best = (points[0][2], initial.copy())
+    reached = target is not None and points[0][2] <= target
+    at_target = initial.copy() if reached else None
+    while points[-1][2] > stop and sweeps < cap and seconds < seconds_cap:
         chunk = max(2, sweeps // 20)
         start = time.perf_counter()
         nlgs_sweeps(matrix, rn, rt, chunk)
         seconds += time.perf_counter() - start
         sweeps += chunk
-        points.append((sweeps, seconds, law(W, q, mu, np.stack([rn, rt], -1))))
-    return points
+        impulse = np.stack([rn, rt], -1)
+        points.append((sweeps, seconds, law(W, q, mu, impulse)))
+        if points[-1][2] < best[0]:
+            best = (points[-1][2], impulse.copy())
+        if at_target is None and target is not None and points[-1][2] <= target:
+            at_target = impulse.copy()
+    return points, best[1], at_target
+
+
+def nlgs_trajectory(W, q, mu, initial, stop=TARGETS[-1]):
+    """[(sweeps, seconds, residual)] of NLGS sweeps from ``initial`` (:func:`nlgs_run`), until the
+    residual is within ``stop``, CAPS['nlgs'] sweeps or SECONDS."""
+    return nlgs_run(W, q, mu, initial, stop, CAPS["nlgs"], SECONDS)[0]
 
 
 def first_reached(trajectory, target):

@@ -63,7 +63,6 @@ from __future__ import annotations
 
 import argparse
 import os
-import subprocess
 import time
 
 import numpy as np
@@ -372,7 +371,7 @@ if __name__ == "__main__":
     parser.add_argument("--out", help="write the tables here (Markdown)")
     args = parser.parse_args()
     from benchmarks.body_admm import DATA, problems
-    from benchmarks.common import machine_description, write_text_keeping_notes
+    from benchmarks.common import measured, results_text, write_text_keeping_notes
 
     found = problems()
     if args.only:
@@ -380,17 +379,10 @@ if __name__ == "__main__":
     if not found:
         raise SystemExit(f"no problem in {DATA} (benchmarks/body_admm.py --build-from FILE captures them)" +
                          (f" whose label starts with {args.only}" if args.only else ""))
-    load = os.getloadavg()
-    start = time.perf_counter()
-    rows = [study(label, entry, args.sweeps, args.sweeps // 2) for label, entry in found]
-    elapsed = time.perf_counter() - start
-    load_end = os.getloadavg()
+    rows, run_line = measured(lambda: [study(label, entry, args.sweeps, args.sweeps // 2) for label, entry in found],
+                             "one thread (nice)")
     text = "\n\n".join([verdict(rows), tables(rows)])
     print(text)
     if args.out:
-        head = subprocess.run(["git", "log", "-1", "--format=%h %s"], capture_output=True, text=True).stdout[:80]
-        write_text_keeping_notes(args.out, "\n".join([
-            f"# {TITLE}", "", INTRO.format(sweeps=args.sweeps, half=args.sweeps // 2), "", machine_description(), "",
-            f"Load average (1, 5, 15 min) at the start {load[0]:.2f}, {load[1]:.2f}, {load[2]:.2f}; at the end "
-            f"{load_end[0]:.2f}, {load_end[1]:.2f}, {load_end[2]:.2f}; {elapsed:.0f} s of wall time; one thread "
-            f"(nice). HEAD: {head.strip()}", "", text, ""]))
+        intro = INTRO.format(sweeps=args.sweeps, half=args.sweeps // 2)
+        write_text_keeping_notes(args.out, results_text(TITLE, intro, [run_line, text]))

@@ -46,13 +46,11 @@ and for the truncated system solved exactly (scipy's sparse LU).
 from __future__ import annotations
 
 import argparse
-import os
-import subprocess
 import time
 
 import numpy as np
 
-from benchmarks.common import machine_description, markdown_table, write_text_keeping_notes
+from benchmarks.common import markdown_table, measured, results_text, write_text_keeping_notes
 from benchmarks.contact_solvers import problems
 
 TITLE = "A two-level method (TNNMG-style) on the stored contact problems"
@@ -244,17 +242,8 @@ if __name__ == "__main__":
         found = [p for p in found if p[0].startswith(prefixes)]
         if not found:
             raise SystemExit(f"--only {args.only}: no problem's label starts with it")
-    load = os.getloadavg()
-    start = time.perf_counter()
-    rows, diagnoses = measure(found)
-    elapsed = time.perf_counter() - start
-    load_end = os.getloadavg()
+    (rows, diagnoses), run_line = measured(lambda: measure(found))
     text = "\n\n".join([tables(rows), diagnosis_table(diagnoses)])
     print(text)
     if args.out:
-        head = subprocess.run(["git", "log", "-1", "--format=%h %s"], capture_output=True, text=True).stdout[:80]
-        write_text_keeping_notes(args.out, "\n".join([
-            f"# {TITLE}", "", INTRO, "", machine_description(), "",
-            f"Load average (1, 5, 15 min) at the start {load[0]:.2f}, {load[1]:.2f}, {load[2]:.2f}; at the end "
-            f"{load_end[0]:.2f}, {load_end[1]:.2f}, {load_end[2]:.2f}; {elapsed:.0f} s of wall time. HEAD: "
-            f"{head.strip()}", "", text, ""]))
+        write_text_keeping_notes(args.out, results_text(TITLE, INTRO, [run_line, text]))
