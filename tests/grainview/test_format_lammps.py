@@ -259,6 +259,25 @@ def test_bad_input_gets_one_line_and_writes_nothing(tmp_path, name, edit, match)
     assert [p.name for p in tmp_path.iterdir() if p.name.startswith(".")] == []
 
 
+def test_a_walls_dump_at_another_step_is_refused(tmp_path):
+    """Every dump's step is compared, the third's too: the walls dump one step off at 40000
+    (the particles and contacts dumps agree) is refused in one line naming it and its step."""
+    folder = _edited(tmp_path, "walls-step",
+                     ("walls", lambda t: t.replace("ITEM: TIMESTEP\n40000\n", "ITEM: TIMESTEP\n40001\n")))
+    files = dump_files(folder)
+    assert "ITEM: TIMESTEP\n40001\n" in files["walls"].read_text()
+    out = tmp_path / "walls-step.nc"
+    with pytest.raises(FileFormatError, match="mismatched steps") as info:
+        convert_lammps(out, files["particles"], files["contacts"], files["walls"], log=files["log"])
+    message = str(info.value)
+    assert "\n" not in message
+    assert f"{files['walls']} at step 40001" in message
+    assert f"{files['contacts']} at step 40000" in message
+    assert not out.exists()
+    with pytest.raises(FileFormatError, match="mismatched steps"):
+        open_lammps(files["particles"], files["contacts"], files["walls"], log=files["log"])
+
+
 def _lammps():
     sys.path.insert(0, str(DATA))
     try:
