@@ -188,3 +188,77 @@ def test_record_cut_short_is_dropped_by_its_flag(tmp_path):
         nc.variables["complete"][0] = 0
     with pytest.raises(FileFormatError, match="snapshot 0 is incomplete"):
         grainview.open_dataset(path)
+
+
+class _FailingWrite:
+    """A netCDF4 Dataset whose variable ``name`` refuses writes, as a full disk would refuse
+    one variable of a snapshot after the ones before it were written; all else is the file's."""
+
+    def __init__(self, nc, name):
+        self._real = nc
+        self.variables = {**nc.variables, name: _Refusing(nc.variables[name])}
+
+    def __getattr__(self, attr):
+        return getattr(self._real, attr)
+
+
+class _Refusing:
+    def __init__(self, var):
+        self._var = var
+
+    def __getitem__(self, key):
+        return self._var[key]
+
+    def __setitem__(self, key, value):
+        raise RuntimeError("NetCDF: HDF error (No space left on device)")
+
+
+def _snapshot_args(ds, k):
+    snap = ds.isel(time=k)
+    m = int(snap.contact_count)
+    contacts = {name: snap[name].values[:m] for name in ("i", "j", "kind", "normal", "fn", "ft", "point", "branch")}
+    return dict(time=float(snap.time), position=snap.position.values, angle=snap.angle.values,
+                contacts=contacts, box_min=snap.box_min.values, box_max=snap.box_max.values)
+
+
+@pytest.mark.parametrize("failing", ["position", "fn", "contact_count"])
+def test_an_append_failing_part_way_leaves_that_snapshot_incomplete(tmp_path, failing):
+    """A write that fails in the middle of a snapshot (the first variable, a contact variable,
+    the contact count) leaves it incomplete: the file reopens with the snapshots before it
+    only, its ``complete`` flags 1 then not 1, and the next append writes that snapshot whole."""
+    import netCDF4
+
+    from grainview.contract.errors import OutputError
+    ds = builders.mixed_contacts(t=3)
+    path = tmp_path / "run.nc"
+    w = SnapshotWriter.create(path, radius=ds.radius.values, n_vertices=ds.n_vertices.values, mass=ds.mass.values,
+                              inertia=ds.inertia.values, n_walls=ds.sizes["wall"], n_contact_slots=ds.sizes["contact"])
+    w.append(**_snapshot_args(ds, 0))
+    real = w._nc
+    w._nc = _FailingWrite(real, failing)
+    with pytest.raises(OutputError, match="could not write snapshot 1 .*keeps its 1 complete snapshots") as info:
+        w.append(**_snapshot_args(ds, 1))
+    assert "\n" not in str(info.value)
+    assert w.n_snapshots == 1
+    w._nc = real
+    w.close()
+
+    with netCDF4.Dataset(path) as nc:
+        nc.set_auto_mask(False)
+        complete, time = nc.variables["complete"][:], nc.variables["time"][:]
+    assert complete[0] == 1 and time[0] == float(ds.time[0])
+    assert all(flag != 1 for flag in complete[1:]), complete
+    back = grainview.open_dataset(path, chunks=None)
+    assert back.sizes["time"] == 1
+    np.testing.assert_array_equal(back.fn.values, ds.fn.values[:1])
+    back.close()
+
+    w = SnapshotWriter.open_append(path)
+    assert w.n_snapshots == 1
+    w.append(**_snapshot_args(ds, 1))
+    w.close()
+    back = grainview.open_dataset(path, chunks=None, validate=True)
+    assert back.sizes["time"] == 2
+    for name in ("time", "position", "fn", "i", "contact_count"):
+        np.testing.assert_array_equal(back[name].values, ds[name].values[:2], err_msg=name)
+    back.close()
