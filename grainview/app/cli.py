@@ -414,32 +414,32 @@ def _inertia(sample, test) -> str:
 def _unconverged_warning(sim, path, unconverged) -> str:
     """What the warning on a run's unconverged steps says: how many of the compaction's and of
     the test's steps stopped at their contact solver's iteration cap or stall test, in that
-    solver's words, and how far their impulses were from a solution (grainview.app.convergence),
-    read from the written file."""
+    solver's words, and how far each phase's impulses were from a solution
+    (grainview.app.convergence), the test's read from the written file: each phase with its
+    own numbers, those the run's report states."""
     import netCDF4
 
     from .convergence import norms_phrase, residual_comparison, stop_rule, tolerances, unconverged_in_file
 
     with netCDF4.Dataset(path) as nc:
         counts = unconverged_in_file(nc.variables, {k: nc.getncattr(k) for k in nc.ncattrs()})
+    p = sim.parameters
+    rule = {"tolerance": p.tolerance, "max_tolerance": p.max_tolerance, "max_iterations": p.max_iterations,
+            "stall_sweeps": p.stall_sweeps, "solver": p.solver}
+    parts = []
     compaction = sim.history.compaction_unconverged
-    parts, law, quad = [], 0.0, 0.0
-    if compaction is not None:
-        parts.append(f"{compaction.steps} of the compaction's {sim.history.compaction_steps}")
-        law, quad = compaction.local_law_residual, compaction.residual
+    if compaction is not None and compaction.steps:
+        phase = {**rule, "residual": compaction.residual, "local_law_residual": compaction.local_law_residual,
+                 "typical_local_law_residual": None}
+        parts.append(f"{compaction.steps} of the compaction's {sim.history.compaction_steps} "
+                     f"({residual_comparison(phase)})")
     if counts is not None and counts["of"]:
-        parts.append(f"{counts['steps']} of the test's {counts['of']}")
-        law, quad = max(law, counts["local_law_residual"]), max(quad, counts["residual"])
-    else:
-        counts = {"tolerance": sim.parameters.tolerance, "typical_local_law_residual": None}
-    counts.update(residual=quad, local_law_residual=law, max_iterations=sim.parameters.max_iterations,
-                  max_tolerance=sim.parameters.max_tolerance, stall_sweeps=sim.parameters.stall_sweeps,
-                  solver=sim.parameters.solver)
-    where = f" ({', '.join(parts)})" if parts else ""
-    return (f"the contact solver ({sim.parameters.solver}) did not converge in {unconverged} step(s){where}: "
-            f"stopped at {stop_rule(counts)} before {norms_phrase(counts)} ({tolerances(counts)}); "
-            f"{residual_comparison(counts)}. "
-            f"{path} records the test's per snapshot (nlgs_unconverged_steps), and its report states them")
+        parts.append(f"{counts['steps']} of the test's {counts['of']} ({residual_comparison({**counts, **rule})})")
+    where = f": {'; '.join(parts)}" if parts else ""
+    return (f"the contact solver ({p.solver}) did not converge in {unconverged} step(s){where}. They stopped at "
+            f"{stop_rule(rule)} before {norms_phrase(rule)} ({tolerances(rule)}). {path} records the test's per "
+            "snapshot (nlgs_unconverged_steps) and the compaction's in its attributes (compaction_unconverged_*), "
+            "and its report states both, apart")
 
 
 def _progress_flag(args):

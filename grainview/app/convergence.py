@@ -88,6 +88,45 @@ def unconverged_in_file(variables, attrs) -> dict | None:
     }
 
 
+def compaction_in_file(attrs) -> dict | None:
+    """The compaction's unconverged steps, as a file's attributes record them.
+
+    Parameters
+    ----------
+    attrs : mapping
+        The file's global attributes (``compaction_steps``, ``compaction_unconverged_steps``,
+        ``compaction_unconverged_local_law_residual``: :class:`solver.sample_history.SampleHistory`).
+
+    Returns
+    -------
+    dict or None
+        None when the file does not record them (a run not compacted by this package's
+        preparation). Otherwise ``steps`` (the compaction's unconverged steps), ``of`` (its
+        steps; None where the file does not say) and ``local_law_residual`` (the largest
+        local-law residual |F|/|r| among them, 1; 0 when there are none).
+    """
+    if "compaction_unconverged_steps" not in attrs:
+        return None
+    of = _number(attrs, "compaction_steps")
+    law = _number(attrs, "compaction_unconverged_local_law_residual")
+    return {"steps": int(attrs["compaction_unconverged_steps"]), "of": None if of is None else int(of),
+            "local_law_residual": float("nan") if law is None else law}
+
+
+def compaction_text(compaction: dict | None) -> str:
+    """One sentence, for a reader of the report, on the compaction's unconverged steps
+    (:func:`compaction_in_file`), which the test's count leaves out; "" when the file does not
+    record them."""
+    if compaction is None:
+        return ""
+    of = f"its {compaction['of']} steps" if compaction["of"] is not None else "its steps"
+    head = f"The isotropic compaction before the test (its steps are not counted above): {compaction['steps']} of {of}"
+    if compaction["steps"] == 0:
+        return f"{head} stopped unconverged."
+    return (f"{head} stopped unconverged, the largest local-law residual |F|/|r| among them "
+            f"{compaction['local_law_residual']:.2g} (the file's compaction_unconverged_* attributes).")
+
+
 def solver_name(attrs) -> str:
     """The contact solver a file's steps were solved with: its ``solver_solver``, or for a file
     written before that attribute its ``solver_acceleration`` ("anderson" or the plain NLGS)."""

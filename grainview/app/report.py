@@ -559,11 +559,16 @@ def write_report(runs: dict, out, residual_strain: float = RESIDUAL_STRAIN, over
 
 def convergence_text(ds: xr.Dataset) -> str:
     """What a run's file says of its steps whose NLGS did not converge, and how far their
-    impulses were from a solution (:func:`grainview.app.convergence.unconverged_text`)."""
-    from .convergence import unconverged_in_file, unconverged_text
+    impulses were from a solution (:func:`grainview.app.convergence.unconverged_text`): the
+    test's steps (its snapshots' counts), then, for a biaxial test whose file records them,
+    its compaction's (:func:`grainview.app.convergence.compaction_text`), the two counted
+    apart as the command that ran it counts them."""
+    from .convergence import compaction_in_file, compaction_text, unconverged_in_file, unconverged_text
 
-    return unconverged_text(unconverged_in_file(ds, ds.attrs), "the test" if ds.attrs.get("scene") == "biaxial"
-                            else "the run")
+    biaxial = ds.attrs.get("scene") == "biaxial"
+    text = unconverged_text(unconverged_in_file(ds, ds.attrs), "the test" if biaxial else "the run")
+    compaction = compaction_text(compaction_in_file(ds.attrs)) if biaxial else ""
+    return f"{text} {compaction}" if compaction else text
 
 
 def convergence_notes(runs: dict) -> list[str]:

@@ -11,7 +11,7 @@ import pytest
 
 import grainview
 from grainview.app.cli import _simulate
-from grainview.app.convergence import unconverged_in_file, unconverged_text
+from grainview.app.convergence import compaction_in_file, compaction_text, unconverged_in_file, unconverged_text
 from grainview.app.report import convergence_notes, convergence_text
 from solver.parameters import BiaxialTest
 from solver.preparation import preparation
@@ -87,29 +87,51 @@ def test_no_unconverged_step_and_no_record_are_said_so():
 
 def test_the_run_command_warns_with_the_counts_its_file_and_report_hold(tmp_path, capsys):
     """30 pentagons capped at 10 sweeps a step: the printed total (the stepper's warnings) is
-    the compaction's count (a file attribute) plus the test's (the snapshots' sum), and the
-    report's text states the same numbers."""
+    the compaction's count (a file attribute) plus the test's (the snapshots' sum); each phase
+    is given with its own largest residuals, and the report states the same two counts and
+    residuals, each named by its phase."""
     path = tmp_path / "run.nc"
     prep = preparation("paper", particles=30, shape="pentagon", seed=0)
     _simulate(prep, path, test=BiaxialTest(strain=0.004, every=10, velocity=0.01), near_contacts=False,
               overwrite=False, progress=False, parameters={"max_iterations": 10})
-    err = capsys.readouterr().err
-    total, compaction, compaction_steps, test, test_steps = map(int, re.search(
-        r"did not converge in (\d+) step\(s\) \((\d+) of the compaction's (\d+), (\d+) of the test's (\d+)\)",
-        err).groups())
+    err = " ".join(capsys.readouterr().err.split())
+    found = re.search(r"did not converge in (\d+) step\(s\): (\d+) of the compaction's (\d+) \((.*?)\); "
+                      r"(\d+) of the test's (\d+) \((.*?)\)\. They stopped at", err)
+    total, compaction, compaction_steps, test, test_steps = map(int, found.group(1, 2, 3, 5, 6))
+    compaction_words, test_words = found.group(4, 7)
     with netCDF4.Dataset(path) as nc:
         stored = int(nc["nlgs_unconverged_steps"][:].sum())
         assert compaction == nc.getncattr("compaction_unconverged_steps") > 0
         assert compaction_steps == nc.getncattr("compaction_steps")
         assert test_steps == nc.getncattr("biaxial_steps") == int(nc["step"][-1] - nc["step"][0])
-        largest = max(float(nc["nlgs_unconverged_local_law_residual"][:].max()),
-                      float(nc.getncattr("compaction_unconverged_local_law_residual")))
+        test_law = float(nc["nlgs_unconverged_local_law_residual"][:].max())
+        compaction_law = float(nc.getncattr("compaction_unconverged_local_law_residual"))
     assert test == stored > 0 and total == compaction + test
     assert "the contact solver (anderson) did not converge in" in err
-    assert "stopped at the sweep cap (10 sweeps) before both stopping norms" in err
-    assert f"largest local-law residual |F|/|r| {largest:.2g}" in err
+    assert "They stopped at the sweep cap (10 sweeps) before both stopping norms" in err
+    assert f"the largest local-law residual |F|/|r| {compaction_law:.2g} (zero for" in compaction_words
+    assert f"the largest local-law residual |F|/|r| {test_law:.2g} (zero for" in test_words
+    assert "its report states both, apart" in err
     with grainview.open_dataset(path, chunks=None) as ds:
         text = convergence_text(ds)
-        assert text == unconverged_text(unconverged_in_file(ds, ds.attrs))
+        assert text.startswith(unconverged_text(unconverged_in_file(ds, ds.attrs)) + " ")
         assert f"NLGS convergence: {test} of the test's {test_steps} steps" in text
+        assert f"local-law residual |F|/|r| {test_law:.2g} (zero for" in text
+        assert (f"The isotropic compaction before the test (its steps are not counted above): {compaction} of its "
+                f"{compaction_steps} steps stopped unconverged, the largest local-law residual |F|/|r| among them "
+                f"{compaction_law:.2g}") in text
         assert convergence_notes({"pentagons": ds}) == [f"**pentagons.** {text}"]
+
+
+def test_the_compaction_sentence_reads_the_attributes_and_says_nothing_without_them():
+    attrs = {"compaction_steps": 1641, "compaction_unconverged_steps": 2,
+             "compaction_unconverged_local_law_residual": 0.048}
+    assert compaction_in_file(attrs) == {"steps": 2, "of": 1641, "local_law_residual": 0.048}
+    assert compaction_text(compaction_in_file(attrs)) == (
+        "The isotropic compaction before the test (its steps are not counted above): 2 of its 1641 steps stopped "
+        "unconverged, the largest local-law residual |F|/|r| among them 0.048 (the file's compaction_unconverged_* "
+        "attributes).")
+    none = compaction_text(compaction_in_file({**attrs, "compaction_unconverged_steps": 0}))
+    assert none == "The isotropic compaction before the test (its steps are not counted above): 0 of its 1641 steps " \
+                   "stopped unconverged."
+    assert compaction_in_file(ATTRS) is None and compaction_text(None) == ""
