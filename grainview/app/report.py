@@ -446,7 +446,7 @@ def write_figures(runs: dict, out: Path, time=-1, residual_strain: float = RESID
     from ..plot import FIGURES, save_figure
     from ..analysis.snapshots import Residual
     from ..plot._style import add_caption
-    from ..plot.captions import describe_figure, interval_note, sampling_note
+    from ..plot.captions import STRAIN_FIGURES, describe_figure, interval_note, sampling_note, strain_note
 
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
@@ -487,6 +487,8 @@ def write_figures(runs: dict, out: Path, time=-1, residual_strain: float = RESID
                 lines += [sampling_note(label, ds, residual_strain) for label, ds in data.items()]
             if number == "20":  # Delta gamma depends on the interval between snapshots
                 lines += [interval_note(label, ds) for label, ds in data.items()]
+            if number in STRAIN_FIGURES:  # where eps_q decreases, the curves fold back
+                lines += [note for note in (strain_note(label, ds) for label, ds in data.items()) if note]
             add_caption(fig, lines)
             if captions is not None:
                 captions[stem] = lines

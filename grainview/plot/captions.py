@@ -15,8 +15,9 @@ from ..analysis.strain import RESIDUAL_STRAIN
 
 DESCRIPTIONS = {
     "02": "The packing at the end of the isotropic compaction (the first snapshot), particles to scale in the box",
-    "03": "Shear stress ratio q/p = (sigma_1 - sigma_2)/(sigma_1 + sigma_2) against the cumulative shear strain "
-          "eps_q",
+    "03": "Shear stress ratio q/p = (sigma_1 - sigma_2)/(sigma_1 + sigma_2) against the shear strain "
+          "eps_q = eps_1 - eps_2 since the first snapshot (the paper's cumulative shear strain: the sum of signed "
+          "increments, so it decreases where the sample narrows faster than it shortens)",
     "04": "Cumulative volumetric strain eps_p (dilation positive) against eps_q",
     "05": "Stress-dilatancy diagram: dilatancy angle psi (sin psi = eps_p/eps_q) against friction angle phi "
           "(sin phi = q/p), one point per snapshot with eps_q >= 0.02; dotted: guides of slope 1 through phi_0, "
@@ -69,6 +70,10 @@ DESCRIPTIONS = {
 final full stop: the report's index joins a caption's lines with semicolons)."""
 
 
+STRAIN_FIGURES = ("03", "04", "06a", "06b", "09", "11", "12", "18", "19", "20", "22", "25")
+"""The report's figures drawn against eps_q: their captions carry :func:`strain_note`."""
+
+
 def describe_figure(number: str) -> str:
     """What figure ``number`` ("03", "06a", ...) of the report plots, in one sentence.
 
@@ -114,6 +119,41 @@ def sampling_note(label: str, ds: xr.Dataset, residual_strain: float = RESIDUAL_
     return (f"{label}: the {res.sizes['time']} snapshots pooled hold only {distinct} different contacts "
             f"({worth:.1f} times the {per_snapshot:.0f} of one): contacts last over many snapshots, so the spikes "
             "of P(theta) are a few long-lived contacts counted in every snapshot, not a texture of the packing")
+
+
+def strain_note(label: str, ds: xr.Dataset) -> str:
+    """A caption line for a figure drawn against eps_q, when eps_q decreases somewhere.
+
+    eps_q = eps_1 - eps_2 is the paper's shear strain, the net strain since the first snapshot
+    (its signed increments summed), not a path length: it decreases where the sample narrows
+    faster than it shortens, and a curve against it folds back there. The line names the
+    largest such fall, from the largest eps_q reached before it.
+
+    Parameters
+    ----------
+    label : str
+        The sample's label.
+    ds : xarray.Dataset
+        The sample's dataset.
+
+    Returns
+    -------
+    str
+        The caption line, or "" when eps_q never decreases.
+    """
+    from ._style import eps_q
+
+    strain = eps_q(ds)
+    strain = strain[np.isfinite(strain)]
+    if strain.size < 2:
+        return ""
+    reached = np.maximum.accumulate(strain)
+    fall = reached - strain
+    k = int(np.argmax(fall))
+    if not fall[k] > 0:
+        return ""
+    return (f"{label}: eps_q decreases from {reached[k]:.4f} to {strain[k]:.4f} (the sample narrowed faster than it "
+            "shortened; eps_q is the net shear strain, not a path length), so curves against eps_q fold back there")
 
 
 def interval_note(label: str, ds: xr.Dataset) -> str:

@@ -724,6 +724,27 @@ def test_every_report_figure_says_what_it_plots_in_readable_type(series):
     assert text.get_fontsize() == CAPTION_FONTSIZE and text.get_text().startswith("Shear stress ratio q/p")
 
 
+def test_the_strain_captions_name_eps_q_as_the_net_strain_and_say_where_it_decreases(series):
+    from grainview.plot.captions import STRAIN_FIGURES, describe_figure, strain_note
+
+    assert "against the shear strain eps_q = eps_1 - eps_2 since the first snapshot" in describe_figure("03")
+    assert "it decreases where the sample narrows faster than it shortens" in describe_figure("03")
+    assert {"03", "04", "20"} <= set(STRAIN_FIGURES) and "13" not in STRAIN_FIGURES
+    assert strain_note("s", series) == ""  # the synthetic box shortens and widens: eps_q only grows
+    # the last snapshot back to the first width: eps_2 = 0 there, so eps_q = eps_1 = ln(1 + 0.1)
+    box_max = series["box_max"].values.copy()
+    box_max[3, 0] = box_max[0, 0]
+    narrowed = series.assign(box_max=(series["box_max"].dims, box_max))
+    h, w = box_max[:, 1], box_max[:, 0]
+    before = np.log(1 + (h[0] - h[2]) / h[0]) - np.log(1 + (w[0] - w[2]) / w[0])
+    after = np.log(1 + (h[0] - h[3]) / h[0])
+    assert after == pytest.approx(np.log(1.1)) and after < before
+    assert strain_note("s", narrowed) == (
+        f"s: eps_q decreases from {before:.4f} to {after:.4f} (the sample narrowed faster than it shortened; eps_q is "
+        "the net shear strain, not a path length), so curves against eps_q fold back there")
+    assert "from 0.0984 to 0.0953" in strain_note("s", narrowed)
+
+
 def test_pooled_contacts_counts_different_pairs(series):
     from grainview.analysis.persistence import pooled_contacts
     from grainview.plot.captions import sampling_note

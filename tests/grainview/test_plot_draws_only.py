@@ -34,6 +34,7 @@ DRAWING_HELPERS = {
     "contact_collection": "the contact lines drawn on a map",
     # captions and files
     "describe_figure": "a figure's caption", "sampling_note": "a caption line", "interval_note": "a caption line",
+    "strain_note": "a caption line",
     "add_caption": "a caption under a figure", "save_figure": "PNG and PDF files of a figure",
     "frame_title": "a movie frame's title", "save_frames": "a movie's frames written",
     "animate": "a movie of the maps", "animate_chains": "a movie of the force chains",
