@@ -222,7 +222,7 @@ def _drop_last_atom(text, step):
     head, tail = text.split(f"ITEM: TIMESTEP\n{step}\n")
     lines = tail.split("\n")
     lines[1] = "219"
-    del lines[8 + 220 - 1]
+    del lines[7 + 220 - 1]  # the rows start at lines[7]
     return head + f"ITEM: TIMESTEP\n{step}\n" + "\n".join(lines)
 
 
