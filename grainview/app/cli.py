@@ -50,7 +50,7 @@ def _info(args) -> int:
 
         problems = []
         try:
-            describe_file(args.file)
+            describe_file(args.file, check=True)  # every stored chunk read: checksums verified
         except SchemaError as exc:
             problems += exc.problems
         try:

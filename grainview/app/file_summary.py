@@ -23,8 +23,8 @@ import os
 import numpy as np
 
 from ..contract.errors import FileFormatError, SchemaError
-from ..contract.file_checks import (COUNT_OUT_OF_RANGE, damaged_snapshots, force_problems, foreign_file_problems,
-                          order_problems)
+from ..contract.file_checks import (COUNT_OUT_OF_RANGE, MISSING_SCHEMA_VERSION, checked_variables, damaged_chunks,
+                                    damaged_snapshots, force_problems, foreign_file_problems, order_problems)
 from ..contract.schema import complete_snapshots, missing_units, structure_problems, unit_problems
 from ..contract.shapes import particle_area, regular_polygons, shape_problems
 from ..contract.writer import netcdf3_data_bytes
@@ -63,13 +63,18 @@ def _check_netcdf3_size(nc, source) -> None:
         check_netcdf3_length(source)
 
 
-def read_facts(path) -> tuple[dict, dict]:
+def read_facts(path, check=False) -> tuple[dict, dict]:
     """The summary's numbers of the file ``path`` and its global attributes.
 
     Parameters
     ----------
     path : str or path-like
         A netCDF file of the contract (netCDF-3 or compressed).
+    check : bool, default False
+        Also read every stored chunk of every variable first, so that a compressed file's
+        chunk whose checksum does not match is found wherever it is
+        (:func:`grainview.contract.file_checks.damaged_chunks`), and count a missing
+        ``grainview_schema_version`` as a problem (``grainview info --check``).
 
     Returns
     -------
@@ -89,9 +94,11 @@ def read_facts(path) -> tuple[dict, dict]:
     ------
     FileFormatError
         Not a readable netCDF file, a netCDF-3 file cut short or whose header hides records, an
-        incomplete snapshot before complete ones.
+        incomplete snapshot before complete ones; stored data the netCDF library refuses (a
+        chunk that fails its checksum), in one line naming the file and the variables.
     SchemaError
-        Not a grainview file; the structure or the units differ from the contract's; the
+        Not a grainview file; the structure or the units differ from the contract's (with
+        ``check``, also: no ``grainview_schema_version``); the
         ``vertices`` break the contract's rules for shapes
         (:func:`grainview.contract.shapes.shape_problems`); times
         that do not increase strictly, non-finite forces or negative normal forces.
@@ -116,15 +123,20 @@ def read_facts(path) -> tuple[dict, dict]:
                      if var.dtype is not str}
         units = {name: (var.getncattr("units") if "units" in var.ncattrs() else None)
                  for name, var in nc.variables.items()}
-        problems = (foreign_file_problems(variables)
-                    or structure_problems(variables, sizes) + unit_problems(units))
+        foreign = foreign_file_problems(variables)
+        if check and not foreign and not nc.data_model.startswith("NETCDF3"):  # netCDF-3 has no checksums
+            damaged = damaged_chunks(nc.variables)
+            if damaged:
+                raise FileFormatError(f"{source}: " + "; ".join(damaged) + " (the file is damaged)")
+        unversioned = [MISSING_SCHEMA_VERSION] if check and "grainview_schema_version" not in nc.ncattrs() else []
+        problems = foreign or structure_problems(variables, sizes) + unit_problems(units) + unversioned
         if problems:
             raise SchemaError(problems, source)
         netcdf3 = nc.data_model.startswith("NETCDF3")
         if netcdf3:
             _check_netcdf3_size(nc, source)
         attrs = {k: nc.getncattr(k) for k in nc.ncattrs()}
-        v = nc.variables
+        v = checked_variables(nc.variables, source)  # a damaged chunk: one line naming the file
         radius, n_vertices = np.asarray(v["radius"][:], float), np.asarray(v["n_vertices"][:])
         vertices = np.asarray(v["vertices"][:], float) if "vertices" in v else None
         if vertices is not None:
@@ -171,13 +183,14 @@ def read_facts(path) -> tuple[dict, dict]:
     return facts, attrs
 
 
-def describe_file(path) -> tuple[list, dict]:
+def describe_file(path, check=False) -> tuple[list, dict]:
     """The lines ``grainview info`` prints for ``path`` (:func:`read_facts`, formatted by
-    :func:`grainview.analysis.summary.summary_lines`, then the file's size and format, and a note on
-    variables without units) and the file's global attributes."""
+    :func:`grainview.analysis.summary.summary_lines`, then the file's size and format, and notes on
+    variables without units and on a missing schema version) and the file's global attributes;
+    ``check``: as for :func:`read_facts` (``grainview info --check``)."""
     from ..analysis.summary import summary_lines
 
-    facts, attrs = read_facts(path)
+    facts, attrs = read_facts(path, check=check)
     lines = summary_lines(facts, attrs)
     size = facts["size"]
     scaled, unit = next(((size / 1024**p, u) for p, u in ((3, "GiB"), (2, "MiB"), (1, "KiB"))
@@ -186,4 +199,7 @@ def describe_file(path) -> tuple[list, dict]:
     if facts["missing_units"]:
         lines.append(f"note: {len(facts['missing_units'])} variable(s) carry no units attribute and are read in the "
                      f"contract's units (docs/schema.md): {', '.join(facts['missing_units'])}")
+    if "grainview_schema_version" not in attrs:
+        lines.append("note: the file has no grainview_schema_version attribute: which version of the contract it "
+                     "follows is unknown ('grainview info --check' refuses it)")
     return lines, attrs

@@ -191,7 +191,8 @@ def netcdf_encoding(ds: xr.Dataset, zlib: bool = False, complevel: int | None = 
     :data:`grainview.contract.writer.COMPRESSED_FORMAT` (docs/schema.md, "Compression"),
     chunked and filtered as :func:`grainview.contract.writer.compress_file` does (one snapshot
     per chunk; a per-snapshot variable that zlib shrinks by less than
-    :data:`~grainview.contract.writer.MIN_SAVING` is not deflated);
+    :data:`~grainview.contract.writer.MIN_SAVING` is not deflated; every variable but the scalars
+    with Fletcher-32 checksums, :data:`~grainview.contract.writer.CHECKSUMS`);
     :func:`grainview.open_dataset` reads it unchanged. :func:`netcdf_options` gives the format
     and the encoding together.
 
@@ -239,6 +240,10 @@ def netcdf_encoding(ds: xr.Dataset, zlib: bool = False, complevel: int | None = 
                 enc[name].update(deflate)
     if "time" in ds.variables:
         enc["time"] = {"_FillValue": np.nan}
+    if zlib and writer.CHECKSUMS:  # every chunk verified as it is read, as compress_file writes it
+        for name in ds.variables:
+            if ds[name].ndim:
+                enc.setdefault(name, {})["fletcher32"] = True
     return enc
 
 

@@ -163,6 +163,138 @@ def hidden_records(source, size, header, fixed, record, n_records, complete=None
                               f"header's record count hides {held - n_records} snapshots (the file is damaged)")
 
 
+DAMAGED_DATA = ("{source}: {name}{where}: its stored data cannot be read ({why}): the file is damaged (a chunk "
+                "that fails its checksum or does not inflate)")
+"""Template of the one-line error of a variable whose stored bytes the netCDF library refuses
+(a finished file's chunk whose Fletcher-32 checksum does not match, or whose deflated bytes do
+not inflate; docs/schema.md, "Checksums")."""
+
+MISSING_SCHEMA_VERSION = ("global attribute grainview_schema_version is missing: which version of the contract the "
+                          "file follows is unknown (every file grainview writes has it; docs/schema.md, "
+                          "\"Global attributes\")")
+"""The problem ``grainview info --check`` names for a file without ``grainview_schema_version``."""
+
+CHECK_BLOCK_BYTES = 8 * 2**20
+"""At most about this many bytes of one variable are read at once by :func:`damaged_chunks`."""
+
+
+def damaged_data(source, name, exc, where="") -> FileFormatError:
+    """The :class:`FileFormatError` of variable ``name`` of the file ``source`` whose stored
+    data could not be read (``exc``, the netCDF library's error), in one line
+    (:data:`DAMAGED_DATA`); ``where`` says which part (e.g. ``" at snapshot 3"``)."""
+    why = " ".join(str(exc).split()) or type(exc).__name__
+    return FileFormatError(DAMAGED_DATA.format(source=source, name=name, where=where, why=why))
+
+
+class _CheckedVariable:
+    """A netCDF4 variable whose reads raise :func:`damaged_data` instead of the library's bare
+    ``RuntimeError`` (which names neither the file nor the variable); everything else is the
+    variable's."""
+
+    def __init__(self, var, name, source):
+        self._var, self._name, self._source = var, name, source
+
+    def __getitem__(self, key):
+        try:
+            return self._var[key]
+        except RuntimeError as exc:
+            raise damaged_data(self._source, self._name, exc) from exc
+
+    def getValue(self):  # noqa: N802 (netCDF4's name)
+        """A scalar variable's value."""
+        try:
+            return self._var.getValue()
+        except RuntimeError as exc:
+            raise damaged_data(self._source, self._name, exc) from exc
+
+    def __getattr__(self, attr):
+        return getattr(self._var, attr)
+
+    def __len__(self):
+        return len(self._var)
+
+
+def checked_variables(variables, source) -> dict:
+    """``variables`` (a netCDF4 Dataset's ``variables``) with each one's reads checked: a
+    stored chunk the library refuses (a checksum that does not match, data that do not
+    inflate) raises :class:`FileFormatError` naming ``source`` and the variable in one line
+    (:func:`damaged_data`), not a bare ``RuntimeError``.
+
+    Parameters
+    ----------
+    variables : mapping of str to netCDF4.Variable
+        An open file's variables.
+    source : str
+        The file's name, for the messages.
+
+    Returns
+    -------
+    dict
+        Name -> a variable that reads as the original does.
+    """
+    return {name: _CheckedVariable(var, name, source) for name, var in variables.items()}
+
+
+def _row_blocks(n_rows, row_bytes, rows_per_chunk):
+    """Slices of whole chunks along the first dimension, about :data:`CHECK_BLOCK_BYTES` each."""
+    step = max(1, CHECK_BLOCK_BYTES // max(1, row_bytes * rows_per_chunk)) * rows_per_chunk
+    return [slice(start, min(n_rows, start + step)) for start in range(0, n_rows, step)]
+
+
+def damaged_chunks(variables) -> list[str]:
+    """Read every stored value of every variable, whole chunks at a time, and name those that
+    the netCDF library refuses to read: in a finished (compressed) file, HDF5 verifies each
+    chunk's Fletcher-32 checksum as it reads it, so a changed bit is found here rather than
+    read as another number (docs/schema.md, "Checksums").
+
+    Parameters
+    ----------
+    variables : mapping of str to netCDF4.Variable
+        An open file's variables (a netCDF-3 file has no checksums: reading it finds only I/O
+        errors).
+
+    Returns
+    -------
+    list of str
+        One line per damaged variable: how many of its snapshots (rows of chunks) cannot be
+        read and the first of them, with the library's reason; empty when every chunk reads.
+    """
+    problems = []
+    for name, var in variables.items():
+        chunking = var.chunking() if hasattr(var, "chunking") else None
+        if chunking not in (None, "contiguous"):
+            var.set_var_chunk_cache(size=0)  # one block in memory at a time, whatever the file's length
+        if var.ndim == 0:
+            try:
+                var.getValue()
+            except RuntimeError as exc:
+                problems.append(f"{name}: its stored value cannot be read ({' '.join(str(exc).split())})")
+            continue
+        rows_per_chunk = chunking[0] if chunking not in (None, "contiguous") else 1
+        row_bytes = var.dtype.itemsize * int(np.prod(var.shape[1:], dtype=np.int64))
+        bad, why = [], ""
+        for block in _row_blocks(var.shape[0], row_bytes, rows_per_chunk):
+            try:
+                var[block]
+                continue
+            except RuntimeError as exc:
+                why = " ".join(str(exc).split())
+            for start in range(block.start, block.stop, rows_per_chunk):  # which chunks
+                rows = slice(start, min(block.stop, start + rows_per_chunk))
+                try:
+                    var[rows]
+                except RuntimeError:
+                    bad.append(rows)
+        if bad:
+            what = "snapshot" if var.dimensions[:1] == ("time",) else f"{var.dimensions[0]} row"
+            first = bad[0]
+            at = f" {first.start}" if first.stop - first.start == 1 else f"s {first.start}-{first.stop - 1}"
+            count = sum(rows.stop - rows.start for rows in bad)
+            problems.append(f"{name}: {count} {what}(s) whose stored data cannot be read (first: {what}{at}; "
+                            f"{why}): a chunk that fails its checksum or does not inflate")
+    return problems
+
+
 def check_version(version, source) -> None:
     """Refuse a schema version newer (by its major number) than this grainview's."""
     if version is None:

@@ -8,6 +8,7 @@ readable netCDF file.
 
 from __future__ import annotations
 
+import functools
 import os
 
 from typing import TYPE_CHECKING
@@ -15,7 +16,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from .errors import FileFormatError
-from .file_checks import check_version, damaged_snapshots
+from .file_checks import check_version, damaged_data, damaged_snapshots
 from .netcdf3 import check_netcdf3_length
 from .schema import complete_snapshots
 
@@ -25,6 +26,37 @@ if TYPE_CHECKING:
 
 REOPEN_ATTEMPTS = 3
 """How many times :func:`open_dataset` opens a file that is replaced while it is opened."""
+
+
+@functools.cache
+def _checked_store():
+    """xarray's netCDF4 store, its variables' reads checked: a stored chunk the netCDF library
+    refuses (a Fletcher-32 checksum that does not match, data that do not inflate) raises
+    :class:`FileFormatError` naming the file and the variable in one line
+    (:func:`grainview.contract.file_checks.damaged_data`) wherever it is read, eagerly or in
+    a dask task, instead of a bare ``RuntimeError: NetCDF: HDF error``."""
+    import xarray as xr
+    from xarray.backends.netCDF4_ import NetCDF4ArrayWrapper, NetCDF4DataStore
+    from xarray.core import indexing
+
+    class CheckedArray(NetCDF4ArrayWrapper):
+        __slots__ = ()
+
+        def _getitem(self, key):
+            try:
+                return super()._getitem(key)
+            except RuntimeError as exc:
+                raise damaged_data(self.datastore.source, self.variable_name, exc) from exc
+
+    class CheckedStore(NetCDF4DataStore):
+        source = None
+
+        def open_store_variable(self, name, var):
+            variable = super().open_store_variable(name, var)
+            data = indexing.LazilyIndexedArray(CheckedArray(name, self))
+            return xr.Variable(variable.dims, data, variable.attrs, variable.encoding)
+
+    return CheckedStore
 
 
 def _open(source):
@@ -38,9 +70,14 @@ def _open(source):
         before = os.stat(source)
         try:
             check_netcdf3_length(source)
-            ds = xr.open_dataset(source, engine="netcdf4", chunks=None, cache=False,
-                                 decode_times=False, mask_and_scale=True)
-            complete = complete_snapshots(ds.variables) if "time" in ds.variables and "time" in ds.dims else None
+            store = _checked_store().open(source, mode="r")
+            store.source = source
+            try:
+                ds = xr.open_dataset(store, chunks=None, cache=False, decode_times=False, mask_and_scale=True)
+                complete = complete_snapshots(ds.variables) if "time" in ds.variables and "time" in ds.dims else None
+            except BaseException:
+                store.close()
+                raise
             return ds, complete
         except (OSError, ValueError, RuntimeError, KeyError, TypeError, IndexError) as exc:
             try:

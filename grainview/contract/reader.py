@@ -22,7 +22,7 @@ import os
 import numpy as np
 
 from .errors import FileFormatError, ParameterError
-from .file_checks import check_version, damaged_snapshots
+from .file_checks import check_version, checked_variables, damaged_snapshots
 from .netcdf3 import check_netcdf3_length
 from .schema import complete_snapshots
 
@@ -65,7 +65,8 @@ class ContractFile:
     ------
     FileFormatError
         No such file, not a readable netCDF file, a netCDF-3 file cut short or hiding records,
-        an incomplete snapshot before complete ones.
+        an incomplete snapshot before complete ones; and, from the methods that read, stored
+        data the netCDF library refuses (a chunk of a finished file that fails its checksum).
     SchemaError
         A schema version newer than this grainview's.
     """
@@ -100,14 +101,15 @@ class ContractFile:
             self.attrs = {name: _attribute(nc.getncattr(name)) for name in nc.ncattrs()}
             check_version(self.attrs.get("grainview_schema_version"), source)
             self.variables = frozenset(nc.variables)
+            self._checked = checked_variables(nc.variables, source)  # a damaged chunk: one line naming the file
             self.sizes = {name: len(dim) for name, dim in nc.dimensions.items()}
             self.n_snapshots = 0
             if "time" in nc.variables and "time" in nc.dimensions:
-                self.n_snapshots = damaged_snapshots(complete_snapshots(nc.variables), source)
+                self.n_snapshots = damaged_snapshots(complete_snapshots(self._checked), source)
                 self.sizes["time"] = self.n_snapshots
             self.wall_names = ()
             if "wall" in nc.variables:
-                names = nc.variables["wall"]
+                names = self._checked["wall"]
                 names.set_auto_chartostring(False)
                 chars = np.asarray(names[:])
                 self.wall_names = tuple(b"".join(row).decode().strip() for row in chars.reshape(len(chars), -1)) \
@@ -129,7 +131,7 @@ class ContractFile:
     def _variable(self, name):
         if name not in self.variables:
             raise FileFormatError(f"{self.source}: the file has no variable {name!r}")
-        return self._nc.variables[name]
+        return self._checked[name]
 
     def static(self, name) -> np.ndarray:
         """The whole of variable ``name`` (one without a ``time`` dimension: ``radius``, ``wall_normal``...)."""

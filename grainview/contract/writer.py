@@ -18,7 +18,7 @@ from .shapes import has_irregular_polygons, shape_problems
 
 __all__ = ["SnapshotWriter", "compress_file", "decompress_file", "is_compressed", "check_complevel",
            "netcdf3_data_bytes", "lock_file", "remove_strays", "last_complete_value", "APPEND_FORMAT",
-           "COMPRESSED_FORMAT", "DEFAULT_COMPLEVEL", "chunk_rows", "chunk_shape", "copy_blocks", "sample_blocks", "deflate_saving", "without_fill"]
+           "COMPRESSED_FORMAT", "DEFAULT_COMPLEVEL", "CHECKSUMS", "chunk_rows", "chunk_shape", "copy_blocks", "sample_blocks", "deflate_saving", "without_fill"]
 
 APPEND_FORMAT = "NETCDF3_64BIT_OFFSET"
 """The format a run is written in while it goes on: its records are appended in place, so a
@@ -31,6 +31,12 @@ same process is opened again (docs/schema.md)."""
 DEFAULT_COMPLEVEL = 1
 """zlib level (1-9) of :func:`compress_file`: level 1 makes files within 2% of level 4's size and
 inflates faster (benchmarks/results/compression.md)."""
+CHECKSUMS = True
+"""Whether a finished file's bytes are guarded: :func:`compress_file` (and
+:func:`grainview.contract.dataset.netcdf_encoding` with ``zlib``) give every variable but the
+scalars HDF5's Fletcher-32 filter, a checksum stored with each chunk that the library verifies
+whenever it reads the chunk, so a changed byte is a read error rather than another number
+(docs/schema.md, "Checksums"). netCDF-3 files (a run while it goes on) have none."""
 COPY_BLOCK_BYTES = 8 * 2**20
 """At most this many bytes of one variable (whole chunks, at least one) are held in memory while
 a file is converted."""
@@ -221,6 +227,8 @@ def _convert(path, fmt, complevel=None, lock=None) -> None:
             row_bytes = max(1, var.dtype.itemsize * int(np.prod(var.shape[1:], dtype=np.int64)))
             per_snapshot = var.ndim > 0 and var.dimensions[0] == "time"
             options, rows_per_chunk, columns = {}, 1, None
+            if complevel is not None and var.ndim > 0 and CHECKSUMS:
+                options["fletcher32"] = True  # every chunk verified as it is read
             if complevel is not None and var.dtype.kind != "S" and var.ndim > 0:
                 if per_snapshot:
                     chunks = chunk_shape(var.shape, var.dtype.itemsize, fill is not None)
