@@ -505,7 +505,7 @@ def common_force_scale(runs: dict, time=-1):
     largest particle–particle normal force of snapshot ``time`` over all runs, so that equal
     widths mean equal forces from one map to the next. Returns ``(force, caption line)``."""
     from ..analysis.contacts import selection
-    from ..plot.maps import force_unit, newtons
+    from ..plot.maps import FORCE_UNIT, per_metre
 
     largest = 0.0
     for ds in runs.values():
@@ -514,8 +514,8 @@ def common_force_scale(runs: dict, time=-1):
         largest = max(largest, float(fn) if np.isfinite(float(fn)) else 0.0)
     names = ", ".join(runs)
     thickness = float(next(iter(runs.values())).attrs.get("thickness_m", 1.0))
-    return largest, (f"line widths on one scale for {names}: the widest line is {newtons(largest)} "
-                     f"{force_unit(thickness)}")
+    return largest, (f"line widths on one scale for {names}: the widest line is {per_metre(largest, thickness)} "
+                     f"({FORCE_UNIT})")
 
 
 def xi_contacts(runs: dict):

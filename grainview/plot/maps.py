@@ -404,6 +404,11 @@ def _network(ds, k, mask, colours, ax, max_linewidth, width_by_force, linewidth,
     return lines, key
 
 
+def _digits(value: float) -> str:
+    """A number as a legend shows it: whole from 100 to 100,000, else 3 significant digits."""
+    return f"{value:.0f}" if 100.0 <= abs(value) < 1e5 else f"{value:.3g}"
+
+
 def newtons(force: float) -> str:
     """A force as a legend shows it, to at least 3 significant digits.
 
@@ -419,7 +424,30 @@ def newtons(force: float) -> str:
     str
         The force with its unit, e.g. "1.4 N" or "250 N".
     """
-    return f"{force:.0f} N" if 100.0 <= abs(force) < 1e5 else f"{force:.3g} N"
+    return f"{_digits(force)} N"
+
+
+def per_metre(force: float, thickness: float = 1.0) -> str:
+    """A force of a 2D sample as a map's legend shows it: per metre of the slab's thickness, in
+    N/m, to at least 3 significant digits.
+
+    A file's forces are in N on the slab of ``thickness`` m its 2D sample stands for
+    (docs/schema.md); divided by that thickness they are forces per metre of thickness, the
+    same numbers for the default 1 m, and comparable between files of any thickness.
+
+    Parameters
+    ----------
+    force : float
+        A force, N, on the slab.
+    thickness : float, default 1.0
+        The slab's thickness, m (a file's ``thickness_m``).
+
+    Returns
+    -------
+    str
+        The force per metre with its unit, e.g. "250 N/m" or "1.4 N/m".
+    """
+    return f"{_digits(force / thickness)} N/m"
 
 
 class WidthKey(NamedTuple):
@@ -427,7 +455,7 @@ class WidthKey(NamedTuple):
 
     The mean force drawn, ``mean_force`` N, is one of the legend's sample widths. Forces are
     those on the slab of thickness ``thickness`` m that the 2D sample stands for
-    (docs/schema.md), i.e. N per metre of thickness for the default 1 m.
+    (docs/schema.md); the legend gives them per metre of thickness (:func:`per_metre`).
 
     Attributes
     ----------
@@ -614,9 +642,9 @@ def plot_contact_kinds(data, ax=None, time: int = -1, walls: bool = False, max_l
 def _legend(ax, entries, key=None, key_colour="0.3"):
     """A legend beside the map (never over the packing): one line per colour of ``entries``
     ({label: colour}) and, when the widths stand for forces (``key``, a :class:`WidthKey`), three
-    sample widths labelled in N, each saying which force it is (the mean force, half the widest
-    line's, the widest line's), under a title giving the slab thickness the forces act on
-    (:func:`force_unit`)."""
+    sample widths labelled in N per metre of thickness (:func:`per_metre`), each saying which
+    force it is (the mean force, half the widest line's, the widest line's), under a title that
+    says so (:data:`FORCE_UNIT`)."""
     from matplotlib.lines import Line2D
     handles = [Line2D([], [], color=c, label=name) for name, c in entries.items()]
     title = None
@@ -625,30 +653,18 @@ def _legend(ax, entries, key=None, key_colour="0.3"):
                  key.top_force: "widest line"}
         for force in sorted(names):
             handles.append(Line2D([], [], color=key_colour, linewidth=key.max_linewidth * force / key.top_force,
-                                  label=f"{newtons(force)}: {names[force]}"))
-        title = f"line width $\\propto f_n$\n(forces {force_unit(key.thickness)})"
+                                  label=f"{per_metre(force, key.thickness)}: {names[force]}"))
+        title = f"line width $\\propto f_n$\n({FORCE_UNIT})"
     if handles:
         ax.legend(handles=handles, fontsize="small", loc="upper left", bbox_to_anchor=(1.02, 1.0),
                   borderaxespad=0.0, title=title, title_fontsize="small")
 
 
-def force_unit(thickness: float = 1.0) -> str:
-    """What a force in N of a 2D sample means: the force on a slab ``thickness`` m thick,
-    "per m of thickness" for the default 1 m (docs/schema.md).
-
-    Parameters
-    ----------
-    thickness : float, default 1.0
-        The slab's thickness, m (a file's ``thickness_m``).
-
-    Returns
-    -------
-    str
-        "per m of thickness", or "on a slab 0.1 m thick".
-    """
-    return "per m of thickness" if thickness == 1.0 else f"on a slab {thickness:g} m thick"
+FORCE_UNIT = "forces per m of thickness, N/m"
+"""What the forces of a map's legend are (:func:`per_metre`), as its title says."""
 
 
 __all__ = ["plot_particles", "plot_force_chains", "plot_force_classes", "plot_contact_kinds",
            "plot_particle_map", "plot_connectivity_map", "plot_rattler_map", "plot_rotation_map",
-           "contact_segments", "force_linewidths", "width_force", "newtons", "WidthKey", "contact_collection"]
+           "contact_segments", "force_linewidths", "width_force", "newtons", "per_metre", "FORCE_UNIT", "WidthKey",
+           "contact_collection"]

@@ -22,7 +22,7 @@ from grainview.analysis.fabric import fabric_anisotropy, orientation_pdf  # noqa
 from grainview.analysis.forces import force_anisotropies, harmonic_prediction  # noqa: E402
 from grainview.plot import PlotAccessor, save_figure  # noqa: E402
 from grainview.analysis.snapshots import select_snapshots  # noqa: E402
-from grainview.plot.maps import CLASS_COLOURS, KIND_COLOURS, contact_collection, newtons  # noqa: E402
+from grainview.plot.maps import CLASS_COLOURS, KIND_COLOURS, contact_collection, newtons, per_metre  # noqa: E402
 from grainview.analysis.strain import friction_and_dilatancy, strains  # noqa: E402
 from grainview.analysis.stress import stress_invariants  # noqa: E402
 from grainview.analysis.synthetic import harmonic_series  # noqa: E402
@@ -350,10 +350,10 @@ def test_kind_map_colours_simple_and_double_as_every_figure_does():
     np.testing.assert_allclose(lines.get_linewidths(), 3.0 * fn[kept] / fn[kept].max())
     top, mean = fn[kept].max(), fn[kept].mean()
     names = {mean: r"mean $\langle f_n\rangle$", top / 2: "half the widest", top: "widest line"}
-    assert legend_texts(ax) == ["simple (s)", "double (d)", *(f"{newtons(f)}: {names[f]}" for f in sorted(names))]
+    assert legend_texts(ax) == ["simple (s)", "double (d)", *(f"{per_metre(f)}: {names[f]}" for f in sorted(names))]
 
 
-def test_map_legends_sit_beside_the_packing_with_a_key_of_line_widths_in_newtons():
+def test_map_legends_sit_beside_the_packing_with_a_key_of_line_widths_per_metre():
     ds = pentagon_grid()
     ax = gp.plot_force_chains(ds, max_linewidth=4.0)
     c = int(ds["contact_count"][0])
@@ -362,13 +362,23 @@ def test_map_legends_sit_beside_the_packing_with_a_key_of_line_widths_in_newtons
     legend = ax.get_legend()
     handles = legend.legend_handles
     forces = sorted({fn.mean(), fn.max() / 2, fn.max()})
-    # each sample width says which force it is, the thinnest the mean, and what N means in 2D
-    assert legend_texts(ax) == [f"{newtons(fn.mean())}: mean " + r"$\langle f_n\rangle$",
-                                f"{newtons(fn.max() / 2)}: half the widest", f"{newtons(fn.max())}: widest line"]
+    # each sample width says which force it is, the thinnest the mean, in the unit its title names
+    assert legend_texts(ax) == [f"{per_metre(fn.mean())}: mean " + r"$\langle f_n\rangle$",
+                                f"{per_metre(fn.max() / 2)}: half the widest", f"{per_metre(fn.max())}: widest line"]
+    assert all(" N/m: " in text for text in legend_texts(ax))
     assert fn.mean() < fn.max() / 2  # the order above is the order of the forces
-    assert "per m of thickness" in legend.get_title().get_text()
+    assert legend.get_title().get_text().endswith("(forces per m of thickness, N/m)")
     assert newtons(1376.4) == "1376 N" and newtons(0.01234) == "0.0123 N" and newtons(3.6) == "3.6 N"
     assert newtons(1.4) != newtons(1.2)
+    # a file's forces act on its slab: per metre, a 0.1 m slab's 137.64 N is 1376.4 N/m
+    assert per_metre(1376.4) == "1376 N/m" and per_metre(137.64, 0.1) == "1376 N/m"
+    thin = gp.plot_force_chains(ds.assign_attrs(thickness_m=0.5), max_linewidth=4.0)
+    assert legend_texts(thin)[-1] == f"{per_metre(2 * fn.max())}: widest line"
+    from grainview.app.report import common_force_scale  # Fig. 13's scale line, in the same unit
+
+    assert common_force_scale({"a": ds}, time=0) == (
+        fn.max(), f"line widths on one scale for a: the widest line is {per_metre(fn.max())} (forces per m of "
+                  "thickness, N/m)")
     np.testing.assert_allclose([h.get_linewidth() for h in handles], [4.0 * f / fn.max() for f in forces])
     anchor = legend.get_bbox_to_anchor().transformed(ax.transAxes.inverted())
     assert anchor.x0 >= 1.0  # outside the axes: it covers no particle

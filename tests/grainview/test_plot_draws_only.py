@@ -30,7 +30,7 @@ DRAWING_HELPERS = {
     "draw_band": "a shear band's lines", "full_turn": "a polar curve closed over [0, 2 pi)",
     "map_axes": "a map's axes and frame", "contact_segments": "the contact lines of a map",
     "force_linewidths": "line widths from forces", "width_force": "the force a line width stands for",
-    "newtons": "a force in words", "force_unit": "the force unit of a map's key",
+    "newtons": "a force in words", "per_metre": "a force per metre of thickness in words",
     "contact_collection": "the contact lines drawn on a map",
     # captions and files
     "describe_figure": "a figure's caption", "sampling_note": "a caption line", "interval_note": "a caption line",
