@@ -118,7 +118,9 @@ def force_chains(ds: xr.Dataset, angle: float = DEFAULT_ANGLE, min_size: int = 3
         over time: ``n_chains``, ``mean_length`` (particles per chain), ``orientation``
         (axial mean of the chains' link directions, rad in [0, pi)), ``particle_fraction``,
         ``deviator_fraction`` ((D_chains : D)/(D : D) with D the deviator of
-        sum_p V_p sigma_p, the chains' share of q), ``pressure_fraction`` (their share of p);
+        sum_p V_p sigma_p: the chains' contribution to q in units of q, signed and above 1
+        where the other particles' deviator opposes the sample's, since the two contributions
+        add up to 1), ``pressure_fraction`` (their share of p);
         over (time, length): ``length_count`` and ``length_pdf`` (the number and fraction of
         chains of each length, in particles; NaN without chains). With ``follow``:
         ``chain_track`` (time, particle), the track id of the particle's chain (-1 outside
@@ -164,7 +166,8 @@ def force_chains(ds: xr.Dataset, angle: float = DEFAULT_ANGLE, min_size: int = 3
         "particle_fraction": with_attrs(particle_fraction, "particle_fraction", "1",
                                         "fraction of the particles in force chains"),
         "deviator_fraction": with_attrs(deviator_fraction, "deviator_fraction", "1",
-                                        "share of the deviatoric stress carried by the chains' particles"),
+                                        "the chains' particles' contribution to the deviatoric stress, in units "
+                                        "of the sample's (above 1 where the other particles' deviator opposes it)"),
         "pressure_fraction": with_attrs(pressure_fraction, "pressure_fraction", "1",
                                         "share of the mean stress carried by the chains' particles"),
         "length_count": with_attrs(length_count, "length_count", "1", "number of chains of each length"),

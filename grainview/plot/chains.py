@@ -94,17 +94,18 @@ def plot_chain_map(data, ax=None, time: int = -1, angle: float = 45.0, min_size:
     ax.add_collection(LineCollection(segments, colors=LINK_COLOUR, linewidths=linewidth, zorder=2, gid="chains"))
     if title:
         ax.set_title(f"snapshot {k}: {int(snap['n_chains'])} chains, {float(snap['particle_fraction']):.0%} of the "
-                     f"particles, {float(snap['deviator_fraction']):.0%} of q", fontsize="small")
+                     f"particles, contributing {float(snap['deviator_fraction']):.0%} of q", fontsize="small")
     return ax
 
 
 @fill_doc
 def plot_chain_fractions(data, ax=None, label=None, angle: float = 45.0, min_size: int = 3):
-    """Shares of the chains along the shear: of the particles, of the deviatoric stress and of
-    the mean stress, against eps_q.
+    """What the chains carry along the shear: their share of the particles and of the mean
+    stress, and their contribution to the deviatoric stress, against eps_q.
 
     ``particle_fraction``, ``deviator_fraction`` ((D_chains : D)/(D : D), D the deviator of
-    sum_p V_p sigma_p) and ``pressure_fraction`` of :func:`grainview.analysis.force_chains.force_chains`;
+    sum_p V_p sigma_p: signed, above 1 where the other particles' deviator opposes the
+    sample's) and ``pressure_fraction`` of :func:`grainview.analysis.force_chains.force_chains`;
     several samples compare on the same axes.
 
     Parameters
@@ -131,11 +132,12 @@ def plot_chain_fractions(data, ax=None, label=None, angle: float = 45.0, min_siz
     ax = get_axes(ax)
     pairs = datasets(data, label)
     draw_evolutions(ax, pairs, lambda ds: force_chains(ds, angle=angle, min_size=min_size),
-                    [("share of q", "deviator_fraction"), ("share of p", "pressure_fraction"),
+                    [("contribution to q", "deviator_fraction"), ("share of p", "pressure_fraction"),
                      ("share of particles", "particle_fraction")])
     ax.axhline(0.0, color="0.6", linewidth=0.5)
+    ax.axhline(1.0, color="0.6", linewidth=0.5)
     ax.set_xlabel(EPS_Q_LABEL)
-    ax.set_ylabel("share carried by the force chains")
+    ax.set_ylabel("carried by the force chains (1: all)")
     return finish(ax, pairs)
 
 

@@ -116,6 +116,33 @@ def test_a_loaded_column_among_lightly_loaded_pairs_is_one_chain(prepare):
     np.testing.assert_array_equal(np.flatnonzero(out.link.values), [0, 1, 2, 3])
 
 
+@pytest.mark.parametrize("light", [0.5, 2.0])
+def test_the_chains_contribution_to_q_exceeds_1_when_the_rest_opposes_it(light):
+    """The column carries a vertical deviator, the horizontal pairs outside the chain a
+    horizontal one, which lowers q: the chains' contribution to q is above 1 and the other
+    particles' is negative, the two adding up to 1. The other particles' contribution is
+    built here from their principal stresses, apart from the kernel's sums."""
+    out = force_chains(column_among_pairs(load=10.0, light=light)).isel(time=0)
+    outside = out.chain.values < 0
+    np.testing.assert_array_equal(np.flatnonzero(outside), np.arange(5, 11))
+    s1, s2, th = out.sigma_1.values, out.sigma_2.values, np.nan_to_num(out.theta_1.values)
+    c, s = np.cos(th), np.sin(th)
+    rot = np.stack([np.stack([c, -s], -1), np.stack([s, c], -1)], -2)  # (P, 2, 2)
+    tensors = VP * rot @ (np.stack([s1, s2], -1)[..., None] * np.eye(2)) @ np.swapaxes(rot, -1, -2)
+
+    def dev(t):
+        return t - 0.5 * np.trace(t) * np.eye(2)
+
+    total, rest = dev(tensors.sum(0)), dev(tensors[outside].sum(0))
+    rest_contribution = float((rest * total).sum() / (total * total).sum())
+    a, b = 100 * R, 6 * light * R  # the column's yy sum, the pairs' xx sum (as above)
+    assert rest_contribution == pytest.approx(-b / (a - b), rel=1e-12) and rest_contribution < 0
+    assert float(out.deviator_fraction) == pytest.approx(1 - rest_contribution, rel=1e-12)
+    assert float(out.deviator_fraction) == pytest.approx(a / (a - b), rel=1e-12) and a / (a - b) > 1
+    assert 0 < float(out.pressure_fraction) < 1
+    assert "above 1 where the other particles' deviator opposes it" in out.deviator_fraction.attrs["long_name"]
+
+
 @pytest.mark.parametrize("rotation", [0.3, 1.1, 2.5])
 def test_a_turned_column_is_the_same_chain_along_its_direction(rotation):
     out = force_chains(column_among_pairs(rotation=rotation)).isel(time=0)

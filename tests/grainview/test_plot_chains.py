@@ -64,6 +64,9 @@ def test_the_fractions_are_the_computed_ones(three):
     np.testing.assert_allclose(ax.lines[2].get_ydata(), out.particle_fraction.values)
     np.testing.assert_allclose(ax.lines[0].get_xdata(), strains(three)["eps_q"].values)
     assert ax.get_xlabel() == r"$\varepsilon_q$"
+    # a contribution, not a share: the legend and the axis say so, and the line at 1 is "all"
+    assert ax.get_legend_handles_labels()[1][0].startswith("contribution to q")
+    assert ax.get_ylabel() == "carried by the force chains (1: all)"
 
 
 def test_the_lengths_pdf_and_the_lifetimes(three):

@@ -145,11 +145,14 @@ def force_chains(i, j, fn, ft, normal, point, branch, mask, position, volume, an
     * ``orientation`` (...): mean orientation of the chains' links, the axial mean
       phi = (1/2) atan2(sum sin 2 phi_l, sum cos 2 phi_l) in [0, pi), rad (NaN without chains);
     * ``particle_fraction`` (...): particles in chains / P;
-    * ``deviator_fraction`` (...): the share of the deviatoric stress carried by the chains,
-      (D_chains : D)/(D : D), D = dev(sum_p V_p sigma_p) over all particles and D_chains the
-      same sum over the chain particles (equal to q_chains/q when both deviators are
-      aligned; the chains and the other particles add up to 1); 0 without chains, NaN for an
-      isotropic sample stress;
+    * ``deviator_fraction`` (...): the chains' contribution to the deviatoric stress in units
+      of the sample's, (D_chains : D)/(D : D), D = dev(sum_p V_p sigma_p) over all particles
+      and D_chains the same sum over the chain particles (equal to q_chains/q when both
+      deviators are aligned). Signed and not bounded by 1: the chains' and the other
+      particles' contributions add up to 1, so it exceeds 1 where the other particles'
+      deviator opposes the sample's (a weak network loaded across the chains) and is
+      ill-conditioned where D is small (a nearly isotropic state); 0 without chains, NaN for
+      an isotropic sample stress;
     * ``pressure_fraction`` (...): tr(sum_chains V_p sigma_p)/tr(sum_p V_p sigma_p).
     """
     moments = particle_moments(i, j, fn, ft, normal, point, mask, position)
