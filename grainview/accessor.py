@@ -51,7 +51,8 @@ class GrainAccessor:
     Each analysis method calls the function of the same name in a topic module, whose
     docstring it shows; on an ensemble (a ``run`` dimension) it runs per run
     (:func:`grainview.analysis.ensemble.map_runs`). Time series come back with the strains
-    :data:`STRAIN_COORDS` as coordinates along ``time`` (when the file has its box).
+    ``eps_1``, ``eps_p`` and ``eps_q`` as coordinates along ``time`` (when the file has its
+    box). ``dir(ds.grain)`` lists the analyses, ``validate`` and ``plot``, nothing internal.
 
     Parameters
     ----------
@@ -79,26 +80,37 @@ class GrainAccessor:
             check_structure(self._ds)
             self._structure_ok = True
 
-    STRAIN_COORDS = ("eps_1", "eps_p", "eps_q")
+    _STRAIN_COORDS = ("eps_1", "eps_p", "eps_q")
     """Strains attached to every time series the accessor returns, as non-index coordinates
     along ``time``, so that ``result.plot(x="eps_q")`` and ``result.swap_dims(time="eps_q")``
     need no merge."""
 
     def _with_strains(self, result):
-        """``result`` with :data:`STRAIN_COORDS` as coordinates along ``time`` when it is a time
+        """``result`` with :data:`_STRAIN_COORDS` as coordinates along ``time`` when it is a time
         series of this dataset (and does not hold strains itself)."""
         ds = self._ds
         if (not isinstance(result, (xr.Dataset, xr.DataArray)) or result.sizes.get("time") != ds.sizes.get("time")
                 or any(name in result.coords or name in getattr(result, "data_vars", {})
-                       or name == getattr(result, "name", None) for name in self.STRAIN_COORDS)
+                       or name == getattr(result, "name", None) for name in self._STRAIN_COORDS)
                 or not {"box_min", "box_max"} <= set(ds.variables)):
             return result
         if self._strains is None:
             from .analysis.strain import strains
 
             eps = strains(ds)
-            self._strains = {name: eps[name] for name in self.STRAIN_COORDS}
+            self._strains = {name: eps[name] for name in self._STRAIN_COORDS}
         return result.assign_coords(self._strains)
+
+    def __dir__(self):
+        """The user-facing names only (the analyses, ``validate`` and ``plot``), for ``dir`` and
+        tab completion.
+
+        Returns
+        -------
+        list of str
+            The public names of the accessor, sorted.
+        """
+        return sorted(name for name in dir(type(self)) if not name.startswith("_"))
 
     def validate(self):
         """Check the dataset against the contract (:func:`grainview.contract.validation.validate`).

@@ -88,10 +88,11 @@ def _delegate(func):
 
 
 class PlotAccessor:
-    """The figures of one dataset: ``PlotAccessor(ds).q_over_p(ax=ax, label="pentagons")``.
+    """The figures of one dataset: ``ds.grain.plot.q_over_p(ax=ax, label="pentagons")``
+    (:attr:`grainview.accessor.GrainAccessor.plot`), or ``PlotAccessor(ds).q_over_p(...)``.
 
-    Or ``ds.grain.plot.q_over_p(...)`` once :class:`grainview.accessor.GrainAccessor` exposes
-    it. Each method is the function ``plot_<name>`` of this package applied to the dataset.
+    Each method is the function ``plot_<name>`` of this package applied to the dataset;
+    ``dir`` lists those methods only.
 
     Parameters
     ----------
@@ -106,6 +107,16 @@ class PlotAccessor:
 
     def __init__(self, ds: xr.Dataset):
         self._ds = ds
+
+    def __dir__(self):
+        """The figure methods only, for ``dir`` and tab completion.
+
+        Returns
+        -------
+        list of str
+            The public names of the accessor, sorted.
+        """
+        return sorted(name for name in dir(type(self)) if not name.startswith("_"))
 
     # macroscopic (Figs. 3, 4, 5, 12, 18)
     q_over_p = _delegate(plot_q_over_p)

@@ -526,6 +526,22 @@ def test_accessor_has_a_method_for_every_figure(series):
     np.testing.assert_allclose(ax.lines[0].get_ydata(), stress_invariants(series)["q_over_p"].values)
 
 
+def test_the_accessors_list_only_their_user_facing_names(series):
+    from grainview.accessor import GrainAccessor, _Delegate
+
+    analyses = {name for name, value in vars(GrainAccessor).items() if isinstance(value, _Delegate)}
+    assert {"stress_invariants", "force_chains", "coarse_grained"} <= analyses
+    assert dir(series.grain) == sorted(analyses | {"validate", "plot"})
+    assert "STRAIN_COORDS" not in dir(series.grain) and not any(n.startswith("_") for n in dir(series.grain))
+    figures = {name for name, value in vars(PlotAccessor).items() if getattr(value, "__wrapped__", None)}
+    assert {f.__name__.removeprefix("plot_") for f in gp.FIGURES.values()} <= figures
+    assert dir(series.grain.plot) == sorted(figures)
+    # the strains still come back as coordinates of the time series
+    assert {"eps_1", "eps_p", "eps_q"} <= set(series.grain.stress_invariants().coords)
+    # the docstring speaks of ds.grain.plot as it is, not as a plan
+    assert "once" not in PlotAccessor.__doc__ and "ds.grain.plot.q_over_p(" in PlotAccessor.__doc__
+
+
 def test_save_figure_writes_png_and_pdf(tmp_path, series):
     ax = gp.plot_q_over_p(series)
     paths = save_figure(ax.figure, tmp_path / "figs" / "fig03")
