@@ -1294,11 +1294,32 @@ def _is_number(text) -> bool:
     return True
 
 
+@contextlib.contextmanager
+def _warnings_as_notes():
+    """Within the block, a warning of the program's (a UserWarning) that reaches the user is one
+    ``note: <message>`` line on stdout, as the conversions' notes are, not Python's report with
+    the source file and line; other warnings are shown as before."""
+    import warnings
+
+    previous = warnings.showwarning
+
+    def show(message, category, filename, lineno, file=None, line=None):
+        if issubclass(category, UserWarning):
+            print(f"note: {message}")
+        else:
+            previous(message, category, filename, lineno, file, line)
+
+    with warnings.catch_warnings():
+        warnings.showwarning = show
+        yield
+
+
 def main(argv=None) -> int:
     parser = build_parser()
     args = parser.parse_args(_negative_values_attached(sys.argv[1:] if argv is None else list(argv)))
     try:
-        return args.func(args)
+        with _warnings_as_notes():
+            return args.func(args)
     except SchemaError as exc:  # one line; `info --check` lists every problem
         listed = args.command == "info" and getattr(args, "check", False) and len(exc.problems) > 1
         message = str(exc).replace("\n", "\n  ") if listed else exc.summary()
