@@ -177,8 +177,10 @@ def _demo(args) -> int:
     from .demo import run_demo
 
     path, frame = run_demo(args.out, snapshots=args.snapshots, contacts=args.contacts, seed=args.seed,
-                           overwrite=args.overwrite, compress=not args.no_compress)
-    print(f"wrote {path}; q/p against the harmonic prediction (a' + a_n + a_t)/2:")
+                           overwrite=args.overwrite, compress=not args.no_compress,
+                           log=lambda line: print(f"demo: {line}", flush=True))
+    print(f"wrote {path} and {path.parent / 'harmonic_prediction.csv'}; q/p against the harmonic prediction "
+          "(a' + a_n + a_t)/2:")
     print(frame.round(4).to_string())
     return 0
 
@@ -1133,7 +1135,9 @@ def _demo_parser(sub):
                           description="Write a synthetic series drawn from the harmonic model (no simulation, "
                           "seconds) and compare q/p with the prediction (a' + a_n + a_t)/2 computed lazily "
                           "from the file.")
-    demo.add_argument("--out", default="demo-out", help="output folder (default: demo-out)")
+    demo.add_argument("--out", default="demo-out", help="output folder, made if needed (default: demo-out in the "
+                      "current folder); the command says where it writes and refuses to replace its files without "
+                      "--overwrite")
     snapshots, contacts = (library_default("grainview.app.demo", "run_demo", k) for k in ("snapshots", "contacts"))
     demo.add_argument("--snapshots", type=int, default=snapshots, help=f"number of snapshots (default {snapshots})")
     demo.add_argument("--contacts", type=int, default=contacts, help=f"contacts per snapshot (default {contacts})")

@@ -14,7 +14,7 @@ from pathlib import Path
 from ..contract.errors import ParameterError
 
 
-def run_demo(out, *, snapshots=11, contacts=20000, seed=None, overwrite=False, compress=True):
+def run_demo(out, *, snapshots=11, contacts=20000, seed=None, overwrite=False, compress=True, log=None):
     """Write ``out/synthetic.nc`` (``snapshots`` snapshots of ``contacts`` contacts; large
     enough by default that reading it lazily matters) and ``out/harmonic_prediction.csv``.
 
@@ -27,14 +27,25 @@ def run_demo(out, *, snapshots=11, contacts=20000, seed=None, overwrite=False, c
     seed : int, optional
         Random seed (default: the series' own).
     overwrite : bool
-        Replace an existing ``synthetic.nc``; otherwise it is refused.
+        Replace existing output files; otherwise either one existing is refused before
+        anything is written.
     compress : bool
         Write the file compressed (zlib).
+    log : callable, optional
+        Called with one line saying where the two files go, once they are known not to
+        replace anything (or ``overwrite`` allows it).
 
     Returns
     -------
     (pathlib.Path, pandas.DataFrame)
         The file, and per snapshot q/p, the prediction (a' + a_n + a_t)/2, a', a_n, a_t (1).
+
+    Raises
+    ------
+    grainview.contract.errors.ParameterError
+        For fewer than 2 snapshots or 1 contact.
+    FileExistsError
+        When an output file exists and ``overwrite`` is False.
     """
     from ..analysis.synthetic import harmonic_series
     from ..contract.dataset import netcdf_options
@@ -43,11 +54,14 @@ def run_demo(out, *, snapshots=11, contacts=20000, seed=None, overwrite=False, c
     if snapshots < 2 or contacts < 1:
         raise ParameterError(f"snapshots={snapshots}, contacts={contacts}: expected at least 2 snapshots and 1 "
                              "contact")
-    out = Path(out)
-    out.mkdir(parents=True, exist_ok=True)
-    path = out / "synthetic.nc"
-    if path.exists() and not overwrite:
-        raise FileExistsError(f"{path} exists; pass overwrite=True to replace it")
+    path, csv = demo_outputs(out)
+    if not overwrite:
+        for target in (path, csv):
+            if target.exists():
+                raise FileExistsError(f"{target} exists; pass overwrite=True to replace it")
+    if log is not None:
+        log(f"writing {path} and {csv} ...")
+    path.parent.mkdir(parents=True, exist_ok=True)
     ds = harmonic_series(n_snapshots=snapshots, n_contacts=contacts, **({} if seed is None else {"seed": seed}))
     tmp = path.with_suffix(".nc.part")  # written whole, then renamed: never a half-written file
     ds.to_netcdf(tmp, **netcdf_options(ds, compress=compress))
@@ -56,5 +70,24 @@ def run_demo(out, *, snapshots=11, contacts=20000, seed=None, overwrite=False, c
     table = lazy.grain.harmonic_prediction().compute()
     table["a"] = lazy.grain.fabric_anisotropy()["a"].compute()
     frame = table.to_dataframe()[["q_over_p", "prediction", "a_prime", "a_n", "a_t"]]
-    frame.to_csv(out / "harmonic_prediction.csv")
+    part = csv.with_suffix(".csv.part")
+    frame.to_csv(part)
+    part.replace(csv)
     return path, frame
+
+
+def demo_outputs(out) -> tuple[Path, Path]:
+    """The two files :func:`run_demo` writes into folder ``out``: the series and its table.
+
+    Parameters
+    ----------
+    out : path-like
+        The output folder.
+
+    Returns
+    -------
+    (pathlib.Path, pathlib.Path)
+        ``out/synthetic.nc`` and ``out/harmonic_prediction.csv``.
+    """
+    out = Path(out)
+    return out / "synthetic.nc", out / "harmonic_prediction.csv"

@@ -32,6 +32,27 @@ def test_demo_writes_a_valid_file_and_a_table_equal_to_the_accessors(tmp_path, c
         xr.testing.assert_identical(plain, packed)
 
 
+def test_demo_says_where_it_writes_and_replaces_neither_file_without_overwrite(tmp_path, monkeypatch, capsys):
+    monkeypatch.chdir(tmp_path)  # the default folder is demo-out in the current folder
+    assert main(["demo", "--snapshots", "2", "--contacts", "50"]) == 0
+    out = capsys.readouterr().out.splitlines()
+    assert out[0] == "demo: writing demo-out/synthetic.nc and demo-out/harmonic_prediction.csv ..."
+    assert out[1].startswith("wrote demo-out/synthetic.nc and demo-out/harmonic_prediction.csv; q/p against")
+    assert sorted(p.name for p in (tmp_path / "demo-out").iterdir()) == ["harmonic_prediction.csv", "synthetic.nc"]
+    # the table alone is enough to refuse, before anything is written
+    (tmp_path / "demo-out" / "synthetic.nc").unlink()
+    table = (tmp_path / "demo-out" / "harmonic_prediction.csv").read_text()
+    assert main(["demo", "--snapshots", "2", "--contacts", "50"]) == 2
+    captured = capsys.readouterr()
+    assert captured.out == ""
+    assert captured.err == ("grainview: error: demo-out/harmonic_prediction.csv exists; pass --overwrite to replace "
+                            "it\n")
+    assert not (tmp_path / "demo-out" / "synthetic.nc").exists()
+    assert (tmp_path / "demo-out" / "harmonic_prediction.csv").read_text() == table
+    assert main(["demo", "--snapshots", "2", "--contacts", "50", "--overwrite"]) == 0
+    assert (tmp_path / "demo-out" / "synthetic.nc").exists()
+
+
 def test_info_prints_summary_and_validates(tmp_path, capsys):
     ds = harmonic_series(n_snapshots=2, n_contacts=50)
     path = tmp_path / "s.nc"
