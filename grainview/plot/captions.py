@@ -126,8 +126,9 @@ def strain_note(label: str, ds: xr.Dataset) -> str:
 
     eps_q = eps_1 - eps_2 is the paper's shear strain, the net strain since the first snapshot
     (its signed increments summed), not a path length: it decreases where the sample narrows
-    faster than it shortens, and a curve against it folds back there. The line names the
-    largest such fall, from the largest eps_q reached before it.
+    faster than it shortens, and a curve against it folds back there. The line says how many
+    times it decreases from a snapshot to the next and names the largest fall, from the largest
+    eps_q reached before it.
 
     Parameters
     ----------
@@ -152,8 +153,11 @@ def strain_note(label: str, ds: xr.Dataset) -> str:
     k = int(np.argmax(fall))
     if not fall[k] > 0:
         return ""
-    return (f"{label}: eps_q decreases from {reached[k]:.4f} to {strain[k]:.4f} (the sample narrowed faster than it "
-            "shortened; eps_q is the net shear strain, not a path length), so curves against eps_q fold back there")
+    steps = int(np.count_nonzero(np.diff(strain) < 0))
+    where = "from one snapshot to the next" if steps == 1 else f"between {steps} pairs of successive snapshots"
+    return (f"{label}: eps_q decreases {where}, most from {reached[k]:.4f} to {strain[k]:.4f} (the sample narrowed "
+            "faster than it shortened; eps_q is the net shear strain, not a path length), so curves against eps_q "
+            "fold back there")
 
 
 def interval_note(label: str, ds: xr.Dataset) -> str:

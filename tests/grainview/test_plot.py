@@ -766,9 +766,16 @@ def test_the_strain_captions_name_eps_q_as_the_net_strain_and_say_where_it_decre
     after = np.log(1 + (h[0] - h[3]) / h[0])
     assert after == pytest.approx(np.log(1.1)) and after < before
     assert strain_note("s", narrowed) == (
-        f"s: eps_q decreases from {before:.4f} to {after:.4f} (the sample narrowed faster than it shortened; eps_q is "
-        "the net shear strain, not a path length), so curves against eps_q fold back there")
+        f"s: eps_q decreases from one snapshot to the next, most from {before:.4f} to {after:.4f} (the sample narrowed "
+        "faster than it shortened; eps_q is the net shear strain, not a path length), so curves against eps_q fold "
+        "back there")
     assert "from 0.0984 to 0.0953" in strain_note("s", narrowed)
+    # widened a lot, then narrowed twice: eps_q falls from snapshot 1 to 2 and from 2 to 3
+    box_max = series["box_max"].values.copy()
+    box_max[1:, 0] = [1.1, box_max[0, 0], 0.9]
+    twice = series.assign(box_max=(series["box_max"].dims, box_max))
+    assert (np.diff(strains(twice)["eps_q"].values) < 0).tolist() == [False, True, True]
+    assert strain_note("s", twice).startswith("s: eps_q decreases between 2 pairs of successive snapshots, most from ")
 
 
 def test_pooled_contacts_counts_different_pairs(series):
