@@ -88,7 +88,7 @@ def _export(args) -> int:
         print(f"wrote {len(paths)} VTK files to {args.out}: open snapshots.pvd in ParaView or OVITO"
               + (", and polygons.pvd (the polygons' outlines) in ParaView" if outlines else ""))
     else:
-        path = write_csv(ds, args.out, every=args.every, overwrite=args.overwrite)
+        path = write_csv(ds, args.out, every=args.every, overwrite=args.overwrite, progress=args.progress != "off")
         print(f"wrote {path}")
     return 0
 

@@ -294,13 +294,23 @@ _CSV_NAMES = {"time": "time_s", "fn": "fn_N", "ft": "ft_N", "point_x": "point_x_
               "branch_x": "branch_x_m", "branch_y": "branch_y_m", "gap": "gap_m"}
 
 
-def write_csv(ds: xr.Dataset, out_dir, every: int = 1, overwrite: bool = False) -> str:
+CSV_BLOCK_SLOTS = 200_000
+"""Contact slots read at once by :func:`write_csv`: the snapshots of a block are read together
+(one read per variable, not one per snapshot) and written as one piece of the table."""
+
+_CSV_VARIABLES = ("contact_count", "i", "j", "kind", "fn", "ft", "normal", "point", "branch", "gap")
+"""The variables :func:`grainview.analysis.tables.contacts_table` reads."""
+
+
+def write_csv(ds: xr.Dataset, out_dir, every: int = 1, overwrite: bool = False, progress=None) -> str:
     """Write ``contacts.csv``: the tidy contact table of every ``every``-th snapshot.
 
     The table is :func:`grainview.analysis.tables.contacts_table`'s, with columns ``snapshot`` and
     ``time_s`` first, the units in the column names, ``kind`` as "simple" or "double" and a
     column ``loaded`` (f_n > 0) that tells the force-bearing contacts from the pairs without
-    force (:data:`CSV_COLUMNS`).
+    force (:data:`CSV_COLUMNS`). The snapshots are read in blocks of about
+    :data:`CSV_BLOCK_SLOTS` contact slots and the table is written block by block, so that
+    neither the reading nor the table's memory grows with the number of snapshots.
 
     Parameters
     ----------
@@ -312,6 +322,8 @@ def write_csv(ds: xr.Dataset, out_dir, every: int = 1, overwrite: bool = False) 
         Write every ``every``-th snapshot (the last always included).
     overwrite : bool, default False
         Replace an existing ``contacts.csv``.
+    progress : bool, optional
+        Show a progress bar over the snapshots (default: none).
 
     Returns
     -------
@@ -333,17 +345,46 @@ def write_csv(ds: xr.Dataset, out_dir, every: int = 1, overwrite: bool = False) 
 
     from ..analysis.tables import contacts_table
 
+    indices = snapshot_indices(ds, every)
+    path = os.path.join(out_dir, "contacts.csv")
+    if os.path.exists(path) and not overwrite:
+        raise ParameterError(f"{path} exists; pass overwrite=True to replace it")
     os.makedirs(out_dir, exist_ok=True)
-    frames = []
-    for k in snapshot_indices(ds, every):
-        table = contacts_table(ds, time=int(k))
+    names = [name for name in _CSV_VARIABLES if name in ds]
+    keep = [name for name in ("radius",) if name in ds]  # the particle count, for the wall column
+    per_block = max(1, CSV_BLOCK_SLOTS // max(1, ds.sizes.get("contact", 1)))
+    kinds = {code: name for code, name in KIND_NAMES.items()}
+
+    def table_of(block, k, local):
+        table = contacts_table(block, time=local)
         table.insert(0, "time", table.attrs["time"])
         table.insert(0, "snapshot", int(k))
         table.insert(table.columns.get_loc("fn"), "loaded", table["fn"] > 0)
-        table["kind"] = table["kind"].map(lambda code: KIND_NAMES.get(int(code), str(int(code))))
-        frames.append(table.rename(columns=_CSV_NAMES))
-    path = os.path.join(out_dir, "contacts.csv")
-    out = pd.concat(frames, ignore_index=True) if frames else pd.DataFrame(columns=[
-        c for c in CSV_COLUMNS if c != "gap_m" or "gap" in ds])
-    write_atomically(path, overwrite, lambda temporary: out.to_csv(temporary, index=False))
+        codes = table["kind"].to_numpy()
+        table["kind"] = [kinds.get(int(code), str(int(code))) for code in codes] if len(codes) else codes
+        return table.rename(columns=_CSV_NAMES)
+
+    def write(temporary):
+        bar = None
+        if progress:
+            from tqdm.auto import tqdm
+
+            bar = tqdm(total=len(indices), desc="CSV export", unit="snapshot")
+        try:
+            with open(temporary, "w", newline="") as stream:
+                if not len(indices):
+                    pd.DataFrame(columns=[c for c in CSV_COLUMNS if c != "gap_m" or "gap" in ds]).to_csv(
+                        stream, index=False)
+                for start in range(0, len(indices), per_block):
+                    chosen = indices[start:start + per_block]
+                    block = ds[names + keep].isel(time=chosen).load()
+                    frames = [table_of(block, k, local) for local, k in enumerate(chosen)]
+                    pd.concat(frames, ignore_index=True).to_csv(stream, index=False, header=start == 0)
+                    if bar is not None:
+                        bar.update(len(chosen))
+        finally:
+            if bar is not None:
+                bar.close()
+
+    write_atomically(path, overwrite, write)
     return path

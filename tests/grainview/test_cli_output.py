@@ -165,6 +165,7 @@ def test_csv_export_flags_the_pairs_without_force_and_names_kinds_and_units(tmp_
 def test_export_refusal_names_the_flag_once(tmp_path, capsys):
     path = _write(chain(), tmp_path / "c.nc")
     assert main(["export", str(path), "--to", "csv", "--out", str(tmp_path / "csv")]) == 0
+    assert "CSV export" in capsys.readouterr().err  # its progress bar
     assert main(["export", str(path), "--to", "csv", "--out", str(tmp_path / "csv")]) == 2
     err = capsys.readouterr().err
     assert err.count("--overwrite") == 1 and err.count("\n") == 1

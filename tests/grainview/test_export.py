@@ -166,6 +166,38 @@ def test_csv_is_the_tidy_table_of_every_snapshot(tmp_path):
     assert (at.time_s == 2.0).all()
 
 
+@pytest.mark.parametrize("every", [1, 2])
+def test_csv_in_blocks_is_the_snapshots_tables_one_after_the_other(tmp_path, monkeypatch, capsys, every):
+    """The table read a block of snapshots at a time, whatever the block, is the tables of the
+    snapshots one by one, concatenated (the per-snapshot way, rebuilt here), with a progress
+    bar over the snapshots when asked for."""
+    import grainview.formats.export as export
+    from grainview.analysis.tables import contacts_table
+
+    ds = polygons_and_disks()
+    chosen = export.snapshot_indices(ds, every)
+    frames = []
+    for k in chosen:
+        table = contacts_table(ds, time=int(k))
+        table.insert(0, "time_s", table.attrs["time"])
+        table.insert(0, "snapshot", int(k))
+        table.insert(table.columns.get_loc("fn"), "loaded", table["fn"] > 0)
+        table["kind"] = table["kind"].map({1: "simple", 2: "double"})
+        frames.append(table.rename(columns={"fn": "fn_N", "ft": "ft_N", "point_x": "point_x_m",
+                                            "point_y": "point_y_m", "branch_x": "branch_x_m",
+                                            "branch_y": "branch_y_m", "gap": "gap_m"}))
+    expected = pd.concat(frames, ignore_index=True).to_csv(index=False)
+    whole = (tmp_path / "whole")
+    with open(write_csv(ds, whole, every=every, progress=False)) as f:
+        assert f.read() == expected
+    assert capsys.readouterr().err == ""
+    monkeypatch.setattr(export, "CSV_BLOCK_SLOTS", 1)  # one snapshot a block
+    with open(write_csv(ds, tmp_path / "blocks", every=every, progress=True)) as f:
+        assert f.read() == expected
+    bar = capsys.readouterr().err
+    assert "CSV export" in bar and f"{len(chosen)}/{len(chosen)}" in bar and len(chosen) > 2
+
+
 def test_export_command(tmp_path, capsys):
     from grainview.app.cli import main
 
