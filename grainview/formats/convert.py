@@ -4,19 +4,30 @@ A reader yields its run snapshot by snapshot (the static particle data once, the
 per snapshot for :meth:`grainview.contract.writer.SnapshotWriter.append`); :func:`write_snapshots`
 appends them to a file under a hidden temporary name, checks the finished file against the
 contract, compresses it and only then gives it its name. A run of any length is written in
-the memory of one snapshot, and bad input anywhere leaves nothing behind.
+the memory of one snapshot, and bad input anywhere leaves nothing behind. Every snapshot is
+checked for values that are not finite or are absurd (:func:`grainview.formats.checks.check_snapshot`)
+before it is stored.
+
+A conversion stopped by Ctrl-C or SIGTERM removes its temporary files before it ends; one killed
+outright (SIGKILL, a power cut) leaves them, and the next conversion to the same file removes
+those whose process is gone (:func:`remove_dead_temporaries`).
 """
 
 from __future__ import annotations
 
 import itertools
 import os
+import re
 
 import numpy as np
 
-from ..contract.errors import FileFormatError
+from ..contract.errors import FileFormatError, ParameterError, SchemaError
+from .checks import Limits, check_snapshot
 
-__all__ = ["check_out", "write_snapshots", "snapshots_dataset"]
+__all__ = ["check_out", "write_snapshots", "snapshots_dataset", "remove_dead_temporaries", "LABELS"]
+
+LABELS = ("lammps", "lmgc90", "mercurydpm", "pegs", "peer", "convert")
+"""The readers' labels: a conversion to ``run.nc`` is written as ``.run.nc.<pid>.<label>``."""
 
 
 def check_out(out, overwrite: bool) -> str:
@@ -60,6 +71,9 @@ def snapshots_dataset(static, snaps, per_snapshot=(), **static_optional):
     from ..contract.dataset import make_dataset
     from ..contract.schema import contact_slots
 
+    limits = _limits(static)
+    for k, snap in enumerate(snaps):
+        check_snapshot(limits, snap, _where(static, k, snap))
     optional = {name: np.stack([s[name] for s in snaps]) for name in per_snapshot if all(name in s for s in snaps)}
     optional.update({name: value for name, value in static_optional.items() if value is not None})
     n = static["radius"].size
@@ -106,11 +120,44 @@ def write_snapshots(out, static, snapshots, optional, *, overwrite=False, compre
     -------
     int
         The number of snapshots written.
+
+    Raises
+    ------
+    FileFormatError
+        A snapshot holding a value that is not finite or is absurd
+        (:func:`grainview.formats.checks.check_snapshot`), or a finished run that breaks the
+        contract (naming ``out``, which is not written).
+    grainview.contract.locks.FileLockedError
+        Another process is writing ``out``.
+
+    Notes
+    -----
+    While it runs, ``out``'s writer's lock is held (:mod:`grainview.contract.locks`) and SIGTERM
+    is turned into an exception, so that a stopped conversion removes its temporary files as
+    Ctrl-C does; the temporary files of conversions to ``out`` whose process is gone are removed
+    first.
     """
+    from solver.interrupt import sigterm_raises
+
+    from ..contract.writer import lock_file
+
+    if label not in LABELS:
+        raise ParameterError(f"label={label!r}: expected one of {', '.join(LABELS)}")
+    out = check_out(out, overwrite)
+    with sigterm_raises():
+        lock = lock_file(out)  # one conversion or run at a time; a killed writer's temporary files removed
+        try:
+            remove_dead_temporaries(out)
+            return _write(out, static, snapshots, optional, overwrite, compress, progress, label, prepare, validate)
+        finally:
+            lock.release()
+
+
+def _write(out, static, snapshots, optional, overwrite, compress, progress, label, prepare, validate) -> int:
+    """:func:`write_snapshots`'s work, under ``out``'s lock."""
     from ..contract.io import open_dataset
     from ..contract.writer import SnapshotWriter, _move_into_place, compress_file
 
-    out = check_out(out, overwrite)
     temporary = os.path.join(os.path.dirname(os.path.abspath(out)), f".{os.path.basename(out)}.{os.getpid()}.{label}")
     stream = iter(snapshots)
     if progress:
@@ -118,6 +165,7 @@ def write_snapshots(out, static, snapshots, optional, *, overwrite=False, compre
 
         stream = tqdm(stream, desc=f"{label} -> {os.path.basename(out)}", unit=" snapshots")
     n = np.asarray(static["radius"]).size
+    limits = _limits(static)
     count = 0
     try:
         with SnapshotWriter.create(temporary, radius=static["radius"], mass=static["mass"], inertia=static["inertia"],
@@ -127,10 +175,16 @@ def write_snapshots(out, static, snapshots, optional, *, overwrite=False, compre
                                    wall_normal=static.get("wall_normal"), optional=tuple(optional),
                                    attrs=static.get("attrs")) as writer:
             for snap in stream:
-                writer.append(**(prepare(snap) if prepare is not None else snap))
+                snap = prepare(snap) if prepare is not None else snap
+                check_snapshot(limits, snap, _where(static, count, snap))
+                writer.append(**snap)
                 count += 1
         if validate:
-            open_dataset(temporary, validate=True).close()
+            try:
+                open_dataset(temporary, validate=True).close()
+            except SchemaError as exc:  # named by the user's file: the temporary one is removed below
+                raise FileFormatError(f"{out}: not written: the run read breaks the grainview data contract: "
+                                      + "; ".join(exc.problems)) from None
         if compress:
             compress_file(temporary)
         _move_into_place(temporary, out, overwrite)
@@ -140,6 +194,55 @@ def write_snapshots(out, static, snapshots, optional, *, overwrite=False, compre
         if os.path.exists(temporary):
             os.remove(temporary)
     return count
+
+
+def _limits(static) -> Limits:
+    """The bounds of a run's values (:class:`grainview.formats.checks.Limits`) from its static part."""
+    attrs = static.get("attrs") or {}
+    return Limits(static["radius"], float(attrs.get("thickness_m", 1.0)), _source(static), mass=static["mass"],
+                  inertia=static["inertia"])
+
+
+def _source(static) -> str:
+    return f"the {(static.get('attrs') or {}).get('source', 'converted')} run"
+
+
+def _where(static, k, snap) -> str:
+    time = np.asarray(snap.get("time", np.nan), float).reshape(-1)[0]
+    return f"{_source(static)}: snapshot {k} (t = {time:.10g} s)"
+
+
+def remove_dead_temporaries(out) -> list[str]:
+    """Remove the temporary files that conversions to ``out`` killed outright (SIGKILL, a power
+    cut) left beside it: ``.<name>.<pid>.<label>`` (:data:`LABELS`) and the files written under
+    it (``..<name>.<pid>.<label>.<pid>.part`` or ``.convert``, and its lock's note ``.writer``),
+    when process ``pid`` is gone. Returns their names.
+
+    Only for a caller holding ``out``'s writer's lock.
+    """
+    from ..contract.locks import process_alive
+
+    directory, base = os.path.split(os.path.abspath(os.fspath(out)))
+    labels = "|".join(LABELS)
+    pattern = re.compile(rf"\.(\.)?{re.escape(base)}\.(\d+)\.(?:{labels})(?(1)\.(?:writer|\d+\.(?:part|convert)))")
+    try:
+        names = os.listdir(directory)
+    except OSError:
+        return []
+    removed = []
+    for name in names:
+        match = pattern.fullmatch(name)
+        if match is None:
+            continue
+        pid = int(match.group(2))
+        if pid == os.getpid() or process_alive(pid):
+            continue
+        try:
+            os.remove(os.path.join(directory, name))
+            removed.append(name)
+        except OSError:
+            pass
+    return removed
 
 
 def chain_first(first, rest):

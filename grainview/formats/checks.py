@@ -1,0 +1,302 @@
+"""What every reader accepts: paths that are what they should be, and numbers that are finite and
+physically plausible.
+
+A reader refuses, in one line naming the file, the row and the quantity, any value that is not
+a finite number or whose size no granular sample could have. "Absurd" is decided here, once,
+in SI units (the contract's, docs/schema.md), from the sample's own particles:
+
+* a **coordinate** (a position, a contact point, a wall or box bound) lies within
+  :data:`LENGTH_SPAN` particle diameters (the largest particle's) of the sample's middle (the
+  median of its particles' positions), and a **length** (a branch, an overlap, a displacement,
+  a radius) is at most that many diameters;
+* a **force** is at most what a stress of :data:`STRESS_LIMIT_PA` (well beyond the strength
+  of any material) exerts on the largest particle's diameter times the slab's thickness; the
+  total force on a wall at most that many times the number of particles;
+* a **speed** is below that of light, and so is the rim speed of a turning particle;
+* a **time** is at most :data:`TIME_LIMIT_S`, a run's **gravity** at most
+  :data:`ACCELERATION_LIMIT_M_S2`, an **angle** at most :data:`ANGLE_LIMIT_RAD`, a
+  component of a unit vector (a normal) at most 1 (within :data:`UNIT_TOLERANCE`);
+* the particles' **radii** are finite and > 0, the largest at most :data:`SIZE_RATIO` times the
+  smallest, and their **masses** finite and > 0, of a density (mass over the disk's area times
+  the thickness) at most :data:`DENSITY_LIMIT_KG_M3`.
+
+Readers check their raw columns with :meth:`Limits.check`, where they still know the line a
+value came from; :func:`check_snapshot` checks every snapshot once more before it is written or
+returned (:mod:`grainview.formats.convert`), so that nothing absurd is ever stored.
+"""
+
+from __future__ import annotations
+
+import errno
+import os
+
+import numpy as np
+
+from ..contract.errors import FileFormatError
+
+__all__ = ["Limits", "check_snapshot", "input_file", "input_folder", "LENGTH_SPAN", "STRESS_LIMIT_PA",
+           "SPEED_LIMIT_M_S", "TIME_LIMIT_S", "ACCELERATION_LIMIT_M_S2", "ANGLE_LIMIT_RAD", "UNIT_TOLERANCE",
+           "SIZE_RATIO", "DENSITY_LIMIT_KG_M3"]
+
+LENGTH_SPAN = 1e6
+"""Particle diameters (the largest particle's) a coordinate may lie from the sample's middle,
+and a length may measure: a 2D packing a million diameters across holds 10^12 particles."""
+STRESS_LIMIT_PA = 1e12
+"""Pa: ten times the compressive strength of diamond. A contact force is at most this stress
+on the largest particle's diameter times the slab's thickness."""
+SPEED_LIMIT_M_S = 299_792_458.0
+"""m/s: the speed of light, above which no particle moves (nor a particle's rim turns)."""
+TIME_LIMIT_S = 1e18
+"""s: about twice the age of the universe."""
+ACCELERATION_LIMIT_M_S2 = 1e13
+"""m/s^2: beyond the gravity at a neutron star's surface (a run's gravity)."""
+ANGLE_LIMIT_RAD = 1e12
+"""rad: beyond it a float64 holds a particle's orientation to worse than 1e-4 rad."""
+SIZE_RATIO = 1e6
+"""The largest radius over the smallest."""
+DENSITY_LIMIT_KG_M3 = 1e6
+"""kg/m^3: about 40 times the densest element's; a particle's mass over its disk's area
+times the slab's thickness is at most this."""
+
+UNIT_TOLERANCE = 1e-6
+"""How far beyond 1 a component of a unit vector may be (the files' rounding)."""
+
+_INT64 = 2**63 - 1
+
+
+def _kind(path) -> str | None:
+    """What ``path`` is when it is not a readable file or folder: None when it exists."""
+    try:
+        os.stat(path)
+    except OSError as exc:
+        if exc.errno == errno.ELOOP:
+            return "a symbolic link that loops back on itself"
+        if os.path.islink(path):
+            return f"a symbolic link to {os.readlink(path)}, which does not exist"
+        if exc.errno == errno.ENOENT:
+            return "no such file or folder"
+        return f"cannot be read ({exc.strerror or exc})"
+    return None
+
+
+def input_file(path, what: str) -> str:
+    """``path`` as a string when it is a file; else one line saying what it is instead.
+
+    Parameters
+    ----------
+    path : str or path-like
+        The file a reader is about to read.
+    what : str
+        What the file should be, for the message (``"a LAMMPS dump"``).
+
+    Raises
+    ------
+    FileFormatError
+        ``path`` does not exist, is a folder, a broken symbolic link, a symbolic link that loops,
+        or something other than a regular file.
+    """
+    path = os.fspath(path)
+    problem = _kind(path)
+    if problem is None and os.path.isdir(path):
+        problem = "a folder, not a file"
+    elif problem is None and not os.path.isfile(path):
+        problem = "not a regular file"
+    elif problem == "no such file or folder":
+        problem = "no such file"
+    if problem is not None:
+        raise FileFormatError(f"{path}: {problem} (expected {what})")
+    return path
+
+
+def input_folder(path, what: str) -> str:
+    """``path`` as a string when it is a folder; else one line saying what it is instead
+    (:func:`input_file`'s counterpart)."""
+    path = os.fspath(path)
+    problem = _kind(path)
+    if problem is None and not os.path.isdir(path):
+        problem = "a file, not a folder"
+    elif problem == "no such file or folder":
+        problem = "no such folder"
+    if problem is not None:
+        raise FileFormatError(f"{path}: {problem} (expected {what})")
+    return path
+
+
+def _row_name(rows, k: int) -> str:
+    if rows is None:
+        return f"row {k + 1}"
+    if callable(rows):
+        return rows(k)
+    return str(rows[k])
+
+
+class Limits:
+    """The bounds of :mod:`this module <grainview.formats.checks>` for one sample.
+
+    Parameters
+    ----------
+    radius : array_like, (N,)
+        The particles' radii, m.
+    thickness : float, default 1
+        The slab's thickness, m (the contract's ``thickness_m``).
+    where : str
+        The file the radii come from, for the messages.
+    mass : array_like, (N,), optional
+        The particles' masses, kg (checked: finite, > 0, of a plausible density).
+    inertia : array_like, (N,), optional
+        Their moments of inertia, kg m^2 (checked: finite and > 0).
+    names : callable or sequence, optional
+        Particle k's name in the messages (default ``"particle k"``).
+
+    Raises
+    ------
+    FileFormatError
+        A radius, mass or moment of inertia that is not finite and > 0, radii spanning more
+        than :data:`SIZE_RATIO`, a mass of an impossible density.
+    """
+
+    def __init__(self, radius, thickness=1.0, where="", mass=None, inertia=None, names=None):
+        radius = np.asarray(radius, float).reshape(-1)
+        self.where = where
+        names = names if names is not None else (lambda k: f"particle {k}")
+        for name, values in (("radius", radius), ("mass", mass), ("inertia", inertia)):
+            if values is None:
+                continue
+            values = np.asarray(values, float).reshape(-1)
+            bad = ~(np.isfinite(values) & (values > 0))
+            if bad.any():
+                k = int(np.flatnonzero(bad)[0])
+                raise FileFormatError(f"{where}: {_row_name(names, k)}: {name} = {values[k]:.6g}; expected a finite "
+                                      f"{name} > 0")
+        if radius.size and radius.max() > SIZE_RATIO * radius.min():
+            raise FileFormatError(f"{where}: radii from {radius.min():.6g} to {radius.max():.6g} m; expected the "
+                                  f"largest at most {SIZE_RATIO:g} times the smallest")
+        self.thickness = float(thickness)
+        self.diameter = 2 * float(radius.max()) if radius.size else 1.0
+        self.smallest = float(radius.min()) if radius.size else 0.5
+        if mass is not None:
+            mass = np.asarray(mass, float).reshape(-1)
+            density = mass / (np.pi * radius**2 * self.thickness)
+            if density.max() > DENSITY_LIMIT_KG_M3:
+                k = int(np.argmax(density))
+                raise FileFormatError(f"{where}: {_row_name(names, k)}: mass = {mass[k]:.6g} kg, a "
+                                      f"density of {density[k]:.3g} kg/m^3 over its disk; expected at most "
+                                      f"{DENSITY_LIMIT_KG_M3:g} kg/m^3")
+
+    def bound(self, kind: str) -> tuple:
+        """``(limit, expected)``: the largest magnitude of a quantity of ``kind`` in SI units, and
+        the words that say so. ``kind`` is one of ``position``, ``length``, ``force``,
+        ``wall_force``, ``speed``, ``angular_velocity``, ``time``, ``acceleration``, ``angle``,
+        ``unit`` (a component of a unit vector) or ``number`` (finite only)."""
+        length = LENGTH_SPAN * self.diameter
+        force = STRESS_LIMIT_PA * self.diameter * self.thickness
+        return {
+            "position": (length, f"a finite coordinate within {LENGTH_SPAN:g} particle diameters ({length:.3g} m) of "
+                                 "the sample's middle"),
+            "length": (length, f"a finite length of at most {LENGTH_SPAN:g} particle diameters ({length:.3g} m)"),
+            "force": (force, f"a finite force of at most {force:.3g} N (a stress of {STRESS_LIMIT_PA:g} Pa on the "
+                             "largest particle's diameter)"),
+            "speed": (SPEED_LIMIT_M_S, "a finite speed below the speed of light"),
+            "angular_velocity": (SPEED_LIMIT_M_S / self.smallest,
+                                 "a finite angular velocity whose rim speed is below the speed of light"),
+            "time": (TIME_LIMIT_S, f"a finite time of at most {TIME_LIMIT_S:g} s"),
+            "acceleration": (ACCELERATION_LIMIT_M_S2, f"a finite acceleration of at most {ACCELERATION_LIMIT_M_S2:g} "
+                                                      "m/s^2"),
+            "angle": (ANGLE_LIMIT_RAD, f"a finite angle of at most {ANGLE_LIMIT_RAD:g} rad"),
+            "unit": (1 + UNIT_TOLERANCE, "a component of a unit vector, from -1 to 1"),
+            "number": (np.inf, "a finite number"),
+        }[kind]
+
+    def check(self, values, quantity: str, kind: str, where: str, rows=None, scale=1.0, centre=None,
+              limit=None) -> None:
+        """Refuse the first value of ``values`` that is not finite or beyond the bound of ``kind``.
+
+        Parameters
+        ----------
+        values : array_like, (K,) or (K, C)
+            The values as the file holds them, one row per line or entry of the file.
+        quantity : str or sequence of str
+            The name of the quantity, or one name per column, for the message (``"fx"``,
+            ``("x", "y")``).
+        kind : str
+            Which bound applies (:meth:`bound`).
+        where : str
+            The file and the snapshot, for the message.
+        rows : callable, sequence or None
+            Row k's name in the message (``rows(k)`` or ``rows[k]``: ``"line 1234"``,
+            ``"body 7"``); default ``"row k+1"``.
+        scale : float, default 1
+            The SI value of one unit of ``values`` (a run in other units).
+        centre : array_like, optional
+            For ``position``: the sample's middle, in the units of ``values`` (default: the
+            median of the finite rows of ``values``).
+        limit : float, optional
+            A bound other than :meth:`bound`'s, in SI units (the expectation's words are kept).
+
+        Raises
+        ------
+        FileFormatError
+            ``"<where>: <row>: <quantity> = <value>; expected <what>"``.
+        """
+        values = np.asarray(values, float)
+        if values.size == 0:
+            return
+        shaped = values.reshape(values.shape[0], -1)
+        bad = ~np.isfinite(shaped)
+        if not bad.any():
+            bound, _ = self.bound(kind)
+            bound = bound if limit is None else limit
+            if np.isfinite(bound):
+                size = shaped
+                if kind == "position":
+                    middle = np.median(shaped, axis=0) if centre is None else np.asarray(centre, float).reshape(-1)
+                    size = shaped - middle
+                with np.errstate(over="ignore"):
+                    bad = np.abs(size) * abs(scale) > bound
+        if bad.any():
+            k, c = (int(x[0]) for x in np.nonzero(bad))
+            name = quantity if isinstance(quantity, str) else quantity[c]
+            expected = self.bound(kind)[1]
+            raise FileFormatError(f"{where}: {_row_name(rows, k)}: {name} = {shaped[k, c]:.6g}; expected {expected}")
+
+
+_SNAPSHOT_VALUES = (("time", "time", None, 1), ("position", "position", "particle", 2),
+                    ("angle", "angle", "particle", 1), ("velocity", "speed", "particle", 2),
+                    ("angular_velocity", "angular_velocity", "particle", 1), ("box_min", "position", None, 2),
+                    ("box_max", "position", None, 2), ("wall_position", "position", "wall", 2),
+                    ("wall_velocity", "speed", "wall", 2), ("wall_force", "wall_force", "wall", 2))
+"""A snapshot's values: (name, kind of bound, what a row is (None: the snapshot's one value), width)."""
+_CONTACT_KINDS = {"fn": "force", "ft": "force", "point": "position", "branch": "length", "gap": "length",
+                  "normal": "unit"}
+
+
+def check_snapshot(limits: Limits, snap: dict, where: str) -> None:
+    """Refuse a snapshot (the dict a reader yields for
+    :meth:`grainview.contract.writer.SnapshotWriter.append`) holding a value that is not finite or
+    is beyond its bound: the last check before anything is stored.
+
+    Raises
+    ------
+    FileFormatError
+        Naming ``where``, the quantity, the particle or contact, and what was expected.
+    """
+    position = np.asarray(snap["position"], float)
+    middle = np.median(position, axis=0) if position.size and np.isfinite(position).all() else None
+    for name, kind, row, width in _SNAPSHOT_VALUES:
+        if name not in snap:
+            continue
+        values = np.asarray(snap[name], float).reshape(-1, width)
+        limit = None
+        if kind == "wall_force":  # a sum over the particles touching the wall
+            kind, limit = "force", limits.bound("force")[0] * max(position.shape[0], 1)
+        limits.check(values, name, kind, where, rows=(lambda k: "the snapshot") if row is None else
+                     (lambda k, row=row: f"{row} {k}"), centre=middle if kind == "position" else None, limit=limit)
+    if "step" in snap:
+        step = snap["step"]
+        if not (isinstance(step, (int, np.integer)) and 0 <= int(step) <= _INT64):
+            raise FileFormatError(f"{where}: step = {step}; expected an integer from 0 to {_INT64}")
+    contacts = snap.get("contacts") or {}
+    for name, kind in _CONTACT_KINDS.items():
+        if name in contacts:
+            limits.check(contacts[name], name, kind, where, rows=lambda k: f"contact {k}",
+                         centre=middle if kind == "position" else None)
