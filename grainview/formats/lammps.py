@@ -40,6 +40,11 @@ How the contract's quantities are made (docs/formats.md states the same for user
 
 Every function checks its input first and refuses bad input in one line
 (:class:`grainview.contract.errors.FileFormatError` or :class:`~grainview.contract.errors.ParameterError`).
+
+A value that is not finite or is absurd (:mod:`grainview.formats.checks`) in a column the
+reader reads is refused naming the dump, the step, the line and the column; so is a snapshot
+with more or fewer rows than its count. The pairs left out for a tensile normal force are
+counted in one warning.
 """
 
 from __future__ import annotations
@@ -51,6 +56,7 @@ import warnings
 import numpy as np
 
 from ..contract.errors import FileFormatError, ParameterError
+from .checks import Limits
 from .lammps_dump import LammpsLog, iter_dump, read_log
 
 __all__ = ["lammps_snapshots", "open_lammps", "convert_lammps", "WALL_NAMES", "PARTICLE_COLUMNS", "PAIR_COLUMNS"]
@@ -130,6 +136,21 @@ def _check_particle_columns(snap, source):
     if missing:
         raise FileFormatError(f"{source}: step {snap.timestep}: no column {', '.join(missing)} (has "
                               f"{' '.join(snap.columns)}); dump custom needs id radius mass x y")
+    _check_ids(snap.column("id"), "id", f"{source}: step {snap.timestep}", snap)
+
+
+def _lines(snap):
+    """Row k of a snapshot named by its line in the dump."""
+    return lambda k: f"line {snap.line + k}"
+
+
+def _check_ids(values, name, where, snap):
+    """Atom ids: positive integers (a float column holds them exactly up to 2**53)."""
+    bad = ~(np.isfinite(values) & (values >= 1) & (values <= 2**53) & (values == np.round(values)))
+    if bad.any():
+        k = int(np.flatnonzero(bad)[0])
+        raise FileFormatError(f"{where}: line {snap.line + k}: {name} = {values[k]:.6g}; expected an atom id, an "
+                              "integer >= 1")
 
 
 def _wall_fixes(columns, source):
@@ -178,12 +199,18 @@ class _Particles:
         self.ids = ids[self.order]
         if np.any(np.diff(self.ids) == 0):
             raise FileFormatError(f"{source}: step {snap.timestep}: an atom id appears twice")
+        where = f"{source}: step {snap.timestep}"
+        for name in ("radius", "mass"):
+            values = snap.column(name)
+            bad = ~(np.isfinite(values) & (values > 0))
+            if bad.any():
+                k = int(np.flatnonzero(bad)[0])
+                raise FileFormatError(f"{where}: line {snap.line + k}: {name} = {values[k]:.6g}; radii and masses "
+                                      "must be finite and > 0 (atom_style sphere, dump custom ... radius mass)")
         self.radius = snap.column("radius")[self.order].copy()
         self.mass = snap.column("mass")[self.order].copy()
-        if not (np.all(self.radius > 0) and np.all(self.mass > 0)):
-            raise FileFormatError(f"{source}: step {snap.timestep}: radii and masses must be > 0 "
-                                  "(atom_style sphere, dump custom ... radius mass)")
         self.inertia = inertia_factor * self.mass * self.radius**2
+        self.limits = Limits(self.radius, 1.0, where, mass=self.mass, inertia=self.inertia)
         self.source = source
 
     def index(self, ids, where):
@@ -196,7 +223,8 @@ class _Particles:
         return k
 
     def state(self, snap):
-        """Positions (N, 2) and the optional velocities of a snapshot, in particle order."""
+        """Positions (N, 2) and the optional velocities of a snapshot, in particle order; one
+        line for a value that is not finite or is absurd (:mod:`grainview.formats.checks`)."""
         _check_particle_columns(snap, self.source)
         ids = snap.column("id").astype(np.int64)
         order = np.argsort(ids, kind="stable")
@@ -204,10 +232,22 @@ class _Particles:
             raise FileFormatError(f"{self.source}: step {snap.timestep}: the atoms differ from the first snapshot's "
                                   f"({ids.size} against {self.ids.size}); the contract needs the same particles "
                                   "throughout")
+        where = f"{self.source}: step {snap.timestep}"
+        self.limits.check(snap.column("radius"), "radius", "length", where, rows=_lines(snap))
+        self.limits.check(snap.column("mass"), "mass", "number", where, rows=_lines(snap))
+        self.limits.check(snap.data[:, [snap.columns.index("x"), snap.columns.index("y")]], ("x", "y"), "position",
+                          where, rows=_lines(snap))
+        kinds = {"vx": "speed", "vy": "speed", "omegaz": "angular_velocity"}
+        for name in PARTICLE_COLUMNS["optional"]:
+            if name in snap.columns:
+                self.limits.check(snap.column(name), name, kinds[name], where, rows=_lines(snap))
         radius = snap.column("radius")[order]
         if not np.allclose(radius, self.radius, rtol=1e-12, atol=0):
             raise FileFormatError(f"{self.source}: step {snap.timestep}: radii changed during the run; the "
                                   "contract holds one radius per particle")
+        if not np.allclose(snap.column("mass")[order], self.mass, rtol=1e-12, atol=0):
+            raise FileFormatError(f"{self.source}: step {snap.timestep}: masses changed during the run; the "
+                                  "contract holds one mass per particle")
         position = np.stack([snap.column("x")[order], snap.column("y")[order]], axis=1)
         extra = {}
         if "vx" in snap.columns and "vy" in snap.columns:
@@ -220,6 +260,10 @@ class _Particles:
 def _pair_contacts(particles, position, snap, columns, where):
     """Contract contacts (dict of arrays) of the touching, compressed pairs of one pairs
     snapshot, and the number of touching pairs left out for a tensile normal force."""
+    for name in ("patom1", "patom2"):
+        _check_ids(snap.data[:, columns[name]], name, where, snap)
+    for name in ("fx", "fy", "p1", "p2"):
+        particles.limits.check(snap.data[:, columns[name]], name, "force", where, rows=_lines(snap))
     a = particles.index(snap.data[:, columns["patom1"]], where)
     b = particles.index(snap.data[:, columns["patom2"]], where)
     force = np.stack([snap.data[:, columns["fx"]] + snap.data[:, columns["p1"]],
@@ -256,6 +300,17 @@ def _pair_contacts(particles, position, snap, columns, where):
 def _wall_contacts(particles, position, snap, fixes, where):
     """Contract contacts of one walls snapshot (fix wall/gran ... contacts arrays)."""
     n_particles = particles.ids.size
+    _check_ids(snap.column("id"), "id", where, snap)
+    for fix, cols in fixes.items():
+        names = [f"f_{fix}[{k}]" for k in range(1, _WALL_ARRAY + 1)]
+        values = snap.data[:, cols]
+        limits = particles.limits
+        limits.check(values[:, 1:4], names[1:4], "force", where, rows=_lines(snap))
+        limits.check(values, names, "number", where, rows=_lines(snap))
+        touching = np.flatnonzero(values[:, 0] != 0)
+        limits.check(values[touching][:, 4:7], names[4:7], "position", where,
+                     rows=lambda k, touching=touching: f"line {snap.line + touching[k]}",
+                     centre=np.r_[np.median(position, axis=0), 0.0])
     index = particles.index(snap.column("id"), where)
     out = {k: [] for k in ("i", "j", "normal", "fn", "ft", "point", "branch", "gap")}
     tensile = 0
@@ -412,6 +467,9 @@ def lammps_snapshots(particles, contacts, walls=None, *, log=None, time_step=Non
             part, pairs = snaps[0], snaps[1]
             where = f"{os.fspath(contacts)}: step {part.timestep}"
             position, extra = static_particles.state(part)
+            static_particles.limits.check(part.bounds[:2].T, ("x", "y"), "position", f"{source}: step {part.timestep}",
+                                          rows=lambda k: ("the lower", "the upper")[k] + " BOX BOUNDS",
+                                          centre=np.median(position, axis=0))
             contacts_now, tensile = _pair_contacts(static_particles, position, pairs, pair_index, where)
             if fixes is not None:
                 on_walls, tensile_walls = _wall_contacts(static_particles, position, snaps[2], fixes,

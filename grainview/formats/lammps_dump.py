@@ -22,13 +22,16 @@ only ``c_ID[k]`` and ``f_ID[k]``.
 
 from __future__ import annotations
 
-import os
 import re
 from dataclasses import dataclass, field
 
 import numpy as np
 
 from ..contract.errors import FileFormatError
+from .checks import input_file
+
+_LARGEST = 2**53
+"""The largest step or row count read: floats hold integers exactly up to it."""
 
 __all__ = ["DumpSnapshot", "LammpsLog", "iter_dump", "read_log"]
 
@@ -49,6 +52,8 @@ class DumpSnapshot:
         The column names of the ``ITEM: ATOMS`` or ``ITEM: ENTRIES`` line.
     data : numpy.ndarray, (n, len(columns))
         The rows, as floats (ids are exact up to 2**53).
+    line : int
+        The line number of the first row in the file (row k is on line ``line + k``).
     """
 
     timestep: int
@@ -56,17 +61,32 @@ class DumpSnapshot:
     boundary: tuple
     columns: tuple
     data: np.ndarray
+    line: int = 0
 
     def column(self, name: str) -> np.ndarray:
         """The values of column ``name``."""
         return self.data[:, self.columns.index(name)]
 
 
+class _Lines:
+    """A text file read line by line, counting the lines (for the messages)."""
+
+    def __init__(self, fh):
+        self._fh = fh
+        self.number = 0
+
+    def readline(self) -> str:
+        line = self._fh.readline()
+        if line:
+            self.number += 1
+        return line
+
+
 def _read_item(fh, path, expect, where):
     line = fh.readline()
     if not line.startswith("ITEM: " + expect):
         found = line.strip()[:60] or "the end of the file"
-        raise FileFormatError(f"{path}: {where}: expected 'ITEM: {expect}', found {found!r} "
+        raise FileFormatError(f"{path}: line {fh.number}: {where}: expected 'ITEM: {expect}', found {found!r} "
                               "(not a LAMMPS text dump, or a truncated one)")
     return line
 
@@ -78,8 +98,30 @@ def _read_numbers(fh, path, count, where):
     except ValueError:
         values = []
     if len(values) < count:
-        raise FileFormatError(f"{path}: {where}: expected {count} number(s), found {line.strip()[:60]!r}")
+        raise FileFormatError(f"{path}: line {fh.number}: {where}: expected {count} number(s), found "
+                              f"{line.strip()[:60]!r}")
     return values
+
+
+def _read_count(fh, path, what, where):
+    """A non-negative integer on a line of its own (a step, a number of rows)."""
+    value = _read_numbers(fh, path, 1, where)[0]
+    if not (np.isfinite(value) and value >= 0 and value == int(value) and value <= _LARGEST):
+        raise FileFormatError(f"{path}: line {fh.number}: {where}: {what} {value:g}; expected an integer from 0 to "
+                              f"{_LARGEST}")
+    return int(value)
+
+
+def _read_rows(fh, path, rows, where):
+    """The ``rows`` lines of a snapshot; one line when the file ends first, without reading on
+    for the rows a damaged header announces beyond its end."""
+    lines = []
+    for _ in range(rows):
+        line = fh.readline()
+        if not line:
+            raise FileFormatError(f"{path}: {where}: {rows} rows announced, {len(lines)} found (a truncated dump)")
+        lines.append(line)
+    return lines
 
 
 def iter_dump(path):
@@ -98,31 +140,34 @@ def iter_dump(path):
     Raises
     ------
     FileFormatError
-        A missing or unreadable file, a header that is not LAMMPS's, a triclinic box, or a
-        snapshot with fewer rows than announced or a row of the wrong length (a truncated or
-        damaged dump), naming the file and the snapshot.
+        A missing or unreadable file (or a folder), a header that is not LAMMPS's, a step or a
+        row count that is not an integer, a triclinic box, or a snapshot with fewer or more
+        rows than announced or a row of the wrong length (a truncated or damaged dump), naming
+        the file, the line and the snapshot.
     """
-    path = os.fspath(path)
+    path = input_file(path, "a LAMMPS text dump")
     try:
-        fh = open(path, encoding="ascii", errors="replace")
+        handle = open(path, encoding="ascii", errors="replace")
     except OSError as exc:
         raise FileFormatError(f"{path}: cannot be read ({exc.strerror or exc})") from None
-    with fh:
+    with handle:
+        fh = _Lines(handle)
         index = 0
+        line = fh.readline()
         while True:
-            line = fh.readline()
             if not line:
                 return
             if not line.strip():
+                line = fh.readline()
                 continue
             where = f"snapshot {index}"
             if not line.startswith("ITEM: TIMESTEP"):
-                raise FileFormatError(f"{path}: {where}: expected 'ITEM: TIMESTEP', found {line.strip()[:60]!r} "
-                                      "(not a LAMMPS text dump)")
-            timestep = int(_read_numbers(fh, path, 1, where)[0])
+                raise FileFormatError(f"{path}: line {fh.number}: {where}: expected 'ITEM: TIMESTEP', found "
+                                      f"{line.strip()[:60]!r} (not a LAMMPS text dump)")
+            timestep = _read_count(fh, path, "step", where)
             where = f"snapshot {index} (step {timestep})"
             _read_item(fh, path, "NUMBER OF", where)
-            rows = int(_read_numbers(fh, path, 1, where)[0])
+            rows = _read_count(fh, path, "row count", where)
             header = _read_item(fh, path, "BOX BOUNDS", where)
             flags = header.split()[3:]
             if any(flag in ("xy", "xz", "yz") for flag in flags):
@@ -130,14 +175,11 @@ def iter_dump(path):
             bounds = np.array([_read_numbers(fh, path, 2, where)[:2] for _ in range(3)])
             header = fh.readline()
             if not (header.startswith("ITEM: ATOMS") or header.startswith("ITEM: ENTRIES")):
-                raise FileFormatError(f"{path}: {where}: expected 'ITEM: ATOMS' or 'ITEM: ENTRIES', found "
-                                      f"{header.strip()[:60]!r}")
+                raise FileFormatError(f"{path}: line {fh.number}: {where}: expected 'ITEM: ATOMS' or 'ITEM: ENTRIES', "
+                                      f"found {header.strip()[:60]!r}")
             columns = tuple(header.split()[2:])
-            lines = [fh.readline() for _ in range(rows)]
-            if rows and not lines[-1]:  # the file ended first
-                lines = [line for line in lines if line]
-                raise FileFormatError(f"{path}: {where}: {rows} rows announced, {len(lines)} found "
-                                      "(a truncated dump)")
+            first_row = fh.number + 1
+            lines = _read_rows(fh, path, rows, where)
             try:
                 values = np.array(" ".join(lines).split(), dtype=np.float64)
             except ValueError:
@@ -145,7 +187,13 @@ def iter_dump(path):
             if values.size != rows * len(columns):
                 raise FileFormatError(f"{path}: {where}: {values.size} values in {rows} rows of "
                                       f"{len(columns)} columns (a damaged dump)")
-            yield DumpSnapshot(timestep, bounds, tuple(flags), columns, values.reshape(rows, len(columns)))
+            line = fh.readline()  # read ahead: a row beyond the count is this snapshot's fault
+            while line and not line.strip():
+                line = fh.readline()
+            if line and not line.startswith("ITEM:"):
+                raise FileFormatError(f"{path}: line {fh.number}: {where}: more rows than the {rows} announced (a "
+                                      "damaged dump)")
+            yield DumpSnapshot(timestep, bounds, tuple(flags), columns, values.reshape(rows, len(columns)), first_row)
             index += 1
 
 
@@ -187,9 +235,9 @@ def read_log(path) -> LammpsLog:
     Raises
     ------
     FileFormatError
-        The file cannot be read.
+        The file cannot be read (or is a folder).
     """
-    path = os.fspath(path)
+    path = input_file(path, "a LAMMPS log or input script")
     log = LammpsLog()
     try:
         fh = open(path, encoding="utf-8", errors="replace")
