@@ -49,17 +49,24 @@ How the contract's quantities are made (docs/formats.md states the same for user
 
 Every function checks its input first and refuses bad input in one line
 (:class:`grainview.contract.errors.FileFormatError`).
+
+A value that is not finite or is absurd (:mod:`grainview.formats.checks`) is refused naming
+the file and the body or the line of the entry, and so is a body number beyond 2^31 - 1 or an
+``$icdan`` entry written twice. The pairs left out for a tensile normal force (``rln/H < 0``)
+are counted in one warning.
 """
 
 from __future__ import annotations
 
 import math
 import os
+import warnings
 
 import numpy as np
 
 from ..contract.errors import FileFormatError
 from ..contract.shapes import polygon_properties, regular_vertices, shape_problems, vertex_phases
+from .checks import Limits, input_folder
 from .lmgc90_text import output_files, read_bodies, read_bulk_behav, read_dof, read_vloc_rloc
 
 __all__ = ["lmgc90_snapshots", "open_lmgc90", "convert_lmgc90", "FAMILIES", "BOX_WALLS", "regular_polygon",
@@ -70,6 +77,8 @@ FAMILIES = ("DKDKx", "DKJCx", "PLPLx", "PLJCx", "DKPLx")
 BOX_WALLS = ("bottom", "right", "top", "left")
 """Names (and order) of the walls of a box of four JONCx."""
 _PARTICLE_CONTACTORS = {"DISKx", "POLYG"}
+_DOUBLE_FAMILIES = {"PLPLx", "PLJCx"}
+"""The families whose pairs may have two points (a polygon's face on a face or a wall)."""
 _NOT_CONVEX = "a POLYG whose vertices are not a convex polygon (the contract holds convex polygons only)"
 
 
@@ -133,6 +142,33 @@ def centred_polygon(vertices):
     return v, g
 
 
+def _check_datbox(bodies_path, particles, walls, behav_path, density, gravity):
+    """One line for a value of DATBOX that is not finite or is absurd (:mod:`grainview.formats.checks`),
+    before any shape is computed from them: lengths are measured against the particles' mean
+    radii ``avrd``."""
+    avrd = np.array([body.avrd for body in particles])
+    limits = Limits(avrd, 1.0, bodies_path, names=lambda k: f"body {particles[k].number}: avrd")
+    bodies = particles + walls
+    reference = np.array([body.reference for body in bodies])
+    name = lambda k: f"body {bodies[k].number}"  # noqa: E731
+    limits.check(reference[:, :2], ("coo1", "coo2"), "number", bodies_path, rows=name)
+    limits.check(reference[:, :2], ("coo1", "coo2"), "position", bodies_path, rows=name,
+                 centre=np.median(reference[:len(particles), :2], axis=0))
+    limits.check(reference[:, 2], "coo3", "angle", bodies_path, rows=name)
+    limits.check([body.gyrd for body in particles], "gyrd", "length", bodies_path,
+                 rows=lambda k: f"body {particles[k].number}")
+    for body in bodies:
+        tact = body.contactors[0]
+        limits.check([list(tact.values.values())], list(tact.values), "length", bodies_path,
+                     rows=lambda k, body=body: f"body {body.number}: {body.contactors[0].kind}")
+        limits.check(np.reshape(tact.vertices, (-1, 2)), ("coo1", "coo2"), "length", bodies_path,
+                     rows=lambda k, body=body: f"body {body.number}: vertex {k + 1}")
+    behaviours = list(density)
+    limits.check([density[b] for b in behaviours], "Umas", "number", behav_path,
+                 rows=lambda k: f"behaviour {behaviours[k]}")
+    limits.check(gravity[None], ("grv1", "grv2", "grv3"), "acceleration", behav_path, rows=lambda k: "gravity")
+
+
 class _Model:
     """The static part of a run, from DATBOX: particles, walls and how bodies map to them."""
 
@@ -162,6 +198,7 @@ class _Model:
                 raise FileFormatError(f"{where}: unknown contactor type {kind!r}; expected DISKx, POLYG or JONCx")
         if not particles:
             raise FileFormatError(f"{bodies_path}: no DISKx or POLYG body (no particles)")
+        _check_datbox(bodies_path, particles, walls, behav_path, density, self.gravity)
         n = len(particles)
         self.radius, self.n_vertices, self.angle0 = np.zeros(n), np.zeros(n, "i4"), np.zeros(n)
         self.mass, self.inertia = np.zeros(n), np.zeros(n)
@@ -188,6 +225,8 @@ class _Model:
                 raise FileFormatError(f"{where}: radius, avrd and gyrd must be > 0")
             self.mass[k] = density[body.behav] * math.pi * body.avrd ** 2
             self.inertia[k] = self.mass[k] * body.gyrd ** 2
+        self.limits = Limits(self.radius, 1.0, bodies_path, mass=self.mass, inertia=self.inertia,
+                             names=lambda k: f"body {particles[k].number}")
         self.vertices = None  # regular polygons only
         if own:
             self.vertices = np.full((n, int(self.n_vertices.max()), 2), np.nan)
@@ -242,7 +281,14 @@ class _Model:
 
 
 def _state(model, dof, where):
-    """Positions, angles, velocities of the particles and the walls' positions from a DOF record."""
+    """Positions, angles, velocities of the particles and the walls' positions from a DOF record;
+    one line for a value that is not finite or is absurd."""
+    body = lambda k: f"body {dof.numbers[k]}"  # noqa: E731
+    model.limits.check([[dof.time]], "time", "time", where, rows=lambda k: "$steps")
+    model.limits.check(dof.X[:, :2], ("X(1)", "X(2)"), "length", where, rows=body)
+    model.limits.check(dof.X[:, 2], "X(3)", "angle", where, rows=body)
+    model.limits.check(dof.V[:, :2], ("V(1)", "V(2)"), "speed", where, rows=body)
+    model.limits.check(dof.V[:, 2], "V(3)", "angular_velocity", where, rows=body)
     row = {int(b): k for k, b in enumerate(dof.numbers)}
     missing = [int(b) for b in model.numbers if int(b) not in row]
     missing += [int(w.number) for w in model.wall_bodies if int(w.number) not in row]
@@ -267,10 +313,32 @@ def _box(model, position, walls):
     return (position - model.radius[:, None]).min(axis=0), (position + model.radius[:, None]).max(axis=0)
 
 
+def _check_entries(model, position, entries, where):
+    """One line for an entry holding a value that is not finite or is absurd, or repeating
+    another (the same ``$icdan`` family and number)."""
+    if not entries:
+        return
+    line = lambda k: f"line {entries[k].line}"  # noqa: E731
+    limits = model.limits
+    limits.check([(e.rln, e.rlt) for e in entries], ("rln/H", "rlt/H"), "force", where, rows=line)
+    limits.check([e.gap for e in entries], "gapTT", "length", where, rows=line)
+    limits.check([e.normal for e in entries], ("n(1)", "n(2)"), "unit", where, rows=line)
+    limits.check([e.point for e in entries], ("coo1", "coo2"), "position", where, rows=line,
+                 centre=np.median(position, axis=0))
+    seen = {}
+    for entry in entries:
+        key = (entry.family, entry.index)
+        if entry.index >= 0 and key in seen:
+            raise FileFormatError(f"{where}: line {entry.line}: a second '$icdan {entry.family} {entry.index}' (the "
+                                  f"first at line {seen[key]}); each entry is written once")
+        seen[key] = entry.line
+
+
 def _contacts(model, position, vloc, where):
-    """Contract contacts (dict of arrays) and the total force on each wall, from one
-    Vloc_Rloc record."""
+    """Contract contacts (dict of arrays), the total force on each wall and the number of pairs
+    left out for a tensile normal force, from one Vloc_Rloc record."""
     n = model.n
+    _check_entries(model, position, vloc.entries, where)
     pairs = {}
     for entry in vloc.entries:
         if entry.family not in FAMILIES:
@@ -286,10 +354,21 @@ def _contacts(model, position, vloc, where):
         pairs.setdefault((min(cd, an), max(cd, an)), []).append((entry, cd))
     out = {k: [] for k in ("i", "j", "kind", "normal", "fn", "ft", "point", "branch", "gap")}
     wall_force = np.zeros((len(model.wall_names), 2))
+    tensile = 0
     for (i, j), points in pairs.items():
         if len(points) > 2:
             raise FileFormatError(f"{where}: {len(points)} entries on the pair of bodies {points[0][0].cd} and "
                                   f"{points[0][0].an}; a 2D contact has at most two points")
+        if len(points) == 2:
+            a, b = points[0][0], points[1][0]
+            if not (a.family in _DOUBLE_FAMILIES and b.family in _DOUBLE_FAMILIES):
+                raise FileFormatError(f"{where}: line {b.line}: a second {b.family} entry on the bodies {b.cd} and "
+                                      f"{b.an} (the first at line {a.line}); a disk touches another body at one "
+                                      "point")
+            if a.point == b.point:
+                raise FileFormatError(f"{where}: line {b.line}: a second {b.family} entry on the bodies {b.cd} and "
+                                      f"{b.an} at the point of the first (line {a.line}); the two points of a double "
+                                      "contact are apart")
         force = np.zeros(2)
         fn_points, xy = [], []
         first = points[0][0]
@@ -303,6 +382,8 @@ def _contacts(model, position, vloc, where):
             fn_points.append(entry.rln)
             xy.append(entry.point)
         fn = float(force @ normal)
+        if fn < 0:
+            tensile += 1
         if not fn > 0:
             continue
         tangent = np.array([-normal[1], normal[0]])
@@ -324,13 +405,11 @@ def _contacts(model, position, vloc, where):
     contacts = {k: np.array(v, dtypes.get(k, "f8")) for k, v in out.items()}
     for k in ("normal", "point", "branch"):
         contacts[k] = contacts[k].reshape(-1, 2)
-    return contacts, wall_force
+    return contacts, wall_force, tensile
 
 
 def _run_folders(run):
-    run = os.fspath(run)
-    if not os.path.isdir(run):
-        raise FileFormatError(f"{run}: no such folder (expected an LMGC90 run folder holding DATBOX/ and OUTBOX/)")
+    run = input_folder(run, "an LMGC90 run folder holding DATBOX/ and OUTBOX/")
     datbox, outbox = os.path.join(run, "DATBOX"), os.path.join(run, "OUTBOX")
     if not os.path.isdir(datbox) or not os.path.isfile(os.path.join(datbox, "BODIES.DAT")):
         raise FileFormatError(f"{run}: no DATBOX/BODIES.DAT (expected an LMGC90 run folder holding DATBOX/ and "
@@ -388,10 +467,10 @@ def lmgc90_snapshots(run):
                 raise FileFormatError(f"{vloc_file}: step {vloc.step}, but {os.path.basename(dof_file)} is at step "
                                       f"{dof.step} (a snapshot's two files must be of the same step)")
             position, angle, velocity, omega, walls = _state(model, dof, dof_file)
-            contacts, wall_force = _contacts(model, position, vloc, vloc_file)
+            contacts, wall_force, tensile = _contacts(model, position, vloc, vloc_file)
             box_min, box_max = _box(model, position, walls)
             snap = dict(time=dof.time, step=dof.step, position=position, angle=angle, velocity=velocity,
-                        angular_velocity=omega, contacts=contacts, box_min=box_min, box_max=box_max)
+                        angular_velocity=omega, contacts=contacts, box_min=box_min, box_max=box_max, tensile=tensile)
             if model.wall_names:
                 snap["wall_force"] = wall_force
             yield snap
@@ -425,9 +504,17 @@ def open_lmgc90(run, *, progress=False):
 
         stream = tqdm(stream, desc="lmgc90", unit=" snapshots")
     snaps = list(stream)
+    _warn_tensile(sum(s.pop("tensile") for s in snaps), len(snaps))
     walls = ("wall_force",) if static["n_walls"] else ()
     return snapshots_dataset(static, snaps, ("step", "velocity", "angular_velocity", *walls),
                              vertices=static["vertices"])
+
+
+def _warn_tensile(count, snapshots):
+    if count:
+        warnings.warn(f"{count} contact(s) over {snapshots} snapshot(s) had a tensile normal force (rln/H < 0, which "
+                      "the contract's fn >= 0 cannot hold) and were left out of the contacts", UserWarning,
+                      stacklevel=3)
 
 
 def convert_lmgc90(out, run, *, overwrite=False, compress=True, progress=False):
@@ -469,5 +556,13 @@ def convert_lmgc90(out, run, *, overwrite=False, compress=True, progress=False):
     out = check_out(out, overwrite)
     static, stream = lmgc90_snapshots(run)
     optional = ("step", "gap", "velocity", "angular_velocity") + (("wall_force",) if static["n_walls"] else ())
-    return write_snapshots(out, static, stream, optional, overwrite=overwrite, compress=compress, progress=progress,
-                           label="lmgc90")
+    tensile = []
+
+    def prepare(snap):
+        tensile.append(snap.pop("tensile"))
+        return snap
+
+    count = write_snapshots(out, static, stream, optional, overwrite=overwrite, compress=compress, progress=progress,
+                            label="lmgc90", prepare=prepare)
+    _warn_tensile(sum(tensile), count)
+    return count

@@ -27,6 +27,7 @@ Every function refuses a file it cannot read in one line (:class:`grainview.cont
 
 from __future__ import annotations
 
+import math
 import os
 import re
 from dataclasses import dataclass, field
@@ -34,6 +35,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..contract.errors import FileFormatError
+from .checks import input_file, input_folder
 
 __all__ = ["Body", "Contactor", "DofSnapshot", "VlocEntry", "VlocSnapshot", "fortran_float", "read_bodies",
            "read_bulk_behav", "read_dof", "read_vloc_rloc", "output_files"]
@@ -61,6 +63,28 @@ def fortran_float(text: str) -> float:
     if match:  # Fortran drops the exponent letter of a three-digit exponent
         text = match.group(1) + "E" + match.group(2)
     return float(text)
+
+
+LARGEST_BODY = 2**31 - 1
+"""The largest body number read (LMGC90 numbers its bodies with default Fortran integers)."""
+
+
+def body_number(text: str, where: str) -> int:
+    """A body number, 1 .. :data:`LARGEST_BODY`; one line for anything else.
+
+    Raises
+    ------
+    FileFormatError
+        ``text`` is not an integer in that range.
+    """
+    try:
+        number = int(text)
+    except ValueError:
+        number = None
+    if number is None or not 1 <= number <= LARGEST_BODY:
+        raise FileFormatError(f"{where}: body number {text.strip()[:30]!r}; expected an integer from 1 to "
+                              f"{LARGEST_BODY}")
+    return number
 
 
 def _values(line: str) -> dict:
@@ -96,9 +120,7 @@ class Body:
 
 
 def _lines(path):
-    path = os.fspath(path)
-    if not os.path.isfile(path):
-        raise FileFormatError(f"{path}: no such file")
+    path = input_file(path, "an LMGC90 text file")
     try:
         with open(path, encoding="ascii", errors="strict") as fh:
             return fh.read().splitlines()
@@ -147,7 +169,7 @@ def read_bodies(path) -> list:
         try:
             if section == "bdyty":
                 model, index = text.split()[:2]
-                body.model, body.number, section = model, int(index), None
+                body.model, body.number, section = model, body_number(index, where), None
             elif section == "blmty":
                 tokens = text.split()
                 if "behav" in tokens:
@@ -184,10 +206,17 @@ def _check_body(body, path):
         raise FileFormatError(f"{where}: no $nodty node (its reference position)")
     for tact in body.contactors:
         if tact.kind == "POLYG":
-            expected = int(tact.values.get("nb_vertex", -1))
+            expected = tact.values.get("nb_vertex", -1)
+            if not (math.isfinite(expected) and expected == int(expected) and 3 <= expected <= 2**31):
+                raise FileFormatError(f"{where}: POLYG with nb_vertex= {expected:g}; expected a vertex count >= 3")
+            expected = int(expected)
             if expected != len(tact.vertices):
                 raise FileFormatError(f"{where}: POLYG with nb_vertex= {expected} but {len(tact.vertices)} vertex "
                                       "lines (a truncated BODIES.DAT)")
+
+
+_BULK_KEYS = ("grv1", "grv2", "grv3", "Umas")
+"""The values the reader takes from a BULK_BEHAV.DAT: each must be a number where it is given."""
 
 
 def read_bulk_behav(path) -> tuple:
@@ -208,6 +237,8 @@ def read_bulk_behav(path) -> tuple:
         try:
             values = _values(text)
             tokens = text.split()
+            if any(re.search(rf"\b{key}\s*=", text) and key not in values for key in _BULK_KEYS):
+                raise ValueError("a value that is not a number")
             if "grv1" in values:
                 gravity = np.array([values.get(f"grv{k}", 0.0) for k in (1, 2, 3)])
                 continue
@@ -239,7 +270,10 @@ def _header(lines, path):
         if match is None:
             raise FileFormatError(f"{path}: expected a '$steps <step> time= <t>' header, found {text[:60]!r} "
                                   "(not an LMGC90 OUTBOX file)")
-        return int(match.group(1)), fortran_float(match.group(2)), k + 1
+        step = int(match.group(1))
+        if step > 2**63 - 1:
+            raise FileFormatError(f"{path}: line {k + 1}: step {step}; expected an integer below 2^63")
+        return step, fortran_float(match.group(2)), k + 1
     raise FileFormatError(f"{path}: an empty file (no '$steps' header)")
 
 
@@ -293,7 +327,7 @@ def read_dof(path) -> DofSnapshot:
                 raise FileFormatError(f"{path}: line {k + 2}: body {number} is a {model} with {block[2][:5]} nodes; "
                                       "only 2D rigid bodies (RBDY2, NO3xx) can be read")
             x, v = _values(block[2]), _values(block[3])
-            numbers.append(int(number))
+            numbers.append(body_number(number, f"{path}: line {k + 2}"))
             X.append([x["X(1)"], x["X(2)"], x["X(3)"]])
             V.append([v["V(1)"], v["V(2)"], v["V(3)"]])
         except (ValueError, KeyError):
@@ -314,7 +348,8 @@ class VlocEntry:
     antagonist's body numbers, ``cd_kind``/``an_kind`` their contactor types, ``behav`` the
     contact law's name, ``status`` its status (``stick``, ``slide``, ``noctc``...); ``rlt``,
     ``rln`` the mean forces over the step (impulse / H, N), ``gap`` (m), ``normal`` (2,) and
-    ``point`` (2,) as LMGC90 wrote them."""
+    ``point`` (2,) as LMGC90 wrote them; ``index`` the entry's number in its family (``$icdan
+    <family> <index>``) and ``line`` the line of its ``$icdan``."""
 
     family: str
     cd: int
@@ -328,6 +363,8 @@ class VlocEntry:
     gap: float
     normal: tuple
     point: tuple
+    index: int = -1
+    line: int = 0
 
 
 @dataclass
@@ -394,16 +431,18 @@ def _entry(block, path, line, last):
         cut = "a truncated Vloc_Rloc.OUT" if last else "a damaged Vloc_Rloc.OUT"
         raise FileFormatError(f"{where}: {family} entry without {', '.join(m.strip(' =') for m in missing)} ({cut})")
     try:
-        cd = int(data[title.index("cdbdy") + 1])
-        an = int(data[title.index("anbdy") + 1])
+        int(data[title.index("cdbdy") + 1]), int(data[title.index("anbdy") + 1])
     except ValueError:
         raise FileFormatError(f"{where}: {family} entry: body numbers {block[2].strip()[:60]!r} do not parse "
                               "(more than 99999 bodies?)") from None
+    cd = body_number(data[title.index("cdbdy") + 1], f"{where}: {family} entry")
+    an = body_number(data[title.index("anbdy") + 1], f"{where}: {family} entry")
+    index = int(head[2]) if len(head) > 2 and head[2].isdigit() else -1
     return VlocEntry(family=family, cd=cd, an=an, cd_kind=data[title.index("cdtac")],
                      an_kind=data[title.index("antac")], behav=data[title.index("behav")],
                      status=data[title.index("sttus")] if "sttus" in title else data[-2], rlt=found["rlt"],
                      rln=found["rln"], gap=found["gap"],
-                     normal=(found["n1"], found["n2"]), point=(found["x"], found["y"]))
+                     normal=(found["n1"], found["n2"]), point=(found["x"], found["y"]), index=index, line=line)
 
 
 def output_files(outbox) -> list:
@@ -415,9 +454,7 @@ def output_files(outbox) -> list:
         No ``DOF.OUT.n`` at all, or a ``DOF.OUT.n`` without its ``Vloc_Rloc.OUT.n`` (or the
         reverse).
     """
-    outbox = os.fspath(outbox)
-    if not os.path.isdir(outbox):
-        raise FileFormatError(f"{outbox}: no such folder (an LMGC90 run writes its results into OUTBOX/)")
+    outbox = input_folder(outbox, "an LMGC90 run's OUTBOX/, where it writes its results")
     found = {"DOF.OUT": set(), "Vloc_Rloc.OUT": set()}
     for name in os.listdir(outbox):
         match = re.fullmatch(r"(DOF\.OUT|Vloc_Rloc\.OUT)\.(\d+)", name)
