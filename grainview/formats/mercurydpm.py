@@ -38,6 +38,9 @@ contract from it. docs/formats.md states the same for users.
 
 Every function checks its input and refuses bad input in one line
 (:class:`grainview.contract.errors.FileFormatError` or :class:`~grainview.contract.errors.ParameterError`).
+
+A value that is not finite or is absurd (:mod:`grainview.formats.checks`) on a ``.data`` or
+``.fstat`` line is refused naming the file and the line.
 """
 
 from __future__ import annotations
@@ -49,6 +52,7 @@ import warnings
 import numpy as np
 
 from ..contract.errors import FileFormatError, ParameterError
+from .checks import Limits
 from .mercurydpm_text import iter_data, iter_fstat, read_restart
 
 __all__ = ["mercurydpm_snapshots", "open_mercurydpm", "convert_mercurydpm", "unit_scales", "BOX_WALLS"]
@@ -116,7 +120,7 @@ def _wall_names(restart):
         name = f"{kind or 'wall'}{index}"
         normal = None
         q = values.get("orientation", [])
-        if kind == "InfiniteWall" and len(q) == 4:
+        if kind == "InfiniteWall" and len(q) == 4 and np.all(np.abs(q) <= 1 + 1e-9):  # a unit quaternion
             w, x, y, z = q
             normal = np.array([1 - 2 * (y * y + z * z), 2 * (x * y + w * z)])  # the wall's axis (1, 0, 0), rotated
             key = tuple(int(round(c)) for c in normal)
@@ -146,6 +150,12 @@ class _Model:
                                   "contract needs the same particles throughout)")
         radius = first.values[:, 4]
         restart_radius = np.array([p["radius"][0] for p in restart.particles])
+        for values, path, rows in ((radius, data_path, lambda k: f"line {first.line + 1 + k}"),
+                                   (restart_radius, restart_path, lambda k: f"particle {k}")):
+            bad = ~(np.isfinite(values) & (values > 0))
+            if bad.any():
+                k = int(np.flatnonzero(bad)[0])
+                raise FileFormatError(f"{path}: {rows(k)}: radius = {values[k]:.6g}; expected a finite radius > 0")
         if not np.allclose(restart_radius, radius, rtol=1e-8, atol=0):
             k = int(np.argmax(np.abs(restart_radius - radius)))
             raise FileFormatError(f"{restart_path}: particle {k} has radius {restart_radius[k]:.10g} but "
@@ -166,10 +176,22 @@ class _Model:
         self.wall_names, self.wall_axes = _wall_names(restart)
         self.scales = scales
         self.data_path = data_path
+        self.limits = Limits(self.radius, scales["length"], restart_path, mass=self.mass, inertia=self.inertia)
 
 
 def _particles(model, snap, where):
     values = snap.values
+    line = lambda k: f"line {snap.line + 1 + k}"  # noqa: E731
+    s, limits = model.scales, model.limits
+    limits.check([[snap.time]], "t", "time", where, rows=lambda k: "the header", scale=s["time"])
+    limits.check(values[:, 0:2], ("x", "y"), "position", where, rows=line, scale=s["length"])
+    limits.check(snap.bounds.reshape(2, 2), ("x", "y"), "position", where,
+                 rows=lambda k: ("the header's xmin, ymin", "the header's xmax, ymax")[k], scale=s["length"],
+                 centre=np.median(values[:, 0:2], axis=0))
+    limits.check(values[:, 2:4], ("vx", "vy"), "speed", where, rows=line, scale=s["velocity"])
+    limits.check(values[:, 4], "r", "length", where, rows=line, scale=s["length"])
+    limits.check(values[:, 5], "angleZ", "angle", where, rows=line)
+    limits.check(values[:, 6], "-omegaZ", "angular_velocity", where, rows=line, scale=1 / s["time"])
     if values.shape[0] != model.n:
         raise FileFormatError(f"{where}: {values.shape[0]} particles against {model.n} in the first snapshot; the "
                               "contract needs the same particles throughout")
@@ -206,10 +228,11 @@ def fstat_contacts(rows, n_particles, n_walls, where):
         A body index out of range, a particle pair whose two lines disagree, a pair written
         more than twice.
     """
+    ids = rows[:, 1:3]
+    if not (np.all(np.abs(ids) < 2**31) and np.all(ids == np.round(ids))):  # NaN fails both
+        raise FileFormatError(f"{where}: a body index that is not an integer")
     p = rows[:, 1].astype(np.int64)
     other = rows[:, 2].astype(np.int64)
-    if np.any(rows[:, 1] != p) or np.any(rows[:, 2] != other):
-        raise FileFormatError(f"{where}: a body index that is not an integer")
     bad = (p < 0) | (p >= n_particles) | (other >= n_particles) | (other < -n_walls)
     if bad.any():
         k = int(np.flatnonzero(bad)[0])
@@ -252,8 +275,22 @@ def fstat_contacts(rows, n_particles, n_walls, where):
     return out, tensile
 
 
-def _contacts(model, position_raw, rows, where):
+def _check_rows(model, position_raw, snap, where):
+    """One line for an ``.fstat`` row holding a value that is not finite or is absurd."""
+    rows, s, limits = snap.rows, model.scales, model.limits
+    line = lambda k: f"line {snap.lines[k]}"  # noqa: E731
+    limits.check(rows[:, 1:3], ("P", "I"), "number", where, rows=line)
+    limits.check(rows[:, 3:5], ("cx", "cy"), "position", where, rows=line, scale=s["length"],
+                 centre=np.median(position_raw, axis=0))
+    limits.check(rows[:, 6:8], ("overlap", "tangential overlap"), "length", where, rows=line, scale=s["length"])
+    limits.check(rows[:, 8:10], ("fn", "ft"), "force", where, rows=line, scale=s["force"])
+    limits.check(rows[:, 10:16], ("nx", "ny", "nz", "tx", "ty", "tz"), "unit", where, rows=line)
+
+
+def _contacts(model, position_raw, snap, where):
     s = model.scales
+    _check_rows(model, position_raw, snap, where)
+    rows = snap.rows
     raw, tensile = fstat_contacts(rows, model.n, len(model.wall_names), where)
     i, j, normal = raw["i"], raw["j"], raw["normal"]
     length = np.hypot(normal[:, 0], normal[:, 1])
@@ -285,6 +322,9 @@ def _zip(data_path, fstat_path):
             longer, shorter, snap = (fstat_path, data_path, f) if d is None else (data_path, fstat_path, d)
             raise FileFormatError(f"{longer} has a snapshot at t = {snap.time:.10g} that {shorter} does not have "
                                   "(the two files must hold the same snapshots)")
+        for path, snap in ((data_path, d), (fstat_path, f)):
+            if not math.isfinite(snap.time):
+                raise FileFormatError(f"{path}: line {snap.line}: t = {snap.time}; expected a finite time")
         if not math.isclose(d.time, f.time, rel_tol=1e-9, abs_tol=1e-12):
             raise FileFormatError(f"mismatched snapshots: {data_path} at t = {d.time:.10g} (line {d.line}), "
                                   f"{fstat_path} at t = {f.time:.10g} (line {f.line}) (the files must hold the same "
@@ -350,7 +390,7 @@ def mercurydpm_snapshots(data, fstat=None, restart=None, *, units=None):
         for d, f in chain_first(first, stream):
             where = f"{fstat_path}: t = {f.time:.10g} (line {f.line})"
             state = _particles(model, d, f"{data_path}: t = {d.time:.10g} (line {d.line})")
-            contacts, wall_force, tensile = _contacts(model, d.values[:, 0:2], f.rows, where)
+            contacts, wall_force, tensile = _contacts(model, d.values[:, 0:2], f, where)
             box = d.bounds * scales["length"]
             snap = dict(time=d.time * scales["time"], contacts=contacts, box_min=box[:2].copy(),
                         box_max=box[2:].copy(), tensile=tensile, **state)

@@ -24,12 +24,12 @@ naming the file, the line and what was expected.
 
 from __future__ import annotations
 
-import os
 from dataclasses import dataclass, field
 
 import numpy as np
 
 from ..contract.errors import FileFormatError
+from .checks import input_file
 
 __all__ = ["DataSnapshot", "FstatSnapshot", "RestartInfo", "iter_data", "iter_fstat", "read_restart",
            "FSTAT_COLUMNS", "DATA_COLUMNS"]
@@ -56,11 +56,13 @@ class DataSnapshot:
 @dataclass
 class FstatSnapshot:
     """One snapshot of an ``.fstat`` file: ``time``, ``rows`` (K, 16) in the order of
-    :data:`FSTAT_COLUMNS`; ``line`` is the first header line's number."""
+    :data:`FSTAT_COLUMNS`; ``line`` is the first header line's number, ``lines`` (K,) the line
+    number of each row."""
 
     time: float
     rows: np.ndarray
     line: int
+    lines: np.ndarray = field(default_factory=lambda: np.zeros(0, np.int64))
 
 
 @dataclass
@@ -86,9 +88,7 @@ def _numbers(text, path, line, count=None, what="numbers"):
 
 
 def _open(path, kind):
-    path = os.fspath(path)
-    if not os.path.isfile(path):
-        raise FileFormatError(f"{path}: no such file (expected MercuryDPM's {kind} file)")
+    path = input_file(path, f"MercuryDPM's {kind} file")
     return path, open(path, encoding="utf-8", errors="replace")
 
 
@@ -115,7 +115,7 @@ def iter_data(path):
             if len(values) == 8:
                 raise FileFormatError(f"{path}: line {number}: a 3D run's header (N t xmin ymin zmin xmax ymax zmax); "
                                       "only 2D runs (setDimension(2)) can be read")
-            if len(values) != 6 or values[0] < 0 or values[0] != int(values[0]):
+            if len(values) != 6 or not (np.isfinite(values[0]) and values[0] >= 0 and values[0] == int(values[0])):
                 raise FileFormatError(f"{path}: line {number}: expected a header 'N t xmin ymin xmax ymax', found "
                                       f"{header.strip()[:80]!r}")
             n = int(values[0])
@@ -183,6 +183,7 @@ def _fstat_snapshot(path, header, rows, start):
     _numbers(header[1][1], path, header[1][0], 6, "numbers (# xmin ymin zmin xmax ymax zmax)")
     if not rows:
         return FstatSnapshot(first[0], np.zeros((0, 16)), start)
+    lines = np.array([number for number, _ in rows], np.int64)
     try:
         block = np.array(" ".join(line for _, line in rows).split(), float)
     except ValueError:
@@ -191,7 +192,7 @@ def _fstat_snapshot(path, header, rows, start):
         for number, line in rows:
             _numbers(line, path, number, 16, "numbers (t P I contact-point overlap tangential-overlap fn ft normal "
                                              "tangent)")
-    return FstatSnapshot(first[0], block.reshape(len(rows), 16), start)
+    return FstatSnapshot(first[0], block.reshape(len(rows), 16), start, lines)
 
 
 def _pairs(tokens):

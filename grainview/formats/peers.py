@@ -40,12 +40,14 @@ from __future__ import annotations
 
 import glob
 import json
+import math
 import os
 
 import numpy as np
 
 from ..contract.errors import FileFormatError, ParameterError
 from ..contract.schema import contact_slots
+from .checks import TIME_LIMIT_S, Limits, check_snapshot, input_file, input_folder
 
 __all__ = ["WALLS", "WALL_NORMALS", "peer_contacts", "wall_forces", "peer_snapshots", "open_peer", "open_box2d",
            "open_pymunk", "convert_peer"]
@@ -104,6 +106,7 @@ def wall_forces(contacts, n) -> np.ndarray:
 
 
 def _load(path, keys, what):
+    path = input_file(path, what)
     try:
         with np.load(path) as data:
             missing = [k for k in keys if k not in data.files]
@@ -141,7 +144,7 @@ def peer_snapshots(raw_dir, sample, engine=None):
         One line: no snapshots, no or bad ``meta.json``, another engine's folder, a sample or
         snapshot lacking arrays, a snapshot whose particle count differs from the sample's.
     """
-    raw_dir = os.fspath(raw_dir)
+    raw_dir = input_folder(raw_dir, "a peer engine's folder of raw snapshots (snap_*.npz and meta.json)")
     files = sorted(glob.glob(os.path.join(raw_dir, "snap_*.npz")))
     if not files:
         raise FileFormatError(f"{raw_dir}: no raw snapshots (snap_*.npz): did the engine run?")
@@ -156,6 +159,10 @@ def peer_snapshots(raw_dir, sample, engine=None):
     radius = np.asarray(data["radius"], float)
     n = radius.size
     dt = float(data["time_step"])
+    sample = os.fspath(sample)
+    limits = Limits(radius, 1.0, sample, mass=data["mass"], inertia=data["inertia"])
+    if not (math.isfinite(dt) and 0 < dt <= TIME_LIMIT_S):
+        raise FileFormatError(f"{sample}: time_step = {dt:.6g}; expected a finite time step > 0 in s")
     attrs = {f"engine_{k}": v for k, v in meta.items() if isinstance(v, (str, int, float))}
     attrs.update({"source": str(meta.get("engine", "peer engine")), "time_step_s": dt})
     for key in ("strain", "velocity", "every", "n_steps"):
@@ -172,6 +179,7 @@ def peer_snapshots(raw_dir, sample, engine=None):
             raw = _load(path, SNAPSHOT_KEYS, "a raw snapshot of the cross-check")
             if len(raw["position"]) != n:
                 raise FileFormatError(f"{path}: {len(raw['position'])} particles, the sample has {n}")
+            _check_raw(limits, raw, path)
             contacts = peer_contacts(raw, raw["position"], dt)
             normal_impulse = contacts.pop("normal_impulse")
             walls = raw["wall_position"]
@@ -184,12 +192,39 @@ def peer_snapshots(raw_dir, sample, engine=None):
     return static, snapshots()
 
 
+def _check_raw(limits, raw, path):
+    """One line for a raw snapshot's value that is not finite or is absurd (a manifold's absent
+    point is NaN: only the present ones are checked)."""
+    middle = np.median(np.asarray(raw["position"], float).reshape(-1, 2), axis=0)
+    contact = lambda k: f"contact {k}"  # noqa: E731  (a row of the pair arrays)
+    for name, kind in (("time", "time"), ("position", "position"), ("angle", "angle"), ("velocity", "speed"),
+                       ("angular_velocity", "angular_velocity"), ("wall_position", "position"),
+                       ("wall_velocity", "speed"), ("normal", "unit"), ("force", "force")):
+        values = np.asarray(raw[name], float)
+        if values.size == 0:
+            continue
+        values = values.reshape(values.shape[0] if values.ndim else 1, -1)
+        what = "contact" if name in ("normal", "force") else "wall" if name.startswith("wall") else "particle"
+        rows = (lambda k: "the snapshot") if name == "time" else (lambda k, what=what: f"{what} {k}")
+        limits.check(values, name, kind, path, rows=rows, centre=middle if kind == "position" else None)
+    a, b, count = (np.asarray(raw[key], float) for key in ("a", "b", "n_points"))
+    limits.check(np.column_stack([a, b, count]), ("a", "b", "n_points"), "number", path, rows=contact)
+    present = np.arange(2)[None, :] < count[:, None]
+    limits.check(np.where(present, raw["point_fn"], 0.0), "point_fn", "force", path, rows=contact)
+    points = np.where(present[..., None], raw["points"], middle)
+    limits.check(points.reshape(-1, 2), "points", "position", path, rows=lambda k: f"contact {k // 2}",
+                 centre=middle)
+
+
 def open_peer(raw_dir, sample, engine=None):
     """A peer engine's run (:func:`peer_snapshots`) as an in-memory dataset of the contract."""
     from ..contract.dataset import make_dataset
 
     static, stream = peer_snapshots(raw_dir, sample, engine)
     snaps = list(stream)
+    limits = Limits(static["radius"], 1.0, os.fspath(sample), mass=static["mass"], inertia=static["inertia"])
+    for path, snap in zip(static["files"], snaps):
+        check_snapshot(limits, snap, path)
     n = static["radius"].size
     slots = max([contact_slots(n, 4)] + [len(s["contacts"]["i"]) for s in snaps])
     impulse = np.zeros((len(snaps), slots, 2))

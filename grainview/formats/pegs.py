@@ -42,6 +42,9 @@ How the contract's quantities are made (docs/formats.md states the same for user
 
 Every function checks its input and refuses bad input in one line
 (:class:`grainview.contract.errors.FileFormatError` or :class:`~grainview.contract.errors.ParameterError`).
+
+A value that is not finite or is absurd (:mod:`grainview.formats.checks`) and an empty adjacency
+list are refused; the frames without a row in the adjacency list are named in one warning.
 """
 
 from __future__ import annotations
@@ -54,6 +57,7 @@ import warnings
 import numpy as np
 
 from ..contract.errors import FileFormatError, ParameterError
+from .checks import Limits, input_file
 
 __all__ = ["pegs_snapshots", "open_pegs", "convert_pegs", "read_adjacency", "read_positions", "WALL_NAMES",
            "EDGE_WALLS"]
@@ -72,17 +76,12 @@ def _paths(value, what):
     paths = [value] if isinstance(value, (str, os.PathLike)) else list(value)
     if not paths:
         raise ParameterError(f"{what}: an empty list of files")
-    out = []
-    for path in paths:
-        path = os.fspath(path)
-        if not os.path.isfile(path):
-            raise FileFormatError(f"{path}: no such file (expected PeGS2's {what})")
-        out.append(path)
-    return out
+    return [input_file(path, f"PeGS2's {what}") for path in paths]
 
 
-def _table(path, columns, what):
-    """The rows of a comma-separated numeric file, (K, columns); one line on a bad row."""
+def _table(path, columns, what, lines=None):
+    """The rows of a comma-separated numeric file, (K, columns); one line on a bad row.
+    ``lines``, a list, receives each row's line number."""
     rows, last = [], ""
     with open(path, encoding="utf-8", errors="replace") as handle:
         for number, line in enumerate(handle, start=1):
@@ -96,6 +95,8 @@ def _table(path, columns, what):
             if len(values) != columns:
                 raise FileFormatError(f"{path}: line {number}: {len(values)} columns, expected {columns} ({what})")
             rows.append(values)
+            if lines is not None:
+                lines.append(number)
             last = line
     if rows and not last.endswith("\n"):
         raise FileFormatError(f"{path}: truncated: its last line ends without a newline (PeGS2's writematrix ends "
@@ -114,19 +115,32 @@ def read_adjacency(paths) -> np.ndarray:
     Raises
     ------
     FileFormatError
-        A missing file, a row without its 5 numbers, a frame or id that is not an integer, a
-        non-finite force.
+        A missing file (or a folder), no row at all (an empty adjacency list), a row without
+        its 5 numbers, a frame or id that is not an integer, a non-finite force (naming its
+        line).
     """
     tables = []
-    for path in _paths(paths, "adjacency list"):
-        table = _table(path, 5, "5 numbers: frame, id1, id2, tangential force, normal force")
+    paths = _paths(paths, "adjacency list")
+    for path in paths:
+        lines = []
+        table = _table(path, 5, "5 numbers: frame, id1, id2, tangential force, normal force", lines)
         ids = table[:, :3]
-        if np.any(ids != np.round(ids)) or np.any(table[:, 1] < 1) or np.any((table[:, 2] < 1) & (table[:, 2] != -1)):
-            raise FileFormatError(f"{path}: frame and ids must be integers, id1 >= 1 and id2 >= 1 or -1 (a wall)")
-        if not np.all(np.isfinite(table[:, 3:])):
-            raise FileFormatError(f"{path}: a force that is not a finite number")
+        bad = ~np.isfinite(ids).all(axis=1) | (ids != np.round(ids)).any(axis=1) | (table[:, 1] < 1) | (
+            (table[:, 2] < 1) & (table[:, 2] != -1)) | (np.abs(ids) > 2**31).any(axis=1)
+        if bad.any():
+            k = int(np.flatnonzero(bad)[0])
+            raise FileFormatError(f"{path}: line {lines[k]}: frame and ids must be integers, id1 >= 1 and id2 >= 1 "
+                                  "or -1 (a wall)")
+        bad = ~np.isfinite(table[:, 3:]).all(axis=1)
+        if bad.any():
+            k = int(np.flatnonzero(bad)[0])
+            raise FileFormatError(f"{path}: line {lines[k]}: a force that is not a finite number")
         tables.append(table)
-    return np.concatenate(tables)
+    table = np.concatenate(tables)
+    if table.shape[0] == 0:
+        raise FileFormatError(f"{', '.join(paths)}: no contact at all (an empty adjacency list); expected rows "
+                              "frame, id1, id2, tangential force, normal force")
+    return table
 
 
 def _frame_number(path, place):
@@ -153,10 +167,11 @@ def read_positions(paths) -> np.ndarray:
         with open(path, encoding="utf-8", errors="replace") as handle:
             first = next((line for line in handle if line.strip()), "")
         width = len(first.replace(",", " ").split())
+        lines = []
         if width == 6:
-            table = _table(path, 6, "frame, id, x, y, r, edge (particle_positions.txt)")
+            table = _table(path, 6, "frame, id, x, y, r, edge (particle_positions.txt)", lines)
         elif width == 4:
-            table = _table(path, 4, "x, y, r, edge (a *_centers.txt)")
+            table = _table(path, 4, "x, y, r, edge (a *_centers.txt)", lines)
             k = table.shape[0]
             table = np.column_stack([np.full(k, _frame_number(path, place)), np.arange(1, k + 1), table])
         else:
@@ -164,6 +179,12 @@ def read_positions(paths) -> np.ndarray:
                                   "y, r, edge (particle_positions.txt)")
         if not np.all(table[:, 4] > 0) or not np.all(np.isfinite(table[:, 2:5])):
             raise FileFormatError(f"{path}: radii must be > 0 and positions finite")
+        ids = table[:, :2]
+        if not (np.isfinite(ids).all() and (ids == np.round(ids)).all() and (np.abs(ids) <= 2**31).all()):
+            raise FileFormatError(f"{path}: frame and id must be integers")
+        if table.shape[0]:  # in pixels: the bounds are relative to the disks' size
+            limits = Limits(table[:, 4], where=path, names=lambda k: f"line {lines[k]}")
+            limits.check(table[:, 2:4], ("x", "y"), "position", path, rows=lambda k: f"line {lines[k]}")
         if not np.all(np.isin(table[:, 5], (0, 1, -1, 2, -2))):
             raise FileFormatError(f"{path}: an edge flag other than 0, 1, -1, 2, -2")
         tables.append(table)
@@ -265,6 +286,15 @@ def pegs_snapshots(adjacency, positions, *, metres_per_pixel=None, force_unit_n=
                            "one"}
     static = dict(radius=radius, mass=mass, inertia=0.5 * mass * radius**2, n_walls=len(WALL_NAMES),
                   wall_names=list(WALL_NAMES), wall_normal=-_WALL_NORMALS, attrs=attrs)
+    limits = Limits(radius, thickness, position_paths[0], mass=mass, names=lambda k: f"particle id {ids[k]}")
+    limits.check(adj[:, 3:5], ("tangential force", "normal force"), "force", adjacency_paths[0], scale=force_scale,
+                 rows=lambda k: f"frame {int(adj[k, 0])}, ids {int(adj[k, 1])} and {int(adj[k, 2])}")
+    limits.check([[frames.min() * interval], [frames.max() * interval]], "time", "time", position_paths[0],
+                 rows=lambda k: f"frame {(frames.min(), frames.max())[k]} (frame_interval_s = {interval:g})")
+    silent = np.setdiff1d(frames, adj[:, 0].astype(np.int64))
+    if silent.size:
+        warnings.warn(f"{silent.size} frame(s) of {position_paths[0]} ({_listed(silent)}) have no row in "
+                      f"{adjacency_paths[0]} and are written without contacts", UserWarning, stacklevel=2)
 
     def snapshots():
         for frame in frames:
@@ -285,6 +315,12 @@ def pegs_snapshots(adjacency, positions, *, metres_per_pixel=None, force_unit_n=
                        box_max=(position + r_frame[:, None]).max(axis=0), wall_force=wall_force, tensile=tensile)
 
     return static, snapshots()
+
+
+def _listed(frames, most=5) -> str:
+    """``frame 3, 7`` or ``frames 1, 2, 3, 4, 5, ...``."""
+    shown = ", ".join(str(int(f)) for f in frames[:most]) + (", ..." if len(frames) > most else "")
+    return f"frame{'s' if len(frames) > 1 else ''} {shown}"
 
 
 def _frame_contacts(rows, index, position, radius, edge, force_scale, where):
