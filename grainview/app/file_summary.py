@@ -12,8 +12,12 @@ before complete ones, the polygons' ``vertices`` (where the file has them) follo
 rules for shapes (:func:`grainview.contract.shapes.shape_problems`), and the values the summary
 reads are sound: times increasing strictly,
 finite forces, normal forces >= 0 (:mod:`grainview.contract.file_checks`, the words of
-:func:`grainview.contract.validation.validate`). Every value is checked by
-:func:`grainview.contract.validation.validate` (``grainview info --check``).
+:func:`grainview.contract.validation.validate`); a stored chunk that the netCDF library refuses
+to read (a compressed file's chunk that fails its checksum) is one line naming the file. With
+``grainview info --check``, every stored chunk of every variable is read first
+(:func:`grainview.contract.file_checks.damaged_chunks`), a file without
+``grainview_schema_version`` is a problem, and every value is checked by
+:func:`grainview.contract.validation.validate`.
 """
 
 from __future__ import annotations

@@ -60,10 +60,11 @@ def _checked_store():
 
 
 def _open(source):
-    """The dataset of ``source`` (not chunked) and its snapshots' ``complete`` mask (None
-    without ``time``). netCDF-C reads a file's format and then opens it again by its name: a
-    finished run compressed in between (renamed over the name) fails as "Unknown file format".
-    A failure on a file whose name now points to another file is therefore tried again."""
+    """The dataset of ``source`` (not chunked), its snapshots' ``complete`` mask (None
+    without ``time``) and the function that closes the file. netCDF-C reads a file's format
+    and then opens it again by its name: a finished run compressed in between (renamed over
+    the name) fails as "Unknown file format". A failure on a file whose name now points to
+    another file is therefore tried again."""
     import xarray as xr
 
     for attempt in range(REOPEN_ATTEMPTS):
@@ -78,7 +79,7 @@ def _open(source):
             except BaseException:
                 store.close()
                 raise
-            return ds, complete
+            return ds, complete, store.close
         except (OSError, ValueError, RuntimeError, KeyError, TypeError, IndexError) as exc:
             try:
                 replaced = not os.path.samestat(before, os.stat(source))
@@ -127,21 +128,26 @@ def open_dataset(path, chunks: int | dict | None = "auto", validate: bool = Fals
     source = os.fspath(path)
     if not os.path.exists(source):
         raise FileFormatError(f"{source}: no such file")
-    ds, complete = _open(source)
-    check_version(ds.attrs.get("grainview_schema_version"), source)
-    if complete is not None:
-        n_complete = damaged_snapshots(complete, source)
-        if n_complete < ds.sizes["time"]:
-            ds = ds.isel(time=slice(0, n_complete))
-    for name in ("xy", "wall"):
-        if name in ds.coords and ds[name].dtype.kind in "SO":
-            ds = ds.assign_coords({name: np.char.strip(ds[name].values.astype(str))})
-    if chunks is not None and "time" in ds.dims:
-        ds = ds.chunk(time_chunks(ds, chunks))
-    ds.encoding["source"] = source
-    if validate:
-        from .validation import validate as _validate
-        _validate(ds, source=source)
+    ds, complete, close = _open(source)  # close: the file's; a dataset made by assign_coords would not close it
+    try:
+        check_version(ds.attrs.get("grainview_schema_version"), source)
+        if complete is not None:
+            n_complete = damaged_snapshots(complete, source)
+            if n_complete < ds.sizes["time"]:
+                ds = ds.isel(time=slice(0, n_complete))
+        for name in ("xy", "wall"):
+            if name in ds.coords and ds[name].dtype.kind in "SO":
+                ds = ds.assign_coords({name: np.char.strip(ds[name].values.astype(str))})
+        if chunks is not None and "time" in ds.dims:
+            ds = ds.chunk(time_chunks(ds, chunks))
+        ds.encoding["source"] = source
+        ds.set_close(close)
+        if validate:
+            from .validation import validate as _validate
+            _validate(ds, source=source)
+    except BaseException:
+        close()
+        raise
     return ds
 
 

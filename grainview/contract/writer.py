@@ -429,7 +429,9 @@ def compress_file(path, complevel: int = DEFAULT_COMPLEVEL, lock=None) -> None:
     Per-snapshot variables are chunked one snapshot per chunk (:func:`chunk_shape`), the chunks
     that hold only empty slots are not written (they read as the fill value), and a variable
     is deflated only when that saves at least :data:`MIN_SAVING` of the bytes of its slots in
-    use (:func:`deflate_saving`, on three chunks); the others are stored as they are. The copy goes block by block
+    use (:func:`deflate_saving`, on three chunks); the others are stored as they are. Every
+    variable but the scalars carries a Fletcher-32 checksum per chunk (:data:`CHECKSUMS`), which
+    the netCDF library verifies whenever it reads the chunk. The copy goes block by block
     (:func:`copy_blocks`) without the library's chunk caches, in memory independent of the
     number of snapshots.
 
