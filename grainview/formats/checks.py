@@ -158,6 +158,7 @@ class Limits:
     def __init__(self, radius, thickness=1.0, where="", mass=None, inertia=None, names=None):
         radius = np.asarray(radius, float).reshape(-1)
         self.where = where
+        self._bounds = None
         names = names if names is not None else (lambda k: f"particle {k}")
         for name, values in (("radius", radius), ("mass", mass), ("inertia", inertia)):
             if values is None:
@@ -185,9 +186,14 @@ class Limits:
 
     def bound(self, kind: str) -> tuple:
         """``(limit, expected)``: the largest magnitude of a quantity of ``kind`` in SI units, and
-        the words that say so. ``kind`` is one of ``position``, ``length``, ``force``,
-        ``wall_force``, ``speed``, ``angular_velocity``, ``time``, ``acceleration``, ``angle``,
-        ``unit`` (a component of a unit vector) or ``number`` (finite only)."""
+        the words that say so. ``kind`` is one of ``position``, ``length``, ``force``, ``speed``,
+        ``angular_velocity``, ``time``, ``acceleration``, ``angle``, ``unit`` (a component of a
+        unit vector) or ``number`` (finite only)."""
+        if self._bounds is None:
+            self._bounds = self._table()
+        return self._bounds[kind]
+
+    def _table(self) -> dict:
         length = LENGTH_SPAN * self.diameter
         force = STRESS_LIMIT_PA * self.diameter * self.thickness
         return {
@@ -205,7 +211,7 @@ class Limits:
             "angle": (ANGLE_LIMIT_RAD, f"a finite angle of at most {ANGLE_LIMIT_RAD:g} rad"),
             "unit": (1 + UNIT_TOLERANCE, "a component of a unit vector, from -1 to 1"),
             "number": (np.inf, "a finite number"),
-        }[kind]
+        }
 
     def check(self, values, quantity: str, kind: str, where: str, rows=None, scale=1.0, centre=None,
               limit=None) -> None:
