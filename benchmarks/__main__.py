@@ -138,6 +138,8 @@ SECTIONS = (
             ("--repeats", "7"), ("--repeats", "1")),
     Section("compression", "compression", "compressed files: size, speed of the analyses, memory",
             ("--repeats", "3")),
+    Section("checksums", "checksums", "the Fletcher-32 checksums of finished files: size and read speed",
+            ("--repeats", "15"), ("--quick",)),
     Section("lammps-convert", "lammps_convert", "`grainview convert lammps` on a large run: time and memory", ()),
 )
 """The current benchmarks, in the order of RESULTS.md. benchmarks/README.md says what each measures."""
