@@ -17,6 +17,7 @@ from __future__ import annotations
 
 import argparse
 import contextlib
+import functools
 import signal
 import sys
 from pathlib import Path
@@ -290,8 +291,10 @@ def setting_option(parser, record, name, *, more="", flag=None, **overrides):
     parser.add_argument(flag or _flag(name), **options)
 
 
+@functools.cache
 def _module_tree(module):
-    """The parsed source of ``module`` of grainview or solver (nothing imported)."""
+    """The parsed source of ``module`` of grainview or solver (nothing imported), parsed once
+    per process however many options read it."""
     import ast
 
     path = Path(__file__).parents[2].joinpath(*module.split(".")).with_suffix(".py")  # beside the grainview package
