@@ -34,7 +34,10 @@ def _checked_store():
     refuses (a Fletcher-32 checksum that does not match, data that do not inflate) raises
     :class:`FileFormatError` naming the file and the variable in one line
     (:func:`grainview.contract.file_checks.damaged_data`) wherever it is read, eagerly or in
-    a dask task, instead of a bare ``RuntimeError: NetCDF: HDF error``."""
+    a dask task, instead of a bare ``RuntimeError: NetCDF: HDF error``. The classes are made
+    here, when a file is first opened (they import xarray), and are this module's attributes
+    ``CheckedStore`` and ``CheckedArray`` (:func:`__getattr__`), so that pickle finds them by
+    name: a dataset opened lazily can be sent to another process."""
     import xarray as xr
     from xarray.backends.netCDF4_ import NetCDF4ArrayWrapper, NetCDF4DataStore
     from xarray.core import indexing
@@ -50,13 +53,26 @@ def _checked_store():
 
     class CheckedStore(NetCDF4DataStore):
         source = None
+        CheckedArray = None  # set below
 
         def open_store_variable(self, name, var):
             variable = super().open_store_variable(name, var)
             data = indexing.LazilyIndexedArray(CheckedArray(name, self))
             return xr.Variable(variable.dims, data, variable.attrs, variable.encoding)
 
+    for cls in (CheckedArray, CheckedStore):
+        cls.__module__, cls.__qualname__ = __name__, cls.__name__
+    CheckedStore.CheckedArray = CheckedArray
     return CheckedStore
+
+
+def __getattr__(name):
+    """``CheckedStore`` and ``CheckedArray``, made on first use (:func:`_checked_store`)."""
+    if name == "CheckedStore":
+        return _checked_store()
+    if name == "CheckedArray":
+        return _checked_store().CheckedArray
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
 
 
 def _open(source):

@@ -190,3 +190,22 @@ def test_a_flipped_byte_in_an_attribute_is_refused_in_one_line(series, tmp_path,
     assert "\n" not in str(caught.value)
     line = _one_line(["info", str(path), "--check"], capsys)
     assert line.startswith(f"grainview: error: {path}: not a readable netCDF file"), line
+
+
+def test_a_lazily_opened_dataset_pickles_and_still_names_a_damaged_chunk(series, tmp_path):
+    """What dask.distributed or multiprocessing does with an opened file: pickle.dumps, then
+    pickle.loads elsewhere; the values read back and a damaged chunk is still one line."""
+    import pickle
+
+    good = _finished(series, tmp_path / "good.nc")
+    with grainview.open_dataset(good) as ds:
+        copy = pickle.loads(pickle.dumps(ds))
+    np.testing.assert_array_equal(copy["fn"].values, series["fn"].values)
+    copy.close()
+    bad = _finished(series, tmp_path / "bad.nc")
+    _flip_a_byte_of_fn(bad, series)
+    with grainview.open_dataset(bad) as ds:
+        copy = pickle.loads(pickle.dumps(ds))
+    with pytest.raises(FileFormatError, match=f"{bad}: fn: its stored data cannot be read"):
+        copy["fn"].values
+    copy.close()
