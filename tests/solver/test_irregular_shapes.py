@@ -11,7 +11,7 @@ import pytest
 import grainview
 from grainview.app.cli import main
 from grainview.contract import shapes as contract
-from grainview.contract.errors import ParameterError
+from grainview.contract.errors import ConvergenceWarning, ParameterError
 from grainview.contract.reader import ContractFile
 from solver import Parameters, Simulation, Walls, biaxial_test, compaction_sample, isotropic_compaction
 from solver.output import Recorder
@@ -160,7 +160,13 @@ def test_a_too_slender_file_is_refused_before_anything_runs(tmp_path):
 def test_a_slender_but_accepted_rectangle_compacts_without_crossing(tmp_path):
     # 9 x 1 rectangles (R/r = 9.06): the compaction keeps every grain inside the box and every
     # interpenetration far below the inradius
-    sim = prepare_sample(preparation("fast", shape=_write(tmp_path, [_rectangle(9)]), particles=12, max_steps=1500))
+    shape = _write(tmp_path, [_rectangle(9)])
+    with warnings.catch_warnings():
+        # slender grains jammed by the fast route: some steps end at the sweep cap, one warning
+        # each, how many depending on the trajectory; this test checks the geometry, and the
+        # warning itself is tested in test_unconverged_counts and test_physics
+        warnings.simplefilter("ignore", ConvergenceWarning)
+        sim = prepare_sample(preparation("fast", shape=shape, particles=12, max_steps=1500))
     assert sim.compaction_steps > 0
     n, points = sim.n_particles, sim.detect()
     inner = sim.shapes.inradius
