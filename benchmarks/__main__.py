@@ -141,6 +141,8 @@ SECTIONS = (
     Section("checksums", "checksums", "the Fletcher-32 checksums of finished files: size and read speed",
             ("--repeats", "15"), ("--quick",)),
     Section("lammps-convert", "lammps_convert", "`grainview convert lammps` on a large run: time and memory", ()),
+    Section("cli-io", "cli_io", "`grainview export --to csv` and `grainview info` on a study-sized file: time",
+            ("--repeats", "5"), ("--repeats", "1", "--snapshots", "20", "--contacts", "200")),
 )
 """The current benchmarks, in the order of RESULTS.md. benchmarks/README.md says what each measures."""
 

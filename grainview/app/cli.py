@@ -1104,7 +1104,9 @@ def _ensemble_parser(sub):
 def _info_parser(sub):
     info = sub.add_parser("info", help="validate a grainview netCDF file and print its summary",
                           description="Print a file's size, snapshots, strain and q/p reached and settings, "
-                          "in under a second, checking its structure and units against the data contract "
+                          "in under a second (about half a second for a 400-particle study's run on two cores "
+                          "shared with other jobs; benchmarks/results/cli-io.md), checking its structure and "
+                          "units against the data contract "
                           "(--check: every value too); exits with 2 and one line naming the fault when it is "
                           "not valid.")
     info.add_argument("file", help="path of a netCDF file of the grainview data contract")
