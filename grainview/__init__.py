@@ -17,6 +17,12 @@ so that the solver, which writes files of the contract, does not load them.
 """
 
 import importlib
+import os
+
+# Numba's vectorised loops may call Intel's SVML (when the icc_rt library is installed), whose
+# results depend on the processor; the solver and analyses must not (docs/reproducibility.md).
+# Effective when numba is first imported after grainview, as the solver does.
+os.environ.setdefault("NUMBA_DISABLE_INTEL_SVML", "1")
 
 from . import _moved, _register
 from .contract.errors import ConvergenceWarning, FileFormatError, GrainviewError, OutputError, ParameterError, SchemaError

@@ -92,13 +92,29 @@ def _small_solve(matrix, rhs, size):
 # prove non-negative needs no wrap-around check, and the loops vectorise.
 
 
-@njit(cache=True, fastmath={"reassoc"})
+# The two sums below run in LANES interleaved partial sums (term k goes to sum k mod LANES), added
+# in a fixed order at the end: the order of every addition is written in the code, so the compiler
+# may map the lanes onto vector registers of any width but cannot reorder the sums, and the result
+# is the same bits on every processor. (Reassociation, which would let it vectorise a single
+# running sum, orders the additions by the target's vector width.)
+LANES = 4
+
+
+@njit(cache=True)
 def _dot2(a, b, c, d):
-    """a . b + c . d (a block's share: reassociated, the same for every thread count)."""
-    total = 0.0
-    for k in range(a.size):
-        total += a[k] * b[k] + c[k] * d[k]
-    return total
+    """a . b + c . d, summed in :data:`LANES` interleaved partial sums (a block's share, the same
+    for every thread count and processor)."""
+    s0 = s1 = s2 = s3 = 0.0
+    n = a.size
+    whole = n - n % LANES
+    for k in range(0, whole, LANES):
+        s0 += a[k] * b[k] + c[k] * d[k]
+        s1 += a[k + 1] * b[k + 1] + c[k + 1] * d[k + 1]
+        s2 += a[k + 2] * b[k + 2] + c[k + 2] * d[k + 2]
+        s3 += a[k + 3] * b[k + 3] + c[k + 3] * d[k + 3]
+    for k in range(whole, n):
+        s0 += a[k] * b[k] + c[k] * d[k]
+    return (s0 + s1) + (s2 + s3)
 
 
 @njit(cache=True)
@@ -113,16 +129,13 @@ def _subtract_scaled(target, rows, lo, hi, gamma, count):
             target[k] -= g * row[k]
 
 
-@njit(cache=True, fastmath={"reassoc"})
+@njit(cache=True)
 def _residual(gn, gt, xn, xt, fn, ft):
-    """f = G(x) - x into (fn, ft), then x <- G(x); returns |f|^2."""
-    size = 0.0
+    """f = G(x) - x into (fn, ft), then x <- G(x); returns |f|^2 (:func:`_dot2`'s order)."""
     for k in range(gn.size):
-        a, b = gn[k] - xn[k], gt[k] - xt[k]
-        fn[k], ft[k] = a, b
-        size += a * a + b * b
+        fn[k], ft[k] = gn[k] - xn[k], gt[k] - xt[k]
         xn[k], xt[k] = gn[k], gt[k]
-    return size
+    return _dot2(fn, fn, ft, ft)
 
 
 @njit(cache=True)

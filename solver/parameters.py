@@ -27,6 +27,7 @@ from dataclasses import MISSING, asdict, dataclass, field, fields
 
 import numpy as np
 
+from grainview.contract import portable_math
 from grainview.contract.errors import ParameterError
 from grainview.contract.schema import MAX_STEP_INDEX
 
@@ -384,7 +385,7 @@ class Preparation:
         h is the deposit's height, aspect x :func:`solver.packing.box_width_for` (m): the
         compacted sample is lower, so its test takes somewhat fewer steps."""
         with np.errstate(over="ignore", divide="ignore"):
-            return float(self.deposit_height() * np.expm1(strain) / (float(velocity) * float(time_step)))
+            return float(self.deposit_height() * portable_math.expm1(float(strain)) / (float(velocity) * float(time_step)))
 
     def deposit_height(self) -> float:
         """The deposit's height in m: aspect x :func:`solver.packing.box_width_for`."""

@@ -9,6 +9,7 @@ from __future__ import annotations
 import sys
 
 import numpy as np
+from grainview.contract import portable_math
 from grainview.contract.errors import ParameterError
 from grainview.contract.schema import MAX_STEP_INDEX
 
@@ -207,7 +208,7 @@ def biaxial_test(sim: Simulation, path, *, strain=BiaxialTest.strain, velocity=B
     check_time_step(sim.parameters.time_step, velocity, float(sim.radius.min()), "the top wall")
     lo, hi = sim.walls.box_bounds()
     h0 = float(hi[1] - lo[1])
-    travel = h0 * (np.exp(strain) - 1)
+    travel = h0 * (portable_math.exp(strain) - 1)
     steps = travel / velocity / sim.parameters.time_step
     if not np.isfinite(steps) or sim.step_index + steps > MAX_STEP_INDEX:
         raise ParameterError(

@@ -38,6 +38,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from grainview.contract import portable_math
 from grainview.contract import shapes as contract
 from grainview.contract.errors import ParameterError
 
@@ -274,8 +275,8 @@ class Shapes:
         np.cumsum(n_vertices, out=first[1:])
         v = np.concatenate(rows) if rows else np.empty((0, 2))
         edge = np.concatenate([np.roll(r, -1, axis=0) - r for r in rows]) if rows else np.empty((0, 2))
-        return cls(radius, n_vertices, first, np.hypot(v[:, 0], v[:, 1]), np.arctan2(v[:, 1], v[:, 0]),
-                   np.arctan2(-edge[:, 0], edge[:, 1]), inner, area, polar, vertex_xy=v)
+        return cls(radius, n_vertices, first, np.hypot(v[:, 0], v[:, 1]), portable_math.arctan2(v[:, 1], v[:, 0]),
+                   portable_math.arctan2(-edge[:, 0], edge[:, 1]), inner, area, polar, vertex_xy=v)
 
     @classmethod
     def of(cls, radius, n_vertices, vertices=None) -> "Shapes":

@@ -81,12 +81,16 @@ def _bins(x, y, angle, bin_width):
 
 def _binned_mean(values, k, k0, n_bins):
     """Mean of ``values`` (..., y, x) over the nodes of each bin (NaN skipped): (..., n_bins)."""
-    flat = values.reshape(values.shape[:-2] + (-1,))
+    flat = values.reshape((-1, k.size))
     ok = np.isfinite(flat)
-    onehot = np.zeros((k.size, n_bins))
-    onehot[np.arange(k.size), k.ravel() - k0] = 1.0
-    sums = np.where(ok, flat, 0.0) @ onehot
-    counts = ok.astype(float) @ onehot
+    # one bincount over (row, bin) pairs: each bin's sum in node order, the same bits on every
+    # processor (a product with a one-hot matrix would sum in the order of the BLAS kernel)
+    where = (np.arange(flat.shape[0])[:, None] * n_bins + (k.ravel() - k0)[None, :]).ravel()
+    size = flat.shape[0] * n_bins
+    sums = np.bincount(where, np.where(ok, flat, 0.0).ravel(), minlength=size).reshape(flat.shape[0], n_bins)
+    counts = np.bincount(where, ok.ravel().astype(float), minlength=size).reshape(flat.shape[0], n_bins)
+    sums = sums.reshape(values.shape[:-2] + (n_bins,))
+    counts = counts.reshape(values.shape[:-2] + (n_bins,))
     with np.errstate(invalid="ignore", divide="ignore"):
         return np.where(counts > 0, sums / np.where(counts > 0, counts, 1.0), np.nan)
 

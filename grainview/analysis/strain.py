@@ -10,6 +10,7 @@ from __future__ import annotations
 import numpy as np
 import xarray as xr
 
+from ..contract import portable_math
 from . import sample
 from ._lift import with_attrs
 from .arrays.strain import log_strain
@@ -102,7 +103,7 @@ def strains(ds: xr.Dataset, reference: int = 0) -> xr.Dataset:
     eps_1 = _log_strain(h, reference)
     eps_2 = _log_strain(l, reference)
     v0 = v.isel(time=reference)
-    eps_p = np.log(1 + (v - v0) / v0)
+    eps_p = portable_math.log(1 + (v - v0) / v0)
     out = xr.Dataset({
         "eps_1": with_attrs(eps_1, "eps_1", "1", "vertical strain eps_1 (compression positive)"),
         "eps_2": with_attrs(eps_2, "eps_2", "1", "horizontal strain eps_2 (compression positive)"),
@@ -181,7 +182,7 @@ def friction_and_dilatancy(ds: xr.Dataset, reference: int = 0) -> xr.Dataset:
     ratio = _ratio(eps["eps_p"], eps["eps_q"])
     rate = _ratio(time_derivative(eps["eps_p"]), time_derivative(eps["eps_q"]))
     def asin(sine):  # NaN outside [-1, 1], without warnings when dask computes later
-        return np.arcsin(sine.where(abs(sine) <= 1))
+        return portable_math.arcsin(sine.where(abs(sine) <= 1))
 
     return xr.Dataset({
         "phi": with_attrs(asin(q_over_p), "phi", "rad", "friction angle, sin phi = q/p"),

@@ -227,6 +227,7 @@ def shape_problems(radius, n_vertices, vertices) -> list[str]:
     real = k[None, :] < count[:, None]
     # left turns everywhere still allow a star (a boundary winding more than once): the
     # exterior angles of a convex polygon add up to one full turn
+    # portable: the winding is only compared with 1 (to 1e-5), which the last bit cannot change
     winding = np.where(real, np.arctan2(turn, np.sum(a * b, axis=-1)), 0.0).sum(-1) / (2 * np.pi)
     concave = np.any((turn <= 0) & real, axis=-1) | ~np.isclose(winding, 1.0)
     ids = np.flatnonzero(polygon)

@@ -327,7 +327,7 @@ def _wall_contacts(particles, position, snap, fixes, where):
         if np.any(length == 0):
             raise FileFormatError(f"{where}: fix {fix}: a wall contact point at a particle centre")
         n = arm / length[:, None]
-        wall = np.argmax(n @ _WALL_DIRECTIONS.T, axis=1)
+        wall = np.argmax(n[:, :1] * _WALL_DIRECTIONS[:, 0] + n[:, 1:] * _WALL_DIRECTIONS[:, 1], axis=1)
         if not np.allclose(n, _WALL_DIRECTIONS[wall], atol=1e-6):
             raise FileFormatError(f"{where}: fix {fix}: a wall that is not an x or y plane (only fix wall/gran "
                                   "xplane and yplane walls can be read)")

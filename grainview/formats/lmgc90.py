@@ -64,6 +64,7 @@ import warnings
 
 import numpy as np
 
+from ..contract import portable_math
 from ..contract.errors import FileFormatError
 from ..contract.shapes import polygon_properties, regular_vertices, shape_problems, vertex_phases
 from .checks import Limits, input_folder
@@ -108,7 +109,7 @@ def regular_polygon(vertices, rtol=1e-5):
     if radius <= 0 or np.abs(r - radius).max() > rtol * radius or np.abs(v.mean(axis=0)).max() > rtol * radius:
         return None
     phi = math.atan2(v[0, 1], v[0, 0])
-    offset = np.sort(np.mod(np.arctan2(v[:, 1], v[:, 0]) - phi + rtol, 2 * np.pi) - rtol)
+    offset = np.sort(np.mod(portable_math.arctan2(v[:, 1], v[:, 0]) - phi + rtol, 2 * np.pi) - rtol)
     if np.abs(offset - vertex_phases(n)).max() > rtol * 2 * np.pi:
         return None
     return radius, n, phi
@@ -381,7 +382,7 @@ def _contacts(model, position, vloc, where):
             force += -on_cd if cd == i else on_cd  # exerted by i on j
             fn_points.append(entry.rln)
             xy.append(entry.point)
-        fn = float(force @ normal)
+        fn = float(force[0] * normal[0] + force[1] * normal[1])  # not np.dot: BLAS's kernel may fuse
         if fn < 0:
             tensile += 1
         if not fn > 0:
@@ -389,13 +390,13 @@ def _contacts(model, position, vloc, where):
         tangent = np.array([-normal[1], normal[0]])
         weights = np.array(fn_points)
         xy = np.array(xy)
-        point = (weights @ xy) / weights.sum() if weights.sum() > 0 else xy.mean(axis=0)
+        point = (weights[:, None] * xy).sum(axis=0) / weights.sum() if weights.sum() > 0 else xy.mean(axis=0)
         out["i"].append(i)
         out["j"].append(j)
         out["kind"].append(len(points))
         out["normal"].append(normal)
         out["fn"].append(fn)
-        out["ft"].append(float(force @ tangent))
+        out["ft"].append(float(force[0] * tangent[0] + force[1] * tangent[1]))
         out["point"].append(point)
         out["branch"].append(position[j] - position[i] if j < n else point - position[i])
         out["gap"].append(min(entry.gap for entry, _ in points))

@@ -30,6 +30,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ...contract import portable_math
 from .._kernels.force_chains import accumulate_moments, aligned_links, follow_tracks, label_components
 from .signature import CONTACT, CONTACT_XY, PARTICLE, SCALAR, TENSOR, core_dims
 from .tensors import principal
@@ -178,10 +179,10 @@ def force_chains(i, j, fn, ft, normal, point, branch, mask, position, volume, an
     where = (np.arange(rows.shape[0])[:, None] * n_bins + rows)[rows >= 0]
     length_count = np.bincount(where, minlength=rows.shape[0] * n_bins).reshape(sizes.shape[:-1] + (n_bins,))
 
-    phi = 2.0 * np.arctan2(branch[..., 1], branch[..., 0])
+    phi = 2.0 * portable_math.arctan2(branch[..., 1], branch[..., 0])
     s = np.where(link, np.sin(phi), 0.0).sum(-1)
     c = np.where(link, np.cos(phi), 0.0).sum(-1)
-    orientation = np.where(link.any(-1), np.mod(0.5 * np.arctan2(s, c), np.pi), np.nan)
+    orientation = np.where(link.any(-1), np.mod(0.5 * portable_math.arctan2(s, c), np.pi), np.nan)
 
     symmetric = 0.5 * (moments + np.swapaxes(moments, -1, -2))
     total = symmetric.sum(-3)

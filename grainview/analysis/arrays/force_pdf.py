@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ...contract import portable_math
 from .binning import batched_bincount
 from .signature import CONTACT, SCALAR, core_dims
 
@@ -27,8 +28,10 @@ def bin_edges(n_bins, scale, value_range):
     """The ``n_bins + 1`` edges of the bins of f_n/<f_n>: evenly spaced (``scale="linear"``) or
     evenly spaced in log (``"log"``, needs ``0 < low``) over ``value_range = (low, high)``."""
     low, high = value_range
-    if scale == "log":
-        return np.geomspace(low, high, n_bins + 1)
+    if scale == "log":  # np.geomspace's edges, through the portable exp and log
+        edges = portable_math.exp(np.linspace(portable_math.log(low), portable_math.log(high), n_bins + 1))
+        edges[0], edges[-1] = low, high
+        return edges
     return np.linspace(low, high, n_bins + 1)
 
 
@@ -90,7 +93,7 @@ def exponential_fit(centres, pdf, counts, low=1.0, high=np.inf):
     counts = np.asarray(counts, float)
     use = (x > low) & (x < high) & (counts > 0) & (pdf > 0) & np.isfinite(pdf)
     w = np.where(use, counts, 0.0)
-    y = np.log(np.where(use, pdf, 1.0))
+    y = portable_math.log(np.where(use, pdf, 1.0))
     s, sx, sy = w.sum(-1), (w * x).sum(-1), (w * y).sum(-1)
     sxx, sxy = (w * x * x).sum(-1), (w * x * y).sum(-1)
     enough = use.sum(-1) >= 2
@@ -115,11 +118,11 @@ def exponential_prefactor(centres, pdf, counts, alpha, low=1.0, high=np.inf):
     alpha = np.asarray(alpha, float)
     use = (x > low) & (x < high) & (counts > 0) & (pdf > 0) & np.isfinite(pdf)
     w = np.where(use, counts, 0.0)
-    y = np.log(np.where(use, pdf, 1.0)) + alpha[..., None] * x
+    y = portable_math.log(np.where(use, pdf, 1.0)) + alpha[..., None] * x
     total = w.sum(-1)
     with np.errstate(invalid="ignore", divide="ignore"):
         log_a = (w * y).sum(-1) / total
-    return np.where((total > 0) & np.isfinite(alpha), np.exp(log_a), np.nan)
+    return np.where((total > 0) & np.isfinite(alpha), portable_math.exp(log_a), np.nan)
 
 
 def counting_error(pdf, counts):

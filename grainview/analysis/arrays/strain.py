@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from ...contract import portable_math
+
 
 def log_strain(size, reference):
     """Logarithmic strain of a box extent, compression positive: ln(1 + (L0 - L)/L0).
@@ -11,4 +13,4 @@ def log_strain(size, reference):
     ``size`` is the extent L (m) of each snapshot, ``reference`` the extent L0 (m) of the
     reference snapshot; eps_1 for the height, eps_2 for the width (paper Sec. III). Works on
     numpy arrays and on DataArrays alike (a ufunc expression)."""
-    return np.log(1 + (reference - size) / reference)
+    return portable_math.log(1 + (reference - size) / reference)

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ...contract import portable_math
 from .signature import SCALAR, TENSOR, core_dims
 
 
@@ -20,7 +21,7 @@ def principal(tensor):
     dev = 0.5 * (t[..., 0, 0] - t[..., 1, 1])
     shear = 0.5 * (t[..., 0, 1] + t[..., 1, 0])
     radius = np.hypot(dev, shear)
-    theta = np.mod(0.5 * np.arctan2(shear, dev), np.pi)
+    theta = np.mod(0.5 * portable_math.arctan2(shear, dev), np.pi)
     return mean + radius, mean - radius, theta
 
 

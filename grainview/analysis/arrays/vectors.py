@@ -5,6 +5,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from ...contract import portable_math
+
 
 def force_vectors(fn, ft, normal):
     """Force f = fn n + ft t with t = (-n_y, n_x), as (..., 2) arrays (docs/conventions.md §0)."""
@@ -14,4 +16,4 @@ def force_vectors(fn, ft, normal):
 
 def angle_of(normal):
     """Orientation theta of each normal folded into [0, pi) (docs/conventions.md §0), rad."""
-    return np.mod(np.arctan2(normal[..., 1], normal[..., 0]), np.pi)
+    return np.mod(portable_math.arctan2(normal[..., 1], normal[..., 0]), np.pi)
