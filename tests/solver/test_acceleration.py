@@ -163,8 +163,12 @@ def test_domain_form_converges_to_an_admissible_solution_whatever_the_threads(pr
     r0 = parallel_nlgs.solve_problem_domains(prob, sim.position[:, 0], *plain, domains=2, tolerance=1e-5,
                                              max_tolerance=1e-3, max_iterations=20000)
     assert r1.iterations < 0.5 * r0.iterations, (r1, r0)
-    # the same confining load on the walls as the plain solution (same statics, other network)
-    assert one[0].sum() == pytest.approx(plain[0].sum(), rel=1e-3)
+    # the same load on the walls as the plain solution (same statics, another network): a dense
+    # packing's contact forces are mostly self-stress, which the contact laws leave loosely fixed,
+    # so solutions of this one problem by other methods and tolerances spread by 0.6% in the walls'
+    # load (docs/reproducibility.md, "Tolerances from measured scatter")
+    on_walls = np.maximum(prob.a, prob.b) >= sim.position.shape[0]
+    assert one[0][on_walls].sum() == pytest.approx(plain[0][on_walls].sum(), rel=1.5e-2)
 
 
 @pytest.mark.parametrize("domains", [1, 3])
@@ -250,3 +254,26 @@ def test_the_scratch_records_cut_the_work_array_without_overlap():
     assert np.all(work[size:] == -1.0)
     assert scratch.dfn.shape == (memory, points) and scratch.dw.shape == (memory, bodies)
     assert not any(np.shares_memory(x, work) for x in (scratch.gram, scratch.row, scratch.rhs))
+
+
+@pytest.mark.parametrize("n", [0, 1, 3, 4, 5, 17, 1001])
+def test_block_sums_add_in_the_order_the_code_writes(n):
+    """The history's sums run in LANES interleaved partial sums added in a fixed order (no
+    reassociation, so the same bits on every processor): equal to that order computed in
+    Python, and to the exact sum within rounding."""
+    import math
+
+    rng = np.random.default_rng(n)
+    a, b, c, d = rng.normal(size=(4, n)) * 10.0 ** rng.uniform(-6, 6, (4, n))
+    lanes = [0.0] * acceleration.LANES
+    whole = n - n % acceleration.LANES
+    terms = [float(a[k] * b[k] + c[k] * d[k]) for k in range(n)]
+    for k, term in enumerate(terms):
+        lanes[k % acceleration.LANES if k < whole else 0] += term
+    written = (lanes[0] + lanes[1]) + (lanes[2] + lanes[3])
+    assert acceleration._dot2(a, b, c, d) == written
+    assert abs(written - math.fsum(terms)) <= 4 * n * np.finfo(float).eps * sum(map(abs, terms))
+    fn, ft, xn, xt = np.empty(n), np.empty(n), c.copy(), d.copy()
+    size = acceleration._residual(a, b, xn, xt, fn, ft)
+    assert np.array_equal(fn, a - c) and np.array_equal(ft, b - d) and np.array_equal(xn, a)
+    assert size == acceleration._dot2(fn, fn, ft, ft)
