@@ -1,7 +1,8 @@
 """The same bits on any x86-64 processor: trajectories, files, analyses and the report compiled
 for three targets on this one machine.
 
-Each target runs :mod:`tests.portability` in a subprocess with its own numba cache:
+Each target runs :mod:`tests.portability` in a subprocess with its own numba cache (the host's is
+``NUMBA_CACHE_DIR`` when set, the one the rest of the suite uses):
 
 - ``host``: numba's default, the host's processor and all its instructions;
 - ``generic``: ``NUMBA_CPU_NAME=generic`` (numba keeps the host's instruction set, the tuning
@@ -82,7 +83,8 @@ def digests_for(target: str, base: Path) -> dict:
     working folder under ``base``)."""
     env = {k: v for k, v in os.environ.items()
            if not k.startswith(("NUMBA_CPU", "NPY_DISABLE_CPU", "OPENBLAS_CORETYPE"))}
-    cache = Path(os.environ.get("NUMBA_CACHE_DIR", base)) / "targets" / target
+    shared = os.environ.get("NUMBA_CACHE_DIR")  # the host's kernels are the rest of the suite's
+    cache = Path(shared) if shared and target == "host" else Path(shared or base) / "targets" / target
     env.update(TARGETS[target](), NUMBA_CACHE_DIR=str(cache), MPLBACKEND="Agg",
                PYTHONPATH=os.pathsep.join([str(ROOT), env.get("PYTHONPATH", "")]))
     done = subprocess.run([sys.executable, "-m", "tests.portability", str(base / target)], cwd=ROOT,
