@@ -447,6 +447,35 @@ def _unconverged_warning(sim, path, unconverged) -> str:
             "and its report states both, apart")
 
 
+def _reissue(caught):
+    """Show again the warnings of ``caught`` (a ``catch_warnings(record=True)`` list) other than
+    the ConvergenceWarnings, which the caller summarises in one line."""
+    import warnings
+
+    for w in caught:
+        if not issubclass(w.category, ConvergenceWarning):
+            warnings.warn_explicit(w.message, w.category, w.filename, w.lineno)
+
+
+def _resumed_unconverged_warning(path, unconverged) -> str:
+    """What the warning on a resumed test's unconverged steps says: how many of the steps taken
+    now stopped at their contact solver's iteration cap or stall test, and, from the written
+    file, how many of the whole test's did and how far their impulses were from a solution
+    (grainview.app.convergence), in the words of :func:`_unconverged_warning`."""
+    import netCDF4
+
+    from .convergence import norms_phrase, residual_comparison, stop_rule, tolerances, unconverged_in_file
+
+    with netCDF4.Dataset(path) as nc:
+        counts = unconverged_in_file(nc.variables, {k: nc.getncattr(k) for k in nc.ncattrs()})
+    if counts is None:  # another engine's file
+        return f"the contact solver did not converge in {unconverged} step(s) of the resumed test"
+    whole = f"; in the whole test {counts['steps']} of its {counts['of']} ({residual_comparison(counts)})"
+    return (f"the contact solver ({counts['solver']}) did not converge in {unconverged} of the resumed test's steps"
+            f"{whole}. They stopped at {stop_rule(counts)} before {norms_phrase(counts)} ({tolerances(counts)}). "
+            f"{path} records the test's per snapshot (nlgs_unconverged_steps), and its report states them")
+
+
 def _progress_flag(args):
     return None if args.progress == "auto" else args.progress == "on"
 
@@ -702,13 +731,20 @@ def _study_sample(label, prep, path, state, checkpoint, *, test, near_contacts, 
         print(f"{label}: {path} is complete (skipped)", flush=True)
         return path
     if state == "partial":
+        import warnings
         from time import monotonic
 
         from solver.paper_size import hours
 
         print(f"{label}: resuming the test in {path} ...", flush=True)
         start = monotonic()
-        steps = runner.resume(path, progress=progress, compress=compress)
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            steps = runner.resume(path, progress=progress, compress=compress)
+        _reissue(caught)
+        unconverged = sum(issubclass(w.category, ConvergenceWarning) for w in caught)
+        if unconverged:
+            print(f"{label}: warning: {_resumed_unconverged_warning(path, unconverged)}", file=sys.stderr)
         print(f"{label}: resumed for {steps} steps ({hours(monotonic() - start)} of wall time); wrote {path}",
               flush=True)
         return path
