@@ -2,7 +2,7 @@
 
 Run as ``python -m tests.portability WORKDIR`` it prints one JSON object: the solver's fingerprint
 digests (:mod:`tests.solver.test_fingerprint`), one digest per file of three short
-``grainview run`` commands (pentagons, disks, pentagons on two domains; compaction included),
+``grainview run`` commands (of what a reader of the file sees, and of its bytes) (pentagons, disks, pentagons on two domains; compaction included),
 one per output of every ``ds.grain`` analysis of the pentagons' file and of the LMGC90 fixture
 converted (the analyses on an input that does not depend on the solver), one per file the readers
 write from the repository's fixtures, and one of the report's table. :mod:`tests.test_processor_independence` runs it in subprocesses that compile the numba
@@ -123,6 +123,7 @@ def all_digests(workdir: Path) -> dict:
         path = workdir / f"{label}-converted.nc"
         main(["convert", *arguments, "--out", str(path), "--overwrite"])
         out[f"convert/{label}"] = file_digest(path)
+        out[f"convert-bytes/{label}"] = hashlib.sha256(path.read_bytes()).hexdigest()[:16]
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", ConvergenceWarning)
         out.update({f"analysis-lmgc90/{k}": v for k, v in analysis_digests(workdir / "lmgc90-converted.nc").items()})
@@ -131,6 +132,7 @@ def all_digests(workdir: Path) -> dict:
         path = workdir / f"{label}.nc"
         main(["run", "biaxial", *arguments, *SHORT, "--out", str(path), "--overwrite"])
         out[f"file/{label}"] = file_digest(path)
+        out[f"file-bytes/{label}"] = hashlib.sha256(path.read_bytes()).hexdigest()[:16]
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", ConvergenceWarning)
         out.update({f"analysis/{k}": v for k, v in analysis_digests(workdir / "pentagons.nc").items()})
