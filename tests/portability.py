@@ -1,13 +1,14 @@
 """Digests of everything a run and its analysis produce, for comparing compile targets.
 
 Run as ``python -m tests.portability WORKDIR`` it prints one JSON object: the solver's fingerprint
-digests (:mod:`tests.solver.test_fingerprint`), one digest per file of three short
-``grainview run`` commands (of what a reader of the file sees, and of its bytes) (pentagons, disks, pentagons on two domains; compaction included),
-one per output of every ``ds.grain`` analysis of the pentagons' file and of the LMGC90 fixture
-converted (the analyses on an input that does not depend on the solver), one per file the readers
-write from the repository's fixtures, and one of the report's table. :mod:`tests.test_processor_independence` runs it in subprocesses that compile the numba
-kernels for different processors (and restrict numpy's and OpenBLAS's kernels to a processor's
-instruction set) and requires the same digests from all of them.
+digests (:mod:`tests.solver.test_fingerprint`); for each of three short ``grainview run`` commands
+(pentagons, disks, pentagons on two domains; compaction included) and each file the readers
+write from the repository's fixtures, a digest of what a reader of the file sees and one of its
+bytes; one per output of every ``ds.grain`` analysis of the pentagons' file and of the converted
+LMGC90 fixture (the analyses on an input that does not depend on the solver); and one of the
+report's table. :mod:`tests.test_processor_independence` runs it in subprocesses that compile the
+numba kernels for different processors (and restrict numpy's and OpenBLAS's kernels to a
+processor's instruction set) and requires the same digests from all of them.
 """
 
 from __future__ import annotations
