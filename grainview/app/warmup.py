@@ -11,11 +11,15 @@ residuals; the analyses' kernels), so that the runs that follow start at once.
 
 The cache lives where numba puts it: ``NUMBA_CACHE_DIR`` when it is set, otherwise a
 ``__pycache__`` folder beside each module (or a user cache folder when that one is not
-writable). :func:`cache_location` says which.
+writable). :func:`cache_location` says which, and :func:`cache_state` whether it holds every
+kernel for this processor (numba keys each compiled version by the target's CPU name and
+features, so a cache filled on another processor, or for ``NUMBA_CPU_NAME=generic``, does not
+count): the command line compiles ahead, with progress, only when it does not.
 """
 
 from __future__ import annotations
 
+import contextlib
 import importlib
 import os
 import pkgutil
@@ -23,10 +27,20 @@ import tempfile
 import warnings
 from pathlib import Path
 
-__all__ = ["warm_up", "kernels", "cache_location"]
+__all__ = ["warm_up", "kernels", "cache_location", "cache_holds", "cache_state"]
 
 PACKAGES = ("solver", "grainview.analysis._kernels")
 """The packages whose modules hold numba kernels."""
+SOLVER_PACKAGES = ("solver",)
+"""The packages whose kernels a simulation calls (``grainview run``); the analysis's are
+:data:`PACKAGES`' others."""
+GROUPS = {"solver": SOLVER_PACKAGES, "analysis": ("grainview.analysis._kernels",)}
+"""The kernels by what needs them: a simulation the solver's, a report the analysis's too (the
+keys of :data:`solver.paper_size.COMPILE_SECONDS`)."""
+RESEARCH_MODULES = ("solver.two_level",)
+"""Modules whose kernels no run or analysis calls (research methods outside the stepper's
+registry, measured by benchmarks/two_level.py): the warm-up's workload does not compile them
+and :func:`cache_state` leaves them out."""
 
 
 def cache_location() -> str:
@@ -42,13 +56,14 @@ def cache_location() -> str:
             "(NUMBA_CACHE_DIR unset; set it to choose a folder)")
 
 
-def kernels() -> dict:
-    """Every numba kernel of :data:`PACKAGES`: {"module.name": dispatcher}, in module order.
-    Kernels marked ``inline="always"`` are compiled into their callers and not listed."""
+def kernels(packages=PACKAGES) -> dict:
+    """Every numba kernel of ``packages`` (default :data:`PACKAGES`): {"module.name":
+    dispatcher}, in module order. Kernels marked ``inline="always"`` are compiled into their
+    callers and not listed."""
     from numba.core.registry import CPUDispatcher
 
     found = {}
-    for package in PACKAGES:
+    for package in packages:
         root = importlib.import_module(package)
         for info in pkgutil.iter_modules(root.__path__):
             module = importlib.import_module(f"{package}.{info.name}")
@@ -57,6 +72,82 @@ def kernels() -> dict:
                         and value.targetoptions.get("inline", "never") != "always"):
                     found[f"{module.__name__}.{name}"] = value
     return found
+
+
+def cache_holds(dispatcher) -> bool | None:
+    """Whether the kernel ``dispatcher`` can run in this process without compiling.
+
+    True when it has a compiled version in this process already, or when numba's on-disk
+    cache holds one for this processor: an entry of its index file (which numba reads only
+    when the index's numba version and source file's stamp are current) whose key matches the
+    one numba would look up, i.e. the same bytecode and the same target (the CPU name and
+    features of ``NUMBA_CPU_NAME``/``NUMBA_CPU_FEATURES``, or the host's).
+
+    Parameters
+    ----------
+    dispatcher : numba.core.registry.CPUDispatcher
+        A kernel of :func:`kernels`.
+
+    Returns
+    -------
+    bool or None
+        True or False as above; None when ``dispatcher`` has no on-disk cache (``cache=False``)
+        or numba's internals are not those this reads (another numba version): unknown.
+    """
+    try:
+        if dispatcher.signatures:
+            return True
+        from numba.core.caching import Cache
+
+        cache = dispatcher._cache
+        if not isinstance(cache, Cache):
+            return None
+        codegen = dispatcher.targetctx.codegen()
+        index = cache._cache_file._load_index()
+        return any(cache._index_key(key[0], codegen) == key for key in index)
+    except Exception:  # numba's private layout differs: say nothing rather than guess
+        return None
+
+
+def cache_state(packages=PACKAGES) -> dict:
+    """Which kernels of ``packages`` a process would compile before it runs (:func:`cache_holds`),
+    :data:`RESEARCH_MODULES`' left out.
+
+    Parameters
+    ----------
+    packages : tuple of str
+        The packages to look at: :data:`PACKAGES` (a study: the solver and the analysis) or
+        :data:`SOLVER_PACKAGES` (a run).
+
+    Returns
+    -------
+    dict
+        ``{"kernels": how many were looked at, "cold": [names of those not in the cache],
+        "unknown": [names of those whose state could not be read]}``; the cache is warm when
+        both lists are empty.
+    """
+    found = {name: d for name, d in kernels(packages).items() if name.rpartition(".")[0] not in RESEARCH_MODULES}
+    state = {name: cache_holds(d) for name, d in found.items()}
+    return {"kernels": len(found), "cold": [n for n, held in state.items() if held is False],
+            "unknown": [n for n, held in state.items() if held is None]}
+
+
+def cold_shares(groups=tuple(GROUPS)) -> dict:
+    """For each group of :data:`GROUPS` named in ``groups``, the share of its kernels that a
+    process would compile (:func:`cache_state`: those not in the cache and those whose state is
+    unknown), with their names.
+
+    Returns
+    -------
+    dict
+        ``{group: (share from 0 to 1, [names of the kernels to compile])}``.
+    """
+    out = {}
+    for group in groups:
+        state = cache_state(GROUPS[group])
+        names = state["cold"] + state["unknown"]
+        out[group] = (len(names) / state["kernels"] if state["kernels"] else 0.0, names)
+    return out
 
 
 def _steps(shape, steps=3, **parameters):
@@ -117,7 +208,38 @@ def _stages(folder):
              analysis)]
 
 
-def warm_up(log=print) -> dict:
+@contextlib.contextmanager
+def compiled_kernels(callback):
+    """Within the block, ``callback(name)`` is called each time numba finishes compiling a
+    kernel of :func:`kernels` (``name``: "module.name"; a kernel loaded from the cache is not
+    compiled), through numba's event API (``numba.core.event``, event "numba:compile"). Where
+    that API is missing, the block runs without calls."""
+    try:
+        from numba.core import event
+    except ImportError:
+        yield
+        return
+
+    class Listener(event.Listener):
+        def on_start(self, ev):
+            pass
+
+        def on_end(self, ev):
+            dispatcher = (ev.data or {}).get("dispatcher")
+            function = getattr(dispatcher, "py_func", None)
+            if function is not None:
+                callback(f"{function.__module__}.{function.__name__}")
+
+    try:
+        listening = event.install_listener("numba:compile", Listener())
+    except Exception:  # another numba's event API
+        yield
+        return
+    with listening:
+        yield
+
+
+def warm_up(log=print, packages=PACKAGES, compiled=None) -> dict:
     """Compile (or load from the cache) every numba kernel the solver and the analysis use.
 
     Runs :func:`_stages`' tiny workload in a temporary folder, calling ``log`` with a line per
@@ -127,23 +249,32 @@ def warm_up(log=print) -> dict:
     ----------
     log : callable, default print
         Called with one line per stage (progress).
+    packages : tuple of str, default PACKAGES
+        :data:`PACKAGES` for every stage, :data:`SOLVER_PACKAGES` for the solver's alone
+        (what a run needs: the analysis's stage left out).
+    compiled : callable, optional
+        Called with a kernel's name each time one is compiled (:func:`compiled_kernels`): a
+        progress bar's update.
 
     Returns
     -------
     dict
         ``{"kernels": number of kernels, "compiled": kernels with a compiled version,
-        "missing": [names of the others], "cache": cache_location()}``.
+        "missing": [names of the others, :data:`RESEARCH_MODULES`' left out], "cache":
+        cache_location()}``.
     """
     from ..contract.errors import ConvergenceWarning
 
-    with tempfile.TemporaryDirectory(prefix="grainview-warmup-") as folder, warnings.catch_warnings():
+    events = compiled_kernels(compiled) if compiled is not None else contextlib.nullcontext()
+    with tempfile.TemporaryDirectory(prefix="grainview-warmup-") as folder, warnings.catch_warnings(), events:
         warnings.simplefilter("ignore", ConvergenceWarning)
         warnings.simplefilter("ignore", RuntimeWarning)  # 2 domains on a machine told to let threads sleep
-        stages = _stages(folder)
+        analysis = any(package.startswith("grainview") for package in packages)
+        stages = [(what, run) for what, run in _stages(folder) if analysis or not what.startswith("analysis:")]
         for k, (what, run) in enumerate(stages, 1):
             log(f"[{k}/{len(stages)}] {what}")
             run()
-    found = kernels()
+    found = {name: d for name, d in kernels(packages).items() if name.rpartition(".")[0] not in RESEARCH_MODULES}
     missing = [name for name, dispatcher in found.items() if not dispatcher.signatures]
     return {"kernels": len(found), "compiled": len(found) - len(missing), "missing": missing,
             "cache": cache_location()}
