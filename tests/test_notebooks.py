@@ -2,8 +2,10 @@
 of grainview and the solver turned into errors: a notebook must not need to silence them. The
 claims their text makes about their outputs are asserted by cells of the notebooks themselves,
 so a run whose numbers no longer match the text fails here. The committed notebooks carry their
-outputs (read without running), small enough to keep in the repository."""
+outputs (read without running), small enough to keep in the repository. With GRAINVIEW_STUDY naming
+a folder of `grainview study`'s files, the notebooks that read them also run on them."""
 
+import os
 import sys
 from pathlib import Path
 
@@ -34,8 +36,8 @@ def text_of(nb):
 
 @pytest.mark.parametrize("path", NOTEBOOKS, ids=[p.stem for p in NOTEBOOKS])
 def test_notebook_runs(path, tmp_path, monkeypatch):
-    for name in ("GRAINVIEW_NB_PARTICLES", "GRAINVIEW_NB_STRAIN", "GRAINVIEW_STUDY"):  # the default sizes,
-        monkeypatch.delenv(name, raising=False)  # whose numbers the text quotes; no study files in tmp_path
+    for name in ("GRAINVIEW_NB_PARTICLES", "GRAINVIEW_NB_STRAIN", "GRAINVIEW_NB_SEED", "GRAINVIEW_STUDY"):
+        monkeypatch.delenv(name, raising=False)  # the default samples, whose ranges the text quotes; no study files in tmp_path
     nb = nbformat.read(path, as_version=4)
     nb.cells.insert(0, nbformat.v4.new_code_cell(STRICT))
     NotebookClient(nb, timeout=600, kernel_name="python3", resources={"metadata": {"path": str(tmp_path)}}).execute()
@@ -44,6 +46,28 @@ def test_notebook_runs(path, tmp_path, monkeypatch):
     assert len(outputs(nb)) >= 3
     if path.stem == "paper_figures":  # without the study's files it says so, and runs the small samples
         assert "no study files" in text_of(nb).lower()
+
+
+STUDY_NOTEBOOKS = [p for p in NOTEBOOKS if "GRAINVIEW_STUDY" in p.read_text(encoding="utf-8")]
+
+
+@pytest.mark.parametrize("path", STUDY_NOTEBOOKS, ids=[p.stem for p in STUDY_NOTEBOOKS])
+def test_notebook_runs_on_the_study(path, tmp_path, monkeypatch):
+    """The notebooks that read the study's files run on them and their checks hold: run when
+    GRAINVIEW_STUDY names a folder with the files of `grainview study` (skipped otherwise)."""
+    study = Path(os.environ.get("GRAINVIEW_STUDY") or tmp_path / "none")
+    if not all((study / f"{label}.nc").is_file() for label in ("pentagons", "disks")):
+        pytest.skip("GRAINVIEW_STUDY does not name a folder with the study's pentagons.nc and disks.nc")
+    for name in ("GRAINVIEW_NB_PARTICLES", "GRAINVIEW_NB_STRAIN", "GRAINVIEW_NB_SEED"):
+        monkeypatch.delenv(name, raising=False)
+    monkeypatch.setenv("GRAINVIEW_STUDY", str(study.resolve()))
+    nb = nbformat.read(path, as_version=4)
+    nb.cells.insert(0, nbformat.v4.new_code_cell(STRICT))
+    NotebookClient(nb, timeout=1200, kernel_name="python3", resources={"metadata": {"path": str(tmp_path)}}).execute()
+    errors = [o for o in outputs(nb) if o.get("output_type") == "error"]
+    assert not errors, "\n".join(f"{o['ename']}: {o['evalue']}" for o in errors)
+    assert "drawing from the study's files" in text_of(nb).lower()
+    assert "does not hold" not in text_of(nb)
 
 
 def test_there_are_notebooks():
