@@ -126,11 +126,20 @@ def test_step_reports_the_measures_and_momentum_balances():
 
 def test_a_tighter_tolerance_gives_a_smaller_local_law_residual():
     """One dense state, solved cold (no warm start) at two NLGS tolerances, with plain and with
-    Anderson sweeps."""
+    Anderson sweeps. The state is a settled compaction under 10 kPa, so its problem carries the
+    confining load whatever the trajectory (a state part-way through the compaction may have only
+    separating contacts, which any tolerance solves exactly); over eight seeds the ratio of the two
+    residuals was 1e-5 to 1e-4 (docs/reproducibility.md)."""
     import copy
     from dataclasses import replace
 
-    sim = compacting(60, seed=5, steps=600)
+    from solver import compaction_sample, isotropic_compaction
+
+    sim = compaction_sample(60, "pentagon", seed=5, acceleration="off")
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        isotropic_compaction(sim, progress=False)
+    assert sim.settled
     for acceleration in ("off", "anderson"):
         found = []
         for tolerance in (1e-2, 1e-7):
