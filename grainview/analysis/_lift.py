@@ -62,6 +62,13 @@ def apply(func, *args, core_dims=None, output_core_dims=None, output_sizes=None,
     return tuple(out) if n_out > 1 else out[0]
 
 
+def ratio(num, den):
+    """``num / den``, NaN where ``den`` is 0: a snapshot with no contacts (p = 0, a zero trace)
+    gives NaN and no floating-point warning, also when dask computes it later, outside any
+    ``np.errstate`` (xarray silences the warning only when it divides eagerly)."""
+    return num / den.where(den != 0)
+
+
 def with_attrs(da: xr.DataArray, name: str, units: str, long_name: str, **extra) -> xr.DataArray:
     """Name ``da`` and give it exactly these attributes: units, long_name and ``extra`` (any
     attribute it carried over from its inputs is dropped: it described something else)."""
@@ -70,4 +77,4 @@ def with_attrs(da: xr.DataArray, name: str, units: str, long_name: str, **extra)
     return da
 
 
-__all__ = ["apply", "with_attrs", "TENSOR_DIMS"]
+__all__ = ["apply", "ratio", "with_attrs", "TENSOR_DIMS"]

@@ -10,7 +10,7 @@ from __future__ import annotations
 import numpy as np
 import xarray as xr
 
-from ._lift import apply, with_attrs
+from ._lift import apply, ratio, with_attrs
 from .arrays import forces as _forces
 from .arrays.tensors import principal
 from .contacts import selection
@@ -146,8 +146,8 @@ def force_anisotropies(ds: xr.Dataset, bins: int = 36, kind="all", walls: bool =
     t1, t2, theta_t = apply(principal, h["H_t"])
     trace = n1 + n2
     ref = reference_direction(ds, reference)
-    a_n = 2 * (n1 - n2) / trace
-    a_t = 2 * (t1 - t2) / trace
+    a_n = ratio(2 * (n1 - n2), trace)
+    a_t = ratio(2 * (t1 - t2), trace)
     return xr.Dataset({
         "a_n": with_attrs(a_n * np.cos(2 * (theta_n - ref)), "a_n", "1", "signed normal force anisotropy a_n"),
         "a_t": with_attrs(a_t * np.cos(2 * (theta_t - ref)), "a_t", "1", "signed tangential force anisotropy a_t"),
@@ -202,7 +202,7 @@ def harmonic_prediction(ds: xr.Dataset, bins: int = 36, walls: bool = False, nea
     fab = fabric_anisotropy(ds, walls=walls, near=near)
     frc = force_anisotropies(ds, bins, walls=walls, near=near)
     total = fab["a_prime"] + frc["a_n"] + frc["a_t"]
-    cross = total / (2 + fab["a_prime"] * frc["a_n"])
+    cross = ratio(total, 2 + fab["a_prime"] * frc["a_n"])
     return xr.Dataset({
         "q_over_p": stress_invariants(ds)["q_over_p"],
         "prediction": with_attrs(total / 2, "prediction", "1", "harmonic prediction (a' + a_n + a_t)/2"),
@@ -261,7 +261,7 @@ def angular_profile(ds: xr.Dataset, component: str = "fn", time="residual", bins
     profile = avg[f"{component}_mean"]
     if normalise:
         count = avg["count"]
-        mean_fn = (avg["fn_mean"].fillna(0) * count).sum("theta") / count.sum("theta")
-        profile = (profile / mean_fn).assign_attrs(units="1", long_name=profile.attrs["long_name"] + " / <f_n>")
+        mean_fn = ratio((avg["fn_mean"].fillna(0) * count).sum("theta"), count.sum("theta"))
+        profile = ratio(profile, mean_fn).assign_attrs(units="1", long_name=profile.attrs["long_name"] + " / <f_n>")
     return time_mean(profile)
 

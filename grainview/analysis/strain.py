@@ -12,7 +12,7 @@ import xarray as xr
 
 from ..contract import portable_math
 from . import sample
-from ._lift import with_attrs
+from ._lift import ratio, with_attrs
 from .arrays.strain import log_strain
 from ..contract.errors import ParameterError
 from .stress import stress_invariants
@@ -52,18 +52,13 @@ def time_derivative(da: xr.DataArray) -> xr.DataArray:
     Sec. III and Eq. 3 (the strain rate of the inertia parameter); docs/analysis.md,
     "Conventions worth knowing".
     """
+    if da.sizes["time"] < 2:  # one snapshot: no rate (dask cannot shift a single snapshot)
+        return xr.full_like(da, np.nan, dtype=float)
     t = da["time"].astype(float)
-    ahead, behind = da.shift(time=-1), da.shift(time=1)
+    ahead, behind = da.shift(time=-1).fillna(da), da.shift(time=1).fillna(da)
     t_ahead, t_behind = t.shift(time=-1), t.shift(time=1)
-    ahead = ahead.fillna(da) if da.sizes["time"] > 1 else ahead
-    behind = behind.fillna(da) if da.sizes["time"] > 1 else behind
     dt = t_ahead.fillna(t) - t_behind.fillna(t)
     return (ahead - behind) / dt.where(dt != 0)
-
-
-def _ratio(num, den):
-    """num/den, NaN where den == 0 (no division warnings, lazily)."""
-    return num / den.where(den != 0)
 
 
 def _log_strain(size, reference):
@@ -179,14 +174,14 @@ def friction_and_dilatancy(ds: xr.Dataset, reference: int = 0) -> xr.Dataset:
     """
     eps = strains(ds, reference)
     q_over_p = stress_invariants(ds)["q_over_p"]
-    ratio = _ratio(eps["eps_p"], eps["eps_q"])
-    rate = _ratio(time_derivative(eps["eps_p"]), time_derivative(eps["eps_q"]))
+    sine_psi = ratio(eps["eps_p"], eps["eps_q"])
+    rate = ratio(time_derivative(eps["eps_p"]), time_derivative(eps["eps_q"]))
     def asin(sine):  # NaN outside [-1, 1], without warnings when dask computes later
         return portable_math.arcsin(sine.where(abs(sine) <= 1))
 
     return xr.Dataset({
         "phi": with_attrs(asin(q_over_p), "phi", "rad", "friction angle, sin phi = q/p"),
-        "psi": with_attrs(asin(ratio), "psi", "rad", "dilatancy angle, sin psi = eps_p/eps_q"),
+        "psi": with_attrs(asin(sine_psi), "psi", "rad", "dilatancy angle, sin psi = eps_p/eps_q"),
         "psi_incremental": with_attrs(asin(rate), "psi_incremental", "rad",
                                       "incremental dilatancy angle, sin psi = d eps_p/d eps_q"),
     })
@@ -217,10 +212,11 @@ def inertia_number(ds: xr.Dataset) -> xr.DataArray:
     Eq. 3 (Sec. III); docs/conventions.md §6.
     """
     h = sample.height(ds)
-    rate = abs(time_derivative(h)) / h
+    rate = ratio(abs(time_derivative(h)), h)
     p_line = stress_invariants(ds)["p"] * sample.thickness(ds)
     total_mass = ds["mass"].sum()
-    return with_attrs(rate * np.sqrt(total_mass / p_line), "inertia_number", "1", "inertia parameter I")
+    per_load = ratio(total_mass, p_line.where(p_line > 0))  # no load (no contacts): NaN
+    return with_attrs(rate * np.sqrt(per_load), "inertia_number", "1", "inertia parameter I")
 
 
 EARLY_STRAIN = 0.02

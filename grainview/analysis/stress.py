@@ -12,7 +12,7 @@ import numpy as np
 import xarray as xr
 
 from . import sample
-from ._lift import apply, with_attrs
+from ._lift import apply, ratio, with_attrs
 from .arrays import stress as _stress
 from .arrays.tensors import principal
 from .contacts import kind_code, selection
@@ -114,7 +114,7 @@ def stress_invariants(ds: xr.Dataset, kind="all", walls: bool = True,
     return xr.Dataset({
         "p": with_attrs(p, "p", "Pa", "mean stress p = (s1 + s2)/2"),
         "q": with_attrs(q, "q", "Pa", "stress deviator q = (s1 - s2)/2"),
-        "q_over_p": with_attrs(q / p_ref, "q_over_p", "1", "normalised shear stress q/p"),
+        "q_over_p": with_attrs(ratio(q, p_ref), "q_over_p", "1", "normalised shear stress q/p"),
         "theta_sigma": with_attrs(theta, "theta_sigma", "rad", "major principal stress direction"),
         "sigma_1": with_attrs(s1, "sigma_1", "Pa", "major principal stress"),
         "sigma_2": with_attrs(s2, "sigma_2", "Pa", "minor principal stress"),
