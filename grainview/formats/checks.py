@@ -18,11 +18,18 @@ in SI units (the contract's, docs/schema.md), from the sample's own particles:
   component of a unit vector (a normal) at most 1 (within :data:`UNIT_TOLERANCE`);
 * the particles' **radii** are finite and > 0, the largest at most :data:`SIZE_RATIO` times the
   smallest, and their **masses** finite and > 0, of a density (mass over the disk's area times
-  the thickness) at most :data:`DENSITY_LIMIT_KG_M3`.
+  the thickness) at most :data:`DENSITY_LIMIT_KG_M3`;
+* a **contact** is possible for its bodies' positions and sizes (:func:`check_contacts`): two
+  particles' centres are at most ``r_i + r_j`` apart, an overlap is shallower than a radius, a
+  gap is not open, and the contact point lies on both bodies, each to within
+  :data:`CONTACT_TOLERANCE` of the smaller radius (a polygon's radius is its circumscribed
+  one).
 
 Readers check their raw columns with :meth:`Limits.check`, where they still know the line a
-value came from; :func:`check_snapshot` checks every snapshot once more before it is written or
-returned (:mod:`grainview.formats.convert`), so that nothing absurd is ever stored.
+value came from, and their contacts with :func:`check_contacts`, where they still know the file
+and the bodies' own names; :func:`check_snapshot` checks every snapshot once more before it is
+written or returned (:mod:`grainview.formats.convert`), so that nothing absurd or impossible is
+ever stored.
 """
 
 from __future__ import annotations
@@ -33,10 +40,11 @@ import os
 import numpy as np
 
 from ..contract.errors import FileFormatError
+from ..contract.schema import MAX_STEP_INDEX
 
-__all__ = ["Limits", "check_snapshot", "input_file", "input_folder", "LENGTH_SPAN", "STRESS_LIMIT_PA",
-           "SPEED_LIMIT_M_S", "TIME_LIMIT_S", "ACCELERATION_LIMIT_M_S2", "ANGLE_LIMIT_RAD", "UNIT_TOLERANCE",
-           "SIZE_RATIO", "DENSITY_LIMIT_KG_M3"]
+__all__ = ["Limits", "check_snapshot", "check_contacts", "check_step", "input_file", "input_folder", "LENGTH_SPAN",
+           "STRESS_LIMIT_PA", "SPEED_LIMIT_M_S", "TIME_LIMIT_S", "ACCELERATION_LIMIT_M_S2", "ANGLE_LIMIT_RAD",
+           "UNIT_TOLERANCE", "SIZE_RATIO", "DENSITY_LIMIT_KG_M3", "CONTACT_TOLERANCE"]
 
 LENGTH_SPAN = 1e6
 """Particle diameters (the largest particle's) a coordinate may lie from the sample's middle,
@@ -60,8 +68,14 @@ times the slab's thickness is at most this."""
 
 UNIT_TOLERANCE = 1e-6
 """How far beyond 1 a component of a unit vector may be (the files' rounding)."""
-
-_INT64 = 2**63 - 1
+CONTACT_TOLERANCE = 0.5
+"""How far a contact's geometry may stray from touching, in radii of the smaller of its two
+bodies (of the particle, for a wall contact): the centres of two particles further apart than
+``r_i + r_j`` by more, a gap open wider, or a contact point further outside a body. Real runs
+stay far within it: soft contacts overlap by a hundredth of a radius, a rigid code's contact
+point lies outside a polygon's circumscribed circle by about as little, and photoelastic
+images, whose radii and centres are fitted to pixels, leave touching disks apart by up to a
+seventh of the smaller radius."""
 
 
 def _kind(path) -> str | None:
@@ -147,6 +161,8 @@ class Limits:
         Their moments of inertia, kg m^2 (checked: finite and > 0).
     names : callable or sequence, optional
         Particle k's name in the messages (default ``"particle k"``).
+    n_vertices : array_like, (N,), optional
+        The particles' vertex counts (0: a disk; default: disks), for :func:`check_contacts`.
 
     Raises
     ------
@@ -155,8 +171,10 @@ class Limits:
         than :data:`SIZE_RATIO`, a mass of an impossible density.
     """
 
-    def __init__(self, radius, thickness=1.0, where="", mass=None, inertia=None, names=None):
+    def __init__(self, radius, thickness=1.0, where="", mass=None, inertia=None, names=None, n_vertices=None):
         radius = np.asarray(radius, float).reshape(-1)
+        self.n_vertices = (np.zeros(radius.size, np.int64) if n_vertices is None else
+                           np.asarray(n_vertices, np.int64).reshape(-1))
         self.where = where
         self._bounds = None
         names = names if names is not None else (lambda k: f"particle {k}")
@@ -173,6 +191,7 @@ class Limits:
             raise FileFormatError(f"{where}: radii from {radius.min():.6g} to {radius.max():.6g} m; expected the "
                                   f"largest at most {SIZE_RATIO:g} times the smallest")
         self.thickness = float(thickness)
+        self.radius = radius
         self.diameter = 2 * float(radius.max()) if radius.size else 1.0
         self.smallest = float(radius.min()) if radius.size else 0.5
         if mass is not None:
@@ -298,11 +317,128 @@ def check_snapshot(limits: Limits, snap: dict, where: str) -> None:
         limits.check(values, name, kind, where, rows=(lambda k: "the snapshot") if row is None else
                      (lambda k, row=row: f"{row} {k}"), centre=middle if kind == "position" else None, limit=limit)
     if "step" in snap:
-        step = snap["step"]
-        if not (isinstance(step, (int, np.integer)) and 0 <= int(step) <= _INT64):
-            raise FileFormatError(f"{where}: step = {step}; expected an integer from 0 to {_INT64}")
+        check_step(snap["step"], where)
     contacts = snap.get("contacts") or {}
     for name, kind in _CONTACT_KINDS.items():
         if name in contacts:
             limits.check(contacts[name], name, kind, where, rows=lambda k: f"contact {k}",
                          centre=middle if kind == "position" else None)
+    if contacts:
+        check_contacts(limits, position, contacts, where)
+
+
+def check_step(step, where: str) -> None:
+    """Refuse a step index the contract's ``step`` (a 32-bit integer) cannot hold.
+
+    Raises
+    ------
+    FileFormatError
+        ``"<where>: step = <step>; expected an integer from 0 to 2147483647 ..."``.
+    """
+    if not (isinstance(step, (int, np.integer)) and 0 <= int(step) <= MAX_STEP_INDEX):
+        raise FileFormatError(f"{where}: step = {step}; expected an integer from 0 to {MAX_STEP_INDEX} (the contract "
+                              "stores the step index as a 32-bit integer; renumber the run's steps from 0, e.g. "
+                              "LAMMPS's reset_timestep, to read it)")
+
+
+def _bodies(n_particles):
+    """Body k's default name in a message: a particle or a wall (``N + w``)."""
+    return lambda k: f"particle {k}" if k < n_particles else f"wall {k - n_particles}"
+
+
+def check_contacts(limits: Limits, position, contacts: dict, where: str, names=None) -> None:
+    """Refuse a contact that cannot exist for its bodies' positions and sizes.
+
+    Each contact of bodies ``i < j`` (``j >= N`` a wall) must touch: the tolerance ``tol`` is
+    :data:`CONTACT_TOLERANCE` times the smaller radius of the two particles (the particle's, for
+    a wall contact), the radii those of ``limits`` (a polygon's circumscribed radius), and
+
+    * two particles' centres are at most ``r_i + r_j + tol`` apart, and their ``branch`` is
+      ``x_j - x_i`` to within ``tol``;
+    * a wall contact's ``branch`` (from the centre to the contact point) is at most
+      ``r_i + tol`` long;
+    * the ``point`` is at most ``r + tol`` from the centre of each particle of the contact;
+    * a ``gap`` is at most ``tol`` (a contact carrying a force is closed) and at least ``-r``
+      (an overlap shallower than the smaller radius); for two disks it is ``|x_j - x_i| - r_i -
+      r_j`` to within ``tol``.
+
+    Parameters
+    ----------
+    limits : Limits
+        The sample's bounds (its ``radius`` and ``n_vertices``).
+    position : array_like, (N, 2)
+        The particles' positions, m.
+    contacts : dict
+        The contract's contact arrays: ``i``, ``j`` and any of ``point``, ``branch``, ``gap``.
+    where : str
+        The file and the snapshot, for the message.
+    names : callable, optional
+        Body k's name in the message (default ``"particle k"``, ``"wall w"`` for ``k = N + w``).
+
+    Raises
+    ------
+    FileFormatError
+        ``"<where>: the contact of <body> and <body>: <what is impossible>; expected ..."``.
+    """
+    i = np.asarray(contacts.get("i", ()), np.int64).reshape(-1)
+    if i.size == 0:
+        return
+    j = np.asarray(contacts["j"], np.int64).reshape(-1)
+    position = np.asarray(position, float).reshape(-1, 2)
+    radius = limits.radius
+    n = radius.size
+    if i.min() < 0 or i.max() >= n or j.min() < 0 or np.any(j <= i):
+        k = int(np.flatnonzero((i < 0) | (i >= n) | (j <= i))[0])
+        raise FileFormatError(f"{where}: contact {k} of bodies {i[k]} and {j[k]}; expected a particle 0..{n - 1} "
+                              "and a body of a higher index")
+    names = names if names is not None else _bodies(n)
+    pair = j < n
+    jp = np.minimum(j, n - 1)
+    r_i, r_j = radius[i], np.where(pair, radius[jp], np.inf)
+    small = np.minimum(r_i, r_j)
+    tol = CONTACT_TOLERANCE * small
+    centres = position[jp] - position[i]
+    distance = np.hypot(centres[:, 0], centres[:, 1])
+    shown = f"{CONTACT_TOLERANCE:g} of the smaller radius"
+    problems = []  # (mask, message of contact k)
+    problems.append((pair & (distance > r_i + r_j + tol), lambda k: (
+        f"the centres are {distance[k]:.6g} m apart, the radii sum to {r_i[k] + r_j[k]:.6g} m; expected bodies that "
+        f"touch (centres at most the sum of the radii and {shown} apart)")))
+    branch = contacts.get("branch")
+    if branch is not None:
+        branch = np.asarray(branch, float).reshape(-1, 2)
+        off = np.hypot(*(branch - centres).T)
+        length = np.hypot(branch[:, 0], branch[:, 1])
+        problems.append((pair & (off > tol), lambda k: (
+            f"branch = ({branch[k, 0]:.6g}, {branch[k, 1]:.6g}) m, but the centres are at ({centres[k, 0]:.6g}, "
+            f"{centres[k, 1]:.6g}) m from one another; expected the branch x_j - x_i")))
+        problems.append((~pair & (length > r_i + tol), lambda k: (
+            f"the contact point is {length[k]:.6g} m from the centre of {names(i[k])}, whose radius is {r_i[k]:.6g} m; "
+            f"expected a point on the particle (at most {shown} outside it)")))
+    point = contacts.get("point")
+    if point is not None:
+        point = np.asarray(point, float).reshape(-1, 2)
+        for body, r, which in ((i, r_i, np.ones(i.size, bool)), (jp, r_j, pair)):
+            away = np.hypot(*(point - position[body]).T)
+            problems.append((which & (away > r + tol), lambda k, away=away, body=body, r=r: (
+                f"the contact point ({point[k, 0]:.6g}, {point[k, 1]:.6g}) m is {away[k]:.6g} m from the centre of "
+                f"{names(body[k])}, whose radius is {r[k]:.6g} m; expected a point on both bodies (at most {shown} "
+                "outside each)")))
+    gap = contacts.get("gap")
+    if gap is not None:
+        gap = np.asarray(gap, float).reshape(-1)
+        problems.append((gap < -small, lambda k: (
+            f"an overlap of {-gap[k]:.6g} m (gap {gap[k]:.6g} m), deeper than the radius {small[k]:.6g} m of "
+            f"{names(i[k]) if r_i[k] <= r_j[k] else names(j[k])}; expected an overlap shallower than a radius")))
+        problems.append((gap > tol, lambda k: (
+            f"a gap of {gap[k]:.6g} m between bodies in contact; expected a closed contact (a gap of at most {shown}, "
+            f"{tol[k]:.3g} m)")))
+        disks = pair & (limits.n_vertices[i] == 0) & (limits.n_vertices[jp] == 0)
+        between = distance - r_i - np.where(pair, radius[jp], 0.0)
+        problems.append((disks & (np.abs(between - gap) > tol), lambda k: (
+            f"gap = {gap[k]:.6g} m, but the disks' centres are {distance[k]:.6g} m apart, a gap of {between[k]:.6g} m; "
+            f"expected the same gap to within {shown}")))
+    for bad, message in problems:
+        if bad.any():
+            k = int(np.flatnonzero(bad)[0])
+            raise FileFormatError(f"{where}: the contact of {names(i[k])} and {names(j[k])}: {message(k)}")

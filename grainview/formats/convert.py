@@ -30,13 +30,23 @@ LABELS = ("lammps", "lmgc90", "mercurydpm", "pegs", "peer", "convert")
 """The readers' labels: a conversion to ``run.nc`` is written as ``.run.nc.<pid>.<label>``."""
 
 
-def check_out(out, overwrite: bool) -> str:
-    """``out`` as a string, refused in one line (before any work) when it is a folder (with
-    ``overwrite`` too), when it exists and ``overwrite`` is False, or when its folder does not
-    exist."""
+def check_out(out, overwrite: bool, inputs=()) -> str:
+    """``out`` as a string, refused in one line (before any work) when it is a folder or one of
+    the files the conversion reads, ``inputs`` (with ``overwrite`` too: the input would be
+    replaced by the output), when it exists and ``overwrite`` is False, or when its folder does
+    not exist."""
     out = os.fspath(out)
     if os.path.isdir(out):
         raise FileFormatError(f"{out} is a folder; expected a file name such as {os.path.join(out, 'run.nc')}")
+    for path in inputs:
+        path = os.fspath(path)
+        try:
+            same = os.path.samefile(out, path)
+        except OSError:  # either does not exist (yet)
+            same = False
+        if same:
+            raise FileFormatError(f"{out} is an input of the conversion ({path}); expected another file name for the "
+                                  "output, which would replace it")
     if os.path.exists(out) and not overwrite:
         raise FileExistsError(f"{out} exists; pass overwrite=True to replace it")
     folder = os.path.dirname(os.path.abspath(out))
@@ -88,7 +98,7 @@ def snapshots_dataset(static, snaps, per_snapshot=(), **static_optional):
 
 
 def write_snapshots(out, static, snapshots, optional, *, overwrite=False, compress=True, progress=False,
-                    label="convert", prepare=None, validate=True) -> int:
+                    label="convert", prepare=None, validate=True, inputs=()) -> int:
     """Write a run's snapshots as the contract file ``out``.
 
     Parameters
@@ -115,6 +125,8 @@ def write_snapshots(out, static, snapshots, optional, *, overwrite=False, compre
     validate : bool, default True
         Check the finished file against the contract, a few snapshots at a time, before it
         gets its name.
+    inputs : sequence of path-like
+        The files the conversion reads: ``out`` may be none of them (:func:`check_out`).
 
     Returns
     -------
@@ -143,7 +155,7 @@ def write_snapshots(out, static, snapshots, optional, *, overwrite=False, compre
 
     if label not in LABELS:
         raise ParameterError(f"label={label!r}: expected one of {', '.join(LABELS)}")
-    out = check_out(out, overwrite)
+    out = check_out(out, overwrite, inputs)
     with sigterm_raises():
         lock = lock_file(out)  # one conversion or run at a time; a killed writer's temporary files removed
         try:
@@ -200,7 +212,7 @@ def _limits(static) -> Limits:
     """The bounds of a run's values (:class:`grainview.formats.checks.Limits`) from its static part."""
     attrs = static.get("attrs") or {}
     return Limits(static["radius"], float(attrs.get("thickness_m", 1.0)), _source(static), mass=static["mass"],
-                  inertia=static["inertia"])
+                  inertia=static["inertia"], n_vertices=static.get("n_vertices"))
 
 
 def _source(static) -> str:

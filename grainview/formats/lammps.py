@@ -56,7 +56,7 @@ import warnings
 import numpy as np
 
 from ..contract.errors import FileFormatError, ParameterError
-from .checks import Limits
+from .checks import Limits, check_contacts, check_step
 from .lammps_dump import LammpsLog, iter_dump, read_log
 
 __all__ = ["lammps_snapshots", "open_lammps", "convert_lammps", "WALL_NAMES", "PARTICLE_COLUMNS", "PAIR_COLUMNS"]
@@ -194,6 +194,9 @@ class _Particles:
 
     def __init__(self, snap, source, inertia_factor):
         _check_particle_columns(snap, source)
+        if snap.data.shape[0] == 0:
+            raise FileFormatError(f"{source}: step {snap.timestep}: no atoms (NUMBER OF ATOMS 0); expected the "
+                                  "particles of the run in every snapshot")
         ids = snap.column("id").astype(np.int64)
         self.order = np.argsort(ids, kind="stable")
         self.ids = ids[self.order]
@@ -212,6 +215,10 @@ class _Particles:
         self.inertia = inertia_factor * self.mass * self.radius**2
         self.limits = Limits(self.radius, 1.0, where, mass=self.mass, inertia=self.inertia)
         self.source = source
+
+    def name(self, k):
+        """Particle k's name in a message: its LAMMPS atom id."""
+        return f"atom {self.ids[k]}" if k < self.ids.size else "a wall"
 
     def index(self, ids, where):
         """Particle indices of LAMMPS atom ids; one line naming an unknown id."""
@@ -259,7 +266,8 @@ class _Particles:
 
 def _pair_contacts(particles, position, snap, columns, where):
     """Contract contacts (dict of arrays) of the touching, compressed pairs of one pairs
-    snapshot, and the number of touching pairs left out for a tensile normal force."""
+    snapshot, the number of touching pairs left out for a tensile normal force, and the number
+    of pairs that do not touch but carry a force (left out)."""
     for name in ("patom1", "patom2"):
         _check_ids(snap.data[:, columns[name]], name, where, snap)
     for name in ("fx", "fy", "p1", "p2"):
@@ -268,10 +276,15 @@ def _pair_contacts(particles, position, snap, columns, where):
     b = particles.index(snap.data[:, columns["patom2"]], where)
     force = np.stack([snap.data[:, columns["fx"]] + snap.data[:, columns["p1"]],
                       snap.data[:, columns["fy"]] + snap.data[:, columns["p2"]]], axis=1)  # on a, from b
+    if np.any(a == b):
+        k = int(np.flatnonzero(a == b)[0])
+        raise FileFormatError(f"{where}: line {snap.line + k}: a pair of atom {particles.ids[a[k]]} with itself; "
+                              "expected pairs of two atoms")
     radius = particles.radius
     d = position[b] - position[a]
     overlap = radius[a] + radius[b] - np.hypot(d[:, 0], d[:, 1])
-    touching = (overlap > 0) & (a != b)
+    touching = overlap > 0
+    apart = int(np.count_nonzero(~touching & np.any(force != 0, axis=1)))
     a, b, force, overlap = a[touching], b[touching], force[touching], overlap[touching]
     i, j = np.minimum(a, b), np.maximum(a, b)
     on_j = np.where((a == i)[:, None], -force, force)  # exerted by i on j
@@ -285,6 +298,7 @@ def _pair_contacts(particles, position, snap, columns, where):
             raise FileFormatError(f"{where}: pair {particles.ids[i[k]]}-{particles.ids[j[k]]} is listed twice "
                                   "with different forces")
         i, j, on_j, overlap = i[first], j[first], on_j[first], overlap[first]
+    check_contacts(particles.limits, position, dict(i=i, j=j, gap=-overlap), where, particles.name)
     branch = position[j] - position[i]
     n = branch / np.hypot(branch[:, 0], branch[:, 1])[:, None]
     fn = np.einsum("ij,ij->i", on_j, n)
@@ -294,7 +308,7 @@ def _pair_contacts(particles, position, snap, columns, where):
     point = position[i] + n * (radius[i] - overlap / 2)[:, None]
     contacts = dict(i=i, j=j, kind=np.ones(i.size, "i1"), normal=n, fn=fn, ft=np.einsum("ij,ij->i", on_j, t),
                     point=point, branch=branch, gap=-overlap)
-    return contacts, int((~loaded).sum())
+    return contacts, int((~loaded).sum()), apart
 
 
 def _wall_contacts(particles, position, snap, fixes, where):
@@ -312,6 +326,10 @@ def _wall_contacts(particles, position, snap, fixes, where):
                      rows=lambda k, touching=touching: f"line {snap.line + touching[k]}",
                      centre=np.r_[np.median(position, axis=0), 0.0])
     index = particles.index(snap.column("id"), where)
+    if np.unique(index).size != index.size:
+        ids = np.sort(snap.column("id").astype(np.int64))
+        twice = ids[np.flatnonzero(np.diff(ids) == 0)[0]]
+        raise FileFormatError(f"{where}: atom id {twice} appears twice; expected each atom once")
     out = {k: [] for k in ("i", "j", "normal", "fn", "ft", "point", "branch", "gap")}
     tensile = 0
     for fix, cols in fixes.items():
@@ -326,6 +344,9 @@ def _wall_contacts(particles, position, snap, fixes, where):
         length = np.hypot(arm[:, 0], arm[:, 1])
         if np.any(length == 0):
             raise FileFormatError(f"{where}: fix {fix}: a wall contact point at a particle centre")
+        check_contacts(particles.limits, position, dict(i=p, j=np.full(p.size, n_particles), point=point, branch=arm,
+                                                        gap=length - particles.radius[p]), where,
+                       lambda k, fix=fix: particles.name(k) if k < n_particles else f"the wall of fix {fix}")
         n = arm / length[:, None]
         wall = np.argmax(n[:, :1] * _WALL_DIRECTIONS[:, 0] + n[:, 1:] * _WALL_DIRECTIONS[:, 1], axis=1)
         if not np.allclose(n, _WALL_DIRECTIONS[wall], atol=1e-6):
@@ -350,6 +371,24 @@ def _wall_contacts(particles, position, snap, fixes, where):
     joined = {k: np.concatenate(v) for k, v in out.items()}
     joined["kind"] = np.ones(joined["i"].size, "i1")
     return joined, tensile
+
+
+def _check_box(particles, position, snap, source):
+    """One line for a particle whose centre lies outside the snapshot's box (the volume of the
+    solid fraction and the stresses) by more than the largest diameter (LAMMPS lets atoms
+    stray a little beyond a fixed boundary between two rebuilds of its neighbour lists)."""
+    margin = particles.limits.diameter
+    for axis, name in enumerate("xy"):
+        low, high = snap.bounds[axis]
+        if not low <= high:  # not a box at all: the contract's check of the finished run says so
+            continue
+        outside = (position[:, axis] < low - margin) | (position[:, axis] > high + margin)
+        if outside.any():
+            k = int(np.flatnonzero(outside)[0])
+            raise FileFormatError(f"{source}: step {snap.timestep}: atom {particles.ids[k]} at {name} = "
+                                  f"{position[k, axis]:.6g} lies outside the box's {name} range {low:.6g} .. "
+                                  f"{high:.6g} (ITEM: BOX BOUNDS); expected the particles inside the box, the volume "
+                                  "of the solid fraction and the stresses")
 
 
 def _join(pairs, walls):
@@ -425,7 +464,10 @@ def lammps_snapshots(particles, contacts, walls=None, *, log=None, time_step=Non
         known from neither ``time_step`` nor the log.
     """
     log_info = read_log(log) if log is not None else None
-    if log_info is not None and log_info.units not in (None, "si"):
+    if log_info is not None and log_info.units is None:
+        raise ParameterError(f"{os.fspath(log)}: no 'units' command, so the run is in LAMMPS's default units, lj "
+                             "(reduced units); only runs in SI units (units si) can be read")
+    if log_info is not None and log_info.units != "si":
         raise ParameterError(f"{os.fspath(log)}: the run is in LAMMPS units {log_info.units!r}; only runs in SI units "
                              "(units si) can be read")
     if time_step is None and log_info is not None:
@@ -466,16 +508,19 @@ def lammps_snapshots(particles, contacts, walls=None, *, log=None, time_step=Non
         for snaps in chain_first(first, stream):
             part, pairs = snaps[0], snaps[1]
             where = f"{os.fspath(contacts)}: step {part.timestep}"
+            check_step(part.timestep, source)
             position, extra = static_particles.state(part)
             static_particles.limits.check(part.bounds[:2].T, ("x", "y"), "position", f"{source}: step {part.timestep}",
                                           rows=lambda k: ("the lower", "the upper")[k] + " BOX BOUNDS",
                                           centre=np.median(position, axis=0))
-            contacts_now, tensile = _pair_contacts(static_particles, position, pairs, pair_index, where)
+            _check_box(static_particles, position, part, source)
+            contacts_now, tensile, apart = _pair_contacts(static_particles, position, pairs, pair_index, where)
             if fixes is not None:
                 on_walls, tensile_walls = _wall_contacts(static_particles, position, snaps[2], fixes,
                                                          f"{os.fspath(walls)}: step {part.timestep}")
                 contacts_now, tensile = _join(contacts_now, on_walls), tensile + tensile_walls
-            yield dict(time=part.timestep * time_step, step=part.timestep, tensile=tensile, position=position,
+            yield dict(time=part.timestep * time_step, step=part.timestep, tensile=tensile, apart=apart,
+                       position=position,
                        angle=np.zeros(position.shape[0]), contacts=contacts_now,
                        box_min=part.bounds[:2, 0].copy(), box_max=part.bounds[:2, 1].copy(), **extra)
 
@@ -506,14 +551,27 @@ def open_lammps(particles, contacts, walls=None, *, log=None, time_step=None, co
 
         stream = tqdm(stream, desc="lammps", unit=" snapshots")
     snaps = list(stream)
-    _warn_tensile(sum(s["tensile"] for s in snaps), len(snaps))
+    _warn_left_out(sum(s.pop("tensile") for s in snaps), sum(s.pop("apart") for s in snaps), len(snaps))
+    _warn_no_log(log)
     return snapshots_dataset(static, snaps, ("step", "velocity", "angular_velocity"))
 
 
-def _warn_tensile(count, snapshots):
-    if count:
-        warnings.warn(f"{count} touching pair(s) over {snapshots} snapshot(s) had a tensile normal force (viscous "
+def _warn_left_out(tensile, apart, snapshots):
+    """One note per kind of pair left out of the contacts."""
+    if tensile:
+        warnings.warn(f"{tensile} touching pair(s) over {snapshots} snapshot(s) had a tensile normal force (viscous "
                       "damping as they separate) and were left out of the contacts", UserWarning, stacklevel=3)
+    if apart:
+        warnings.warn(f"{apart} pair(s) over {snapshots} snapshot(s) whose disks do not overlap at the dumped "
+                      "positions carried a force and were left out of the contacts (LAMMPS's granular pair styles "
+                      "give no force to pairs that do not touch: positions dumped with too few digits? dump_modify "
+                      "format float %.17g)", UserWarning, stacklevel=3)
+
+
+def _warn_no_log(log):
+    if log is None:
+        warnings.warn("no LAMMPS log given: the run is taken to be in SI units (units si), which only its log can "
+                      "confirm (log=..., --log)", UserWarning, stacklevel=3)
 
 
 def convert_lammps(out, particles, contacts, walls=None, *, log=None, time_step=None, columns=None, inertia="auto",
@@ -553,18 +611,21 @@ def convert_lammps(out, particles, contacts, walls=None, *, log=None, time_step=
     """
     from .convert import chain_first, check_out, write_snapshots
 
-    out = check_out(out, overwrite)
+    out = check_out(out, overwrite, inputs=[path for path in (particles, contacts, walls, log) if path is not None])
     static, stream = lammps_snapshots(particles, contacts, walls, log=log, time_step=time_step, columns=columns,
                                       inertia=inertia)
     first = next(stream)
     optional = ("step", "gap") + tuple(name for name in ("velocity", "angular_velocity") if name in first)
-    tensile = []
+    tensile, apart = [], []
 
     def prepare(snap):
         tensile.append(snap.pop("tensile"))
+        apart.append(snap.pop("apart"))
         return snap
 
     count = write_snapshots(out, static, chain_first(first, stream), optional, overwrite=overwrite,
-                            compress=compress, progress=progress, label="lammps", prepare=prepare)
-    _warn_tensile(sum(tensile), count)
+                            compress=compress, progress=progress, label="lammps", prepare=prepare,
+                            inputs=[path for path in (particles, contacts, walls, log) if path is not None])
+    _warn_left_out(sum(tensile), sum(apart), count)
+    _warn_no_log(log)
     return count

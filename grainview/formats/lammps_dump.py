@@ -121,6 +121,9 @@ def _read_rows(fh, path, rows, where):
         if not line:
             raise FileFormatError(f"{path}: {where}: {rows} rows announced, {len(lines)} found (a truncated dump)")
         lines.append(line)
+    if lines and not lines[-1].endswith("\n"):
+        raise FileFormatError(f"{path}: line {fh.number}: {where}: the last row ends without a newline (a truncated "
+                              "dump: LAMMPS ends every row with one, and a cut row may have lost digits)")
     return lines
 
 
@@ -142,8 +145,8 @@ def iter_dump(path):
     FileFormatError
         A missing or unreadable file (or a folder), a header that is not LAMMPS's, a step or a
         row count that is not an integer, a triclinic box, or a snapshot with fewer or more
-        rows than announced or a row of the wrong length (a truncated or damaged dump), naming
-        the file, the line and the snapshot.
+        rows than announced, a row of the wrong length or a file ending inside a row (a
+        truncated or damaged dump), naming the file, the line and the snapshot.
     """
     path = input_file(path, "a LAMMPS text dump")
     try:

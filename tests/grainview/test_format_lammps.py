@@ -203,10 +203,12 @@ def test_columns_named_by_colname_or_mapped_by_hand(tmp_path, ds):
     named = tmp_path / "named.contacts"
     named.write_text(text.replace("c_pairs[1] c_pairs[2] c_forces[1] c_forces[2] c_forces[3] c_forces[4] "
                                   "c_forces[5] c_forces[6] c_forces[7]", "patom1 patom2 dist fx fy fz p1 p2 p3"))
-    by_name = open_lammps(files["particles"], named, files["walls"], time_step=2e-5)
-    mapped = open_lammps(files["particles"], files["contacts"], files["walls"], time_step=2e-5,
-                         columns={"patom1": "c_pairs[1]", "patom2": "c_pairs[2]", "fx": "c_forces[2]",
-                                  "fy": "c_forces[3]", "p1": "c_forces[5]", "p2": "c_forces[6]"})
+    with pytest.warns(UserWarning, match="no LAMMPS log given: the run is taken to be in SI units"):
+        by_name = open_lammps(files["particles"], named, files["walls"], time_step=2e-5)
+    with pytest.warns(UserWarning, match="no LAMMPS log given"):
+        mapped = open_lammps(files["particles"], files["contacts"], files["walls"], time_step=2e-5,
+                             columns={"patom1": "c_pairs[1]", "patom2": "c_pairs[2]", "fx": "c_forces[2]",
+                                      "fy": "c_forces[3]", "p1": "c_forces[5]", "p2": "c_forces[6]"})
     for other in (by_name, mapped):
         for name in ("i", "j", "fn", "ft", "normal", "point", "branch"):
             np.testing.assert_array_equal(other[name].values, ds[name].values)

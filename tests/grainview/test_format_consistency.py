@@ -1,0 +1,272 @@
+"""Input that is well formed line by line but impossible as a whole, made by mutating the
+project's own fixtures (tests/data/) as tests/grainview/test_format_bad_values.py does: contacts
+that cannot exist for the bodies' positions and sizes (grainview.formats.checks.check_contacts),
+step indices the contract cannot hold, files cut between rows, pairs written on one side only,
+bodies written twice, an output that would replace an input. Each is refused in one line
+naming the file, the snapshot and the bodies (exit code 2, nothing written), or written with
+one note per kind of thing left out; nothing raises a traceback or a raw numpy warning."""
+
+from __future__ import annotations
+
+import re
+
+import numpy as np
+import pytest
+
+from grainview.app.cli import main
+from grainview.contract.errors import FileFormatError
+from grainview.formats.lammps import open_lammps
+
+from .test_format_bad_values import LAMMPS, _converts, _lammps, _lammps_argv, _refused
+
+
+# --- LAMMPS -------------------------------------------------------------------------------------
+
+def _snapshot_rows(lines, k):
+    """The line indices of the rows of snapshot ``k`` of a dump's lines."""
+    start = [n for n, line in enumerate(lines) if line.startswith("ITEM: TIMESTEP")][k]
+    return range(start + 9, start + 9 + int(lines[start + 3]))
+
+
+def _particle(text, k, pick):
+    """The row (split) of snapshot ``k`` of a particles dump for which ``pick(rows)`` chooses."""
+    lines = text.split("\n")
+    return pick([lines[n].split() for n in _snapshot_rows(lines, k)])
+
+
+def _replace_rows(text, k, edit):
+    """``text`` (a dump) with ``edit(values)`` applied to each row of snapshot ``k`` (a row it
+    returns None for is kept)."""
+    lines = text.split("\n")
+    for n in _snapshot_rows(lines, k):
+        values = edit(lines[n].split())
+        if values is not None:
+            lines[n] = " ".join(values)
+    return "\n".join(lines)
+
+
+def test_lammps_refuses_a_wall_contact_of_a_particle_far_from_the_wall(tmp_path, capsys):
+    """The walls dump says the highest atom touches the floor (force 5 N at (x, 0)) while it is
+    0.09 m up: it was stored as a floor contact with a gap of 18 radii and 'info --check' said
+    valid. Now refused, naming the walls dump, the step and the atom."""
+    top = _particle((LAMMPS / "dump.particles").read_text(), 3, lambda rows: max(rows, key=lambda v: float(v[5])))
+
+    def on_floor(values):
+        if values[0] == top[0]:
+            values[1:9] = ["1", "0", "5", "0", top[4], "0", "0", "0"]
+            return values
+        return None
+
+    files = _lammps(tmp_path, walls=lambda t: _replace_rows(t, 3, on_floor))
+    out = tmp_path / "run.nc"
+    line = _refused(_lammps_argv(files, out), capsys, out)
+    assert line.startswith(f"grainview: error: {files['walls']}: step 60000: the contact of atom {top[0]} and the "
+                           "wall of fix floor: the contact point is "), line
+    assert f"from the centre of atom {top[0]}, whose radius is" in line and "expected a point on the particle" in line
+    with pytest.raises(FileFormatError, match=f"the contact of atom {top[0]} and the wall of fix floor"):
+        open_lammps(files["particles"], files["contacts"], files["walls"], log=files["log"])
+
+
+def test_lammps_refuses_an_overlap_deeper_than_a_radius(tmp_path, capsys):
+    """An atom moved onto the centre of a neighbour it is listed with: an overlap of r_i + r_j
+    was stored as a contact."""
+    lines = (LAMMPS / "dump.contacts").read_text().split("\n")
+    first, second = lines[_snapshot_rows(lines, 3)[0]].split()[:2]
+    target = _particle((LAMMPS / "dump.particles").read_text(), 3, lambda rows: next(v for v in rows
+                                                                                     if v[0] == second))
+
+    def onto(values):
+        if values[0] == first:
+            values[4:6] = target[4:6]
+            return values
+        return None
+
+    files = _lammps(tmp_path, particles=lambda t: _replace_rows(t, 3, onto))
+    out = tmp_path / "run.nc"
+    line = _refused(_lammps_argv(files, out), capsys, out)
+    low, high = sorted((int(first), int(second)))
+    assert line.startswith(f"grainview: error: {files['contacts']}: step 60000: the contact of atom {low} and atom "
+                           f"{high}: an overlap of "), line
+    assert "expected an overlap shallower than a radius" in line
+
+
+def test_lammps_refuses_a_step_the_contract_cannot_hold(tmp_path, capsys):
+    """Steps beyond 2^31 - 1 (a long run, reset_timestep) raised OverflowError from the writer
+    (a traceback) while open_dataset read them: both now refuse in one line naming it."""
+    steps = {"0": "0", "20000": "2147483647", "40000": "2147503647", "60000": "2147523647"}
+
+    def renumber(text):
+        lines = text.split("\n")
+        for n, line in enumerate(lines):
+            if line == "ITEM: TIMESTEP":
+                lines[n + 1] = steps[lines[n + 1]]
+        return "\n".join(lines)
+
+    files = _lammps(tmp_path, particles=renumber, contacts=renumber, walls=renumber)
+    out = tmp_path / "run.nc"
+    line = _refused(_lammps_argv(files, out), capsys, out)
+    assert line == (f"grainview: error: {files['particles']}: step = 2147503647; expected an integer from 0 to "
+                    "2147483647 (the contract stores the step index as a 32-bit integer; renumber the run's steps "
+                    "from 0, e.g. LAMMPS's reset_timestep, to read it)")
+    with pytest.raises(FileFormatError, match="step = 2147503647; expected an integer from 0 to 2147483647"):
+        open_lammps(files["particles"], files["contacts"], files["walls"], log=files["log"])
+
+
+def test_lammps_refuses_a_run_without_atoms(tmp_path, capsys):
+    """Every dump with 0 atoms raised numpy's 'zero-size array' ValueError (a traceback)."""
+    def empty(text):
+        lines = text.split("\n")
+        out, skip = [], 0
+        for n, line in enumerate(lines):
+            if skip:
+                skip -= 1
+                continue
+            if line.startswith("ITEM: NUMBER OF"):
+                out += [line, "0"]
+                rows = int(lines[n + 1])
+                out += lines[n + 2:n + 7]  # the box and the ATOMS or ENTRIES line
+                skip = 1 + 5 + rows
+                continue
+            out.append(line)
+        return "\n".join(out)
+
+    files = _lammps(tmp_path, particles=empty, contacts=empty, walls=empty)
+    out = tmp_path / "run.nc"
+    line = _refused(_lammps_argv(files, out), capsys, out)
+    assert line == (f"grainview: error: {files['particles']}: step 0: no atoms (NUMBER OF ATOMS 0); expected the "
+                    "particles of the run in every snapshot")
+
+
+def test_lammps_refuses_a_dump_cut_inside_its_last_row(tmp_path, capsys):
+    """With y last, a dump cut inside the last row's y was read with y = 0.0 for that atom (two
+    contacts lost, no word): LAMMPS ends every row with a newline, so a last row without one is
+    cut."""
+    def y_last(text):
+        out, rows, index = [], False, None
+        for line in text.split("\n"):
+            if line.startswith("ITEM: ATOMS"):
+                header = line.split()[2:]
+                index = header.index("y")
+                header.append(header.pop(index))
+                out.append("ITEM: ATOMS " + " ".join(header))
+                rows = True
+                continue
+            if line.startswith("ITEM:"):
+                rows = False
+            if rows and line.strip():
+                values = line.split()
+                values.append(values.pop(index))
+                line = " ".join(values)
+            out.append(line)
+        text = "\n".join(out).rstrip("\n")
+        return text[:text.rfind(" ") + 4]  # "0.0" of the last y
+
+    files = _lammps(tmp_path, particles=y_last)
+    out = tmp_path / "run.nc"
+    line = _refused(_lammps_argv(files, out), capsys, out)
+    assert line.startswith(f"grainview: error: {files['particles']}: line ") and line.endswith(
+        "snapshot 3 (step 60000): the last row ends without a newline (a truncated dump: LAMMPS ends every row with "
+        "one, and a cut row may have lost digits)"), line
+
+
+def test_lammps_refuses_a_log_without_units(tmp_path, capsys):
+    """A log without a 'units' command is a run in LAMMPS's default lj units: it was read as SI."""
+    files = _lammps(tmp_path, log=lambda t: re.sub(r"(?m)^units.*\n", "", t))
+    out = tmp_path / "run.nc"
+    line = _refused(_lammps_argv(files, out), capsys, out)
+    assert line == (f"grainview: error: {files['log']}: no 'units' command, so the run is in LAMMPS's default units, "
+                    "lj (reduced units); only runs in SI units (units si) can be read")
+
+
+def test_lammps_says_that_without_a_log_si_is_assumed(tmp_path, capsys):
+    files = _lammps(tmp_path)
+    out = tmp_path / "run.nc"
+    argv = _lammps_argv(files, out)
+    at = argv.index("--log")
+    argv[at:at + 2] = ["--time-step", "5e-6", "--columns", "patom1=c_pairs[1],patom2=c_pairs[2],fx=c_forces[2],"
+                       "fy=c_forces[3],p1=c_forces[5],p2=c_forces[6]"]
+    stdout = _converts(argv, capsys, out)
+    assert ("note: no LAMMPS log given: the run is taken to be in SI units (units si), which only its log can "
+            "confirm (log=..., --log)") in stdout.splitlines()
+
+
+def test_lammps_refuses_a_box_that_does_not_hold_the_particles(tmp_path, capsys):
+    """A box 1e-7 m wide in x (the volume of the solid fraction and the stresses) was accepted
+    while the particles span 0.15 m."""
+    files = _lammps(tmp_path, particles=lambda t: t.replace(
+        "ITEM: BOX BOUNDS ff ff pp\n0.0000000000000000e+00 1.4999999999999999e-01\n",
+        "ITEM: BOX BOUNDS ff ff pp\n0.07 0.0700001\n"))
+    out = tmp_path / "run.nc"
+    line = _refused(_lammps_argv(files, out), capsys, out)
+    assert line.startswith(f"grainview: error: {files['particles']}: step 0: atom 1 at x = 0.0115147 lies outside "
+                           "the box's x range 0.07 .. 0.0700001 (ITEM: BOX BOUNDS); expected the particles inside the "
+                           "box"), line
+
+
+def test_lammps_refuses_a_self_pair_and_notes_a_loaded_pair_that_does_not_touch(tmp_path, capsys):
+    """A pair of an atom with itself, and a pair 50 N strong whose disks do not overlap, were
+    dropped without a word."""
+    lines = (LAMMPS / "dump.contacts").read_text().split("\n")
+    rows = _snapshot_rows(lines, 3)
+    position = {v[0]: (float(v[4]), float(v[5]), float(v[2])) for v in (
+        line.split() for line in (LAMMPS / "dump.particles").read_text().split("\n")[-221:-1])}
+    apart = next(n for n in rows if (lambda a, b: np.hypot(a[0] - b[0], a[1] - b[1]) > a[2] + b[2])(
+        position[lines[n].split()[0]], position[lines[n].split()[1]]))
+
+    def loaded(text):
+        lines = text.split("\n")
+        values = lines[apart].split()
+        values[3] = "50"
+        lines[apart] = " ".join(values)
+        return "\n".join(lines)
+
+    files = _lammps(tmp_path, contacts=loaded)
+    out = tmp_path / "run.nc"
+    stdout = _converts(_lammps_argv(files, out), capsys, out)
+    assert ("note: 1 pair(s) over 4 snapshot(s) whose disks do not overlap at the dumped positions carried a force "
+            "and were left out of the contacts (LAMMPS's granular pair styles give no force to pairs that do not "
+            "touch: positions dumped with too few digits? dump_modify format float %.17g)") in stdout.splitlines()
+
+    def itself(text):
+        lines = text.split("\n")
+        values = lines[rows[0]].split()
+        values[1] = values[0]
+        lines[rows[0]] = " ".join(values)
+        return "\n".join(lines)
+
+    files = _lammps(tmp_path, "self", contacts=itself)
+    out = tmp_path / "self.nc"
+    line = _refused(_lammps_argv(files, out), capsys, out)
+    assert line.startswith(f"grainview: error: {files['contacts']}: step 60000: line {rows[0] + 1}: a pair of atom "
+                           ) and line.endswith("with itself; expected pairs of two atoms"), line
+
+
+def test_lammps_names_an_atom_written_twice_in_the_walls_dump(tmp_path, capsys):
+    """A walls dump listing an atom twice was called 'a wall that is not an x or y plane'."""
+    def twice(text):
+        lines = text.split("\n")
+        rows = _snapshot_rows(lines, 3)
+        lines[rows[1]] = lines[rows[0]]
+        return "\n".join(lines)
+
+    files = _lammps(tmp_path, walls=twice)
+    lines = files["walls"].read_text().split("\n")
+    atom = lines[_snapshot_rows(lines, 3)[0]].split()[0]
+    out = tmp_path / "run.nc"
+    line = _refused(_lammps_argv(files, out), capsys, out)
+    assert line == (f"grainview: error: {files['walls']}: step 60000: atom id {atom} appears twice; expected each "
+                    "atom once")
+
+
+@pytest.mark.parametrize("key", ["particles", "log"])
+def test_a_conversion_refuses_to_write_over_its_input(tmp_path, capsys, key):
+    """`--out dump.particles --overwrite` replaced the dump with the converted file (exit 0)."""
+    files = _lammps(tmp_path)
+    before = files[key].read_bytes()
+    argv = _lammps_argv(files, files[key]) + ["--overwrite"]
+    code = main([str(a) for a in argv])
+    stderr = capsys.readouterr().err.strip().splitlines()
+    assert code == 2 and stderr == [f"grainview: error: {files[key]} is an input of the conversion ({files[key]}); "
+                                    "expected another file name for the output, which would replace it"], stderr
+    assert files[key].read_bytes() == before
+    assert [p.name for p in files[key].parent.iterdir() if p.name.startswith(".")] == []
