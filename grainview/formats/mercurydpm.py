@@ -27,8 +27,10 @@ contract from it. docs/formats.md states the same for users.
   wall is ``N + w``), ``normal`` the unit vector from i to j, the force exerted by i on j,
   ``fn``, ``ft`` its components along ``normal`` and ``(-normal_y, normal_x)``; ``point`` is
   MercuryDPM's contact point (the middle of the overlap), ``branch = x_j - x_i`` (the centre
-  to the contact point for a wall), ``gap = -overlap``. Pairs whose two lines disagree are
-  refused; pairs that do not overlap or whose normal force is tensile (viscous damping as they
+  to the contact point for a wall), ``gap = -overlap``. Pairs whose two lines disagree (force,
+  normal, overlap or contact point) are refused, and so are pairs written on one side only,
+  except in the last snapshot, the mark of a file cut while it was written: that snapshot is
+  left out with a warning. Pairs that do not overlap or whose normal force is tensile (viscous damping as they
   separate) are left out and counted in a warning.
 * **Walls** are the ``.restart``'s walls in its order. An ``InfiniteWall`` whose outward
   normal is ``-y, +x, +y, -x`` is named ``bottom, right, top, left``; any other wall
@@ -40,7 +42,8 @@ Every function checks its input and refuses bad input in one line
 (:class:`grainview.contract.errors.FileFormatError` or :class:`~grainview.contract.errors.ParameterError`).
 
 A value that is not finite or is absurd (:mod:`grainview.formats.checks`) on a ``.data`` or
-``.fstat`` line is refused naming the file and the line.
+``.fstat`` line is refused naming the file and the line, and so is a contact that cannot exist
+for its bodies' positions and sizes (:func:`grainview.formats.checks.check_contacts`).
 """
 
 from __future__ import annotations
@@ -52,13 +55,17 @@ import warnings
 import numpy as np
 
 from ..contract.errors import FileFormatError, ParameterError
-from .checks import Limits
+from .checks import Limits, check_contacts
 from .mercurydpm_text import iter_data, iter_fstat, read_restart
 
 __all__ = ["mercurydpm_snapshots", "open_mercurydpm", "convert_mercurydpm", "unit_scales", "BOX_WALLS"]
 
 BOX_WALLS = {(0, -1): "bottom", (1, 0): "right", (0, 1): "top", (-1, 0): "left"}
 """Names of the axis-aligned InfiniteWalls by their outward normal (pointing out of the sample)."""
+UNIT_RANGE = (1e-30, 1e30)
+"""The SI values one unit of length (m), mass (kg) or time (s) of a run may have: far beyond
+any granular run's, and narrow enough that the derived units (a force's ``M L / T^2``) stay
+finite and > 0."""
 _UNITS_HINT = ("MercuryDPM runs carry no units: give units='si' (m, kg, s) or the SI value of one unit of "
                "length, mass and time of the run (units={'length': m, 'mass': kg, 'time': s}; --units si or "
                "--units length=L,mass=M,time=T)")
@@ -82,7 +89,7 @@ def unit_scales(units) -> dict:
     Raises
     ------
     ParameterError
-        ``units`` missing, or not one of the two forms.
+        ``units`` missing, or not one of the two forms, or a value outside :data:`UNIT_RANGE`.
     """
     if units is None:
         raise ParameterError(_UNITS_HINT)
@@ -100,6 +107,9 @@ def unit_scales(units) -> dict:
             raise ParameterError(f"units: {key}={value!r} is not a number; {_UNITS_HINT}") from None
         if isinstance(units[key], bool) or not (math.isfinite(value) and value > 0):
             raise ParameterError(f"units: {key}={units[key]!r}: expected a finite number > 0")
+        if not UNIT_RANGE[0] <= value <= UNIT_RANGE[1]:
+            raise ParameterError(f"units: {key}={units[key]!r}: expected the SI value of one unit of the run from "
+                                 f"{UNIT_RANGE[0]:g} to {UNIT_RANGE[1]:g} ({dict(length='m', mass='kg', time='s')[key]})")
         scales[key] = value
     L, M, T = scales["length"], scales["mass"], scales["time"]
     scales.update(velocity=L / T, force=M * L / T**2, inertia=M * L**2)
@@ -178,6 +188,10 @@ class _Model:
         self.data_path = data_path
         self.limits = Limits(self.radius, scales["length"], restart_path, mass=self.mass, inertia=self.inertia)
 
+    def name(self, k):
+        """Body k's name in a message: MercuryDPM's particle index, or the wall's index and name."""
+        return f"particle {k}" if k < self.n else f"wall {k - self.n} ({self.wall_names[k - self.n]})"
+
 
 def _particles(model, snap, where):
     values = snap.values
@@ -203,6 +217,16 @@ def _particles(model, snap, where):
                 angular_velocity=-values[:, 6] / s["time"])
 
 
+class OneSidedPair(FileFormatError):
+    """A particle pair written on one side only in an ``.fstat`` snapshot (``count``: how many):
+    the mark of a file cut while it was written, accepted in its last snapshot only (left out
+    with a note)."""
+
+    def __init__(self, message, count):
+        super().__init__(message)
+        self.count = count
+
+
 def fstat_contacts(rows, n_particles, n_walls, where):
     """One contact per body pair from an ``.fstat`` snapshot's lines, in MercuryDPM's units.
 
@@ -225,8 +249,9 @@ def fstat_contacts(rows, n_particles, n_walls, where):
     Raises
     ------
     FileFormatError
-        A body index out of range, a particle pair whose two lines disagree, a pair written
-        more than twice.
+        A body index out of range, a particle pair whose two lines disagree (force, normal,
+        overlap or contact point), a pair written more than twice, and (:class:`OneSidedPair`)
+        a particle pair written on one side only.
     """
     ids = rows[:, 1:3]
     if not (np.all(np.abs(ids) < 2**31) and np.all(ids == np.round(ids))):  # NaN fails both
@@ -256,13 +281,28 @@ def fstat_contacts(rows, n_particles, n_walls, where):
         k = int(first[np.argmax(counts > 2)])
         raise FileFormatError(f"{where}: the pair {i[k]}-{j[k]} is written {counts.max()} times (expected once per "
                               "side)")
+    one_sided = ~wall[first] & (counts == 1)
+    if one_sided.any():
+        k = int(first[np.flatnonzero(one_sided)[0]])
+        raise OneSidedPair(f"{where}: the pair of particles {i[k]} and {j[k]} is written on one side only (line of "
+                           f"particle {p[k]}); expected the two lines MercuryDPM writes for each particle pair (a file "
+                           f"cut while being written?)", int(one_sided.sum()))
     index = np.searchsorted(unique, key)
+    size = np.abs(rows[:, 6]).max(initial=0.0) + np.abs(rows[:, 3:5]).max(initial=1.0)
     same = np.isclose(force, force[first[index]], rtol=1e-6, atol=1e-9 * np.abs(force).max(initial=1.0)).all(axis=1) \
         & np.isclose(normal, normal[first[index]], rtol=0, atol=1e-6).all(axis=1)
     if not same.all():
         k = int(np.flatnonzero(~same)[0])
         raise FileFormatError(f"{where}: the two lines of the pair {i[k]}-{j[k]} disagree (force on one is not minus "
                               "the force on the other)")
+    same = np.isclose(rows[:, 6], rows[first[index], 6], rtol=1e-6, atol=1e-12 * size) \
+        & np.isclose(rows[:, 3:5], rows[first[index], 3:5], rtol=0, atol=1e-9 * size).all(axis=1)
+    if not same.all():
+        k = int(np.flatnonzero(~same)[0])
+        raise FileFormatError(f"{where}: the two lines of the pair {i[k]}-{j[k]} disagree (overlap "
+                              f"{rows[first[index[k]], 6]:.10g} and {rows[k, 6]:.10g}, contact points "
+                              f"({rows[first[index[k]], 3]:.10g}, {rows[first[index[k]], 4]:.10g}) and "
+                              f"({rows[k, 3]:.10g}, {rows[k, 4]:.10g})); expected one contact written from each side")
     keep = first
     i, j, normal, force = i[keep], j[keep], normal[keep], force[keep]
     point, overlap = rows[keep, 3:5], rows[keep, 6]
@@ -306,6 +346,7 @@ def _contacts(model, position_raw, snap, where):
     contacts = dict(i=i.astype("i4"), j=j.astype("i4"), kind=np.ones(i.size, "i1"), normal=normal,
                     fn=np.einsum("ij,ij->i", force, normal), ft=np.einsum("ij,ij->i", force, tangent), point=point,
                     branch=branch, gap=-raw["overlap"] * s["length"])
+    check_contacts(model.limits, position_raw * s["length"], contacts, where, model.name)
     wall_force = np.zeros((len(model.wall_names), 2))
     np.add.at(wall_force, j[on_wall] - model.n, force[on_wall])
     return contacts, wall_force, tensile
@@ -385,18 +426,28 @@ def mercurydpm_snapshots(data, fstat=None, restart=None, *, units=None):
                   wall_names=list(model.wall_names) or None, wall_normal=wall_normal, attrs=attrs)
 
     def snapshots():
-        from .convert import chain_first
-
-        for d, f in chain_first(first, stream):
+        current = first
+        while current is not None:
+            d, f = current
+            following = next(stream, None)  # read ahead: is this the last snapshot?
             where = f"{fstat_path}: t = {f.time:.10g} (line {f.line})"
             state = _particles(model, d, f"{data_path}: t = {d.time:.10g} (line {d.line})")
-            contacts, wall_force, tensile = _contacts(model, d.values[:, 0:2], f, where)
+            try:
+                contacts, wall_force, tensile = _contacts(model, d.values[:, 0:2], f, where)
+            except OneSidedPair as exc:
+                if following is not None or current is first:  # not the last snapshot, or the only one
+                    raise
+                warnings.warn(f"{fstat_path}: its last snapshot (t = {f.time:.10g}, line {f.line}) has {exc.count} "
+                              "particle pair(s) written on one side only, the mark of a file cut while it was "
+                              "written: that snapshot is left out", UserWarning, stacklevel=2)
+                return
             box = d.bounds * scales["length"]
             snap = dict(time=d.time * scales["time"], contacts=contacts, box_min=box[:2].copy(),
                         box_max=box[2:].copy(), tensile=tensile, **state)
             if model.wall_names:
                 snap["wall_force"] = wall_force
             yield snap
+            current = following
 
     return static, snapshots()
 
@@ -465,7 +516,8 @@ def convert_mercurydpm(out, data, fstat=None, restart=None, *, units=None, overw
     """
     from .convert import check_out, write_snapshots
 
-    out = check_out(out, overwrite)
+    inputs = (os.fspath(data), _sibling(data, ".fstat", fstat), _sibling(data, ".restart", restart))
+    out = check_out(out, overwrite, inputs)
     static, stream = mercurydpm_snapshots(data, fstat, restart, units=units)
     optional = ("gap", "velocity", "angular_velocity") + (("wall_force",) if static["n_walls"] else ())
     tensile = []
@@ -475,6 +527,6 @@ def convert_mercurydpm(out, data, fstat=None, restart=None, *, units=None, overw
         return snap
 
     count = write_snapshots(out, static, stream, optional, overwrite=overwrite, compress=compress, progress=progress,
-                            label="mercurydpm", prepare=prepare)
+                            label="mercurydpm", prepare=prepare, inputs=inputs)
     _warn_tensile(sum(tensile), count)
     return count

@@ -210,14 +210,56 @@ def _pairs(tokens):
     return out
 
 
+def _count(tokens, path, number):
+    """The count of a ``Species N``, ``Walls N`` or ``Particles N`` line: a non-negative integer."""
+    text = tokens[1]
+    if not text.isdigit():
+        raise FileFormatError(f"{path}: line {number}: '{tokens[0]} {text[:30]}'; expected '{tokens[0]} <count>', "
+                              "a whole number")
+    return int(text)
+
+
+def _dimension(values, key, path, number):
+    """``systemDimensions`` or ``particleDimensions``: 1, 2 or 3."""
+    try:
+        value = values[key][0]
+    except (KeyError, IndexError):
+        raise FileFormatError(f"{path}: line {number}: expected 'systemDimensions D particleDimensions D'") from None
+    if value not in (1, 2, 3):
+        raise FileFormatError(f"{path}: line {number}: {key} {value:g}; expected 1, 2 or 3")
+    return int(value)
+
+
+_WALL_KEYS = ("id", "indSpecies")
+"""What every wall line of a ``.restart`` holds after the wall's type (``InfiniteWall id 0
+indSpecies 0 position ...``)."""
+
+
+def _wall(line, path, number, index, count):
+    """One wall line: (type, {key: values}); one line for a line that is not a wall's or whose
+    position or orientation holds a number that is not finite."""
+    tokens = line.split()
+    values = _pairs(tokens[1:])
+    if not tokens or any(not values.get(key) for key in _WALL_KEYS):
+        raise FileFormatError(f"{path}: line {number}: expected wall {index} of 'Walls {count}' ('<type> id <n> "
+                              f"indSpecies <n> ...'), found {line.strip()[:60]!r} (fewer wall lines than announced?)")
+    for key in ("position", "orientation"):  # what the reader takes from a wall
+        numbers = values.get(key, [])
+        if not np.all(np.isfinite(numbers)):
+            raise FileFormatError(f"{path}: line {number}: wall {index}: {key} {' '.join(f'{v:g}' for v in numbers)}; "
+                                  "expected finite numbers")
+    return tokens[0], values
+
+
 def read_restart(path) -> RestartInfo:
     """Read the dimensions, species densities, walls and particles of a MercuryDPM ``.restart``.
 
     Raises
     ------
     FileFormatError
-        A missing file, no ``systemDimensions``/``particleDimensions`` line, a species without
-        a density, fewer wall or particle lines than announced.
+        A missing file, no ``systemDimensions``/``particleDimensions`` line or dimensions other
+        than 1, 2 or 3, a count that is not a whole number, a species without a density, fewer
+        wall or particle lines than announced, a wall's position or orientation that is not finite.
     """
     path, handle = _open(path, ".restart")
     with handle:
@@ -235,13 +277,10 @@ def read_restart(path) -> RestartInfo:
             version = tokens[1]
         elif head == "systemDimensions" or "systemDimensions" in tokens:
             values = _pairs(tokens)
-            try:
-                info = RestartInfo(int(values["systemDimensions"][0]), int(values["particleDimensions"][0]))
-            except (KeyError, IndexError):
-                raise FileFormatError(f"{path}: line {k + 1}: expected 'systemDimensions D particleDimensions D'") \
-                    from None
+            info = RestartInfo(_dimension(values, "systemDimensions", path, k + 1),
+                               _dimension(values, "particleDimensions", path, k + 1))
         elif head == "Species" and len(tokens) == 2 and info is not None:
-            count = int(tokens[1])
+            count = _count(tokens, path, k + 1)
             for s in range(count):
                 if k + 1 + s >= len(lines):
                     raise FileFormatError(f"{path}: truncated: 'Species {count}' is followed by {s} species lines")
@@ -251,15 +290,14 @@ def read_restart(path) -> RestartInfo:
                 info.densities[s] = values["density"][0]
             k += count
         elif head == "Walls" and len(tokens) == 2 and info is not None:
-            count = int(tokens[1])
+            count = _count(tokens, path, k + 1)
             for w in range(count):
                 if k + 1 + w >= len(lines):
                     raise FileFormatError(f"{path}: truncated: 'Walls {count}' is followed by {w} wall lines")
-                line = lines[k + 1 + w].split()
-                info.walls.append((line[0] if line else "", _pairs(line[1:])))
+                info.walls.append(_wall(lines[k + 1 + w], path, k + 2 + w, w, count))
             k += count
         elif head == "Particles" and len(tokens) == 2 and info is not None:
-            count = int(tokens[1])
+            count = _count(tokens, path, k + 1)
             for p in range(count):
                 if k + 1 + p >= len(lines):
                     raise FileFormatError(f"{path}: truncated: 'Particles {count}' is followed by {p} particle lines")

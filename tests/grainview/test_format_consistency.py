@@ -13,11 +13,13 @@ import re
 import numpy as np
 import pytest
 
+import grainview
 from grainview.app.cli import main
 from grainview.contract.errors import FileFormatError
 from grainview.formats.lammps import open_lammps
 
-from .test_format_bad_values import LAMMPS, _converts, _lammps, _lammps_argv, _refused
+from .test_format_bad_values import (LAMMPS, MERCURY, _converts, _lammps, _lammps_argv, _mercury, _mercury_argv,
+                                     _refused, _set)
 
 
 # --- LAMMPS -------------------------------------------------------------------------------------
@@ -270,3 +272,113 @@ def test_a_conversion_refuses_to_write_over_its_input(tmp_path, capsys, key):
                                     "expected another file name for the output, which would replace it"], stderr
     assert files[key].read_bytes() == before
     assert [p.name for p in files[key].parent.iterdir() if p.name.startswith(".")] == []
+
+
+# --- MercuryDPM ---------------------------------------------------------------------------------
+
+def _fstat_lines():
+    return (MERCURY / "Settle2D.fstat").read_text().split("\n")
+
+
+def _pair_lines(lines, start=0):
+    """The 1-based numbers of the two lines of the first particle pair at or after line ``start``."""
+    for n in range(start, len(lines) - 1):
+        a, b = lines[n].split(), lines[n + 1].split()
+        if a and not lines[n].startswith("#") and int(b[1]) == int(a[2]) and int(b[2]) == int(a[1]) >= 0:
+            return n + 1, n + 2
+    raise AssertionError("no pair")
+
+
+def test_mercurydpm_refuses_contacts_of_a_particle_far_away(tmp_path, capsys):
+    """A particle moved a million metres away kept its .fstat contacts (branches of 1.1e6 m)."""
+    data = _mercury(tmp_path, data=lambda t: _set(t, 137, 1, "1.1e6"))  # particle 3 at t = 20
+    out = tmp_path / "run.nc"
+    line = _refused(_mercury_argv(data, out), capsys, out)
+    assert line.startswith(f"grainview: error: {data.with_suffix('.fstat')}: t = 20 (line ") and re.search(
+        r": the contact of particle \d+ and particle \d+: the centres are 1\.1e\+06 m apart, the radii sum to ", line) \
+        and "particle 3" in line, line
+
+
+@pytest.mark.parametrize("column, value, message", [
+    (6, "3.0", "an overlap of 3 m (gap -3 m), deeper than the radius"),  # 7 radii
+    (3, "500", "the contact point is 4"),
+])
+def test_mercurydpm_refuses_an_impossible_wall_contact(tmp_path, capsys, column, value, message):
+    """A wall line's overlap of 3.0 (7 radii) was stored as gap -3.0, a contact point 500 m
+    away as it was."""
+    lines = _fstat_lines()
+    number = next(n + 1 for n, line in enumerate(lines) if n > 700 and not line.startswith("#") and line.split()
+                  and int(line.split()[2]) < 0)
+    data = _mercury(tmp_path, fstat=lambda t: _set(t, number, column, value))
+    out = tmp_path / "run.nc"
+    line = _refused(_mercury_argv(data, out), capsys, out)
+    assert line.startswith(f"grainview: error: {data.with_suffix('.fstat')}: t = 40 (line 686): the contact of "
+                           "particle ") and message in line and "(bottom)" in line, line
+
+
+def test_mercurydpm_refuses_a_pair_written_on_one_side_only(tmp_path, capsys):
+    """One line of a pair in a snapshot before the last: the pair was kept from that side."""
+    first, _ = _pair_lines(_fstat_lines(), 700)
+    data = _mercury(tmp_path, fstat=lambda t: "\n".join(line for n, line in enumerate(t.split("\n"), start=1)
+                                                        if n != first))
+    out = tmp_path / "run.nc"
+    line = _refused(_mercury_argv(data, out), capsys, out)
+    assert line.startswith(f"grainview: error: {data.with_suffix('.fstat')}: t = 40 (line 686): the pair of "
+                           "particles ") and "is written on one side only" in line, line
+
+
+def test_mercurydpm_leaves_out_a_last_snapshot_cut_between_a_pairs_lines(tmp_path, capsys):
+    """An .fstat cut at a line boundary in its last snapshot was read with that snapshot's lost
+    contacts missing and no word; a cut between the two lines of a pair now shows, and that
+    snapshot is left out with a note."""
+    first, _ = _pair_lines(_fstat_lines(), 800)
+    data = _mercury(tmp_path, fstat=lambda t: "\n".join(t.split("\n")[:first]) + "\n",
+                    data=lambda t: t)
+    out = tmp_path / "run.nc"
+    stdout = _converts(_mercury_argv(data, out), capsys, out)
+    assert (f"note: {data.with_suffix('.fstat')}: its last snapshot (t = 40.001, line 791) has 1 particle pair(s) "
+            "written on one side only, the mark of a file cut while it was written: that snapshot is left out") \
+        in stdout.splitlines(), stdout
+    assert grainview.open_dataset(out, chunks=None).sizes["time"] == 9
+
+
+def test_mercurydpm_refuses_a_pair_whose_lines_disagree_on_the_overlap(tmp_path, capsys):
+    """One line of a pair said overlap 2.69, the other 0.0027: one side's values were kept."""
+    _, second = _pair_lines(_fstat_lines(), 700)
+    data = _mercury(tmp_path, fstat=lambda t: _set(t, second, 6, "2.69"))
+    out = tmp_path / "run.nc"
+    line = _refused(_mercury_argv(data, out), capsys, out)
+    assert "disagree (overlap " in line and "and 2.69, contact points" in line, line
+
+
+@pytest.mark.parametrize("old, new, message", [
+    ("Particles 32", "Particles 32.0", "line 19: 'Particles 32.0'; expected 'Particles <count>', a whole number"),
+    ("Walls 4", "Walls four", "line 13: 'Walls four'; expected 'Walls <count>', a whole number"),
+    ("Species 1", "Species nan", "line 11: 'Species nan'; expected 'Species <count>', a whole number"),
+    ("systemDimensions 2", "systemDimensions nan", "line 10: systemDimensions nan; expected 1, 2 or 3"),
+    ("systemDimensions 2", "systemDimensions inf", "line 10: systemDimensions inf; expected 1, 2 or 3"),
+    ("particleDimensions 2", "particleDimensions 2.5", "line 10: particleDimensions 2.5; expected 1, 2 or 3"),
+    ("Walls 4", "Walls 5", "line 18: expected wall 4 of 'Walls 5' ('<type> id <n> indSpecies <n> ...'), found "
+                           "'Boundaries 0' (fewer wall lines than announced?)"),
+    ("orientation 0.707106781186548 0 0 -0.707106781186548", "orientation nan 0 0 -0.707106781186548",
+     "line 14: wall 0: orientation nan 0 0 -0.707107; expected finite numbers"),
+])
+def test_mercurydpm_refuses_a_restart_it_cannot_read(tmp_path, capsys, old, new, message):
+    """Counts that are not whole numbers and dimensions that are not finite raised ValueError
+    or OverflowError (tracebacks); 'particleDimensions 2.5' was read as 2; 'Walls 5' over 4
+    wall lines made a wall of 'Boundaries 0'; a NaN orientation renamed the floor."""
+    data = _mercury(tmp_path, restart=lambda t: t.replace(old, new, 1))
+    out = tmp_path / "run.nc"
+    line = _refused(_mercury_argv(data, out), capsys, out)
+    assert line == f"grainview: error: {data.with_suffix('.restart')}: {message}"
+
+
+def test_mercurydpm_refuses_an_absurd_unit(tmp_path, capsys):
+    """time=1e300 raised OverflowError (a traceback) computing the unit of force."""
+    data = _mercury(tmp_path)
+    out = tmp_path / "run.nc"
+    argv = _mercury_argv(data, out)
+    argv[argv.index("si")] = "length=1,mass=1,time=1e300"
+    line = _refused(argv, capsys, out)
+    assert line == ("grainview: error: units: time=1e+300: expected the SI value of one unit of the run from 1e-30 to "
+                    "1e+30 (s)")
