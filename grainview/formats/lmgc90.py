@@ -67,7 +67,7 @@ import numpy as np
 from ..contract import portable_math
 from ..contract.errors import FileFormatError
 from ..contract.shapes import polygon_properties, regular_vertices, shape_problems, vertex_phases
-from .checks import Limits, input_folder
+from .checks import Limits, check_contacts, check_step, input_folder
 from .lmgc90_text import output_files, read_bodies, read_bulk_behav, read_dof, read_vloc_rloc
 
 __all__ = ["lmgc90_snapshots", "open_lmgc90", "convert_lmgc90", "FAMILIES", "BOX_WALLS", "regular_polygon",
@@ -78,6 +78,9 @@ FAMILIES = ("DKDKx", "DKJCx", "PLPLx", "PLJCx", "DKPLx")
 BOX_WALLS = ("bottom", "right", "top", "left")
 """Names (and order) of the walls of a box of four JONCx."""
 _PARTICLE_CONTACTORS = {"DISKx", "POLYG"}
+_FAMILY_CONTACTORS = {"DKDKx": ("DISKx", "DISKx"), "DKJCx": ("DISKx", "JONCx"), "PLPLx": ("POLYG", "POLYG"),
+                      "PLJCx": ("POLYG", "JONCx"), "DKPLx": ("DISKx", "POLYG")}
+"""The contactors of each family's candidate and antagonist."""
 _DOUBLE_FAMILIES = {"PLPLx", "PLJCx"}
 """The families whose pairs may have two points (a polygon's face on a face or a wall)."""
 _NOT_CONVEX = "a POLYG whose vertices are not a convex polygon (the contract holds convex polygons only)"
@@ -227,7 +230,8 @@ class _Model:
             self.mass[k] = density[body.behav] * math.pi * body.avrd ** 2
             self.inertia[k] = self.mass[k] * body.gyrd ** 2
         self.limits = Limits(self.radius, 1.0, bodies_path, mass=self.mass, inertia=self.inertia,
-                             names=lambda k: f"body {particles[k].number}")
+                             names=lambda k: f"body {particles[k].number}", n_vertices=self.n_vertices)
+        self.contactor = {int(body.number): body.contactors[0].kind for body in particles + walls}
         self.vertices = None  # regular polygons only
         if own:
             self.vertices = np.full((n, int(self.n_vertices.max()), 2), np.nan)
@@ -245,6 +249,12 @@ class _Model:
     @property
     def n(self):
         return self.radius.size
+
+    def name(self, k):
+        """Particle or wall k's name in a message: its body number (and the wall's name)."""
+        if k < self.n:
+            return f"body {self.numbers[k]}"
+        return f"body {self.walls[k - self.n].number} ({self.wall_names[k - self.n]})"
 
     def name_walls(self, dof):
         """Name the walls from their place in the first snapshot; four axis-aligned JONCx
@@ -295,6 +305,10 @@ def _state(model, dof, where):
     missing += [int(w.number) for w in model.wall_bodies if int(w.number) not in row]
     if missing:
         raise FileFormatError(f"{where}: body {missing[0]} of BODIES.DAT is not in the file")
+    unknown = [b for b in row if b not in model.contactor]
+    if unknown:
+        raise FileFormatError(f"{where}: body {unknown[0]} is not in {model.source} (files of another run?); expected "
+                              "the bodies of BODIES.DAT")
     k = np.array([row[int(b)] for b in model.numbers])
     X, V = dof.X[k], dof.V[k]
     walls = np.array([w.reference + dof.X[row[int(w.number)]] for w in model.walls]).reshape(-1, 3)
@@ -352,6 +366,13 @@ def _contacts(model, position, vloc, where):
                                   f"{model.source}") from None
         if cd >= n:
             raise FileFormatError(f"{where}: {entry.family} entry whose candidate (body {entry.cd}) is a wall")
+        expected = _FAMILY_CONTACTORS[entry.family]
+        found = (model.contactor[entry.cd], model.contactor[entry.an])
+        if found != expected or (entry.cd_kind, entry.an_kind) != expected:
+            raise FileFormatError(f"{where}: line {entry.line}: a {entry.family} entry (a {expected[0]} on a "
+                                  f"{expected[1]}) on body {entry.cd}, a {found[0]}, and body {entry.an}, a {found[1]} "
+                                  f"in {os.path.basename(model.source)} ({entry.cd_kind} on {entry.an_kind} in the "
+                                  "entry): files of another run?")
         pairs.setdefault((min(cd, an), max(cd, an)), []).append((entry, cd))
     out = {k: [] for k in ("i", "j", "kind", "normal", "fn", "ft", "point", "branch", "gap")}
     wall_force = np.zeros((len(model.wall_names), 2))
@@ -406,6 +427,7 @@ def _contacts(model, position, vloc, where):
     contacts = {k: np.array(v, dtypes.get(k, "f8")) for k, v in out.items()}
     for k in ("normal", "point", "branch"):
         contacts[k] = contacts[k].reshape(-1, 2)
+    check_contacts(model.limits, position, contacts, where, model.name)
     return contacts, wall_force, tensile
 
 
@@ -416,6 +438,19 @@ def _run_folders(run):
         raise FileFormatError(f"{run}: no DATBOX/BODIES.DAT (expected an LMGC90 run folder holding DATBOX/ and "
                               "OUTBOX/)")
     return run, datbox, outbox
+
+
+def _run_files(run):
+    """The files of a run folder's DATBOX/ and OUTBOX/ (what a conversion may read, and must not
+    write over)."""
+    files = []
+    for folder in ("DATBOX", "OUTBOX"):
+        folder = os.path.join(os.fspath(run), folder)
+        try:
+            files += [os.path.join(folder, name) for name in sorted(os.listdir(folder))]
+        except OSError:
+            pass
+    return files
 
 
 def lmgc90_snapshots(run):
@@ -467,6 +502,11 @@ def lmgc90_snapshots(run):
             if vloc.step != dof.step:
                 raise FileFormatError(f"{vloc_file}: step {vloc.step}, but {os.path.basename(dof_file)} is at step "
                                       f"{dof.step} (a snapshot's two files must be of the same step)")
+            if not math.isclose(vloc.time, dof.time, rel_tol=1e-6, abs_tol=1e-12):
+                raise FileFormatError(f"{vloc_file}: step {vloc.step} at time {vloc.time:.7g} s, but "
+                                      f"{os.path.basename(dof_file)} has step {dof.step} at time {dof.time:.7g} s (a "
+                                      "snapshot's two files must be of the same step, of the same run)")
+            check_step(dof.step, dof_file)
             position, angle, velocity, omega, walls = _state(model, dof, dof_file)
             contacts, wall_force, tensile = _contacts(model, position, vloc, vloc_file)
             box_min, box_max = _box(model, position, walls)
@@ -554,7 +594,8 @@ def convert_lmgc90(out, run, *, overwrite=False, compress=True, progress=False):
     """
     from .convert import check_out, write_snapshots
 
-    out = check_out(out, overwrite)
+    inputs = _run_files(run)
+    out = check_out(out, overwrite, inputs)
     static, stream = lmgc90_snapshots(run)
     optional = ("step", "gap", "velocity", "angular_velocity") + (("wall_force",) if static["n_walls"] else ())
     tensile = []
@@ -564,6 +605,6 @@ def convert_lmgc90(out, run, *, overwrite=False, compress=True, progress=False):
         return snap
 
     count = write_snapshots(out, static, stream, optional, overwrite=overwrite, compress=compress, progress=progress,
-                            label="lmgc90", prepare=prepare)
+                            label="lmgc90", prepare=prepare, inputs=inputs)
     _warn_tensile(sum(tensile), count)
     return count

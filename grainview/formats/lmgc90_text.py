@@ -139,7 +139,7 @@ def read_bodies(path) -> list:
     ------
     FileFormatError
         Not a BODIES.DAT (no ``$bdyty`` block), a block without its node or bulk, a number
-        that does not parse, a truncated block.
+        that does not parse, a truncated block, a body number defined twice.
     """
     path = os.fspath(path)
     bodies, body, section = [], None, None
@@ -195,6 +195,10 @@ def read_bodies(path) -> list:
         raise FileFormatError(f"{path}: the last $bdyty block has no closing $$$$$$ (a truncated BODIES.DAT)")
     if not bodies:
         raise FileFormatError(f"{path}: no $bdyty block (not an LMGC90 BODIES.DAT)")
+    numbers = [body.number for body in bodies]
+    if len(set(numbers)) != len(numbers):
+        twice = next(number for k, number in enumerate(numbers) if number in numbers[:k])
+        raise FileFormatError(f"{path}: body {twice} is defined twice; expected each body number once")
     return bodies
 
 
@@ -296,13 +300,14 @@ def read_dof(path) -> DofSnapshot:
     ------
     FileFormatError
         No ``$steps`` header, a body block without its ``X`` or ``V`` line, a file that ends
-        inside a block or before its closing ``!---`` line (truncated), a deformable body.
+        inside a block or before its closing ``!---`` line (truncated), a deformable body, a
+        body written twice.
     """
     path = os.fspath(path)
     lines = _lines(path)
     step, time, start = _header(lines, path)
     _one_record(lines, start, path)
-    numbers, X, V = [], [], []
+    numbers, X, V, lines_of = [], [], [], []
     k, finished = start, False
     while k < len(lines):
         text = lines[k].strip()
@@ -328,6 +333,7 @@ def read_dof(path) -> DofSnapshot:
                                       "only 2D rigid bodies (RBDY2, NO3xx) can be read")
             x, v = _values(block[2]), _values(block[3])
             numbers.append(body_number(number, f"{path}: line {k + 2}"))
+            lines_of.append(k + 2)
             X.append([x["X(1)"], x["X(2)"], x["X(3)"]])
             V.append([v["V(1)"], v["V(2)"], v["V(3)"]])
         except (ValueError, KeyError):
@@ -336,6 +342,12 @@ def read_dof(path) -> DofSnapshot:
         k += 6
     if not finished:
         raise FileFormatError(f"{path}: no closing '!---' line after the bodies (a truncated DOF.OUT)")
+    seen = {}
+    for number, line in zip(numbers, lines_of):
+        if number in seen:
+            raise FileFormatError(f"{path}: line {line}: a second block of body {number} (the first at line "
+                                  f"{seen[number]}); expected each body once")
+        seen[number] = line
     return DofSnapshot(step, time, np.array(numbers, np.int64), np.array(X, float).reshape(-1, 3),
                        np.array(V, float).reshape(-1, 3))
 
@@ -451,20 +463,25 @@ def output_files(outbox) -> list:
     Raises
     ------
     FileFormatError
-        No ``DOF.OUT.n`` at all, or a ``DOF.OUT.n`` without its ``Vloc_Rloc.OUT.n`` (or the
-        reverse).
+        No ``DOF.OUT.n`` at all, a ``DOF.OUT.n`` without its ``Vloc_Rloc.OUT.n`` (or the
+        reverse), two files of one snapshot (``DOF.OUT.2`` and ``DOF.OUT.02``).
     """
     outbox = input_folder(outbox, "an LMGC90 run's OUTBOX/, where it writes its results")
-    found = {"DOF.OUT": set(), "Vloc_Rloc.OUT": set()}
-    for name in os.listdir(outbox):
+    found = {"DOF.OUT": {}, "Vloc_Rloc.OUT": {}}
+    for name in sorted(os.listdir(outbox)):
         match = re.fullmatch(r"(DOF\.OUT|Vloc_Rloc\.OUT)\.(\d+)", name)
         if match:
-            found[match.group(1)].add(int(match.group(2)))
+            kind, n = match.group(1), int(match.group(2))
+            if n in found[kind]:
+                raise FileFormatError(f"{outbox}: {found[kind][n]} and {name} are both snapshot {n}; expected one "
+                                      f"{kind} file per snapshot")
+            found[kind][n] = name
     if not found["DOF.OUT"]:
         raise FileFormatError(f"{outbox}: no DOF.OUT.n file (write them with chipy.WriteOut or WriteOutDof)")
     for one, other in (("DOF.OUT", "Vloc_Rloc.OUT"), ("Vloc_Rloc.OUT", "DOF.OUT")):
-        alone = sorted(found[one] - found[other])
+        alone = sorted(set(found[one]) - set(found[other]))
         if alone:
-            raise FileFormatError(f"{outbox}: {one}.{alone[0]} has no {other}.{alone[0]} (every snapshot needs both)")
-    return [(n, os.path.join(outbox, f"DOF.OUT.{n}"), os.path.join(outbox, f"Vloc_Rloc.OUT.{n}"))
+            raise FileFormatError(f"{outbox}: {found[one][alone[0]]} has no {other}.{alone[0]} (every snapshot needs "
+                                  "both)")
+    return [(n, os.path.join(outbox, found["DOF.OUT"][n]), os.path.join(outbox, found["Vloc_Rloc.OUT"][n]))
             for n in sorted(found["DOF.OUT"])]

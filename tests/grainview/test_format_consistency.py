@@ -18,8 +18,8 @@ from grainview.app.cli import main
 from grainview.contract.errors import FileFormatError
 from grainview.formats.lammps import open_lammps
 
-from .test_format_bad_values import (LAMMPS, MERCURY, _converts, _lammps, _lammps_argv, _mercury, _mercury_argv,
-                                     _refused, _set)
+from .test_format_bad_values import (LAMMPS, MERCURY, _converts, _lammps, _lammps_argv, _lmgc90, _lmgc90_argv, _mercury,
+                                     _mercury_argv, _refused, _set)
 
 
 # --- LAMMPS -------------------------------------------------------------------------------------
@@ -382,3 +382,110 @@ def test_mercurydpm_refuses_an_absurd_unit(tmp_path, capsys):
     line = _refused(argv, capsys, out)
     assert line == ("grainview: error: units: time=1e+300: expected the SI value of one unit of the run from 1e-30 to "
                     "1e+30 (s)")
+
+
+# --- LMGC90 -------------------------------------------------------------------------------------
+
+def _first_entry(text, old, new):
+    """The first $icdan entry of a Vloc_Rloc.OUT with ``old`` (a regular expression) replaced."""
+    start = text.index("$icdan")
+    end = text.index("$icdan", start + 1)
+    return text[:start] + re.sub(old, new, text[start:end], count=1) + text[end:]
+
+
+@pytest.mark.parametrize("old, new, message", [
+    (r"gapTT-0\.5546195D-06", "gapTT 0.5000000D+00", "a gap of 0.5 m between bodies in contact; expected a closed "
+                                                      "contact"),
+    (r"coo1= 0\.4657701D\+01", "coo1= 0.4657701D+03", "the contact point (465.77, 0.801088) m is "),
+])
+def test_lmgc90_refuses_an_impossible_contact(tmp_path, capsys, old, new, message):
+    """A gapTT of +0.5 m under a force of 54 kN and a contact point 460 m away were stored."""
+    folder = _lmgc90(tmp_path, **{"OUTBOX/Vloc_Rloc.OUT.4": lambda t: _first_entry(t, old, new)})
+    out = tmp_path / "run.nc"
+    line = _refused(_lmgc90_argv(folder, out), capsys, out)
+    assert line.startswith(f"grainview: error: {folder / 'OUTBOX/Vloc_Rloc.OUT.4'}: the contact of body 4 and body "
+                           "12: ") and message in line, line
+
+
+def _body_block(text, number):
+    match = re.search(rf"\$bdyty\n RBDY2 +{number}\n.*?\$\$\$\$\$\$\n", text, re.S)
+    return match
+
+
+def test_lmgc90_refuses_a_body_written_twice_in_dof_out(tmp_path, capsys):
+    """Body 1's block written a second time, 0.77 m away: the second silently won."""
+    def twice(text):
+        match = _body_block(text, 1)
+        return text[:match.end()] + match.group(0).replace("X(1)= 0.", "X(1)= 0.9", 1) + text[match.end():]
+
+    folder = _lmgc90(tmp_path, **{"OUTBOX/DOF.OUT.2": twice})
+    out = tmp_path / "run.nc"
+    line = _refused(_lmgc90_argv(folder, out), capsys, out)
+    assert line == (f"grainview: error: {folder / 'OUTBOX/DOF.OUT.2'}: line 14: a second block of body 1 (the first "
+                    "at line 8); expected each body once")
+
+
+def test_lmgc90_refuses_a_body_that_bodies_dat_does_not_have(tmp_path, capsys):
+    """A DOF.OUT block of a body BODIES.DAT does not define was ignored without a word."""
+    def extra(text):
+        match = _body_block(text, 1)
+        return text[:match.end()] + match.group(0).replace(" RBDY2        1\n", " RBDY2      999\n") + text[match.end():]
+
+    folder = _lmgc90(tmp_path, **{"OUTBOX/DOF.OUT.3": extra})
+    out = tmp_path / "run.nc"
+    line = _refused(_lmgc90_argv(folder, out), capsys, out)
+    assert line == (f"grainview: error: {folder / 'OUTBOX/DOF.OUT.3'}: body 999 is not in "
+                    f"{folder / 'DATBOX/BODIES.DAT'} (files of another run?); expected the bodies of BODIES.DAT")
+
+
+def test_lmgc90_refuses_a_body_number_defined_twice(tmp_path, capsys):
+    """Two bodies numbered 2 in BODIES.DAT: an entry on body 2 was called 'not a body'."""
+    folder = _lmgc90(tmp_path, **{"DATBOX/BODIES.DAT": lambda t: t.replace(" RBDY2      3\n", " RBDY2      2\n", 1)})
+    out = tmp_path / "run.nc"
+    line = _refused(_lmgc90_argv(folder, out), capsys, out)
+    assert line == (f"grainview: error: {folder / 'DATBOX/BODIES.DAT'}: body 2 is defined twice; expected each body "
+                    "number once")
+
+
+def test_lmgc90_refuses_files_of_one_step_at_two_times(tmp_path, capsys):
+    folder = _lmgc90(tmp_path, **{"OUTBOX/Vloc_Rloc.OUT.4": lambda t: t.replace("time= 0.5000000D+01",
+                                                                                "time= 0.7000000D+01", 1)})
+    out = tmp_path / "run.nc"
+    line = _refused(_lmgc90_argv(folder, out), capsys, out)
+    assert line == (f"grainview: error: {folder / 'OUTBOX/Vloc_Rloc.OUT.4'}: step 500 at time 7 s, but DOF.OUT.4 has "
+                    "step 500 at time 5 s (a snapshot's two files must be of the same step, of the same run)")
+
+
+def test_lmgc90_names_the_files_of_a_snapshot_as_they_are(tmp_path, capsys):
+    """DOF.OUT.02 beside DOF.OUT.2 was ignored; DOF.OUT.04 was looked for as DOF.OUT.4 ('no such
+    file')."""
+    folder = _lmgc90(tmp_path)
+    outbox = folder / "OUTBOX"
+    (outbox / "DOF.OUT.4").rename(outbox / "DOF.OUT.04")
+    out = tmp_path / "run.nc"
+    _converts(_lmgc90_argv(folder, out), capsys, out)
+    (outbox / "DOF.OUT.02").write_text((outbox / "DOF.OUT.2").read_text())
+    out = tmp_path / "again.nc"
+    line = _refused(_lmgc90_argv(folder, out), capsys, out)
+    assert line == (f"grainview: error: {outbox}: DOF.OUT.02 and DOF.OUT.2 are both snapshot 2; expected one DOF.OUT "
+                    "file per snapshot")
+
+
+def test_lmgc90_refuses_an_entry_whose_family_is_not_its_bodies(tmp_path, capsys):
+    """A DKDKx entry (two disks) on body 1, a POLYG, was read."""
+    folder = _lmgc90(tmp_path, **{"OUTBOX/Vloc_Rloc.OUT.4": lambda t: _first_entry(
+        t, r"RBDY2      4  DISKx", "RBDY2      1  DISKx")})
+    out = tmp_path / "run.nc"
+    line = _refused(_lmgc90_argv(folder, out), capsys, out)
+    assert line == (f"grainview: error: {folder / 'OUTBOX/Vloc_Rloc.OUT.4'}: line 7: a DKDKx entry (a DISKx on a "
+                    "DISKx) on body 1, a POLYG, and body 12, a DISKx in BODIES.DAT (DISKx on DISKx in the entry): files "
+                    "of another run?")
+
+
+def test_lmgc90_refuses_a_step_the_contract_cannot_hold(tmp_path, capsys):
+    edit = lambda t: t.replace("$steps      500 ", "$steps      2147483648 ", 1)  # noqa: E731
+    folder = _lmgc90(tmp_path, **{"OUTBOX/DOF.OUT.4": edit, "OUTBOX/Vloc_Rloc.OUT.4": edit})
+    out = tmp_path / "run.nc"
+    line = _refused(_lmgc90_argv(folder, out), capsys, out)
+    assert line.startswith(f"grainview: error: {folder / 'OUTBOX/DOF.OUT.4'}: step = 2147483648; expected an integer "
+                           "from 0 to 2147483647"), line
