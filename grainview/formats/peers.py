@@ -42,12 +42,16 @@ import glob
 import json
 import math
 import os
+import re
+import zipfile
+import zlib
 
 import numpy as np
 
 from ..contract.errors import FileFormatError, ParameterError
 from ..contract.schema import contact_slots
-from .checks import TIME_LIMIT_S, Limits, check_snapshot, input_file, input_folder
+from .checks import TIME_LIMIT_S, UNIT_TOLERANCE, Limits, check_contacts, check_snapshot, check_step, input_file, \
+    input_folder
 
 __all__ = ["WALLS", "WALL_NORMALS", "peer_contacts", "wall_forces", "peer_snapshots", "open_peer", "open_box2d",
            "open_pymunk", "convert_peer"]
@@ -106,15 +110,54 @@ def wall_forces(contacts, n) -> np.ndarray:
 
 
 def _load(path, keys, what):
+    """The arrays of an ``.npz`` file; one line naming it when it lacks one of ``keys`` or
+    cannot be read (empty, truncated, damaged: an engine killed while writing it)."""
     path = input_file(path, what)
     try:
-        with np.load(path) as data:
+        with open(path, "rb") as fh, np.load(fh, allow_pickle=False) as data:
             missing = [k for k in keys if k not in data.files]
             if missing:
                 raise FileFormatError(f"{path}: not {what}: it lacks {', '.join(missing)}")
             return {k: data[k] for k in data.files}
-    except (OSError, ValueError) as exc:
-        raise FileFormatError(f"{path}: cannot be read as {what} ({exc})") from None
+    except (OSError, ValueError, EOFError, KeyError, zipfile.BadZipFile, zlib.error) as exc:
+        if os.path.getsize(path) == 0:
+            raise FileFormatError(f"{path}: an empty file, not {what} (an engine stopped while writing it?)") from None
+        raise FileFormatError(f"{path}: cannot be read as {what}: a truncated or damaged .npz ({exc})") from None
+
+
+def _snapshot_files(raw_dir):
+    """The raw snapshots ``snap_000000.npz``, ``snap_000001.npz``, ... of a folder, in order; one
+    line when there are none or one is missing between two others."""
+    found = {}
+    for path in glob.glob(os.path.join(raw_dir, "snap_*.npz")):
+        match = re.fullmatch(r"snap_(\d+)\.npz", os.path.basename(path))
+        if match:
+            found[int(match.group(1))] = path
+    if not found:
+        raise FileFormatError(f"{raw_dir}: no raw snapshots (snap_*.npz): did the engine run?")
+    missing = sorted(set(range(max(found) + 1)) - set(found))
+    if missing:
+        raise FileFormatError(f"{raw_dir}: no snap_{missing[0]:06d}.npz, but snapshots up to snap_{max(found):06d}.npz; "
+                              "expected the raw snapshots numbered from 0 without a gap")
+    return [found[k] for k in sorted(found)]
+
+
+_SHAPES = {"time": (), "step": (), "position": ("N", 2), "angle": ("N",), "velocity": ("N", 2),
+           "angular_velocity": ("N",), "wall_position": (4, 2), "wall_velocity": (4, 2), "a": ("M",), "b": ("M",),
+           "normal": ("M", 2), "force": ("M", 2), "n_points": ("M",), "points": ("M", 2, 2), "point_fn": ("M", 2)}
+"""The shape of each array of a raw snapshot: N particles, M contacts."""
+
+
+def _check_shapes(raw, n, path):
+    """One line for an array of a raw snapshot whose shape is not its format's."""
+    sizes = {"N": n, "M": np.shape(raw["a"])[0] if np.ndim(raw["a"]) == 1 else -1}
+    for name, shape in _SHAPES.items():
+        expected = tuple(sizes.get(d, d) for d in shape)
+        found = np.shape(raw[name])
+        if found != expected and not (shape == () and found == (1,)):
+            words = "x".join(str(d) for d in shape) or "a scalar"
+            raise FileFormatError(f"{path}: {name} of shape {found}; expected {words} ({n} particles, "
+                                  f"{sizes['M']} contacts)")
 
 
 def peer_snapshots(raw_dir, sample, engine=None):
@@ -145,14 +188,19 @@ def peer_snapshots(raw_dir, sample, engine=None):
         snapshot lacking arrays, a snapshot whose particle count differs from the sample's.
     """
     raw_dir = input_folder(raw_dir, "a peer engine's folder of raw snapshots (snap_*.npz and meta.json)")
-    files = sorted(glob.glob(os.path.join(raw_dir, "snap_*.npz")))
-    if not files:
-        raise FileFormatError(f"{raw_dir}: no raw snapshots (snap_*.npz): did the engine run?")
+    files = _snapshot_files(raw_dir)
     try:
         with open(os.path.join(raw_dir, "meta.json")) as fh:
             meta = json.load(fh)
     except (OSError, ValueError) as exc:
         raise FileFormatError(f"{raw_dir}: no readable meta.json ({exc})") from None
+    if not isinstance(meta, dict):
+        raise FileFormatError(f"{os.path.join(raw_dir, 'meta.json')}: a JSON {type(meta).__name__}; expected an "
+                              "object of the engine's settings ({\"engine\": ..., \"snapshots\": ...})")
+    announced = meta.get("snapshots")
+    if isinstance(announced, int) and not isinstance(announced, bool) and announced != len(files):
+        raise FileFormatError(f"{raw_dir}: {len(files)} raw snapshots (snap_*.npz), but meta.json announces "
+                              f"{announced}")
     if engine is not None and meta.get("engine") != engine:
         raise ParameterError(f"{raw_dir}: written by {meta.get('engine')!r}, not {engine!r}")
     data = _load(sample, SAMPLE_KEYS, "a cross-check sample")
@@ -160,7 +208,7 @@ def peer_snapshots(raw_dir, sample, engine=None):
     n = radius.size
     dt = float(data["time_step"])
     sample = os.fspath(sample)
-    limits = Limits(radius, 1.0, sample, mass=data["mass"], inertia=data["inertia"])
+    limits = Limits(radius, 1.0, sample, mass=data["mass"], inertia=data["inertia"], n_vertices=data["n_vertices"])
     if not (math.isfinite(dt) and 0 < dt <= TIME_LIMIT_S):
         raise FileFormatError(f"{sample}: time_step = {dt:.6g}; expected a finite time step > 0 in s")
     attrs = {f"engine_{k}": v for k, v in meta.items() if isinstance(v, (str, int, float))}
@@ -177,10 +225,14 @@ def peer_snapshots(raw_dir, sample, engine=None):
     def snapshots():
         for path in files:
             raw = _load(path, SNAPSHOT_KEYS, "a raw snapshot of the cross-check")
-            if len(raw["position"]) != n:
+            if np.ndim(raw["position"]) != 2 or len(raw["position"]) != n:
                 raise FileFormatError(f"{path}: {len(raw['position'])} particles, the sample has {n}")
+            _check_shapes(raw, n, path)
             _check_raw(limits, raw, path)
+            check_step(int(raw["step"]), path)
             contacts = peer_contacts(raw, raw["position"], dt)
+            check_contacts(limits, raw["position"], contacts, path,
+                           lambda k: f"particle {k}" if k < n else f"the {WALLS[k - n]} wall")
             normal_impulse = contacts.pop("normal_impulse")
             walls = raw["wall_position"]
             yield dict(time=float(raw["time"]), position=raw["position"], angle=raw["angle"], contacts=contacts,
@@ -209,6 +261,31 @@ def _check_raw(limits, raw, path):
         limits.check(values, name, kind, path, rows=rows, centre=middle if kind == "position" else None)
     a, b, count = (np.asarray(raw[key], float) for key in ("a", "b", "n_points"))
     limits.check(np.column_stack([a, b, count]), ("a", "b", "n_points"), "number", path, rows=contact)
+    n = limits.radius.size
+    step = float(np.asarray(raw["step"], float).reshape(-1)[0])
+    if not (np.isfinite(step) and step == round(step) and step >= 0):
+        raise FileFormatError(f"{path}: step = {step:g}; expected a whole number >= 0")
+    for name, values in (("a", a), ("b", b)):
+        bad = (values != np.round(values)) | (values < 0) | (values >= n + len(WALLS))
+        if bad.any():
+            k = int(np.flatnonzero(bad)[0])
+            raise FileFormatError(f"{path}: contact {k}: {name} = {values[k]:g}; expected a body index, a particle 0 .. "
+                                  f"{n - 1} or a wall {n} .. {n + len(WALLS) - 1}")
+    bad = (a == b) | ((a >= n) & (b >= n))
+    if bad.any():
+        k = int(np.flatnonzero(bad)[0])
+        raise FileFormatError(f"{path}: contact {k} of bodies {a[k]:g} and {b[k]:g}; expected a particle and another "
+                              "body")
+    bad = (count != 1) & (count != 2)
+    if bad.any():
+        k = int(np.flatnonzero(bad)[0])
+        raise FileFormatError(f"{path}: contact {k}: n_points = {count[k]:g}; expected 1 or 2 (the points of the "
+                              "engine's contact manifold)")
+    length = np.hypot(*np.asarray(raw["normal"], float).reshape(-1, 2).T)
+    bad = np.abs(length - 1) > UNIT_TOLERANCE
+    if bad.any():
+        k = int(np.flatnonzero(bad)[0])
+        raise FileFormatError(f"{path}: contact {k}: normal of length {length[k]:.6g}; expected a unit vector")
     present = np.arange(2)[None, :] < count[:, None]
     limits.check(np.where(present, raw["point_fn"], 0.0), "point_fn", "force", path, rows=contact)
     points = np.where(present[..., None], raw["points"], middle)
@@ -264,7 +341,8 @@ def convert_peer(out, raw_dir, sample, *, engine=None, attrs=None, extra=None, o
     """
     from .convert import chain_first, check_out, write_snapshots
 
-    out = check_out(out, overwrite)
+    inputs = sorted(glob.glob(os.path.join(os.fspath(raw_dir), "*"))) + [os.fspath(sample)]
+    out = check_out(out, overwrite, inputs)
     static, stream = peer_snapshots(raw_dir, sample, engine)
     if extra is not None:  # each snapshot's extra variables, computed once
         stream = (dict(snap, **extra(snap["raw"])) for snap in stream)
@@ -282,4 +360,4 @@ def convert_peer(out, raw_dir, sample, *, engine=None, attrs=None, extra=None, o
         return dict(snap, normal_impulse=impulse)
 
     return write_snapshots(out, static, chain_first(first, stream), OPTIONAL + more, overwrite=overwrite,
-                           compress=compress, label="peer", prepare=prepare)
+                           compress=compress, label="peer", prepare=prepare, inputs=inputs)

@@ -57,7 +57,7 @@ import warnings
 import numpy as np
 
 from ..contract.errors import FileFormatError, ParameterError
-from .checks import Limits, input_file
+from .checks import Limits, check_contacts, input_file
 
 __all__ = ["pegs_snapshots", "open_pegs", "convert_pegs", "read_adjacency", "read_positions", "WALL_NAMES",
            "EDGE_WALLS"]
@@ -307,9 +307,11 @@ def pegs_snapshots(adjacency, positions, *, metres_per_pixel=None, force_unit_n=
             position = np.column_stack([px[:, 0] * scale, (y0 - px[:, 1]) * scale])
             r_frame = np.zeros(n)
             r_frame[order] = rows[:, 4] * scale
-            contacts, wall_force, tensile = _frame_contacts(
-                adj[adj[:, 0] == frame], index, position, radius, edge, force_scale, f"{adjacency_paths[0]}: frame "
-                f"{frame}")
+            where = f"{adjacency_paths[0]}: frame {frame}"
+            contacts, wall_force, tensile = _frame_contacts(adj[adj[:, 0] == frame], index, position, radius, edge,
+                                                            force_scale, where)
+            check_contacts(limits, position, contacts, where,
+                           lambda k: f"id {ids[k]}" if k < n else f"the {WALL_NAMES[k - n]} wall")
             yield dict(time=float(frame) * interval, position=position, angle=np.zeros(n), contacts=contacts,
                        box_min=(position - r_frame[:, None]).min(axis=0),
                        box_max=(position + r_frame[:, None]).max(axis=0), wall_force=wall_force, tensile=tensile)
@@ -351,6 +353,9 @@ def _frame_contacts(rows, index, position, radius, edge, force_scale, where):
             tensile += 1
             continue
         branch = position[j] - position[i]
+        if not np.hypot(*branch) > 0:
+            raise FileFormatError(f"{where}: a contact of two particles at one centre (indices {i} and {j}); expected "
+                                  "disks apart")
         normal = branch / np.hypot(*branch)
         out["i"].append(i)
         out["j"].append(j)
@@ -434,7 +439,9 @@ def convert_pegs(out, adjacency, positions, *, metres_per_pixel=None, force_unit
     """
     from .convert import check_out, write_snapshots
 
-    out = check_out(out, overwrite)
+    inputs = [path for paths in (adjacency, positions) for path in
+              ([paths] if isinstance(paths, (str, os.PathLike)) else list(paths or ()))]
+    out = check_out(out, overwrite, inputs)
     static, stream = pegs_snapshots(adjacency, positions, metres_per_pixel=metres_per_pixel,
                                     force_unit_n=force_unit_n, frame_interval_s=frame_interval_s,
                                     thickness_m=thickness_m, density_kg_m3=density_kg_m3)
@@ -445,6 +452,6 @@ def convert_pegs(out, adjacency, positions, *, metres_per_pixel=None, force_unit
         return snap
 
     count = write_snapshots(out, static, stream, ("wall_force",), overwrite=overwrite, compress=compress,
-                            progress=progress, label="pegs", prepare=prepare)
+                            progress=progress, label="pegs", prepare=prepare, inputs=inputs)
     _report(sum(tensile), count)
     return count

@@ -18,8 +18,8 @@ from grainview.app.cli import main
 from grainview.contract.errors import FileFormatError
 from grainview.formats.lammps import open_lammps
 
-from .test_format_bad_values import (LAMMPS, MERCURY, _converts, _lammps, _lammps_argv, _lmgc90, _lmgc90_argv, _mercury,
-                                     _mercury_argv, _refused, _set)
+from .test_format_bad_values import (LAMMPS, MERCURY, PEERS, _converts, _lammps, _lammps_argv, _lmgc90, _lmgc90_argv,
+                                     _mercury, _mercury_argv, _peer, _pegs, _pegs_argv, _refused, _set)
 
 
 # --- LAMMPS -------------------------------------------------------------------------------------
@@ -489,3 +489,105 @@ def test_lmgc90_refuses_a_step_the_contract_cannot_hold(tmp_path, capsys):
     line = _refused(_lmgc90_argv(folder, out), capsys, out)
     assert line.startswith(f"grainview: error: {folder / 'OUTBOX/DOF.OUT.4'}: step = 2147483648; expected an integer "
                            "from 0 to 2147483647"), line
+
+
+# --- PeGS2 --------------------------------------------------------------------------------------
+
+def test_pegs_refuses_a_contact_of_disks_far_apart(tmp_path, capsys):
+    """A row joining disks 1 and 2, five diameters apart, was stored as a contact."""
+    adjacency, positions = _pegs(tmp_path, adjacency=lambda t: t + "1,1,2,0.001,0.05\n")
+    out = tmp_path / "run.nc"
+    line = _refused(_pegs_argv(adjacency, positions, out), capsys, out)
+    assert line.startswith(f"grainview: error: {adjacency}: frame 1: the contact of id 1 and id 2: the centres are "
+                           "0.0242"), line
+    assert "expected bodies that touch (centres at most the sum of the radii and 0.5 of the smaller radius apart)" \
+        in line
+
+
+# --- Box2D and pymunk ---------------------------------------------------------------------------
+
+def _peer_argv(folder, out):
+    return ["convert", "box2d", folder, "--sample", PEERS / "sample.npz", "--out", out]
+
+
+def _spoil(name, value, index=0):
+    def edit(arrays):
+        array = np.asarray(arrays[name]).copy()
+        if array.ndim == 0 or np.shape(value) == array.shape and np.ndim(value):
+            arrays[name] = np.asarray(value, array.dtype if np.ndim(value) == array.ndim else float)
+        else:
+            array = array.astype(np.result_type(array, np.asarray(value)))
+            array.flat[index] = value
+            arrays[name] = array
+    return edit
+
+
+@pytest.mark.parametrize("edit, message", [
+    (_spoil("b", 99), "contact 0: b = 99; expected a body index, a particle 0 .. 29 or a wall 30 .. 33"),
+    (_spoil("b", 1.5), "contact 0: b = 1.5; expected a body index"),
+    (_spoil("n_points", 0), "contact 0: n_points = 0; expected 1 or 2 (the points of the engine's contact manifold)"),
+    (_spoil("n_points", 3), "contact 0: n_points = 3; expected 1 or 2"),
+    (lambda arrays: arrays["normal"].__setitem__(0, [0.6, 0.6]), "contact 0: normal of length 0.848528; expected a "
+                                                                 "unit vector"),
+    (lambda arrays: arrays.update(time=np.array([0.0, 1.0])), "time of shape (2,); expected a scalar"),
+    (lambda arrays: arrays.update(step=np.array(2**31)), "step = 2147483648; expected an integer from 0 to "
+                                                         "2147483647"),
+])
+def test_the_peers_reader_refuses_a_raw_snapshot_it_cannot_read(tmp_path, capsys, edit, message):
+    """An index beyond the bodies raised IndexError, a shape other than the format's TypeError,
+    n_points = 0 numpy's divide warning and n_points = 3 'points = nan'; a body index of 1.5
+    was cut to 1, a normal of length 2 renormalised; a step beyond 2^31 - 1 OverflowError in
+    the writer."""
+    folder = _peer(tmp_path, edit)
+    out = tmp_path / "run.nc"
+    line = _refused(_peer_argv(folder, out), capsys, out)
+    assert line.startswith(f"grainview: error: {folder / 'snap_000003.npz'}: {message}"), line
+
+
+def test_the_peers_reader_refuses_a_wall_contact_point_off_the_particle(tmp_path, capsys):
+    """A wall contact's points moved 0.5 m gave a branch of 0.48 m (ten grain sizes)."""
+    def move(arrays):
+        k = int(np.flatnonzero(arrays["b"] >= 30)[0])
+        arrays["points"] = arrays["points"].copy()
+        arrays["points"][k] += 0.5
+
+    folder = _peer(tmp_path, move)
+    out = tmp_path / "run.nc"
+    line = _refused(_peer_argv(folder, out), capsys, out)
+    assert re.match(rf"grainview: error: {re.escape(str(folder / 'snap_000003.npz'))}: the contact of particle \d+ "
+                    r"and the \w+ wall: the contact point is 0\.\d+ m from the centre of particle", line), line
+
+
+@pytest.mark.parametrize("damage, message", [
+    (lambda path: path.write_bytes(b""), "an empty file, not a raw snapshot of the cross-check (an engine stopped "
+                                          "while writing it?)"),
+    (lambda path: path.write_bytes(path.read_bytes()[:4000]), "cannot be read as a raw snapshot of the cross-check: "
+                                                               "a truncated or damaged .npz"),
+    (lambda path: path.write_bytes((lambda b: b[:600] + bytes([b[600] ^ 0xFF]) + b[601:])(path.read_bytes())),
+     "cannot be read as a raw snapshot of the cross-check: a truncated or damaged .npz"),
+])
+def test_the_peers_reader_names_a_damaged_snapshot(tmp_path, capsys, damage, message):
+    """An empty, a truncated and a corrupted snapshot raised EOFError and BadZipFile (with a
+    ResourceWarning for the file left open)."""
+    folder = _peer(tmp_path)
+    damage(folder / "snap_000003.npz")
+    out = tmp_path / "run.nc"
+    line = _refused(_peer_argv(folder, out), capsys, out)
+    assert line.startswith(f"grainview: error: {folder / 'snap_000003.npz'}: {message}"), line
+
+
+def test_the_peers_reader_refuses_a_folder_missing_a_snapshot_or_a_meta_that_is_not_an_object(tmp_path, capsys):
+    """A missing middle snapshot was skipped (5 of the 6 meta.json announces); a meta.json
+    holding a list raised AttributeError."""
+    folder = _peer(tmp_path)
+    (folder / "snap_000003.npz").unlink()
+    out = tmp_path / "run.nc"
+    line = _refused(_peer_argv(folder, out), capsys, out)
+    assert line == (f"grainview: error: {folder}: no snap_000003.npz, but snapshots up to snap_000005.npz; expected "
+                    "the raw snapshots numbered from 0 without a gap")
+    (folder / "snap_000005.npz").rename(folder / "snap_000003.npz")
+    line = _refused(_peer_argv(folder, out), capsys, out)
+    assert line == f"grainview: error: {folder}: 5 raw snapshots (snap_*.npz), but meta.json announces 6"
+    (folder / "meta.json").write_text("[1, 2]")
+    line = _refused(_peer_argv(folder, out), capsys, out)
+    assert line.startswith(f"grainview: error: {folder / 'meta.json'}: a JSON list; expected an object"), line
