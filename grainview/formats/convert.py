@@ -16,8 +16,10 @@ those whose process is gone (:func:`remove_dead_temporaries`).
 from __future__ import annotations
 
 import itertools
+import math
 import os
 import re
+import warnings
 
 import numpy as np
 
@@ -82,8 +84,11 @@ def snapshots_dataset(static, snaps, per_snapshot=(), **static_optional):
     from ..contract.schema import contact_slots
 
     limits = _limits(static)
+    empty = _EmptySnapshots(static)
     for k, snap in enumerate(snaps):
         check_snapshot(limits, snap, _where(static, k, snap))
+        empty.add(snap)
+    empty.warn()
     optional = {name: np.stack([s[name] for s in snaps]) for name in per_snapshot if all(name in s for s in snaps)}
     optional.update({name: value for name, value in static_optional.items() if value is not None})
     n = static["radius"].size
@@ -178,6 +183,7 @@ def _write(out, static, snapshots, optional, overwrite, compress, progress, labe
         stream = tqdm(stream, desc=f"{label} -> {os.path.basename(out)}", unit=" snapshots")
     n = np.asarray(static["radius"]).size
     limits = _limits(static)
+    empty = _EmptySnapshots(static)
     count = 0
     try:
         with SnapshotWriter.create(temporary, radius=static["radius"], mass=static["mass"], inertia=static["inertia"],
@@ -189,6 +195,7 @@ def _write(out, static, snapshots, optional, overwrite, compress, progress, labe
             for snap in stream:
                 snap = prepare(snap) if prepare is not None else snap
                 check_snapshot(limits, snap, _where(static, count, snap))
+                empty.add(snap)
                 writer.append(**snap)
                 count += 1
         if validate:
@@ -200,12 +207,42 @@ def _write(out, static, snapshots, optional, overwrite, compress, progress, labe
         if compress:
             compress_file(temporary)
         _move_into_place(temporary, out, overwrite)
+        empty.warn()
     finally:
         if progress:
             stream.close()
         if os.path.exists(temporary):
             os.remove(temporary)
     return count
+
+
+class _EmptySnapshots:
+    """The snapshots without a contact that follow one holding many (a quarter of the
+    particles' count, at least two): the mark a contact file cut between two entries leaves
+    where a code writes no end mark, reported in one warning. ``static["empty_explained"]``,
+    when given, holds the indices of snapshots whose emptiness the reader reports itself."""
+
+    def __init__(self, static):
+        self.source = _source(static)
+        self.explained = set(static.get("empty_explained") or ())
+        self.many = max(2, math.ceil(np.asarray(static["radius"]).size / 4))
+        self.previous, self.index, self.found = 0, 0, []
+
+    def add(self, snap):
+        count = len((snap.get("contacts") or {}).get("i", ()))
+        if count == 0 and self.previous >= self.many and self.index not in self.explained:
+            time = np.asarray(snap.get("time", np.nan), float).reshape(-1)[0]
+            self.found.append((self.index, time, self.previous))
+        self.previous, self.index = count, self.index + 1
+
+    def warn(self):
+        if not self.found:
+            return
+        shown = ", ".join(f"{k} (t = {t:.10g} s, after {m})" for k, t, m in self.found[:5])
+        more = f" and {len(self.found) - 5} more" if len(self.found) > 5 else ""
+        warnings.warn(f"{self.source}: {len(self.found)} snapshot(s) without a contact right after one with many: "
+                      f"snapshot {shown}{more}; written as they are (a contact file cut between two entries reads "
+                      "the same: check it)", UserWarning, stacklevel=3)
 
 
 def _limits(static) -> Limits:

@@ -285,7 +285,8 @@ def pegs_snapshots(adjacency, positions, *, metres_per_pixel=None, force_unit_n=
              "pegs_pairs": f"{int((fits == 2).sum())} particle pairs fitted on both disks, {int((fits == 1).sum())} on "
                            "one"}
     static = dict(radius=radius, mass=mass, inertia=0.5 * mass * radius**2, n_walls=len(WALL_NAMES),
-                  wall_names=list(WALL_NAMES), wall_normal=-_WALL_NORMALS, attrs=attrs)
+                  wall_names=list(WALL_NAMES), wall_normal=-_WALL_NORMALS, attrs=attrs,
+                  empty_explained=set(np.flatnonzero(~np.isin(frames, adj[:, 0].astype(np.int64))).tolist()))
     limits = Limits(radius, thickness, position_paths[0], mass=mass, names=lambda k: f"particle id {ids[k]}")
     limits.check(adj[:, 3:5], ("tangential force", "normal force"), "force", adjacency_paths[0], scale=force_scale,
                  rows=lambda k: f"frame {int(adj[k, 0])}, ids {int(adj[k, 1])} and {int(adj[k, 2])}")

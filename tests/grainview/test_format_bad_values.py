@@ -432,6 +432,7 @@ def test_pegs_notes_a_frame_without_contacts(tmp_path, capsys):
     stdout = _converts(_pegs_argv(adjacency, positions, out), capsys, out)
     assert (f"note: 1 frame(s) of {positions} (frame 2) have no row in {adjacency} and are written without "
             "contacts") in stdout.splitlines()
+    assert len([line for line in stdout.splitlines() if line.startswith("note: ")]) == 1, stdout  # said once
     assert grainview.open_dataset(out, chunks=None)["contact_count"].values[1] == 0
 
 

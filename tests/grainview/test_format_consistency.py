@@ -591,3 +591,17 @@ def test_the_peers_reader_refuses_a_folder_missing_a_snapshot_or_a_meta_that_is_
     (folder / "meta.json").write_text("[1, 2]")
     line = _refused(_peer_argv(folder, out), capsys, out)
     assert line.startswith(f"grainview: error: {folder / 'meta.json'}: a JSON list; expected an object"), line
+
+
+def test_a_snapshot_without_contacts_after_many_gets_a_note(tmp_path, capsys):
+    """A Vloc_Rloc.OUT cut just after its header (LMGC90 writes no end mark) gave its snapshot 0
+    contacts after 77, without a word."""
+    def cut(text):
+        return text[:text.index("$icdan")]
+
+    folder = _lmgc90(tmp_path, **{"OUTBOX/Vloc_Rloc.OUT.4": cut})
+    out = tmp_path / "run.nc"
+    stdout = _converts(_lmgc90_argv(folder, out), capsys, out)
+    assert ("note: the LMGC90 run: 1 snapshot(s) without a contact right after one with many: snapshot 3 (t = 5 s, "
+            "after 77); written as they are (a contact file cut between two entries reads the same: check it)") \
+        in stdout.splitlines(), stdout
