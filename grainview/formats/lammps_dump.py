@@ -30,6 +30,8 @@ import numpy as np
 from ..contract.errors import FileFormatError
 from .checks import input_file
 
+_BOM = "\ufffd" * 3
+"""A UTF-8 byte-order mark as the dump's ASCII reading sees it."""
 _LARGEST = 2**53
 """The largest step or row count read: floats hold integers exactly up to it."""
 
@@ -164,6 +166,9 @@ def iter_dump(path):
                 line = fh.readline()
                 continue
             where = f"snapshot {index}"
+            if fh.number == 1 and line.startswith(_BOM):
+                raise FileFormatError(f"{path}: line 1: a byte-order mark before 'ITEM: TIMESTEP' (an editor's; "
+                                      "LAMMPS writes none): save the dump without it")
             if not line.startswith("ITEM: TIMESTEP"):
                 raise FileFormatError(f"{path}: line {fh.number}: {where}: expected 'ITEM: TIMESTEP', found "
                                       f"{line.strip()[:60]!r} (not a LAMMPS text dump)")

@@ -125,6 +125,10 @@ def _lines(path):
         with open(path, encoding="ascii", errors="strict") as fh:
             return fh.read().splitlines()
     except UnicodeDecodeError:
+        with open(path, "rb") as fh:
+            if fh.read(3) == b"\xef\xbb\xbf":
+                raise FileFormatError(f"{path}: a byte-order mark at its start (an editor's; LMGC90 writes none): save "
+                                      "the file without it") from None
         raise FileFormatError(f"{path}: not a text file (an LMGC90 text file holds ASCII only)") from None
 
 

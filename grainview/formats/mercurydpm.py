@@ -108,8 +108,9 @@ def unit_scales(units) -> dict:
         if isinstance(units[key], bool) or not (math.isfinite(value) and value > 0):
             raise ParameterError(f"units: {key}={units[key]!r}: expected a finite number > 0")
         if not UNIT_RANGE[0] <= value <= UNIT_RANGE[1]:
+            unit = {"length": "m", "mass": "kg", "time": "s"}[key]
             raise ParameterError(f"units: {key}={units[key]!r}: expected the SI value of one unit of the run from "
-                                 f"{UNIT_RANGE[0]:g} to {UNIT_RANGE[1]:g} ({dict(length='m', mass='kg', time='s')[key]})")
+                                 f"{UNIT_RANGE[0]:g} to {UNIT_RANGE[1]:g} ({unit})")
         scales[key] = value
     L, M, T = scales["length"], scales["mass"], scales["time"]
     scales.update(velocity=L / T, force=M * L / T**2, inertia=M * L**2)

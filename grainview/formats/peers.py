@@ -137,8 +137,8 @@ def _snapshot_files(raw_dir):
         raise FileFormatError(f"{raw_dir}: no raw snapshots (snap_*.npz): did the engine run?")
     missing = sorted(set(range(max(found) + 1)) - set(found))
     if missing:
-        raise FileFormatError(f"{raw_dir}: no snap_{missing[0]:06d}.npz, but snapshots up to snap_{max(found):06d}.npz; "
-                              "expected the raw snapshots numbered from 0 without a gap")
+        raise FileFormatError(f"{raw_dir}: no snap_{missing[0]:06d}.npz, but snapshots up to "
+                              f"snap_{max(found):06d}.npz; expected the raw snapshots numbered from 0 without a gap")
     return [found[k] for k in sorted(found)]
 
 
@@ -269,8 +269,8 @@ def _check_raw(limits, raw, path):
         bad = (values != np.round(values)) | (values < 0) | (values >= n + len(WALLS))
         if bad.any():
             k = int(np.flatnonzero(bad)[0])
-            raise FileFormatError(f"{path}: contact {k}: {name} = {values[k]:g}; expected a body index, a particle 0 .. "
-                                  f"{n - 1} or a wall {n} .. {n + len(WALLS) - 1}")
+            raise FileFormatError(f"{path}: contact {k}: {name} = {values[k]:g}; expected a body index, a particle "
+                                  f"0 .. {n - 1} or a wall {n} .. {n + len(WALLS) - 1}")
     bad = (a == b) | ((a >= n) & (b >= n))
     if bad.any():
         k = int(np.flatnonzero(bad)[0])

@@ -64,6 +64,10 @@ __all__ = ["pegs_snapshots", "open_pegs", "convert_pegs", "read_adjacency", "rea
 
 WALL_NAMES = ("bottom", "right", "top", "left")
 """The walls of a PeGS2 experiment, in the contract's order (bodies N .. N + 3)."""
+ESTIMATES_APART = 10.0
+"""How many times apart the two normal forces fitted for one pair (one on each disk) may be
+before a note says so: real fits differ by a few times at most; a thousandfold difference is a
+failed fit or a unit slip, and their mean is not a measurement."""
 EDGE_WALLS = {2: 0, 1: 1, -2: 2, -1: 3}
 """PeGS2's edge flag -> index in :data:`WALL_NAMES` (2: the image's bottom, -2: its top)."""
 _WALL_NORMALS = np.array([[0.0, -1.0], [1.0, 0.0], [0.0, 1.0], [-1.0, 0.0]])
@@ -234,7 +238,8 @@ def pegs_snapshots(adjacency, positions, *, metres_per_pixel=None, force_unit_n=
     -------
     (static, iterator)
         As the other readers (:func:`grainview.formats.lammps.lammps_snapshots`); each
-        snapshot also gives ``tensile`` (the contacts left out).
+        snapshot also gives ``tensile`` (the contacts left out) and ``apart`` (the pairs whose
+        two estimates of the normal force differ more than :data:`ESTIMATES_APART`-fold).
 
     Raises
     ------
@@ -286,7 +291,7 @@ def pegs_snapshots(adjacency, positions, *, metres_per_pixel=None, force_unit_n=
                            "one"}
     static = dict(radius=radius, mass=mass, inertia=0.5 * mass * radius**2, n_walls=len(WALL_NAMES),
                   wall_names=list(WALL_NAMES), wall_normal=-_WALL_NORMALS, attrs=attrs,
-                  empty_explained=set(np.flatnonzero(~np.isin(frames, adj[:, 0].astype(np.int64))).tolist()))
+                  ids=ids, empty_explained=set(np.flatnonzero(~np.isin(frames, adj[:, 0].astype(np.int64))).tolist()))
     limits = Limits(radius, thickness, position_paths[0], mass=mass, names=lambda k: f"particle id {ids[k]}")
     limits.check(adj[:, 3:5], ("tangential force", "normal force"), "force", adjacency_paths[0], scale=force_scale,
                  rows=lambda k: f"frame {int(adj[k, 0])}, ids {int(adj[k, 1])} and {int(adj[k, 2])}")
@@ -309,13 +314,14 @@ def pegs_snapshots(adjacency, positions, *, metres_per_pixel=None, force_unit_n=
             r_frame = np.zeros(n)
             r_frame[order] = rows[:, 4] * scale
             where = f"{adjacency_paths[0]}: frame {frame}"
-            contacts, wall_force, tensile = _frame_contacts(adj[adj[:, 0] == frame], index, position, radius, edge,
-                                                            force_scale, where)
+            contacts, wall_force, tensile, apart = _frame_contacts(adj[adj[:, 0] == frame], index, position, radius,
+                                                                   edge, force_scale, where)
             check_contacts(limits, position, contacts, where,
                            lambda k: f"id {ids[k]}" if k < n else f"the {WALL_NAMES[k - n]} wall")
             yield dict(time=float(frame) * interval, position=position, angle=np.zeros(n), contacts=contacts,
                        box_min=(position - r_frame[:, None]).min(axis=0),
-                       box_max=(position + r_frame[:, None]).max(axis=0), wall_force=wall_force, tensile=tensile)
+                       box_max=(position + r_frame[:, None]).max(axis=0), wall_force=wall_force, tensile=tensile,
+                       apart=apart)
 
     return static, snapshots()
 
@@ -347,8 +353,12 @@ def _frame_contacts(rows, index, position, radius, edge, force_scale, where):
                                   "same disk")
         fitted[a] = (N, T)
     out = {k: [] for k in ("i", "j", "normal", "fn", "ft", "point", "branch")}
-    tensile = 0
+    tensile, apart = 0, []
     for (i, j), fitted in pairs.items():
+        if len(fitted) == 2:
+            on_i, on_j = fitted[i][0], fitted[j][0]
+            if min(on_i, on_j) > 0 and max(on_i, on_j) > ESTIMATES_APART * min(on_i, on_j):
+                apart.append((i, j, on_i, on_j))
         N, T = np.mean(list(fitted.values()), axis=0)
         if not N > 0:
             tensile += 1
@@ -393,13 +403,18 @@ def _frame_contacts(rows, index, position, radius, edge, force_scale, where):
     for k in ("normal", "point", "branch"):
         contacts[k] = contacts[k].reshape(-1, 2)
     contacts["kind"] = np.ones(contacts["i"].size, "i1")
-    return contacts, wall_force, tensile
+    return contacts, wall_force, tensile, apart
 
 
-def _report(tensile, count):
+def _report(tensile, count, apart=(), ids=None):
     if tensile:
         warnings.warn(f"{tensile} contact(s) over {count} frame(s) had a normal force that is not "
                       "compressive (a fit that failed) and were left out", UserWarning, stacklevel=3)
+    if apart:
+        i, j, a, b = apart[0]
+        warnings.warn(f"{len(apart)} particle pair(s) over {count} frame(s) were fitted on both disks with normal "
+                      f"forces more than {ESTIMATES_APART:g} times apart (e.g. ids {ids[i]} and {ids[j]}: {a:.6g} "
+                      f"fitted on id {ids[i]}, {b:.6g} on id {ids[j]}, in force units); the mean of the two is stored", UserWarning, stacklevel=3)
 
 
 def open_pegs(adjacency, positions, *, metres_per_pixel=None, force_unit_n=None, frame_interval_s=1.0,
@@ -421,7 +436,8 @@ def open_pegs(adjacency, positions, *, metres_per_pixel=None, force_unit_n=None,
                                     force_unit_n=force_unit_n, frame_interval_s=frame_interval_s,
                                     thickness_m=thickness_m, density_kg_m3=density_kg_m3)
     snaps = list(stream)
-    _report(sum(s["tensile"] for s in snaps), len(snaps))
+    _report(sum(s.pop("tensile") for s in snaps), len(snaps), [a for s in snaps for a in s.pop("apart")],
+            static["ids"])
     return snapshots_dataset(static, snaps, ("wall_force",), wall_normal=static["wall_normal"])
 
 
@@ -446,13 +462,14 @@ def convert_pegs(out, adjacency, positions, *, metres_per_pixel=None, force_unit
     static, stream = pegs_snapshots(adjacency, positions, metres_per_pixel=metres_per_pixel,
                                     force_unit_n=force_unit_n, frame_interval_s=frame_interval_s,
                                     thickness_m=thickness_m, density_kg_m3=density_kg_m3)
-    tensile = []
+    tensile, apart = [], []
 
     def prepare(snap):
         tensile.append(snap.pop("tensile"))
+        apart.extend(snap.pop("apart"))
         return snap
 
     count = write_snapshots(out, static, stream, ("wall_force",), overwrite=overwrite, compress=compress,
                             progress=progress, label="pegs", prepare=prepare, inputs=inputs)
-    _report(sum(tensile), count)
+    _report(sum(tensile), count, apart, static["ids"])
     return count

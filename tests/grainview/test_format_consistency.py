@@ -429,7 +429,8 @@ def test_lmgc90_refuses_a_body_that_bodies_dat_does_not_have(tmp_path, capsys):
     """A DOF.OUT block of a body BODIES.DAT does not define was ignored without a word."""
     def extra(text):
         match = _body_block(text, 1)
-        return text[:match.end()] + match.group(0).replace(" RBDY2        1\n", " RBDY2      999\n") + text[match.end():]
+        block = match.group(0).replace(" RBDY2        1\n", " RBDY2      999\n")
+        return text[:match.end()] + block + text[match.end():]
 
     folder = _lmgc90(tmp_path, **{"OUTBOX/DOF.OUT.3": extra})
     out = tmp_path / "run.nc"
@@ -478,8 +479,8 @@ def test_lmgc90_refuses_an_entry_whose_family_is_not_its_bodies(tmp_path, capsys
     out = tmp_path / "run.nc"
     line = _refused(_lmgc90_argv(folder, out), capsys, out)
     assert line == (f"grainview: error: {folder / 'OUTBOX/Vloc_Rloc.OUT.4'}: line 7: a DKDKx entry (a DISKx on a "
-                    "DISKx) on body 1, a POLYG, and body 12, a DISKx in BODIES.DAT (DISKx on DISKx in the entry): files "
-                    "of another run?")
+                    "DISKx) on body 1, a POLYG, and body 12, a DISKx in BODIES.DAT (DISKx on DISKx in the entry): "
+                    "files of another run?")
 
 
 def test_lmgc90_refuses_a_step_the_contract_cannot_hold(tmp_path, capsys):
@@ -605,3 +606,33 @@ def test_a_snapshot_without_contacts_after_many_gets_a_note(tmp_path, capsys):
     assert ("note: the LMGC90 run: 1 snapshot(s) without a contact right after one with many: snapshot 3 (t = 5 s, "
             "after 77); written as they are (a contact file cut between two entries reads the same: check it)") \
         in stdout.splitlines(), stdout
+
+
+def test_pegs_notes_two_estimates_of_a_force_far_apart(tmp_path, capsys):
+    """The two normal forces fitted for the pair of ids 12 and 3, one made a thousand times the
+    other, were averaged without a word."""
+    adjacency, positions = _pegs(tmp_path, adjacency=lambda t: t.replace(",0.00947452301345562\n",
+                                                                         ",9.47452301345562\n", 1))
+    out = tmp_path / "run.nc"
+    stdout = _converts(_pegs_argv(adjacency, positions, out), capsys, out)
+    assert ("note: 1 particle pair(s) over 1 frame(s) were fitted on both disks with normal forces more than 10 times "
+            "apart (e.g. ids 3 and 12: 0.00764624 fitted on id 3, 9.47452 on id 12, in force units); the mean of the "
+            "two is stored") \
+        in stdout.splitlines(), stdout
+
+
+def test_a_byte_order_mark_is_called_what_it_is(tmp_path, capsys):
+    """A dump or a BODIES.DAT saved with a byte-order mark was 'found '���ITEM: TIMESTEP'' and
+    'not a text file'."""
+    files = _lammps(tmp_path)
+    files["walls"].write_bytes(b"\xef\xbb\xbf" + files["walls"].read_bytes())
+    out = tmp_path / "run.nc"
+    line = _refused(_lammps_argv(files, out), capsys, out)
+    assert line == (f"grainview: error: {files['walls']}: line 1: a byte-order mark before 'ITEM: TIMESTEP' (an "
+                    "editor's; LAMMPS writes none): save the dump without it")
+    folder = _lmgc90(tmp_path)
+    bodies = folder / "DATBOX/BODIES.DAT"
+    bodies.write_bytes(b"\xef\xbb\xbf" + bodies.read_bytes())
+    line = _refused(_lmgc90_argv(folder, out), capsys, out)
+    assert line == (f"grainview: error: {bodies}: a byte-order mark at its start (an editor's; LMGC90 writes none): "
+                    "save the file without it")
