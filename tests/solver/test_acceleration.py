@@ -277,3 +277,5 @@ def test_block_sums_add_in_the_order_the_code_writes(n):
     size = acceleration._residual(a, b, xn, xt, fn, ft)
     assert np.array_equal(fn, a - c) and np.array_equal(ft, b - d) and np.array_equal(xn, a)
     assert size == acceleration._dot2(fn, fn, ft, ft)
+    e, f = rng.normal(size=(2, n)) * 10.0 ** rng.uniform(-6, 6, (2, n))
+    assert acceleration._dot2_pair(a, b, c, d, e, f) == (acceleration._dot2(a, c, b, d), acceleration._dot2(e, c, f, d))
