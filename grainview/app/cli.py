@@ -545,6 +545,18 @@ def _run(args) -> int:
     _check_output_file(args.out, args.overwrite)
     prep = _preparation(args, _shape_of(args.shape))
     _check_settings(args, prep)
+    from solver.engine import DEFAULT_ENGINE
+
+    if (args.engine or DEFAULT_ENGINE) == DEFAULT_ENGINE:
+        from solver.paper_size import machine_load
+
+        from .warmup import cold_shares
+
+        shares = cold_shares(["solver"])
+        line = _compile_line("run", shares, machine_load())
+        if line:
+            print(line, flush=True)
+            _compile_ahead("run", shares, _progress_flag(args))
     _simulate(prep, args.out, scene=args.scene, **_simulation_kwargs(args))
     return 0
 
@@ -754,24 +766,115 @@ def _study_sample(label, prep, path, state, checkpoint, *, test, near_contacts, 
     return path
 
 
-def _print_estimate(preps, tests, parameters, jobs):
-    """Print the expected steps and wall time of each stage of each sample, and of the study,
-    with where the costs come from (:func:`solver.paper_size.estimate`)."""
-    from solver.paper_size import estimate, hours
+def _print_estimate(preps, tests, parameters, jobs, shares=None, report=True, load=None):
+    """Print the expected wall time of the study: each stage of each sample on idle cores, with
+    where its cost comes from, the compiling (``shares``: :func:`grainview.app.warmup.cold_shares`
+    of a cold cache) and the report (``report``), the machine's load (``load``: (load average,
+    cores), default this machine's) and what it makes of them, and the whole
+    (:func:`solver.paper_size.study_estimate`)."""
+    from solver.paper_size import STUDY_TIME, hours, machine_load, study_estimate
     from solver.parameters import Parameters
 
     p = Parameters(**parameters)
-    totals = {}
-    for label, prep in preps.items():
-        stages = estimate(prep, tests[label], p.time_step, p.domains)
-        totals[label] = sum(stage[2] for stage in stages.values())
+    load, cores = machine_load() if load is None else load
+    shares = {group: share for group, (share, _) in (shares or {}).items() if share}
+    whole = study_estimate({label: (prep, tests[label]) for label, prep in preps.items()}, p.time_step,
+                           domains=p.domains, jobs=jobs, compile_share=shares, report=report, load=load, cores=cores)
+    for label, stages in whole["samples"].items():
         for stage, (steps, cost, seconds, source) in stages.items():
-            print(f"estimate: {label} ({prep.particles}), {stage}: ~{steps} steps x {cost:.3g} us per particle and "
-                  f"step = ~{hours(seconds)} ({source})", flush=True)
-    whole = max(totals.values()) if jobs > 1 else sum(totals.values())
-    print(f"estimate: the study ~{hours(whole)} of wall time ({'side by side' if jobs > 1 else 'one after the other'}"
-          f", {'serial sweeps' if p.domains <= 1 else f'{p.domains} domains'}), within a factor of about 2; a "
+            print(f"estimate: {label} ({preps[label].particles}), {stage}: ~{steps} steps x {cost:.3g} us per particle "
+                  f"and step = ~{hours(seconds)} ({source})", flush=True)
+    idle, factor, seconds = whole["idle"], whole["factor"], whole["seconds"]
+    extra = []
+    if idle["compile"]:
+        which = " and ".join(f"{100 * share:.0f}% of the {group}'s" for group, share in shares.items())
+        extra.append(f"compiling {which} kernels (not in numba's cache for this processor) ~{hours(idle['compile'])}")
+    if report:
+        extra.append(f"the report ~{hours(idle['report'])}")
+    if extra:
+        print(f"estimate: {', '.join(extra)}, on an idle core ({STUDY_TIME})", flush=True)
+    if factor["simulation"] > 1 or factor["compile"] > 1:
+        busy = "busy" if max(factor.values()) >= 1.5 else "lightly loaded"
+        print(f"estimate: this machine is {busy} (load {load:.1f} on {cores} cores): each stage takes longer than on "
+              f"idle cores, ~{factor['simulation']:.1f}x for the {whole['processes']} simulating process(es), "
+              f"~{factor['compile']:.1f}x for one process (compiling, the report)", flush=True)
+    else:
+        print(f"estimate: the cores are free (load {load:.1f} on {cores} cores): the times above hold as they are",
+              flush=True)
+    parts = [f"{name} ~{hours(seconds[key])}" for key, name in
+             (("compile", "compiling"), ("simulation", "the samples"), ("report", "the report")) if seconds[key]]
+    print(f"estimate: the study ~{hours(whole['total'])} of wall time ({', '.join(parts)}; "
+          f"{'side by side' if jobs > 1 else 'one after the other'}, "
+          f"{'serial sweeps' if p.domains <= 1 else f'{p.domains} domains'}), within a factor of about 2; a "
           "stopped or killed run resumes with the same command", flush=True)
+
+
+def _compile_line(command, shares, load) -> str:
+    """The line that says, before anything else, that the kernels are compiled first and for
+    about how long (``shares``: :func:`grainview.app.warmup.cold_shares`; ``load``: (load
+    average, cores)); "" on a warm cache."""
+    from solver.paper_size import COMPILE_SECONDS, hours, load_factor
+
+    seconds = sum(COMPILE_SECONDS[group] * share for group, (share, _) in shares.items())
+    if not seconds:
+        return ""
+    seconds *= load_factor(1, *load)
+    return (f"{command}: compiling the kernels, first run only, about {hours(seconds)} (grainview warmup does it ahead "
+            "of time)")
+
+
+def _compile_ahead(command, shares, progress):
+    """Compile, in this process and before any work, the kernels that ``shares``
+    (:func:`grainview.app.warmup.cold_shares`) names, with progress: a line per stage of the
+    warm-up's workload (:func:`grainview.app.warmup.warm_up`) with the kernels compiled so far,
+    and in a terminal a bar over the kernels (``progress``: the command line's flag, None:
+    auto), else a line a minute too. Ends with a line saying how long it took."""
+    from time import monotonic
+
+    from solver.paper_size import hours
+
+    from .warmup import GROUPS, warm_up
+
+    names = {name for _, found in shares.values() for name in found}
+    if not names:
+        return
+    packages = tuple(package for group in GROUPS for package in GROUPS[group]
+                     if group in shares and (group != "analysis" or shares[group][0]))
+    done, start = set(), monotonic()
+    bar = None
+    if (sys.stderr.isatty() if progress is None else progress is True):
+        from tqdm.std import tqdm
+
+        bar = tqdm(total=len(names), desc=f"{command}: compiling", unit="kernel", leave=False)
+
+    last = [start]
+
+    def compiled(name):
+        if name in names and name not in done:
+            done.add(name)
+            if bar is not None:
+                bar.update(1)
+            elif monotonic() - last[0] >= _SampleProgress.every:  # a log's line now and then
+                last[0] = monotonic()
+                print(f"{command}: compiling: {len(done)} of {len(names)} kernels, {hours(last[0] - start)}",
+                      flush=True)
+
+    def log(line):
+        last[0] = monotonic()
+        text = (f"{command}: compiling, stage {line}; {len(done)} of {len(names)} kernels so far, "
+                f"{hours(last[0] - start)}")
+        if bar is not None:
+            bar.write(text)
+        else:
+            print(text, flush=True)
+
+    try:
+        result = warm_up(log=log, packages=packages, compiled=compiled)
+    finally:
+        if bar is not None:
+            bar.close()
+    print(f"{command}: kernels compiled in {hours(monotonic() - start)} ({len(done)} compiled, the others loaded; "
+          f"cache: {result['cache']})", flush=True)
 
 
 def _study(args) -> int:
@@ -808,8 +911,22 @@ def _study(args) -> int:
                                   _expected_attrs(preps[label], tests[label], recorded), args.overwrite)
               for label in samples}
     out.mkdir(parents=True, exist_ok=True)
-    if any(state != "finished" for state in states.values()):
-        _print_estimate(preps, tests, parameters, args.jobs)
+    to_run = [label for label, state in states.items() if state != "finished"]
+    if to_run:
+        from solver.engine import DEFAULT_ENGINE
+        from solver.paper_size import machine_load
+
+        from .warmup import GROUPS, cold_shares
+
+        load = machine_load()
+        groups = [group for group in GROUPS if group != "solver" or (args.engine or DEFAULT_ENGINE) == DEFAULT_ENGINE]
+        shares = cold_shares(groups if not args.no_report else [g for g in groups if g == "solver"])
+        line = _compile_line("study", shares, load)
+        if line:
+            print(line, flush=True)
+        _print_estimate({label: preps[label] for label in to_run}, tests, parameters, args.jobs, shares,
+                        report=not args.no_report, load=load)
+        _compile_ahead("study", shares, _progress_flag(args))
     args.near_contacts = True  # the report counts near pairs as well (docs/fidelity.md)
     kwargs = _simulation_kwargs(args)
     kwargs.pop("test")
@@ -1190,11 +1307,16 @@ def _demo_parser(sub):
 
 
 def _warmup_parser(sub):
+    from solver.paper_size import COMPILE_SECONDS, STUDY_TIME, hours
+
+    cold = hours(sum(COMPILE_SECONDS.values()))
     warmup = sub.add_parser("warmup", help="compile every numba kernel into the cache, so that runs start at once",
                             description="Compile (or load) every numba kernel of the solver and the analysis into "
                             "numba's cache (NUMBA_CACHE_DIR when set, else __pycache__ beside the modules) with a "
-                            "tiny workload (seconds once warm, about a minute cold). A run on a cold cache spends "
-                            "its first step compiling, and acts on SIGTERM only after that step: warm the cache "
+                            f"tiny workload (seconds once warm; cold, about {cold} of processor time, the wall time "
+                            f"on an idle core, longer on a busy one: {STUDY_TIME}). grainview run and study do it "
+                            "first when the cache lacks their kernels; a batch job that runs the solver otherwise "
+                            "spends its first step compiling and acts on SIGTERM only after that step: warm the cache "
                             "once per installation, e.g. before submitting batch jobs (docs/solver.md).")
     warmup.set_defaults(func=_warmup)
 
