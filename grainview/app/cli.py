@@ -868,8 +868,11 @@ def _compile_ahead(command, shares, progress):
         else:
             print(text, flush=True)
 
+    from solver.interrupt import sigterm_raises
+
     try:
-        result = warm_up(log=log, packages=packages, compiled=compiled)
+        with sigterm_raises():  # nothing is written yet: SIGTERM stops the command at once, as Ctrl-C does
+            result = warm_up(log=log, packages=packages, compiled=compiled)
     finally:
         if bar is not None:
             bar.close()

@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import math
 import os
+import signal
 import subprocess
 import sys
 import textwrap
@@ -185,7 +186,11 @@ def test_on_a_cold_cache_the_first_line_comes_before_any_compiling(tmp_path, com
     try:
         first = proc.stdout.readline()
         compiled = list(cache.rglob("*.nbi")) if cache.exists() else []
-        second = proc.stdout.readline()
+        second = line = proc.stdout.readline()
+        while line and not line.startswith(f"{command[0]}: compiling, stage "):
+            line = proc.stdout.readline()
+        proc.send_signal(signal.SIGTERM)  # while compiling: stopped at once, as after a whole step
+        _, err = proc.communicate(timeout=300)
     finally:
         proc.kill()
         proc.communicate()
@@ -193,6 +198,7 @@ def test_on_a_cold_cache_the_first_line_comes_before_any_compiling(tmp_path, com
     assert first.rstrip().endswith("(grainview warmup does it ahead of time)")
     assert not compiled  # nothing compiled yet
     assert second.startswith(then)
+    assert proc.returncode == 143 and err.strip().splitlines()[-1] == "grainview: terminated (SIGTERM)"
 
 
 def test_a_resumed_test_sums_up_its_unconverged_steps_in_one_line(tmp_path, monkeypatch, capsys):
