@@ -113,6 +113,9 @@ SECTIONS = (
                    ("--domains", "1,2", "--skip", "200", "--steps", "200", "--repeats", "2")),
     Section("step-variants", "step_variants", "whole steps of every way of solving, each on its own trajectory",
             ("--build", "--particles", "1000", "--serial", "--steps", "3000")),
+    _shear_section("portable-sums", "portable_sums", "what the fixed-order (processor-independent) sums of the "
+                   "Anderson history cost against the reassociated ones of b3039cc: the kernels, whole steps and "
+                   "solves of the same problems", 2000, (), ("--quick",)),
     Section("contact-solvers", "contact_solvers", "the problem-level methods (nlgs, newton, pcg) on Siconos' and "
             "the stepper's problems", ()),
     Section("two-level", "two_level", "a two-level method (NLGS sweeps + an AMG V-cycle on the truncated face, "
