@@ -4,7 +4,7 @@ each of their lines appears.
 
     python -m benchmarks.study_time [--runs warmup-cold,warmup-warm,study-cold,study-warm,calibration]
                                     [--study-args "--jobs 1"] [--sources DIR --commit C]
-                                    [--cache DIR] [--out results/study-time.md]
+                                    [--cache DIR] [--pause 120] [--out results/study-time.md]
 
 Every run is a fresh process of the command line, timed from outside, with ``NUMBA_CACHE_DIR``
 set to a folder of its own: ``-cold`` runs start from an empty folder, ``-warm`` runs reuse the
@@ -45,6 +45,8 @@ ROOT = HERE.parent
 RUNS = ("warmup-cold", "warmup-warm", "study-cold", "study-warm", "calibration")
 """What can be measured: each command on an empty and on a filled cache, and the calibration: a
 ``--jobs 1`` study on a filled cache, whose stages' processor times are their costs."""
+PAUSE = 120.0
+"""Seconds between two runs: the 1-minute load average decays as exp(-t / 60 s)."""
 LOAD_EVERY = 5.0
 """Seconds between two samples of the load average."""
 ENTRY = "import sys; from grainview.app.cli import main; sys.exit(main())"
@@ -118,10 +120,12 @@ def timed(argv, env, cwd) -> dict:
             "load_mean": sum(loads) / len(loads), "rc": proc.returncode}
 
 
-def measure(runs, study_args, sources: Path, folder: Path, cache: Path | None = None) -> dict:
+def measure(runs, study_args, sources: Path, folder: Path, cache: Path | None = None, pause: float = 0.0) -> dict:
     """Each run of ``runs`` (names of :data:`RUNS`), in that order: {name: :func:`timed`'s dict};
     ``cache``: a filled cache folder of the same sources, copied for the warm runs that have no
-    cold run before them (instead of a ``grainview warmup`` into an empty one)."""
+    cold run before them (instead of a ``grainview warmup`` into an empty one); ``pause``:
+    seconds to wait before each run after the first, so that the load average at a run's start
+    (which the study's estimate reads) holds little of the previous run's own processes."""
     import shutil
 
     env = {**os.environ, "PYTHONPATH": str(sources)}
@@ -141,6 +145,8 @@ def measure(runs, study_args, sources: Path, folder: Path, cache: Path | None = 
                                                          *shlex.split(study_args)]
         if name == "calibration":
             argv += ["--jobs", "1"]
+        if results and pause:
+            time.sleep(pause)
         print(f"study_time: {name} ...", file=sys.stderr, flush=True)
         results[name] = timed(argv, {**env, "NUMBA_CACHE_DIR": str(cache_dir)}, folder)
         print(f"study_time: {name}: {results[name]['wall']:.0f} s (rc {results[name]['rc']})", file=sys.stderr,
@@ -191,6 +197,8 @@ def main(argv=None) -> int:
                         "its packages have uncommitted changes)")
     parser.add_argument("--cache", type=Path, help="a numba cache folder filled for --sources (e.g. by grainview "
                         "warmup), copied for the warm runs instead of warming an empty one first")
+    parser.add_argument("--pause", type=float, default=PAUSE, help=f"seconds to wait between runs (default {PAUSE:g}: "
+                        "the 1-minute load average then holds about a seventh of the previous run's processes)")
     parser.add_argument("--out", type=Path, help="markdown file to write (default: print)")
     args = parser.parse_args(argv)
     runs = [r.strip() for r in args.runs.split(",") if r.strip()]
@@ -205,7 +213,7 @@ def main(argv=None) -> int:
                                  text=True, cwd=ROOT).stdout.strip()
         commit += " with uncommitted changes" if changed else ""
     with tempfile.TemporaryDirectory(prefix="study-time-") as scratch:
-        results = measure(runs, args.study_args, args.sources.resolve(), Path(scratch), args.cache)
+        results = measure(runs, args.study_args, args.sources.resolve(), Path(scratch), args.cache, args.pause)
         text = table(results, args.study_args, commit)
     if args.out:
         args.out.write_text(text)

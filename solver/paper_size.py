@@ -93,37 +93,37 @@ kernels compiled, each stage's processor time."""
 COSTS = {
     ("pentagon", "compaction"): (
         # 2 domains not measured at 400: costed as serial
-        Cost(400, 7.3, 7.3, 4091, _AT_400),
+        Cost(400, 5.7, 5.7, 4091, _AT_400),
         # the 'paper' route with Anderson sweeps: 22,923 steps at 14,400 pentagons, 2.52 h serially, the time per
         # particle and step grown from the compactions measured at 1000 and 4000 (8.6 and 15.8 us) as N^0.43;
         # on 2 domains the 1.54x measured on the 4000-pentagon 'fast' route (benchmarks/results/compaction.md)
         Cost(14400, 27.5, 27.5 / 1.54, 22923,
              "benchmarks/archive/time-to-strain.md, 14,400 pentagons, 'paper' route, extrapolated from 1000 and 4000")),
     ("disk", "compaction"): (
-        Cost(400, 8.1, 8.1, 711, _AT_400),
+        Cost(400, 7.4, 7.4, 711, _AT_400),
         # disks settle in far fewer steps: 2001 measured at 14,400; the time per step as the pentagons'
         Cost(14400, 27.5, 27.5 / 1.54, 2001,
              "benchmarks/archive/time-to-strain.md, 14,400 disks: steps measured, time per step extrapolated")),
     ("pentagon", "test"): (
-        Cost(400, 11.4, 11.4, None, _AT_400),
+        Cost(400, 10.4, 10.4, None, _AT_400),
         # the first 0.01 of eps_q of a 14,400-pentagon shear, 6651 steps (2026-11-25, commit 80ed2db), where the
         # sweeps per step are the shear's highest (a 200-step window of benchmarks/RESULTS.md section a: 9.15 / 6.58)
         Cost(14400, 14.9, 7.1, None, "benchmarks/archive/time-to-strain.md, 14,400 pentagons sheared to eps_q = 0.01")),
     ("disk", "test"): (
-        Cost(400, 7.4, 7.4, None, _AT_400),
+        Cost(400, 6.1, 6.1, None, _AT_400),
         # 200 biaxial steps early in the shear of 14,400 dense disks
         Cost(14400, 4.05, 2.02, None, "benchmarks/RESULTS.md section a, 14,400 dense disks")),
 }
 """Measured microseconds per particle and step, by (shape, stage): a :class:`Cost` per measured
 size, smallest first."""
 
-COMPILE_SECONDS = {"solver": 69.0, "analysis": 17.0}
+COMPILE_SECONDS = {"solver": 60.0, "analysis": 15.0}
 """Seconds that compiling every kernel takes on an empty cache, in one process on a core with
 nothing else on it, by group (:data:`grainview.app.warmup.GROUPS`: the solver's kernels, what
 ``grainview run`` needs; the analysis's, what the report adds): the processor time of
-``grainview warmup``'s stages on an empty NUMBA_CACHE_DIR (:data:`STUDY_TIME`, warmup-cold)."""
+the study's compiling stages on an empty NUMBA_CACHE_DIR (:data:`STUDY_TIME`, study-cold)."""
 
-REPORT_SECONDS = (50.0, 800)
+REPORT_SECONDS = (34.0, 800)
 """(seconds, particles): the study's report of two 400-particle runs, its kernels compiled, on a
 core with nothing else on it: the processor time from the last sample's 'wrote' line to the end
 (:data:`STUDY_TIME`, calibration); costed in proportion to the particles of both runs, and

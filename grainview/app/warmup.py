@@ -37,10 +37,19 @@ SOLVER_PACKAGES = ("solver",)
 GROUPS = {"solver": SOLVER_PACKAGES, "analysis": ("grainview.analysis._kernels",)}
 """The kernels by what needs them: a simulation the solver's, a report the analysis's too (the
 keys of :data:`solver.paper_size.COMPILE_SECONDS`)."""
-RESEARCH_MODULES = ("solver.two_level",)
-"""Modules whose kernels no run or analysis calls (research methods outside the stepper's
-registry, measured by benchmarks/two_level.py): the warm-up's workload does not compile them
-and :func:`cache_state` leaves them out."""
+NOT_IN_RUNS = ("solver.two_level", "solver.body_admm", "solver.residuals.local_law_residuals")
+"""Kernels that no run, study or report calls, by module or by name: the research methods
+outside the stepper's registry (matrix-form solvers of captured problems, measured by
+benchmarks/two_level.py and benchmarks/body_admm.py) and a public helper of the residuals that
+only a user's own code calls. The warm-up's workload does not compile them and
+:func:`cache_state` leaves them out (tests/grainview/test_study_time.py checks that after a
+warm-up no other kernel is missing from the cache)."""
+
+
+def _in_runs(name) -> bool:
+    """Whether the kernel "module.name" is one a run, a study or a report may call (not one of
+    :data:`NOT_IN_RUNS`)."""
+    return name not in NOT_IN_RUNS and name.rpartition(".")[0] not in NOT_IN_RUNS
 
 
 def cache_location() -> str:
@@ -111,7 +120,7 @@ def cache_holds(dispatcher) -> bool | None:
 
 def cache_state(packages=PACKAGES) -> dict:
     """Which kernels of ``packages`` a process would compile before it runs (:func:`cache_holds`),
-    :data:`RESEARCH_MODULES`' left out.
+    :data:`NOT_IN_RUNS`' left out.
 
     Parameters
     ----------
@@ -126,7 +135,7 @@ def cache_state(packages=PACKAGES) -> dict:
         "unknown": [names of those whose state could not be read]}``; the cache is warm when
         both lists are empty.
     """
-    found = {name: d for name, d in kernels(packages).items() if name.rpartition(".")[0] not in RESEARCH_MODULES}
+    found = {name: d for name, d in kernels(packages).items() if _in_runs(name)}
     state = {name: cache_holds(d) for name, d in found.items()}
     return {"kernels": len(found), "cold": [n for n, held in state.items() if held is False],
             "unknown": [n for n, held in state.items() if held is None]}
@@ -260,7 +269,7 @@ def warm_up(log=print, packages=PACKAGES, compiled=None) -> dict:
     -------
     dict
         ``{"kernels": number of kernels, "compiled": kernels with a compiled version,
-        "missing": [names of the others, :data:`RESEARCH_MODULES`' left out], "cache":
+        "missing": [names of the others, :data:`NOT_IN_RUNS`' left out], "cache":
         cache_location()}``.
     """
     from ..contract.errors import ConvergenceWarning
@@ -274,7 +283,7 @@ def warm_up(log=print, packages=PACKAGES, compiled=None) -> dict:
         for k, (what, run) in enumerate(stages, 1):
             log(f"[{k}/{len(stages)}] {what}")
             run()
-    found = {name: d for name, d in kernels(packages).items() if name.rpartition(".")[0] not in RESEARCH_MODULES}
+    found = {name: d for name, d in kernels(packages).items() if _in_runs(name)}
     missing = [name for name, dispatcher in found.items() if not dispatcher.signatures]
     return {"kernels": len(found), "compiled": len(found) - len(missing), "missing": missing,
             "cache": cache_location()}
