@@ -14,6 +14,7 @@ import numpy as np
 from .errors import ParameterError
 from .schema import (CONTACT_VARIABLES, DEFAULT_WALL_NAMES, OPTIONAL_CONTACT_VARIABLES, TIME_ATTRS, VARIABLES,
                      XY, contact_slots, empty_slots, global_attrs, variable_attrs)
+from .cell import CELL_VECTORS, minimum_image, restricted_cell, wrap
 from .shapes import has_irregular_polygons, inertia_per_mass, particle_area, shape_problems
 
 if TYPE_CHECKING:
@@ -22,9 +23,11 @@ if TYPE_CHECKING:
 __all__ = ["make_dataset", "netcdf_encoding", "netcdf_options"]
 
 
-def _coords(times, n_walls, wall_names):
+def _coords(times, n_walls, wall_names, cell=False):
     coords = {"time": ("time", np.asarray(times, dtype="f8"), dict(TIME_ATTRS)),
               "xy": ("xy", np.array(XY), {"long_name": "Cartesian component"})}
+    if cell:
+        coords["cell_vector"] = ("cell_vector", np.array(CELL_VECTORS), {"long_name": "lattice vector of the cell"})
     if n_walls:
         names = tuple(wall_names) if wall_names is not None else DEFAULT_WALL_NAMES[:n_walls]
         if len(names) != n_walls:
@@ -66,7 +69,7 @@ def make_dataset(
         T dicts with keys ``i, j, kind, normal, fn, ft`` and optionally ``point``, ``branch``
         and ``gap`` (one entry per contact; a double contact is one entry; forces in N, ``gap``
         in m, given for every snapshot or none). ``branch`` defaults to ``x_j - x_i`` for
-        particle pairs; ``point`` defaults to the point on the segment i-j at distance ``r_i``
+        particle pairs (its minimum image in a periodic cell); ``point`` defaults to the point on the segment i-j at distance ``r_i``
         from i (exact for disks). For wall contacts (``j >= N``) both ``point`` and ``branch``
         must be given.
     box_min, box_max : array_like, (T, 2) or (2,)
@@ -89,7 +92,12 @@ def make_dataset(
     n_contact_slots : int, optional
         Size of the ``contact`` dimension (default: :func:`grainview.contract.schema.contact_slots`).
     **optional
-        Any optional contract variable (``velocity``, ``wall_force``, ``step``...).
+        Any optional contract variable (``velocity``, ``wall_force``, ``step``...). A periodic
+        sample gives ``periodic`` (2,) (1 where it repeats along the cell vector a, b) and
+        ``cell`` (T, 2, 2) or (2, 2), its lattice vectors (m, :mod:`grainview.contract.cell`),
+        or ``cell=None`` for the rectangular cell of the box; the global attribute
+        ``cell_positions`` says whether the positions are ``wrapped`` into the cell (the default
+        when they all are) or ``unwrapped``.
 
     Returns
     -------
@@ -122,6 +130,22 @@ def make_dataset(
     inertia = mass * inertia_per_mass(radius, n_vertices, optional.get("vertices")) if inertia is None else np.broadcast_to(np.asarray(inertia, "f8"), (n,))
     angle = np.zeros((t, n)) if angle is None else np.broadcast_to(np.asarray(angle, "f8"), (t, n))
     slots = n_contact_slots or contact_slots(n, n_walls)
+    box_min = np.broadcast_to(np.asarray(box_min, "f8"), (t, 2))
+    box_max = np.broadcast_to(np.asarray(box_max, "f8"), (t, 2))
+    periodic = optional.get("periodic")
+    if "cell" in optional and periodic is None:
+        raise ParameterError("cell given without periodic: say along which cell vectors (a, b) the sample repeats")
+    if periodic is not None:
+        periodic = np.asarray(periodic, "i1")
+        cell = optional.get("cell")
+        cell = restricted_cell(box_min, box_max) if cell is None else np.broadcast_to(np.asarray(cell, "f8"),
+                                                                                      (t, 2, 2))
+        optional = {**optional, "cell": cell, "periodic": periodic}
+        attrs = dict(attrs or {})
+        if "cell_positions" not in attrs:
+            inside = np.allclose(wrap(position, box_min[:, None], cell[:, None], periodic), position, rtol=0,
+                                 atol=1e-12 * float(np.abs(box_max - box_min).max()))
+            attrs["cell_positions"] = "wrapped" if inside else "unwrapped"
 
     names = CONTACT_VARIABLES + tuple(v for v in OPTIONAL_CONTACT_VARIABLES if contacts and v in contacts[0])
     data = {name: empty_slots((t, slots) + ((2,) if VARIABLES[name].dims[-1] == "xy" else ()), name)
@@ -151,7 +175,8 @@ def make_dataset(
         else:
             if wall.any():
                 raise ParameterError("wall contacts need an explicit 'branch' (particle centre to contact point)")
-            data["branch"][k, :m] = position[k, j] - position[k, i]
+            d = position[k, j] - position[k, i]
+            data["branch"][k, :m] = d if periodic is None else minimum_image(d, optional["cell"][k], periodic)
         if "point" in snap:
             data["point"][k, :m] = np.asarray(snap["point"], "f8").reshape(m, 2)
         else:
@@ -159,8 +184,6 @@ def make_dataset(
                 raise ParameterError("wall contacts need an explicit 'point'")
             data["point"][k, :m] = position[k, i] + radius[i, None] * normal
 
-    box_min = np.broadcast_to(np.asarray(box_min, "f8"), (t, 2))
-    box_max = np.broadcast_to(np.asarray(box_max, "f8"), (t, 2))
     arrays = {
         "radius": radius, "n_vertices": n_vertices, "mass": mass, "inertia": inertia,
         "position": position, "angle": angle, "contact_count": count, **data,
@@ -177,8 +200,10 @@ def make_dataset(
         variables[name] = (var.dims, np.asarray(value).astype(var.dtype, copy=False), variable_attrs(name))
     import xarray as xr
 
-    ds = xr.Dataset(variables, coords=_coords(np.arange(t, dtype="f8") if time is None else time, n_walls, wall_names))
-    ds.attrs = global_attrs(n, n_walls, attrs, has_irregular_polygons(radius, n_vertices, optional.get("vertices")))
+    ds = xr.Dataset(variables, coords=_coords(np.arange(t, dtype="f8") if time is None else time, n_walls, wall_names,
+                                              periodic is not None))
+    ds.attrs = global_attrs(n, n_walls, attrs, has_irregular_polygons(radius, n_vertices, optional.get("vertices")),
+                            periodic is not None)
     return ds
 
 

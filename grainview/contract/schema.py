@@ -26,21 +26,31 @@ from dataclasses import dataclass
 
 import numpy as np
 
-SCHEMA_VERSION = "2.0"
+SCHEMA_VERSION = "3.0"
 """The newest version of the contract: this grainview reads files up to its major number and
 refuses newer ones. Written as ``grainview_schema_version`` into the files that need it
 (:func:`schema_version`)."""
+CELL_VERSION = "3.0"
+"""The version written into files holding a periodic cell (``cell``, ``periodic``): a grainview
+before 3.0 would take such a sample for one bounded by its box (wrong strains, fields and
+pictures), so it must refuse the file rather than misread it."""
+IRREGULAR_SHAPES_VERSION = "2.0"
+"""The version written into files holding polygons that are not regular (their ``vertices``)
+and no cell: a grainview before 2.0 would read every polygon as the regular one of its
+``radius`` and ``n_vertices``."""
 REGULAR_SHAPES_VERSION = "1.0"
-"""The version written into files whose particles are all disks or regular polygons. Such a file
-means the same to every grainview: one before 2.0 reads a polygon as the regular one of its
-``radius`` and ``n_vertices``, which it is. A file holding any other polygon (its ``vertices``,
-version 2.0) is refused by those older readers, instead of being read as regular polygons."""
+"""The version written into files whose particles are all disks or regular polygons, in a box.
+Such a file means the same to every grainview."""
 
 
-def schema_version(irregular: bool) -> str:
-    """The version a file is written with: :data:`SCHEMA_VERSION` when it holds polygons that
-    are not regular (``irregular``), else :data:`REGULAR_SHAPES_VERSION`."""
-    return SCHEMA_VERSION if irregular else REGULAR_SHAPES_VERSION
+def schema_version(irregular: bool, cell: bool = False) -> str:
+    """The version a file is written with: the oldest that reads it right.
+    :data:`CELL_VERSION` for a file with a periodic cell (``cell``), else
+    :data:`IRREGULAR_SHAPES_VERSION` when it holds polygons that are not regular
+    (``irregular``), else :data:`REGULAR_SHAPES_VERSION`."""
+    if cell:
+        return CELL_VERSION
+    return IRREGULAR_SHAPES_VERSION if irregular else REGULAR_SHAPES_VERSION
 
 XY = ("x", "y")
 
@@ -114,6 +124,11 @@ VARIABLES: dict[str, Var] = {
     # sample box
     "box_min": Var(("time", "xy"), "f8", "m", "lower-left corner of the sample box"),
     "box_max": Var(("time", "xy"), "f8", "m", "upper-right corner of the sample box"),
+    # periodic cell (docs/schema.md, "The periodic cell"; grainview.contract.cell)
+    "cell": Var(("time", "cell_vector", "xy"), "f8", "m", "lattice vectors a = (l, 0) and b = (tilt, h) of the "
+                "periodic cell box_min + s a + t b, 0 <= s, t < 1", False),
+    "periodic": Var(("cell_vector",), "i1", "1", "1 where the sample repeats along the cell vector, 0 where walls "
+                    "bound it", False),
     # walls
     "wall_normal": Var(("wall", "xy"), "f8", "1", "unit wall normal pointing into the sample", False),
     "wall_position": Var(("time", "wall", "xy"), "f8", "m", "a point of the wall line", False),
@@ -213,12 +228,13 @@ def empty_slots(shape, name):
     return np.full(shape, np.nan, dtype=var.dtype)
 
 
-def global_attrs(n_particles: int, n_walls: int, attrs: dict | None = None, irregular: bool = False) -> dict:
+def global_attrs(n_particles: int, n_walls: int, attrs: dict | None = None, irregular: bool = False,
+                 cell: bool = False) -> dict:
     """Global attributes every file carries, merged with the run's own ``attrs``; the schema
     version is :func:`schema_version` of ``irregular`` (the file holds polygons that are not
-    regular)."""
+    regular) and ``cell`` (it holds a periodic cell)."""
     out = {
-        "grainview_schema_version": schema_version(irregular),
+        "grainview_schema_version": schema_version(irregular, cell),
         "Conventions": "CF-1.8",
         "thickness_m": 1.0,
         "n_particles": int(n_particles),
@@ -266,6 +282,12 @@ def structure_problems(variables: dict, sizes: dict) -> list[str]:
             problems.append(f"variable {name!r} has dtype {dtype}, expected floating point ({var.dtype})")
     if "xy" in sizes and sizes["xy"] != 2:
         problems.append(f"dimension 'xy' has size {sizes['xy']}, expected 2 (x, y)")
+    if "cell_vector" in sizes and sizes["cell_vector"] != 2:
+        problems.append(f"dimension 'cell_vector' has size {sizes['cell_vector']}, expected 2 (a, b)")
+    if ("cell" in variables) != ("periodic" in variables):
+        have, lack = ("cell", "periodic") if "cell" in variables else ("periodic", "cell")
+        problems.append(f"variable {have!r} without {lack!r}: a periodic cell needs both its vectors (cell) and "
+                        "which of them repeat (periodic)")
     return problems
 
 

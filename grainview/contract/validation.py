@@ -12,6 +12,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from .cell import CELL_POSITIONS, branch_problems, cell_problems, fractional
 from .errors import SchemaError
 from .file_checks import (COUNT_OUT_OF_RANGE, NON_FINITE_FORCES, foreign_file_problems, negative_force_problem,
                           order_problems)
@@ -129,10 +130,63 @@ def _value_checks(ds: xr.Dataset) -> dict[str, xr.DataArray]:
                                 output_dtypes=[np.int64])
     checks["i, j: {} slot(s) repeating a pair already stored in the same snapshot (a pair is stored once, "
            "a double contact with its resultant)"] = duplicates.sum()
+    if "cell" in ds.variables and "periodic" in ds.variables:
+        checks.update(_cell_checks(ds, occ))
     box_ok = (np.isfinite(ds["box_min"]) & np.isfinite(ds["box_max"]) & (ds["box_max"] > ds["box_min"])).all("xy")
     checks["box_min, box_max: {} snapshot(s) where the box is not finite with box_max above box_min "
            "in x and y"] = (~box_ok).sum()
     return checks
+
+
+def _branch_counts(position, i, j, branch, count, cell, radius, periodic, gap=None):
+    """:func:`grainview.contract.cell.branch_problems` of a block of snapshots, for apply_ufunc."""
+    return branch_problems(position, i, j, branch, count, cell, radius, periodic, gap)
+
+
+def _cell_checks(ds: xr.Dataset, occ) -> dict:
+    """Lazy counts of a periodic file's bad branches and of the centres outside a wrapped cell."""
+    import xarray as xr
+
+    periodic = np.asarray(ds["periodic"].values).astype(bool)
+    if periodic.shape != (2,):
+        return {}
+    args = [ds["position"], ds["i"], ds["j"], ds["branch"], ds["contact_count"], ds["cell"]]
+    core = [["particle", "xy"], ["contact"], ["contact"], ["contact", "xy"], [], ["cell_vector", "xy"]]
+    if "gap" in ds.variables:
+        args.append(ds["gap"])
+        core.append(["contact"])
+
+    def counts(position, i, j, branch, count, cell, *gap):
+        return _branch_counts(position, i, j, branch, count, cell, ds["radius"].values, periodic, *gap)
+
+    bad = xr.apply_ufunc(counts, *args, input_core_dims=core, output_core_dims=[["problem"]], dask="parallelized",
+                         output_dtypes=[np.int64], dask_gufunc_kwargs={"output_sizes": {"problem": 2}})
+    checks = {
+        "branch: {} particle pair(s) whose branch is not the minimum image of their centres in the periodic cell "
+        "(x_j - x_i moved by whole cell vectors to its shortest)": bad.isel(problem=0).sum(),
+        "branch: {} particle pair(s) whose branch is longer than the particles allow (r_i + r_j, plus the gap of a "
+        "near contact): a branch across the periodic cell instead of its minimum image?": bad.isel(problem=1).sum(),
+    }
+    if ds.attrs.get("cell_positions", "wrapped") == "wrapped":
+        st = xr.apply_ufunc(fractional, ds["position"] - ds["box_min"], ds["cell"],
+                            input_core_dims=[["xy"], ["cell_vector", "xy"]], output_core_dims=[["xy"]],
+                            dask="parallelized", output_dtypes=[float])
+        outside = ((st < -1e-9) | (st > 1 + 1e-9)) & xr.DataArray(periodic, dims="xy")
+        checks["position: {} centre(s) outside the periodic cell although the file says cell_positions = "
+               "'wrapped' (0 <= s, t <= 1 along the periodic vectors)"] = outside.any("xy").sum()
+    return checks
+
+
+def _cell_problems(ds: xr.Dataset) -> list[str]:
+    """The problems of a periodic file's ``cell``, ``periodic`` and ``cell_positions``
+    (:func:`grainview.contract.cell.cell_problems`)."""
+    if "cell" not in ds.variables or "periodic" not in ds.variables:
+        return []
+    problems = cell_problems(ds["cell"].values, ds["box_min"].values, ds["box_max"].values, ds["periodic"].values)
+    positions = ds.attrs.get("cell_positions", "wrapped")
+    if positions not in CELL_POSITIONS:
+        problems.append(f"global attribute cell_positions={positions!r}: expected one of {CELL_POSITIONS}")
+    return problems
 
 
 def _shape_problems(ds: xr.Dataset) -> list[str]:
@@ -182,7 +236,10 @@ def validate(ds: xr.Dataset, source: str | None = None) -> xr.Dataset:
     positions; ``contact_count`` within the slots; in occupied slots: ids in range and
     ``i < j`` for particle pairs, each pair at most once per snapshot, kind 1 or 2, finite
     forces, normal forces >= 0 (the first negative one named by snapshot, slot and bodies),
-    finite points and branches, unit normals; a box of positive size; ``time`` (and ``step``,
+    finite points and branches, unit normals; a box of positive size; in a periodic file, its
+    cell (:func:`grainview.contract.cell.cell_problems`), every particle pair's branch the
+    minimum image of its centres and no longer than the particles allow, and the centres inside
+    the cell when the file says they are wrapped; ``time`` (and ``step``,
     where the file has it) increasing strictly, so no snapshot is repeated; every variable's
     ``units`` those of the contract. A file holding none of the contract's variables gets one
     problem, that it is not a grainview file. On a dask-backed dataset the value checks are computed
@@ -210,7 +267,7 @@ def validate(ds: xr.Dataset, source: str | None = None) -> xr.Dataset:
 
     source = source or (ds.encoding.get("source") if isinstance(ds, xr.Dataset) else None)
     check_structure(ds, source)  # values cannot be checked reliably on a malformed structure
-    problems = _unit_problems(ds) + _shape_problems(ds)
+    problems = _unit_problems(ds) + _shape_problems(ds) + _cell_problems(ds)
     checks = _value_checks(ds)
     per_snapshot = _per_snapshot(ds)
     values = list(checks.values()) + list(per_snapshot.values())

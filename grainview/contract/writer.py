@@ -10,6 +10,7 @@ import os
 
 import numpy as np
 
+from .cell import CELL_POSITIONS, CELL_VECTORS, cell_problems
 from .errors import FileFormatError, GrainviewError, OutputError, ParameterError
 from .locks import WriterLock, process_alive
 from .schema import (CONTACT_VARIABLES, DEFAULT_WALL_NAMES, OPTIONAL_CONTACT_VARIABLES, REQUIRED, TIME_ATTRS,
@@ -509,7 +510,8 @@ class SnapshotWriter:
     @classmethod
     def create(cls, path, *, radius, n_vertices, mass, inertia, n_walls=0, wall_names=None,
                wall_normal=None, optional=(),
-               attrs=None, n_contact_slots=None, overwrite=False, format=APPEND_FORMAT, lock=None, vertices=None):
+               attrs=None, n_contact_slots=None, overwrite=False, format=APPEND_FORMAT, lock=None, vertices=None,
+               periodic=None):
         """Create ``path`` with the static particle data, ready for :meth:`append`.
 
         Parameters
@@ -531,6 +533,11 @@ class SnapshotWriter:
             One name per wall (default: bottom, right, top, left).
         wall_normal : array_like, (n_walls, 2), optional
             The walls' inward unit normals, written as ``wall_normal``.
+        periodic : array_like of bool, (2,), optional
+            A periodic sample: whether it repeats along the cell vectors a and b, written as
+            ``periodic``; every snapshot then gives its ``cell`` (2, 2) (lattice vectors, m,
+            :mod:`grainview.contract.cell`), and ``attrs`` may say ``cell_positions``
+            (``wrapped``, the default, or ``unwrapped``).
         optional : sequence of str
             The optional per-snapshot variables this file will hold (e.g.
             ``("velocity", *DIAGNOSTICS)``); the others are not written at all.
@@ -576,7 +583,7 @@ class SnapshotWriter:
             lock = lock_file(path)  # never replace a file another run is still writing
         try:
             nc = cls._create(path, radius, n_vertices, mass, inertia, n_walls, wall_names, wall_normal, optional,
-                             attrs, n_contact_slots, overwrite, format, vertices)
+                             attrs, n_contact_slots, overwrite, format, vertices, periodic)
         except BaseException:
             if own:
                 lock.release()
@@ -585,7 +592,7 @@ class SnapshotWriter:
 
     @staticmethod
     def _create(path, radius, n_vertices, mass, inertia, n_walls, wall_names, wall_normal, optional, attrs,
-                n_contact_slots, overwrite, format, vertices=None):
+                n_contact_slots, overwrite, format, vertices=None, periodic=None):
         """:meth:`create`'s file, under the lock: written, moved into place and opened to append."""
         import netCDF4
 
@@ -597,6 +604,16 @@ class SnapshotWriter:
             raise ParameterError(f"unknown optional variables {unknown}")
         if not n_walls:
             optional = [o for o in optional if "wall" not in VARIABLES[o].dims]
+        optional = [o for o in optional if o not in ("cell", "periodic")]
+        if periodic is not None:
+            periodic = np.asarray(periodic)
+            problems = cell_problems(np.zeros((0, 2, 2)), np.zeros((0, 2)), np.ones((0, 2)), periodic)
+            if problems:
+                raise ParameterError("; ".join(problems))
+            optional.append("cell")
+            attrs = {"cell_positions": "wrapped", **(attrs or {})}
+            if attrs["cell_positions"] not in CELL_POSITIONS:
+                raise ParameterError(f"cell_positions={attrs['cell_positions']!r}: expected one of {CELL_POSITIONS}")
         if vertices is not None:
             vertices = np.asarray(vertices, "f8")
             problems = shape_problems(radius, n_vertices, vertices) if vertices.ndim == 3 and \
@@ -638,7 +655,16 @@ class SnapshotWriter:
                 wv[:] = netCDF4.stringtochar(np.array(names, dtype=f"S{width}"))
                 wv.long_name = "wall name"
                 wv._Encoding = "utf-8"
+            if periodic is not None:
+                nc.createDimension("cell_vector", 2)
+                nc.createDimension("cell_vector_strlen", 1)
+                cv = nc.createVariable("cell_vector", "S1", ("cell_vector", "cell_vector_strlen"))
+                cv[:] = np.array([[name.encode()] for name in CELL_VECTORS])
+                cv.long_name = "lattice vector of the cell"
+                cv._Encoding = "utf-8"
             names = [*REQUIRED, *optional]
+            if periodic is not None:
+                names.append("periodic")
             if n_walls and wall_normal is not None:
                 names.append("wall_normal")
             if vertices is not None:
@@ -654,10 +680,13 @@ class SnapshotWriter:
                 static["wall_normal"] = wall_normal
             if vertices is not None:
                 static["vertices"] = vertices
+            if periodic is not None:
+                static["periodic"] = periodic
             for name, value in static.items():
                 nc.variables[name][:] = np.broadcast_to(np.asarray(value, VARIABLES[name].dtype),
                                                         nc.variables[name].shape)
-            nc.setncatts(global_attrs(n, n_walls, attrs, has_irregular_polygons(radius, n_vertices, vertices)))
+            nc.setncatts(global_attrs(n, n_walls, attrs, has_irregular_polygons(radius, n_vertices, vertices),
+                                      periodic is not None))
             nc.close()
             _move_into_place(temporary, path, overwrite)
         except BaseException as exc:

@@ -70,7 +70,7 @@ def test_a_newer_schema_version_is_refused(tmp_path):
 
     path = _write(builders.mixed_contacts(t=1), tmp_path / "run.nc")
     with netCDF4.Dataset(path, "a") as nc:
-        nc.grainview_schema_version = "3.0"
+        nc.grainview_schema_version = "4.0"
     with pytest.raises(SchemaError, match="newer than this grainview"):
         ContractFile(path)
 
