@@ -11,6 +11,7 @@ import numpy as np
 import xarray as xr
 
 from ..contract import portable_math
+from ..contract.cell import unwrap_tilt
 from . import sample
 from ._lift import ratio, with_attrs
 from .arrays.strain import log_strain
@@ -18,8 +19,8 @@ from ..contract.errors import ParameterError
 from .stress import stress_invariants
 from ._docs import fill_doc
 
-__all__ = ["time_derivative", "strains", "residual_window", "friction_and_dilatancy", "friction_offset",
-           "inertia_number"]
+__all__ = ["time_derivative", "strains", "deformation_gradient", "residual_window", "friction_and_dilatancy",
+           "friction_offset", "inertia_number"]
 
 RESIDUAL_STRAIN = 0.3
 """Start of the residual state in shear strain eps_q (the paper reads its residual values at
@@ -65,6 +66,68 @@ def _log_strain(size, reference):
     return log_strain(size, size.isel(time=reference))
 
 
+def _continuous_cell(ds: xr.Dataset) -> np.ndarray:
+    """The lattice vectors (T, 2, 2) of a file's cell, its tilt made continuous across the
+    flips of the code that wrote it (:func:`grainview.contract.cell.unwrap_tilt`): read at once
+    (four numbers per snapshot)."""
+    cell = np.array(ds["cell"].values, dtype=float)
+    cell[:, 1, 0] = unwrap_tilt(cell[:, 1, 0], cell[:, 0, 0])
+    return cell
+
+
+@fill_doc
+def deformation_gradient(ds: xr.Dataset, reference: int = 0) -> xr.DataArray:
+    """The deformation gradient F (time, xy_a, xy_b) of the sample from the snapshot
+    ``reference``, dimensionless.
+
+    With a periodic cell (``cell``), F maps the reference cell's lattice vectors onto the
+    current ones, ``a = F a_0`` and ``b = F b_0``:
+
+        F = C^T (C_0^T)^-1,
+
+    C the matrix whose rows are ``a`` and ``b`` (docs/schema.md, "The periodic cell"), the tilt
+    made continuous first where the code flipped the cell
+    (:func:`grainview.contract.cell.unwrap_tilt`). In the restricted form a = (l, 0),
+    b = (tilt, h):
+
+        F = [[l/l_0, (tilt - tilt_0 l/l_0)/h_0], [0, h/h_0]],
+
+    so a simple shear of the cell at fixed l and h has F_xy = (tilt - tilt_0)/h, the shear
+    strain gamma. Without a cell F is that of the box, diag(l/l_0, h/h_0).
+
+    Parameters
+    ----------
+    {ds}
+    reference : int, default 0
+        Index of the reference snapshot along ``time``.
+
+    Returns
+    -------
+    xarray.DataArray
+        ``deformation_gradient`` (time, xy_a, xy_b), F[a, b] = d x_a / d X_b, dimensionless.
+        With a cell, the cell is read (four numbers per snapshot) and the result is eager;
+        otherwise lazy on dask input.
+    """
+    if "cell" not in ds.variables:
+        l, h = sample.width(ds), sample.height(ds)
+        sx, sy = l / l.isel(time=reference), h / h.isel(time=reference)
+        zero = xr.zeros_like(sx)
+        rows = [xr.concat([sx, zero], "xy_b"), xr.concat([zero, sy], "xy_b")]
+        f = xr.concat(rows, "xy_a").transpose("time", "xy_a", "xy_b")
+    else:
+        cell = _continuous_cell(ds)
+        c0 = cell[reference]
+        # columns of A = C^T are the lattice vectors; F = A A0^-1, A0^-1 by its adjugate
+        det0 = c0[0, 0] * c0[1, 1] - c0[1, 0] * c0[0, 1]
+        inv = np.array([[c0[1, 1], -c0[1, 0]], [-c0[0, 1], c0[0, 0]]]) / det0  # A0^-1
+        a = np.swapaxes(cell, -1, -2)  # (T, 2, 2): A[x, k] = vector k's component x
+        f_values = a[..., :, 0, None] * inv[None, 0, :] + a[..., :, 1, None] * inv[None, 1, :]
+        f = xr.DataArray(f_values, dims=("time", "xy_a", "xy_b"), coords={"time": ds["time"].values})
+    f = f.assign_coords(xy_a=["x", "y"], xy_b=["x", "y"])
+    return with_attrs(f, "deformation_gradient", "1", "deformation gradient F of the sample from the reference "
+                      "snapshot")
+
+
 @fill_doc
 def strains(ds: xr.Dataset, reference: int = 0) -> xr.Dataset:
     """eps_1, eps_2, eps_p, eps_q (dimensionless) of every snapshot.
@@ -77,6 +140,18 @@ def strains(ds: xr.Dataset, reference: int = 0) -> xr.Dataset:
     h, l are the box height and width (m) and V the box area l h (m2) of each snapshot; h0, l0,
     V0 those of the snapshot ``reference``.
 
+    A file with a periodic cell (``cell``) has the same four from the cell's widths (the box is
+    the cell's bounds, so V = l h whatever its tilt) and also ``gamma``, the simple-shear
+    strain of the cell, the xy component of its deformation gradient
+    (:func:`deformation_gradient`):
+
+        gamma = (tilt - tilt_0 l/l_0) / h_0,
+
+    which is (tilt - tilt_0)/h at fixed l and h; the tilt is made continuous first where the
+    code flipped the cell (LAMMPS's flips, :func:`grainview.contract.cell.unwrap_tilt`). The
+    widths do not see a simple shear: eps_q = eps_1 - eps_2 measures the biaxial part of the
+    deformation only (0 in a simple shear at fixed l and h), and ``gamma`` is its shear strain.
+
     Parameters
     ----------
     {ds}
@@ -87,7 +162,7 @@ def strains(ds: xr.Dataset, reference: int = 0) -> xr.Dataset:
     -------
     xarray.Dataset
         ``eps_1``, ``eps_2``, ``eps_p``, ``eps_q`` over ``time``, dimensionless; lazy on dask
-        input.
+        input; with a cell also ``gamma`` (the cell is read).
 
     References
     ----------
@@ -105,6 +180,10 @@ def strains(ds: xr.Dataset, reference: int = 0) -> xr.Dataset:
         "eps_p": with_attrs(eps_p, "eps_p", "1", "volumetric strain eps_p (dilation positive)"),
         "eps_q": with_attrs(eps_1 - eps_2, "eps_q", "1", "shear strain eps_q = eps_1 - eps_2"),
     })
+    if "cell" in ds.variables:
+        gamma = deformation_gradient(ds, reference).sel(xy_a="x", xy_b="y", drop=True)
+        out["gamma"] = with_attrs(gamma.assign_coords(time=ds["time"]), "gamma", "1",
+                                  "simple-shear strain of the periodic cell, F_xy")
     return out.drop_vars([c for c in out.coords if c != "time"])
 
 
