@@ -90,7 +90,8 @@ def read_facts(path, check=False) -> tuple[dict, dict]:
         the first, docs/conventions.md §6; the particles' areas from their shapes,
         :func:`grainview.contract.shapes.particle_area`) and ``q_over_p`` per snapshot (q/p of the stress
         sigma = (1/V) sum_c f^c (x) l^c over every pair the file holds, paper Eq. M), plus
-        ``missing_units``.
+        ``missing_units``; for a periodic file ``cell`` (its flags, tilt, shear and how the
+        positions are stored, :func:`cell_line`).
     attrs : dict
         The file's global attributes.
 
@@ -110,6 +111,7 @@ def read_facts(path, check=False) -> tuple[dict, dict]:
     import netCDF4
 
     from ..analysis.arrays.strain import log_strain
+    from ..contract.cell import unwrap_tilt
     from ..analysis.arrays.stress import stress_tensor
     from ..analysis.arrays.tensors import principal
 
@@ -173,6 +175,10 @@ def read_facts(path, check=False) -> tuple[dict, dict]:
             raise SchemaError(problems, source)
         box_min, box_max = np.asarray(v["box_min"][k]), np.asarray(v["box_max"][k])
         length, height = box_max[:, 0] - box_min[:, 0], box_max[:, 1] - box_min[:, 1]
+        if "cell" in v and "periodic" in v:
+            tilt = unwrap_tilt(np.asarray(v["cell"][k], float)[:, 1, 0], length)
+            facts["cell"] = {"periodic": np.asarray(v["periodic"][:]).astype(bool), "tilt": tilt,
+                             "gamma": (tilt - tilt[0]) / height, "positions": attrs.get("cell_positions", "wrapped")}
         solid = float(particle_area(radius, n_vertices, vertices).sum())
         with np.errstate(all="ignore"):  # a box of no size gives an infinite fraction, not a warning
             facts["solid_fraction"] = solid / (length * height)
@@ -187,6 +193,19 @@ def read_facts(path, check=False) -> tuple[dict, dict]:
     return facts, attrs
 
 
+def cell_line(cell: dict) -> str:
+    """The line ``grainview info`` gives a periodic cell: which vectors repeat, the tilt's range,
+    the simple shear gamma = (tilt - tilt_0) / h at the last snapshot (the tilt made continuous
+    across flips, :func:`grainview.contract.cell.unwrap_tilt`) and how the positions are stored."""
+    along = {(True, True): "along x and along the cell's second vector (biperiodic)",
+             (True, False): "along x (walls bound it in y)",
+             (False, True): "along the cell's second vector (walls bound it in x)"}[tuple(bool(p) for p in
+                                                                                    cell["periodic"])]
+    tilt = cell["tilt"]
+    return (f"periodic cell: repeats {along}; tilt {tilt.min():.4g} .. {tilt.max():.4g} m, shear gamma "
+            f"{cell['gamma'][-1]:.4g} at the last snapshot; positions {cell['positions']}")
+
+
 def describe_file(path, check=False) -> tuple[list, dict]:
     """The lines ``grainview info`` prints for ``path`` (:func:`read_facts`, formatted by
     :func:`grainview.analysis.summary.summary_lines`, then the file's size and format, and notes on
@@ -199,6 +218,8 @@ def describe_file(path, check=False) -> tuple[list, dict]:
     size = facts["size"]
     scaled, unit = next(((size / 1024**p, u) for p, u in ((3, "GiB"), (2, "MiB"), (1, "KiB"))
                          if size >= 1024**p), (size, "bytes"))
+    if "cell" in facts:
+        lines.append(cell_line(facts["cell"]))
     lines.append(f"file: {scaled:.1f} {unit} ({size:,} bytes), {facts['format']}")
     if facts["missing_units"]:
         lines.append(f"note: {len(facts['missing_units'])} variable(s) carry no units attribute and are read in the "

@@ -202,3 +202,21 @@ def test_make_dataset_and_the_writer_refuse_what_is_not_a_cell(tmp_path):
         grainview.SnapshotWriter.create(tmp_path / "x.nc", radius=[1.0], n_vertices=[0], mass=[1.0], inertia=[1.0],
                                         periodic=[2, 1])
     assert not (tmp_path / "x.nc").exists()
+
+
+def test_info_describes_the_cell_and_its_shear(tmp_path, capsys):
+    from grainview.app.cli import main
+
+    first, second = lattice(tilt=0.0), lattice(tilt=1.0)
+    ds = grainview.make_dataset(radius=first["radius"].values,
+                                position=np.stack([first["position"].values[0], second["position"].values[0]]),
+                                contacts=[{name: snap[name].values[0, :32] for name in ("i", "j", "normal", "fn")}
+                                          for snap in (first, second)],
+                                box_min=[0, 0], box_max=[4, 4], periodic=[1, 1],
+                                cell=np.stack([first["cell"].values[0], second["cell"].values[0]]))
+    path = tmp_path / "sheared.nc"
+    ds.to_netcdf(path, **grainview.contract.dataset.netcdf_options(ds))
+    assert main(["info", "--check", str(path)]) == 0
+    out = capsys.readouterr().out
+    assert ("periodic cell: repeats along x and along the cell's second vector (biperiodic); tilt 0 .. 1 m, "
+            "shear gamma 0.25 at the last snapshot; positions wrapped") in out
