@@ -129,6 +129,11 @@ def force_chains(ds: xr.Dataset, angle: float = DEFAULT_ANGLE, min_size: int = 3
         ``mean_size`` (particles) and ``censored`` (seen in the first or last snapshot, so
         its life may be longer). Lazy on dask input unless ``follow``.
 
+        In a periodic cell (``cell``) the links and chains read only the pairs (i, j) and
+        their minimum-image branches, so a chain across the cell's boundary is one chain; each
+        particle's stress takes its levers from one image of each pair
+        (:func:`grainview.analysis.arrays.force_chains.periodic_points`).
+
     Raises
     ------
     grainview.contract.errors.ParameterError
@@ -146,7 +151,8 @@ def force_chains(ds: xr.Dataset, angle: float = DEFAULT_ANGLE, min_size: int = 3
     n_bins = max_length - min_size + 1
     outputs = apply(_chains.force_chains, ds["i"], ds["j"], ds["fn"], ds["ft"], ds["normal"], ds["point"],
                     ds["branch"], mask, ds["position"], particle_volume(ds),
-                    kwargs={"angle": float(angle), "min_size": int(min_size), "max_length": int(max_length)},
+                    kwargs={"angle": float(angle), "min_size": int(min_size), "max_length": int(max_length),
+                            "periodic": "cell" in ds.variables},
                     output_sizes={"length": n_bins},
                     output_dtypes=[np.int64, bool, float, float, float, np.int64, np.int64, float, float, float,
                                    float])

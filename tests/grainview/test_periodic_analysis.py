@@ -63,3 +63,53 @@ def test_deformation_gradient_without_a_cell_is_that_of_the_box():
     f = grainview.analysis.strain.deformation_gradient(ds).values
     np.testing.assert_allclose(f[1], [[1.25, 0.0], [0.0, 0.5]])
     assert "gamma" not in ds.grain.strains()
+
+
+def chain_across(shift=(0.0, 0.0), tilt=0.0):
+    """A straight row of 6 disks (radius 0.5) along x at y = 5 in a 10 x 10 periodic cell, three
+    each side of the boundary x = 0 (centres 7.5 ... 9.5 and 0.5 ... 1.5), pushed along the row
+    by 10 N; and five weakly loaded vertical pairs elsewhere (1 N). The row is one chain of 6
+    particles (even its ends, loaded on one side, are above the mean sigma_1): its contact at the
+    boundary is the minimum image (branch (1, 0))."""
+    row = np.array([[7.5 + k, 5.0] for k in range(6)])
+    pairs = np.array([[x, y + dy] for x, y in ((3.0, 1.0), (4.5, 1.0), (6.0, 1.0), (3.0, 7.0), (4.5, 7.0))
+                      for dy in (0.0, 1.0)])
+    centres = np.concatenate([row, pairs])
+    cell = cells.restricted_cell([0, 0], [10, 10], tilt)
+    position = cells.wrap(centres + np.asarray(shift), [0, 0], cell, [1, 1])
+    i = [0, 1, 2, 3, 4] + list(range(6, 16, 2))
+    j = [1, 2, 3, 4, 5] + list(range(7, 16, 2))
+    normal = [[1.0, 0.0]] * 5 + [[0.0, 1.0]] * 5
+    fn = [10.0] * 5 + [1.0] * 5
+    return grainview.make_dataset(radius=np.full(16, 0.5), position=position,
+                                  contacts=[dict(i=i, j=j, normal=normal, fn=fn)], box_min=[0, 0], box_max=[10, 10],
+                                  periodic=[1, 1], cell=cell)
+
+
+def test_a_straight_chain_across_the_boundary_is_one_chain(prepare):
+    ds = chain_across()
+    assert abs(ds["position"].values[0, 2, 0] - ds["position"].values[0, 3, 0]) > 8  # stored a cell apart
+    chains = prepare(ds).grain.force_chains().compute()
+    chain = chains["chain"].values[0]
+    assert int(chains["n_chains"][0]) == 1
+    np.testing.assert_array_equal(chain, [0] * 6 + [-1] * 10)
+    # every row particle carries 10 N over a lever of 0.5 on each loaded side: sigma_xx = 10 / (pi/4)
+    ends = 10 * 0.5 / (np.pi * 0.25)
+    np.testing.assert_allclose(chains["sigma_1"].values[0, :6], [ends, 2 * ends, 2 * ends, 2 * ends, 2 * ends, ends],
+                               rtol=1e-12)
+    # the particle stresses add up to the sample's
+    volume = np.pi * 0.25
+    total = chains["sigma_1"].values[0] * volume + chains["sigma_2"].values[0] * volume
+    sigma = ds.grain.stress_tensor().values[0]
+    assert total.sum() == pytest.approx(np.trace(sigma) * 100, rel=1e-12)
+
+
+def test_force_chains_do_not_move_with_the_sample_across_the_cell():
+    rng = np.random.default_rng(5)
+    for tilt in (0.0, 2.7):
+        base = chain_across(tilt=tilt).grain.force_chains()
+        for _ in range(3):
+            moved = chain_across(shift=rng.uniform(-30, 30, 2), tilt=tilt).grain.force_chains()
+            np.testing.assert_array_equal(moved["chain"].values, base["chain"].values)
+            np.testing.assert_allclose(moved["sigma_1"].values, base["sigma_1"].values, rtol=1e-12)
+            np.testing.assert_allclose(moved["sigma_2"].values, base["sigma_2"].values, rtol=1e-12, atol=1e-12)

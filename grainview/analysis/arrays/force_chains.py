@@ -54,7 +54,7 @@ def _rows(a, tail):
 
 @core_dims(CONTACT, CONTACT, CONTACT, CONTACT, CONTACT_XY, CONTACT_XY, CONTACT, PARTICLE_XY,
            out=(PARTICLE_TENSOR,))
-def particle_moments(i, j, fn, ft, normal, point, mask, position):
+def particle_moments(i, j, fn, ft, normal, point, mask, position, branch=None):
     """Sum over each particle's contacts of s f (x) (x^c - x_p), N m (..., P, 2, 2).
 
         M_p,ab = sum_{c of p} s_pc f^c_a (x^c - x_p)_b,
@@ -63,20 +63,76 @@ def particle_moments(i, j, fn, ft, normal, point, mask, position):
     the particle side of a wall contact (j >= P). ``i, j, fn, ft, mask`` (..., C),
     ``normal, point`` (..., C, 2), ``position`` (..., P, 2). sigma_p = M_p / V_p, and
     sum_p M_p = sum_c f (x) l.
+
+    In a periodic cell, give the contacts' minimum-image ``branch`` (..., C, 2): the lever
+    arms x^c - x_i and x^c - x_j are then those of one image of the pair
+    (:func:`periodic_points`), so that a contact across the cell's boundary loads both its
+    particles with levers of the size of the particles, whichever image its point is stored at.
+    Without ``branch`` the levers are taken from the stored centres as they are (a bounded
+    sample).
     """
     lead = np.broadcast_shapes(np.shape(fn), np.shape(mask), np.shape(i))
     n_part = np.shape(position)[-2]
     force = force_vectors(np.broadcast_to(fn, lead), np.broadcast_to(ft, lead), np.broadcast_to(normal, lead + (2,)))
     point = np.broadcast_to(point, lead + (2,))
     position = np.broadcast_to(position, lead[:-1] + (n_part, 2))
-    moments = accumulate_moments(_rows(np.broadcast_to(i, lead), 1).astype(np.int64),
-                                 _rows(np.broadcast_to(j, lead), 1).astype(np.int64),
-                                 _rows(force[..., 0], 1), _rows(force[..., 1], 1),
-                                 _rows(point[..., 0], 1).astype(np.float64), _rows(point[..., 1], 1).astype(np.float64),
-                                 _rows(position[..., 0], 1).astype(np.float64),
-                                 _rows(position[..., 1], 1).astype(np.float64),
-                                 _rows(np.broadcast_to(mask, lead), 1).astype(bool))
+    i_rows = _rows(np.broadcast_to(i, lead), 1).astype(np.int64)
+    j_rows = _rows(np.broadcast_to(j, lead), 1).astype(np.int64)
+    common = (_rows(force[..., 0], 1), _rows(force[..., 1], 1))
+    centres = (_rows(position[..., 0], 1).astype(np.float64), _rows(position[..., 1], 1).astype(np.float64))
+    mask_rows = _rows(np.broadcast_to(mask, lead), 1).astype(bool)
+    if branch is None:
+        moments = accumulate_moments(i_rows, j_rows, *common, _rows(point[..., 0], 1).astype(np.float64),
+                                     _rows(point[..., 1], 1).astype(np.float64), *centres, mask_rows)
+        return moments.reshape(lead[:-1] + (n_part, 2, 2))
+    point_i, point_j = periodic_points(i, j, point, np.broadcast_to(branch, lead + (2,)), position)
+    nobody = np.full_like(i_rows, -1)
+    moments = accumulate_moments(i_rows, nobody, *common, _rows(point_i[..., 0], 1), _rows(point_i[..., 1], 1),
+                                 *centres, mask_rows)
+    moments += accumulate_moments(nobody, j_rows, *common, _rows(point_j[..., 0], 1), _rows(point_j[..., 1], 1),
+                                  *centres, mask_rows)
     return moments.reshape(lead[:-1] + (n_part, 2, 2))
+
+
+def periodic_points(i, j, point, branch, position):
+    """Each contact's point as seen from its body i and from its body j, m (..., C, 2) each:
+    ``x_i + lever_i`` and ``x_j + lever_j`` with ``lever_i - lever_j = branch``, the levers of
+    one image of the pair.
+
+    In a periodic cell the stored centres of a contact's two particles may be whole cells apart
+    from the image its point sits at. The point is at most a particle's size from the image of
+    the body it was computed from, so of ``point - x_i`` and ``point - x_j`` the shorter is a
+    true lever; the other is that one less (or plus) the minimum-image ``branch``. Wall
+    contacts (j outside the particles) and empty slots keep their point.
+
+    Parameters
+    ----------
+    i, j : array_like of int, (..., C)
+        Bodies of each slot.
+    point, branch : array_like, (..., C, 2)
+        Contact points and minimum-image branch vectors, m.
+    position : array_like, (..., P, 2)
+        Centres, m.
+
+    Returns
+    -------
+    point_i, point_j : numpy.ndarray, (..., C, 2)
+        The point relative to body i's and to body j's stored centre, m.
+    """
+    point, branch = np.asarray(point, float), np.asarray(branch, float)
+    position = np.asarray(position, float)
+    n_part = position.shape[-2]
+    i, j = np.broadcast_to(i, point.shape[:-1]), np.broadcast_to(j, point.shape[:-1])
+    pair = (i >= 0) & (i < n_part) & (j >= 0) & (j < n_part)
+    xi = np.take_along_axis(position, np.clip(i, 0, n_part - 1)[..., None], axis=-2)
+    xj = np.take_along_axis(position, np.clip(j, 0, n_part - 1)[..., None], axis=-2)
+    lever_i, lever_j = point - xi, point - xj
+    near_i = (lever_i * lever_i).sum(-1) <= (lever_j * lever_j).sum(-1)
+    lever_i = np.where(near_i[..., None], lever_i, lever_j + branch)
+    lever_j = np.where(near_i[..., None], lever_i - branch, lever_j)
+    point_i = np.where(pair[..., None], xi + lever_i, point)
+    point_j = np.where(pair[..., None], xj + lever_j, point)
+    return np.ascontiguousarray(point_i), np.ascontiguousarray(point_j)
 
 
 def chain_particles(sigma_1, sigma_2):
@@ -130,7 +186,7 @@ def chain_sizes(chain):
 @core_dims(CONTACT, CONTACT, CONTACT, CONTACT, CONTACT_XY, CONTACT_XY, CONTACT_XY, CONTACT, PARTICLE_XY, PARTICLE,
            out=(PARTICLE, CONTACT, PARTICLE, PARTICLE, PARTICLE, SCALAR, LENGTH, SCALAR, SCALAR, SCALAR, SCALAR))
 def force_chains(i, j, fn, ft, normal, point, branch, mask, position, volume, angle=45.0, min_size=3,
-                 max_length=50):
+                 max_length=50, periodic=False):
     """Force chains of every snapshot and their statistics (module docstring, steps 1-5).
 
     ``i, j, fn, ft, mask`` (..., C), ``normal, point, branch`` (..., C, 2), ``position``
@@ -155,8 +211,14 @@ def force_chains(i, j, fn, ft, normal, point, branch, mask, position, volume, an
       ill-conditioned where D is small (a nearly isotropic state); 0 without chains, NaN for
       an isotropic sample stress;
     * ``pressure_fraction`` (...): tr(sum_chains V_p sigma_p)/tr(sum_p V_p sigma_p).
+
+    ``periodic``: the sample is a periodic cell, its branches minimum images; the particle
+    stresses take their levers from one image of each pair (:func:`particle_moments`). The
+    links and the connected sets read only the branches and the pairs (i, j), so a chain that
+    crosses the cell's boundary is one chain.
     """
-    moments = particle_moments(i, j, fn, ft, normal, point, mask, position)
+    moments = particle_moments(i, j, fn, ft, normal, point, mask, position,
+                               branch=np.asarray(branch, float) if periodic else None)
     volume = np.asarray(volume, float)
     with np.errstate(invalid="ignore", divide="ignore"):
         stress = moments / volume[..., None, None]
@@ -232,5 +294,5 @@ def follow_chains(chain):
     return track, first, last, total / np.maximum(last - first + 1, 1)
 
 
-__all__ = ["particle_moments", "chain_particles", "chain_links", "components", "chain_sizes", "force_chains",
+__all__ = ["particle_moments", "periodic_points", "chain_particles", "chain_links", "components", "chain_sizes", "force_chains",
            "follow_chains", "ISOTROPY_TOLERANCE"]
