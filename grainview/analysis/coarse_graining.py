@@ -60,8 +60,31 @@ def _grid(ds, spacing, x, y, reach):
         raise ParameterError("the grid: expected spacing= (m), or both x= and y= (coordinates in m)")
     dx, dy = _spacing(spacing)
     box = xr.Dataset({"lo": ds["box_min"].min("time"), "hi": ds["box_max"].max("time")}).compute()  # one read
-    lo, hi = np.asarray(box["lo"].values, dtype=float) - reach, np.asarray(box["hi"].values, dtype=float) + reach
+    widen = reach * (1 - _periodic(ds))  # a periodic direction's fields repeat: the cell's bounds hold them all
+    lo, hi = np.asarray(box["lo"].values, dtype=float) - widen, np.asarray(box["hi"].values, dtype=float) + widen
     return _cg.grid_nodes(lo[0], hi[0], dx), _cg.grid_nodes(lo[1], hi[1], dy)
+
+
+def _periodic(ds: xr.Dataset) -> np.ndarray:
+    """(2,) of 0/1: along x and y, whether the file's cell repeats (its ``periodic`` flags; 0, 0
+    without a cell). In the restricted form a lies along x, and b's images are h apart in y."""
+    if "cell" not in ds.variables:
+        return np.zeros(2, dtype=int)
+    return np.asarray(ds["periodic"].values, dtype=int)
+
+
+def _cell_arguments(ds: xr.Dataset):
+    """The cell (time, cell_vector, xy), its rate of change (m s-1; the tilt made continuous
+    across a code's flips first) and its origin ``box_min``, for the periodic fields."""
+    from .strain import _continuous_cell, time_derivative
+
+    continuous = xr.DataArray(_continuous_cell(ds), dims=ds["cell"].dims, coords={"time": ds["time"].values})
+    # one snapshot (or two at one time) has no rate: its images move as the particle does
+    rate = time_derivative(continuous).fillna(0.0) if "velocity" in ds.variables else xr.zeros_like(continuous)
+    rate = rate.assign_coords(time=ds["time"])
+    if ds["cell"].chunks is not None:
+        rate = rate.chunk(dict(zip(ds["cell"].dims, ds["cell"].chunks)))
+    return ds["cell"], rate, ds["box_min"]
 
 
 def _areas(ds: xr.Dataset) -> xr.DataArray:
@@ -117,6 +140,22 @@ def coarse_grained(ds: xr.Dataset, width=None, spacing=None, kernel: str = "gaus
     contacts, as :func:`grainview.analysis.fabric.fabric_tensor`. Masses are the file's, areas those of
     the particles' shapes (:func:`grainview.contract.shapes.particle_area`).
 
+    In a periodic cell (``cell``) the fields are those of the infinite periodic packing: every
+    particle and every contact's segment (its minimum-image branch from the centre of i) is
+    spread with all its images ``+ m a + n b`` that reach the grid, so a particle near one
+    edge counts near the opposite one and a contact across the boundary is spread on both
+    sides; an image's velocity adds ``m da/dt + n db/dt`` (Lees–Edwards; the rates from the
+    cell's series, the tilt made continuous across flips, zero for a single snapshot). The
+    default grid then covers the cell's bounds box_min..box_max along each periodic direction,
+    not widened: that rectangle l x h tiles the plane under the lattice, a tilted cell's
+    included (its rows of images are shifted by the tilt, not stacked), so the fields on it
+    are one whole cell, and when ``spacing`` divides l and h their sums times the cell area
+    of the grid are the integrals over the cell (sum_c f (x) l / t for the contact stress,
+    the particles' mass and area). Given ``x`` and ``y`` may lie anywhere: the fields are
+    periodic over the plane. :func:`interior` counts every node as inside along a periodic
+    direction; the derivatives of ``scalar_field("shear_rate")`` are one-sided at the grid's
+    edges, as for a bounded sample.
+
     Parameters
     ----------
     {ds}
@@ -127,8 +166,8 @@ def coarse_grained(ds: xr.Dataset, width=None, spacing=None, kernel: str = "gaus
     spacing : float or (float, float), optional
         Grid spacing (dx, dy) in m: cells of that side covering the union of the snapshots' boxes
         widened by the kernel's radius c on every side (so that the grid holds every kernel whole
-        and its integrals are exact), nodes at their centres (reads ``box_min`` and ``box_max``).
-        Default w/2. Or give ``x`` and ``y``.
+        and its integrals are exact; along a periodic direction of a cell not widened), nodes at
+        their centres (reads ``box_min`` and ``box_max``). Default w/2. Or give ``x`` and ``y``.
     kernel : {"gaussian"}, default "gaussian"
         The kernel (:data:`KERNELS`).
     cutoff : float, default 3
@@ -145,8 +184,9 @@ def coarse_grained(ds: xr.Dataset, width=None, spacing=None, kernel: str = "gaus
         NaN where no contact reaches), and, when the file has particle velocities, ``momentum``
         (xy; kg m-2 s-1), ``velocity`` (xy; m s-1, NaN where rho = 0) and ``kinetic_stress``
         (xy_a, xy_b; Pa). The snapshots' boxes as coordinates ``box_min``, ``box_max`` (time,
-        xy; m). Attributes: the kernel, its width and cutoff, the grid spacing. Lazy on dask
-        input.
+        xy; m). Attributes: the kernel, its width and cutoff, the grid spacing, and for a
+        periodic cell ``periodic`` (along x, y). Lazy on dask input (a cell's four numbers per
+        snapshot are read).
 
     Raises
     ------
@@ -169,11 +209,16 @@ def coarse_grained(ds: xr.Dataset, width=None, spacing=None, kernel: str = "gaus
     has_velocity = "velocity" in ds.variables
     velocity = ds["velocity"] if has_velocity else xr.zeros_like(ds["position"])
     area = _areas(ds)
-    outputs = apply(_cg.coarse_grained_fields, ds["position"], velocity, ds["mass"], area, ds["i"], ds["fn"],
-                    ds["ft"], ds["normal"], ds["branch"], selection(ds, walls=True, near=np.inf),
-                    selection(ds, walls=False), sample.thickness(ds),
-                    output_sizes={"y": gy.size, "x": gx.size},
-                    kwargs={"x": gx, "y": gy, "width": width, "cutoff": cutoff})
+    args = [ds["position"], velocity, ds["mass"], area, ds["i"], ds["fn"], ds["ft"], ds["normal"], ds["branch"],
+            selection(ds, walls=True, near=np.inf), selection(ds, walls=False), sample.thickness(ds)]
+    kwargs = {"x": gx, "y": gy, "width": width, "cutoff": cutoff}
+    core_dims = _cg.coarse_grained_fields.core_dims
+    if "cell" in ds.variables:
+        args += list(_cell_arguments(ds))
+        core_dims = core_dims + (_cg.CELL, _cg.CELL, _cg.XY)
+        kwargs["periodic"] = np.asarray(ds["periodic"].values, bool)
+    outputs = apply(_cg.coarse_grained_fields, *args, core_dims=core_dims,
+                    output_sizes={"y": gy.size, "x": gx.size}, kwargs=kwargs)
     fields = {}
     for name, da in zip(_FIELDS, outputs):
         if name in ("momentum", "velocity", "kinetic_stress") and not has_velocity:
@@ -188,6 +233,8 @@ def coarse_grained(ds: xr.Dataset, width=None, spacing=None, kernel: str = "gaus
                  "spacing_m": [float(np.diff(gx).mean()) if gx.size > 1 else np.nan,
                                float(np.diff(gy).mean()) if gy.size > 1 else np.nan],
                  "thickness_m": sample.thickness(ds)}
+    if "cell" in ds.variables:
+        out.attrs["periodic"] = [int(v) for v in _periodic(ds)]
     return out
 
 
@@ -333,6 +380,9 @@ def interior(fields: xr.Dataset, margin: float | None = None) -> xr.DataArray:
 
         box_min + margin <= (x, y) <= box_max - margin
 
+    along each direction that has walls; along a periodic direction of a cell (the fields'
+    attribute ``periodic``) every node is inside.
+
     Within a few kernel widths of the walls the fields fall off (the kernel reaches past the
     packing: 2.3% of it at two widths), so profiles and averages of the bulk leave that layer out.
 
@@ -358,8 +408,14 @@ def interior(fields: xr.Dataset, margin: float | None = None) -> xr.DataArray:
             or not np.isfinite(margin) or margin < 0:
         raise ParameterError(f"margin={margin!r}: expected a distance >= 0 in m")
     lo, hi = fields["box_min"] + margin, fields["box_max"] - margin
-    inside = ((fields["x"] >= lo.sel(xy="x", drop=True)) & (fields["x"] <= hi.sel(xy="x", drop=True))
-              & (fields["y"] >= lo.sel(xy="y", drop=True)) & (fields["y"] <= hi.sel(xy="y", drop=True)))
+    periodic = fields.attrs.get("periodic", (0, 0))
+    inside_x = (fields["x"] >= lo.sel(xy="x", drop=True)) & (fields["x"] <= hi.sel(xy="x", drop=True))
+    inside_y = (fields["y"] >= lo.sel(xy="y", drop=True)) & (fields["y"] <= hi.sel(xy="y", drop=True))
+    if periodic[0]:  # no wall along a periodic direction: every node is in the bulk
+        inside_x = xr.ones_like(inside_x, dtype=bool)
+    if periodic[1]:
+        inside_y = xr.ones_like(inside_y, dtype=bool)
+    inside = inside_x & inside_y
     return inside.transpose(..., "y", "x").rename("interior")
 
 

@@ -30,6 +30,7 @@ from __future__ import annotations
 import numpy as np
 
 from .._kernels.coarse_graining import spread_points, spread_segments
+from ...contract.cell import fractional, from_fractional, wrap
 from ...contract.errors import ParameterError
 from .signature import CONTACT, CONTACT_XY, PARTICLE, SCALAR, TENSOR, core_dims
 from .vectors import force_vectors
@@ -38,7 +39,7 @@ GRID = ("y", "x")
 """Dimension names of a field on the grid: rows along y, columns along x."""
 PARTICLE_XY = ("particle", "xy")
 
-__all__ = ["GRID", "kernel_radius", "grid_nodes", "check_grid", "coarse_grained_fields"]
+__all__ = ["GRID", "CELL", "kernel_radius", "grid_nodes", "check_grid", "image_offsets", "coarse_grained_fields"]
 
 
 def kernel_radius(width: float, cutoff: float) -> float:
@@ -73,11 +74,72 @@ def _rows(a, lead, tail=()):
     return np.ascontiguousarray(a.reshape((-1,) + tail))
 
 
+CELL = ("cell_vector", "xy")
+"""Core dimensions of a periodic cell's lattice vectors (rows a, b)."""
+XY = ("xy",)
+
+
+def image_offsets(cell, origin, periodic, x, y, reach):
+    """The whole-cell shifts (m, n) whose images of the cell can reach the grid: every
+    ``m a + n b`` such that a source wrapped into the cell ``origin + s a + t b`` (0 <= s, t < 1)
+    and moved by it comes within ``reach`` of the grid's bounding box, for every snapshot.
+
+    Parameters
+    ----------
+    cell : numpy.ndarray, (B, 2, 2)
+        Lattice vectors, m, in the restricted form a = (l, 0), b = (tilt, h).
+    origin : numpy.ndarray, (B, 2)
+        The cell's origin (``box_min``), m.
+    periodic : array_like of bool, (2,)
+        Along which vectors the sample repeats (0: only shift 0 along it).
+    x, y : numpy.ndarray
+        The grid's coordinates, m.
+    reach : float
+        How far a source reaches (the kernel's radius plus the longest segment), m.
+
+    Returns
+    -------
+    numpy.ndarray of int64, (K, 2)
+        The shifts (m, n), (0, 0) among them.
+    """
+    periodic = np.asarray(periodic, bool)
+    l, tilt, h = cell[:, 0, 0], cell[:, 1, 0], cell[:, 1, 1]
+    ox, oy = origin[:, 0], origin[:, 1]
+    if periodic[1]:
+        n_lo = int(np.floor(((y[0] - reach - oy - h) / h).min()))
+        n_hi = int(np.ceil(((y[-1] + reach - oy) / h).max()))
+    else:
+        n_lo = n_hi = 0
+    shifts = []
+    for n in range(n_lo, n_hi + 1):
+        if periodic[0]:
+            # the wrapped sources lie within x in [ox + min(0, tilt), ox + l + max(0, tilt)]; moved by n b
+            left = ox + np.minimum(0.0, tilt) + n * tilt
+            right = ox + l + np.maximum(0.0, tilt) + n * tilt
+            m_lo = int(np.floor(((x[0] - reach - right) / l).min()))
+            m_hi = int(np.ceil(((x[-1] + reach - left) / l).max()))
+        else:
+            m_lo = m_hi = 0
+        shifts.extend((m, n) for m in range(m_lo, m_hi + 1))
+    return np.array(shifts, dtype=np.int64).reshape(-1, 2)
+
+
+def _images(points, offsets, extra=()):
+    """``points`` (B, N, 2) moved by each of ``offsets`` (B, K, 2), as (B, K N, 2); each array of
+    ``extra`` ((B, N, ...)) repeated alongside, image after image."""
+    moved = (points[:, None, :, :] + offsets[:, :, None, :]).reshape(points.shape[0], -1, 2)
+    k = offsets.shape[1]
+    return (np.ascontiguousarray(moved),) + tuple(
+        np.ascontiguousarray(np.broadcast_to(e[:, None], (e.shape[0], k) + e.shape[1:]).reshape(
+            (e.shape[0], k * e.shape[1]) + e.shape[2:])) for e in extra)
+
+
 @core_dims(PARTICLE_XY, PARTICLE_XY, PARTICLE, PARTICLE, CONTACT, CONTACT, CONTACT, CONTACT_XY, CONTACT_XY,
            CONTACT, CONTACT, SCALAR,
            out=(GRID, GRID, GRID + ("xy",), GRID + ("xy",), GRID + TENSOR, GRID + TENSOR, GRID + TENSOR))
 def coarse_grained_fields(position, velocity, mass, area, i, fn, ft, normal, branch, stress_mask, fabric_mask,
-                          thickness, *, x, y, width, cutoff=3.0):
+                          thickness, cell=None, cell_rate=None, origin=None, *, x, y, width, cutoff=3.0,
+                          periodic=None):
     """Density, solid fraction, momentum, velocity, kinetic and contact stress and fabric on the
     grid (x, y) (the module's formulas), for every snapshot of the leading axes.
 
@@ -103,6 +165,16 @@ def coarse_grained_fields(position, velocity, mass, area, i, fn, ft, normal, bra
         Standard deviation w of the Gaussian kernel, m.
     cutoff : float, default 3
         The kernel is cut at radius ``cutoff * width`` and renormalised to integral 1.
+    cell, cell_rate : array_like, (..., 2, 2), optional
+        A periodic cell's lattice vectors (rows a, b; m) and their rates of change (m s-1),
+        with ``origin`` (..., 2) (m) and ``periodic`` (2,): the sample repeats along the
+        vectors flagged in ``periodic``, and every particle and every contact's segment is
+        spread with all its images ``+ m a + n b`` that reach the grid (:func:`image_offsets`),
+        so that the fields are those of the infinite periodic packing: periodic over the plane,
+        a particle near one edge of the cell counted near the opposite one, a contact across
+        the boundary spread along its minimum-image branch on both sides. An image's velocity
+        is ``v + m da/dt + n db/dt`` (Lees–Edwards: the images above a cell sheared at the
+        rate d tilt/dt move that much faster). Without ``cell`` the sample is bounded.
 
     Returns
     -------
@@ -138,8 +210,35 @@ def coarse_grained_fields(position, velocity, mass, area, i, fn, ft, normal, bra
                         m * v[..., 1] ** 2], axis=-1)
     active = np.isfinite(pos).all(-1) & np.isfinite(m) & np.isfinite(a)
     points = np.zeros((b, y.size, x.size, weights.shape[-1]))
-    spread_points(np.ascontiguousarray(pos[..., 0]), np.ascontiguousarray(pos[..., 1]), active,
-                  np.ascontiguousarray(np.where(active[..., None], weights, 0.0)), x, y, float(width), radius, points)
+    if cell is not None:
+        cells_ = _rows(cell, lead, (2, 2))
+        rates = _rows(0.0 if cell_rate is None else cell_rate, lead, (2, 2))
+        start_of = _rows(origin, lead, (2,))
+        periodic = np.asarray(periodic, bool)
+        seg = np.abs(_rows(branch, lead, (n_c, 2)))
+        longest = float(np.nanmax(seg, initial=0.0)) if seg.size else 0.0
+        shifts = image_offsets(cells_, start_of, periodic, x, y, radius + longest).astype(float)
+        offsets = shifts[None, :, 0:1] * cells_[:, None, 0] + shifts[None, :, 1:2] * cells_[:, None, 1]  # (B, K, 2)
+        kicks = shifts[None, :, 0:1] * rates[:, None, 0] + shifts[None, :, 1:2] * rates[:, None, 1]
+        home = np.where(np.isfinite(pos), wrap(np.nan_to_num(pos), start_of[:, None], cells_[:, None], periodic), pos)
+        into = home - pos  # what wrapping moved each centre by (whole cells)
+        fraction = fractional(into, cells_[:, None])
+        into_rate = from_fractional(np.rint(fraction), rates[:, None])  # the velocity that move adds
+        v_home = v + np.where(moving[..., None], into_rate, 0.0)
+        (centres, speeds, masses, areas, alive) = _images(home, offsets, (v_home, m, a, active))
+        speeds = speeds + np.broadcast_to(kicks[:, :, None, :], (b, shifts.shape[0], n_p, 2)).reshape(b, -1, 2)
+        moving_images = np.broadcast_to(moving[:, None], (b, shifts.shape[0], n_p)).reshape(b, -1)
+        speeds = np.where(moving_images[..., None], speeds, 0.0)
+        weights = np.stack([masses, areas, masses * speeds[..., 0], masses * speeds[..., 1],
+                            masses * speeds[..., 0] ** 2, masses * speeds[..., 0] * speeds[..., 1],
+                            masses * speeds[..., 1] ** 2], axis=-1)
+        spread_points(np.ascontiguousarray(centres[..., 0]), np.ascontiguousarray(centres[..., 1]), alive,
+                      np.ascontiguousarray(np.where(alive[..., None], weights, 0.0)), x, y, float(width), radius,
+                      points)
+    else:
+        spread_points(np.ascontiguousarray(pos[..., 0]), np.ascontiguousarray(pos[..., 1]), active,
+                      np.ascontiguousarray(np.where(active[..., None], weights, 0.0)), x, y, float(width), radius,
+                      points)
 
     # contacts: f (x) l (xx, xy, yx, yy) where stressed, n (x) n (xx, xy, yy) and 1 where in the fabric
     stress_mask = np.broadcast_to(np.asarray(stress_mask, bool), lead + (n_c,)).reshape(b, n_c)
@@ -161,11 +260,20 @@ def coarse_grained_fields(position, velocity, mass, area, i, fn, ft, normal, bra
                                                 np.ones_like(nrm[..., 0])], -1), 0.0)
     weights = np.where(active[..., None], np.concatenate([fl, nn], axis=-1), 0.0)
     segments = np.zeros((b, y.size, x.size, weights.shape[-1]))
-    spread_segments(np.ascontiguousarray(np.where(active, start[..., 0], 0.0)),
-                    np.ascontiguousarray(np.where(active, start[..., 1], 0.0)),
-                    np.ascontiguousarray(np.where(active, arm[..., 0], 0.0)),
-                    np.ascontiguousarray(np.where(active, arm[..., 1], 0.0)),
-                    active, np.ascontiguousarray(weights), x, y, float(width), radius, segments)
+    if cell is not None:
+        start = np.where(active[..., None], start, 0.0)
+        home = wrap(start, start_of[:, None], cells_[:, None], periodic)
+        arm = np.where(active[..., None], arm, 0.0)
+        (starts, arms, used_images, weight_images) = _images(home, offsets, (arm, active, weights))
+        spread_segments(np.ascontiguousarray(starts[..., 0]), np.ascontiguousarray(starts[..., 1]),
+                        np.ascontiguousarray(arms[..., 0]), np.ascontiguousarray(arms[..., 1]),
+                        used_images, weight_images, x, y, float(width), radius, segments)
+    else:
+        spread_segments(np.ascontiguousarray(np.where(active, start[..., 0], 0.0)),
+                        np.ascontiguousarray(np.where(active, start[..., 1], 0.0)),
+                        np.ascontiguousarray(np.where(active, arm[..., 0], 0.0)),
+                        np.ascontiguousarray(np.where(active, arm[..., 1], 0.0)),
+                        active, np.ascontiguousarray(weights), x, y, float(width), radius, segments)
 
     per_t = (1.0 / t)[:, None, None, None]
     points_t = points * per_t  # per unit volume
