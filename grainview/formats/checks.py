@@ -289,16 +289,19 @@ _SNAPSHOT_VALUES = (("time", "time", None, 1), ("position", "position", "particl
                     ("angle", "angle", "particle", 1), ("velocity", "speed", "particle", 2),
                     ("angular_velocity", "angular_velocity", "particle", 1), ("box_min", "position", None, 2),
                     ("box_max", "position", None, 2), ("wall_position", "position", "wall", 2),
-                    ("wall_velocity", "speed", "wall", 2), ("wall_force", "wall_force", "wall", 2))
+                    ("wall_velocity", "speed", "wall", 2), ("wall_force", "wall_force", "wall", 2),
+                    ("cell", "length", None, 4))
 """A snapshot's values: (name, kind of bound, what a row is (None: the snapshot's one value), width)."""
 _CONTACT_KINDS = {"fn": "force", "ft": "force", "point": "position", "branch": "length", "gap": "length",
                   "normal": "unit"}
 
 
-def check_snapshot(limits: Limits, snap: dict, where: str) -> None:
+def check_snapshot(limits: Limits, snap: dict, where: str, periodic=None) -> None:
     """Refuse a snapshot (the dict a reader yields for
     :meth:`grainview.contract.writer.SnapshotWriter.append`) holding a value that is not finite or
-    is beyond its bound: the last check before anything is stored.
+    is beyond its bound: the last check before anything is stored. In a periodic sample
+    (``periodic``, the run's flags per cell vector, and the snapshot's ``cell``) the contacts are
+    checked against the minimum images of the centres (:func:`check_contacts`).
 
     Raises
     ------
@@ -324,7 +327,8 @@ def check_snapshot(limits: Limits, snap: dict, where: str) -> None:
             limits.check(contacts[name], name, kind, where, rows=lambda k: f"contact {k}",
                          centre=middle if kind == "position" else None)
     if contacts:
-        check_contacts(limits, position, contacts, where)
+        cell = snap.get("cell") if periodic is not None else None
+        check_contacts(limits, position, contacts, where, cell=cell, periodic=periodic if cell is not None else None)
 
 
 def check_step(step, where: str) -> None:
@@ -346,7 +350,8 @@ def _bodies(n_particles):
     return lambda k: f"particle {k}" if k < n_particles else f"wall {k - n_particles}"
 
 
-def check_contacts(limits: Limits, position, contacts: dict, where: str, names=None) -> None:
+def check_contacts(limits: Limits, position, contacts: dict, where: str, names=None, cell=None,
+                   periodic=None) -> None:
     """Refuse a contact that cannot exist for its bodies' positions and sizes.
 
     Each contact of bodies ``i < j`` (``j >= N`` a wall) must touch: the tolerance ``tol`` is
@@ -374,6 +379,11 @@ def check_contacts(limits: Limits, position, contacts: dict, where: str, names=N
         The file and the snapshot, for the message.
     names : callable, optional
         Body k's name in the message (default ``"particle k"``, ``"wall w"`` for ``k = N + w``).
+    cell : array_like, (2, 2), optional
+        A periodic sample's lattice vectors (:mod:`grainview.contract.cell`), with ``periodic``
+        (2,), the cell vectors along which it repeats: particle j is then the image of j nearest
+        i, ``x_i + minimum_image(x_j - x_i)``, wherever the cell's boundary lies between them
+        (its ``branch`` the minimum image, its contact point near that image).
 
     Raises
     ------
@@ -398,6 +408,11 @@ def check_contacts(limits: Limits, position, contacts: dict, where: str, names=N
     small = np.minimum(r_i, r_j)
     tol = CONTACT_TOLERANCE * small
     centres = position[jp] - position[i]
+    if cell is not None and periodic is not None and np.any(periodic):
+        from ..contract.cell import minimum_image
+
+        centres = minimum_image(centres, np.asarray(cell, float), np.asarray(periodic).astype(bool))
+    image_j = position[i] + centres  # particle j, or its image nearest i in a periodic cell
     distance = np.hypot(centres[:, 0], centres[:, 1])
     shown = f"{CONTACT_TOLERANCE:g} of the smaller radius"
     problems = []  # (mask, message of contact k)
@@ -411,15 +426,16 @@ def check_contacts(limits: Limits, position, contacts: dict, where: str, names=N
         length = np.hypot(branch[:, 0], branch[:, 1])
         problems.append((pair & (off > tol), lambda k: (
             f"branch = ({branch[k, 0]:.6g}, {branch[k, 1]:.6g}) m, but the centres are at ({centres[k, 0]:.6g}, "
-            f"{centres[k, 1]:.6g}) m from one another; expected the branch x_j - x_i")))
+            f"{centres[k, 1]:.6g}) m from one another; expected the branch x_j - x_i"
+            + (" (its minimum image in the periodic cell)" if cell is not None else ""))))
         problems.append((~pair & (length > r_i + tol), lambda k: (
             f"the contact point is {length[k]:.6g} m from the centre of {names(i[k])}, whose radius is {r_i[k]:.6g} m; "
             f"expected a point on the particle (at most {shown} outside it)")))
     point = contacts.get("point")
     if point is not None:
         point = np.asarray(point, float).reshape(-1, 2)
-        for body, r, which in ((i, r_i, np.ones(i.size, bool)), (jp, r_j, pair)):
-            away = np.hypot(*(point - position[body]).T)
+        for body, centre, r, which in ((i, position[i], r_i, np.ones(i.size, bool)), (jp, image_j, r_j, pair)):
+            away = np.hypot(*(point - centre).T)
             problems.append((which & (away > r + tol), lambda k, away=away, body=body, r=r: (
                 f"the contact point ({point[k, 0]:.6g}, {point[k, 1]:.6g}) m is {away[k]:.6g} m from the centre of "
                 f"{names(body[k])}, whose radius is {r[k]:.6g} m; expected a point on both bodies (at most {shown} "

@@ -65,10 +65,13 @@ def snapshots_dataset(static, snaps, per_snapshot=(), **static_optional):
     ----------
     static : dict
         The reader's static data: ``radius``, ``mass``, ``inertia`` (and ``n_vertices`` for
-        polygons; disks without it), ``n_walls``, ``wall_names``, ``attrs``.
+        polygons; disks without it), ``n_walls``, ``wall_names``, ``attrs``; for a periodic
+        sample ``periodic`` (2,), the flags of the cell vectors a, b (and ``attrs`` may say
+        ``cell_positions``).
     snaps : list of dict
         One dict per snapshot: ``time``, ``position``, ``box_min``, ``box_max``, ``contacts``
-        and, where every snapshot has it, ``angle`` (zero otherwise).
+        and, where every snapshot has it, ``angle`` (zero otherwise); in a periodic sample each
+        its ``cell`` (2, 2), the lattice vectors (:mod:`grainview.contract.cell`).
     per_snapshot : sequence of str
         Optional contract variables stacked over the snapshots where every snapshot has them.
     **static_optional
@@ -85,12 +88,15 @@ def snapshots_dataset(static, snaps, per_snapshot=(), **static_optional):
 
     limits = _limits(static)
     empty = _EmptySnapshots(static)
+    periodic = static.get("periodic")
     for k, snap in enumerate(snaps):
-        check_snapshot(limits, snap, _where(static, k, snap))
+        check_snapshot(limits, snap, _where(static, k, snap), periodic)
         empty.add(snap)
     empty.warn()
     optional = {name: np.stack([s[name] for s in snaps]) for name in per_snapshot if all(name in s for s in snaps)}
     optional.update({name: value for name, value in static_optional.items() if value is not None})
+    if periodic is not None:
+        optional.update(periodic=np.asarray(periodic), cell=np.stack([s["cell"] for s in snaps]))
     n = static["radius"].size
     slots = max([contact_slots(n, static["n_walls"])] + [len(s["contacts"]["i"]) for s in snaps])
     angle = np.stack([s["angle"] for s in snaps]) if all("angle" in s for s in snaps) else None
@@ -114,10 +120,12 @@ def write_snapshots(out, static, snapshots, optional, *, overwrite=False, compre
         ``radius``, ``mass``, ``inertia`` (N,), and optionally ``n_vertices`` (default: disks),
         ``vertices`` (N, V, 2: the polygons' own-frame vertices, :mod:`grainview.contract.shapes`;
         absent: regular polygons),
-        ``n_walls``, ``wall_names``, ``wall_normal`` and ``attrs`` (global attributes).
+        ``n_walls``, ``wall_names``, ``wall_normal``, ``periodic`` (a periodic sample's flags of
+        the cell vectors a, b) and ``attrs`` (global attributes; ``cell_positions`` for a
+        periodic sample).
     snapshots : iterable of dict
         One dict per snapshot, as :meth:`~grainview.contract.writer.SnapshotWriter.append` takes it
-        (after ``prepare``).
+        (after ``prepare``); in a periodic sample each with its ``cell`` (2, 2).
     optional : sequence of str
         The optional variables the snapshots hold.
     overwrite, compress : bool
@@ -191,10 +199,10 @@ def _write(out, static, snapshots, optional, overwrite, compress, progress, labe
                                    vertices=static.get("vertices"),
                                    n_walls=static.get("n_walls", 0), wall_names=static.get("wall_names"),
                                    wall_normal=static.get("wall_normal"), optional=tuple(optional),
-                                   attrs=static.get("attrs")) as writer:
+                                   attrs=static.get("attrs"), periodic=static.get("periodic")) as writer:
             for snap in stream:
                 snap = prepare(snap) if prepare is not None else snap
-                check_snapshot(limits, snap, _where(static, count, snap))
+                check_snapshot(limits, snap, _where(static, count, snap), static.get("periodic"))
                 empty.add(snap)
                 writer.append(**snap)
                 count += 1

@@ -4,7 +4,8 @@ A 2D granular LAMMPS run (``dimension 2``, ``atom_style sphere``, a granular pai
 its particles and its contacts in two text dumps, and optionally its wall contacts in a third:
 
 * **particles**: a ``dump custom`` with columns (found by name) ``id``, ``radius``, ``mass``,
-  ``x``, ``y``, and optionally ``vx``, ``vy``, ``omegaz``;
+  ``x``, ``y`` (or the unwrapped ``xu``, ``yu`` of a periodic run), and optionally ``vx``,
+  ``vy``, ``omegaz``;
 * **contacts**: a ``dump local`` of ``compute property/local patom1 patom2`` and
   ``compute pair/local fx fy fz p1 p2 p3``: one row per neighbour pair, with the force on
   ``patom1`` from ``patom2``. For the granular pair styles ``fx, fy, fz`` is only the central
@@ -32,7 +33,21 @@ How the contract's quantities are made (docs/formats.md states the same for user
   told apart by the direction from the particle to the contact point); ``normal`` points from
   the particle to the wall, ``branch`` is from the centre to the contact point, and the force
   exerted by the particle on the wall is minus the force the fix reports on the particle.
-* ``time = step x time step``; the box is each snapshot's ``BOX BOUNDS`` (x and y);
+* ``time = step x time step``; the box is each snapshot's ``BOX BOUNDS`` (x and y; a
+  triclinic header's bounding box undone, :mod:`grainview.formats.lammps_dump`), except where
+  the log defines a plane ``fix wall/gran`` of the walls dump: there the box's side is the
+  wall, where it stands at that step (moved by the fix's ``wiggle``,
+  ``lo + A - A cos(2 pi (step - step0) dt / P)``, step0 the step the fix was defined at), and
+  every contact point of that wall must lie on it; with all four walls known, ``wall_position``;
+* **periodic** boxes (``boundary p ...`` in x and/or y) give the contract's cell
+  (:mod:`grainview.contract.cell`): ``a = (l, 0)``, ``b = (xy, h)`` with ``xy`` the triclinic
+  tilt (``change_box all triclinic``, ``fix deform ... xy ... remap v``, box flips included:
+  each snapshot's own tilt is taken), ``periodic`` the flags of x and y; separations of centres
+  are minimum images, so ``branch``, ``normal``, overlap and ``point`` (which may lie outside
+  the cell) are those of the nearest images; positions ``x y`` are wrapped into the cell
+  (LAMMPS wraps atoms only when it rebuilds its neighbour lists; the contact points move with
+  them), ``xu yu`` are kept unwrapped (``cell_positions``). A tilt is read only in a cell
+  periodic in x and y, no wall may stand across a periodic direction, and ``xz = yz = 0``;
   ``inertia = m r^2 / 2`` for disks (``fix nve/sphere ... disc``; ``2 m r^2 / 5`` when the log
   shows ``nve/sphere`` without ``disc``).
 * LAMMPS's 2D forces are taken as forces per unit thickness: ``thickness_m = 1``, so stresses
@@ -49,12 +64,14 @@ counted in one warning.
 
 from __future__ import annotations
 
+import math
 import os
 import re
 import warnings
 
 import numpy as np
 
+from ..contract.cell import fractional, minimum_image, restricted_cell, wrap
 from ..contract.errors import FileFormatError, ParameterError
 from .checks import Limits, check_contacts, check_step
 from .lammps_dump import LammpsLog, iter_dump, read_log
@@ -66,8 +83,10 @@ WALL_NAMES = ("bottom", "right", "top", "left")
 _WALL_DIRECTIONS = np.array([[0.0, -1.0], [1.0, 0.0], [0.0, 1.0], [-1.0, 0.0]])
 """Direction from a particle to each wall of :data:`WALL_NAMES`."""
 
-PARTICLE_COLUMNS = {"required": ("id", "radius", "mass", "x", "y"), "optional": ("vx", "vy", "omegaz")}
-"""Columns of the particles' ``dump custom``, by LAMMPS's own names."""
+PARTICLE_COLUMNS = {"required": ("id", "radius", "mass", "x", "y"), "optional": ("vx", "vy", "omegaz"),
+                    "unwrapped": ("xu", "yu")}
+"""Columns of the particles' ``dump custom``, by LAMMPS's own names; ``xu yu`` (unwrapped
+positions of a periodic run) may stand for ``x y``."""
 PAIR_COLUMNS = ("patom1", "patom2", "fx", "fy", "p1", "p2")
 """Quantities the reader needs from the pairs' ``dump local``: the atom ids, and the force on
 ``patom1`` from ``patom2`` as LAMMPS's granular pair styles give it, a central part ``fx, fy``
@@ -131,11 +150,22 @@ def pair_columns(columns, log: LammpsLog | None = None, mapping: dict | None = N
     return found
 
 
+def _position_columns(columns):
+    """The position columns of a particles' dump: ``x y`` (wrapped into a periodic cell by
+    LAMMPS), else ``xu yu`` (unwrapped), else None."""
+    for pair in (("x", "y"), PARTICLE_COLUMNS["unwrapped"]):
+        if all(name in columns for name in pair):
+            return pair
+    return None
+
+
 def _check_particle_columns(snap, source):
-    missing = [c for c in PARTICLE_COLUMNS["required"] if c not in snap.columns]
+    missing = [c for c in PARTICLE_COLUMNS["required"][:3] if c not in snap.columns]
+    if _position_columns(snap.columns) is None:
+        missing += ["x", "y"]
     if missing:
         raise FileFormatError(f"{source}: step {snap.timestep}: no column {', '.join(missing)} (has "
-                              f"{' '.join(snap.columns)}); dump custom needs id radius mass x y")
+                              f"{' '.join(snap.columns)}); dump custom needs id radius mass x y (or xu yu)")
     _check_ids(snap.column("id"), "id", f"{source}: step {snap.timestep}", snap)
 
 
@@ -215,6 +245,7 @@ class _Particles:
         self.inertia = inertia_factor * self.mass * self.radius**2
         self.limits = Limits(self.radius, 1.0, where, mass=self.mass, inertia=self.inertia)
         self.source = source
+        self.xy = _position_columns(snap.columns)
 
     def name(self, k):
         """Particle k's name in a message: its LAMMPS atom id."""
@@ -242,8 +273,11 @@ class _Particles:
         where = f"{self.source}: step {snap.timestep}"
         self.limits.check(snap.column("radius"), "radius", "length", where, rows=_lines(snap))
         self.limits.check(snap.column("mass"), "mass", "number", where, rows=_lines(snap))
-        self.limits.check(snap.data[:, [snap.columns.index("x"), snap.columns.index("y")]], ("x", "y"), "position",
-                          where, rows=_lines(snap))
+        if _position_columns(snap.columns) != self.xy:
+            raise FileFormatError(f"{where}: positions in columns {' '.join(_position_columns(snap.columns))}, the "
+                                  f"first snapshot's in {' '.join(self.xy)}; expected the same columns throughout")
+        self.limits.check(snap.data[:, [snap.columns.index(self.xy[0]), snap.columns.index(self.xy[1])]], self.xy,
+                          "position", where, rows=_lines(snap))
         kinds = {"vx": "speed", "vy": "speed", "omegaz": "angular_velocity"}
         for name in PARTICLE_COLUMNS["optional"]:
             if name in snap.columns:
@@ -255,7 +289,7 @@ class _Particles:
         if not np.allclose(snap.column("mass")[order], self.mass, rtol=1e-12, atol=0):
             raise FileFormatError(f"{self.source}: step {snap.timestep}: masses changed during the run; the "
                                   "contract holds one mass per particle")
-        position = np.stack([snap.column("x")[order], snap.column("y")[order]], axis=1)
+        position = np.stack([snap.column(self.xy[0])[order], snap.column(self.xy[1])[order]], axis=1)
         extra = {}
         if "vx" in snap.columns and "vy" in snap.columns:
             extra["velocity"] = np.stack([snap.column("vx")[order], snap.column("vy")[order]], axis=1)
@@ -264,10 +298,11 @@ class _Particles:
         return position, extra
 
 
-def _pair_contacts(particles, position, snap, columns, where):
+def _pair_contacts(particles, position, snap, columns, where, cell=None, periodic=None):
     """Contract contacts (dict of arrays) of the touching, compressed pairs of one pairs
     snapshot, the number of touching pairs left out for a tensile normal force, and the number
-    of pairs that do not touch but carry a force (left out)."""
+    of pairs that do not touch but carry a force (left out). In a periodic cell (``cell``,
+    ``periodic``) the separation of two centres is its minimum image."""
     for name in ("patom1", "patom2"):
         _check_ids(snap.data[:, columns[name]], name, where, snap)
     for name in ("fx", "fy", "p1", "p2"):
@@ -281,7 +316,7 @@ def _pair_contacts(particles, position, snap, columns, where):
         raise FileFormatError(f"{where}: line {snap.line + k}: a pair of atom {particles.ids[a[k]]} with itself; "
                               "expected pairs of two atoms")
     radius = particles.radius
-    d = position[b] - position[a]
+    d = _separation(position[b] - position[a], cell, periodic)
     overlap = radius[a] + radius[b] - np.hypot(d[:, 0], d[:, 1])
     touching = overlap > 0
     apart = int(np.count_nonzero(~touching & np.any(force != 0, axis=1)))
@@ -298,8 +333,9 @@ def _pair_contacts(particles, position, snap, columns, where):
             raise FileFormatError(f"{where}: pair {particles.ids[i[k]]}-{particles.ids[j[k]]} is listed twice "
                                   "with different forces")
         i, j, on_j, overlap = i[first], j[first], on_j[first], overlap[first]
-    check_contacts(particles.limits, position, dict(i=i, j=j, gap=-overlap), where, particles.name)
-    branch = position[j] - position[i]
+    check_contacts(particles.limits, position, dict(i=i, j=j, gap=-overlap), where, particles.name, cell=cell,
+                   periodic=periodic)
+    branch = _separation(position[j] - position[i], cell, periodic)
     n = branch / np.hypot(branch[:, 0], branch[:, 1])[:, None]
     fn = np.einsum("ij,ij->i", on_j, n)
     loaded = fn > 0
@@ -311,8 +347,19 @@ def _pair_contacts(particles, position, snap, columns, where):
     return contacts, int((~loaded).sum()), apart
 
 
-def _wall_contacts(particles, position, snap, fixes, where):
-    """Contract contacts of one walls snapshot (fix wall/gran ... contacts arrays)."""
+def _separation(d, cell, periodic):
+    """``d`` itself, or its minimum image in a periodic cell."""
+    if cell is None or periodic is None or not np.any(periodic):
+        return d
+    return minimum_image(d, cell, periodic)
+
+
+def _wall_contacts(particles, position, snap, fixes, where, periodic=(False, False), walls_at=None):
+    """Contract contacts of one walls snapshot (fix wall/gran ... contacts arrays).
+
+    ``periodic``: the directions x, y along which the cell repeats (no wall may stand across
+    them); ``walls_at``: wall index -> its coordinate (x of left and right, y of bottom and
+    top) where the run's log defines it, against which every contact point is checked."""
     n_particles = particles.ids.size
     _check_ids(snap.column("id"), "id", where, snap)
     for fix, cols in fixes.items():
@@ -353,6 +400,26 @@ def _wall_contacts(particles, position, snap, fixes, where):
             raise FileFormatError(f"{where}: fix {fix}: a wall that is not an x or y plane (only fix wall/gran "
                                   "xplane and yplane walls can be read)")
         n = _WALL_DIRECTIONS[wall]
+        normal_axis = 1 - wall % 2  # the coordinate a wall bounds: y for bottom and top, x for right and left
+        across = np.flatnonzero(np.asarray(periodic, bool)[normal_axis])
+        if across.size:
+            k = int(across[0])
+            raise FileFormatError(f"{where}: fix {fix}: atom {particles.ids[p[k]]} touches the {WALL_NAMES[wall[k]]} "
+                                  f"wall, across {'xy'[normal_axis[k]]}, a periodic direction; expected walls only "
+                                  "across directions that are not periodic (LAMMPS refuses a wall in a periodic "
+                                  "dimension)")
+        if walls_at:
+            for w, at in walls_at.items():
+                on = wall == w
+                axis = 1 - w % 2
+                off = np.abs(point[on, axis] - at) > 1e-9 * max(particles.limits.diameter, abs(at))
+                if off.any():
+                    k = int(np.flatnonzero(on)[np.flatnonzero(off)[0]])
+                    raise FileFormatError(
+                        f"{where}: fix {fix}: atom {particles.ids[p[k]]} touches the {WALL_NAMES[w]} wall at "
+                        f"{'xy'[axis]} = {point[k, axis]:.17g}, but the log's definition of the wall puts it at "
+                        f"{'xy'[axis]} = {at:.17g} at this step; expected the wall the log describes (a wall moved "
+                        "otherwise than by the fix's wiggle, e.g. fix wall/gran/region, cannot be placed)")
         on_wall = -on_particle
         loaded = np.einsum("ij,ij->i", on_wall, n) > 0
         tensile += int((~loaded).sum())
@@ -373,22 +440,154 @@ def _wall_contacts(particles, position, snap, fixes, where):
     return joined, tensile
 
 
-def _check_box(particles, position, snap, source):
-    """One line for a particle whose centre lies outside the snapshot's box (the volume of the
-    solid fraction and the stresses) by more than the largest diameter (LAMMPS lets atoms
-    stray a little beyond a fixed boundary between two rebuilds of its neighbour lists)."""
+def _check_box(particles, position, snap, source, box_min, box_max, cell=None, periodic=(False, False),
+               unwrapped=False, walls=False):
+    """One line for a particle whose centre lies outside the sample by more than the largest
+    diameter (LAMMPS lets atoms stray a little beyond a fixed boundary, and beyond a periodic
+    cell's edge, between two rebuilds of its neighbour lists). Along a bounded direction the
+    sample is ``box_min .. box_max`` (the box, or the region between the walls: the volume of
+    the solid fraction and the stresses); along a periodic one the cell, in its own coordinates
+    (a tilted cell's edges are tilted), unless the positions are ``unwrapped`` (``xu yu``)."""
     margin = particles.limits.diameter
     for axis, name in enumerate("xy"):
-        low, high = snap.bounds[axis]
+        low, high = box_min[axis], box_max[axis]
         if not low <= high:  # not a box at all: the contract's check of the finished run says so
+            continue
+        if periodic[axis]:
+            if unwrapped:
+                continue
+            st = fractional(position - box_min, cell)[:, axis]
+            outside = (st < -margin / (high - low)) | (st > 1 + margin / (high - low))
+            if outside.any():
+                k = int(np.flatnonzero(outside)[0])
+                raise FileFormatError(
+                    f"{source}: step {snap.timestep}: atom {particles.ids[k]} at ({position[k, 0]:.6g}, "
+                    f"{position[k, 1]:.6g}) lies outside the periodic cell along {name} by more than a particle "
+                    f"diameter (cell coordinate {st[k]:.6g}, expected 0 to 1); expected positions wrapped into the "
+                    "cell (dump custom ... x y), or unwrapped ones named xu yu")
             continue
         outside = (position[:, axis] < low - margin) | (position[:, axis] > high + margin)
         if outside.any():
             k = int(np.flatnonzero(outside)[0])
+            if walls:
+                raise FileFormatError(f"{source}: step {snap.timestep}: atom {particles.ids[k]} at {name} = "
+                                      f"{position[k, axis]:.6g} lies outside the region between the walls, {name} = "
+                                      f"{low:.6g} .. {high:.6g} (where the log's fix wall/gran puts them at this "
+                                      "step); expected the particles between the walls, the volume of the solid "
+                                      "fraction and the stresses")
             raise FileFormatError(f"{source}: step {snap.timestep}: atom {particles.ids[k]} at {name} = "
                                   f"{position[k, axis]:.6g} lies outside the box's {name} range {low:.6g} .. "
                                   f"{high:.6g} (ITEM: BOX BOUNDS); expected the particles inside the box, the volume "
                                   "of the solid fraction and the stresses")
+
+
+_PLANES = {"xplane": (0, 3, 1), "yplane": (1, 0, 2)}
+"""A plane wall style -> (the coordinate it bounds, the wall index of its lo and of its hi plane)."""
+
+
+def _wall_planes(log, fixes, periodic, source):
+    """What the log says of the plane walls of the walls dump's fixes: fix ID -> (axis, lo,
+    hi, wiggle, defined at step), ``lo``/``hi`` None where the fix sets it NULL, ``wiggle``
+    (amplitude, period) when the fix moves its planes along their own axis (``wiggle``), else
+    None. A fix the log does not define, or not a plane of ``fix wall/gran``, is left out; one
+    that stands across a periodic direction is refused."""
+    planes = {}
+    if log is None or not fixes:
+        return planes
+    for fix in fixes:
+        style, args = log.fixes.get(fix, (None, ()))
+        if style != "wall/gran":
+            continue
+        found = [k for k, word in enumerate(args) if word in _PLANES]
+        if not found or found[0] + 2 >= len(args):
+            continue
+        k = found[0]
+        axis = _PLANES[args[k]][0]
+        if periodic[axis]:
+            raise FileFormatError(f"{source}: fix {fix} is a wall/gran {args[k]}, a wall across {'xy'[axis]}, but the "
+                                  f"box is periodic in {'xy'[axis]}; expected walls only across directions that are "
+                                  "not periodic")
+        try:
+            lo, hi = (None if args[k + m] == "NULL" else float(args[k + m]) for m in (1, 2))
+        except ValueError:  # a position the log does not give as a number
+            continue
+        wiggle = None
+        rest = list(args[k + 3:])
+        if "wiggle" in rest:
+            w = rest.index("wiggle")
+            try:
+                if rest[w + 1] == "xy"[axis]:
+                    wiggle = (float(rest[w + 2]), float(rest[w + 3]))
+            except (IndexError, ValueError):
+                continue
+        planes[fix] = (axis, lo, hi, wiggle, log.fix_steps.get(fix, 0))
+    return planes
+
+
+def _walls_at(planes, step, time_step):
+    """Wall index -> its coordinate at ``step``, from :func:`_wall_planes`: a plane at ``lo``
+    (``hi``), moved by a wiggle of amplitude A and period P as LAMMPS's fix wall/gran moves it,
+    ``lo + A - A cos(2 pi / P (step - step0) dt)``, step0 the step the fix was defined at."""
+    out = {}
+    for axis, lo, hi, wiggle, step0 in planes.values():
+        _, lo_wall, hi_wall = _PLANES[("xplane", "yplane")[axis]]
+        for value, index in ((lo, lo_wall), (hi, hi_wall)):
+            if value is None:
+                continue
+            if wiggle is not None:
+                amplitude, period = wiggle
+                arg = 2.0 * math.pi / period * (step - step0) * time_step
+                value = value + amplitude - amplitude * math.cos(arg)
+            out[index] = value
+    return out
+
+
+def _box(snap, boundary, periodic, source):
+    """``box_min``, ``box_max`` (x, y) and the tilt ``xy`` of a particles' snapshot; one line
+    for a boundary that changed since the first snapshot, a tilt in 2D that LAMMPS's 2D runs do
+    not have (``xz``, ``yz``), or an ``xy`` tilt of a cell not periodic in both x and y."""
+    where = f"{source}: step {snap.timestep}"
+    if tuple(snap.boundary) != boundary:
+        raise FileFormatError(f"{where}: boundary {' '.join(snap.boundary)}, the first snapshot's "
+                              f"{' '.join(boundary)}; expected the same boundaries throughout")
+    xy, xz, yz = (float(t) for t in snap.tilt)
+    if xz != 0 or yz != 0:
+        raise FileFormatError(f"{where}: a triclinic box with tilts xz = {xz:.6g}, yz = {yz:.6g}; a 2D run has "
+                              "only xy (LAMMPS keeps xz = yz = 0 in 2D)")
+    if xy != 0 and not all(periodic):
+        raise FileFormatError(f"{where}: a triclinic box with tilt xy = {xy:.6g} but boundary "
+                              f"{' '.join(boundary)}; expected a tilt only in a cell periodic in both x and y (a tilt "
+                              "across walls has no sample region)")
+    return snap.bounds[:2, 0].copy(), snap.bounds[:2, 1].copy(), xy
+
+
+def _between_walls(walls_at, box_min, box_max, boundary) -> bool:
+    """Move the sides of the box (``box_min``, ``box_max``, in place) to the walls of
+    ``walls_at`` (wall index -> coordinate): a wall replaces the box's side where it lies within
+    the box (LAMMPS's fixed boundaries hold every atom, so a wall that holds them stands inside
+    the box or on its edge), or where that side is shrink-wrapped (``s``, ``m``: the box follows
+    the atoms, the wall holds them). A wall outside a fixed box holds nothing and is left out;
+    a box that is not one (lo above hi) is left to the contract's check. Returns whether a
+    side moved."""
+    moved = False
+    for index, at in walls_at.items():
+        axis, side = 1 - index % 2, (0 if index in (0, 3) else 1)
+        low, high = box_min[axis], box_max[axis]
+        if not low < high:
+            continue
+        slack = 1e-9 * (high - low)
+        if boundary[axis][side] in "sm" or low - slack <= at <= high + slack:
+            (box_min if side == 0 else box_max)[axis] = at
+            moved = True
+    return moved
+
+
+def _wall_points(walls_at, box_min, box_max):
+    """A point of each wall line (bottom, right, top, left): the wall's coordinate and the
+    middle of the sample along the wall."""
+    middle = (np.asarray(box_min) + np.asarray(box_max)) / 2
+    return np.array([[middle[0], walls_at[0]], [walls_at[1], middle[1]], [middle[0], walls_at[2]],
+                     [walls_at[3], middle[1]]])
 
 
 def _join(pairs, walls):
@@ -437,7 +636,8 @@ def lammps_snapshots(particles, contacts, walls=None, *, log=None, time_step=Non
         A ``dump custom`` of ``id`` and the arrays ``f_ID[1..8]`` of ``fix wall/gran ...
         contacts`` (plane walls).
     log : str or path-like, optional
-        The run's ``log.lammps`` (or input script): the time step and the computes' definitions.
+        The run's ``log.lammps`` (or input script): the time step, the computes' definitions,
+        and the walls' fixes (where the walls stand, and how they move: the sample's box).
     time_step : float, optional
         The time step, s (overrides the log's).
     columns : dict, optional
@@ -453,7 +653,9 @@ def lammps_snapshots(particles, contacts, walls=None, *, log=None, time_step=Non
         ``n_walls``, ``wall_names`` and ``attrs`` (the conversion's provenance); the iterator
         yields one dict per snapshot with ``time`` (s), ``position`` (N, 2), ``angle`` (N,),
         ``contacts`` (dict of contract contact arrays), ``box_min``, ``box_max`` (2,) and,
-        when the dump has them, ``velocity`` and ``angular_velocity``. The static part is read
+        when the dump has them, ``velocity`` and ``angular_velocity``; a periodic run's static
+        part holds ``periodic`` (2,) and each snapshot its ``cell`` (2, 2); a run whose four
+        walls the log places, ``wall_position`` (4, 2). The static part is read
         from the first snapshot at once; the iterator reads the rest one snapshot at a time.
 
     Raises
@@ -487,9 +689,10 @@ def lammps_snapshots(particles, contacts, walls=None, *, log=None, time_step=Non
     static_particles = _Particles(first[0], source, factor)
     pair_index = pair_columns(first[1].columns, log_info, columns, source=os.fspath(contacts))
     fixes = _wall_fixes(first[2].columns, os.fspath(walls)) if walls is not None else None
-    if any(flag.startswith("p") for flag in first[0].boundary[:2]):
-        raise FileFormatError(f"{source}: periodic in x or y (boundary {' '.join(first[0].boundary)}); the contract "
-                              "holds bounded samples only")
+    boundary = tuple(first[0].boundary)
+    periodic = tuple(flag.startswith("p") for flag in boundary[:2])
+    unwrapped = static_particles.xy == PARTICLE_COLUMNS["unwrapped"]
+    planes = _wall_planes(log_info, fixes, periodic, os.fspath(log) if log is not None else source)
     attrs = {"source": "LAMMPS", "lammps_particles": os.path.basename(os.fspath(particles)),
              "lammps_contacts": os.path.basename(os.fspath(contacts)), "lammps_time_step_s": time_step,
              "lammps_inertia": inertia_rule, "thickness_m": 1.0,
@@ -498,9 +701,17 @@ def lammps_snapshots(particles, contacts, walls=None, *, log=None, time_step=Non
         attrs["lammps_walls"] = os.path.basename(os.fspath(walls))
     if log_info is not None and log_info.version:
         attrs["lammps_version"] = log_info.version
+    attrs["lammps_boundary"] = " ".join(boundary)
+    if planes:
+        attrs["lammps_sample_box"] = ("between the walls of " + ", ".join(f"fix {fix}" for fix in planes)
+                                      + " as the log defines them (moved by wiggle where it does), elsewhere the "
+                                        "dump's BOX BOUNDS")
     static = dict(radius=static_particles.radius, mass=static_particles.mass, inertia=static_particles.inertia,
                   n_walls=len(WALL_NAMES) if walls is not None else 0,
                   wall_names=list(WALL_NAMES) if walls is not None else None, attrs=attrs)
+    if any(periodic):
+        static["periodic"] = np.array(periodic, "i1")
+        attrs["cell_positions"] = "unwrapped" if unwrapped else "wrapped"
 
     def snapshots():
         from .convert import chain_first
@@ -513,16 +724,33 @@ def lammps_snapshots(particles, contacts, walls=None, *, log=None, time_step=Non
             static_particles.limits.check(part.bounds[:2].T, ("x", "y"), "position", f"{source}: step {part.timestep}",
                                           rows=lambda k: ("the lower", "the upper")[k] + " BOX BOUNDS",
                                           centre=np.median(position, axis=0))
-            _check_box(static_particles, position, part, source)
-            contacts_now, tensile, apart = _pair_contacts(static_particles, position, pairs, pair_index, where)
+            box_min, box_max, tilt = _box(part, boundary, periodic, source)
+            cell = restricted_cell(box_min, box_max, tilt) if any(periodic) else None
+            _check_box(static_particles, position, part, source, box_min, box_max, cell, periodic, unwrapped)
+            walls_at = _walls_at(planes, part.timestep, time_step)
+            if _between_walls(walls_at, box_min, box_max, boundary):  # the region between the walls
+                cell = restricted_cell(box_min, box_max, tilt) if any(periodic) else None
+                _check_box(static_particles, position, part, source, box_min, box_max, cell, periodic, unwrapped,
+                           walls=True)
+            contacts_now, tensile, apart = _pair_contacts(static_particles, position, pairs, pair_index, where, cell,
+                                                          periodic)
             if fixes is not None:
                 on_walls, tensile_walls = _wall_contacts(static_particles, position, snaps[2], fixes,
-                                                         f"{os.fspath(walls)}: step {part.timestep}")
+                                                         f"{os.fspath(walls)}: step {part.timestep}", periodic,
+                                                         walls_at)
                 contacts_now, tensile = _join(contacts_now, on_walls), tensile + tensile_walls
-            yield dict(time=part.timestep * time_step, step=part.timestep, tensile=tensile, apart=apart,
-                       position=position,
-                       angle=np.zeros(position.shape[0]), contacts=contacts_now,
-                       box_min=part.bounds[:2, 0].copy(), box_max=part.bounds[:2, 1].copy(), **extra)
+            if cell is not None and not unwrapped:  # wrapped into the cell: LAMMPS wraps only at re-neighbouring
+                moved = wrap(position, box_min, cell, periodic)
+                contacts_now["point"] = contacts_now["point"] + (moved - position)[contacts_now["i"]]
+                position = moved
+            snapshot = dict(time=part.timestep * time_step, step=part.timestep, tensile=tensile, apart=apart,
+                            position=position, angle=np.zeros(position.shape[0]), contacts=contacts_now,
+                            box_min=box_min, box_max=box_max, **extra)
+            if cell is not None:
+                snapshot["cell"] = cell
+            if fixes is not None and len(walls_at) == len(WALL_NAMES):
+                snapshot["wall_position"] = _wall_points(walls_at, box_min, box_max)
+            yield snapshot
 
     return static, snapshots()
 
@@ -553,7 +781,7 @@ def open_lammps(particles, contacts, walls=None, *, log=None, time_step=None, co
     snaps = list(stream)
     _warn_left_out(sum(s.pop("tensile") for s in snaps), sum(s.pop("apart") for s in snaps), len(snaps))
     _warn_no_log(log)
-    return snapshots_dataset(static, snaps, ("step", "velocity", "angular_velocity"))
+    return snapshots_dataset(static, snaps, ("step", "velocity", "angular_velocity", "wall_position"))
 
 
 def _warn_left_out(tensile, apart, snapshots):
@@ -615,7 +843,8 @@ def convert_lammps(out, particles, contacts, walls=None, *, log=None, time_step=
     static, stream = lammps_snapshots(particles, contacts, walls, log=log, time_step=time_step, columns=columns,
                                       inertia=inertia)
     first = next(stream)
-    optional = ("step", "gap") + tuple(name for name in ("velocity", "angular_velocity") if name in first)
+    optional = ("step", "gap") + tuple(name for name in ("velocity", "angular_velocity", "wall_position")
+                                       if name in first)
     tensile, apart = [], []
 
     def prepare(snap):

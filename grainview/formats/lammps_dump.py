@@ -15,9 +15,18 @@ and ``dump_local.cpp``) is a series of snapshots, each::
     <n rows of numbers>
 
 :func:`iter_dump` reads one snapshot at a time, so a dump of any length is read in the memory
-of one snapshot. :func:`read_log` takes from a LAMMPS log (or input script) what a dump does not
-say: the time step, and the definitions of the computes and fixes whose columns a dump names
-only ``c_ID[k]`` and ``f_ID[k]``.
+of one snapshot. A triclinic box (``ITEM: BOX BOUNDS xy xz yz pp pp pp``) has a third number on
+each bounds line, the tilts ``xy``, ``xz``, ``yz``, and its first two are the **bounding box** of
+the tilted cell, not its edges: LAMMPS's ``Domain::set_global_box`` writes
+``xlo_bound = min(xlo, xlo + xy, xlo + xz, xlo + xy + xz)``, ``xhi_bound = max(xhi, xhi + xy,
+xhi + xz, xhi + xy + xz)``, ``ylo_bound = min(ylo, ylo + yz)``, ``yhi_bound = max(yhi, yhi + yz)``,
+``z`` unchanged, and the dump prints those (``Dump::write`` takes ``boxlo_bound`` for a triclinic
+box). :func:`iter_dump` undoes it, so that :attr:`DumpSnapshot.bounds` always holds the box's own
+``xlo xhi`` (the cell's edges) and :attr:`DumpSnapshot.tilt` the tilts.
+
+:func:`read_log` takes from a LAMMPS log (or input script) what a dump does not say: the time
+step, the definitions of the computes and fixes whose columns a dump names only ``c_ID[k]`` and
+``f_ID[k]``, and the step at which each fix was defined (a moving wall's origin in time).
 """
 
 from __future__ import annotations
@@ -35,7 +44,7 @@ _BOM = "\ufffd" * 3
 _LARGEST = 2**53
 """The largest step or row count read: floats hold integers exactly up to it."""
 
-__all__ = ["DumpSnapshot", "LammpsLog", "iter_dump", "read_log"]
+__all__ = ["DumpSnapshot", "LammpsLog", "iter_dump", "read_log", "box_from_bounds"]
 
 
 @dataclass(frozen=True)
@@ -56,6 +65,12 @@ class DumpSnapshot:
         The rows, as floats (ids are exact up to 2**53).
     line : int
         The line number of the first row in the file (row k is on line ``line + k``).
+    tilt : numpy.ndarray, (3,)
+        The tilts ``xy, xz, yz`` of a triclinic box (zero for an orthogonal one). ``bounds``
+        then holds the box's own ``lo, hi``, the bounding box of the dump's header undone
+        (:func:`box_from_bounds`).
+    triclinic : bool
+        The header said ``xy xz yz``.
     """
 
     timestep: int
@@ -64,10 +79,26 @@ class DumpSnapshot:
     columns: tuple
     data: np.ndarray
     line: int = 0
+    tilt: np.ndarray = field(default_factory=lambda: np.zeros(3))
+    triclinic: bool = False
 
     def column(self, name: str) -> np.ndarray:
         """The values of column ``name``."""
         return self.data[:, self.columns.index(name)]
+
+
+def box_from_bounds(bounding, tilt) -> np.ndarray:
+    """The box ``[[xlo, xhi], [ylo, yhi], [zlo, zhi]]`` of a triclinic dump's bounding box
+    ``bounding`` (3, 2) and tilts ``xy, xz, yz``: LAMMPS's ``Domain::set_global_box`` rule
+    undone, ``xlo = xlo_bound - min(0, xy, xz, xy + xz)``, ``xhi = xhi_bound - max(0, xy, xz,
+    xy + xz)``, ``ylo = ylo_bound - min(0, yz)``, ``yhi = yhi_bound - max(0, yz)``."""
+    xy, xz, yz = (float(t) for t in tilt)
+    box = np.array(bounding, float).copy()
+    box[0, 0] -= min(0.0, xy, xz, xy + xz)
+    box[0, 1] -= max(0.0, xy, xz, xy + xz)
+    box[1, 0] -= min(0.0, yz)
+    box[1, 1] -= max(0.0, yz)
+    return box
 
 
 class _Lines:
@@ -146,8 +177,8 @@ def iter_dump(path):
     ------
     FileFormatError
         A missing or unreadable file (or a folder), a header that is not LAMMPS's, a step or a
-        row count that is not an integer, a triclinic box, or a snapshot with fewer or more
-        rows than announced, a row of the wrong length or a file ending inside a row (a
+        row count that is not an integer, a triclinic box's bounds line without its tilt, or a
+        snapshot with fewer or more rows than announced, a row of the wrong length or a file ending inside a row (a
         truncated or damaged dump), naming the file, the line and the snapshot.
     """
     path = input_file(path, "a LAMMPS text dump")
@@ -178,9 +209,15 @@ def iter_dump(path):
             rows = _read_count(fh, path, "row count", where)
             header = _read_item(fh, path, "BOX BOUNDS", where)
             flags = header.split()[3:]
-            if any(flag in ("xy", "xz", "yz") for flag in flags):
-                raise FileFormatError(f"{path}: {where}: a triclinic box; only orthogonal boxes can be read")
-            bounds = np.array([_read_numbers(fh, path, 2, where)[:2] for _ in range(3)])
+            triclinic = flags[:3] == ["xy", "xz", "yz"]
+            if triclinic:
+                flags = flags[3:]
+                rows3 = np.array([_read_numbers(fh, path, 3, where)[:3] for _ in range(3)])
+                tilt = rows3[:, 2].copy()
+                bounds = box_from_bounds(rows3[:, :2], tilt)
+            else:
+                tilt = np.zeros(3)
+                bounds = np.array([_read_numbers(fh, path, 2, where)[:2] for _ in range(3)])
             header = fh.readline()
             if not (header.startswith("ITEM: ATOMS") or header.startswith("ITEM: ENTRIES")):
                 raise FileFormatError(f"{path}: line {fh.number}: {where}: expected 'ITEM: ATOMS' or 'ITEM: ENTRIES', "
@@ -201,7 +238,8 @@ def iter_dump(path):
             if line and not line.startswith("ITEM:"):
                 raise FileFormatError(f"{path}: line {fh.number}: {where}: more rows than the {rows} announced (a "
                                       "damaged dump)")
-            yield DumpSnapshot(timestep, bounds, tuple(flags), columns, values.reshape(rows, len(columns)), first_row)
+            yield DumpSnapshot(timestep, bounds, tuple(flags), columns, values.reshape(rows, len(columns)), first_row,
+                               tilt, triclinic)
             index += 1
 
 
@@ -221,6 +259,11 @@ class LammpsLog:
         The LAMMPS version line (``LAMMPS (22 Jul 2025 - Update 4)``).
     units : str or None
         The ``units`` command's style (``si``, ``lj``, ...).
+    fix_steps : dict
+        fix ID -> the step at which its (last) definition was read: the steps of the runs
+        before it (the log's ``Loop time of ... for N steps`` lines, and ``reset_timestep``).
+        An input script, which has no such lines, gives the steps set by ``reset_timestep``
+        only (0 without one). A ``fix wall/gran ... wiggle`` moves from that step on.
     """
 
     time_step: float | None = None
@@ -228,9 +271,11 @@ class LammpsLog:
     computes: dict = field(default_factory=dict)
     fixes: dict = field(default_factory=dict)
     version: str | None = None
+    fix_steps: dict = field(default_factory=dict)
 
 
-_COMMAND = re.compile(r"^\s*(compute|fix|timestep|units)\s+(.*)$")
+_COMMAND = re.compile(r"^\s*(compute|fix|timestep|units|reset_timestep|unfix)\s+(.*)$")
+_LOOP = re.compile(r"^Loop time of \S+ on \d+ procs for (\d+) steps")
 
 
 def read_log(path) -> LammpsLog:
@@ -251,16 +296,29 @@ def read_log(path) -> LammpsLog:
         fh = open(path, encoding="utf-8", errors="replace")
     except OSError as exc:
         raise FileFormatError(f"{path}: cannot be read ({exc.strerror or exc})") from None
+    step = 0
     with fh:
         for line in fh:
             if log.version is None and line.startswith("LAMMPS ("):
                 log.version = line.strip()
+            loop = _LOOP.match(line)
+            if loop is not None:
+                step += int(loop.group(1))
+                continue
             match = _COMMAND.match(line.split("#", 1)[0])
             if match is None or "$" in line:
                 continue
             command, words = match.group(1), match.group(2).split()
             if command == "units" and words:
                 log.units = words[0]
+            elif command == "reset_timestep" and words:
+                try:
+                    step = int(float(words[0]))
+                except ValueError:
+                    pass
+            elif command == "unfix" and words:
+                log.fixes.pop(words[0], None)
+                log.fix_steps.pop(words[0], None)
             elif command == "timestep":
                 try:
                     log.time_step = float(words[0])
@@ -269,4 +327,6 @@ def read_log(path) -> LammpsLog:
             elif len(words) >= 3:  # ID group style args...
                 target = log.computes if command == "compute" else log.fixes
                 target[words[0]] = (words[2], words[3:])
+                if command == "fix":
+                    log.fix_steps[words[0]] = step
     return log
