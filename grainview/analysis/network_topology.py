@@ -12,6 +12,7 @@ import xarray as xr
 
 from ._lift import apply, with_attrs
 from .arrays import network_topology as _topology
+from .arrays import periodic as _periodic
 from .contacts import near_attr, selection
 from ..contract.errors import ParameterError
 from .persistence import body_count
@@ -62,6 +63,21 @@ def network_persistence(ds: xr.Dataset, xi=DEFAULT_XI, dimensions=(0, 1), strong
     (neither diagonal a contact: a 4-cycle with one is two 3-cycles) with k strong edges; a
     contact is strong when f_n >= ``strong`` <f_n>.
 
+    In a periodic cell the network lives on the torus: the graph is that of the pairs (i, j),
+    whatever boundary a contact crosses, so a loop may wind around the cell (its contacts'
+    image shifts, :func:`grainview.analysis.arrays.periodic.contact_image_shifts`, sum to a
+    non-zero number of cells). ``beta_1`` counts every independent unfilled loop, the winding
+    ones included: on a 4 x 4 square lattice on the torus (16 particles, 32 contacts) it is
+    32 - 16 + 1 = 17, the 16 squares (15 independent: their sum is zero) and 2 loops around the
+    cell, one along each lattice vector. ``beta_1_winding`` (time, xi) counts the winding ones
+    (:func:`grainview.analysis.arrays.network_topology.winding_loops`: per connected component
+    the rank, 0, 1 or 2, of its loops' windings, summed), so that ``beta_1 - beta_1_winding``
+    are the loops that close within the packing; a winding loop is never filled (no triangle
+    winds). A strand of contacts around the cell is a winding loop: the network percolates
+    along that direction. The 3- and 4-cycles are cycles of the graph: in a cell less than
+    four particles wide, four contacts around it make a 4-cycle too (the 4 x 4 lattice has 24:
+    16 squares and the 8 rows and columns).
+
     Walls are left out by default: a wall touches every particle along a side, so as a node it
     joins all of them into one component at the first wall contact and closes a loop with every
     pair of paths that reach it, loops of the box rather than of the packing. ``walls=True``
@@ -101,8 +117,8 @@ def network_persistence(ds: xr.Dataset, xi=DEFAULT_XI, dimensions=(0, 1), strong
         ``birth``, ``death`` (time, feature), in units of <f_n>, NaN padding, and ``dimension``
         (time, feature), 0 or 1, -1 in the padding: each snapshot's diagram, its features in
         decreasing persistence birth - death (the never-dying first); ``beta_0``, ``beta_1``
-        (time, xi); ``cycles_3``, ``cycles_4`` (time, strong_edges), strong_edges = 0..4.
-        Lazy on dask input.
+        (time, xi); ``cycles_3``, ``cycles_4`` (time, strong_edges), strong_edges = 0..4; in a
+        periodic cell with dimension 1 also ``beta_1_winding`` (time, xi). Lazy on dask input.
 
     Raises
     ------
@@ -128,6 +144,13 @@ def network_persistence(ds: xr.Dataset, xi=DEFAULT_XI, dimensions=(0, 1), strong
                             "dimension_1": dimension_1},
                     output_dtypes=[float, float, np.int8, np.int64, np.int64, np.int64, np.int64])
     birth, death, dimension, beta_0, beta_1, cycles_3, cycles_4 = outputs
+    winding = None
+    if dimension_1 and "cell" in ds.variables:
+        shift = apply(_periodic.contact_image_shifts, ds["i"], ds["j"], ds["branch"], ds["position"], ds["cell"],
+                      kwargs={"periodic": np.asarray(ds["periodic"].values, bool)}, output_dtypes=[np.int64])
+        winding = apply(_topology.winding_loops, ds["fn"], ds["i"], ds["j"], selection(ds, walls=walls, near=near),
+                        shift, output_sizes={"xi": xi.size}, kwargs={"xi": xi, "n_nodes": n_nodes},
+                        output_dtypes=[np.int64])
     out = xr.Dataset({
         "birth": with_attrs(birth, "birth", "1", "threshold xi = f_n/<f_n> at which the feature appears"),
         "death": with_attrs(death, "death", "1",
@@ -141,6 +164,10 @@ def network_persistence(ds: xr.Dataset, xi=DEFAULT_XI, dimensions=(0, 1), strong
     if dimension_1:
         out["beta_1"] = with_attrs(beta_1, "beta_1", "1",
                                    "independent loops not filled by triangles of the network with f_n >= xi <f_n>")
+    if winding is not None:
+        out["beta_1_winding"] = with_attrs(winding, "beta_1_winding", "1",
+                                           "independent loops of the network with f_n >= xi <f_n> that wind around "
+                                           "the periodic cell")
     out = out.assign_coords(
         xi=("xi", xi, {"units": "1", "long_name": "force threshold xi (contacts with f_n >= xi <f_n>)"}),
         strong_edges=("strong_edges", np.arange(_topology.N_STRONG_EDGES),

@@ -117,10 +117,10 @@ def test_force_chains_do_not_move_with_the_sample_across_the_cell():
             np.testing.assert_allclose(moved["sigma_2"].values, base["sigma_2"].values, rtol=1e-12, atol=1e-12)
 
 
-def random_periodic(shift=(0.0, 0.0), tilt=0.0, seed=2, n=40, size=(6.0, 5.0), snapshots=1):
+def random_periodic(shift=(0.0, 0.0), tilt=0.0, seed=2, n=40, size=(6.0, 5.0), snapshots=1, reach=0.75):
     """Disks of radius 0.3 at random centres in a periodic cell, with random velocities and a
     contact (random normal and tangential forces, along the minimum image) between every pair
-    whose minimum-image distance is below 0.75: many across the boundary. ``shift`` moves the
+    whose minimum-image distance is below ``reach``: many across the boundary. ``shift`` moves the
     whole sample (wrapped back into the cell)."""
     rng = np.random.default_rng(seed)
     box_max = np.tile(size, (snapshots, 1))
@@ -132,14 +132,15 @@ def random_periodic(shift=(0.0, 0.0), tilt=0.0, seed=2, n=40, size=(6.0, 5.0), s
     for k in range(snapshots):
         position = cells.wrap(centres + np.asarray(shift), [0, 0], cell[k], [1, 1])
         d = cells.minimum_image(position[None, :] - position[:, None], cell[k], [1, 1])
-        a, b = np.nonzero(np.triu(np.linalg.norm(d, axis=-1) < 0.75, 1))
+        a, b = np.nonzero(np.triu(np.linalg.norm(d, axis=-1) < reach, 1))
         branch = d[a, b]
         contacts.append(dict(i=a, j=b, normal=branch / np.linalg.norm(branch, axis=-1)[:, None],
                              fn=rng.uniform(0.5, 2, a.size), ft=rng.uniform(-0.3, 0.3, a.size)))
         positions.append(position)
     return grainview.make_dataset(radius=np.full(n, 0.3), position=np.array(positions), contacts=contacts,
                                   velocity=np.tile(velocity, (snapshots, 1, 1)), box_min=np.zeros((snapshots, 2)),
-                                  box_max=box_max, time=np.arange(snapshots, dtype=float), periodic=[1, 1], cell=cell)
+                                  box_max=box_max, time=np.arange(snapshots, dtype=float), periodic=[1, 1], cell=cell,
+                                  n_contact_slots=8 * n)
 
 
 FIELDS = ("density", "solid_fraction", "momentum", "velocity", "kinetic_stress", "contact_stress", "fabric")
@@ -210,3 +211,50 @@ def test_images_across_a_sheared_cell_carry_the_shear_velocity():
     v = out.velocity.isel(time=1).values  # (y, x, xy)
     np.testing.assert_allclose(v[1, :, 0], 0.5, rtol=1e-12)  # by the top edge: the image
     np.testing.assert_allclose(v[0, :, 0], 0.0, atol=1e-12)  # by the particle itself
+
+
+def square_lattice_on_the_torus(n=4, tilt=0.0, shift=(0.0, 0.0)):
+    """The n x n square lattice of test_periodic_cell, forces 2 N along x and 1 N along y."""
+    import importlib
+
+    lattice = importlib.import_module("tests.grainview.test_periodic_cell").lattice
+    return lattice(tilt=tilt, shift=shift)
+
+
+@pytest.mark.parametrize("tilt", [0.0, 1.0])
+def test_network_topology_of_a_lattice_on_the_torus_by_hand(prepare, tilt):
+    """4 x 4 square lattice on the torus: V = 16, E = 32, no triangle: beta_0 = 1 and
+    beta_1 = E - V + 1 = 17, of which 2 wind around the cell (the 16 squares give 15
+    independent loops); the strong network (the 16 horizontal contacts of 2 N, xi = 4/3) is 4
+    rows, each a loop around the cell along a: beta_0 = 4, beta_1 = 4, all winding."""
+    ds = prepare(square_lattice_on_the_torus(tilt=tilt))
+    top = ds.grain.network_persistence(xi=[0.0, 1.0, 1.5]).compute()
+    np.testing.assert_array_equal(top["beta_0"].values[0], [1, 4, 0])
+    np.testing.assert_array_equal(top["beta_1"].values[0], [17, 4, 0])
+    np.testing.assert_array_equal(top["beta_1_winding"].values[0], [2, 4, 0])
+    assert int(top["cycles_3"].sum()) == 0
+    assert int(top["cycles_4"].sum()) == 24  # 16 squares, and the 4 rows and 4 columns around the cell
+
+
+def test_winding_loops_do_not_move_with_the_sample():
+    rng = np.random.default_rng(4)
+    base = random_periodic(tilt=0.8, n=40, size=(4.0, 4.0), reach=1.0)
+    want = base.grain.network_persistence(xi=np.linspace(0, 3, 13))
+    assert int(want["beta_1_winding"].max()) > 0
+    for _ in range(3):
+        moved = random_periodic(shift=rng.uniform(-9, 9, 2), tilt=0.8, n=40, size=(4.0, 4.0), reach=1.0)
+        got = moved.grain.network_persistence(xi=np.linspace(0, 3, 13))
+        for name in ("beta_0", "beta_1", "beta_1_winding"):
+            np.testing.assert_array_equal(got[name].values, want[name].values)
+
+
+def test_winding_ranks_of_two_strands_joined():
+    """Two loops around the cell along a (rank 1 each: 2), joined by a contact (one component:
+    the loop around the band between them winds zero times, 1); a loop along b makes it 2."""
+    from grainview.analysis._kernels.network_topology import winding_ranks
+
+    u = np.array([0, 1, 0, 0], np.int64)
+    v = np.array([0, 1, 1, 1], np.int64)
+    # self-loops stand for a strand around the cell: a particle touching its own image one cell along a
+    shift = np.array([[1, 0], [1, 0], [0, 0], [0, 1]], np.int64)
+    np.testing.assert_array_equal(winding_ranks(2, u, v, shift), [1, 2, 1, 2])

@@ -367,3 +367,112 @@ def flag_persistence_1(n_nodes, u, v, value):
             death[n] = -np.inf
             n += 1
     return birth[:n], death[:n], tri.shape[0]
+
+
+@njit(cache=True)
+def _offset_root(parent, offset, a):
+    """Root of ``a`` and the image offset of ``a`` relative to it (p_a - p_root, whole cells),
+    compressing the path (each node on it then points to the root, its offset summed)."""
+    root = a
+    ox = 0
+    oy = 0
+    while parent[root] != root:
+        ox += offset[root, 0]
+        oy += offset[root, 1]
+        root = parent[root]
+    # compress: walk again, giving each node its offset to the root
+    node = a
+    rx = ox
+    ry = oy
+    while parent[node] != node:
+        nxt = parent[node]
+        nx_ = rx - offset[node, 0]
+        ny_ = ry - offset[node, 1]
+        offset[node, 0] = rx
+        offset[node, 1] = ry
+        parent[node] = root
+        node = nxt
+        rx = nx_
+        ry = ny_
+    return root, ox, oy
+
+
+@njit(cache=True)
+def winding_ranks(n_nodes, u, v, shift):
+    """The number of independent loops that wind around a periodic cell, after each edge of a
+    graph whose edges cross the cell's boundary by whole cells.
+
+    Each edge e = (u, v) carries the shift s_e = (m, n), the whole cells between the image of
+    v it reaches and the stored v (p_v = p_u + s_e, p a node's image). A loop's winding is the
+    sum of the shifts along it; the loops of a connected component wind along a sublattice of
+    Z^2 of rank 0, 1 or 2, and the number of independent loops that wind is the sum of these
+    ranks over the components. Union-find with offsets: each node keeps p_node - p_root; an
+    edge inside a component closes a loop of winding p_u + s_e - p_v; components that merge
+    keep the span of both their windings.
+
+    Parameters
+    ----------
+    n_nodes : int
+        Node ids are in [0, n_nodes).
+    u, v : ndarray of int64, shape (E,)
+        The edges' endpoints, in the order they enter.
+    shift : ndarray of int64, shape (E, 2)
+        Each edge's shift (m, n).
+
+    Returns
+    -------
+    ndarray of int64, shape (E,)
+        The number of independent winding loops of the graph of the first e + 1 edges.
+    """
+    parent = np.arange(n_nodes)
+    size = np.ones(n_nodes, np.int64)
+    offset = np.zeros((n_nodes, 2), np.int64)
+    rank = np.zeros(n_nodes, np.int64)
+    basis = np.zeros((n_nodes, 2), np.int64)  # a component of rank 1: its winding direction
+    out = np.empty(u.size, np.int64)
+    total = 0
+    for e in range(u.size):
+        ra, ax, ay = _offset_root(parent, offset, u[e])
+        rb, bx, by = _offset_root(parent, offset, v[e])
+        sx = shift[e, 0]
+        sy = shift[e, 1]
+        if ra == rb:
+            wx = ax + sx - bx
+            wy = ay + sy - by
+            if (wx != 0 or wy != 0) and rank[ra] < 2:
+                if rank[ra] == 0:
+                    rank[ra] = 1
+                    basis[ra, 0] = wx
+                    basis[ra, 1] = wy
+                    total += 1
+                elif basis[ra, 0] * wy - basis[ra, 1] * wx != 0:
+                    rank[ra] = 2
+                    total += 1
+        else:
+            # p_rb - p_ra = (p_v - b) - (p_u - a) = s + a - b
+            dx = sx + ax - bx
+            dy = sy + ay - by
+            if size[ra] < size[rb]:
+                ra, rb = rb, ra
+                dx = -dx
+                dy = -dy
+            parent[rb] = ra
+            offset[rb, 0] = dx
+            offset[rb, 1] = dy
+            size[ra] += size[rb]
+            before = rank[ra] + rank[rb]
+            if rank[ra] == 2 or rank[rb] == 2:
+                merged = 2
+            elif rank[ra] == 1 and rank[rb] == 1:
+                cross = basis[ra, 0] * basis[rb, 1] - basis[ra, 1] * basis[rb, 0]
+                merged = 2 if cross != 0 else 1
+            elif rank[rb] == 1:
+                merged = 1
+                basis[ra, 0] = basis[rb, 0]
+                basis[ra, 1] = basis[rb, 1]
+            else:
+                merged = rank[ra]
+            rank[ra] = merged
+            total += merged - before
+        out[e] = total
+    return out

@@ -32,10 +32,10 @@ from __future__ import annotations
 
 import numpy as np
 
-from .._kernels.network_topology import cycle_counts, flag_persistence_1, union_find_pairs
+from .._kernels.network_topology import cycle_counts, flag_persistence_1, union_find_pairs, winding_ranks
 from ...contract.errors import ParameterError
 from .force_pdf import mean_normal_force
-from .signature import CONTACT, core_dims
+from .signature import CONTACT, CONTACT_XY, core_dims
 
 FEATURE = ("feature",)
 XI = ("xi",)
@@ -312,5 +312,76 @@ def network_persistence(fn, i, j, mask, xi, n_nodes, n_features, strong=1.0, dim
             shape(squares))
 
 
-__all__ = ["filtration_edges", "diagram_0", "diagram_1", "diagrams_gudhi", "betti_curve", "short_cycles",
+@core_dims(CONTACT, CONTACT, CONTACT, CONTACT, CONTACT_XY, out=(XI,))
+def winding_loops(fn, i, j, mask, shift, xi, n_nodes):
+    """The independent loops of each snapshot's force network above each threshold that wind
+    around a periodic cell.
+
+    The network's edges are those of :func:`filtration_edges` (a pair listed twice keeps its
+    larger force, and the shift of that slot); each edge carries the whole cells ``shift``
+    (m, n) between the stored centre of j and the image of j it touches. A loop winds when its
+    shifts sum to a non-zero (m, n); the loops of a connected component wind along a lattice of
+    rank 0, 1 or 2 (around the cell along a, b or both), and the count is the sum of these ranks
+    over the components (:func:`grainview.analysis._kernels.network_topology.winding_ranks`).
+    It is at most beta_1: no triangle winds, so a winding loop is never filled, and
+    beta_1 - winding are the loops that close within the packing. Two components that each
+    wind along a count 2; joined by a contact, 1 (the loop around the band between them
+    winds zero times), so the count need not grow as the threshold falls.
+
+    Parameters
+    ----------
+    fn : ndarray, shape (..., C)
+        Normal forces (N).
+    i, j : ndarray of int, shape (..., C)
+        The contacts' bodies.
+    mask : ndarray of bool, shape (..., C)
+        The contacts of the network.
+    shift : ndarray of int, shape (..., C, 2)
+        Each contact's image shift (m, n) (0 for a wall contact).
+    xi : ndarray, shape (K,)
+        Thresholds, in units of <f_n>.
+    n_nodes : int
+        Body ids are in [0, n_nodes).
+
+    Returns
+    -------
+    ndarray of int64, shape (..., K)
+        The winding loops of the network with f_n >= xi <f_n>.
+    """
+    fn = np.asarray(fn)
+    n_c = fn.shape[-1]
+    lead = fn.shape[:-1]
+    flat = [np.asarray(a).reshape(-1, n_c) for a in (fn, i, j, mask)]
+    shifts = np.asarray(shift, np.int64).reshape(-1, n_c, 2)
+    xi = np.asarray(xi, float)
+    out = np.zeros((flat[0].shape[0], xi.size), np.int64)
+    for r in range(out.shape[0]):
+        fn_r, i_r, j_r, mask_r = (a[r] for a in flat)
+        u, v, value = filtration_edges(fn_r, i_r, j_r, mask_r)
+        if u.size == 0:
+            continue
+        _check_nodes(u, v, n_nodes)
+        # the same edges with their shifts, oriented from u to v (s of j seen from i; negated when i > j)
+        sel = np.flatnonzero(np.asarray(mask_r, bool))
+        a, b = np.asarray(i_r)[sel].astype(np.int64), np.asarray(j_r)[sel].astype(np.int64)
+        s = shifts[r, sel] * np.where(a <= b, 1, -1)[:, None]
+        forces = np.asarray(fn_r, np.float64)[sel]
+        lo, hi = np.minimum(a, b), np.maximum(a, b)
+        order = np.lexsort((-forces, hi, lo))  # as filtration_edges: by pair, the largest force first
+        lo, hi, s = lo[order], hi[order], s[order]
+        first = np.ones(lo.size, bool)
+        first[1:] = (lo[1:] != lo[:-1]) | (hi[1:] != hi[:-1])
+        key = lo[first] * (int(n_nodes) + 1) + hi[first]
+        s = s[first]
+        index = np.argsort(key)
+        where = np.searchsorted(key[index], u * (int(n_nodes) + 1) + v)
+        edge_shift = np.ascontiguousarray(s[index[where]])
+        ranks = winding_ranks(int(n_nodes), np.ascontiguousarray(u, np.int64), np.ascontiguousarray(v, np.int64),
+                              edge_shift)
+        entered = np.searchsorted(-value, -xi, side="right")  # edges with value >= xi (value non-increasing)
+        out[r] = np.where(entered > 0, ranks[np.maximum(entered - 1, 0)], 0)
+    return out.reshape(lead + (xi.size,))
+
+
+__all__ = ["winding_loops", "filtration_edges", "diagram_0", "diagram_1", "diagrams_gudhi", "betti_curve", "short_cycles",
            "network_persistence", "gudhi_module", "FEATURE", "XI", "STRONG_EDGES"]

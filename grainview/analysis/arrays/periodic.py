@@ -1,0 +1,54 @@
+"""Contacts in a periodic cell on plain arrays: which boundaries each contact crosses
+(docs/schema.md, "The periodic cell"; docs/analysis.md, "Periodic cells")."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ...contract.cell import image_shift
+from .signature import CONTACT, CONTACT_XY, PARTICLE, core_dims
+
+PARTICLE_XY = PARTICLE + ("xy",)
+CELL = ("cell_vector", "xy")
+"""Core dimensions of a cell's lattice vectors (rows a, b)."""
+
+__all__ = ["CELL", "contact_image_shifts"]
+
+
+@core_dims(CONTACT, CONTACT, CONTACT_XY, PARTICLE_XY, CELL, out=(CONTACT_XY,))
+def contact_image_shifts(i, j, branch, position, cell, periodic):
+    """The whole cells (m, n) between each contact's branch and its stored centres:
+
+        x_i + branch = x_j + m a + n b,
+
+    i.e. the contact touches the image of j that is (m, n) cells from its stored centre
+    (:func:`grainview.contract.cell.image_shift` of ``branch - (x_j - x_i)``). (0, 0) for a
+    contact inside the cell, for a wall contact (j outside the particles) and an empty slot.
+
+    Parameters
+    ----------
+    i, j : array_like of int, (..., C)
+        The contacts' bodies.
+    branch : array_like, (..., C, 2)
+        Minimum-image branch vectors, m.
+    position : array_like, (..., P, 2)
+        Centres, m (wrapped or unwrapped).
+    cell : array_like, (..., 2, 2)
+        Lattice vectors, m.
+    periodic : array_like of bool, (2,)
+        Along which vectors the sample repeats.
+
+    Returns
+    -------
+    numpy.ndarray of int64, (..., C, 2)
+    """
+    position = np.asarray(position, float)
+    branch = np.asarray(branch, float)
+    n_part = position.shape[-2]
+    i, j = np.broadcast_to(i, branch.shape[:-1]), np.broadcast_to(j, branch.shape[:-1])
+    pair = (i >= 0) & (i < n_part) & (j >= 0) & (j < n_part) & np.isfinite(branch).all(-1)
+    xi = np.take_along_axis(position, np.clip(i, 0, n_part - 1)[..., None], axis=-2)
+    xj = np.take_along_axis(position, np.clip(j, 0, n_part - 1)[..., None], axis=-2)
+    d = np.where(pair[..., None], np.nan_to_num(branch - (xj - xi)), 0.0)
+    shift = image_shift(d, np.asarray(cell, float)[..., None, :, :], periodic)
+    return np.where(pair[..., None], shift, 0)
