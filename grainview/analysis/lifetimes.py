@@ -104,8 +104,11 @@ def contact_events(ds: xr.Dataset, walls: bool = True, near=None) -> xr.Dataset:
     the first snapshot), ``kind_at_birth`` (1 simple, 2 double), ``kind_switches`` (simple <->
     double changes during the life), ``mean_fn`` and ``max_fn`` (N, over the snapshots of the
     life), ``birth_fn`` (N, the normal force at the first snapshot of the life) and, when the
-    file has its box, ``lifetime_eps_q`` (the shear strain eps_q over the life, 1). Snapshot
-    times must increase. Computed one time-chunk at a time.
+    file has its box, ``lifetime_eps_q`` (the shear strain eps_q over the life, 1); when it has
+    a periodic cell, ``lifetime_gamma`` (the cell's simple-shear strain gamma over the life, 1,
+    :func:`grainview.analysis.strain.strains`). A contact is the pair (i, j) whatever boundary
+    of a periodic cell it crosses: it keeps its identity when its particles are stored a cell
+    apart. Snapshot times must increase. Computed one time-chunk at a time.
 
     Parameters
     ----------
@@ -157,6 +160,10 @@ def contact_events(ds: xr.Dataset, walls: bool = True, near=None) -> xr.Dataset:
         eps_q = np.asarray(ds.grain.strains()["eps_q"].values, dtype=float)
         out["lifetime_eps_q"] = with_attrs(xr.DataArray(eps_q[end_index] - eps_q[e["birth"]], dims=dim),
                                            "lifetime_eps_q", "1", "shear strain eps_q over the life")
+    if "cell" in ds.variables:
+        gamma = np.asarray(ds.grain.strains()["gamma"].values, dtype=float)
+        out["lifetime_gamma"] = with_attrs(xr.DataArray(gamma[end_index] - gamma[e["birth"]], dims=dim),
+                                           "lifetime_gamma", "1", "simple-shear strain gamma of the cell over the life")
     for name, units, long_name in (("birth", "s", "time of the first snapshot of the life"),
                                    ("death", "s", "time of the first snapshot without the contact"),
                                    ("lifetime", "s", "lifetime t_death - t_birth (observed duration if censored)"),
@@ -222,7 +229,7 @@ def lifetime_survival(ds: xr.Dataset, walls: bool = True, near=None, by=None, un
     (f > <f>), weak (``very_weak`` <f> <= f <= <f>) and very weak (f < ``very_weak`` <f>;
     paper Sec. V), f the mean normal force over the life (``force_at="life"``) or the force at
     birth (``"birth"``) and <f> its mean over all lives; ``unit``: ``"time"`` (tau in s) or
-    ``"strain"`` (tau in eps_q).
+    ``"strain"`` (tau in eps_q) or ``"gamma"`` (tau in a periodic cell's gamma).
 
     Parameters
     ----------
@@ -232,8 +239,9 @@ def lifetime_survival(ds: xr.Dataset, walls: bool = True, near=None, by=None, un
         Which contacts are followed, as in :func:`contact_events`.
     by : {None, "kind", "force"}
         Grouping of the lives.
-    unit : {"time", "strain"}
-        Lifetimes in s, or in shear strain eps_q (needs the file's box).
+    unit : {"time", "strain", "gamma"}
+        Lifetimes in s, in shear strain eps_q (needs the file's box), or in the simple-shear
+        strain gamma of a periodic cell (eps_q does not see a simple shear).
     force_at : {"life", "birth"}
         The force that classifies a life for ``by="force"``.
     very_weak : float, default 0.1
@@ -255,13 +263,14 @@ def lifetime_survival(ds: xr.Dataset, walls: bool = True, near=None, by=None, un
         raise ParameterError(f"by={by!r}: expected None, 'kind' or 'force'")
     if force_at not in ("life", "birth"):
         raise ParameterError(f"force_at={force_at!r}: expected 'life' or 'birth'")
-    if unit not in ("time", "strain"):
-        raise ParameterError(f"unit={unit!r}: expected 'time' or 'strain'")
+    if unit not in ("time", "strain", "gamma"):
+        raise ParameterError(f"unit={unit!r}: expected 'time', 'strain' or 'gamma'")
     events = contact_events(ds, walls=walls, near=near)
     events = events.isel(contact_event=~events["left_censored"].values)
-    column = "lifetime" if unit == "time" else "lifetime_eps_q"
+    column = {"time": "lifetime", "strain": "lifetime_eps_q", "gamma": "lifetime_gamma"}[unit]
     if column not in events:
-        raise ParameterError("unit='strain' needs the file's box (box_min, box_max)")
+        raise ParameterError("unit='strain' needs the file's box (box_min, box_max)" if unit == "strain" else
+                             "unit='gamma' needs a periodic cell (cell): gamma is the cell's simple-shear strain")
     tau = events[column].values
     observed = ~events["censored"].values
     if by is None:
@@ -283,7 +292,8 @@ def lifetime_survival(ds: xr.Dataset, walls: bool = True, near=None, by=None, un
                       coords={"group": list(groups), "lifetime": grid,
                               "lives": ("group", [int(m.sum()) for m in groups.values()])})
     da["lifetime"].attrs.update(units="s" if unit == "time" else "1",
-                                long_name="lifetime tau" + ("" if unit == "time" else " in shear strain eps_q"))
+                                long_name="lifetime tau" + {"time": "", "strain": " in shear strain eps_q",
+                                                            "gamma": " in the cell's shear strain gamma"}[unit])
     return with_attrs(da, "survival", "1", "Kaplan-Meier survival S(tau) of the contacts' lives",
                       walls=int(walls), near=near_attr(near), by=str(by), unit=unit, force_at=force_at)
 

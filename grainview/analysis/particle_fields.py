@@ -7,7 +7,8 @@ For each snapshot and particle (``time``, ``particle``), lazily like the input:
 * ``strong``: contacts carrying more than the snapshot's mean normal force <f_n> (Sec. V);
 * ``rattler``: c < ``min_contacts`` (the rattler rule of z and P(c), docs/conventions.md §7);
 * ``rotation`` (rad) and ``displacement`` (m): the particle's rotation and the length of its
-  displacement since the ``reference`` snapshot.
+  displacement since the ``reference`` snapshot (followed across a periodic cell's boundary,
+  :func:`unwrapped_positions`).
 """
 
 from __future__ import annotations
@@ -19,8 +20,9 @@ from ._lift import with_attrs
 from .connectivity import _check_min, counts_of
 from .contacts import selection, snapshot_index
 from ._docs import fill_doc
+from ..contract.cell import minimum_image
 
-__all__ = ["particle_fields"]
+__all__ = ["particle_fields", "unwrapped_positions"]
 
 
 @fill_doc
@@ -35,7 +37,11 @@ def particle_fields(ds: xr.Dataset, reference: int = 0, walls: bool = True, near
     * ``strong``: contacts carrying more than the snapshot's mean normal force <f_n> (Sec. V);
     * ``rattler``: c < ``min_contacts`` (the rattler rule of z and P(c), docs/conventions.md §7);
     * ``rotation`` (rad) and ``displacement`` (m): the particle's rotation and the length of its
-      displacement since the ``reference`` snapshot.
+      displacement since the ``reference`` snapshot. In a periodic cell whose centres are
+      stored wrapped (``cell_positions = "wrapped"``) a particle that crosses the boundary
+      jumps by a cell: the displacement then adds up the minimum images of the steps between
+      consecutive snapshots (:func:`unwrapped_positions`), right while no particle moves half
+      a cell between two snapshots.
 
     Parameters
     ----------
@@ -85,9 +91,55 @@ def particle_fields(ds: xr.Dataset, reference: int = 0, walls: bool = True, near
     start = ds.isel(time=reference)
     out["rotation"] = with_attrs(ds["angle"] - start["angle"], "rotation", "rad",
                                  "rotation since the reference snapshot")
-    step = ds["position"] - start["position"]
+    step = _unwrapped(ds) - _unwrapped(ds).isel(time=reference) if _wrapped_cell(ds) else \
+        ds["position"] - start["position"]
     out["displacement"] = with_attrs(np.hypot(step.isel(xy=0, drop=True), step.isel(xy=1, drop=True)),
                                      "displacement", "m", "displacement since the reference snapshot")
     out = out.drop_vars([v for v in out.coords if v not in ("time", "particle")])
     out.attrs.update(reference=reference, walls=int(walls), min_contacts=min_contacts)
     return out.transpose("time", "particle")
+
+
+def _wrapped_cell(ds: xr.Dataset) -> bool:
+    return "cell" in ds.variables and ds.attrs.get("cell_positions", "wrapped") == "wrapped"
+
+
+def _minimum_image(d, cell, periodic):
+    return minimum_image(d, cell[..., None, :, :], periodic)
+
+
+def _unwrapped(ds: xr.Dataset) -> xr.DataArray:
+    return unwrapped_positions(ds)
+
+
+@fill_doc
+def unwrapped_positions(ds: xr.Dataset) -> xr.DataArray:
+    """The particles' centres followed across a periodic cell's boundary (time, particle, xy), m.
+
+        x_k = x_0 + sum_{k' <= k} minimum_image(x_k' - x_(k'-1))
+
+    the steps between consecutive snapshots taken as their minimum images in the later
+    snapshot's cell (:func:`grainview.contract.cell.minimum_image`): the trajectory of a
+    particle that crosses the boundary, as long as no particle moves half a cell between two
+    snapshots. A file without a cell, or whose centres are stored unwrapped, gives its
+    ``position`` as it is.
+
+    Parameters
+    ----------
+    {ds}
+
+    Returns
+    -------
+    xarray.DataArray
+        ``position`` (time, particle, xy), m; lazy on dask input.
+    """
+    if not _wrapped_cell(ds):
+        return ds["position"]
+    position = ds["position"]
+    step = (position - position.shift(time=1)).fillna(0.0)
+    periodic = np.asarray(ds["periodic"].values, bool)
+    step = xr.apply_ufunc(_minimum_image, step, ds["cell"], input_core_dims=[["particle", "xy"], ["cell_vector", "xy"]],
+                          output_core_dims=[["particle", "xy"]], kwargs={"periodic": periodic}, dask="parallelized",
+                          output_dtypes=[float])
+    out = position.isel(time=0, drop=True) + step.cumsum("time")
+    return out.transpose(*position.dims).rename("position").assign_attrs(position.attrs)

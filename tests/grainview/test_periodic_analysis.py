@@ -258,3 +258,48 @@ def test_winding_ranks_of_two_strands_joined():
     # self-loops stand for a strand around the cell: a particle touching its own image one cell along a
     shift = np.array([[1, 0], [1, 0], [0, 0], [0, 1]], np.int64)
     np.testing.assert_array_equal(winding_ranks(2, u, v, shift), [1, 2, 1, 2])
+
+
+def test_displacement_of_a_particle_across_the_boundary(prepare):
+    """A disk moving 0.3 m per snapshot along x through the right edge of a 2 x 2 cell (stored
+    wrapped): its displacement grows 0.3 per snapshot, with no jump of a cell."""
+    t = 6
+    x = np.mod(1.2 + 0.3 * np.arange(t), 2.0)
+    position = np.stack([np.stack([x, np.full(t, 1.0)], -1), np.tile([0.5, 0.3], (t, 1))], axis=1)
+    ds = grainview.make_dataset(radius=[0.1, 0.1], position=position,
+                                contacts=[dict(i=[], j=[], normal=np.zeros((0, 2)), fn=[])] * t,
+                                box_min=np.zeros((t, 2)), box_max=np.full((t, 2), 2.0), time=np.arange(t, dtype=float),
+                                periodic=[1, 1], cell=cells.restricted_cell([0, 0], [2, 2]))
+    assert ds.attrs["cell_positions"] == "wrapped"
+    out = prepare(ds).grain.particle_fields().compute()
+    np.testing.assert_allclose(out["displacement"].values[:, 0], 0.3 * np.arange(t), atol=1e-12)
+    np.testing.assert_allclose(out["displacement"].values[:, 1], 0.0)
+    later = prepare(ds).grain.particle_fields(reference=2).compute()
+    np.testing.assert_allclose(later["displacement"].values[:, 0], 0.3 * np.abs(np.arange(t) - 2), atol=1e-12)
+
+
+def test_a_contact_keeps_its_identity_across_the_boundary():
+    """Two disks in contact drifting together across the right edge (the pair stored a cell
+    apart in the middle snapshots): one life, from the first snapshot to the last."""
+    t = 5
+    x0 = 1.5 + 0.2 * np.arange(t)
+    centres = np.stack([np.stack([x0, np.ones(t)], -1), np.stack([x0 + 0.2, np.ones(t)], -1)], axis=1)
+    cell = cells.restricted_cell([0, 0], [2, 2])
+    position = cells.wrap(centres, [0, 0], cell, [1, 1])
+    ds = grainview.make_dataset(radius=[0.1, 0.1], position=position,
+                                contacts=[dict(i=[0], j=[1], normal=[[1.0, 0.0]], fn=[1.0])] * t,
+                                box_min=np.zeros((t, 2)), box_max=np.full((t, 2), 2.0), time=np.arange(t, dtype=float),
+                                periodic=[1, 1], cell=cell)
+    grainview.validate(ds)
+    events = ds.grain.contact_events()
+    assert events.sizes["contact_event"] == 1
+    assert bool(events["censored"][0]) and float(events["lifetime"][0]) == 4.0
+
+
+def test_lifetimes_in_the_cells_shear_strain():
+    ds = sheared_series([0.2, 0.6, 1.0, 1.4, 1.8 - 4.0])
+    events = ds.grain.contact_events()
+    assert float(events["lifetime_gamma"][0]) == pytest.approx(0.8)
+    assert float(events["lifetime_eps_q"][0]) == 0.0
+    survival = ds.grain.lifetime_survival(unit="gamma")
+    assert survival["lifetime"].attrs["units"] == "1"
