@@ -38,7 +38,10 @@ How the contract's quantities are made (docs/formats.md states the same for user
   the log defines a plane ``fix wall/gran`` of the walls dump: there the box's side is the
   wall, where it stands at that step (moved by the fix's ``wiggle``,
   ``lo + A - A cos(2 pi (step - step0) dt / P)``, step0 the step the fix was defined at), and
-  every contact point of that wall must lie on it; with all four walls known, ``wall_position``;
+  every contact point of that wall must lie on it; with all four walls known, ``wall_position``.
+  A wall the log does not place (``fix wall/gran/region``, or no log) stands where its contact
+  points lie in the snapshots where particles touch it (a note names those it leaves at the
+  ``BOX BOUNDS`` in others);
 * **periodic** boxes (``boundary p ...`` in x and/or y) give the contract's cell
   (:mod:`grainview.contract.cell`): ``a = (l, 0)``, ``b = (xy, h)`` with ``xy`` the triclinic
   tilt (``change_box all triclinic``, ``fix deform ... xy ... remap v``, box flips included:
@@ -359,7 +362,10 @@ def _wall_contacts(particles, position, snap, fixes, where, periodic=(False, Fal
 
     ``periodic``: the directions x, y along which the cell repeats (no wall may stand across
     them); ``walls_at``: wall index -> its coordinate (x of left and right, y of bottom and
-    top) where the run's log defines it, against which every contact point is checked."""
+    top) where the run's log defines it, against which every contact point is checked.
+
+    Returns the contacts (None without any), the number left out for a tensile normal force,
+    and wall index -> (fix ID, the coordinates of its contact points across the wall)."""
     n_particles = particles.ids.size
     _check_ids(snap.column("id"), "id", where, snap)
     for fix, cols in fixes.items():
@@ -379,6 +385,7 @@ def _wall_contacts(particles, position, snap, fixes, where, periodic=(False, Fal
         raise FileFormatError(f"{where}: atom id {twice} appears twice; expected each atom once")
     out = {k: [] for k in ("i", "j", "normal", "fn", "ft", "point", "branch", "gap")}
     tensile = 0
+    seen = {}
     for fix, cols in fixes.items():
         values = snap.data[:, cols]
         touching = values[:, 0] != 0
@@ -408,6 +415,8 @@ def _wall_contacts(particles, position, snap, fixes, where, periodic=(False, Fal
                                   f"wall, across {'xy'[normal_axis[k]]}, a periodic direction; expected walls only "
                                   "across directions that are not periodic (LAMMPS refuses a wall in a periodic "
                                   "dimension)")
+        for w in np.unique(wall):
+            seen.setdefault(int(w), (fix, []))[1].append(point[wall == w, 1 - w % 2])
         if walls_at:
             for w, at in walls_at.items():
                 on = wall == w
@@ -433,11 +442,29 @@ def _wall_contacts(particles, position, snap, fixes, where, periodic=(False, Fal
         out["point"].append(point)
         out["branch"].append(arm)
         out["gap"].append(length - particles.radius[p])
+    seen = {w: (fix, np.concatenate(at)) for w, (fix, at) in seen.items()}
     if not out["i"]:
-        return None, tensile
+        return None, tensile, seen
     joined = {k: np.concatenate(v) for k, v in out.items()}
     joined["kind"] = np.ones(joined["i"].size, "i1")
-    return joined, tensile
+    return joined, tensile, seen
+
+
+def _walls_touched(seen, walls_at, where, diameter):
+    """Wall index -> coordinate of the walls the log does not place but particles touch in this
+    snapshot: where their contact points lie (LAMMPS reports the point on the wall's plane).
+    One line when a wall's points are not on one line across it."""
+    out = {}
+    for w, (fix, at) in seen.items():
+        if w in walls_at:
+            continue
+        low, high = float(at.min()), float(at.max())
+        if high - low > 1e-9 * max(diameter, abs(high)):
+            raise FileFormatError(f"{where}: fix {fix}: the contact points of the {WALL_NAMES[w]} wall lie from "
+                                  f"{'yxyx'[w]} = {low:.17g} to {high:.17g}; expected a plane wall, its points on one "
+                                  "line")
+        out[w] = float(np.median(at))
+    return out
 
 
 def _check_box(particles, position, snap, source, box_min, box_max, cell=None, periodic=(False, False),
@@ -702,10 +729,12 @@ def lammps_snapshots(particles, contacts, walls=None, *, log=None, time_step=Non
     if log_info is not None and log_info.version:
         attrs["lammps_version"] = log_info.version
     attrs["lammps_boundary"] = " ".join(boundary)
-    if planes:
-        attrs["lammps_sample_box"] = ("between the walls of " + ", ".join(f"fix {fix}" for fix in planes)
-                                      + " as the log defines them (moved by wiggle where it does), elsewhere the "
-                                        "dump's BOX BOUNDS")
+    if walls is not None:
+        attrs["lammps_sample_box"] = (("between the walls of " + ", ".join(f"fix {fix}" for fix in planes)
+                                       + " where the log places them (moved by wiggle where it does), " if planes
+                                       else "")
+                                      + "between the other walls where particles touch them, elsewhere the dump's "
+                                        "BOX BOUNDS")
     static = dict(radius=static_particles.radius, mass=static_particles.mass, inertia=static_particles.inertia,
                   n_walls=len(WALL_NAMES) if walls is not None else 0,
                   wall_names=list(WALL_NAMES) if walls is not None else None, attrs=attrs)
@@ -727,29 +756,36 @@ def lammps_snapshots(particles, contacts, walls=None, *, log=None, time_step=Non
             box_min, box_max, tilt = _box(part, boundary, periodic, source)
             cell = restricted_cell(box_min, box_max, tilt) if any(periodic) else None
             _check_box(static_particles, position, part, source, box_min, box_max, cell, periodic, unwrapped)
-            walls_at = _walls_at(planes, part.timestep, time_step)
+            # minimum images along the periodic directions, which the walls (across the others) leave unchanged
+            contacts_now, tensile, apart = _pair_contacts(static_particles, position, pairs, pair_index, where, cell,
+                                                          periodic)
+            logged = _walls_at(planes, part.timestep, time_step)
+            walls_at, touched, on_walls, tensile_walls = logged, {}, None, 0
+            if fixes is not None:
+                where_walls = f"{os.fspath(walls)}: step {part.timestep}"
+                on_walls, tensile_walls, seen = _wall_contacts(static_particles, position, snaps[2], fixes,
+                                                               where_walls, periodic, walls_at)
+                touched = _walls_touched(seen, walls_at, where_walls, static_particles.limits.diameter)
+                walls_at = {**walls_at, **touched}
+            bounds = (box_min.copy(), box_max.copy())
             if _between_walls(walls_at, box_min, box_max, boundary):  # the region between the walls
                 cell = restricted_cell(box_min, box_max, tilt) if any(periodic) else None
                 _check_box(static_particles, position, part, source, box_min, box_max, cell, periodic, unwrapped,
                            walls=True)
-            contacts_now, tensile, apart = _pair_contacts(static_particles, position, pairs, pair_index, where, cell,
-                                                          periodic)
             if fixes is not None:
-                on_walls, tensile_walls = _wall_contacts(static_particles, position, snaps[2], fixes,
-                                                         f"{os.fspath(walls)}: step {part.timestep}", periodic,
-                                                         walls_at)
                 contacts_now, tensile = _join(contacts_now, on_walls), tensile + tensile_walls
             if cell is not None and not unwrapped:  # wrapped into the cell: LAMMPS wraps only at re-neighbouring
                 moved = wrap(position, box_min, cell, periodic)
                 contacts_now["point"] = contacts_now["point"] + (moved - position)[contacts_now["i"]]
                 position = moved
             snapshot = dict(time=part.timestep * time_step, step=part.timestep, tensile=tensile, apart=apart,
+                            touched=_touched_moved(touched, bounds, box_min, box_max),
                             position=position, angle=np.zeros(position.shape[0]), contacts=contacts_now,
                             box_min=box_min, box_max=box_max, **extra)
             if cell is not None:
                 snapshot["cell"] = cell
-            if fixes is not None and len(walls_at) == len(WALL_NAMES):
-                snapshot["wall_position"] = _wall_points(walls_at, box_min, box_max)
+            if fixes is not None and len(logged) == len(WALL_NAMES):  # the same in every snapshot
+                snapshot["wall_position"] = _wall_points(logged, box_min, box_max)
             yield snapshot
 
     return static, snapshots()
@@ -780,6 +816,7 @@ def open_lammps(particles, contacts, walls=None, *, log=None, time_step=None, co
         stream = tqdm(stream, desc="lammps", unit=" snapshots")
     snaps = list(stream)
     _warn_left_out(sum(s.pop("tensile") for s in snaps), sum(s.pop("apart") for s in snaps), len(snaps))
+    _warn_touched([s.pop("touched") for s in snaps], static)
     _warn_no_log(log)
     return snapshots_dataset(static, snaps, ("step", "velocity", "angular_velocity", "wall_position"))
 
@@ -794,6 +831,28 @@ def _warn_left_out(tensile, apart, snapshots):
                       "positions carried a force and were left out of the contacts (LAMMPS's granular pair styles "
                       "give no force to pairs that do not touch: positions dumped with too few digits? dump_modify "
                       "format float %.17g)", UserWarning, stacklevel=3)
+
+
+def _touched_moved(touched, bounds, box_min, box_max):
+    """(the walls placed by their contact points, those of them that moved the box's side off
+    the dump's BOX BOUNDS)."""
+    moved = [w for w in touched if (box_min if w in (0, 3) else box_max)[1 - w % 2]
+             != (bounds[0] if w in (0, 3) else bounds[1])[1 - w % 2]]
+    return set(touched), set(moved)
+
+
+def _warn_touched(touched, static):
+    """One note naming the walls placed by their contact points (the log does not place them)
+    that moved the sample's side off the dump's BOX BOUNDS in some snapshots and touched nothing
+    in others, where the side is the BOX BOUNDS."""
+    moved = set().union(*(m for _, m in touched)) if touched else set()
+    counts = {w: sum(w in t for t, _ in touched) for w in moved}
+    partial = [f"{WALL_NAMES[w]} ({n} of {len(touched)})" for w, n in sorted(counts.items()) if n < len(touched)]
+    if partial:
+        warnings.warn(f"{static['attrs']['lammps_particles']}: walls the log does not place (fix wall/gran/region, or "
+                      f"no log) are placed where particles touch them: {', '.join(partial)} snapshot(s); in the "
+                      "others the sample's side is the dump's BOX BOUNDS (give the log of a fix wall/gran, whose "
+                      "walls it places at every step)", UserWarning, stacklevel=3)
 
 
 def _warn_no_log(log):
@@ -845,16 +904,18 @@ def convert_lammps(out, particles, contacts, walls=None, *, log=None, time_step=
     first = next(stream)
     optional = ("step", "gap") + tuple(name for name in ("velocity", "angular_velocity", "wall_position")
                                        if name in first)
-    tensile, apart = [], []
+    tensile, apart, touched = [], [], []
 
     def prepare(snap):
         tensile.append(snap.pop("tensile"))
         apart.append(snap.pop("apart"))
+        touched.append(snap.pop("touched"))
         return snap
 
     count = write_snapshots(out, static, chain_first(first, stream), optional, overwrite=overwrite,
                             compress=compress, progress=progress, label="lammps", prepare=prepare,
                             inputs=[path for path in (particles, contacts, walls, log) if path is not None])
     _warn_left_out(sum(tensile), sum(apart), count)
+    _warn_touched(touched, static)
     _warn_no_log(log)
     return count

@@ -19,7 +19,7 @@ from grainview.contract.errors import FileFormatError, ParameterError
 from grainview.formats.lammps import convert_lammps, open_lammps
 
 DATA = Path(__file__).resolve().parents[1] / "data" / "lammps_periodic"
-RUNS = ("periodic", "sheared", "walls", "walls_periodic_x")
+RUNS = ("periodic", "sheared", "walls", "walls_periodic_x", "walls_region")
 COLUMNS = {"patom1": "c_pairs[1]", "patom2": "c_pairs[2]", "fx": "c_forces[2]", "fy": "c_forces[3]",
            "p1": "c_forces[5]", "p2": "c_forces[6]"}  # the pairs' dump, for a read without the log
 WIGGLE = dict(height=0.2, amp=-0.06, period=1.6, dt=2e-5)  # in.walls: the top wall's fix wall/gran ... wiggle
@@ -140,7 +140,7 @@ def sample_box(name, step, hand):
     xlo, xhi, ylo, yhi, xy, _ = hand["box"]
     if name.startswith("walls"):
         ylo, yhi = 0.0, top_wall(step)
-        if name == "walls":
+        if name != "walls_periodic_x":
             xlo, xhi = 0.0, 0.1
     return xlo, xhi, ylo, yhi, xy
 
@@ -238,20 +238,29 @@ def test_the_cell_and_the_positions(datasets):
 
 
 def test_the_walled_runs_sample_is_the_region_between_the_walls(datasets):
-    """The top wall moves (fix wall/gran ... wiggle): the sample's height, strain and solid
-    fraction are those of the region between the floor and the top wall where it stands at
-    each step (the dump's BOX BOUNDS stay 0 .. 0.2); the walls' contact points lie on it."""
-    for name in ("walls", "walls_periodic_x"):
+    """The top wall moves (fix wall/gran ... wiggle, placed by the log; in walls_region a fix
+    wall/gran/region on a moving plane region, placed by its contact points): the sample's
+    height, strain and solid fraction are those of the region between the floor and the top
+    wall where it stands at each step (the dump's BOX BOUNDS stay 0 .. 0.2); the walls' contact
+    points lie on it."""
+    for name in ("walls", "walls_periodic_x", "walls_region"):
         ds = datasets[name]
         hand = by_hand(name)
         steps = [int(s) for s in ds["step"].values]
         top = np.array([top_wall(s) for s in steps])
         assert all(hand[s]["box"][3] == 0.2 for s in steps)
-        np.testing.assert_array_equal(ds["box_max"].values[:, 1], top)
+        if name == "walls_region":  # the median of its contact points, each on the plane to round-off
+            points = [np.median([point[1] for _, _, point, fix in hand[s]["walls"] if fix == "top"]) for s in steps]
+            np.testing.assert_array_equal(ds["box_max"].values[:, 1], points)
+            np.testing.assert_allclose(points, top, rtol=1e-15)
+            top = np.array(points)
+        else:
+            np.testing.assert_array_equal(ds["box_max"].values[:, 1], top)
         np.testing.assert_array_equal(ds["box_min"].values[:, 1], 0.0)
         for s, y in zip(steps, top):
             tops = [point[1] for _, _, point, fix in hand[s]["walls"] if fix == "top"]
             np.testing.assert_allclose(tops, y, rtol=1e-15)
+        assert ds.attrs["lammps_sample_box"].startswith("between the walls of fix floor")
         assert any(fix == "top" for s in steps for *_, fix in hand[s]["walls"])
         eps_1 = np.log(1 + (top[0] - top) / top[0])  # grainview's vertical strain (docs/conventions.md)
         np.testing.assert_allclose(ds.grain.strains()["eps_1"].values, eps_1, rtol=1e-12, atol=1e-15)
@@ -263,12 +272,22 @@ def test_the_walled_runs_sample_is_the_region_between_the_walls(datasets):
     np.testing.assert_array_equal(wall_position[:, 2, 1], datasets["walls"]["box_max"].values[:, 1])
     np.testing.assert_array_equal(wall_position[:, [0, 3, 1], [1, 0, 0]], [[0.0, 0.0, 0.1]] * len(wall_position))
     assert "wall_position" not in datasets["walls_periodic_x"]  # no wall on the periodic sides
-    # only the log says where a fix wall/gran stands: without it the box is the dump's BOX BOUNDS
+    assert "wall_position" not in datasets["walls_region"]  # the top placed only where it is touched
+    # without the log, a wall stands where particles touch it: the top from its second snapshot
+    # on, the dump's BOX BOUNDS before (with a note)
     f = files("walls")
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore")
+    hand = by_hand("walls")
+    steps = [int(s) for s in datasets["walls"]["step"].values]
+    touched = [any(fix == "top" for *_, fix in hand[s]["walls"]) for s in steps]
+    assert touched == [False, True, True, True]
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
         ds = open_lammps(f["particles"], f["contacts"], f["walls"], time_step=2e-5, columns=COLUMNS)
-    np.testing.assert_array_equal(ds["box_max"].values, [[0.1, 0.2]] * ds.sizes["time"])
+    notes = [str(w.message) for w in caught if "walls the log does not place" in str(w.message)]
+    assert len(notes) == 1 and "placed where particles touch them: top (3 of 4) snapshot(s)" in notes[0], notes
+    np.testing.assert_array_equal(ds["box_max"].values[:, 1], [0.2] + [top_wall(s) for s in steps[1:]])
+    np.testing.assert_array_equal(ds["box_min"].values, 0.0)
+    np.testing.assert_array_equal(ds["box_max"].values[:, 0], 0.1)
 
 
 # --- bad input: one line each -------------------------------------------------------------------

@@ -17,7 +17,9 @@ into its own folder of ``--out`` (default: this folder, the committed fixtures):
 * ``walls/``: 136 disks under gravity between a floor, two side walls and a top wall moved down
   by ``fix wall/gran ... wiggle``, all ``fix wall/gran ... contacts``, 4 snapshots;
 * ``walls_periodic_x/``: the same with the cell periodic in x and walls in y only
-  (``boundary p f p``), 2 snapshots.
+  (``boundary p f p``), 2 snapshots;
+* ``walls_region/``: the same walled run with the top wall a ``fix wall/gran/region`` on a
+  plane region moved the same way (``region ... move``), 2 snapshots.
 
 Each run takes about a second on one core.
 """
@@ -39,6 +41,7 @@ RUNS = {
     "sheared": ("in.periodic", {"shear": 2, "every": 4000}),
     "walls": ("in.walls", {}),
     "walls_periodic_x": ("in.walls", {"xbc": "p", "first": 36000, "steps": 2000}),
+    "walls_region": ("in.walls", {"top": "region", "first": 36000, "steps": 2000}),
 }
 """Folder -> (input, variables given on the command line)."""
 
