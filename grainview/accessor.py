@@ -142,6 +142,7 @@ class GrainAccessor:
     stress_tensor = _Delegate("stress")
     stress_invariants = _Delegate("stress")
     strains = _Delegate("strain")
+    deformation_gradient = _Delegate("strain")
     friction_and_dilatancy = _Delegate("strain")
     friction_offset = _Delegate("strain")
     inertia_number = _Delegate("strain")

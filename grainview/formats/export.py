@@ -24,6 +24,15 @@ VTK, written as VTK's XML PolyData (:mod:`grainview.formats.vtk_xml`), per snaps
   mesh blank, and its Tachyon renderer stopped (segmentation fault) on such a mesh of a few
   polygons;
 
+In a periodic cell (a file with ``cell``) the particles are written wrapped into the cell
+(whatever the file's ``cell_positions``), each contact as one line from the wrapped centre of i
+along its minimum-image branch (a contact across the boundary sticks out of the cell by at
+most its branch, to the image of j, never a line across the box; one line per contact, so sums
+over the lines and OVITO's bond list count it once), and ``cell_<k>.vtp`` holds the cell's
+outline, the parallelogram origin, origin + a, origin + a + b, origin + b, as one closed line
+with cell data ``periodic_a``, ``periodic_b``; not a block of the ``.vtm`` (the blocks of a
+file without a cell stay as they were);
+
 then ``snapshots.pvd`` and ``polygons.pvd``, the ParaView collections that put the ``.vtm``
 and the polygons' files on the time axis. The names ``id``, ``radius``, ``v``, ``id1``/``id2``,
 ``particle_id``/``wall_id`` and the one-vertex-per-point, two-points-per-line layout are those
@@ -51,6 +60,7 @@ import os
 import numpy as np
 import xarray as xr
 
+from ..contract.cell import wrap
 from ..contract.errors import ParameterError
 from ..contract.shapes import body_vertices_of, world_vertices
 from .vtk_xml import collection, multiblock, polydata, write_xml
@@ -142,6 +152,25 @@ VTK_BLOCKS = ("particles", "contacts", "wall_contacts")
 """The blocks of each snapshot's ``.vtm`` file, in order, each the stem of its ``.vtp`` file."""
 
 
+def _centres(snap: xr.Dataset) -> np.ndarray:
+    """The centres (P, 2) written: as stored, or wrapped into a periodic cell."""
+    position = np.asarray(snap["position"].values, float)
+    if "cell" not in snap.variables:
+        return position
+    periodic = np.asarray(snap["periodic"].values, bool)
+    home = wrap(np.nan_to_num(position), np.asarray(snap["box_min"].values, float),
+                np.asarray(snap["cell"].values, float), periodic)
+    return np.where(np.isfinite(position), home, position)
+
+
+def _cell_outline(snap: xr.Dataset):
+    """The periodic cell's outline: its four corners, closed (5 points), one polyline."""
+    cell, origin = np.asarray(snap["cell"].values, float), np.asarray(snap["box_min"].values, float)
+    corners = origin + np.array([[0.0, 0.0], cell[0], cell[0] + cell[1], cell[1], [0.0, 0.0]])
+    periodic = np.asarray(snap["periodic"].values, np.int64)
+    return polydata(corners, lines=np.array([5]), cell_data={"periodic_a": periodic[:1], "periodic_b": periodic[1:]})
+
+
 def _particle_data(snap: xr.Dataset, fields: xr.Dataset) -> dict:
     """Per-particle arrays by name: id, radius, n_vertices, angle, v (when present), the fields."""
     n = snap.sizes["particle"]
@@ -159,7 +188,7 @@ def _particle_data(snap: xr.Dataset, fields: xr.Dataset) -> dict:
 def _polygons(snap: xr.Dataset, data: dict):
     """The polygons' outlines, grouped by vertex count: their vertices (one polygon after the
     other), each polygon's vertex count and its data."""
-    position = np.asarray(snap["position"].values, float)
+    position = _centres(snap)
     n_vertices = data["n_vertices"]
     groups = [np.flatnonzero(n_vertices == n) for n in np.unique(n_vertices[n_vertices > 0])]
     world = world_vertices(position, data["angle"], body_vertices_of(snap))
@@ -177,7 +206,7 @@ def _contact_lines(snap: xr.Dataset, classes: np.ndarray, walls: bool):
     j = np.asarray(snap["j"].values).astype(np.int64)
     used = np.flatnonzero((kind > 0) & ((j >= n) if walls else (j < n)))
     i = np.asarray(snap["i"].values)[used].astype(np.int64)
-    start = np.asarray(snap["position"].values, float)[i]
+    start = _centres(snap)[i]
     points = np.empty((2 * used.size, 2))
     points[0::2], points[1::2] = start, start + np.asarray(snap["branch"].values, float)[used]
     ids = {"particle_id": i, "wall_id": j[used] - n} if walls else {"id1": i, "id2": j[used]}
@@ -191,7 +220,7 @@ def _snapshot_files(snap: xr.Dataset, fields: xr.Dataset, classes: np.ndarray, p
     when ``polygons``); None for the contacts of a snapshot without particle-particle contact
     (no file: OVITO stops on a contacts file without lines)."""
     data = _particle_data(snap, fields)
-    trees = {"particles": polydata(np.asarray(snap["position"].values, float), verts=True, point_data=data)}
+    trees = {"particles": polydata(_centres(snap), verts=True, point_data=data)}
     for block, walls in (("contacts", False), ("wall_contacts", True)):
         points, cell_data = _contact_lines(snap, classes, walls)
         empty = len(points) == 0 and not walls
@@ -199,6 +228,8 @@ def _snapshot_files(snap: xr.Dataset, fields: xr.Dataset, classes: np.ndarray, p
     if polygons:
         points, sizes, cell_data = _polygons(snap, data)
         trees["polygons"] = polydata(points, polys=sizes, cell_data=cell_data)
+    if "cell" in snap.variables:
+        trees["cell"] = _cell_outline(snap)
     return trees
 
 
@@ -208,7 +239,8 @@ def write_vtk(ds: xr.Dataset, out_dir, every: int = 1, overwrite: bool = False, 
     For ParaView and OVITO (open ``snapshots.pvd``: every snapshot on the time axis, or one
     ``snapshot_<k>.vtm``; in ParaView also ``polygons.pvd``); ``out_dir`` is created if
     needed. Per snapshot k, ``particles_<k>.vtp``, ``contacts_<k>.vtp``,
-    ``wall_contacts_<k>.vtp``, ``polygons_<k>.vtp`` (files with polygons) and
+    ``wall_contacts_<k>.vtp``, ``polygons_<k>.vtp`` (files with polygons), ``cell_<k>.vtp``
+    (files with a periodic cell: its outline; the particles wrapped into it) and
     ``snapshot_<k>.vtm``, then ``snapshots.pvd`` and ``polygons.pvd`` (files with polygons).
 
     Parameters
@@ -245,7 +277,7 @@ def write_vtk(ds: xr.Dataset, out_dir, every: int = 1, overwrite: bool = False, 
 
     indices = snapshot_indices(ds, every)
     polygons = bool((np.asarray(ds["n_vertices"].values) > 0).any())
-    stems = list(VTK_BLOCKS) + ["polygons"] * polygons
+    stems = list(VTK_BLOCKS) + ["polygons"] * polygons + ["cell"] * ("cell" in ds.variables)
     collections = ["snapshots"] + ["polygons"] * polygons
     targets = [os.path.join(out_dir, name) for k in indices
                for name in [f"{stem}_{int(k):05d}.vtp" for stem in stems] + [f"snapshot_{int(k):05d}.vtm"]]

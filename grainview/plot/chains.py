@@ -79,7 +79,7 @@ def plot_chain_map(data, ax=None, time: int = -1, angle: float = 45.0, min_size:
     import matplotlib as mpl
     from matplotlib.collections import LineCollection
 
-    from .maps import contact_segments, map_axes, plot_particles
+    from .maps import _clip_to_cell, contact_segments, map_axes, plot_particles
 
     _, ds = single_dataset(data)
     k = snapshot_index(ds, time)
@@ -91,7 +91,9 @@ def plot_chain_map(data, ax=None, time: int = -1, angle: float = 45.0, min_size:
     ax = map_axes(ax, ds, k)
     plot_particles(ds, ax=ax, time=k, values=values, cmap=colours, norm=norm)
     segments, _ = contact_segments(ds, k, np.asarray(snap["link"].values, bool))
-    ax.add_collection(LineCollection(segments, colors=LINK_COLOUR, linewidths=linewidth, zorder=2, gid="chains"))
+    links = ax.add_collection(LineCollection(segments, colors=LINK_COLOUR, linewidths=linewidth, zorder=2,
+                                             gid="chains"))
+    _clip_to_cell(ax, ds, k, links)
     if title:
         ax.set_title(f"snapshot {k}: {int(snap['n_chains'])} chains, {float(snap['particle_fraction']):.0%} of the "
                      f"particles, contributing {float(snap['deviator_fraction']):.0%} of q", fontsize="small")

@@ -19,6 +19,7 @@ from matplotlib.collections import EllipseCollection, LineCollection, PolyCollec
 
 from ..analysis.contacts import selection
 from ..contract.errors import ParameterError
+from ..contract.cell import fractional, image_shift, wrap
 from ..contract.shapes import body_vertices_of, world_vertices
 from ._docs import fill_doc
 from ._style import PALETTE, axis_label, get_axes, single_dataset, snapshot_index
@@ -47,6 +48,10 @@ def plot_particles(data, ax=None, time: int = -1, facecolor=PARTICLE_FACE, edgec
     sin(angle[p] + 2 pi k/n)), docs/schema.md). With ``values`` (one number per particle) the
     faces are coloured by them through ``cmap`` and ``norm`` (a matplotlib Normalize) instead of
     ``facecolor``. Sets equal aspect, the box as limits, x and y labels in m.
+
+    In a periodic cell the particles are drawn wrapped into the cell, with the images of those
+    that reach across a boundary, clipped by the cell's parallelogram, which is drawn as the
+    frame (the limits hold it whole when it is tilted).
 
     Parameters
     ----------
@@ -80,7 +85,16 @@ def plot_particles(data, ax=None, time: int = -1, facecolor=PARTICLE_FACE, edgec
     angle = np.asarray(ds["angle"].isel(time=k).values, float)
     radius = np.asarray(ds["radius"].values, float)
     n_vertices = np.asarray(ds["n_vertices"].values, int)
+    vertices = body_vertices_of(ds)
     style = dict(edgecolors=edgecolor, linewidths=linewidth, zorder=1)
+    clip = None
+    if "cell" in ds.variables:  # wrapped into the cell, with the images that reach into it, clipped by it
+        index, position = _cell_images(ds, k, position, radius)
+        angle, radius, n_vertices, vertices = angle[index], radius[index], n_vertices[index], vertices[index]
+        values = None if values is None else np.asarray(values, float)[index]
+        clip = _cell_outline(ds, k, fill=False)
+        ax.add_patch(clip)
+        clip.set_visible(False)
 
     def faces(collection, sel):
         if values is None:
@@ -90,17 +104,81 @@ def plot_particles(data, ax=None, time: int = -1, facecolor=PARTICLE_FACE, edgec
             collection.set_cmap(cmap)
             collection.set_norm(norm)
         ax.add_collection(collection)
+        if clip is not None:
+            collection.set_clip_path(clip)
 
     disks = n_vertices == 0
     if disks.any():
         faces(EllipseCollection(2 * radius[disks], 2 * radius[disks], np.zeros(disks.sum()), units="xy",
                                 offsets=position[disks], offset_transform=ax.transData, **style), disks)
-    outlines = world_vertices(position, angle, body_vertices_of(ds))
+    outlines = world_vertices(position, angle, vertices)
     for n in np.unique(n_vertices[~disks]):
         sel = n_vertices == n
         faces(PolyCollection(outlines[sel, :int(n)], **style), sel)
     _frame(ax, ds, k)
     return ax
+
+
+def _cell_of(ds: xr.Dataset, k: int):
+    """Snapshot ``k``'s cell (2, 2), origin (2,) and periodic flags (2,) of bool."""
+    return (np.asarray(ds["cell"].isel(time=k).values, float), np.asarray(ds["box_min"].isel(time=k).values, float),
+            np.asarray(ds["periodic"].values, bool))
+
+
+def _cell_corners(ds: xr.Dataset, k: int) -> np.ndarray:
+    """The corners (4, 2), m, of snapshot ``k``'s periodic cell, the parallelogram
+    origin, origin + a, origin + a + b, origin + b (origin ``box_min``)."""
+    cell, origin, _ = _cell_of(ds, k)
+    return origin + np.array([[0.0, 0.0], cell[0], cell[0] + cell[1], cell[1]])
+
+
+def _cell_outline(ds: xr.Dataset, k: int, fill: bool = False, **style):
+    """The parallelogram of snapshot ``k``'s periodic cell as a matplotlib Polygon (not added)."""
+    from matplotlib.patches import Polygon
+
+    return Polygon(_cell_corners(ds, k), closed=True, fill=fill, **style)
+
+
+def _cell_images(ds: xr.Dataset, k: int, position, reach) -> tuple[np.ndarray, np.ndarray]:
+    """The particles of a periodic snapshot wrapped into the cell, and the images of those that
+    reach into it across a boundary (within ``reach``, (P,) m, of it): the particle index and
+    the centre (m) of each drawn copy, the wrapped centres first.
+
+    Parameters
+    ----------
+    ds : xarray.Dataset
+        A dataset with a cell.
+    k : int
+        Snapshot index.
+    position : array_like, (P, 2)
+        Centres, m.
+    reach : array_like, (P,)
+        How far each particle reaches from its centre (its circumscribed radius), m.
+
+    Returns
+    -------
+    index : numpy.ndarray of int, (Q,)
+    centres : numpy.ndarray, (Q, 2)
+    """
+    cell, origin, periodic = _cell_of(ds, k)
+    position = np.asarray(position, float)
+    finite = np.isfinite(position).all(-1)
+    home = np.where(finite[:, None], wrap(np.nan_to_num(position), origin, cell, periodic), position)
+    st = fractional(home - origin, cell)
+    reach = np.asarray(reach, float)
+    # how far a particle of radius r reaches in cell coordinates: r over the distance between opposite edges
+    area = abs(cell[0, 0] * cell[1, 1] - cell[0, 1] * cell[1, 0])
+    span = reach[:, None] * np.array([np.hypot(*cell[1]), np.hypot(*cell[0])]) / area
+    index, centres = [np.arange(position.shape[0])], [home]
+    for m in (-1, 0, 1):
+        for n in (-1, 0, 1):
+            if (m, n) == (0, 0) or (m and not periodic[0]) or (n and not periodic[1]):
+                continue
+            moved = st + [m, n]
+            near = finite & np.all((moved > -span) & (moved < 1 + span), axis=-1)
+            index.append(np.flatnonzero(near))
+            centres.append(home[near] + m * cell[0] + n * cell[1])
+    return np.concatenate(index), np.concatenate(centres)
 
 
 PARTICLE_FIELDS = {"c": "contacts c", "m_s": "simple contacts m_s", "m_d": "double contacts m_d",
@@ -287,6 +365,13 @@ def map_axes(ax, ds: xr.Dataset, k: int):
 def _frame(ax, ds, k):
     lo = np.asarray(ds["box_min"].isel(time=k).values, float)
     hi = np.asarray(ds["box_max"].isel(time=k).values, float)
+    if "cell" in ds.variables:  # the parallelogram, and limits that hold it
+        corners = _cell_corners(ds, k)
+        lo, hi = corners.min(axis=0), corners.max(axis=0)
+        if not any(p.get_gid() == "cell" for p in ax.patches):
+            outline = _cell_outline(ds, k, fill=False, edgecolor="0.3", linewidth=0.8, zorder=3)
+            outline.set_gid("cell")
+            ax.add_patch(outline)
     ax.set_xlim(lo[0], hi[0])
     ax.set_ylim(lo[1], hi[1])
     ax.set_aspect("equal")
@@ -301,6 +386,12 @@ def contact_segments(ds: xr.Dataset, k: int, mask) -> tuple[np.ndarray, np.ndarr
     (C, 2, 2) segments, m, from the centre of body i to that centre plus the branch vector (the
     centre of j, or the contact point on a wall), and the slot indices of the C contacts of
     snapshot ``k`` selected by the boolean ``mask`` (contact,).
+
+    In a periodic cell the centres are wrapped into the cell and the branch is the minimum
+    image: a contact across the boundary is two segments, its branch from the centre of i and
+    back from the centre of j (``-branch``), each with the contact's slot. Clipped by the cell
+    (as the maps clip them), the two pieces inside it are the whole contact, drawn on both sides
+    of the boundary, never a line across the box.
 
     Parameters
     ----------
@@ -325,9 +416,21 @@ def contact_segments(ds: xr.Dataset, k: int, mask) -> tuple[np.ndarray, np.ndarr
     slots = np.flatnonzero(np.asarray(mask, bool))
     snap = ds.isel(time=k, contact=slots)
     i = np.asarray(snap["i"].values, int)
-    start = np.asarray(ds["position"].isel(time=k).values, float)[i]
-    end = start + np.asarray(snap["branch"].values, float)
-    return np.stack([start, end], axis=1), slots
+    position = np.asarray(ds["position"].isel(time=k).values, float)
+    branch = np.asarray(snap["branch"].values, float)
+    if "cell" not in ds.variables:
+        start = position[i]
+        return np.stack([start, start + branch], axis=1), slots
+    cell, origin, periodic = _cell_of(ds, k)
+    home = wrap(np.nan_to_num(position), origin, cell, periodic)
+    j = np.asarray(snap["j"].values, int)
+    start = home[i]
+    pair = (j >= 0) & (j < position.shape[0])
+    far = home[np.where(pair, j, 0)]
+    across = pair & np.any(image_shift(start + branch - far, cell, periodic) != 0, axis=-1)
+    segments = np.concatenate([np.stack([start, start + branch], axis=1),
+                               np.stack([far[across], far[across] - branch[across]], axis=1)])
+    return segments, np.concatenate([slots, slots[across]])
 
 
 def force_linewidths(fn, max_linewidth: float, force_scale=None) -> np.ndarray:
@@ -401,7 +504,20 @@ def _network(ds, k, mask, colours, ax, max_linewidth, width_by_force, linewidth,
     lines = LineCollection(segments, linewidths=widths, colors=colours, capstyle="round", zorder=zorder)
     lines.set_gid("contacts")
     ax.add_collection(lines)
+    _clip_to_cell(ax, ds, k, lines)
     return lines, key
+
+
+def _clip_to_cell(ax, ds: xr.Dataset, k: int, artist) -> None:
+    """Clip ``artist`` (added to ``ax``) by snapshot ``k``'s periodic cell, when the file has
+    one (nothing otherwise): what lies beyond the parallelogram is drawn by the images on the
+    other side."""
+    if "cell" not in ds.variables:
+        return
+    clip = _cell_outline(ds, k, fill=False)
+    ax.add_patch(clip)
+    clip.set_visible(False)
+    artist.set_clip_path(clip)
 
 
 def _digits(value: float) -> str:

@@ -10,6 +10,7 @@ import pytest
 import grainview
 import grainview.analysis.coarse_graining
 import grainview.analysis.strain
+import grainview.formats.export
 from grainview.contract import cell as cells
 
 
@@ -34,7 +35,8 @@ def test_strains_of_a_sheared_cell_by_hand(prepare):
     np.testing.assert_allclose(eps["gamma"].values, (0.2 + 0.4 * np.arange(7) - 0.2) / 2.0, rtol=0, atol=1e-15)
     for name in ("eps_1", "eps_2", "eps_p", "eps_q"):  # the widths do not change: no biaxial strain
         np.testing.assert_array_equal(eps[name].values, 0.0)
-    f = grainview.analysis.strain.deformation_gradient(ds).values
+    f = ds.grain.deformation_gradient().values
+    assert ds.grain.deformation_gradient().attrs["units"] == "1"
     np.testing.assert_allclose(f[:, 0, 1], eps["gamma"].values, atol=1e-15)
     np.testing.assert_allclose(f[:, [0, 1, 1], [0, 0, 1]], np.tile([1.0, 0.0, 1.0], (7, 1)), atol=1e-15)
 
@@ -303,3 +305,59 @@ def test_lifetimes_in_the_cells_shear_strain():
     assert float(events["lifetime_eps_q"][0]) == 0.0
     survival = ds.grain.lifetime_survival(unit="gamma")
     assert survival["lifetime"].attrs["units"] == "1"
+
+
+def test_maps_draw_the_cell_and_contacts_across_it():
+    """A contact across the boundary is drawn as its branch from each particle (two segments of
+    the length of the branch, never one across the box), particles wrapped with their images, the
+    cell a parallelogram."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    from grainview.plot import maps
+
+    ds = chain_across(tilt=2.0)
+    segments, slots = maps.contact_segments(ds, 0, np.ones(ds.sizes["contact"], bool) & (
+        np.arange(ds.sizes["contact"]) < int(ds["contact_count"][0])))
+    lengths = np.linalg.norm(segments[:, 1] - segments[:, 0], axis=-1)
+    np.testing.assert_allclose(lengths, 1.0)  # every piece is a branch
+    assert np.bincount(slots).max() == 2 and (np.bincount(slots) == 2).sum() == 1  # the one contact across x = 0
+    ax = ds.grain.plot.force_chains()
+    lines = [c for c in ax.collections if c.get_gid() == "contacts"][0]
+    assert lines.get_clip_path() is not None
+    outline = [p for p in ax.patches if p.get_gid() == "cell"][0]
+    np.testing.assert_allclose(outline.get_xy()[:4], [[0, 0], [10, 0], [12, 10], [2, 10]])
+    assert ax.get_xlim() == (0.0, 12.0)
+    index, centres = maps._cell_images(ds, 0, ds["position"].values[0], ds["radius"].values)
+    assert index.size > ds.sizes["particle"]  # the particles by the boundary have images
+    plt.close("all")
+
+
+def test_vtk_export_wraps_the_particles_and_writes_the_cell(tmp_path):
+    """Stored unwrapped (a cell to the right), the particles are written inside the cell; the
+    contact across the boundary is one line of its branch's length from the centre of i; the
+    cell's outline is a closed line of its four corners."""
+    from tests.grainview.test_export import read_vtp
+
+    base = chain_across(tilt=2.0)
+    position = base["position"].values.copy()
+    position[0, :3] += [10.0, 0.0]  # three particles one cell along a: unwrapped
+    ds = grainview.make_dataset(radius=base["radius"].values, position=position,
+                                contacts=[dict(i=base["i"].values[0, :10], j=base["j"].values[0, :10],
+                                               normal=base["normal"].values[0, :10], fn=base["fn"].values[0, :10],
+                                               branch=base["branch"].values[0, :10])],
+                                box_min=[0, 0], box_max=[10, 10], periodic=[1, 1], cell=base["cell"].values)
+    assert ds.attrs["cell_positions"] == "unwrapped"
+    written = grainview.formats.export.write_vtk(ds, tmp_path)
+    assert any(p.endswith("cell_00000.vtp") for p in written)
+
+    def points(name):
+        return read_vtp(tmp_path / name)[2]["Points"]["Points"][:, :2]
+
+    centres = points("particles_00000.vtp")
+    np.testing.assert_allclose(centres, base["position"].values[0], atol=1e-12)
+    ends = points("contacts_00000.vtp").reshape(-1, 2, 2)
+    np.testing.assert_allclose(np.linalg.norm(ends[:, 1] - ends[:, 0], axis=-1), 1.0)
+    np.testing.assert_allclose(points("cell_00000.vtp"), [[0, 0], [10, 0], [12, 10], [2, 10], [0, 0]])
