@@ -738,6 +738,7 @@ def lammps_snapshots(particles, contacts, walls=None, *, log=None, time_step=Non
     static = dict(radius=static_particles.radius, mass=static_particles.mass, inertia=static_particles.inertia,
                   n_walls=len(WALL_NAMES) if walls is not None else 0,
                   wall_names=list(WALL_NAMES) if walls is not None else None, attrs=attrs)
+    static["deforming"] = log_info is not None and any(style == "deform" for style, _ in log_info.fixes.values())
     if any(periodic):
         static["periodic"] = np.array(periodic, "i1")
         attrs["cell_positions"] = "unwrapped" if unwrapped else "wrapped"
@@ -815,14 +816,16 @@ def open_lammps(particles, contacts, walls=None, *, log=None, time_step=None, co
 
         stream = tqdm(stream, desc="lammps", unit=" snapshots")
     snaps = list(stream)
-    _warn_left_out(sum(s.pop("tensile") for s in snaps), sum(s.pop("apart") for s in snaps), len(snaps))
+    _warn_left_out(sum(s.pop("tensile") for s in snaps), sum(s.pop("apart") for s in snaps), len(snaps),
+                   static["deforming"])
     _warn_touched([s.pop("touched") for s in snaps], static)
     _warn_no_log(log)
     return snapshots_dataset(static, snaps, ("step", "velocity", "angular_velocity", "wall_position"))
 
 
-def _warn_left_out(tensile, apart, snapshots):
-    """One note per kind of pair left out of the contacts."""
+def _warn_left_out(tensile, apart, snapshots, deforming=False):
+    """One note per kind of pair left out of the contacts (``deforming``: the log has a fix
+    deform, whose dumps are a step's deformation ahead of the forces)."""
     if tensile:
         warnings.warn(f"{tensile} touching pair(s) over {snapshots} snapshot(s) had a tensile normal force (viscous "
                       "damping as they separate) and were left out of the contacts", UserWarning, stacklevel=3)
@@ -830,7 +833,9 @@ def _warn_left_out(tensile, apart, snapshots):
         warnings.warn(f"{apart} pair(s) over {snapshots} snapshot(s) whose disks do not overlap at the dumped "
                       "positions carried a force and were left out of the contacts (LAMMPS's granular pair styles "
                       "give no force to pairs that do not touch: positions dumped with too few digits? dump_modify "
-                      "format float %.17g)", UserWarning, stacklevel=3)
+                      "format float %.17g" + ("; or the run's fix deform, which changes the box (and, with remap x, "
+                                              "the positions) after the forces and before the dumps of each step"
+                                              if deforming else "") + ")", UserWarning, stacklevel=3)
 
 
 def _touched_moved(touched, bounds, box_min, box_max):
@@ -915,7 +920,7 @@ def convert_lammps(out, particles, contacts, walls=None, *, log=None, time_step=
     count = write_snapshots(out, static, chain_first(first, stream), optional, overwrite=overwrite,
                             compress=compress, progress=progress, label="lammps", prepare=prepare,
                             inputs=[path for path in (particles, contacts, walls, log) if path is not None])
-    _warn_left_out(sum(tensile), sum(apart), count)
+    _warn_left_out(sum(tensile), sum(apart), count, static["deforming"])
     _warn_touched(touched, static)
     _warn_no_log(log)
     return count

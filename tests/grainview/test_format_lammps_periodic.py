@@ -373,3 +373,39 @@ def test_a_contact_across_the_cell_without_its_minimum_image_would_be_refused():
     check_contacts(limits, position, contacts, "here", cell=cell, periodic=[1, 1])
     with pytest.raises(FileFormatError, match="centres are 9.2 m apart"):
         check_contacts(limits, position, contacts, "here", cell=cell, periodic=[0, 1])
+
+
+def test_grainview_info_reports_the_region_between_the_walls(tmp_path, capsys):
+    """`grainview convert lammps` then `grainview info`: the strain and the solid fraction of the
+    region between the floor and the moving top wall, by hand (the dump's BOX BOUNDS would give
+    eps_1 0.000 and a solid fraction below 0.4)."""
+    from grainview.app.cli import main
+
+    f = files("walls")
+    out = tmp_path / "walls.nc"
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        assert main(["convert", "lammps", "--particles", str(f["particles"]), "--contacts", str(f["contacts"]),
+                     "--walls", str(f["walls"]), "--log", str(f["log"]), "--out", str(out)]) == 0
+    capsys.readouterr()
+    assert main(["info", str(out)]) == 0
+    text = capsys.readouterr().out
+    steps = sorted(plain_dump(f["particles"]))
+    top = [top_wall(s) for s in steps]
+    radius = [row[2] for row in plain_dump(f["particles"])[steps[0]][2]]  # id type radius ...
+    area = math.pi * sum(r * r for r in radius)
+    phi = [area / (0.1 * h) for h in top]
+    eps_1 = math.log(1 + (top[0] - top[-1]) / top[0])
+    assert f"solid fraction {min(phi):.3f} .. {max(phi):.3f}" in text, text
+    assert f"strain reached: eps_1 {eps_1:.3f}" in text, text
+
+
+def test_a_deforming_cells_note_names_fix_deform():
+    """A pair that touches at the forces' step but not at the dumped one (the box deformed in
+    between) is counted in a note that says why."""
+    f = files("sheared")
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        open_lammps(f["particles"], f["contacts"], log=f["log"])
+    notes = [str(w.message) for w in caught if "do not overlap at the dumped positions" in str(w.message)]
+    assert len(notes) == 1 and "or the run's fix deform, which changes the box" in notes[0], notes
