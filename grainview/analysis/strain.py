@@ -194,6 +194,11 @@ def residual_window(ds: xr.Dataset, start: float = RESIDUAL_STRAIN) -> xr.DataAr
     A run that stops short of ``start`` has no residual snapshot (all False): its residual
     values are "not reached" rather than those of another state.
 
+    A periodic cell that is sheared (its continuous tilt changes over the run) is in simple
+    shear, where eps_q, which reads the widths only, stays near 0: its window is
+    |gamma| >= ``start`` instead, gamma the cell's shear strain (:func:`strains`; a simple
+    shear gamma has principal strains +-gamma/2, so gamma plays eps_q's part).
+
     Parameters
     ----------
     {ds}
@@ -219,9 +224,19 @@ def residual_window(ds: xr.Dataset, start: float = RESIDUAL_STRAIN) -> xr.DataAr
     if isinstance(start, bool) or not isinstance(start, (int, float, np.integer, np.floating)) \
             or not np.isfinite(start) or start < 0:
         raise ParameterError(f"residual strain start={start!r}: expected a shear strain eps_q >= 0")
-    eps_q = strains(ds)["eps_q"].compute()
+    eps = strains(ds)
+    if "gamma" in eps and _sheared(ds):
+        window = abs(eps["gamma"].compute()) >= start
+        return window.rename("residual").assign_attrs(long_name=f"residual state, |gamma| >= {start:g}", units="1")
+    eps_q = eps["eps_q"].compute()
     window = eps_q >= start
     return window.rename("residual").assign_attrs(long_name=f"residual state, eps_q >= {start:g}", units="1")
+
+
+def _sheared(ds: xr.Dataset) -> bool:
+    """Whether a file's periodic cell is sheared over the run: its continuous tilt changes."""
+    tilt = _continuous_cell(ds)[:, 1, 0]
+    return bool(tilt.size and np.ptp(tilt) > 0)
 
 
 @fill_doc

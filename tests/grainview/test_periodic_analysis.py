@@ -361,3 +361,12 @@ def test_vtk_export_wraps_the_particles_and_writes_the_cell(tmp_path):
     ends = points("contacts_00000.vtp").reshape(-1, 2, 2)
     np.testing.assert_allclose(np.linalg.norm(ends[:, 1] - ends[:, 0], axis=-1), 1.0)
     np.testing.assert_allclose(points("cell_00000.vtp"), [[0, 0], [10, 0], [12, 10], [2, 10], [0, 0]])
+
+
+def test_the_residual_window_of_a_sheared_cell_reads_gamma():
+    ds = sheared_series(0.2 + 0.4 * np.arange(6))  # gamma 0, 0.2, ..., 1.0; eps_q 0 throughout
+    window = grainview.analysis.strain.residual_window(ds, 0.5)
+    np.testing.assert_array_equal(window.values, [False, False, False, True, True, True])
+    assert "gamma" in window.attrs["long_name"]
+    still = sheared_series(np.full(3, 0.7))  # a cell that is not sheared keeps eps_q's window
+    assert "eps_q" in grainview.analysis.strain.residual_window(still).attrs["long_name"]
