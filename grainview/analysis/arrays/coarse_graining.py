@@ -106,8 +106,8 @@ def image_offsets(cell, origin, periodic, x, y, reach):
     l, tilt, h = cell[:, 0, 0], cell[:, 1, 0], cell[:, 1, 1]
     ox, oy = origin[:, 0], origin[:, 1]
     if periodic[1]:
-        n_lo = int(np.floor(((y[0] - reach - oy - h) / h).min()))
-        n_hi = int(np.ceil(((y[-1] + reach - oy) / h).max()))
+        n_lo = int(np.ceil(((y[0] - reach - oy - h) / h).min() - 1e-9))
+        n_hi = int(np.floor(((y[-1] + reach - oy) / h).max() + 1e-9))
     else:
         n_lo = n_hi = 0
     shifts = []
@@ -116,22 +116,60 @@ def image_offsets(cell, origin, periodic, x, y, reach):
             # the wrapped sources lie within x in [ox + min(0, tilt), ox + l + max(0, tilt)]; moved by n b
             left = ox + np.minimum(0.0, tilt) + n * tilt
             right = ox + l + np.maximum(0.0, tilt) + n * tilt
-            m_lo = int(np.floor(((x[0] - reach - right) / l).min()))
-            m_hi = int(np.ceil(((x[-1] + reach - left) / l).max()))
+            m_lo = int(np.ceil(((x[0] - reach - right) / l).min() - 1e-9))
+            m_hi = int(np.floor(((x[-1] + reach - left) / l).max() + 1e-9))
         else:
             m_lo = m_hi = 0
         shifts.extend((m, n) for m in range(m_lo, m_hi + 1))
     return np.array(shifts, dtype=np.int64).reshape(-1, 2)
 
 
-def _images(points, offsets, extra=()):
-    """``points`` (B, N, 2) moved by each of ``offsets`` (B, K, 2), as (B, K N, 2); each array of
-    ``extra`` ((B, N, ...)) repeated alongside, image after image."""
-    moved = (points[:, None, :, :] + offsets[:, :, None, :]).reshape(points.shape[0], -1, 2)
-    k = offsets.shape[1]
-    return (np.ascontiguousarray(moved),) + tuple(
-        np.ascontiguousarray(np.broadcast_to(e[:, None], (e.shape[0], k) + e.shape[1:]).reshape(
-            (e.shape[0], k * e.shape[1]) + e.shape[2:])) for e in extra)
+def _reaching(lo, hi, alive, offsets, x, y, reach):
+    """The images that reach the grid: for each row, which source and which of ``offsets`` each
+    drawn copy is, padded to the longest row.
+
+    Parameters
+    ----------
+    lo, hi : numpy.ndarray, (B, N, 2)
+        Each source's lower and upper corner (a point: its centre twice), m.
+    alive : numpy.ndarray of bool, (B, N)
+        The sources spread.
+    offsets : numpy.ndarray, (B, K, 2)
+        The shifts m a + n b of the images, m.
+    x, y : numpy.ndarray
+        The grid's coordinates, m.
+    reach : float
+        The kernel's radius, m.
+
+    Returns
+    -------
+    source, image : numpy.ndarray of int64, (B, M)
+        The source and the offset of each copy (0 in the padding).
+    valid : numpy.ndarray of bool, (B, M)
+        The copies (False: padding).
+    """
+    grid_lo = np.array([x[0], y[0]]) - reach
+    grid_hi = np.array([x[-1], y[-1]]) + reach
+    near = alive[:, None, :] & np.all((hi[:, None] + offsets[:, :, None] >= grid_lo)
+                                      & (lo[:, None] + offsets[:, :, None] <= grid_hi), axis=-1)  # (B, K, N)
+    n_rows, n_sources = alive.shape
+    flat = near.reshape(n_rows, -1)
+    counts = flat.sum(axis=1)
+    width = max(int(counts.max(initial=0)), 1)
+    rows, which = np.nonzero(flat)  # by row, then image after image
+    first = np.concatenate([[0], np.cumsum(counts)[:-1]])
+    rank = np.arange(rows.size) - first[rows]
+    source = np.zeros((n_rows, width), np.int64)
+    image = np.zeros((n_rows, width), np.int64)
+    valid = np.zeros((n_rows, width), bool)
+    source[rows, rank], image[rows, rank], valid[rows, rank] = which % n_sources, which // n_sources, True
+    return source, image, valid
+
+
+def _gather(values, index):
+    """``values`` (B, N, ...) at ``index`` (B, M) along axis 1: (B, M, ...)."""
+    index = index.reshape(index.shape + (1,) * (values.ndim - 2))
+    return np.take_along_axis(values, index, axis=1)
 
 
 @core_dims(PARTICLE_XY, PARTICLE_XY, PARTICLE, PARTICLE, CONTACT, CONTACT, CONTACT, CONTACT_XY, CONTACT_XY,
@@ -225,10 +263,10 @@ def coarse_grained_fields(position, velocity, mass, area, i, fn, ft, normal, bra
         fraction = fractional(into, cells_[:, None])
         into_rate = from_fractional(np.rint(fraction), rates[:, None])  # the velocity that move adds
         v_home = v + np.where(moving[..., None], into_rate, 0.0)
-        (centres, speeds, masses, areas, alive) = _images(home, offsets, (v_home, m, a, active))
-        speeds = speeds + np.broadcast_to(kicks[:, :, None, :], (b, shifts.shape[0], n_p, 2)).reshape(b, -1, 2)
-        moving_images = np.broadcast_to(moving[:, None], (b, shifts.shape[0], n_p)).reshape(b, -1)
-        speeds = np.where(moving_images[..., None], speeds, 0.0)
+        source, image, alive = _reaching(np.nan_to_num(home), np.nan_to_num(home), active, offsets, x, y, radius)
+        centres = _gather(home, source) + _gather(offsets, image)
+        speeds = np.where(_gather(moving, source)[..., None], _gather(v_home, source) + _gather(kicks, image), 0.0)
+        masses, areas = _gather(m, source), _gather(a, source)
         weights = np.stack([masses, areas, masses * speeds[..., 0], masses * speeds[..., 1],
                             masses * speeds[..., 0] ** 2, masses * speeds[..., 0] * speeds[..., 1],
                             masses * speeds[..., 1] ** 2], axis=-1)
@@ -264,10 +302,14 @@ def coarse_grained_fields(position, velocity, mass, area, i, fn, ft, normal, bra
         start = np.where(active[..., None], start, 0.0)
         home = wrap(start, start_of[:, None], cells_[:, None], periodic)
         arm = np.where(active[..., None], arm, 0.0)
-        (starts, arms, used_images, weight_images) = _images(home, offsets, (arm, active, weights))
+        source, image, used_images = _reaching(np.minimum(home, home + arm), np.maximum(home, home + arm), active,
+                                               offsets, x, y, radius)
+        starts = _gather(home, source) + _gather(offsets, image)
+        arms = _gather(arm, source)
+        weight_images = np.where(used_images[..., None], _gather(weights, source), 0.0)
         spread_segments(np.ascontiguousarray(starts[..., 0]), np.ascontiguousarray(starts[..., 1]),
                         np.ascontiguousarray(arms[..., 0]), np.ascontiguousarray(arms[..., 1]),
-                        used_images, weight_images, x, y, float(width), radius, segments)
+                        used_images, np.ascontiguousarray(weight_images), x, y, float(width), radius, segments)
     else:
         spread_segments(np.ascontiguousarray(np.where(active, start[..., 0], 0.0)),
                         np.ascontiguousarray(np.where(active, start[..., 1], 0.0)),
