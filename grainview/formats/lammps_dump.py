@@ -209,6 +209,10 @@ def iter_dump(path):
             rows = _read_count(fh, path, "row count", where)
             header = _read_item(fh, path, "BOX BOUNDS", where)
             flags = header.split()[3:]
+            if flags[:2] == ["abc", "origin"]:
+                raise FileFormatError(f"{path}: {where}: a general triclinic box (ITEM: BOX BOUNDS abc origin, "
+                                      "dump_modify triclinic/general yes); expected LAMMPS's restricted triclinic "
+                                      "form, its default (ITEM: BOX BOUNDS xy xz yz)")
             triclinic = flags[:3] == ["xy", "xz", "yz"]
             if triclinic:
                 flags = flags[3:]

@@ -325,6 +325,10 @@ BAD = [
      "touches the top wall at y = .*but the log's definition of the wall puts it at"),
     ("a wrapped atom far outside the cell", "periodic", "particles", outside_the_cell,
      r"atom \d+ at .* lies outside the periodic cell along x by more than a particle diameter"),
+    ("a general triclinic box", "sheared", "particles",
+     lambda t: t.replace("ITEM: BOX BOUNDS xy xz yz pp pp pp", "ITEM: BOX BOUNDS abc origin pp pp pp"),
+     r"a general triclinic box \(ITEM: BOX BOUNDS abc origin, dump_modify triclinic/general yes\); expected "
+     "LAMMPS's restricted triclinic form"),
     ("a boundary that changes", "periodic", "particles",
      lambda t: t[::-1].replace("pp pp pp"[::-1], "pp ff pp"[::-1], 1)[::-1], "boundary pp ff pp, the first snapshot's "
                                                                             "pp pp pp; expected the same boundaries"),
