@@ -37,6 +37,31 @@ contract from it. docs/formats.md states the same for users.
   ``<type><index>``. ``wall_force`` is the total force the particles exert on each wall.
 * ``time`` is the snapshots' time (MercuryDPM's ``t``, scaled); the box (``box_min``,
   ``box_max``) is the ``.data`` header's domain (``xmin ymin xmax ymax``).
+* **Periodic cells** (docs/schema.md, "The periodic cell") come from the ``.restart``'s
+  boundaries. A ``PeriodicBoundary`` of normal ``(1, 0, 0)`` makes the run periodic in x
+  between its ``distanceLeft`` and ``distanceRight``, one of normal ``(0, 1, 0)`` in y (its
+  ``shift``'s x component, set by ``setPlanewiseShift``, is the cell's tilt: only with x
+  periodic too); a ``LeesEdwardsBoundary`` makes it periodic in x between ``left`` and
+  ``right`` and in y between ``down`` and ``up``, the images across the top and the bottom
+  shifted in x by its shift: the cell ``a = (l, 0)``, ``b = (tilt, h)`` with ``tilt`` the shift
+  (moved by whole widths into ``[-l/2, l/2]``). The ``.restart`` holds the shift ``s`` and its
+  rate ``v`` at its own time ``T`` only; MercuryDPM reads a restart as the shift ``s + v t``
+  (a constant rate), and so does the reader: the shift of a snapshot at ``t > 0`` is ``s + v (t
+  - dt - T)``, ``dt`` the time step, because the positions and contacts MercuryDPM writes at
+  ``t`` are those of the step that began at ``t - dt``, whose ghost particles were shifted by
+  the shift of that time; at ``t = 0`` (the forces of MercuryDPM's initial computation) it is
+  ``s - v T``. The box is the cell's bounds along its periodic directions (the
+  ``.data`` header's domain along a bounded one). Branches and contact points are minimum
+  images (a contact across the boundary is computed on a ghost particle; MercuryDPM writes it
+  under the real particles' indices, its contact point at the ghost): ``branch`` the shortest
+  image of ``x_j - x_i``, ``point`` moved by whole cell vectors to its image nearest ``x_i``.
+  Positions are wrapped into the cell (MercuryDPM wraps them into its rectangle; in a tilted
+  cell they are moved by whole widths into the parallelogram), ``cell_positions = wrapped``.
+  Refused in one line: another periodic boundary type (``AngledPeriodicBoundary``,
+  ``CircularPeriodicBoundary``, ``TimeDependentPeriodicBoundary``...), a ``PeriodicBoundary``
+  whose normal is not along x or y or whose shift is not its width along it, two boundaries
+  across one direction, a ``LeesEdwardsBoundary`` with a ``PeriodicBoundary`` in the plane, a
+  restart that lists only some of its boundaries (``...``), and a centre outside the cell.
 
 Every function checks its input and refuses bad input in one line
 (:class:`grainview.contract.errors.FileFormatError` or :class:`~grainview.contract.errors.ParameterError`).
@@ -54,6 +79,7 @@ import warnings
 
 import numpy as np
 
+from ..contract.cell import minimum_image, restricted_cell, wrap
 from ..contract.errors import FileFormatError, ParameterError
 from .checks import Limits, check_contacts
 from .mercurydpm_text import iter_data, iter_fstat, read_restart
@@ -144,6 +170,120 @@ def _wall_names(restart):
     return names, normals
 
 
+PERIODIC_BOUNDARIES = ("PeriodicBoundary", "LeesEdwardsBoundary")
+"""The ``.restart`` boundaries that give the reader a periodic cell."""
+_OTHER_PERIODIC = ("Periodic", "LeesEdwards", "Maser", "StressStrainControl", "ShearBox")
+"""Parts of the names of MercuryDPM's other boundaries that repeat the sample (refused)."""
+
+
+class _Cell:
+    """A run's periodic cell, from its ``.restart``'s boundaries: ``periodic`` (x, y) flags,
+    ``bounds`` {axis: (lo, hi)} along the periodic directions, and the tilt of each snapshot
+    (a ``PeriodicBoundary``'s planewise shift, or a ``LeesEdwardsBoundary``'s shift at the
+    snapshot's force computation); all in MercuryDPM's units."""
+
+    def __init__(self, info, path):
+        self.path = path
+        self.periodic = [False, False]
+        self.bounds = {}
+        self.tilt = 0.0
+        self.lees_edwards = None  # (shift, velocity, restart time, time step)
+        self.described = []
+        kinds = [(kind, values, line) for kind, values, line in info.boundaries
+                 if kind in PERIODIC_BOUNDARIES or any(part in kind for part in _OTHER_PERIODIC)]
+        if info.boundary_count > len(info.boundaries):
+            raise FileFormatError(f"{path}: 'Boundaries {info.boundary_count}' lists {len(info.boundaries)} of them "
+                                  "and '...' (MercuryDPM writes every boundary only when it has fewer than 9); the "
+                                  "reader cannot tell whether the run is periodic")
+        for kind, values, line in kinds:
+            where = f"{path}: line {line}: {kind}"
+            if kind == "PeriodicBoundary":
+                self._periodic(values, where)
+            elif kind == "LeesEdwardsBoundary":
+                self._lees_edwards(values, where, info)
+            else:
+                raise FileFormatError(f"{where}; the reader takes a periodic cell from PeriodicBoundary and "
+                                      "LeesEdwardsBoundary only")
+        if self.lees_edwards is not None and len(kinds) > 1:
+            raise FileFormatError(f"{path}: a LeesEdwardsBoundary and {len(kinds) - 1} other periodic "
+                                  "boundar(y/ies); expected the LeesEdwardsBoundary alone (it is periodic in x and y)")
+        if self.tilt != 0.0 and not self.periodic[0]:
+            raise FileFormatError(f"{path}: a PeriodicBoundary in y whose images are shifted in x by {self.tilt:.10g} "
+                                  "but no PeriodicBoundary in x; a shifted (tilted) cell is read only when periodic in "
+                                  "x and y")
+
+    def _number(self, values, key, where, count=1):
+        numbers = values.get(key, [])
+        if len(numbers) != count or not np.all(np.isfinite(numbers)):
+            raise FileFormatError(f"{where}: expected '{key}' with {count} finite number(s), found "
+                                  f"{' '.join(f'{v:g}' for v in numbers) or 'none'}")
+        return numbers[0] if count == 1 else np.array(numbers, float)
+
+    def _axis(self, axis, lo, hi, where):
+        if self.periodic[axis]:
+            raise FileFormatError(f"{where}: a second periodic boundary across {'xy'[axis]}; expected one per "
+                                  "direction")
+        if not hi > lo:
+            raise FileFormatError(f"{where}: bounds {lo:.10g} to {hi:.10g} along {'xy'[axis]}; expected the lower "
+                                  "below the upper")
+        self.periodic[axis] = True
+        self.bounds[axis] = (lo, hi)
+
+    def _periodic(self, values, where):
+        normal = self._number(values, "normal", where, 3)
+        left, right = self._number(values, "distanceLeft", where), self._number(values, "distanceRight", where)
+        shift = self._number(values, "shift", where, 3)
+        axis = next((a for a in (0, 1) if np.allclose(normal, np.eye(3)[a], rtol=0, atol=1e-12)), None)
+        if axis is None:
+            raise FileFormatError(f"{where}: normal {' '.join(f'{v:g}' for v in normal)}; expected a cell periodic "
+                                  "along x (normal 1 0 0) or y (normal 0 1 0)")
+        width = right - left
+        planewise = shift[1 - axis]
+        if abs(shift[axis] - width) > 1e-9 * max(abs(width), 1.0) or shift[2] != 0 or (axis == 0 and planewise != 0):
+            raise FileFormatError(f"{where}: shift {' '.join(f'{v:.10g}' for v in shift)} for the width {width:.10g}; "
+                                  "expected the width along the normal (and, for the boundary across y only, a shift "
+                                  "in x: the cell's tilt)")
+        self._axis(axis, left, right, where)
+        if axis == 1:
+            self.tilt = planewise
+        self.described.append(f"PeriodicBoundary in {'xy'[axis]} from {left:.10g} to {right:.10g}"
+                              + (f" shifted by {planewise:.10g} in x" if axis == 1 and planewise else ""))
+
+    def _lees_edwards(self, values, where, info):
+        left, right, down, up, shift, velocity = (self._number(values, key, where) for key in
+                                                  ("left", "right", "down", "up", "shift", "vel"))
+        self._axis(0, left, right, where)
+        self._axis(1, down, up, where)
+        if info.time is None or info.time_step is None:
+            raise FileFormatError(f"{where}: the restart has no 'timeStep dt time t' line, which gives the time its "
+                                  "shift was written at")
+        self.lees_edwards = (shift, velocity, info.time, info.time_step)
+        self.described.append(f"LeesEdwardsBoundary x from {left:.10g} to {right:.10g}, y from {down:.10g} to "
+                              f"{up:.10g}, shift {shift:.10g} + {velocity:.10g} (t - {info.time:.10g}) at the force "
+                              f"computation (t - {info.time_step:.10g})")
+
+    def box_and_tilt(self, bounds):
+        """The box (xmin, ymin, xmax, ymax) of a snapshot whose ``.data`` header has ``bounds``:
+        the cell's bounds along its periodic directions, the header's along the others."""
+        box = np.array(bounds, float)
+        for axis, (lo, hi) in self.bounds.items():
+            box[axis], box[axis + 2] = lo, hi
+        return box
+
+    def tilt_at(self, time):
+        """The cell's tilt at a snapshot of MercuryDPM time ``time``, within [-l/2, l/2]."""
+        if self.lees_edwards is None:
+            tilt = self.tilt
+        else:
+            shift, velocity, written, step = self.lees_edwards
+            # the forces of a snapshot at t > 0 are those of the step that began at t - dt; the
+            # first snapshot's (t = 0) those of MercuryDPM's initial force computation, at t
+            computed = time if time <= 0 else max(time - step, 0.0)
+            tilt = shift + velocity * (computed - written)
+        width = self.bounds[0][1] - self.bounds[0][0] if self.periodic[0] else 0.0
+        return tilt - width * np.rint(tilt / width) if width else tilt
+
+
 class _Model:
     """The static part of a run: particles (from the first ``.data`` snapshot and ``.restart``),
     walls and the unit scales."""
@@ -216,6 +356,22 @@ def _particles(model, snap, where):
     position = values[:, 0:2] * s["length"]
     return dict(position=position, velocity=values[:, 2:4] * s["velocity"], angle=values[:, 5].copy(),
                 angular_velocity=-values[:, 6] / s["time"])
+
+
+def _wrapped(model, position, box, cell, periodic, where):
+    """The centres (MercuryDPM's units) wrapped into the periodic cell; one line for a centre
+    more than a particle's diameter outside MercuryDPM's rectangle along a periodic direction
+    (MercuryDPM moves a particle that crossed the boundary back every step)."""
+    for axis in np.flatnonzero(periodic):
+        lo, hi = box[axis], box[axis + 2]
+        slack = 2 * model.radius_raw
+        out = (position[:, axis] < lo - slack) | (position[:, axis] > hi + slack)
+        if out.any():
+            k = int(np.flatnonzero(out)[0])
+            raise FileFormatError(f"{where}: particle {k} at ({position[k, 0]:.10g}, {position[k, 1]:.10g}) lies outside "
+                                  f"the periodic cell along {'xy'[axis]} ({lo:.10g} to {hi:.10g}) by more than its "
+                                  "diameter; expected the positions MercuryDPM keeps inside its periodic boundaries")
+    return wrap(position, box[:2], cell, periodic)
 
 
 class OneSidedPair(FileFormatError):
@@ -328,7 +484,10 @@ def _check_rows(model, position_raw, snap, where):
     limits.check(rows[:, 10:16], ("nx", "ny", "nz", "tx", "ty", "tz"), "unit", where, rows=line)
 
 
-def _contacts(model, position_raw, snap, where):
+def _contacts(model, position_raw, snap, where, cell=None, periodic=None):
+    """The contract's contacts of an ``.fstat`` snapshot, with ``position_raw`` the centres in
+    MercuryDPM's units; in a periodic ``cell`` (raw units) branches and contact points are
+    minimum images."""
     s = model.scales
     _check_rows(model, position_raw, snap, where)
     rows = snap.rows
@@ -340,14 +499,19 @@ def _contacts(model, position_raw, snap, where):
     normal = normal / length[:, None]
     force = raw["force"] * s["force"]
     tangent = np.stack([-normal[:, 1], normal[:, 0]], axis=1)
-    point = raw["point"] * s["length"]
     on_wall = j >= model.n
-    branch = np.where(on_wall[:, None], point - position_raw[i] * s["length"],
-                      (position_raw[np.minimum(j, model.n - 1)] - position_raw[i]) * s["length"])
+    point_raw = raw["point"]
+    centres = position_raw[np.minimum(j, model.n - 1)] - position_raw[i]
+    if cell is not None:  # the images nearest particle i: of j, and of the point (computed at a ghost)
+        centres = minimum_image(centres, cell, periodic)
+        point_raw = position_raw[i] + minimum_image(point_raw - position_raw[i], cell, periodic)
+    point = point_raw * s["length"]
+    branch = np.where(on_wall[:, None], point - position_raw[i] * s["length"], centres * s["length"])
     contacts = dict(i=i.astype("i4"), j=j.astype("i4"), kind=np.ones(i.size, "i1"), normal=normal,
                     fn=np.einsum("ij,ij->i", force, normal), ft=np.einsum("ij,ij->i", force, tangent), point=point,
                     branch=branch, gap=-raw["overlap"] * s["length"])
-    check_contacts(model.limits, position_raw * s["length"], contacts, where, model.name)
+    check_contacts(model.limits, position_raw * s["length"], contacts, where, model.name,
+                   cell=None if cell is None else cell * s["length"], periodic=periodic)
     wall_force = np.zeros((len(model.wall_names), 2))
     np.add.at(wall_force, j[on_wall] - model.n, force[on_wall])
     return contacts, wall_force, tensile
@@ -393,7 +557,8 @@ def mercurydpm_snapshots(data, fstat=None, restart=None, *, units=None):
         ``wall_names``, ``wall_normal`` and ``attrs``; the iterator yields one dict per snapshot
         with ``time`` (s), ``position``, ``velocity`` (N, 2), ``angle``, ``angular_velocity``
         (N,), ``contacts``, ``box_min``, ``box_max``, ``wall_force`` (with walls) and
-        ``tensile`` (the lines left out for a tensile normal force).
+        ``tensile`` (the lines left out for a tensile normal force); a periodic run's static
+        part holds ``periodic`` (2,) and each snapshot its ``cell`` (2, 2).
 
     Raises
     ------
@@ -406,6 +571,8 @@ def mercurydpm_snapshots(data, fstat=None, restart=None, *, units=None):
     data_path = os.fspath(data)
     fstat_path, restart_path = _sibling(data, ".fstat", fstat), _sibling(data, ".restart", restart)
     info = read_restart(restart_path)
+    cell_of = _Cell(info, restart_path)
+    periodic = np.array(cell_of.periodic) if any(cell_of.periodic) else None
     stream = _zip(data_path, fstat_path)
     first = next(stream, None)
     if first is None:
@@ -425,6 +592,14 @@ def mercurydpm_snapshots(data, fstat=None, restart=None, *, units=None):
         attrs["mercurydpm_version"] = info.version
     static = dict(radius=model.radius, mass=model.mass, inertia=model.inertia, n_walls=len(model.wall_names),
                   wall_names=list(model.wall_names) or None, wall_normal=wall_normal, attrs=attrs)
+    if periodic is not None:
+        if wall_normal is not None and np.any(np.abs(wall_normal[:, periodic]) > 0):
+            k = int(np.flatnonzero(np.any(np.abs(wall_normal[:, periodic]) > 0, axis=1))[0])
+            raise FileFormatError(f"{restart_path}: wall {k} ({model.wall_names[k]}) stands across a periodic "
+                                  "direction; expected walls only across the directions that are not periodic")
+        static["periodic"] = periodic.astype("i1")
+        attrs["cell_positions"] = "wrapped"
+        attrs["mercurydpm_cell"] = "; ".join(cell_of.described)
 
     def snapshots():
         current = first
@@ -432,9 +607,16 @@ def mercurydpm_snapshots(data, fstat=None, restart=None, *, units=None):
             d, f = current
             following = next(stream, None)  # read ahead: is this the last snapshot?
             where = f"{fstat_path}: t = {f.time:.10g} (line {f.line})"
-            state = _particles(model, d, f"{data_path}: t = {d.time:.10g} (line {d.line})")
+            where_data = f"{data_path}: t = {d.time:.10g} (line {d.line})"
+            state = _particles(model, d, where_data)
+            position_raw, cell, bounds = d.values[:, 0:2], None, d.bounds
+            if periodic is not None:
+                bounds = cell_of.box_and_tilt(d.bounds)
+                cell = restricted_cell(bounds[:2], bounds[2:], cell_of.tilt_at(d.time))
+                position_raw = _wrapped(model, position_raw, bounds, cell, periodic, where_data)
+                state["position"] = position_raw * scales["length"]
             try:
-                contacts, wall_force, tensile = _contacts(model, d.values[:, 0:2], f, where)
+                contacts, wall_force, tensile = _contacts(model, position_raw, f, where, cell, periodic)
             except OneSidedPair as exc:
                 if following is not None or current is first:  # not the last snapshot, or the only one
                     raise
@@ -442,9 +624,11 @@ def mercurydpm_snapshots(data, fstat=None, restart=None, *, units=None):
                               "particle pair(s) written on one side only, the mark of a file cut while it was "
                               "written: that snapshot is left out", UserWarning, stacklevel=2)
                 return
-            box = d.bounds * scales["length"]
+            box = bounds * scales["length"]
             snap = dict(time=d.time * scales["time"], contacts=contacts, box_min=box[:2].copy(),
                         box_max=box[2:].copy(), tensile=tensile, **state)
+            if cell is not None:
+                snap["cell"] = cell * scales["length"]
             if model.wall_names:
                 snap["wall_force"] = wall_force
             yield snap

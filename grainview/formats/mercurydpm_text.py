@@ -14,9 +14,14 @@ What MercuryDPM writes (read in its sources: ``DPMBase::outputXBallsData``,
   ``-index - 1``, the contact point, the overlap, the tangential overlap, the normal force
   ``fn``, the magnitude ``ft`` of the tangential force, the unit normal and the unit direction
   of the tangential force).
-* ``.restart``: ``key value`` lines, among them ``systemDimensions 2 particleDimensions 2``,
-  one line per species (``... id 0 density 1 ...``), ``Walls W`` then W wall lines, and
-  ``Particles N`` then N particle lines (``... radius r invMass m^-1 ...``).
+* ``.restart``: ``key value`` lines, among them ``timeStep dt time t ...``,
+  ``systemDimensions 2 particleDimensions 2``, one line per species (``... id 0 density 1
+  ...``), ``Walls W`` then W wall lines, ``Boundaries B`` then B boundary lines (``<type> id k
+  ...``: a ``PeriodicBoundary``'s ``normal nx ny nz scaleFactor f distanceLeft L distanceRight
+  R shift sx sy sz``, a ``LeesEdwardsBoundary``'s ``left L right R down D up U shift s vel v``,
+  written by ``PeriodicBoundary::write`` and ``LeesEdwardsBoundary::write``; only two lines and
+  ``...`` when B >= 9) and ``Particles N`` then N particle lines (``... radius r invMass m^-1
+  ...``).
 
 Every parser refuses bad input in one line (:class:`~grainview.contract.errors.FileFormatError`)
 naming the file, the line and what was expected.
@@ -75,6 +80,10 @@ class RestartInfo:
     walls: list = field(default_factory=list)  # (type, {key: values})
     particles: list = field(default_factory=list)  # {key: values} per particle
     version: str | None = None
+    boundaries: list = field(default_factory=list)  # (type, {key: values}, line number)
+    boundary_count: int = 0  # the 'Boundaries B' count (more than len(boundaries) when cut with '...')
+    time: float | None = None  # the time the restart was written at ('time t')
+    time_step: float | None = None  # 'timeStep dt'
 
 
 def _numbers(text, path, line, count=None, what="numbers"):
@@ -266,6 +275,8 @@ def read_restart(path) -> RestartInfo:
         lines = handle.read().splitlines()
     info = None
     version = None
+    clock = {}
+    boundaries, boundary_count = [], 0
     k = 0
     while k < len(lines):
         tokens = lines[k].split()
@@ -275,6 +286,26 @@ def read_restart(path) -> RestartInfo:
         head = tokens[0]
         if head == "MercuryDPM" and len(tokens) > 1 and version is None:
             version = tokens[1]
+        elif head == "timeStep" and not clock:
+            clock = _pairs(tokens)
+            for key in ("timeStep", "time"):
+                if len(clock.get(key, ())) != 1 or not np.isfinite(clock[key][0]):
+                    raise FileFormatError(f"{path}: line {k + 1}: expected 'timeStep dt time t ...' with finite "
+                                          f"numbers, found {lines[k].strip()[:80]!r}")
+        elif head == "Boundaries" and len(tokens) == 2 and info is not None:
+            boundary_count = _count(tokens, path, k + 1)
+            for b in range(boundary_count):
+                if k + 1 + b >= len(lines):
+                    raise FileFormatError(f"{path}: truncated: 'Boundaries {boundary_count}' is followed by {b} "
+                                          "boundary lines")
+                text = lines[k + 1 + b]
+                if text.strip() == "...":  # MercuryDPM writes two boundaries and '...' when it has 9 or more
+                    k += b
+                    break
+                words = text.split()
+                boundaries.append((words[0] if words else "", _pairs(words[1:]), k + 2 + b))
+            else:
+                k += boundary_count
         elif head == "systemDimensions" or "systemDimensions" in tokens:
             values = _pairs(tokens)
             info = RestartInfo(_dimension(values, "systemDimensions", path, k + 1),
@@ -312,5 +343,8 @@ def read_restart(path) -> RestartInfo:
         raise FileFormatError(f"{path}: no 'systemDimensions D particleDimensions D' line (is it a MercuryDPM "
                               ".restart file?)")
     info.version = version
+    info.boundaries, info.boundary_count = boundaries, boundary_count
+    if clock:
+        info.time_step, info.time = clock["timeStep"][0], clock["time"][0]
     return info
 

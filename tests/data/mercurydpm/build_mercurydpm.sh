@@ -1,5 +1,5 @@
 #!/bin/bash
-# Build MercuryDPM's Kernel library (libMercuryBase.a) and the Settle2D driver of this folder.
+# Build MercuryDPM's Kernel library (libMercuryBase.a) and the drivers of this folder (Settle2D, Periodic2D).
 #
 #   tests/data/mercurydpm/build_mercurydpm.sh SOURCE BUILD
 #
@@ -7,8 +7,9 @@
 # committed fixtures were made from the fork kuwt/MercuryDPM_fork at fb0ebf1, 2024-07-26, "add
 # collision measure"). BUILD: the build folder (created). Needs cmake, g++ and gfortran (the
 # kernel's small linear-algebra library is Fortran). Only the kernel is built (about 6 minutes
-# on one core at -O1), then the driver is compiled and linked by hand; the executable is
-# BUILD/Settle2D. tests/data/mercurydpm/make_fixtures.py runs it.
+# on one core at -O1), then the drivers are compiled and linked by hand; the executables are
+# BUILD/Settle2D and BUILD/Periodic2D. tests/data/mercurydpm/make_fixtures.py runs them. A BUILD
+# that already holds the kernel is reused (make does nothing), so the drivers alone are rebuilt.
 set -euo pipefail
 SOURCE=$(cd "$1" && pwd)
 BUILD=$2
@@ -22,6 +23,8 @@ nice -n 15 make -j1 MercuryBase > make.log
 # the driver is compiled with the kernel's own definitions, includes and flags (CMake's flags.make)
 FLAGS=Kernel/CMakeFiles/MercuryBase.dir/flags.make
 field() { sed -n "s/^$1 = //p" "$FLAGS"; }
-nice -n 15 g++ $(field CXX_DEFINES) $(field CXX_INCLUDES) $(field CXX_FLAGS) "$HERE/Settle2D.cpp" -o Settle2D \
-    Kernel/libMercuryBase.a Kernel/Math/libLinearAlgebra.a -lgfortran -lpthread
-echo "$BUILD/Settle2D"
+for driver in Settle2D Periodic2D; do
+    nice -n 15 g++ $(field CXX_DEFINES) $(field CXX_INCLUDES) $(field CXX_FLAGS) "$HERE/$driver.cpp" -o $driver \
+        Kernel/libMercuryBase.a Kernel/Math/libLinearAlgebra.a -lgfortran -lpthread
+    echo "$BUILD/$driver"
+done
