@@ -49,6 +49,7 @@ from typing import NamedTuple
 
 import numpy as np
 from numba import njit
+from numba.extending import overload
 
 from .solve_records import ContactProblem, DelassusBlocks, Impulses, Limits, Velocities
 
@@ -144,9 +145,26 @@ def local_solve(ufn, uft, bias, wnn, wnt, wtt, mu):
 # indices are never negative, and the arithmetic is unchanged, bit for bit).
 
 
+def tangential_slip(problem, k):
+    """The tangential velocity (m s-1) that ``problem`` adds at point k to the bodies' relative
+    velocity: ``problem.slip[k]`` for a :class:`solver.solve_records.PeriodicContactProblem` (a
+    pair across a moving boundary: the image moves with the cell), none for a
+    :class:`ContactProblem`, whose compiled kernels are those without the term (it adds -0.0,
+    which leaves every float as it is and which the compiler drops)."""
+    return problem.slip[k] if hasattr(problem, "slip") else -0.0
+
+
+@overload(tangential_slip, jit_options={"cache": True})
+def _tangential_slip(problem, k):
+    if "slip" in getattr(problem, "fields", ()):
+        return lambda problem, k: problem.slip[k]
+    return lambda problem, k: -0.0
+
+
 @njit(cache=True)
 def relative_velocity(k, problem, velocities):
-    """Relative velocity (u_n, u_t) of body b with respect to body a at point k (m s-1)."""
+    """Relative velocity (u_n, u_t) of body b with respect to body a at point k (m s-1), with
+    the problem's :func:`tangential_slip` (the normal one is in its Signorini shift ``bias``)."""
     vx, vy, w = velocities
     bb, aa = np.uint64(problem.b[k]), np.uint64(problem.a[k])
     ubx = vx[bb] - w[bb] * problem.rby[k]
@@ -155,7 +173,7 @@ def relative_velocity(k, problem, velocities):
     uay = vy[aa] + w[aa] * problem.rax[k]
     dx, dy = ubx - uax, uby - uay
     nx, ny = problem.nx[k], problem.ny[k]
-    return dx * nx + dy * ny, -dx * ny + dy * nx
+    return dx * nx + dy * ny, (-dx * ny + dy * nx) + tangential_slip(problem, k)
 
 
 @njit(cache=True)

@@ -14,8 +14,8 @@ decides what is written, for the contacts and for the restart impulses alike.
 
 The kind is the detection's (geometric: two edges facing each other within the alert distance
 give a double contact), also when only one of its two points carries a force. ``branch`` is
-x_j - x_i for particle pairs (positions of the snapshot) and the contact point minus x_i for
-wall contacts; ``wall_force`` is the total force exerted by the particles on each wall, sum of
+x_j - x_i for particle pairs (positions of the snapshot; in a periodic cell its minimum image,
+and the contact point beside x_i) and the contact point minus x_i for wall contacts; ``wall_force`` is the total force exerted by the particles on each wall, sum of
 f over its contacts (f = f_n n + f_t t, force of i on j = the wall).
 """
 
@@ -102,11 +102,24 @@ def pair_contacts(sim, near=None, n_slots=None):
     j = pts.body_j[first]
     centre_i = sim.position[i]
     branch = np.where((j >= n)[:, None], point - centre_i, sim.position[np.minimum(j, n - 1)] - centre_i)
+    if getattr(sim, "cell", None) is not None:  # periodic: minimum images, the point beside x_i
+        branch = _nearest_image(sim.cell, branch)
+        point = centre_i + _nearest_image(sim.cell, point - centre_i)
     keep = written_pairs(sim, near, n_slots)
     loaded_pair = fn > 0
     return dict(i=i[keep], j=j[keep], kind=pts.kind[first][keep], normal=pts.normal[first][keep],
                 fn=np.where(loaded_pair, fn, 0.0)[keep], ft=np.where(loaded_pair, ft, 0.0)[keep],
                 point=point[keep], branch=branch[keep], gap=_pair_gaps(pts)[keep])
+
+
+def _nearest_image(cell, d):
+    """The vectors ``d`` (P, 2) moved by whole cells to their image of fractional coordinates
+    within 1/2 (:mod:`solver.periodic_detection`): the minimum image of a vector shorter than
+    half the cell's widths, such as a branch or a contact point's offset from a centre."""
+    t = d[:, 1] / cell.height
+    n = np.rint(t)
+    m = np.rint((d[:, 0] - t * cell.tilt) / cell.length)
+    return np.stack([d[:, 0] - m * cell.length - n * cell.tilt, d[:, 1] - n * cell.height], -1)
 
 
 # --- restart state (read back by solver.restart) -------------------------------------------
@@ -148,6 +161,8 @@ def sample_box(sim):
     walls' reference points."""
     from .walls import BOX_NAMES
 
+    if getattr(sim, "cell", None) is not None:
+        return sim.cell.box()
     if set(BOX_NAMES) <= set(sim.walls.names):
         return sim.walls.box_bounds()
     r = sim.radius[:, None]
@@ -198,13 +213,14 @@ class Recorder:
         params["near_contacts_m"] = "none" if self.near is None else self.near
         self.sim = sim
         sim.take_unconverged()  # each snapshot counts the unconverged steps since the one before it
+        periodic = sim.cell.periodic if getattr(sim, "cell", None) is not None else None
         with sigterm_raises():
             self.writer = SnapshotWriter.create(
                 path, radius=sim.radius, n_vertices=sim.n_vertices, mass=sim.mass, inertia=sim.inertia,
                 n_walls=sim.n_walls, wall_names=sim.walls.names, wall_normal=sim.walls.normal,
                 optional=optional, attrs=params, overwrite=overwrite,
-                vertices=sim.shapes.body_vertices() if sim.shapes.max_vertices else None)
-        self._hold(resumable=params.get("scene") == "biaxial", own=True)
+                vertices=sim.shapes.body_vertices() if sim.shapes.max_vertices else None, periodic=periodic)
+        self._hold(resumable=params.get("scene") in ("biaxial", "shear"), own=True)
 
     @classmethod
     def append_to(cls, path, sim, compress=DEFAULT_COMPLEVEL, lock=None):
@@ -249,6 +265,7 @@ class Recorder:
         slots = self.writer.n_slots
         normal_impulse, tangential_impulse = point_impulses(sim, slots, self.near)
         unconverged = sim.take_unconverged()
+        cell = {} if getattr(sim, "cell", None) is None else {"cell": sim.cell.vectors()}
         self.writer.append(
             time=sim.time, position=sim.position, angle=sim.angle, contacts=pair_contacts(sim, self.near, slots),
             box_min=lo, box_max=hi,
@@ -260,7 +277,8 @@ class Recorder:
             unbalanced_force=info.unbalanced_force if info else 0.0, nlgs_unconverged_steps=unconverged.steps,
             nlgs_unconverged_residual=unconverged.residual,
             nlgs_unconverged_local_law_residual=unconverged.local_law_residual,
-            max_interpenetration=info.max_interpenetration if info else 0.0, kinetic_energy=sim.kinetic_energy())
+            max_interpenetration=info.max_interpenetration if info else 0.0, kinetic_energy=sim.kinetic_energy(),
+            **cell)
 
     def _hold(self, resumable, own):
         """Keep the writer's lock until the file is closed and compressed (released then when

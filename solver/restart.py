@@ -92,7 +92,25 @@ def _parameters(attrs, source) -> Parameters:
     return Parameters(**values, acceleration=acceleration)
 
 
+SHEAR_ATTRIBUTES = ("strain_target", "snapshot_every", "shear_steps", "cell_shear_rate_s", "cell_stress_Pa",
+                    "cell_mass_kg", "cell_max_speed_m_s")
+"""What a periodic shear's file says of its test and its cell (:mod:`solver.periodic_shear`)."""
+SHEAR_STATE_VARIABLES = ("velocity", "angular_velocity", "normal_impulse", "tangential_impulse", "step", "cell")
+
+
 def _check_resumable(ds, source):
+    if ds.attrs.get("scene") == "shear":
+        missing = [name for name in SHEAR_STATE_VARIABLES if name not in ds.variables]
+        missing += [name for name in SHEAR_ATTRIBUTES if name not in ds.attrs]
+        if missing:
+            raise FileFormatError(f"{source}: cannot resume, the file lacks {missing}")
+        if not isinstance(ds.attrs["cell_stress_Pa"], str) and "cell_velocity" not in ds.variables:
+            raise FileFormatError(f"{source}: cannot resume a shear whose cell height follows a stress: the file "
+                                  "does not hold the cell's rate of height (the contract has no cell velocity "
+                                  "yet); a shear at a fixed height resumes")
+        if ds.n_snapshots == 0:
+            raise FileFormatError(f"{source}: cannot resume, the file holds no complete snapshot")
+        return
     missing = [name for name in STATE_VARIABLES if name not in ds.variables]
     missing += [name for name in (*WALL_ATTRIBUTES, *BIAXIAL_ATTRIBUTES) if name not in ds.attrs]
     if missing:
@@ -109,12 +127,17 @@ def _check_resumable(ds, source):
 def snapshot_state(ds, index, source):
     """The whole solver state at snapshot ``index`` of an open :class:`ContractFile` (plain numpy arrays)."""
     count = int(ds.snapshot("contact_count", index))
-    state = {name: ds.snapshot(name, index).copy() for name in (
-        "position", "angle", "velocity", "angular_velocity", "wall_position", "wall_velocity")}
+    periodic = "cell" in ds.variables
+    names = ("position", "angle", "velocity", "angular_velocity") + (
+        ("cell", "box_min") if periodic else ("wall_position", "wall_velocity"))
+    state = {name: ds.snapshot(name, index).copy() for name in names}
+    if periodic:
+        state.update(wall_position=np.empty((0, 2)), wall_velocity=np.empty((0, 2)))
     for name, value in state.items():
         if not np.all(np.isfinite(value)):
             raise FileFormatError(f"{source}: cannot restart, {name} of snapshot {index} is not finite")
-    state.update({name: ds.static(name) for name in ("radius", "n_vertices", "mass", "inertia", "wall_normal")})
+    state.update({name: ds.static(name) for name in ("radius", "n_vertices", "mass", "inertia")})
+    state["wall_normal"] = ds.static("wall_normal") if "wall_normal" in ds.variables else np.empty((0, 2))
     state["vertices"] = ds.static("vertices") if "vertices" in ds.variables else None
     state.update({name: ds.snapshot(name, index)[:count].copy()
                   for name in ("i", "j", "normal_impulse", "tangential_impulse")})
@@ -123,20 +146,48 @@ def snapshot_state(ds, index, source):
     return state
 
 
+def _periodic_cell(state):
+    """The :class:`solver.periodic_cell.PeriodicCell` of a shear's snapshot state (its vectors,
+    corner and the attributes of how it is driven)."""
+    from .periodic_cell import PeriodicCell
+
+    attrs, vectors = state["attrs"], state["cell"]
+    stress = attrs["cell_stress_Pa"]
+    return PeriodicCell(state["box_min"], float(vectors[0, 0]), float(vectors[1, 1]), tilt=float(vectors[1, 0]),
+                        shear_rate=float(attrs["cell_shear_rate_s"]), height_rate=0.0,
+                        stress=None if isinstance(stress, str) else float(stress),
+                        mass=float(attrs["cell_mass_kg"]), max_speed=float(attrs["cell_max_speed_m_s"]))
+
+
 def simulation_from_state(state, source) -> Simulation:
-    """Rebuild a :class:`Simulation` (walls, parameters, warm start) from :func:`snapshot_state`."""
+    """Rebuild a :class:`Simulation` (walls or periodic cell, parameters, warm start) from
+    :func:`snapshot_state`."""
     attrs = state["attrs"]
+    if "cell" in state:
+        return _finish(Simulation(state["position"], state["angle"], walls=None, parameters=_parameters(attrs, source),
+                                  velocity=state["velocity"], angular_velocity=state["angular_velocity"],
+                                  shapes=_shapes(state, source), cell=_periodic_cell(state)), state, source)
     walls = Walls(state["wall_position"], state["wall_normal"], state["names"],
                   mode=np.asarray(attrs["wall_mode"], np.int64), velocity=state["wall_velocity"],
                   stress=np.asarray(attrs["wall_stress_Pa"], float), mass=np.asarray(attrs["wall_mass_kg"], float),
                   length_axis=np.asarray(attrs["wall_length_axis"], np.int64),
                   max_speed=np.asarray(attrs["wall_max_speed_m_s"], float))
+    sim = Simulation(state["position"], state["angle"], walls=walls, parameters=_parameters(attrs, source),
+                     velocity=state["velocity"], angular_velocity=state["angular_velocity"],
+                     shapes=_shapes(state, source))
+    return _finish(sim, state, source)
+
+
+def _shapes(state, source):
     try:
-        shapes = Shapes.of(state["radius"], state["n_vertices"], state["vertices"])
+        return Shapes.of(state["radius"], state["n_vertices"], state["vertices"])
     except ParameterError as exc:
         raise FileFormatError(f"{source}: cannot restart, its shapes are not the contract's: {exc}") from None
-    sim = Simulation(state["position"], state["angle"], walls=walls, parameters=_parameters(attrs, source),
-                     velocity=state["velocity"], angular_velocity=state["angular_velocity"], shapes=shapes)
+
+
+def _finish(sim, state, source):
+    """Check the masses, set the time, the history and the warm start of a rebuilt ``sim``."""
+    attrs = state["attrs"]
     if not (np.array_equal(sim.mass, state["mass"]) and np.array_equal(sim.inertia, state["inertia"])):
         raise FileFormatError(f"{source}: cannot restart, the masses and inertias of the file differ from those "
                               "of its solver parameters (density, thickness)")
@@ -191,8 +242,9 @@ def load_state(path):
         snapshots = ds.n_snapshots
     sim = simulation_from_state(state, source)
     attrs = state["attrs"]
-    test = {"first_step": state["first_step"], "n_steps": int(attrs["biaxial_steps"]),
-            "every": int(attrs["snapshot_every"]), "snapshots": snapshots}
+    steps = attrs["shear_steps"] if attrs.get("scene") == "shear" else attrs["biaxial_steps"]
+    test = {"first_step": state["first_step"], "n_steps": int(steps), "every": int(attrs["snapshot_every"]),
+            "snapshots": snapshots}
     return sim, test
 
 
@@ -234,8 +286,8 @@ def check_settings(path, expected, advice="pass overwrite=True to replace it"):
 
 
 def resume(path, progress=None, compress=True) -> int:
-    """Continue the biaxial test written to ``path`` from its last complete snapshot until its
-    strain target, appending the snapshots to the same file. Returns the number of steps
+    """Continue the biaxial test (or periodic shear, :mod:`solver.periodic_shear`) written to
+    ``path`` from its last complete snapshot until its strain target, appending the snapshots to the same file. Returns the number of steps
     taken (0 when the test had already finished).
 
     The snapshots written are those an uninterrupted run writes, bit for bit (see the module
@@ -273,9 +325,12 @@ def resume(path, progress=None, compress=True) -> int:
             if level and not is_compressed(source):
                 compress_finished(source, level, lock)
             return 0
+        if sim.cell is not None:  # a periodic shear (solver.periodic_shear)
+            from .periodic_shear import shear_steps as steps
+        else:
+            steps = biaxial_steps
         with recorder:
-            biaxial_steps(sim, recorder, first=first, n_steps=test["n_steps"], every=test["every"],
-                          progress=progress)
+            steps(sim, recorder, first=first, n_steps=test["n_steps"], every=test["every"], progress=progress)
         return test["n_steps"] - first + 1
     finally:
         if lock is not None:

@@ -18,7 +18,7 @@ from typing import NamedTuple
 
 import numpy as np
 
-__all__ = ["ContactProblem", "Impulses", "Velocities", "DelassusBlocks", "Limits", "AndersonScratch",
+__all__ = ["ContactProblem", "PeriodicContactProblem", "Impulses", "Velocities", "DelassusBlocks", "Limits", "AndersonScratch",
            "MatrixProblem", "StepStart", "StepLaw"]
 
 
@@ -59,6 +59,30 @@ class ContactProblem(NamedTuple):
     minv_xy: np.ndarray
     minv_yy: np.ndarray
     iinv: np.ndarray
+
+
+class PeriodicContactProblem(NamedTuple):
+    """A :class:`ContactProblem` in a periodic cell whose boundary moves (:mod:`solver.periodic_cell`):
+    the same fields and ``slip`` (P,), the tangential velocity (m s-1) of the image of body b
+    relative to body b along t = (-n_y, n_x) at each point (0 for a pair inside the cell); the
+    image's normal velocity is in ``bias``. Every kernel that takes a ContactProblem takes it
+    (:func:`solver.nlgs.tangential_slip`)."""
+
+    a: np.ndarray
+    b: np.ndarray
+    nx: np.ndarray
+    ny: np.ndarray
+    rax: np.ndarray
+    ray: np.ndarray
+    rbx: np.ndarray
+    rby: np.ndarray
+    bias: np.ndarray
+    mu: np.ndarray
+    minv_xx: np.ndarray
+    minv_xy: np.ndarray
+    minv_yy: np.ndarray
+    iinv: np.ndarray
+    slip: np.ndarray
 
 
 class Impulses(NamedTuple):

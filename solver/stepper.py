@@ -41,13 +41,14 @@ import numpy as np
 
 from grainview.contract.errors import ConvergenceWarning, ParameterError
 
-from . import broadphase, contact_solvers, narrowphase, nlgs, parallel_nlgs, problem_assembly, residuals, warm_start
+from . import (broadphase, contact_solvers, narrowphase, nlgs, parallel_nlgs, periodic_assembly, periodic_detection,
+               problem_assembly, residuals, warm_start)
 from .contact_solvers import ContactState, Limits
 from .contact_points import PairIndex, force_vectors, point_keys
 from .parameters import ACCELERATIONS, MAX_FRICTION, Parameters, check_time_step  # noqa: F401 (their home)
 from .sample_history import SampleHistory
 from .shapes import Shapes
-from .solve_records import StepLaw, StepStart
+from .solve_records import PeriodicContactProblem, StepLaw, StepStart
 from .walls import FIXED, STRESS, VELOCITY, Walls
 
 
@@ -158,17 +159,25 @@ class Simulation:
         The particles' shapes (any convex polygon, :meth:`Shapes.convex`); given, ``radius``
         and ``n_vertices`` are left out (None) and taken from it. Without it the particles are
         disks and regular polygons (:meth:`Shapes.regular` of ``radius`` and ``n_vertices``).
+    cell : :class:`solver.periodic_cell.PeriodicCell`, optional
+        A biperiodic cell (then ``walls`` may be None: no walls): detection finds pairs through
+        their images (:mod:`solver.periodic_detection`), the problem takes body b at its image
+        (:mod:`solver.periodic_assembly`), and after each step the cell moves, its height under
+        its stress control, and the centres are wrapped into it (:meth:`_move_cell`). One domain
+        and the ``anderson`` or ``nlgs`` solver.
     """
 
     def __init__(self, position, angle, radius=None, n_vertices=None, walls: Walls | None = None,
                  parameters: Parameters | None = None, velocity=None, angular_velocity=None,
-                 shapes: Shapes | None = None):
+                 shapes: Shapes | None = None, cell=None):
         p = (parameters or Parameters()).validate()
         self.parameters = p
         self.position = np.array(position, dtype=float).reshape(-1, 2)
         n = len(self.position)
         if n == 0:
             raise ParameterError("the sample is empty: expected at least one particle")
+        if walls is None and cell is not None:
+            walls = Walls(np.empty((0, 2)), np.empty((0, 2)))
         if walls is None:
             raise ParameterError("walls: expected the scene's Walls (solver.walls.Walls)")
         if shapes is not None:
@@ -219,6 +228,24 @@ class Simulation:
         self.counters = {"steps": 0, "broad_phase_runs": 0, "sweeps": 0, "point_sweeps": 0, "recovery_sweeps": 0,
                          "unconverged_steps": 0}
         self.unconverged = Unconverged()  # the unconverged steps since the last take_unconverged()
+        self.cell = cell  # a PeriodicCell, or None between walls
+        self.point_image = None  # periodic: (P, 2) image numbers (m, n) of body j seen from body i per point
+        self.cell_stress = np.zeros((2, 2))  # periodic: the last step's contact stress (Pa), compression positive
+        if cell is not None:
+            self._check_cell()
+
+    def _check_cell(self):
+        """A periodic simulation's settings: what the periodic path supports, a cell wide enough
+        for detection (:meth:`solver.periodic_cell.PeriodicCell.check_reach`), the centres in it."""
+        p = self.parameters
+        if p.domains != 1 or p.solver not in ("anderson", "nlgs"):
+            raise ParameterError(f"a periodic cell is stepped on one domain by the anderson or nlgs solver; got "
+                                 f"domains={p.domains}, solver={p.solver!r}")
+        if self.n_walls:
+            raise ParameterError("a periodic cell has no walls (biperiodic): expected walls=None")
+        self.cell.thickness = float(p.thickness)
+        self.cell.check_reach(2.0 * float(self.radius.max()) + self.alert + self.skin)
+        self.cell.wrap(self.position, self.velocity)
 
     FIXED_PARAMETERS = ("density", "thickness", "alert", "skin")
     """Parameters the simulation is built on (masses, detection distances): :meth:`set_parameters`
@@ -260,6 +287,8 @@ class Simulation:
 
     # -- detection --------------------------------------------------------------------------
     def detect(self):
+        if self.cell is not None:
+            return self._detect_periodic()
         start = time.perf_counter()
         moved = np.inf if self._anchor is None else float(np.sqrt(np.max(np.sum((self.position - self._anchor) ** 2, axis=1))))
         walls_moved = 0.0 if self._wall_anchor is None else float(
@@ -280,6 +309,41 @@ class Simulation:
         points = narrowphase.detect(self.position, self.angle, self.shapes, self.walls.point,
                                     self.walls.normal, alert, pi, pj, wp, ww, double_alert=self.alert,
                                     threads=self.parameters.domains)
+        self.timings["broad_phase"] += middle - start
+        self.timings["narrow_phase"] += time.perf_counter() - middle
+        return points
+
+    def _detect_periodic(self):
+        """:meth:`detect` in the periodic cell: the broad phase of :mod:`solver.periodic_detection`,
+        rerun when a centre moved (its displacement's nearest image) more than half the skin
+        less half the change of b since the last run; the points with their images
+        (:attr:`point_image`)."""
+        start = time.perf_counter()
+        cell = self.cell
+        alert = self.step_alert if self.step_alert is not None else self.alert
+        margin = alert + self.skin
+        moved = np.inf
+        if self._anchor is not None:
+            d = self.position - self._anchor
+            t = d[:, 1] / cell.height
+            n = np.rint(t)
+            m = np.rint((d[:, 0] - t * cell.tilt) / cell.length)
+            dx = d[:, 0] - m * cell.length - n * cell.tilt
+            dy = d[:, 1] - n * cell.height
+            change = cell.vectors()[1] - self._wall_anchor
+            moved = float(np.sqrt(np.max(dx * dx + dy * dy))) + 0.5 * float(np.hypot(change[0], change[1]))
+        if moved > 0.5 * self.skin or not self.reuse_detection or margin > self._margin:
+            pi, pj = periodic_detection.candidate_pairs(self.position, self.radius, margin, cell)
+            none = np.empty(0, np.int32)
+            self._candidates = (pi, pj, none, none)
+            self._anchor = self.position.copy()
+            self._wall_anchor = cell.vectors()[1]
+            self._margin = margin
+            self.counters["broad_phase_runs"] += 1
+        middle = time.perf_counter()
+        pi, pj = self._candidates[:2]
+        points, self.point_image = periodic_detection.detect(self.position, self.angle, self.shapes, alert, pi, pj,
+                                                             cell, double_alert=self.alert)
         self.timings["broad_phase"] += middle - start
         self.timings["narrow_phase"] += time.perf_counter() - middle
         return points
@@ -305,6 +369,8 @@ class Simulation:
         # the two fastest particles head on, or the fastest against the fastest wall (gravity
         # moves every particle alike: it changes only the particle-wall closing speed)
         closing = h * max(float(fastest.sum()), float(fastest[-1]) + wall_speed + h * float(np.hypot(*p.gravity)))
+        if self.cell is not None:  # a pair across the boundary: the image moves with the cell
+            closing = max(closing, h * (float(fastest.sum()) + float(np.hypot(*self.cell.b_rate()))))
         cap = float(self.radius.min())
         if closing > cap:
             warnings.warn(f"step {self.step_index}: bodies may close {closing:.3g} m in one step, more than the "
@@ -423,6 +489,8 @@ class Simulation:
         recovery = self.timings["overlap_recovery"]
         v_end, om = self._end_velocities(vx, vy, om)
         self._integrate(pts, problem, posed.ra, posed.rb, posed.v_start, posed.omega_start, v_end, om, decomposition)
+        if self.cell is not None:
+            self._move_cell(problem, pn, pt)
         self.points = pts
         self.impulse = np.stack([pn, pt], -1)
         self._keys, self._impulse = keys, self.impulse
@@ -485,6 +553,8 @@ class Simulation:
         shift comes from the gaps predicted to mid-step with the start velocities)."""
         p = self.parameters
         centre = np.concatenate([self.position, self.walls.point])
+        if self.cell is not None:
+            return self._periodic_problem(pts, centre, v_start, omega_start)
         a, b, ra, rb, nx, ny, bias, mu = problem_assembly.assemble(
             pts, StepStart(centre, v_start, omega_start, self.n_particles),
             StepLaw(float(p.time_step), float(p.theta), float(p.friction), float(p.wall_friction)))
@@ -493,6 +563,38 @@ class Simulation:
             a, b, nx, ny, ra[:, 0].copy(), ra[:, 1].copy(), rb[:, 0].copy(), rb[:, 1].copy(), bias, mu,
             minv[:, 0].copy(), minv[:, 1].copy(), minv[:, 2].copy(), iinv)
         return problem, ra, rb
+
+    def _periodic_problem(self, pts, centre, v_start, omega_start):
+        """:meth:`_contact_problem` in the periodic cell: body b at its image
+        (:mod:`solver.periodic_assembly`), a :class:`PeriodicContactProblem`."""
+        p = self.parameters
+        images = periodic_assembly.Images(self.cell.image_shifts(self.point_image),
+                                          self.cell.image_velocities(self.point_image))
+        self._images = images
+        a, b, ra, rb, nx, ny, bias, mu, slip = periodic_assembly.assemble(
+            pts, images, StepStart(centre, v_start, omega_start, self.n_particles),
+            StepLaw(float(p.time_step), float(p.theta), float(p.friction), float(p.wall_friction)))
+        minv, iinv = self._mobility()
+        problem = PeriodicContactProblem(
+            a, b, nx, ny, ra[:, 0].copy(), ra[:, 1].copy(), rb[:, 0].copy(), rb[:, 1].copy(), bias, mu,
+            minv[:, 0].copy(), minv[:, 1].copy(), minv[:, 2].copy(), iinv, slip)
+        return problem, ra, rb
+
+    def _move_cell(self, problem, pn, pt):
+        """After a periodic step: the contact stress of its impulses over the cell's volume
+        (:attr:`cell_stress`), the cell moved over the step, its height's rate for the next one
+        from sigma_yy (:meth:`solver.periodic_cell.PeriodicCell.control_height`), the
+        particles' velocities following the change of the cell's rate (:meth:`~solver.periodic_cell.PeriodicCell.follow_rate`),
+        and the centres that left the cell wrapped into it with their velocities."""
+        p = self.parameters
+        h = float(p.time_step)
+        sums = periodic_assembly.stress_sums(problem, pn, pt, h)
+        self.cell_stress = sums / (self.cell.area() * p.thickness)
+        before = self.cell.b_rate()
+        self.cell.advance(h)
+        self.cell.control_height(float(self.cell_stress[1, 1]), h)
+        self.cell.follow_rate(self.position, self.velocity, self.cell.b_rate() - before)
+        self.cell.wrap(self.position, self.velocity)
 
     def _count_solve(self, result, n_points):
         """Count the sweeps (a solver's iterations); warn (ConvergenceWarning) when the iteration
@@ -545,6 +647,8 @@ class Simulation:
         if p.overlap_recovery_speed > 0 and len(a):
             # the end-of-step gaps (first order) tell which overlaps remain
             g_end = problem_assembly.end_gaps(pts, problem, step_v, step_om, h)
+            if self.cell is not None:  # the image moved with the cell
+                g_end = g_end + h * np.sum(self._images.velocity * pts.normal, axis=1)
             if g_end.min() < -p.overlap_recovery_threshold * 2 * float(self.radius.min()):
                 pseudo_v, pseudo_om = self._recover_overlaps(problem, g_end, decomposition)
                 pseudo_v[n + np.flatnonzero(self.walls.mode != STRESS)] = 0.0

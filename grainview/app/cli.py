@@ -348,14 +348,16 @@ def _shape_of(text, option=None):
 
 
 def _simulate(prep, path, *, test, near_contacts, overwrite, progress, scene="biaxial", parameters=None,
-              compress=True, engine=None, checkpoint=None, label=None):
+              compress=True, engine=None, checkpoint=None, label=None, shear_rate=None):
     """Deposit, compact isotropically (as ``prep`` says) and, for ``scene="biaxial"``, shear
     one sample in the biaxial ``test`` (:class:`solver.parameters.BiaxialTest`) into ``path``,
     with the engine named ``engine`` (:mod:`solver.engine`; None: the default); returns the
     path. An isotropic run writes its compacted state. ``parameters``: solver settings
     (:class:`solver.Parameters` fields) other than the defaults. ``checkpoint``: the file where
     the compaction saves its state as it goes and resumes from (:func:`solver.engine.prepare`).
-    ``label``: the sample's name in the messages (default: its shape's)."""
+    ``label``: the sample's name in the messages (default: its shape's). ``scene="shear"``: the
+    compacted sample in the biperiodic cell of its box, sheared at ``shear_rate`` (s-1) to
+    gamma = ``test.strain`` under sigma_yy = sigma0 (:mod:`solver.periodic_shear`)."""
     import warnings
 
     from solver.engine import DEFAULT_ENGINE
@@ -363,6 +365,9 @@ def _simulate(prep, path, *, test, near_contacts, overwrite, progress, scene="bi
     from solver.engine import prepare
 
     runner = engine_named(engine or DEFAULT_ENGINE)
+    if scene == "shear" and (engine or DEFAULT_ENGINE) != DEFAULT_ENGINE:
+        raise GrainviewError(f"scene shear: the periodic cell is this package's solver's ({DEFAULT_ENGINE}), "
+                             f"not engine {engine}'s")
     path = Path(path)
     if path.exists() and not overwrite:
         raise GrainviewError(f"{path} exists; pass --overwrite to replace it")
@@ -391,6 +396,15 @@ def _simulate(prep, path, *, test, near_contacts, overwrite, progress, scene="bi
         if scene == "isotropic":
             runner.write_state(sample, path, attrs={"scene": "isotropic"}, overwrite=overwrite,
                                near_contacts=near_contacts, compress=compress)
+        elif scene == "shear":
+            from solver.periodic_shear import SHEAR_RATE, periodic_sample, shear_test
+
+            rate = SHEAR_RATE if shear_rate is None else shear_rate
+            print(f"{name}: periodic simple shear to gamma = {test.strain} at {rate:g} s-1 under "
+                  f"sigma_yy = {prep.sigma0:g} Pa ...", flush=True)
+            shear_test(periodic_sample(sample), path, strain=test.strain, shear_rate=rate, every=int(test.every),
+                       overwrite=overwrite, attrs=history.attrs(), progress=progress, near_contacts=near_contacts,
+                       compress=compress)
         else:
             print(f"{name}: biaxial compression to eps_1 = {test.strain} at {test.velocity:g} m/s{_inertia(sample, test)}"
                   " ...", flush=True)
@@ -557,7 +571,7 @@ def _run(args) -> int:
         if line:
             print(line, flush=True)
             _compile_ahead("run", shares, _progress_flag(args))
-    _simulate(prep, args.out, scene=args.scene, **_simulation_kwargs(args))
+    _simulate(prep, args.out, scene=args.scene, shear_rate=args.shear_rate, **_simulation_kwargs(args))
     return 0
 
 
@@ -1175,8 +1189,12 @@ def _run_parser(sub):
                          description=f"Geometric deposit, isotropic compaction under sigma0 ({Preparation.sigma0 / 1e3:g} "
                          f"kPa), then (scene biaxial) compression by the top wall ({BiaxialTest.velocity * 100:g} cm/s) "
                          "with sigma0 held on the right wall.")
-    run.add_argument("scene", nargs="?", choices=["biaxial", "isotropic"], default="biaxial",
-                     help="biaxial (default) or isotropic (writes the compacted state)")
+    run.add_argument("scene", nargs="?", choices=["biaxial", "isotropic", "shear"], default="biaxial",
+                     help="biaxial (default), isotropic (writes the compacted state) or shear (the compacted sample "
+                     "in a biperiodic cell, sheared to gamma = --strain under sigma_yy = sigma0)")
+    run.add_argument("--shear-rate", type=float, default=None,
+                     help="scene shear: the imposed shear rate gamma_dot, s-1 (default "
+                     f"{library_constant('solver.periodic_shear', 'SHEAR_RATE'):g})")
     setting_option(run, Preparation, "shape", help=f"pentagon, disk, a number of vertices from 3 to "
                    f"{MAX_VERTICES} (6: hexagons), irregular (random convex polygons) or a .json file of vertex lists "
                    "{\"polygons\": [[[x, y], ...], ...]} (docs/solver.md, \"Shapes\"; default "

@@ -188,9 +188,14 @@ def _stages(folder):
         return run
 
     def written():
+        from solver.periodic_shear import periodic_sample, shear_test
+
         for shape in ("pentagon", "disk"):
             biaxial_test(_steps(shape, steps=1), Path(folder) / f"{shape}.nc", strain=5e-4, every=2,
                          near_contacts=True, progress=False, compress=False)
+            for name in ("anderson", "nlgs"):  # grainview run shear: the periodic cell's kernels
+                shear_test(periodic_sample(_steps(shape, steps=1, solver=name)), Path(folder) / f"{shape}_shear.nc",
+                           strain=2e-3, shear_rate=1.0, every=2, overwrite=True, progress=False, compress=False)
 
     def matrix():
         import numpy as np
@@ -211,7 +216,7 @@ def _stages(folder):
 
     return [("solver: pentagon steps (plain, Anderson, shuffled, stall test, 2 domains)", solver_shape("pentagon")),
             ("solver: disk steps (plain, Anderson, shuffled, stall test, 2 domains)", solver_shape("disk")),
-            ("solver: a written biaxial test and its residuals", written),
+            ("solver: a written biaxial test, a periodic shear and their residuals", written),
             ("solver: a contact problem given as a matrix", matrix),
             ("analysis: the xi-network, the coarse-grained fields, the network's topology, the force chains",
              analysis)]
