@@ -4,7 +4,9 @@ tests/data/mercurydpm/periodic/ holds three runs of the driver Periodic2D.cpp (m
 make_fixtures.py --periodic with the kernel that build_mercurydpm.sh builds): ``Periodic2D``
 (100 disks jammed in a cell periodic in x and y: two PeriodicBoundary), ``LeesEdwards2D`` (the
 same packing sheared by a LeesEdwardsBoundary whose shift grows as t and passes half the cell's
-width) and ``Channel2D`` (40 disks under gravity between a floor and a lid, periodic in x).
+width), ``Channel2D`` (40 disks under gravity between a floor and a lid, periodic in x) and
+``Tilted2D`` (the jammed packing in a fixed tilted cell: the PeriodicBoundary across y shifts
+its images by 2 in x, ``setPlanewiseShift``).
 Every expected number is computed here from the files' text by a plain parse (its own minimum
 images, its own cell from the .restart's boundary lines), never with the reader.
 """
@@ -27,7 +29,7 @@ from grainview.formats.mercurydpm import convert_mercurydpm, open_mercurydpm
 
 HERE = Path(__file__).resolve().parents[1] / "data" / "mercurydpm"
 DATA = HERE / "periodic"
-RUNS = ("Periodic2D", "LeesEdwards2D", "Channel2D")
+RUNS = ("Periodic2D", "LeesEdwards2D", "Channel2D", "Tilted2D")
 
 
 def files(name, folder=DATA):
@@ -105,8 +107,8 @@ def hand_cell(name, time, bounds, folder=DATA):
             px = py = True
         elif b["normal"][:2] == [1.0, 0.0]:
             xlo, xhi, px = b["distanceLeft"][0], b["distanceRight"][0], True
-        else:
-            ylo, yhi, py = b["distanceLeft"][0], b["distanceRight"][0], True
+        else:  # across y; its shift's x component shifts the images in x (a tilted cell)
+            ylo, yhi, py, tilt = b["distanceLeft"][0], b["distanceRight"][0], True, b["shift"][0]
     return xlo, xhi, ylo, yhi, tilt, px, py
 
 
@@ -161,14 +163,16 @@ def test_the_fixtures_are_real_mercurydpm_runs_in_periodic_cells():
         restart = files(name)[2].read_text()
         assert restart.startswith(f"MercuryDPM 1.0 name {name}")
         (dt, written), boundaries = plain_restart(files(name)[2])
-        assert dt == 0.001 and written == pytest.approx(6.0, abs=2e-3)
+        end = 2.0 if name == "Tilted2D" else 6.0
+        assert dt == 0.001 and written == pytest.approx(end, abs=2e-3)
         kinds = [b["type"] for b in boundaries]
         assert kinds == {"Periodic2D": ["PeriodicBoundary"] * 2, "LeesEdwards2D": ["LeesEdwardsBoundary"],
-                         "Channel2D": ["PeriodicBoundary"]}[name]
+                         "Channel2D": ["PeriodicBoundary"], "Tilted2D": ["PeriodicBoundary"] * 2}[name]
         hand = by_hand(name)
-        assert [round(h["time"], 6) for h in hand] == [0, 2, 4, 6]
+        times = [0, 2, 2.001] if name == "Tilted2D" else [0, 2, 4, 6]  # MercuryDPM's last write at t >= 2
+        assert [round(h["time"], 6) for h in hand] == times
         assert all(h["pairs"] for h in hand)
-    lees = plain_restart(files("LeesEdwards2D")[2])[1][0]
+    (_, written), (lees,) = plain_restart(files("LeesEdwards2D")[2])
     assert lees["vel"] == [1.0] and lees["shift"][0] == pytest.approx(written)  # shift v t, v = 1
     # contacts across the boundary in x, and in y where it is periodic (in every snapshot but the
     # channel's first: its disks start on a grid, a row touching its neighbours in places only)
@@ -250,6 +254,8 @@ def test_the_cell_and_the_positions(datasets):
     assert datasets["Periodic2D"]["periodic"].values.tolist() == [1, 1]
     assert datasets["LeesEdwards2D"]["periodic"].values.tolist() == [1, 1]
     assert datasets["Channel2D"]["periodic"].values.tolist() == [1, 0]
+    assert datasets["Tilted2D"]["periodic"].values.tolist() == [1, 1]
+    np.testing.assert_array_equal(datasets["Tilted2D"]["cell"].values[:, 1], [[2.0, 9.5]] * 3)
     assert "LeesEdwardsBoundary" in datasets["LeesEdwards2D"].attrs["mercurydpm_cell"]
     tilt = datasets["LeesEdwards2D"]["cell"].values[:, 1, 0]
     width = datasets["LeesEdwards2D"]["cell"].values[0, 0, 0]
@@ -343,6 +349,11 @@ def _cut_boundaries(text):
         "\nParticles ", "\n...\nParticles ", 1)
 
 
+def _without_x(text):
+    line = _boundary_line(text, "PeriodicBoundary id 1")
+    return text.replace("Boundaries 2\n", "Boundaries 1\n").replace(line + "\n", "")
+
+
 BAD = [
     ("another periodic boundary", "Periodic2D", ".restart",
      lambda t: t.replace("\nPeriodicBoundary id 1", "\nAngledPeriodicBoundary id 1", 1),
@@ -360,6 +371,10 @@ BAD = [
      "a second periodic boundary across x"),
     ("boundaries cut with ...", "Periodic2D", ".restart", _cut_boundaries,
      "'Boundaries 12' lists 2 of them and '...'"),
+    ("a tilt without x periodic", "Tilted2D", ".restart", _without_x,
+     "shifted in x by 2 but no PeriodicBoundary in x; a shifted .tilted. cell is read only when periodic in x and y"),
+    ("a boundary across x shifting in y", "Periodic2D", ".restart",
+     lambda t: t.replace(" shift 9.5 0 0", " shift 9.5 1 0", 1), "shift 9.5 1 0 for the width 9.5"),
     ("a centre far outside the cell", "Periodic2D", ".data", _outside,
      r"particle 0 at \(25, .*lies outside the periodic cell along x"),
     ("a Lees-Edwards boundary without its shift", "LeesEdwards2D", ".restart",
@@ -391,7 +406,18 @@ def _make_fixtures():
 @pytest.mark.slow
 @pytest.mark.skipif(_make_fixtures().find_driver(name="Periodic2D") is None,
                     reason="MercuryDPM's Periodic2D is not built (tests/data/mercurydpm/build_mercurydpm.sh)")
-@pytest.mark.parametrize("mode", ["periodic", "lees", "channel"])
+def test_the_driver_writes_the_committed_fixtures_again(tmp_path):
+    make = _make_fixtures()
+    for mode, name in make.PERIODIC.items():
+        make.run_periodic(tmp_path, mode, seed=1)
+        for path in files(name):
+            assert (tmp_path / path.name).read_bytes() == path.read_bytes(), path.name
+
+
+@pytest.mark.slow
+@pytest.mark.skipif(_make_fixtures().find_driver(name="Periodic2D") is None,
+                    reason="MercuryDPM's Periodic2D is not built (tests/data/mercurydpm/build_mercurydpm.sh)")
+@pytest.mark.parametrize("mode", ["periodic", "lees", "channel", "tilted"])
 def test_a_fresh_periodic_run_converts_and_equals_the_hand_computation(tmp_path, mode):
     """MercuryDPM runs Periodic2D anew with a seed no other test has seen: the run converts,
     passes `grainview info --check`, and every snapshot equals the hand computation."""

@@ -10,6 +10,9 @@
 //       v = 1): simple shear driven through the boundary; the shift passes half the cell's width.
 //   Periodic2D channel [seed]   -> Channel2D.*: 40 disks under gravity between a floor and a lid
 //       (InfiniteWalls), periodic in x only (one PeriodicBoundary).
+//   Periodic2D tilted [seed]    -> Tilted2D.*: the periodic packing in a fixed tilted cell: the
+//       PeriodicBoundary across y shifts its images by 2 in x too (setPlanewiseShift); it is added
+//       before the one across x, which then wraps in x what it moved. Up to t = 2 only (2 snapshots).
 //
 // MercuryDPM's own nondimensional units: radii 0.4 to 0.6, density 1, collision time 0.05, time step
 // 0.001; a snapshot every 2 time units (saveCount 2000) up to t = 6 (4 snapshots; the first, at t = 0,
@@ -46,6 +49,12 @@ public:
         else
         {
             PeriodicBoundary b;
+            if (mode == "tilted")
+            {
+                b.set(Vec3D(0.0, 1.0, 0.0), getYMin(), getYMax());
+                b.setPlanewiseShift(Vec3D(2.0, 0.0, 0.0));
+                boundaryHandler.copyAndAddObject(b);
+            }
             b.set(Vec3D(1.0, 0.0, 0.0), getXMin(), getXMax());
             boundaryHandler.copyAndAddObject(b);
             if (mode == "periodic")
@@ -53,7 +62,7 @@ public:
                 b.set(Vec3D(0.0, 1.0, 0.0), getYMin(), getYMax());
                 boundaryHandler.copyAndAddObject(b);
             }
-            else  // channel: walls across y
+            else if (mode == "channel")  // walls across y
             {
                 InfiniteWall w;
                 w.setSpecies(speciesHandler.getObject(0));
@@ -83,12 +92,13 @@ int main(int argc, char* argv[])
     Periodic2D problem;
     if (argc > 1) problem.mode = argv[1];
     if (argc > 2) problem.seed = std::strtoul(argv[2], nullptr, 10);
-    if (problem.mode != "periodic" && problem.mode != "lees" && problem.mode != "channel")
+    if (problem.mode != "periodic" && problem.mode != "lees" && problem.mode != "channel" && problem.mode != "tilted")
     {
-        std::cerr << "usage: Periodic2D periodic|lees|channel [seed]\n";
+        std::cerr << "usage: Periodic2D periodic|lees|channel|tilted [seed]\n";
         return 2;
     }
-    problem.setName(problem.mode == "periodic" ? "Periodic2D" : problem.mode == "lees" ? "LeesEdwards2D" : "Channel2D");
+    problem.setName(problem.mode == "periodic" ? "Periodic2D" : problem.mode == "lees" ? "LeesEdwards2D" :
+                    problem.mode == "channel" ? "Channel2D" : "Tilted2D");
     problem.setDimension(2);  // a 2D system of disks: mass = density pi r^2, inertia = m r^2 / 2
     if (problem.mode == "channel")
     {
@@ -104,7 +114,7 @@ int main(int argc, char* argv[])
         problem.setMin(Vec3D(0.0, 0.0, -0.5));
         problem.setMax(Vec3D(problem.nx * problem.spacing, problem.ny * problem.spacing, 0.5));
     }
-    problem.setTimeMax(6.0);
+    problem.setTimeMax(problem.mode == "tilted" ? 2.0 : 6.0);
 
     LinearViscoelasticSlidingFrictionSpecies species;
     species.setDensity(1.0);

@@ -8,9 +8,10 @@ and the drivers ``Settle2D.cpp`` and ``Periodic2D.cpp`` from a MercuryDPM source
 script runs the executable ``BUILD/Settle2D`` (``--build``, or $GRAINVIEW_MERCURYDPM_BUILD;
 default /work/mercury-build) in ``--out`` (default: this folder, the committed fixtures), which
 writes ``Settle2D.data``, ``Settle2D.fstat`` and ``Settle2D.restart``; with ``--periodic``,
-``BUILD/Periodic2D`` three times (default ``--out``: this folder's ``periodic/``), which writes
-``Periodic2D.*`` (periodic in x and y), ``LeesEdwards2D.*`` (a LeesEdwardsBoundary shearing) and
-``Channel2D.*`` (periodic in x, walls across y).
+``BUILD/Periodic2D`` four times (default ``--out``: this folder's ``periodic/``), which writes
+``Periodic2D.*`` (periodic in x and y), ``LeesEdwards2D.*`` (a LeesEdwardsBoundary shearing),
+``Channel2D.*`` (periodic in x, walls across y) and ``Tilted2D.*`` (a fixed tilted cell: the
+PeriodicBoundary across y shifts its images in x too).
 """
 
 from __future__ import annotations
@@ -24,7 +25,7 @@ from pathlib import Path
 HERE = Path(__file__).resolve().parent
 DEFAULT_BUILD = "/work/mercury-build"
 FILES = ("Settle2D.data", "Settle2D.fstat", "Settle2D.restart")
-PERIODIC = {"periodic": "Periodic2D", "lees": "LeesEdwards2D", "channel": "Channel2D"}
+PERIODIC = {"periodic": "Periodic2D", "lees": "LeesEdwards2D", "channel": "Channel2D", "tilted": "Tilted2D"}
 """Periodic2D's modes and the run name each writes (NAME.data, NAME.fstat, NAME.restart)."""
 
 
