@@ -146,6 +146,9 @@ SECTIONS = (
     Section("lammps-convert", "lammps_convert", "`grainview convert lammps` on a large run: time and memory", ()),
     Section("cli-io", "cli_io", "`grainview export --to csv` and `grainview info` on a study-sized file: time",
             ("--repeats", "5"), ("--repeats", "1", "--snapshots", "20", "--contacts", "200")),
+    Section("study-time", "study_time", "`grainview warmup` and `grainview study` with the kernels compiled and "
+            "not: wall time, first line, stages' processor time, the study's own estimate",
+            (), ("--runs", "warmup-warm,study-warm", "--study-args", "--particles 20 --strain 0.002", "--pause", "0")),
 )
 """The current benchmarks, in the order of RESULTS.md. benchmarks/README.md says what each measures."""
 
