@@ -149,6 +149,8 @@ SECTIONS = (
     Section("study-time", "study_time", "`grainview warmup` and `grainview study` with the kernels compiled and "
             "not: wall time, first line, stages' processor time, the study's own estimate",
             (), ("--runs", "warmup-warm,study-warm", "--study-args", "--particles 20 --strain 0.002", "--pause", "0")),
+    Section("periodic-shear", "periodic_shear", "the periodic simple shear against the walled biaxial test at equal N: "
+            "processor time per particle-step and per sweep", (), ("--quick",)),
 )
 """The current benchmarks, in the order of RESULTS.md. benchmarks/README.md says what each measures."""
 
