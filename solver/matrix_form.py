@@ -63,6 +63,8 @@ def matrix_problem(problem, vx, vy, w, H=None, minv=None):
     W.sort_indices()
     q = H @ np.stack([vx, vy, w], -1).reshape(-1)
     q[0::2] += problem.bias
+    if hasattr(problem, "slip"):  # a periodic cell's moving images (solver.solve_records.PeriodicContactProblem)
+        q[1::2] += problem.slip
     return W, q, problem.mu.copy()
 
 

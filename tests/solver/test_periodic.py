@@ -116,11 +116,11 @@ def test_the_tilt_flips_by_the_cell_length_past_half_of_it():
     assert cell.advance(0.02) and cell.tilt == pytest.approx(0.51 - 1.0)
 
 
-def two_disks(shear_rate, height_rate, friction):
+def two_disks(shear_rate, height_rate, friction, solver="nlgs"):
     """Disk 0 under the top of a 1 x 1 cell, disk 1 above its bottom, whose image one cell up
     touches disk 0: the image moves at db/dt = (shear_rate, height_rate) (h = 1)."""
     cell = PeriodicCell([0.0, 0.0], 1.0, 1.0, shear_rate=shear_rate, height_rate=height_rate)
-    p = Parameters(time_step=1e-4, friction=friction, tolerance=1e-12, max_tolerance=1e-12, solver="nlgs",
+    p = Parameters(time_step=1e-4, friction=friction, tolerance=1e-12, max_tolerance=1e-12, solver=solver,
                    overlap_recovery_speed=0.0, alert=0.01, skin=0.01)
     sim = Simulation([[0.5, 0.95], [0.5, 0.05]], None, [0.05, 0.05], [0, 0], parameters=p, cell=cell)
     return sim
@@ -142,11 +142,13 @@ def test_a_collision_across_a_closing_boundary_by_hand():
     np.testing.assert_allclose(sim.cell_stress, [[0, 0], [0, f * 0.1 / sim.parameters.thickness]], atol=1e-9)
 
 
+@pytest.mark.parametrize("solver", ["nlgs", "anderson", "pcg"])
 @pytest.mark.parametrize("friction, sticks", [(1.0, True), (0.2, False)])
-def test_the_moving_image_drags_disk_0_along_by_coulomb(friction, sticks):
+def test_the_moving_image_drags_disk_0_along_by_coulomb(friction, sticks, solver):
     """Sheared and closing: the image moves at (0.2, -0.1) m/s. Sticking, the contact points'
-    velocities are equal after the step (u = 0); sliding, |p_t| = mu p_n against the slip."""
-    sim = two_disks(0.2, -0.1, friction)
+    velocities are equal after the step (u = 0); sliding, |p_t| = mu p_n against the slip. Each
+    of the stepper's solvers (pcg through the matrix form's q)."""
+    sim = two_disks(0.2, -0.1, friction, solver)
     sim.step()
     v, w = sim.velocity, sim.angular_velocity
     # after the step the cell's rate is (0.2 h, -0.1) with h = 1 - 1e-5 and the velocities
@@ -251,7 +253,7 @@ def test_a_step_of_the_sample_shifted_modulo_the_cell_is_the_step_shifted():
 
 def test_the_periodic_path_refuses_what_it_does_not_do():
     pos, angle, radius, nv, size = gas_sample(n=10)
-    for settings in (dict(domains=2), dict(solver="pcg")):
+    for settings in (dict(domains=2),):
         with pytest.raises(ParameterError, match="periodic"):
             Simulation(pos, angle, radius, nv, parameters=Parameters(**settings),
                        cell=PeriodicCell([0, 0], size, size))
