@@ -46,6 +46,18 @@ How the contract's quantities are made (docs/formats.md states the same for user
   ``gap`` is the smallest ``gapTT`` of the pair's points; ``point`` is LMGC90's contact point
   (``coo1, coo2``). ``wall_force`` is the total force exerted by the particles on each wall.
 * ``time`` and ``step`` are DOF.OUT's header's.
+* **Periodic runs.** LMGC90's 2D rigid runs repeat along x only, with a period set in the
+  computation script (``chipy.SetPeriodicCondition(xperiod=L)``, or ``RBDY2_SetPeriodicCondition``
+  with the contact families'), which no DATBOX or OUTBOX file records: the reader takes it as
+  ``x_period=L``. The cell is then ``a = (L, 0)``, ``b = (0, h)``, periodic along ``a`` only
+  (``periodic = (1, 0)``), from x = 0 (LMGC90 moves a body whose ``reference + X(1)`` leaves
+  ``[0, L]`` by one period, every step); ``box_min``, ``box_max`` span x from 0 to L and, in y,
+  the inner faces of two horizontal JONCx (named ``bottom`` and ``top``: walls across the
+  periodic direction are refused) or else the particles' extent. A pair across the boundary is
+  detected on the antagonist's image: ``branch`` is the minimum image of ``x_j - x_i``,
+  ``point`` LMGC90's contact point moved by whole periods to its image nearest ``x_i`` (a
+  wall's arm likewise); positions are wrapped into ``[0, L)`` (``cell_positions = wrapped``).
+  A centre more than its diameter outside ``[0, L]`` (the wrong period) is refused.
 
 Every function checks its input first and refuses bad input in one line
 (:class:`grainview.contract.errors.FileFormatError`).
@@ -65,7 +77,8 @@ import warnings
 import numpy as np
 
 from ..contract import portable_math
-from ..contract.errors import FileFormatError
+from ..contract.cell import minimum_image, restricted_cell
+from ..contract.errors import FileFormatError, ParameterError
 from ..contract.shapes import polygon_properties, regular_vertices, shape_problems, vertex_phases
 from .checks import Limits, check_contacts, check_step, input_folder
 from .lmgc90_text import output_files, read_bodies, read_bulk_behav, read_dof, read_vloc_rloc
@@ -256,11 +269,13 @@ class _Model:
             return f"body {self.numbers[k]}"
         return f"body {self.walls[k - self.n].number} ({self.wall_names[k - self.n]})"
 
-    def name_walls(self, dof):
+    def name_walls(self, dof, x_period=None):
         """Name the walls from their place in the first snapshot; four axis-aligned JONCx
-        around the particles make a box (:data:`BOX_WALLS`)."""
+        around the particles make a box (:data:`BOX_WALLS`); in a run periodic in x
+        (``x_period``), two horizontal ones below and above the particles bound it in y."""
         walls = self.wall_bodies
         self.body_index = {int(b): k for k, b in enumerate(self.numbers)}
+        self.box_walls = False
         if not walls:
             return
         state = {int(b): x for b, x in zip(dof.numbers, dof.X)}
@@ -280,7 +295,15 @@ class _Model:
             else:
                 break
             named.setdefault(name, body)
-        if len(walls) == 4 and len(named) == 4:
+        if x_period is not None and ({"left", "right"} & set(named)):
+            body = named["left"] if "left" in named else named["right"]
+            raise FileFormatError(f"{self.source}: body {body.number}, a vertical JONCx, stands across x, the periodic "
+                                  "direction (x_period); expected walls only across y in a run periodic in x")
+        if x_period is not None and len(walls) == 2 and set(named) == {"bottom", "top"}:
+            self.walls = [named["bottom"], named["top"]]
+            self.wall_names = ["bottom", "top"]
+            self.box_walls = "y"
+        elif len(walls) == 4 and len(named) == 4:
             self.walls = [named[name] for name in BOX_WALLS]
             self.wall_names = list(BOX_WALLS)
             self.box_walls = True
@@ -319,7 +342,14 @@ def _state(model, dof, where):
             walls)
 
 
-def _box(model, position, walls):
+def _box(model, position, walls, x_period=None):
+    if x_period is not None:  # x from 0 to the period; y between two walls, or the particles' extent
+        low, high = (position - model.radius[:, None]).min(axis=0), (position + model.radius[:, None]).max(axis=0)
+        if model.box_walls == "y":
+            half = [w.contactors[0].values.get("axe2", 0.0) for w in model.walls]
+            low[1], high[1] = walls[0, 1] + half[0], walls[1, 1] - half[1]
+        low[0], high[0] = 0.0, x_period
+        return low, high
     if model.box_walls:
         half = [w.contactors[0].values.get("axe2", 0.0) for w in model.walls]
         bottom, right, top, left = walls[:, :2]
@@ -349,10 +379,12 @@ def _check_entries(model, position, entries, where):
         seen[key] = entry.line
 
 
-def _contacts(model, position, vloc, where):
+def _contacts(model, position, vloc, where, cell=None, periodic=None):
     """Contract contacts (dict of arrays), the total force on each wall and the number of pairs
-    left out for a tensile normal force, from one Vloc_Rloc record."""
+    left out for a tensile normal force, from one Vloc_Rloc record; in a periodic ``cell``,
+    branches and contact points are minimum images."""
     n = model.n
+    image = (lambda d: d) if cell is None else (lambda d: minimum_image(d, cell, periodic))  # noqa: E731
     _check_entries(model, position, vloc.entries, where)
     pairs = {}
     for entry in vloc.entries:
@@ -412,6 +444,7 @@ def _contacts(model, position, vloc, where):
         weights = np.array(fn_points)
         xy = np.array(xy)
         point = (weights[:, None] * xy).sum(axis=0) / weights.sum() if weights.sum() > 0 else xy.mean(axis=0)
+        point = position[i] + image(point - position[i])  # at the antagonist's image: its image nearest i
         out["i"].append(i)
         out["j"].append(j)
         out["kind"].append(len(points))
@@ -419,7 +452,7 @@ def _contacts(model, position, vloc, where):
         out["fn"].append(fn)
         out["ft"].append(float(force[0] * tangent[0] + force[1] * tangent[1]))
         out["point"].append(point)
-        out["branch"].append(position[j] - position[i] if j < n else point - position[i])
+        out["branch"].append(image(position[j] - position[i]) if j < n else point - position[i])
         out["gap"].append(min(entry.gap for entry, _ in points))
         if j >= n:
             wall_force[j - n] += force
@@ -427,7 +460,7 @@ def _contacts(model, position, vloc, where):
     contacts = {k: np.array(v, dtypes.get(k, "f8")) for k, v in out.items()}
     for k in ("normal", "point", "branch"):
         contacts[k] = contacts[k].reshape(-1, 2)
-    check_contacts(model.limits, position, contacts, where, model.name)
+    check_contacts(model.limits, position, contacts, where, model.name, cell=cell, periodic=periodic)
     return contacts, wall_force, tensile
 
 
@@ -453,7 +486,36 @@ def _run_files(run):
     return files
 
 
-def lmgc90_snapshots(run):
+def _x_period(x_period):
+    """``x_period`` as a float > 0, or None; one line for anything else."""
+    if x_period is None:
+        return None
+    try:
+        value = float(x_period)
+    except (TypeError, ValueError):
+        value = math.nan
+    if isinstance(x_period, bool) or not (math.isfinite(value) and value > 0):
+        raise ParameterError(f"x_period={x_period!r}: expected the period in x of a periodic run (m, a finite number "
+                             "> 0, the xperiod of its chipy.SetPeriodicCondition), or None")
+    return value
+
+
+def _wrapped(model, position, x_period, where):
+    """Centres wrapped into [0, x_period) in x; one line for one more than its diameter outside
+    [0, x_period] (LMGC90 moves bodies back every step: the wrong period?)."""
+    slack = 2 * model.radius
+    out = (position[:, 0] < -slack) | (position[:, 0] > x_period + slack)
+    if out.any():
+        k = int(np.flatnonzero(out)[0])
+        raise FileFormatError(f"{where}: {model.name(k)} at x = {position[k, 0]:.10g} lies outside the periodic cell "
+                              f"(x from 0 to x_period = {x_period:.10g}) by more than its diameter; expected the "
+                              "period of the run's chipy.SetPeriodicCondition")
+    shifted = position.copy()
+    shifted[:, 0] -= x_period * np.floor(position[:, 0] / x_period)
+    return shifted
+
+
+def lmgc90_snapshots(run, *, x_period=None):
     """Read an LMGC90 2D run snapshot by snapshot, as the contract's per-snapshot arrays.
 
     Parameters
@@ -461,6 +523,9 @@ def lmgc90_snapshots(run):
     run : str or path-like
         The run folder, holding ``DATBOX/BODIES.DAT``, ``DATBOX/BULK_BEHAV.DAT`` and
         ``OUTBOX/DOF.OUT.n``, ``OUTBOX/Vloc_Rloc.OUT.n``.
+    x_period : float, optional
+        The run's period in x (m) when it is periodic (``chipy.SetPeriodicCondition(xperiod=L)``
+        in its computation script; no output file records it); None for a bounded run.
 
     Returns
     -------
@@ -481,12 +546,14 @@ def lmgc90_snapshots(run):
         contactor than DISKx, POLYG or JONCx, a POLYG that is not convex, an unknown contact family, a
         truncated file, DOF.OUT and Vloc_Rloc.OUT of different steps.
     """
+    x_period = _x_period(x_period)
     run, datbox, outbox = _run_folders(run)
     model = _Model(datbox)
     files = output_files(outbox)
     n_first, dof_path, vloc_path = files[0]
     first = read_dof(dof_path)
-    model.name_walls(first)
+    model.name_walls(first, x_period)
+    periodic = None if x_period is None else np.array([True, False])
     attrs = {"source": "LMGC90", "lmgc90_run": os.path.basename(os.path.abspath(run)), "thickness_m": 1.0,
              "lmgc90_gravity_m_s2": np.asarray(model.gravity[:2], float),
              "lmgc90_contact_rule": "body pairs with a compressive normal force; two points on a pair make a double "
@@ -494,6 +561,10 @@ def lmgc90_snapshots(run):
     static = dict(radius=model.radius, n_vertices=model.n_vertices, mass=model.mass, inertia=model.inertia,
                   vertices=model.vertices,
                   n_walls=len(model.wall_names), wall_names=list(model.wall_names) or None, attrs=attrs)
+    if periodic is not None:
+        static["periodic"] = periodic.astype("i1")
+        attrs["cell_positions"] = "wrapped"
+        attrs["lmgc90_x_period_m"] = x_period
 
     def snapshots():
         for k, (number, dof_file, vloc_file) in enumerate(files):
@@ -508,10 +579,17 @@ def lmgc90_snapshots(run):
                                       "snapshot's two files must be of the same step, of the same run)")
             check_step(dof.step, dof_file)
             position, angle, velocity, omega, walls = _state(model, dof, dof_file)
-            contacts, wall_force, tensile = _contacts(model, position, vloc, vloc_file)
-            box_min, box_max = _box(model, position, walls)
+            cell = None
+            if periodic is not None:
+                position = _wrapped(model, position, x_period, dof_file)
+            box_min, box_max = _box(model, position, walls, x_period)
+            if periodic is not None:
+                cell = restricted_cell(box_min, box_max)
+            contacts, wall_force, tensile = _contacts(model, position, vloc, vloc_file, cell, periodic)
             snap = dict(time=dof.time, step=dof.step, position=position, angle=angle, velocity=velocity,
                         angular_velocity=omega, contacts=contacts, box_min=box_min, box_max=box_max, tensile=tensile)
+            if cell is not None:
+                snap["cell"] = cell
             if model.wall_names:
                 snap["wall_force"] = wall_force
             yield snap
@@ -519,13 +597,15 @@ def lmgc90_snapshots(run):
     return static, snapshots()
 
 
-def open_lmgc90(run, *, progress=False):
+def open_lmgc90(run, *, x_period=None, progress=False):
     """An LMGC90 2D run as an in-memory dataset of the contract.
 
     Parameters
     ----------
     run : str or path-like
         The run folder (:func:`lmgc90_snapshots`).
+    x_period : float, optional
+        A periodic run's period in x, m (:func:`lmgc90_snapshots`).
     progress : bool, default False
         Show a progress bar over the snapshots.
 
@@ -539,7 +619,7 @@ def open_lmgc90(run, *, progress=False):
     """
     from .convert import snapshots_dataset
 
-    static, stream = lmgc90_snapshots(run)
+    static, stream = lmgc90_snapshots(run, x_period=x_period)
     if progress:
         from tqdm.auto import tqdm
 
@@ -558,7 +638,7 @@ def _warn_tensile(count, snapshots):
                       stacklevel=3)
 
 
-def convert_lmgc90(out, run, *, overwrite=False, compress=True, progress=False):
+def convert_lmgc90(out, run, *, x_period=None, overwrite=False, compress=True, progress=False):
     """Convert an LMGC90 2D run into a file of the contract, snapshot by snapshot.
 
     Each snapshot (a DOF.OUT.n and its Vloc_Rloc.OUT.n) is read and appended to the file in
@@ -573,6 +653,8 @@ def convert_lmgc90(out, run, *, overwrite=False, compress=True, progress=False):
         The netCDF file to write; an existing one is refused unless ``overwrite``.
     run : str or path-like
         The LMGC90 run folder (:func:`lmgc90_snapshots`).
+    x_period : float, optional
+        A periodic run's period in x, m (:func:`lmgc90_snapshots`).
     overwrite : bool, default False
         Replace an existing ``out``.
     compress : bool, default True
@@ -596,7 +678,7 @@ def convert_lmgc90(out, run, *, overwrite=False, compress=True, progress=False):
 
     inputs = _run_files(run)
     out = check_out(out, overwrite, inputs)
-    static, stream = lmgc90_snapshots(run)
+    static, stream = lmgc90_snapshots(run, x_period=x_period)
     optional = ("step", "gap", "velocity", "angular_velocity") + (("wall_force",) if static["n_walls"] else ())
     tensile = []
 

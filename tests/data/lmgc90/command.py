@@ -7,6 +7,8 @@ below, two of them consecutive (so that a test can take the velocity change over
 * ``sample``: time step 1e-2 s, 500 steps (at rest from about step 400 on); files at steps
   100, 200 (still flowing), 499, 500.
 * ``handmade``: time step 1e-3 s, 20 steps; files at steps 19, 20.
+* ``periodic``: periodic in x with gen_sample.PERIOD (``chipy.SetPeriodicCondition``, after the
+  DATBOX is read); time step 1e-2 s, 600 steps; files at steps 300, 400, 599, 600.
 
 Run it in the folder holding DATBOX: ``python command.py --scene sample``.
 """
@@ -16,7 +18,8 @@ import argparse
 from pylmgc90 import chipy
 
 SCENES = {"sample": dict(dt=1e-2, steps=500, write=(100, 200, 499, 500), tol=1e-5),
-          "handmade": dict(dt=1e-3, steps=20, write=(19, 20), tol=1e-8)}
+          "handmade": dict(dt=1e-3, steps=20, write=(19, 20), tol=1e-8),
+          "periodic": dict(dt=1e-2, steps=600, write=(300, 400, 599, 600), tol=1e-5, period=10.0)}
 
 
 def main():
@@ -30,6 +33,8 @@ def main():
     chipy.TimeEvolution_SetTimeStep(scene["dt"])
     chipy.Integrator_InitTheta(0.5)
     chipy.ReadDatbox(deformable=False)
+    if "period" in scene:
+        chipy.SetPeriodicCondition(xperiod=scene["period"])
     chipy.ComputeMass()
     for k in range(1, scene["steps"] + 1):
         chipy.IncrementStep()

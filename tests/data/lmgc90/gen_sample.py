@@ -5,6 +5,10 @@ Two scenes, chosen with ``--scene``:
 * ``sample`` (default): 36 regular pentagons (POLYG) and 12 disks (DISKx) on a square lattice
   in a box of four JONCx walls, under gravity; contact law IQS_CLB, friction 0.4 everywhere.
   Radii are drawn from [0.4, 0.6] m with ``--seed`` (default 7).
+* ``periodic``: 30 regular pentagons and 10 disks (radii from [0.4, 0.6] m, ``--seed``) on a
+  lattice between a floor and a lid (two JONCx spanning the cell), thrown sideways at up to
+  1 m/s under gravity; command.py makes the run periodic in x with period :data:`PERIOD`
+  (``chipy.SetPeriodicCondition(xperiod=PERIOD)``: LMGC90 keeps x in [0, PERIOD]).
 * ``handmade``: bodies whose forces are known by hand, far enough apart not to touch one
   another: a disk resting on a floor (DKJCx) with a second disk on top of it (DKDKx); a
   square (POLYG, 4 vertices) resting on a floor with a second square on top of it, face to
@@ -26,6 +30,8 @@ from pathlib import Path
 import numpy as np
 from pylmgc90 import pre
 
+PERIOD = 10.0
+"""The x period of the ``periodic`` scene (m): 8 columns of pitch 1.25."""
 FRICTION = 0.4
 DENSITY = 1000.0
 GRAVITY = [0.0, -9.81, 0.0]
@@ -81,6 +87,28 @@ def sample(bodies, mod, grain, wall, seed):
     jonc(bodies, mod, wall, 0.5 * height + t, t, (width + t, 0.5 * height), angle=0.5 * math.pi)  # right
 
 
+def periodic(bodies, mod, grain, wall, seed):
+    rng = np.random.default_rng(seed)
+    columns, rows, pitch = 8, 5, PERIOD / 8
+    height = rows * pitch + 1.0
+    k = 0
+    for row in range(rows):
+        for column in range(columns):
+            radius = rng.uniform(0.4, 0.6)
+            centre = [pitch * (column + 0.5), pitch * (row + 0.5)]
+            if k % 4 == 3:  # one disk in four
+                body = pre.rigidDisk(r=radius, center=centre, model=mod, material=grain, color="BLEUx")
+            else:
+                body = pre.rigidPolygon(model=mod, material=grain, center=centre, theta=rng.uniform(0, 2 * math.pi),
+                                        color="BLEUx", generation_type="regular", nb_vertices=5, radius=radius)
+            body.imposeInitValue(component=1, value=rng.uniform(-1.0, 1.0))
+            bodies += body
+            k += 1
+    t = 0.2  # walls' half thickness; they span the cell and a wall's thickness beyond it
+    jonc(bodies, mod, wall, 0.5 * PERIOD + t, t, (0.5 * PERIOD, -t))  # floor
+    jonc(bodies, mod, wall, 0.5 * PERIOD + t, t, (0.5 * PERIOD, height + t))  # lid
+
+
 def handmade(bodies, mod, grain, wall):
     t = 0.1
     # a disk on a floor, a second disk on top of it
@@ -109,13 +137,15 @@ def handmade(bodies, mod, grain, wall):
 
 def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--scene", choices=("sample", "handmade"), default="sample")
+    parser.add_argument("--scene", choices=("sample", "handmade", "periodic"), default="sample")
     parser.add_argument("--seed", type=int, default=7)
     args = parser.parse_args()
     mats, mods, svs, tacts, grain, wall, mod = containers()
     bodies = pre.avatars()
     if args.scene == "sample":
         sample(bodies, mod, grain, wall, args.seed)
+    elif args.scene == "periodic":
+        periodic(bodies, mod, grain, wall, args.seed)
     else:
         handmade(bodies, mod, grain, wall)
     Path("DATBOX").mkdir(exist_ok=True)

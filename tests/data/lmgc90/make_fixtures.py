@@ -1,6 +1,7 @@
 """Run LMGC90 on the two scenes of gen_sample.py and keep what the reader's tests read.
 
     python tests/data/lmgc90/make_fixtures.py            # rewrites sample/ and handmade/ here
+    python tests/data/lmgc90/make_fixtures.py periodic   # rewrites periodic/ (x period 10 m)
 
 LMGC90 has no wheel: build it first with build_lmgc90.sh (its build folder, /work/lmgc90-build
 by default, or the folder named by LMGC90_BUILD, holds the ``pylmgc90`` package). :func:`run`
@@ -56,7 +57,7 @@ def keep(source, target):
 
 
 def main():
-    for scene in ("sample", "handmade"):
+    for scene in sys.argv[1:] or ("sample", "handmade"):
         with tempfile.TemporaryDirectory() as tmp:
             folder = run(Path(tmp) / scene, scene)
             target = HERE / scene
