@@ -40,10 +40,11 @@ from typing import NamedTuple
 
 import numpy as np
 from numba import njit, prange
+from numba.extending import overload
 
 from . import scratch
 from .nlgs import NLGSResult, delassus_into, stalled, sweep, sweep_norms, velocities_from_impulses
-from .solve_records import ContactProblem, DelassusBlocks, Impulses, Limits, Velocities
+from .solve_records import ContactProblem, DelassusBlocks, Impulses, Limits, PeriodicContactProblem, Velocities
 
 FREE = -1
 """Domain of a body that never moves (zero inverse mass and inertia): shared by every domain."""
@@ -261,8 +262,9 @@ class Decomposition(NamedTuple):
 
     @property
     def gathered_size(self):
-        """Floats that :meth:`gather` writes: 10 per point and 7 per body, new numbering."""
-        return 10 * self.point_order.size + 7 * self.source.size
+        """Floats that :meth:`gather` writes: 11 per point (the last, a periodic problem's
+        slip, unused otherwise) and 7 per body, new numbering."""
+        return 11 * self.point_order.size + 7 * self.source.size
 
     @property
     def blocks(self):
@@ -284,32 +286,67 @@ class Decomposition(NamedTuple):
         scatter_from(self, impulses, velocities, Impulses(pn, pt), Velocities(vx, vy, w))
 
 
+def point_slip(problem, k):
+    """A periodic problem's ``slip[k]`` (:class:`PeriodicContactProblem`); 0.0 for a
+    :class:`ContactProblem`, which has none (the row is then not read)."""
+    return problem.slip[k] if hasattr(problem, "slip") else 0.0
+
+
+@overload(point_slip, jit_options={"cache": True})
+def _point_slip(problem, k):
+    if "slip" in getattr(problem, "fields", ()):
+        return lambda problem, k: problem.slip[k]
+    return lambda problem, k: 0.0
+
+
+def renumbered_problem(problem, a, b, points, bodies):
+    """The problem of the kind of ``problem`` from the renumbered bodies ``a``, ``b`` and the
+    gathered rows ``points`` (nx .. mu, then slip at row 10) and ``bodies`` (minv_xx .. iinv)."""
+    fields = (a, b, *points[:8], *bodies[:4])
+    return PeriodicContactProblem(*fields, points[10]) if hasattr(problem, "slip") else ContactProblem(*fields)
+
+
+@overload(renumbered_problem, jit_options={"cache": True})
+def _renumbered_problem(problem, a, b, points, bodies):
+    if "slip" in getattr(problem, "fields", ()):
+        def periodic(problem, a, b, points, bodies):
+            return PeriodicContactProblem(a, b, points[0], points[1], points[2], points[3], points[4], points[5],
+                                          points[6], points[7], bodies[0], bodies[1], bodies[2], bodies[3], points[10])
+        return periodic
+
+    def walled(problem, a, b, points, bodies):
+        return ContactProblem(a, b, points[0], points[1], points[2], points[3], points[4], points[5], points[6],
+                              points[7], bodies[0], bodies[1], bodies[2], bodies[3])
+    return walled
+
+
 @njit(cache=True, parallel=True)
 def gather_into(decomposition, problem, impulses, velocities, out):
-    """Copies in the new numbering of ``decomposition`` (:class:`Decomposition`): the ten
-    point arrays (nx .. rby, bias, mu, pn, pt) taken at its ``point_order``, then the seven body
-    arrays (minv_xx .. iinv, vx, vy, w) at its ``source``, written into ``out`` (10 P + 7 B
-    floats or more). Plain copies, shared among the threads. Returns the renumbered
-    (:class:`ContactProblem`, :class:`Impulses`, :class:`Velocities`), views of ``out``."""
+    """Copies in the new numbering of ``decomposition`` (:class:`Decomposition`): the eleven
+    point arrays (nx .. rby, bias, mu, pn, pt, and a periodic problem's slip) taken at its
+    ``point_order``, then the seven body arrays (minv_xx .. iinv, vx, vy, w) at its ``source``,
+    written into ``out`` (11 P + 7 B floats or more). Plain copies, shared among the threads.
+    Returns the renumbered (problem of ``problem``'s kind, :class:`Impulses`,
+    :class:`Velocities`), views of ``out``."""
     point_order, source = decomposition.point_order, decomposition.source
     p = problem
     pn, pt = impulses
     vx, vy, w = velocities
     m = point_order.size
-    points = out[:10 * m].reshape((10, m))
+    points = out[:11 * m].reshape((11, m))
     for q in prange(m):
         k = point_order[q]
         points[0, q], points[1, q], points[2, q] = p.nx[k], p.ny[k], p.rax[k]
         points[3, q], points[4, q], points[5, q] = p.ray[k], p.rbx[k], p.rby[k]
         points[6, q], points[7, q], points[8, q], points[9, q] = p.bias[k], p.mu[k], pn[k], pt[k]
+        points[10, q] = point_slip(p, k)
     n = source.size
-    bodies = out[10 * m:10 * m + 7 * n].reshape((7, n))
+    bodies = out[11 * m:11 * m + 7 * n].reshape((7, n))
     for q in prange(n):
         j = source[q]
         bodies[0, q], bodies[1, q], bodies[2, q], bodies[3, q] = p.minv_xx[j], p.minv_xy[j], p.minv_yy[j], p.iinv[j]
         bodies[4, q], bodies[5, q], bodies[6, q] = vx[j], vy[j], w[j]
-    renumbered = ContactProblem(decomposition.a, decomposition.b, points[0], points[1], points[2], points[3], points[4],
-                                points[5], points[6], points[7], bodies[0], bodies[1], bodies[2], bodies[3])
+    renumbered = renumbered_problem(problem, decomposition.a, decomposition.b, points, bodies)
     return renumbered, Impulses(points[8], points[9]), Velocities(bodies[4], bodies[5], bodies[6])
 
 

@@ -163,7 +163,7 @@ class Simulation:
         A biperiodic cell (then ``walls`` may be None: no walls): detection finds pairs through
         their images (:mod:`solver.periodic_detection`), the problem takes body b at its image
         (:mod:`solver.periodic_assembly`), and after each step the cell moves, its height under
-        its stress control, and the centres are wrapped into it (:meth:`_move_cell`). One domain.
+        its stress control, and the centres are wrapped into it (:meth:`_move_cell`).
     """
 
     def __init__(self, position, angle, radius=None, n_vertices=None, walls: Walls | None = None,
@@ -234,11 +234,9 @@ class Simulation:
             self._check_cell()
 
     def _check_cell(self):
-        """A periodic simulation's settings: what the periodic path supports, a cell wide enough
-        for detection (:meth:`solver.periodic_cell.PeriodicCell.check_reach`), the centres in it."""
+        """A periodic simulation's settings: no walls, a cell wide enough for detection
+        (:meth:`solver.periodic_cell.PeriodicCell.check_reach`), the centres in it."""
         p = self.parameters
-        if p.domains != 1:
-            raise ParameterError(f"a periodic cell is stepped on one domain; got domains={p.domains}")
         if self.n_walls:
             raise ParameterError("a periodic cell has no walls (biperiodic): expected walls=None")
         self.cell.thickness = float(p.thickness)

@@ -251,12 +251,36 @@ def test_a_step_of_the_sample_shifted_modulo_the_cell_is_the_step_shifted():
     assert checked >= 4 and across >= 2
 
 
-def test_the_periodic_path_refuses_what_it_does_not_do():
-    pos, angle, radius, nv, size = gas_sample(n=10)
-    for settings in (dict(domains=2),):
-        with pytest.raises(ParameterError, match="periodic"):
-            Simulation(pos, angle, radius, nv, parameters=Parameters(**settings),
-                       cell=PeriodicCell([0, 0], size, size))
+@pytest.mark.parametrize("solver", ["nlgs", "anderson"])
+def test_a_step_on_two_domains_is_the_step_on_one(solver):
+    """The same states stepped on one and on two domains (slabs in x: the pairs across the
+    cell's left and right sides join the interface) give the same step, to the tolerance."""
+    pos, angle, radius, nv, size = gas_sample(seed=8)
+    velocity = np.random.default_rng(9).normal(0.0, 0.5, (len(pos), 2))
+    cell = PeriodicCell([0.0, 0.0], size, size, shear_rate=2.0, height_rate=-0.01)
+    p = Parameters(time_step=1e-4, friction=0.4, tolerance=1e-12, max_tolerance=1e-12, max_iterations=20000,
+                   solver=solver, alert=1e-3)
+    sim = Simulation(pos, angle, radius, nv, parameters=p, cell=cell, velocity=velocity)
+    checked = across = 0
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        for k in range(32):
+            if k % 8 == 7:
+                other = copy.deepcopy(sim)
+                other.set_parameters(domains=2)
+                other.step()
+                sim.step()
+                if sim.last.n_points:
+                    np.testing.assert_allclose(other.position, sim.position, rtol=0, atol=1e-13)
+                    np.testing.assert_allclose(other.velocity, sim.velocity, rtol=0, atol=1e-11)
+                    np.testing.assert_array_equal(other.points.body_j, sim.points.body_j)
+                    np.testing.assert_allclose(other.impulse, sim.impulse, rtol=0,
+                                               atol=1e-10 * np.abs(sim.impulse).max())
+                    checked += 1
+                    across += np.count_nonzero(sim.point_image[:, 0] != 0)
+            else:
+                sim.step()
+    assert checked >= 3 and across >= 1
 
 
 # -- the shear scene's file ---------------------------------------------------------------------
