@@ -20,7 +20,7 @@ from ._lift import with_attrs
 from .connectivity import _check_min, counts_of
 from .contacts import selection, snapshot_index
 from ._docs import fill_doc
-from ..contract.cell import minimum_image
+from .arrays.periodic import unwrapped_trajectory
 
 __all__ = ["particle_fields", "unwrapped_positions"]
 
@@ -104,10 +104,6 @@ def _wrapped_cell(ds: xr.Dataset) -> bool:
     return "cell" in ds.variables and ds.attrs.get("cell_positions", "wrapped") == "wrapped"
 
 
-def _minimum_image(d, cell, periodic):
-    return minimum_image(d, cell[..., None, :, :], periodic)
-
-
 def _unwrapped(ds: xr.Dataset) -> xr.DataArray:
     return unwrapped_positions(ds)
 
@@ -116,13 +112,14 @@ def _unwrapped(ds: xr.Dataset) -> xr.DataArray:
 def unwrapped_positions(ds: xr.Dataset) -> xr.DataArray:
     """The particles' centres followed across a periodic cell's boundary (time, particle, xy), m.
 
-        x_k = x_0 + sum_{k' <= k} minimum_image(x_k' - x_(k'-1))
+        u_0 = x_0,    u_k = u_(k-1) + minimum_image(x_k - u_(k-1))
 
-    the steps between consecutive snapshots taken as their minimum images in the later
-    snapshot's cell (:func:`grainview.contract.cell.minimum_image`): the trajectory of a
-    particle that crosses the boundary, as long as no particle moves half a cell between two
-    snapshots. A file without a cell, or whose centres are stored unwrapped, gives its
-    ``position`` as it is.
+    in the cell of snapshot k with its tilt made continuous across flips
+    (:func:`grainview.analysis.arrays.periodic.unwrapped_trajectory`): ``u_k = x_k + m a + n b_k``
+    with the whole cells (m, n) the particle has crossed, so that in a sheared cell an image
+    across the top or bottom edge keeps moving with the tilt. Exact as long as no particle moves
+    half a cell between two snapshots. A file without a cell, or whose centres are stored
+    unwrapped, gives its ``position`` as it is.
 
     Parameters
     ----------
@@ -131,15 +128,15 @@ def unwrapped_positions(ds: xr.Dataset) -> xr.DataArray:
     Returns
     -------
     xarray.DataArray
-        ``position`` (time, particle, xy), m; lazy on dask input.
+        ``position`` (time, particle, xy), m; lazy on dask input (one task over the snapshots:
+        each snapshot follows from the one before).
     """
     if not _wrapped_cell(ds):
         return ds["position"]
     position = ds["position"]
-    step = (position - position.shift(time=1)).fillna(0.0)
     periodic = np.asarray(ds["periodic"].values, bool)
-    step = xr.apply_ufunc(_minimum_image, step, ds["cell"], input_core_dims=[["particle", "xy"], ["cell_vector", "xy"]],
-                          output_core_dims=[["particle", "xy"]], kwargs={"periodic": periodic}, dask="parallelized",
-                          output_dtypes=[float])
-    out = position.isel(time=0, drop=True) + step.cumsum("time")
+    out = xr.apply_ufunc(unwrapped_trajectory, position, ds["cell"],
+                         input_core_dims=[["time", "particle", "xy"], ["time", "cell_vector", "xy"]],
+                         output_core_dims=[["time", "particle", "xy"]], kwargs={"periodic": periodic},
+                         dask="parallelized", output_dtypes=[float], dask_gufunc_kwargs={"allow_rechunk": True})
     return out.transpose(*position.dims).rename("position").assign_attrs(position.attrs)

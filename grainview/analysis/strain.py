@@ -287,7 +287,10 @@ def inertia_number(ds: xr.Dataset) -> xr.DataArray:
         I = eps_dot sqrt(m / p),    eps_dot = |dh/dt| / h
 
     eps_dot is the vertical strain rate (s-1), m the total mass of the particles (kg) and p the
-    mean stress times the slab thickness (N m-1), as in the paper's 2D setting.
+    mean stress times the slab thickness (N m-1), as in the paper's 2D setting. In a periodic
+    cell sheared over the run, eps_dot is the shear rate |d gamma/dt| (gamma of
+    :func:`strains`): there the height only follows the normal stress's control, and its rate
+    says nothing of the shear.
 
     Parameters
     ----------
@@ -305,8 +308,11 @@ def inertia_number(ds: xr.Dataset) -> xr.DataArray:
     Azéma, Radjai, Peyroux & Saussine, Phys. Rev. E 76, 011301 (2007),
     Eq. 3 (Sec. III); docs/conventions.md §6.
     """
-    h = sample.height(ds)
-    rate = ratio(abs(time_derivative(h)), h)
+    if "cell" in ds.variables and _sheared(ds):
+        rate = abs(time_derivative(strains(ds)["gamma"]))
+    else:
+        h = sample.height(ds)
+        rate = ratio(abs(time_derivative(h)), h)
     p_line = stress_invariants(ds)["p"] * sample.thickness(ds)
     total_mass = ds["mass"].sum()
     per_load = ratio(total_mass, p_line.where(p_line > 0))  # no load (no contacts): NaN

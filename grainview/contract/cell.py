@@ -261,7 +261,12 @@ def cell_problems(cell, box_min, box_max, periodic) -> list[str]:
 
 BRANCH_TOLERANCE = 1e-6
 """How far, relative to r_i + r_j, a stored particle pair's branch may be from the minimum
-image of its centres, and longer than the particles allow."""
+image of its centres (rounding: a reader computes it from the centres)."""
+REACH_TOLERANCE = 0.5
+"""How much longer than the particles allow a branch may be, in units of the smaller radius:
+a code that finds its contacts before it moves the bodies writes, at the end of a step,
+pairs slightly farther apart than their radii (the same allowance as the readers' own check,
+:func:`grainview.formats.checks.check_contacts`); a branch across the cell is longer by far."""
 
 
 def branch_problems(position, i, j, branch, count, cell, radius, periodic, gap=None) -> np.ndarray:
@@ -270,8 +275,8 @@ def branch_problems(position, i, j, branch, count, cell, radius, periodic, gap=N
 
     A contact's branch in a periodic cell is ``x_j - x_i`` brought to its nearest image
     (:func:`minimum_image`); its length is at most ``r_i + r_j`` (circumscribed radii) plus the
-    pair's gap where it is positive (a near contact), each within :data:`BRANCH_TOLERANCE` of
-    ``r_i + r_j``. A branch of the size of the box is the mark of a reader or writer that did
+    pair's gap where it is positive (a near contact): the first within :data:`BRANCH_TOLERANCE`
+    of ``r_i + r_j``, the second within :data:`REACH_TOLERANCE` of the smaller radius. A branch of the size of the box is the mark of a reader or writer that did
     not take the minimum image.
 
     Parameters
@@ -308,10 +313,12 @@ def branch_problems(position, i, j, branch, count, cell, radius, periodic, gap=N
     xi = np.take_along_axis(position, ii[..., None], axis=1)
     xj = np.take_along_axis(position, jj[..., None], axis=1)
     image = minimum_image(xj - xi, np.asarray(cell, float)[:, None], periodic)
-    reach = np.asarray(radius, float)[ii] + np.asarray(radius, float)[jj]
+    r_i, r_j = np.asarray(radius, float)[ii], np.asarray(radius, float)[jj]
+    reach = r_i + r_j
     tolerance = BRANCH_TOLERANCE * reach
     dx, dy = branch[..., 0] - image[..., 0], branch[..., 1] - image[..., 1]
     miss = np.sqrt(dx * dx + dy * dy) > tolerance
     allowed = reach + (0.0 if gap is None else np.maximum(np.nan_to_num(np.asarray(gap, float)), 0.0))
-    long = np.sqrt(branch[..., 0] * branch[..., 0] + branch[..., 1] * branch[..., 1]) > allowed + tolerance
+    long = np.sqrt(branch[..., 0] * branch[..., 0] + branch[..., 1] * branch[..., 1]) > (
+        allowed + REACH_TOLERANCE * np.minimum(r_i, r_j))
     return np.stack([(pair & miss).sum(axis=1), (pair & long).sum(axis=1)], axis=-1).astype(np.int64)

@@ -748,7 +748,8 @@ def lammps_snapshots(particles, contacts, walls=None, *, log=None, time_step=Non
     static = dict(radius=static_particles.radius, mass=static_particles.mass, inertia=static_particles.inertia,
                   n_walls=len(WALL_NAMES) if walls is not None else 0,
                   wall_names=list(WALL_NAMES) if walls is not None else None, attrs=attrs)
-    static["deforming"] = log_info is not None and any(style == "deform" for style, _ in log_info.fixes.values())
+    static["deforming"] = log_info is not None and any(style.split("/")[0] == "deform"  # deform, deform/pressure
+                                                       for style, _ in log_info.fixes.values())
     if any(periodic):
         static["periodic"] = np.array(periodic, "i1")
         attrs["cell_positions"] = "unwrapped" if unwrapped else "wrapped"

@@ -421,6 +421,21 @@ def test_a_deforming_cells_note_names_fix_deform():
     assert len(notes) == 1 and "or the run's fix deform, which changes the box" in notes[0], notes
 
 
+def test_a_fix_deform_pressure_is_a_deforming_cell_too(tmp_path):
+    """The same run whose log shears with fix deform/pressure (a height held at a pressure): the
+    note names the box's deformation, not the dump's digits."""
+    f = files("sheared")
+    log = tmp_path / "log.lammps"
+    text = Path(f["log"]).read_text()
+    assert " deform " in text
+    log.write_text(text.replace(" deform ", " deform/pressure "))
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        open_lammps(f["particles"], f["contacts"], log=log)
+    notes = [str(w.message) for w in caught if "do not overlap at the dumped positions" in str(w.message)]
+    assert len(notes) == 1 and "or the run's fix deform, which changes the box" in notes[0], notes
+
+
 def _fixtures():
     """tests/data/lammps_periodic/make_fixtures.py, under a name of its own."""
     import importlib.util

@@ -280,6 +280,34 @@ def test_displacement_of_a_particle_across_the_boundary(prepare):
     np.testing.assert_allclose(later["displacement"].values[:, 0], 0.3 * np.abs(np.arange(t) - 2), atol=1e-12)
 
 
+def test_unwrapped_positions_in_a_sheared_cell_follow_the_tilt(prepare):
+    """A 4 x 4 cell sheared by 0.4 m of tilt per snapshot, with a flip past l/2 = 2 (LAMMPS sets the
+    tilt back by l); a disk at rest in the lab at x = 1 rising 0.3 m per snapshot from y = 3.5
+    through the top edge. Stored wrapped, after the crossing it sits at y - 4 and x - tilt_k
+    (mod 4): the image across the top edge moves with the tilt. Unwrapped, it is back at
+    (1, 3.5 + 0.3 k) in every snapshot, by hand; a sum of the wrapped steps' minimum images would
+    drift by the tilt's growth since the crossing (0.4 m per snapshot)."""
+    t = 8
+    tilt = 0.4 * np.arange(t)
+    stored_tilt = np.where(tilt > 2.0, tilt - 4.0, tilt)  # flipped
+    true = np.stack([np.ones(t), 3.5 + 0.3 * np.arange(t)], axis=-1)
+    crossed = true[:, 1] >= 4.0
+    wrapped = true - crossed[:, None] * np.stack([tilt, np.full(t, 4.0)], axis=-1)
+    cell = cells.restricted_cell(np.zeros((t, 2)), np.full((t, 2), 4.0), stored_tilt)
+    wrapped = cells.wrap(wrapped, np.zeros(2), cell, [1, 1])
+    position = np.stack([wrapped, np.tile([2.0, 2.0], (t, 1))], axis=1)
+    ds = grainview.make_dataset(radius=[0.1, 0.1], position=position,
+                                contacts=[dict(i=[], j=[], normal=np.zeros((0, 2)), fn=[])] * t,
+                                box_min=np.zeros((t, 2)), box_max=np.full((t, 2), 4.0),
+                                time=np.arange(t, dtype=float), periodic=[1, 1], cell=cell)
+    from grainview.analysis.particle_fields import unwrapped_positions
+
+    u = unwrapped_positions(prepare(ds)).values
+    np.testing.assert_allclose(u[:, 0], true, atol=1e-12)
+    displacement = prepare(ds).grain.particle_fields().compute()["displacement"].values[:, 0]
+    np.testing.assert_allclose(displacement, 0.3 * np.arange(t), atol=1e-12)
+
+
 def test_a_contact_keeps_its_identity_across_the_boundary():
     """Two disks in contact drifting together across the right edge (the pair stored a cell
     apart in the middle snapshots): one life, from the first snapshot to the last."""
@@ -370,3 +398,23 @@ def test_the_residual_window_of_a_sheared_cell_reads_gamma():
     assert "gamma" in window.attrs["long_name"]
     still = sheared_series(np.full(3, 0.7))  # a cell that is not sheared keeps eps_q's window
     assert "eps_q" in grainview.analysis.strain.residual_window(still).attrs["long_name"]
+
+
+def test_inertia_number_of_a_sheared_cell_reads_the_shear_rate(prepare):
+    """Two snapshots of a loaded 4 x 4 lattice, 2 s apart, the cell's tilt 0 then 1 m at a fixed
+    height: gamma_dot = 1/4 / 2 s; I = gamma_dot sqrt(m / (p t)) by hand (the height's rate, zero,
+    would give I = 0)."""
+    from .test_periodic_cell import lattice
+
+    first, second = lattice(0.0), lattice(1.0)
+    ds = grainview.make_dataset(radius=first["radius"].values,
+                                position=np.stack([first["position"].values[0], second["position"].values[0]]),
+                                contacts=[{name: snap[name].values[0, :32] for name in ("i", "j", "normal", "fn")}
+                                          for snap in (first, second)],
+                                box_min=[0, 0], box_max=[4, 4], time=[0.0, 2.0], periodic=[1, 1],
+                                cell=np.stack([first["cell"].values[0], second["cell"].values[0]]))
+    sigma = ds.grain.stress_tensor().values
+    p = (sigma[:, 0, 0] + sigma[:, 1, 1]) / 2
+    mass = float(ds["mass"].sum())
+    by_hand = 0.125 * np.sqrt(mass / p)
+    np.testing.assert_allclose(prepare(ds).grain.inertia_number().values, by_hand, rtol=1e-12)

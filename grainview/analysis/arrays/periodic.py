@@ -12,7 +12,7 @@ PARTICLE_XY = PARTICLE + ("xy",)
 CELL = ("cell_vector", "xy")
 """Core dimensions of a cell's lattice vectors (rows a, b)."""
 
-__all__ = ["CELL", "contact_image_shifts"]
+__all__ = ["CELL", "contact_image_shifts", "unwrapped_trajectory"]
 
 
 @core_dims(CONTACT, CONTACT, CONTACT_XY, PARTICLE_XY, CELL, out=(CONTACT_XY,))
@@ -52,3 +52,42 @@ def contact_image_shifts(i, j, branch, position, cell, periodic):
     d = np.where(pair[..., None], np.nan_to_num(branch - (xj - xi)), 0.0)
     shift = image_shift(d, np.asarray(cell, float)[..., None, :, :], periodic)
     return np.where(pair[..., None], shift, 0)
+
+
+def unwrapped_trajectory(position, cell, periodic):
+    """Centres followed across a periodic cell's boundary, snapshot after snapshot:
+
+        u_0 = x_0,    u_k = u_(k-1) + minimum_image(x_k - u_(k-1); a_k, b~_k),
+
+    so that ``u_k = x_k + m a_k + n b~_k`` with the whole cells (m, n) the particle has crossed,
+    counted in the cell of snapshot k with its tilt made continuous across flips
+    (``b~_k``, :func:`grainview.contract.cell.unwrap_tilt`). In a sheared cell an image across
+    the top or bottom edge moves with the tilt: a particle that crossed it n times is ``n b~_k``
+    away from its stored centre at every later snapshot, not ``n b`` of the snapshot it crossed
+    at. Exact as long as no particle moves more than half a cell between two snapshots.
+
+    Parameters
+    ----------
+    position : array_like, (T, N, 2)
+        Centres wrapped into the cell, m.
+    cell : array_like, (T, 2, 2)
+        Lattice vectors, m.
+    periodic : array_like of bool, (2,)
+        Along which vectors the sample repeats.
+
+    Returns
+    -------
+    numpy.ndarray
+        (T, N, 2), m.
+    """
+    from ...contract.cell import minimum_image, unwrap_tilt
+
+    position = np.asarray(position, float)
+    cell = np.array(cell, float)
+    cell[:, 1, 0] = unwrap_tilt(cell[:, 1, 0], cell[:, 0, 0])
+    out = np.empty_like(position)
+    if position.shape[0]:
+        out[0] = position[0]
+    for k in range(1, position.shape[0]):  # a loop over snapshots; each is vectorised over particles
+        out[k] = out[k - 1] + minimum_image(position[k] - out[k - 1], cell[k], periodic)
+    return out
