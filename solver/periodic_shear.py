@@ -23,6 +23,7 @@ import numpy as np
 from grainview.contract.errors import ParameterError
 from grainview.contract.schema import MAX_STEP_INDEX
 
+from .contact_points import rank_in_pair
 from .interrupt import interruptible, progress_bar, resume_instructions, stop_exception, stop_reason
 from .output import Recorder
 from .periodic_cell import PeriodicCell
@@ -38,7 +39,8 @@ SHEAR_EVERY = 200
 
 def periodic_sample(sim: Simulation, *, stress=None, mass=None, max_speed=np.inf) -> Simulation:
     """The particles of the walled ``sim`` in the biperiodic cell of its box (module doc), at
-    rest, with ``sim``'s parameters, shapes and history; the height held at the normal stress
+    rest, with ``sim``'s parameters, shapes and history, the particle pairs' last impulses as
+    the warm start (shown as the contacts of the test's first snapshot); the height held at the normal stress
     ``stress`` (Pa; default ``sim.history.sigma0``; None for a fixed height when sigma0 is not
     known) with the inertia ``mass`` (kg; default the particles' total mass)."""
     lo, hi = sim.walls.box_bounds()
@@ -50,6 +52,17 @@ def periodic_sample(sim: Simulation, *, stress=None, mass=None, max_speed=np.inf
     out = Simulation(sim.position[:n], sim.angle, walls=None, parameters=sim.parameters, shapes=sim.shapes, cell=cell)
     out.history = sim.history
     out.time, out.step_index = sim.time, sim.step_index
+    pts = sim.points
+    if pts is not None and len(pts.pair):  # the particle pairs keep their last impulses as the warm start
+        keep = pts.body_j < n
+        rank = rank_in_pair(pts.pair)[keep]
+        pairs, slot = np.unique(pts.pair[keep], return_inverse=True)
+        normal, tangential = np.zeros((pairs.size, 2)), np.zeros((pairs.size, 2))
+        normal[slot, rank] = sim.impulse[keep, 0]
+        tangential[slot, rank] = sim.impulse[keep, 1]
+        first = np.flatnonzero(keep)[np.unique(slot, return_index=True)[1]]
+        out.set_warm_start(pts.body_i[first], pts.body_j[first], normal, tangential)
+    out.show_warm_start()  # the test's first snapshot shows the sample's contacts and forces
     return out
 
 

@@ -362,3 +362,30 @@ def test_a_stress_controlled_shear_is_not_resumed_without_the_cell_rate(tmp_path
         small_shear(path, stop_after=6, stress=100.0, mass=1.0)
     with pytest.raises(FileFormatError, match="rate of height"):
         resume(path, progress=False, compress=False)
+
+
+def test_a_compacted_sample_keeps_its_contacts_and_their_impulses_in_the_cell():
+    """periodic_sample: the particles of a compacted walled sample in the cell of its box, at
+    rest, with their pairs' last impulses as the warm start; the wall contacts are gone and
+    pairs across the old walls may appear."""
+    from solver.contact_points import point_keys
+    from solver.periodic_shear import periodic_sample
+    from solver.preparation import prepare_sample, preparation
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        walled = prepare_sample(preparation("fast", shape="pentagon", particles=30, seed=4), progress=False)
+    cell_sim = periodic_sample(walled)
+    lo, hi = walled.walls.box_bounds()
+    np.testing.assert_array_equal(cell_sim.cell.box()[0], lo)
+    np.testing.assert_allclose(cell_sim.cell.vectors(), [[hi[0] - lo[0], 0.0], [0.0, hi[1] - lo[1]]])
+    assert cell_sim.cell.stress == walled.history.sigma0 and cell_sim.cell.mass == walled.mass.sum()
+    assert not np.any(cell_sim.velocity)
+    n = walled.n_particles
+    pts = walled.points
+    inside = (pts.body_j < n) & (walled.impulse[:, 0] > 0)
+    assert inside.sum() > 20
+    walled_keys = point_keys(pts, n)[inside]  # the keys the periodic simulation (no walls) gives them
+    shown = dict(zip(point_keys(cell_sim.points, n).tolist(), map(tuple, cell_sim.impulse)))
+    for key, impulse in zip(walled_keys.tolist(), walled.impulse[inside]):
+        assert shown[key] == tuple(impulse)
