@@ -124,8 +124,8 @@ def _convert(args) -> int:
 def _convert_lmgc90(args) -> int:
     from ..formats.lmgc90 import convert_lmgc90
 
-    count = convert_lmgc90(args.out, args.run, overwrite=args.overwrite, compress=not args.no_compress,
-                           progress=args.progress != "off")
+    count = convert_lmgc90(args.out, args.run, x_period=args.x_period, overwrite=args.overwrite,
+                           compress=not args.no_compress, progress=args.progress != "off")
     print(f"wrote {args.out}: {count} snapshots from LMGC90 (check it: grainview info {args.out} --check)")
     return 0
 
@@ -1380,6 +1380,9 @@ def _convert_parser(sub):
                                 "Contacts: body pairs with a compressive normal force; two points on a pair make a "
                                 "double contact (docs/formats.md).")
     lmgc90.add_argument("run", help="the run folder (holding DATBOX/ and OUTBOX/)")
+    lmgc90.add_argument("--x-period", type=float, default=None, metavar="L",
+                        help="the run's period along x in m, as its script gave chipy.SetPeriodicCondition(xperiod=L) "
+                             "(no output file records it; default: a run bounded by walls)")
     lmgc90.add_argument("--out", required=True, help="the netCDF file to write")
     lmgc90.add_argument("--overwrite", action="store_true", help="replace an existing --out")
     lmgc90.add_argument("--progress", choices=("on", "off"), default="on", help="progress bar (default: on)")

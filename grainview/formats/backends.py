@@ -79,17 +79,19 @@ class Lmgc90Backend(BackendEntrypoint):
     """LMGC90 2D rigid runs (:func:`grainview.formats.lmgc90.open_lmgc90`).
 
     ``xr.open_dataset("run_folder", engine="lmgc90")``: the path is the run's folder, holding
-    ``DATBOX/`` (BODIES.DAT, BULK_BEHAV.DAT) and ``OUTBOX/`` (DOF.OUT.n, Vloc_Rloc.OUT.n).
+    ``DATBOX/`` (BODIES.DAT, BULK_BEHAV.DAT) and ``OUTBOX/`` (DOF.OUT.n, Vloc_Rloc.OUT.n); a run
+    periodic in x gives its period, ``x_period=L`` (m).
     """
 
     description = "LMGC90 2D rigid runs (DATBOX and OUTBOX text files) as a grainview dataset"
     url = "https://git-xen.lmgc.univ-montp2.fr/lmgc90/lmgc90_user"
-    open_dataset_parameters = ("filename_or_obj", "drop_variables")
+    open_dataset_parameters = ("filename_or_obj", "drop_variables", "x_period")
 
-    def open_dataset(self, filename_or_obj, *, drop_variables=None):
+    def open_dataset(self, filename_or_obj, *, drop_variables=None, x_period=None):
         from .lmgc90 import open_lmgc90
 
-        return open_lmgc90(filename_or_obj).drop_vars(list(drop_variables or []), errors="ignore")
+        return open_lmgc90(filename_or_obj, x_period=x_period).drop_vars(list(drop_variables or []),
+                                                                         errors="ignore")
 
     def guess_can_open(self, filename_or_obj) -> bool:
         return False

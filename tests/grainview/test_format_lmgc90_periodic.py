@@ -255,3 +255,17 @@ def test_a_fresh_periodic_run_equals_the_hand_computation(tmp_path):
         volume = PERIOD * (high - low)
         np.testing.assert_allclose(stress[k], moment / volume, rtol=1e-12, atol=1e-12 * np.abs(moment).max() / volume)
     shutil.rmtree(folder)
+
+
+def test_the_command_line_and_the_xarray_engine_take_the_period(tmp_path, capsys):
+    import xarray as xr
+
+    from grainview.app.cli import main
+
+    out = tmp_path / "periodic.nc"
+    assert main(["convert", "lmgc90", str(RUN), "--x-period", str(PERIOD), "--out", str(out), "--progress", "off"]) == 0
+    written = grainview.open_dataset(out)
+    np.testing.assert_array_equal(written["periodic"].values, [1, 0])
+    by_engine = xr.open_dataset(RUN, engine="lmgc90", x_period=PERIOD)
+    np.testing.assert_array_equal(by_engine["cell"].values, written["cell"].values)
+    np.testing.assert_array_equal(by_engine["branch"].values, written["branch"].values)
