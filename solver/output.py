@@ -214,6 +214,8 @@ class Recorder:
         self.sim = sim
         sim.take_unconverged()  # each snapshot counts the unconverged steps since the one before it
         periodic = sim.cell.periodic if getattr(sim, "cell", None) is not None else None
+        if periodic is not None:  # the cell's rates: what a resumed run needs of a cell that moves
+            optional = (*optional, "cell_velocity")
         with sigterm_raises():
             self.writer = SnapshotWriter.create(
                 path, radius=sim.radius, n_vertices=sim.n_vertices, mass=sim.mass, inertia=sim.inertia,
@@ -265,7 +267,8 @@ class Recorder:
         slots = self.writer.n_slots
         normal_impulse, tangential_impulse = point_impulses(sim, slots, self.near)
         unconverged = sim.take_unconverged()
-        cell = {} if getattr(sim, "cell", None) is None else {"cell": sim.cell.vectors()}
+        cell = {} if getattr(sim, "cell", None) is None else {
+            "cell": sim.cell.vectors(), "cell_velocity": np.stack([np.zeros(2), sim.cell.b_rate()])}
         self.writer.append(
             time=sim.time, position=sim.position, angle=sim.angle, contacts=pair_contacts(sim, self.near, slots),
             box_min=lo, box_max=hi,

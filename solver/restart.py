@@ -106,8 +106,8 @@ def _check_resumable(ds, source):
             raise FileFormatError(f"{source}: cannot resume, the file lacks {missing}")
         if not isinstance(ds.attrs["cell_stress_Pa"], str) and "cell_velocity" not in ds.variables:
             raise FileFormatError(f"{source}: cannot resume a shear whose cell height follows a stress: the file "
-                                  "does not hold the cell's rate of height (the contract has no cell velocity "
-                                  "yet); a shear at a fixed height resumes")
+                                  "does not hold the cell's rate of height (cell_velocity; written by a solver "
+                                  "before it); a shear at a fixed height resumes")
         if ds.n_snapshots == 0:
             raise FileFormatError(f"{source}: cannot resume, the file holds no complete snapshot")
         return
@@ -129,7 +129,8 @@ def snapshot_state(ds, index, source):
     count = int(ds.snapshot("contact_count", index))
     periodic = "cell" in ds.variables
     names = ("position", "angle", "velocity", "angular_velocity") + (
-        ("cell", "box_min") if periodic else ("wall_position", "wall_velocity"))
+        ("cell", "box_min") + (("cell_velocity",) if "cell_velocity" in ds.variables else ()) if periodic
+        else ("wall_position", "wall_velocity"))
     state = {name: ds.snapshot(name, index).copy() for name in names}
     if periodic:
         state.update(wall_position=np.empty((0, 2)), wall_velocity=np.empty((0, 2)))
@@ -154,7 +155,8 @@ def _periodic_cell(state):
     attrs, vectors = state["attrs"], state["cell"]
     stress = attrs["cell_stress_Pa"]
     return PeriodicCell(state["box_min"], float(vectors[0, 0]), float(vectors[1, 1]), tilt=float(vectors[1, 0]),
-                        shear_rate=float(attrs["cell_shear_rate_s"]), height_rate=0.0,
+                        shear_rate=float(attrs["cell_shear_rate_s"]),
+                        height_rate=float(state["cell_velocity"][1, 1]) if "cell_velocity" in state else 0.0,
                         stress=None if isinstance(stress, str) else float(stress),
                         mass=float(attrs["cell_mass_kg"]), max_speed=float(attrs["cell_max_speed_m_s"]))
 

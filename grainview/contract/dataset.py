@@ -133,6 +133,9 @@ def make_dataset(
     box_min = np.broadcast_to(np.asarray(box_min, "f8"), (t, 2))
     box_max = np.broadcast_to(np.asarray(box_max, "f8"), (t, 2))
     periodic = optional.get("periodic")
+    if "cell_velocity" in optional and periodic is None:
+        raise ParameterError("cell_velocity given without periodic: the rates of a periodic cell's vectors need "
+                             "the cell")
     if "cell" in optional and periodic is None:
         raise ParameterError("cell given without periodic: say along which cell vectors (a, b) the sample repeats")
     if periodic is not None:
@@ -141,6 +144,8 @@ def make_dataset(
         cell = restricted_cell(box_min, box_max) if cell is None else np.broadcast_to(np.asarray(cell, "f8"),
                                                                                       (t, 2, 2))
         optional = {**optional, "cell": cell, "periodic": periodic}
+        if "cell_velocity" in optional:
+            optional["cell_velocity"] = np.broadcast_to(np.asarray(optional["cell_velocity"], "f8"), (t, 2, 2))
         attrs = dict(attrs or {})
         if "cell_positions" not in attrs:
             inside = np.allclose(wrap(position, box_min[:, None], cell[:, None], periodic), position, rtol=0,

@@ -129,6 +129,8 @@ VARIABLES: dict[str, Var] = {
                 "periodic cell box_min + s a + t b, 0 <= s, t < 1", False),
     "periodic": Var(("cell_vector",), "i1", "1", "1 where the sample repeats along the cell vector, 0 where walls "
                     "bound it", False),
+    "cell_velocity": Var(("time", "cell_vector", "xy"), "f8", "m s-1", "rates of the cell's lattice vectors, da/dt and "
+                         "db/dt (a simple shear: db/dt = (gamma_dot h, dh/dt))", False),
     # walls
     "wall_normal": Var(("wall", "xy"), "f8", "1", "unit wall normal pointing into the sample", False),
     "wall_position": Var(("time", "wall", "xy"), "f8", "m", "a point of the wall line", False),
@@ -284,6 +286,8 @@ def structure_problems(variables: dict, sizes: dict) -> list[str]:
         problems.append(f"dimension 'xy' has size {sizes['xy']}, expected 2 (x, y)")
     if "cell_vector" in sizes and sizes["cell_vector"] != 2:
         problems.append(f"dimension 'cell_vector' has size {sizes['cell_vector']}, expected 2 (a, b)")
+    if "cell_velocity" in variables and "cell" not in variables:
+        problems.append("variable 'cell_velocity' without 'cell': the rates of a periodic cell's vectors need the cell")
     if ("cell" in variables) != ("periodic" in variables):
         have, lack = ("cell", "periodic") if "cell" in variables else ("periodic", "cell")
         problems.append(f"variable {have!r} without {lack!r}: a periodic cell needs both its vectors (cell) and "

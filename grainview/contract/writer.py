@@ -605,6 +605,8 @@ class SnapshotWriter:
         if not n_walls:
             optional = [o for o in optional if "wall" not in VARIABLES[o].dims]
         optional = [o for o in optional if o not in ("cell", "periodic")]
+        if periodic is None and "cell_velocity" in optional:
+            raise ParameterError("cell_velocity needs a periodic cell: give periodic=(.., ..)")
         if periodic is not None:
             periodic = np.asarray(periodic)
             problems = cell_problems(np.zeros((0, 2, 2)), np.zeros((0, 2)), np.ones((0, 2)), periodic)

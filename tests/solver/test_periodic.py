@@ -334,34 +334,47 @@ def test_a_shear_file_is_a_valid_periodic_file_of_the_contract(tmp_path):
     assert problems.sum() == 0 and ds.contact_count.values.sum() > 0
 
 
-def test_a_shear_stopped_and_resumed_writes_the_uninterrupted_file(tmp_path):
+@pytest.mark.parametrize("settings", [{}, {"stress": 100.0, "mass": 1.0}], ids=["fixed-height", "stress-controlled"])
+def test_a_shear_stopped_and_resumed_writes_the_uninterrupted_file(tmp_path, settings):
+    """Stopped at step 13 and resumed with solver.restart, the shear writes the file of the run
+    that was not stopped, bit for bit: at a fixed height, and with the height driven by the
+    normal stress (its rate dh/dt, the cell's state beside its vectors, read back from
+    cell_velocity)."""
     import netCDF4
 
     from solver.restart import resume
 
     whole, cut = tmp_path / "whole.nc", tmp_path / "cut.nc"
-    small_shear(whole)
+    small_shear(whole, **settings)
     with pytest.raises(KeyboardInterrupt):
-        small_shear(cut, stop_after=13)
+        small_shear(cut, stop_after=13, **settings)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         assert resume(cut, progress=False, compress=False) == 30 - 12
     with netCDF4.Dataset(whole) as a, netCDF4.Dataset(cut) as b:
         assert len(a.dimensions["time"]) == len(b.dimensions["time"]) == 9
+        if settings:  # the height moved: the test resumes a cell in motion
+            rate = np.asarray(a["cell_velocity"][:])[:, 1, 1]
+            assert np.abs(rate).max() > 0 and np.ptp(np.asarray(a["cell"][:])[:, 1, 1]) > 0
         for name, var in a.variables.items():
             if "time" in var.dimensions:
                 np.testing.assert_array_equal(np.asarray(b[name][:]), np.asarray(var[:]), err_msg=name)
 
 
 def test_a_stress_controlled_shear_is_not_resumed_without_the_cell_rate(tmp_path):
+    """A file without cell_velocity (a solver from before it) cannot give the height's rate: refused."""
+    import xarray as xr
+
     from grainview.contract.errors import FileFormatError
     from solver.restart import resume
 
-    path = tmp_path / "cut.nc"
+    path, older = tmp_path / "cut.nc", tmp_path / "older.nc"
     with pytest.raises(KeyboardInterrupt):
         small_shear(path, stop_after=6, stress=100.0, mass=1.0)
+    with xr.open_dataset(path) as ds:
+        ds.load().drop_vars("cell_velocity").to_netcdf(older, format="NETCDF3_64BIT")
     with pytest.raises(FileFormatError, match="rate of height"):
-        resume(path, progress=False, compress=False)
+        resume(older, progress=False, compress=False)
 
 
 def test_a_compacted_sample_keeps_its_contacts_and_their_impulses_in_the_cell():
