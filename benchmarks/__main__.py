@@ -151,6 +151,8 @@ SECTIONS = (
             (), ("--runs", "warmup-warm,study-warm", "--study-args", "--particles 20 --strain 0.002", "--pause", "0")),
     Section("periodic-shear", "periodic_shear", "the periodic simple shear against the walled biaxial test at equal N: "
             "processor time per particle-step and per sweep", (), ("--quick",)),
+    Section("periodic-control", "periodic_control", "a periodic cell's height under a normal stress: how steadily "
+            "sigma_yy holds sigma0, and the sweeps and time it costs, per cell mass and solver", (), ("--quick",)),
 )
 """The current benchmarks, in the order of RESULTS.md. benchmarks/README.md says what each measures."""
 

@@ -46,6 +46,7 @@ import numpy as np
 from numba import njit, prange
 
 from . import scratch
+from .cell_coupling import couple_cell
 from .nlgs import (NLGSResult, apply_impulse_change, delassus_into, stalled, sweep, sweep_norms,
                    velocities_from_impulses)
 from .parallel_nlgs import solve_decomposed, start_domains, sweep_domains
@@ -363,6 +364,7 @@ def solve_anderson(blocks, problem, impulses, velocities, limits, memory, period
     else:
         delassus_into(problem, delassus_blocks)
         velocities_from_impulses(problem, impulses, velocities)
+    couple_cell(problem, impulses)
     order = np.arange(m)
     ptr = blocks[:-1].copy()
     points = order[:blocks[-2]]
@@ -384,6 +386,7 @@ def solve_anderson(blocks, problem, impulses, velocities, limits, memory, period
                                                      delassus_blocks))
         else:
             quad, worst = sweep_norms(*sweep(order, problem, impulses, velocities, delassus_blocks))
+        couple_cell(problem, impulses)
         if (quad <= tol and worst <= max_tol) or stalled(it, quad, tol, watch, limits.stall):
             return it, quad, worst
         if it % period != 0 or it == max_iterations:  # the last sweep's iterate is the one its norms describe
@@ -420,6 +423,7 @@ def solve_anderson(blocks, problem, impulses, velocities, limits, memory, period
         else:
             _extrapolate_bodies(0, n_bodies, gamma, count, velocities, scratch)
             _extrapolate_points(0, m, gamma, count, problem, impulses, velocities, scratch)
+        couple_cell(problem, impulses)
     return max_iterations, quad, worst
 
 

@@ -51,6 +51,7 @@ import numpy as np
 from numba import njit
 from numba.extending import overload
 
+from .cell_coupling import couple_cell
 from .solve_records import ContactProblem, DelassusBlocks, Impulses, Limits, Velocities
 
 __all__ = ["ContactProblem", "NLGSResult", "STALL_IMPROVEMENT", "delassus", "delassus_block", "delassus_into",
@@ -241,12 +242,15 @@ def solve(problem, impulses, velocities, limits, shuffle, seed):
     seeded by ``seed``.
 
     On entry ``impulses`` hold the warm start and ``velocities`` the free velocities; they are
-    combined first. Returns (iterations, quadratic residual, max residual).
+    combined first. A stress-controlled cell's rate is solved after every sweep
+    (:func:`solver.cell_coupling.couple_cell`). Returns (iterations, quadratic residual, max
+    residual).
     """
     m = problem.a.size
     blocks = delassus(problem)
     # velocities consistent with the warm-start impulses
     velocities_from_impulses(problem, impulses, velocities)
+    couple_cell(problem, impulses)
     order = np.arange(m)
     state = np.uint64(seed) * np.uint64(0x9E3779B97F4A7C15) + np.uint64(1)  # never 0
     quad = 0.0
@@ -257,6 +261,7 @@ def solve(problem, impulses, velocities, limits, shuffle, seed):
         if shuffle:
             state = _shuffle(order, state)
         quad, worst = sweep_norms(*sweep(order, problem, impulses, velocities, blocks))
+        couple_cell(problem, impulses)
         if (quad <= tol and worst <= max_tol) or stalled(it, quad, tol, watch, limits.stall):
             return it, quad, worst
     return limits.max_iterations, quad, worst

@@ -20,7 +20,7 @@ the sample (the representative of each particle); the 1/2 keeps the mean velocit
 
 The cell moves at ``da/dt = 0`` (``l`` fixed) and ``db/dt = (gamma_dot h, dh/dt)``: a simple
 shear at the imposed rate ``shear_rate`` (the tilt's rate is gamma_dot h) and a height that is
-either fixed or driven by the normal stress (:meth:`PeriodicCell.control_height`). The tilt is
+either fixed or held at a normal stress (solved with the contacts: :mod:`solver.cell_coupling`). The tilt is
 flipped by ``l`` once it passes ``l/2`` (the same lattice, LAMMPS's flip): the cell then never
 gets thinner than ``h / sqrt(1 + (l / 2h)^2)`` across, and detection's cell lists keep working.
 
@@ -46,7 +46,7 @@ class PeriodicCell:
     (m); tilt (m), the x-offset of the top edge; ``shear_rate`` gamma_dot (s-1): the tilt grows
     at gamma_dot h; ``height_rate`` dh/dt (m s-1), the cell's current rate of height; ``stress``
     the target normal stress sigma_yy (Pa, compression positive) or None for a fixed height;
-    ``mass`` (kg) the inertia of the height's stress control; ``max_speed`` (m s-1) a cap on
+    ``mass`` (kg) the inertia of the height under stress control; ``max_speed`` (m s-1) a cap on
     |dh/dt|; ``thickness`` (m) the slab's, for the stress's volume l h thickness.
     """
 
@@ -177,12 +177,7 @@ class PeriodicCell:
             return True
         return False
 
-    def control_height(self, sigma_yy, time_step):
-        """The height's rate for the next step from the measured normal stress ``sigma_yy`` (Pa,
-        compression positive): M d2h/dt2 = (sigma_yy - stress) l thickness, explicit, the
-        speed capped at ``max_speed``. Nothing with a fixed height (``stress`` None)."""
-        if self.stress is None:
-            return
-        force = (sigma_yy - self.stress) * self.length * self.thickness
-        rate = self.height_rate + time_step * force / self.mass
-        self.height_rate = float(min(max(rate, -self.max_speed), self.max_speed))
+    def set_height_rate(self, rate):
+        """dh/dt = ``rate`` (m s-1, the one solved with the contacts under stress control,
+        :mod:`solver.cell_coupling`), capped at ``max_speed``."""
+        self.height_rate = float(min(max(float(rate), -self.max_speed), self.max_speed))

@@ -18,7 +18,7 @@ from typing import NamedTuple
 
 import numpy as np
 
-__all__ = ["ContactProblem", "PeriodicContactProblem", "Impulses", "Velocities", "DelassusBlocks", "Limits", "AndersonScratch",
+__all__ = ["ContactProblem", "PeriodicContactProblem", "StressedCellProblem", "Impulses", "Velocities", "DelassusBlocks", "Limits", "AndersonScratch",
            "MatrixProblem", "StepStart", "StepLaw"]
 
 
@@ -83,6 +83,33 @@ class PeriodicContactProblem(NamedTuple):
     minv_yy: np.ndarray
     iinv: np.ndarray
     slip: np.ndarray
+
+
+class StressedCellProblem(NamedTuple):
+    """A :class:`PeriodicContactProblem` whose cell's height is held at a normal stress, its rate
+    solved with the points (:mod:`solver.cell_coupling`): the same fields and ``image`` (P,)
+    float, the image number n_k across the cell's height of each point's body b, and ``cell``
+    (4,): the rate dh/dt the bias and slip hold at assembly and now (m s-1), the cell's mass (kg)
+    and the external impulse h sigma0 l t (N s) (:data:`solver.cell_coupling.RATE_AT_ASSEMBLY`
+    ...)."""
+
+    a: np.ndarray
+    b: np.ndarray
+    nx: np.ndarray
+    ny: np.ndarray
+    rax: np.ndarray
+    ray: np.ndarray
+    rbx: np.ndarray
+    rby: np.ndarray
+    bias: np.ndarray
+    mu: np.ndarray
+    minv_xx: np.ndarray
+    minv_xy: np.ndarray
+    minv_yy: np.ndarray
+    iinv: np.ndarray
+    slip: np.ndarray
+    image: np.ndarray
+    cell: np.ndarray
 
 
 class Impulses(NamedTuple):

@@ -41,17 +41,20 @@ import numpy as np
 
 from grainview.contract.errors import ConvergenceWarning, ParameterError
 
-from . import (broadphase, contact_solvers, narrowphase, nlgs, parallel_nlgs, periodic_assembly, periodic_detection,
-               problem_assembly, residuals, warm_start)
+from . import (broadphase, cell_coupling, contact_solvers, narrowphase, nlgs, parallel_nlgs, periodic_assembly,
+               periodic_detection, problem_assembly, residuals, warm_start)
 from .contact_solvers import ContactState, Limits
 from .contact_points import PairIndex, force_vectors, point_keys
 from .parameters import ACCELERATIONS, MAX_FRICTION, Parameters, check_time_step  # noqa: F401 (their home)
 from .sample_history import SampleHistory
 from .shapes import Shapes
-from .solve_records import PeriodicContactProblem, StepLaw, StepStart
+from .solve_records import PeriodicContactProblem, StepLaw, StepStart, StressedCellProblem
 from .walls import FIXED, STRESS, VELOCITY, Walls
 
 
+STRESSED_CELL_SOLVERS = ("anderson", "nlgs")
+"""The stepper methods that sweep a stress-controlled cell's rate with the contacts
+(:func:`solver.cell_coupling.couple_cell`)."""
 STAGES = ("broad_phase", "narrow_phase", "warm_start", "contact_problem", "solve", "diagnostics",
           "overlap_recovery", "update", "other")
 """The stages whose seconds :attr:`Simulation.timings` accumulates, disjoint, in the order of a
@@ -473,7 +476,10 @@ class Simulation:
         p = self.parameters
         solve_start = time.perf_counter()
         decomposition = self._decomposition(problem)
-        result = self._solve(problem, state, posed.limits, shuffle=p.shuffle, decomposition=decomposition)
+        if self.cell is not None and self.cell.stress is not None:
+            result = self._solve_with_cell(problem, state, posed.limits, shuffle=p.shuffle)
+        else:
+            result = self._solve(problem, state, posed.limits, shuffle=p.shuffle, decomposition=decomposition)
         converged_start = time.perf_counter()
         self.timings["solve"] += converged_start - solve_start
         converged = self._count_solve(result, len(keys))
@@ -576,19 +582,43 @@ class Simulation:
             minv[:, 0].copy(), minv[:, 1].copy(), minv[:, 2].copy(), iinv, slip)
         return problem, ra, rb
 
+    def _solve_with_cell(self, problem, state: ContactState, limits: Limits, shuffle=False):
+        """The periodic problem with the cell's height rate as one more unknown, under its normal
+        stress (:mod:`solver.cell_coupling`), by the NLGS or Anderson sweeps on one domain; the
+        rate is kept in :attr:`cell_rate` for :meth:`_move_cell`. Returns the method's
+        :class:`solver.nlgs.NLGSResult`."""
+        p = self.parameters
+        cell = self.cell
+        if p.solver not in STRESSED_CELL_SOLVERS:
+            raise ParameterError(f"solver={p.solver!r}: a periodic cell under a normal stress is solved by "
+                                 f"{' or '.join(STRESSED_CELL_SOLVERS)} (its height's rate is swept with the contacts)")
+        load = float(p.time_step) * cell.stress * cell.length * float(p.thickness)
+        stressed = StressedCellProblem(*problem, self.point_image[:, 1].astype(np.float64),
+                                       np.array([cell.height_rate, cell.height_rate, cell.mass, load]))
+        method = contact_solvers.method(p.solver)
+        options = method.options(p, x=self.position[:self.n_particles, 0], shuffle=shuffle,
+                                 seed=p.seed + self.step_index)
+        if "domains" in options:
+            options["domains"] = 1
+        result = method.solve(stressed, state, limits, **options)
+        self.cell_rate = float(stressed.cell[cell_coupling.RATE])
+        return result
+
     def _move_cell(self, problem, pn, pt):
         """After a periodic step: the contact stress of its impulses over the cell's volume
-        (:attr:`cell_stress`), the cell moved over the step, its height's rate for the next one
-        from sigma_yy (:meth:`solver.periodic_cell.PeriodicCell.control_height`), the
-        particles' velocities following the change of the cell's rate (:meth:`~solver.periodic_cell.PeriodicCell.follow_rate`),
-        and the centres that left the cell wrapped into it with their velocities."""
+        (:attr:`cell_stress`), the cell moved over the step at its new height rate (the one
+        solved with the points under stress control, :meth:`_solve_with_cell`), the particles'
+        velocities following the change of the cell's rate
+        (:meth:`~solver.periodic_cell.PeriodicCell.follow_rate`), and the centres that left the
+        cell wrapped into it with their velocities."""
         p = self.parameters
         h = float(p.time_step)
         sums = periodic_assembly.stress_sums(problem, pn, pt, h)
         self.cell_stress = sums / (self.cell.area() * p.thickness)
         before = self.cell.b_rate()
+        if self.cell.stress is not None:
+            self.cell.set_height_rate(self.cell_rate)
         self.cell.advance(h)
-        self.cell.control_height(float(self.cell_stress[1, 1]), h)
         self.cell.follow_rate(self.position, self.velocity, self.cell.b_rate() - before)
         self.cell.wrap(self.position, self.velocity)
 
