@@ -397,10 +397,10 @@ def _simulate(prep, path, *, test, near_contacts, overwrite, progress, scene="bi
             runner.write_state(sample, path, attrs={"scene": "isotropic"}, overwrite=overwrite,
                                near_contacts=near_contacts, compress=compress)
         elif scene == "shear":
-            from solver.periodic_shear import SHEAR_RATE, periodic_sample, shear_test
+            from solver.periodic_shear import matching_shear_rate, periodic_sample, shear_test
 
-            rate = SHEAR_RATE if shear_rate is None else shear_rate
-            print(f"{name}: periodic simple shear to gamma = {test.strain} at {rate:g} s-1 under "
+            rate = matching_shear_rate(sample, test.velocity) if shear_rate is None else shear_rate
+            print(f"{name}: periodic simple shear to gamma = {test.strain} at {rate:.3g} s-1 under "
                   f"sigma_yy = {prep.sigma0:g} Pa ...", flush=True)
             shear_test(periodic_sample(sample), path, strain=test.strain, shear_rate=rate, every=int(test.every),
                        overwrite=overwrite, attrs=history.attrs(), progress=progress, near_contacts=near_contacts,
@@ -555,6 +555,10 @@ def _check_settings(args, prep):
 
 
 def _run(args) -> int:
+    if args.scene == "shear" and "strain" not in _given(args):
+        from solver.periodic_shear import SHEAR_STRAIN
+
+        args.strain = SHEAR_STRAIN  # a shear gamma, not the biaxial test's eps_1
     _test(args)
     _check_output_file(args.out, args.overwrite)
     prep = _preparation(args, _shape_of(args.shape))
@@ -1191,10 +1195,12 @@ def _run_parser(sub):
                          "with sigma0 held on the right wall.")
     run.add_argument("scene", nargs="?", choices=["biaxial", "isotropic", "shear"], default="biaxial",
                      help="biaxial (default), isotropic (writes the compacted state) or shear (the compacted sample "
-                     "in a biperiodic cell, sheared to gamma = --strain under sigma_yy = sigma0)")
+                     "in a biperiodic cell, sheared to gamma = --strain, default "
+                     f"{library_constant('solver.periodic_shear', 'SHEAR_STRAIN'):g}, under sigma_yy = sigma0)")
     run.add_argument("--shear-rate", type=float, default=None,
-                     help="scene shear: the imposed shear rate gamma_dot, s-1 (default "
-                     f"{library_constant('solver.periodic_shear', 'SHEAR_RATE'):g})")
+                     help="scene shear: the imposed shear rate gamma_dot, s-1 (default 2 v/h, v the --velocity "
+                     "and h the compacted sample's height: the pace of the biaxial test at v in eps_q = "
+                     "eps_1 - eps_2; docs/solver.md)")
     setting_option(run, Preparation, "shape", help=f"pentagon, disk, a number of vertices from 3 to "
                    f"{MAX_VERTICES} (6: hexagons), irregular (random convex polygons) or a .json file of vertex lists "
                    "{\"polygons\": [[[x, y], ...], ...]} (docs/solver.md, \"Shapes\"; default "

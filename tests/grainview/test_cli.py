@@ -288,3 +288,21 @@ def test_info_checks_structure_at_once_and_every_value_with_check(tmp_path, caps
     cut.write_bytes(path.read_bytes()[: path.stat().st_size // 2])
     assert main(["info", str(cut)]) == 2
     assert "truncated" in capsys.readouterr().err
+
+
+def test_run_shear_shears_the_cell_at_the_biaxial_tests_pace(tmp_path, capsys):
+    """`grainview run shear`: the compacted sample in its biperiodic cell, sheared to gamma =
+    --strain at gamma_dot = 2 v / h0 (v the --velocity, h0 the compacted box's height: the
+    biaxial test's pace in eps_q) under sigma_yy = sigma0."""
+    path = tmp_path / "shear.nc"
+    argv = ["run", "shear", "--shape", "disk", "--particles", "60", "--strain", "0.004", "--every", "20",
+            "--velocity", "0.02", "--out", str(path), "--progress", "off"]
+    assert main(argv) == 0
+    out = capsys.readouterr().out
+    assert "periodic simple shear to gamma = 0.004 at" in out
+    with grainview.open_dataset(path, chunks=None) as ds:
+        np.testing.assert_array_equal(ds.periodic.values, [1, 1])
+        h0 = float(ds.cell.values[0, 1, 1])
+        assert ds.attrs["scene"] == "shear"
+        assert ds.attrs["cell_shear_rate_s"] == pytest.approx(2 * 0.02 / h0, rel=1e-12)
+        assert float(ds.grain.strains()["gamma"][-1]) == pytest.approx(0.004, rel=0.01)
