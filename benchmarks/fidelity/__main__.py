@@ -5,6 +5,7 @@
     python -m benchmarks.fidelity --quick              # tiny sizes: checks the script
     python -m benchmarks.fidelity --large              # adds 4000 particles to 'sizes'
     python -m benchmarks.fidelity --large pentagon     # ... of one shape only
+    python -m benchmarks.fidelity --only periodic --large   # periodic cells beside walls
 
 Sections (each a table in ``benchmarks/fidelity/RESULTS.md``, read with docs/fidelity.md):
 
@@ -13,7 +14,10 @@ Sections (each a table in ``benchmarks/fidelity/RESULTS.md``, read with docs/fid
 * ``sizes``: residual values at 400 and 1000 particles (and 4000 with ``--large``);
 * ``counting``: z, very weak fraction, fabric a with near pairs counted up to a gap;
 * ``relations``: the paper's twelve pentagon-versus-disk relations, N = 1000, eps_q >= 0.4,
-  three seeds (mean ± spread), per preparation and counting convention.
+  three seeds (mean ± spread), per preparation and counting convention;
+* ``periodic``: the same compacted samples sheared in their biperiodic cell (no walls) beside
+  their biaxial test between walls, N = 1000, three seeds (and 4000 with ``--large``), with
+  the twelve relations of the periodic runs.
 
 Runs are cached in ``benchmarks/_data/fidelity`` (``runs.py``), so sections share them and a
 second call only recomputes the tables.
@@ -33,7 +37,7 @@ from benchmarks.fidelity import figures, measure, relations
 from benchmarks.fidelity import runs as runs_module
 from benchmarks.fidelity.runs import Run, ensure
 
-SECTIONS = ["preparations", "rates", "sizes", "counting", "relations"]
+SECTIONS = ["preparations", "rates", "sizes", "counting", "relations", "periodic"]
 D_MIN = 0.025  # m, the smallest circumscribed diameter of the paper's size mix
 NEAR = (0.0025, 0.005, 0.01, 0.02)
 """Near-contact gap thresholds as fractions of D_MIN (0.02 = the solver's alert distance)."""
@@ -62,6 +66,8 @@ class Config:
                            "disk": (0.01, 0.04) if quick else (0.01, 0.02, 0.04, 0.08)}
         self.sizes = (30, 60) if quick else (400, 1000)
         self.every = 20 if quick else 400
+        self.shear_strain = 0.04 if quick else 0.8
+        """gamma at the end of the periodic shears (the biaxial tests reach eps_q ~0.6)."""
 
     def velocity(self, particles):
         """Top-wall speed (m s-1) that shears ``particles`` at the study's strain rate: the rate
@@ -294,6 +300,71 @@ def section_relations(cfg, jobs):
             "engines of benchmarks/crosscheck on this solver's 400-particle samples. Relations that hold: "
             f"{held}.\n\n")
     return text + _table(header, rows)
+
+
+def _spread(summaries, key, digits=3):
+    values = np.array([s[key] for s in summaries], float)
+    if values.size == 1:
+        return _f(values[0], digits)
+    return f"{values.mean():.{digits}f} ± {values.std(ddof=1):.{digits}f}"
+
+
+PERIODIC_KEYS = [("q/p", 3), ("a", 3), ("a_n", 3), ("a_t", 3), ("z", 2), ("alpha", 2), ("very weak", 3),
+                 ("solid fraction", 3)]
+"""The residual descriptors of the periodic section's tables, with their digits."""
+
+
+def section_periodic(cfg, jobs):
+    n_large = 120 if cfg.quick else 4000
+    sizes = [(cfg.relation_particles, cfg.seeds, ("pentagon", "disk"))]
+    sizes += [(n_large, cfg.seeds[:1], cfg.large_shapes)] if cfg.large_shapes else []
+    runs = {}
+    for n, seeds, shapes in sizes:
+        for shape in shapes:
+            for seed in seeds:
+                walled = cfg.run(shape=shape, particles=n, seed=seed)
+                runs[(shape, n, seed)] = (walled, walled.with_(scene="shear", strain=cfg.shear_strain))
+    paths = ensure([r for pair in runs.values() for r in pair], jobs)
+    rows, summaries = [], {}
+    for (shape, n, seed), pair in runs.items():
+        for run in pair:
+            s = measure.window_means(paths[run], cfg.residual)
+            s["solid fraction initial"] = measure.initial_state(run.sample_path())["solid fraction"]
+            scene = "periodic" if run.scene == "shear" else "walls"
+            summaries.setdefault((shape, n, scene), []).append(s)
+            if not s["snapshots"]:
+                rows.append([shape, n, seed, scene, 0] + ["-"] * (len(PERIODIC_KEYS) + 1))
+                continue
+            p10, p90 = s["p 10-90%"]
+            rows.append([shape, n, seed, scene, s["snapshots"]] + [_f(s[k], d) for k, d in PERIODIC_KEYS]
+                        + [f"{s['p'] / 1e3:.1f} ({p10 / 1e3:.1f}-{p90 / 1e3:.1f})"])
+    header = ["shape", "N", "seed", "test", "snapshots"] + [k for k, _ in PERIODIC_KEYS] + ["p kPa (10-90%)"]
+    means = [[shape, n, scene, len(group)] + [_spread(group, k, d) for k, d in PERIODIC_KEYS]
+             for (shape, n, scene), group in summaries.items() if all(g["snapshots"] for g in group)]
+    n_rel = cfg.relation_particles
+    relation_rows = []
+    if all(summaries.get((shape, n_rel, scene)) for shape in ("pentagon", "disk") for scene in ("walls", "periodic")):
+        walls = relations.evaluate(summaries[("pentagon", n_rel, "walls")], summaries[("disk", n_rel, "walls")])
+        cells = relations.evaluate(summaries[("pentagon", n_rel, "periodic")], summaries[("disk", n_rel, "periodic")])
+        for (name, paper, _c, held_w, *_), (_n, _p, _c2, held_p, *_r) in zip(walls, cells):
+            relation_rows.append([name, paper, f"{'holds' if held_w else 'FAILS'}: {_c}",
+                                  f"{'holds' if held_p else 'FAILS'}: {_c2}"])
+    text = (f"Each compacted sample (preparation 'paper', friction 0.4, sigma0 10 kPa) tested twice: between walls "
+            f"(the biaxial test, top wall at {cfg.velocity(n_rel) * 100:g} cm/s for {n_rel} particles"
+            + (f", {cfg.velocity(n_large) * 100:g} cm/s for {n_large}" if cfg.large_shapes else "")
+            + f") and in the biperiodic cell of its box, sheared to gamma = {cfg.shear_strain:g} under sigma_yy = "
+            "sigma0 at gamma_dot = 2 v/h, the biaxial test's pace in eps_q (solver.periodic_shear."
+            f"matching_shear_rate). Residual window: eps_q >= {cfg.residual[0]:g} between walls, |gamma| >= "
+            f"{cfg.residual[0]:g} in the cell; force-bearing contacts; q/p from the stress tensor "
+            "(minimum-image branches in the cell, wall contacts included between walls); p: the window's mean "
+            "stress and its 10th-90th percentiles.\n\n")
+    out = text + _table(header, rows) + "\n\nMeans ± sample standard deviation over the seeds:\n\n" + \
+        _table(["shape", "N", "test", "seeds"] + [k for k, _ in PERIODIC_KEYS], means)
+    if relation_rows:
+        out += (f"\n\nThe twelve relations at N = {n_rel}, walls against periodic cell (seeds "
+                f"{', '.join(map(str, cfg.seeds))}):\n\n"
+                + _table(["relation", "paper", "walls", "periodic cell"], relation_rows))
+    return out
 
 
 def main(argv=None):

@@ -26,17 +26,21 @@ def points_coordination(ds, near=None):
 
 
 def window_means(path, window=(0.4, np.inf), near=None) -> dict:
-    """Means over the snapshots with window[0] <= eps_q < window[1] of: q/p, the harmonic
+    """Means over the snapshots with window[0] <= eps_q < window[1] (|gamma| in a sheared
+    periodic cell: :func:`grainview.analysis.strain.shear_strain`) of: q/p, the harmonic
     prediction and a', a (fabric), a_n, a_t, z (with and without walls, and counting points),
     alpha, the weak, very weak (simple, double) fractions, k_d, f_s, f_d, k_s^S, k_d^S, q_s/p,
     q_d/p, q(xi = 1)/p (the weak network's deviator), a'(xi = 0.1) (the signed fabric
     anisotropy of the very weak contacts: < 0 when they lie across the major principal
-    stress), the solid fraction; plus the window's snapshot count and eps_q range. ``near``:
+    stress), the solid fraction, the mean stress p (Pa; and its 10th and 90th percentiles
+    over the window, "p 10-90%"); plus the window's snapshot count and eps_q range. ``near``:
     the counting convention (module docstring)."""
     from grainview.analysis.force_pdf import pooled_force_pdf, strong_force_exponent
 
+    from grainview.analysis.strain import shear_strain
+
     ds = grainview.open_dataset(path, chunks=None)
-    eps_q = ds.grain.strains()["eps_q"].values
+    eps_q = shear_strain(ds).values  # |gamma| in a sheared periodic cell
     keep = np.flatnonzero((eps_q >= window[0]) & (eps_q < window[1]))
     out = {"snapshots": int(keep.size), "eps_q max": float(eps_q.max())}
     if keep.size == 0:
@@ -78,6 +82,8 @@ def window_means(path, window=(0.4, np.inf), near=None) -> dict:
         "q(xi<1)/p": _mean(xi["q_over_p"].sel(xi=1.0), everything),
         "a'(very weak)": float(xi["a_prime"].sel(xi=0.1).mean("time", skipna=True)),
         "solid fraction": _mean(res.grain.solid_fraction(), everything),
+        "p": _mean(inv["p"], everything),
+        "p 10-90%": tuple(float(v) for v in np.percentile(inv["p"].values, [10, 90])),
     })
     ds.close()
     return out

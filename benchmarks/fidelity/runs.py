@@ -31,6 +31,7 @@ class Run:
     velocity: float = 0.01  # m s-1, top wall
     strain: float = 0.2  # eps_1 of the biaxial test (eps_q ~0.6)
     every: int = 400  # steps between snapshots
+    scene: str = "biaxial"  # or "shear": the sample in its biperiodic cell, strain = gamma
 
     @property
     def sample_name(self) -> str:
@@ -39,6 +40,8 @@ class Run:
     @property
     def name(self) -> str:
         every = "" if self.every == Run.every else f"_k{self.every}"
+        if self.scene == "shear":
+            return f"{self.sample_name}_shear_v{self.velocity * 100:g}cm_g{self.strain:g}{every}"
         return f"{self.sample_name}_v{self.velocity * 100:g}cm_e{self.strain:g}{every}"
 
     def sample_path(self, cache=None) -> str:
@@ -93,11 +96,26 @@ def make_sample(run: Run, cache=None) -> str:
 
 
 def simulate(run: Run, cache=None) -> str:
-    """The biaxial test of ``run`` (simulated unless cached); returns its path."""
+    """The test of ``run`` (simulated unless cached; a test stopped part-way is resumed from
+    its file, bit for bit); returns its path. A biaxial test compresses the sample at the top
+    wall's ``velocity``; a shear test shears it in the biperiodic cell of its box to gamma =
+    ``strain`` at the rate of the biaxial test at ``velocity``
+    (:func:`solver.periodic_shear.matching_shear_rate`)."""
     import solver
+    from solver.restart import file_state, resume
 
     path = run.path(cache)
     if os.path.exists(path):
+        return path
+    part = path + ".part"
+    start = time.perf_counter()
+    if os.path.exists(part) and file_state(part) in ("partial", "finished"):
+        _log(f"{run.name}: resuming {part}")
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            resume(part, progress=False)
+        os.replace(part, path)
+        _log(f"{run.name}: resumed and finished in {time.perf_counter() - start:.0f} s")
         return path
     sample = make_sample(run, cache)
     os.makedirs(os.path.dirname(path), exist_ok=True)
@@ -105,9 +123,16 @@ def simulate(run: Run, cache=None) -> str:
     start = time.perf_counter()
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
-        steps = solver.biaxial_test(sim, path + ".part", strain=run.strain, velocity=run.velocity, every=run.every,
-                                    overwrite=True, progress=False, near_contacts=True)
-    os.replace(path + ".part", path)
+        if run.scene == "shear":
+            from solver.periodic_shear import matching_shear_rate, periodic_sample, shear_test
+
+            rate = matching_shear_rate(sim, run.velocity)
+            steps = shear_test(periodic_sample(sim), part, strain=run.strain, shear_rate=rate, every=run.every,
+                               overwrite=True, progress=False, near_contacts=True)
+        else:
+            steps = solver.biaxial_test(sim, part, strain=run.strain, velocity=run.velocity, every=run.every,
+                                        overwrite=True, progress=False, near_contacts=True)
+    os.replace(part, path)
     _log(f"{run.name}: {steps} steps in {time.perf_counter() - start:.0f} s")
     return path
 

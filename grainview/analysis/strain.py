@@ -19,8 +19,8 @@ from ..contract.errors import ParameterError
 from .stress import stress_invariants
 from ._docs import fill_doc
 
-__all__ = ["time_derivative", "strains", "deformation_gradient", "residual_window", "friction_and_dilatancy",
-           "friction_offset", "inertia_number"]
+__all__ = ["time_derivative", "strains", "deformation_gradient", "residual_window", "shear_strain",
+           "friction_and_dilatancy", "friction_offset", "inertia_number"]
 
 RESIDUAL_STRAIN = 0.3
 """Start of the residual state in shear strain eps_q (the paper reads its residual values at
@@ -224,13 +224,29 @@ def residual_window(ds: xr.Dataset, start: float = RESIDUAL_STRAIN) -> xr.DataAr
     if isinstance(start, bool) or not isinstance(start, (int, float, np.integer, np.floating)) \
             or not np.isfinite(start) or start < 0:
         raise ParameterError(f"residual strain start={start!r}: expected a shear strain eps_q >= 0")
+    strain = shear_strain(ds)
+    window = strain >= start
+    return window.rename("residual").assign_attrs(long_name=f"residual state, {strain.name} >= {start:g}", units="1")
+
+
+@fill_doc
+def shear_strain(ds: xr.Dataset) -> xr.DataArray:
+    """The shear strain a test is read in (time,), computed: eps_q, or |gamma| in a periodic
+    cell sheared over the run (:func:`residual_window`).
+
+    Parameters
+    ----------
+    {ds}
+
+    Returns
+    -------
+    xarray.DataArray
+        (time,), dimensionless, named ``eps_q`` or ``|gamma|``.
+    """
     eps = strains(ds)
     if "gamma" in eps and _sheared(ds):
-        window = abs(eps["gamma"].compute()) >= start
-        return window.rename("residual").assign_attrs(long_name=f"residual state, |gamma| >= {start:g}", units="1")
-    eps_q = eps["eps_q"].compute()
-    window = eps_q >= start
-    return window.rename("residual").assign_attrs(long_name=f"residual state, eps_q >= {start:g}", units="1")
+        return abs(eps["gamma"].compute()).rename("|gamma|")
+    return eps["eps_q"].compute().rename("eps_q")
 
 
 def _sheared(ds: xr.Dataset) -> bool:
