@@ -89,6 +89,16 @@ def matching_shear_rate(sim: Simulation, velocity: float) -> float:
     return 2.0 * float(velocity) / height
 
 
+def check_solver(parameters):
+    """Refuse, in one line, a stepper solver that cannot sweep a stress-controlled cell's rate
+    with the contacts (:data:`solver.stepper.STRESSED_CELL_SOLVERS`)."""
+    from .stepper import STRESSED_CELL_SOLVERS
+
+    if parameters.solver not in STRESSED_CELL_SOLVERS:
+        raise ParameterError(f"solver={parameters.solver!r}: a periodic cell under a normal stress is solved by "
+                             f"{' or '.join(STRESSED_CELL_SOLVERS)} (its height's rate is swept with the contacts)")
+
+
 def cell_settings(cell: PeriodicCell) -> dict:
     """Global attributes of how the cell is driven (read back by a resume)."""
     return {"cell_shear_rate_s": float(cell.shear_rate),
@@ -114,6 +124,8 @@ def shear_test(sim: Simulation, path, *, strain=SHEAR_STRAIN, shear_rate, every=
         raise ParameterError(f"the shear would take {steps:.3g} steps, beyond a file's step counter")
     n_steps = int(np.ceil(steps))
     cell = sim.cell
+    if cell.stress is not None:
+        check_solver(sim.parameters)
     cell.shear_rate = float(shear_rate)
     if affine_start:
         n = sim.n_particles

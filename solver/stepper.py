@@ -590,8 +590,9 @@ class Simulation:
         p = self.parameters
         cell = self.cell
         if p.solver not in STRESSED_CELL_SOLVERS:
-            raise ParameterError(f"solver={p.solver!r}: a periodic cell under a normal stress is solved by "
-                                 f"{' or '.join(STRESSED_CELL_SOLVERS)} (its height's rate is swept with the contacts)")
+            from .periodic_shear import check_solver
+
+            check_solver(p)
         load = float(p.time_step) * cell.stress * cell.length * float(p.thickness)
         stressed = StressedCellProblem(*problem, self.point_image[:, 1].astype(np.float64),
                                        np.array([cell.height_rate, cell.height_rate, cell.mass, load]))

@@ -550,8 +550,13 @@ def _check_settings(args, prep):
     from solver.engine import engine
 
     parameters = _solver_parameters(args)
-    biaxial = getattr(args, "scene", "biaxial") == "biaxial"
-    engine(args.engine).check(prep, parameters, _test(args) if biaxial else None)
+    scene = getattr(args, "scene", "biaxial")
+    if scene == "shear":
+        from solver.periodic_shear import check_solver
+        from solver.parameters import Parameters
+
+        check_solver(Parameters(**parameters))
+    engine(args.engine).check(prep, parameters, _test(args) if scene == "biaxial" else None)
 
 
 def _run(args) -> int:

@@ -306,3 +306,13 @@ def test_run_shear_shears_the_cell_at_the_biaxial_tests_pace(tmp_path, capsys):
         assert ds.attrs["scene"] == "shear"
         assert ds.attrs["cell_shear_rate_s"] == pytest.approx(2 * 0.02 / h0, rel=1e-12)
         assert float(ds.grain.strains()["gamma"][-1]) == pytest.approx(0.004, rel=0.01)
+
+
+def test_run_shear_refuses_a_solver_that_cannot_hold_the_cell_before_any_work(tmp_path, capsys):
+    """Under a normal stress the cell's rate is swept with the contacts by NLGS or Anderson:
+    --solver pcg is refused in one line before the compaction."""
+    path = tmp_path / "shear.nc"
+    assert main(["run", "shear", "--particles", "60", "--solver", "pcg", "--out", str(path)]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "solver='pcg'" in err[0] and "anderson or nlgs" in err[0]
+    assert not path.exists()
