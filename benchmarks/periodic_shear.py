@@ -7,8 +7,9 @@ solver settings of every shear benchmark (Anderson sweeps every 2 sweeps, the st
 
 * walled: ``solver.biaxial_test``, the top wall at 1 cm/s (strain rate v / h0);
 * periodic: the same particles in the biperiodic cell of the box
-  (``solver.periodic_shear.periodic_sample``), sheared at gamma_dot = v / h0 under
-  sigma_yy = sigma0 (``solver.periodic_shear.shear_test``).
+  (``solver.periodic_shear.periodic_sample``), sheared at gamma_dot = 2 v / h0 (the walled
+  test's pace in eps_q, ``solver.periodic_shear.matching_shear_rate``) under sigma_yy = sigma0,
+  the cell's rate swept with the contacts (``solver.cell_coupling``).
 
 Each run takes ``--warm`` steps (1000: compiling, the start's transient), then ``--steps`` (300) timed ones,
 one after the other in this process: for each step its wall and processor time (``time.
@@ -109,9 +110,10 @@ def measure(shape, particles, warm, steps):
     """Rows (shape, way, N, medians...) of one shape."""
     from solver.periodic_shear import periodic_sample
 
+    from solver.periodic_shear import matching_shear_rate
+
     sample = compacted(shape, particles)
-    lo, hi = sample.walls.box_bounds()
-    rate = 0.01 / float(hi[1] - lo[1])
+    rate = matching_shear_rate(sample, 0.01)
     rows = {}
     a = copy.deepcopy(sample)
     _settings(a)
@@ -158,13 +160,13 @@ def main(argv=None):
             rows, rate = measure(shape, args.particles, args.warm, args.steps)
             text, rate = table(shape, args.particles, rows, rate)
             parts.append(f"## {shape}s, N = {args.particles} (periodic at gamma_dot = {rate:.4g} s-1, the walled "
-                         "test's v / h0)\n\n" + text)
+                         "test's 2 v / h0)\n\n" + text)
         return parts
 
     parts, how = measured(run, "one process, one domain, one numba thread")
     intro = (f"One compacted sample per shape (the `fast` preparation), stepped from the same state between walls "
              f"(`biaxial_test`, top wall at 1 cm/s) and in the biperiodic cell of its box (`periodic_shear`, "
-             f"gamma_dot = v / h0, sigma_yy held at sigma0 by the cell's height), Anderson sweeps every 2 sweeps and the "
+             f"gamma_dot = 2 v / h0, sigma_yy held at sigma0 by the cell's height solved with the contacts), Anderson sweeps every 2 sweeps and the "
              f"stall test over 200 sweeps on one domain. Steps 1-{args.warm} of each run are not timed (compiling, the "
              f"start's transient: the periodic sample's boundary contacts form and its height settles); the next "
              f"{args.steps} are, each on its own (processor time: the 2 cores are shared). {how}")
