@@ -201,8 +201,8 @@ def _finish(sim, state, source):
 
 def load_sample(path, index=-1) -> Simulation:
     """The simulation at snapshot ``index`` (default: the last complete one) of a file this
-    solver wrote, whatever its scene: positions, velocities, walls driven as recorded, solver
-    parameters, the sample's history ``sim.history`` (its confining stress ``sigma0`` in Pa, NaN if
+    solver wrote, whatever its scene: positions, velocities, walls (or a periodic shear's cell)
+    driven as recorded, solver parameters, the sample's history ``sim.history`` (its confining stress ``sigma0`` in Pa, NaN if
     the file does not say; :class:`solver.sample_history.SampleHistory`) and the
     warm start of the next step. Use it to start a test from a saved compacted sample::
 
@@ -213,8 +213,12 @@ def load_sample(path, index=-1) -> Simulation:
     """
     source = os.fspath(path)
     with ContractFile(source) as ds:
-        missing = [name for name in STATE_VARIABLES if name not in ds.variables]
-        missing += [name for name in WALL_ATTRIBUTES if name not in ds.attrs]
+        if "cell" in ds.variables:  # a periodic shear's file: its cell instead of walls
+            missing = [name for name in SHEAR_STATE_VARIABLES if name not in ds.variables]
+            missing += [name for name in SHEAR_ATTRIBUTES if name not in ds.attrs and name.startswith("cell_")]
+        else:
+            missing = [name for name in STATE_VARIABLES if name not in ds.variables]
+            missing += [name for name in WALL_ATTRIBUTES if name not in ds.attrs]
         if missing:
             raise FileFormatError(f"{source}: cannot restart from it, the file lacks {missing} (written by a "
                                   "solver without restart support, or not by this solver)")

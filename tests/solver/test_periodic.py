@@ -468,3 +468,28 @@ def test_a_stress_controlled_shear_holds_sigma_yy(tmp_path, seed):
     assert abs(sigma_yy.mean() - 1.0) < 0.06, sigma_yy
     assert abs(np.median(sigma_yy) - 1.0) < 0.1, sigma_yy
     assert ds.grain.coordination()["z"].values[keep].min() >= 2.3
+
+
+def test_load_sample_reads_a_periodic_shear_at_any_snapshot(tmp_path):
+    """solver.load_sample of a shear's file: the snapshot's wrapped centres, its cell (vectors,
+    corner, rates, the stress and mass it is driven with) and the warm start, ready to go on
+    (it refused the file for lacking walls)."""
+    import xarray as xr
+
+    import solver
+
+    path = tmp_path / "shear.nc"
+    small_shear(path, stress=50.0, mass=0.02)
+    with xr.open_dataset(path) as ds:
+        ds.load()
+    sim = solver.load_sample(path, index=3)
+    np.testing.assert_array_equal(sim.position, ds.position.values[3])
+    np.testing.assert_array_equal(sim.cell.vectors(), ds.cell.values[3])
+    np.testing.assert_array_equal(sim.cell.box()[0], ds.box_min.values[3])
+    assert sim.cell.height_rate == ds.cell_velocity.values[3, 1, 1] and sim.cell.shear_rate == 5.0
+    assert sim.cell.stress == 50.0 and sim.cell.mass == 0.02 and len(sim.walls.point) == 0
+    assert sim.step_index == int(ds.step.values[3])
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        sim.step()
+    assert np.all(np.isfinite(sim.position))
