@@ -552,18 +552,12 @@ def _check_settings(args, prep):
     parameters = _solver_parameters(args)
     scene = getattr(args, "scene", "biaxial")
     if scene == "shear":
-        from solver.periodic_shear import check_solver
-        from solver.parameters import Parameters
-
-        check_solver(Parameters(**parameters))
+        _check_shear(args, parameters)
     engine(args.engine).check(prep, parameters, _test(args) if scene == "biaxial" else None)
 
 
 def _run(args) -> int:
-    if args.scene == "shear" and "strain" not in _given(args):
-        from solver.periodic_shear import SHEAR_STRAIN
-
-        args.strain = SHEAR_STRAIN  # a shear gamma, not the biaxial test's eps_1
+    _shear_strain_default(args)
     _test(args)
     _check_output_file(args.out, args.overwrite)
     prep = _preparation(args, _shape_of(args.shape))
@@ -743,16 +737,19 @@ def _study_state(runner, prep, parameters, path, checkpoint, expected, overwrite
     return "start"
 
 
-def _expected_attrs(prep, test, parameters) -> dict:
-    """File attributes a study file of ``prep`` sheared in ``test`` with the solver settings
-    ``parameters`` (the command line's :data:`SOLVER_OPTIONS`, given or default) holds."""
-    return {"strain_target": test.strain, "wall_velocity_m_s": test.velocity, "snapshot_every": test.every,
+def _expected_attrs(prep, test, parameters, scene="biaxial") -> dict:
+    """File attributes a study file of ``prep`` sheared in ``test`` (the biaxial test, or the
+    periodic cell's shear for ``scene="shear"``: its rate comes from the compacted sample, so
+    only its strain is known) with the solver settings ``parameters`` (the command line's
+    :data:`SOLVER_OPTIONS`, given or default) holds."""
+    velocity = {"wall_velocity_m_s": test.velocity} if scene == "biaxial" else {}
+    return {"scene": scene, "strain_target": test.strain, **velocity, "snapshot_every": test.every,
             "solver_friction": prep.friction, "sigma0_Pa": prep.sigma0, **prep.attrs(),
             **{f"solver_{k}": v for k, v in parameters.items()}}
 
 
 def _study_sample(label, prep, path, state, checkpoint, *, test, near_contacts, overwrite, progress,
-                  parameters=None, compress=True, engine=None):
+                  parameters=None, compress=True, engine=None, scene="biaxial"):
     """One sample of the study: skipped when finished (a file whose compression was stopped is
     compressed), its test resumed when partial, else prepared (from the compaction's
     checkpoint ``checkpoint`` when it holds one) and sheared into ``path``; the checkpoint is
@@ -784,7 +781,8 @@ def _study_sample(label, prep, path, state, checkpoint, *, test, near_contacts, 
               flush=True)
         return path
     _simulate(prep, path, test=test, near_contacts=near_contacts, overwrite=True, progress=progress,
-              parameters=parameters, compress=compress, engine=engine, checkpoint=checkpoint, label=label)
+              parameters=parameters, compress=compress, engine=engine, checkpoint=checkpoint, label=label,
+              scene=scene)
     Path(checkpoint).unlink(missing_ok=True)
     return path
 
@@ -903,11 +901,46 @@ def _compile_ahead(command, shares, progress):
           f"cache: {result['cache']})", flush=True)
 
 
+def _shear_strain_default(args):
+    """Scene shear: the test's strain is a shear gamma, SHEAR_STRAIN unless --strain is given
+    (the biaxial test's default is an eps_1)."""
+    if getattr(args, "scene", "biaxial") == "shear" and "strain" not in _given(args):
+        from solver.periodic_shear import SHEAR_STRAIN
+
+        args.strain = SHEAR_STRAIN
+
+
+def _check_shear(args, parameters):
+    """Scene shear: the settings only this package's solver and its NLGS or Anderson sweeps take
+    (:func:`solver.periodic_shear.check_solver`), before any work."""
+    from solver.engine import DEFAULT_ENGINE
+    from solver.parameters import Parameters
+    from solver.periodic_shear import check_solver
+
+    if (args.engine or DEFAULT_ENGINE) != DEFAULT_ENGINE:
+        raise GrainviewError(f"scene shear: the periodic cell is this package's solver's ({DEFAULT_ENGINE}), "
+                             f"not engine {args.engine}'s")
+    check_solver(Parameters(**parameters))
+
+
+def _estimated_tests(tests, scene):
+    """The biaxial tests whose estimate stands for the study's tests: for scene shear, the one
+    that reaches the same eps_q in as many steps (h (e^eps_1 - 1) = gamma h / 2 at the same top
+    wall speed); a periodic step's cost is the walled one's in the estimate."""
+    if scene != "shear":
+        return tests
+    import math
+    from dataclasses import replace
+
+    return {label: replace(test, strain=math.log1p(test.strain / 2)) for label, test in tests.items()}
+
+
 def _study(args) -> int:
     from concurrent.futures import ProcessPoolExecutor
 
     from solver.engine import engine
 
+    _shear_strain_default(args)
     _test(args)
     if args.jobs < 1:
         raise GrainviewError(f"--jobs {args.jobs}: expected at least 1 process")
@@ -924,8 +957,11 @@ def _study(args) -> int:
     preps = {label: _preparation(args, shape, particles[label]) for label, shape in samples.items()}
     parameters = _solver_parameters(args)
     runner = engine(args.engine)
+    shear = args.scene == "shear"
+    if shear:
+        _check_shear(args, parameters)
     for label, prep in preps.items():
-        runner.check(prep, parameters, tests[label])
+        runner.check(prep, parameters, None if shear else tests[label])
     paths = {label: out / f"{label}.nc" for label in samples}
     checkpoints = {label: out / f"{label}.compaction.nc" for label in samples}
     if out.is_file():
@@ -934,7 +970,7 @@ def _study(args) -> int:
 
     recorded = {name: parameters.get(name, default_of(Parameters, name)) for name in SOLVER_OPTIONS}
     states = {label: _study_state(runner, preps[label], parameters, paths[label], checkpoints[label],
-                                  _expected_attrs(preps[label], tests[label], recorded), args.overwrite)
+                                  _expected_attrs(preps[label], tests[label], recorded, args.scene), args.overwrite)
               for label in samples}
     out.mkdir(parents=True, exist_ok=True)
     to_run = [label for label, state in states.items() if state != "finished"]
@@ -950,13 +986,14 @@ def _study(args) -> int:
         line = _compile_line("study", shares, load)
         if line:
             print(line, flush=True)
-        _print_estimate({label: preps[label] for label in to_run}, tests, parameters, args.jobs, shares,
-                        report=not args.no_report, load=load)
+        _print_estimate({label: preps[label] for label in to_run}, _estimated_tests(tests, args.scene), parameters,
+                        args.jobs, shares, report=not args.no_report, load=load)
         _compile_ahead("study", shares, _progress_flag(args))
     args.near_contacts = True  # the report counts near pairs as well (docs/fidelity.md)
     kwargs = _simulation_kwargs(args)
     kwargs.pop("test")
     kwargs["overwrite"] = args.overwrite
+    kwargs["scene"] = args.scene
     if args.jobs == 1:
         for label in samples:
             _study_sample(label, preps[label], paths[label], states[label], checkpoints[label], test=tests[label],
@@ -1184,6 +1221,11 @@ def _study_parser(sub):
                        "goes on where a stopped or killed run was (docs/fidelity.md, section 4)")
     study.add_argument("--no-report", action="store_true",
                        help="simulate only (grainview report OUT/pentagons.nc OUT/disks.nc --out DIR reports later)")
+    study.add_argument("--scene", choices=["biaxial", "shear"], default="biaxial",
+                       help="biaxial (default: the top wall compresses each sample) or shear (each compacted sample in "
+                       "the biperiodic cell of its box, sheared to gamma = --strain, default "
+                       f"{library_constant('solver.periodic_shear', 'SHEAR_STRAIN'):g}, at 2 v/h under sigma_yy = "
+                       "sigma0; as grainview run shear)")
     _residual_option(study)
     _simulation_options(study, samples=len(STUDY_SAMPLES))
     study.set_defaults(func=_study)
