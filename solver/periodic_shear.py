@@ -22,6 +22,7 @@ import numpy as np
 from grainview.contract.errors import ParameterError
 from grainview.contract.schema import MAX_STEP_INDEX
 
+from .cell_coupling import check_solver
 from .contact_points import rank_in_pair
 from .interrupt import interruptible, progress_bar, resume_instructions, stop_exception, stop_reason
 from .output import Recorder
@@ -87,16 +88,6 @@ def matching_shear_rate(sim: Simulation, velocity: float) -> float:
     if not (np.isfinite(velocity) and velocity > 0):
         raise ParameterError(f"velocity={velocity!r}: expected a positive speed in m s-1")
     return 2.0 * float(velocity) / height
-
-
-def check_solver(parameters):
-    """Refuse, in one line, a stepper solver that cannot sweep a stress-controlled cell's rate
-    with the contacts (:data:`solver.stepper.STRESSED_CELL_SOLVERS`)."""
-    from .stepper import STRESSED_CELL_SOLVERS
-
-    if parameters.solver not in STRESSED_CELL_SOLVERS:
-        raise ParameterError(f"solver={parameters.solver!r}: a periodic cell under a normal stress is solved by "
-                             f"{' or '.join(STRESSED_CELL_SOLVERS)} (its height's rate is swept with the contacts)")
 
 
 def cell_settings(cell: PeriodicCell) -> dict:

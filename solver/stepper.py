@@ -52,9 +52,6 @@ from .solve_records import PeriodicContactProblem, StepLaw, StepStart, StressedC
 from .walls import FIXED, STRESS, VELOCITY, Walls
 
 
-STRESSED_CELL_SOLVERS = ("anderson", "nlgs")
-"""The stepper methods that sweep a stress-controlled cell's rate with the contacts
-(:func:`solver.cell_coupling.couple_cell`)."""
 STAGES = ("broad_phase", "narrow_phase", "warm_start", "contact_problem", "solve", "diagnostics",
           "overlap_recovery", "update", "other")
 """The stages whose seconds :attr:`Simulation.timings` accumulates, disjoint, in the order of a
@@ -589,10 +586,7 @@ class Simulation:
         :class:`solver.nlgs.NLGSResult`."""
         p = self.parameters
         cell = self.cell
-        if p.solver not in STRESSED_CELL_SOLVERS:
-            from .periodic_shear import check_solver
-
-            check_solver(p)
+        cell_coupling.check_solver(p)
         load = float(p.time_step) * cell.stress * cell.length * float(p.thickness)
         stressed = StressedCellProblem(*problem, self.point_image[:, 1].astype(np.float64),
                                        np.array([cell.height_rate, cell.height_rate, cell.mass, load]))

@@ -912,10 +912,10 @@ def _shear_strain_default(args):
 
 def _check_shear(args, parameters):
     """Scene shear: the settings only this package's solver and its NLGS or Anderson sweeps take
-    (:func:`solver.periodic_shear.check_solver`), before any work."""
+    (:func:`solver.cell_coupling.check_solver`), before any work."""
+    from solver.cell_coupling import check_solver
     from solver.engine import DEFAULT_ENGINE
     from solver.parameters import Parameters
-    from solver.periodic_shear import check_solver
 
     if (args.engine or DEFAULT_ENGINE) != DEFAULT_ENGINE:
         raise GrainviewError(f"scene shear: the periodic cell is this package's solver's ({DEFAULT_ENGINE}), "
