@@ -5,8 +5,9 @@ box (:func:`periodic_sample`): the particles that touched the left wall now touc
 those that touched the right one, within the walls' overlap. The cell is then sheared at the
 imposed rate gamma_dot (its tilt grows at gamma_dot h; Lees–Edwards: the images one cell up
 move at db/dt = (gamma_dot h, dh/dt)), its height held at sigma_yy = sigma0 with the inertia
-of the sample's mass, its rate solved with the contacts (:mod:`solver.cell_coupling`), until the shear
-gamma = gamma_dot t reaches ``strain``. The particles start from the affine velocity field
+of :data:`CELL_MASS` times the sample's mass, its rate solved with the contacts
+(:mod:`solver.cell_coupling`), until the shear gamma = gamma_dot t reaches ``strain``; by
+default gamma_dot is the biaxial test's pace (:func:`matching_shear_rate`). The particles start from the affine velocity field
 gamma_dot (y - y_mid) e_x, so that the flow does not have to grow from the boundary.
 
 The file is the contract's periodic layout (docs/schema.md, "The periodic cell"): ``cell`` per
