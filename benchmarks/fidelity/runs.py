@@ -72,7 +72,8 @@ def _log(message):
 
 
 def make_sample(run: Run, cache=None) -> str:
-    """The compacted sample of ``run`` (built and written unless cached); returns its path."""
+    """The compacted sample of ``run`` (built and written unless cached; a compaction stopped
+    part-way goes on from its checkpoint, ``<sample>.nc.checkpoint``); returns its path."""
     from solver.output import Recorder
     from solver.preparation import prepare_sample, record
 
@@ -82,15 +83,18 @@ def make_sample(run: Run, cache=None) -> str:
     os.makedirs(os.path.dirname(path), exist_ok=True)
     prep = preparation_of(run)
     start = time.perf_counter()
+    checkpoint = path + ".checkpoint"  # the compaction's state every ten minutes: a killed one goes on
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
-        sim = prepare_sample(prep, progress=False)
+        sim = prepare_sample(prep, progress=False, checkpoint=checkpoint)
     # the study's own preparation names (the LADDER's are not presets)
     attrs = {"scene": "isotropic", **record(sim), "preparation_name": run.preparation,
              "compaction_seconds": time.perf_counter() - start}
     with Recorder(path + ".part", sim, attrs=attrs, near_contacts=True, overwrite=True) as rec:
         rec.write()
     os.replace(path + ".part", path)
+    if os.path.exists(checkpoint):
+        os.remove(checkpoint)
     _log(f"{run.sample_name}: compacted in {sim.compaction_steps} steps, {time.perf_counter() - start:.0f} s")
     return path
 
