@@ -509,12 +509,12 @@ def test_the_limits_follow_the_sample():
 # --- interrupted conversions --------------------------------------------------------------------
 
 def _long_lammps(tmp_path):
-    """The LAMMPS fixtures repeated 30 times (120 snapshots, later steps), for a conversion that
-    lasts a few seconds."""
+    """The LAMMPS fixtures repeated 60 times (240 snapshots, later steps), for a conversion that
+    lasts a few seconds even on a fast machine."""
     def repeat(text):
         snapshots = text.split("ITEM: TIMESTEP\n")[1:]
         out = []
-        for copy in range(30):
+        for copy in range(60):
             for snap in snapshots:
                 step, rest = snap.split("\n", 1)
                 out.append(f"ITEM: TIMESTEP\n{int(step) + copy * 80000}\n{rest}")
@@ -536,8 +536,7 @@ def _start_and_stop(command, folder, signum):
         assert process.poll() is None, process.communicate()
         assert time.monotonic() < deadline
         time.sleep(0.005)
-    time.sleep(0.2)  # into the conversion
-    process.send_signal(signum)
+    process.send_signal(signum)  # at once: on a loaded machine a pause could outlast the conversion
     process.stdout_text, process.stderr_text = process.communicate(timeout=120)
     return process
 
