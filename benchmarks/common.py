@@ -205,6 +205,18 @@ def write_results(path: str, title: str, intro: str, sections: list) -> str:
     return text
 
 
+def print_or_write(path, title: str, intro: str, sections: list, quick: bool = False) -> str:
+    """A benchmark's results: a ``quick`` run with no file given (``path`` None) is printed only;
+    any other run is written to ``path`` (:func:`write_results`); a quick run's title says so.
+    Returns the text."""
+    title = title + (" (quick)" if quick else "")
+    if path is None:
+        text = results_text(title, intro, sections)
+        print(text)
+        return text
+    return write_results(path, title, intro, sections)
+
+
 def run_and_record(description: str, run, results_name: str, argv=None) -> None:
     """The command line of a benchmark whose ``run(quick=...)`` returns its results as text:
     ``--quick`` runs a short version and prints it only; without it the text is printed and

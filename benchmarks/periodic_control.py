@@ -66,7 +66,7 @@ def run_variant(sample_path, variant, strain, velocity, folder):
 
 
 def main(argv=None):
-    from benchmarks.common import markdown_table, measured, results_text, write_results
+    from benchmarks.common import markdown_table, measured, print_or_write
     from benchmarks.fidelity.__main__ import Config
     from benchmarks.fidelity.runs import Run, make_sample
 
@@ -105,11 +105,9 @@ def main(argv=None):
              f"{velocity * 100:g} cm/s, the fidelity study's wall speed for this size) under sigma0 = 10 kPa, the "
              f"cell's rate swept with the contacts (solver.cell_coupling); snapshots every 50 steps, those with "
              f"gamma >= {args.strain / 4:g} counted. {how}")
-    title = "Periodic cell under a normal stress: steadiness and cost of the height's control"
-    if args.quick and args.out is None:
-        print(results_text(title + " (quick)", intro, parts))
-        return 0
-    write_results(args.out or RESULTS, title, intro, parts)
+    print_or_write(args.out or (None if args.quick else RESULTS),
+                   "Periodic cell under a normal stress: steadiness and cost of the height's control", intro, parts,
+                   quick=args.quick)
     return 0
 
 

@@ -140,7 +140,7 @@ def table(shape, particles, rows, rate):
 
 
 def main(argv=None):
-    from benchmarks.common import measured, write_results
+    from benchmarks.common import measured, print_or_write
 
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     parser.add_argument("--particles", type=int, default=400)
@@ -170,13 +170,8 @@ def main(argv=None):
              f"stall test over 200 sweeps on one domain. Steps 1-{args.warm} of each run are not timed (compiling, the "
              f"start's transient: the periodic sample's boundary contacts form and its height settles); the next "
              f"{args.steps} are, each on its own (processor time: the 2 cores are shared). {how}")
-    title = "Periodic shear against the walled test: cost per particle-step"
-    if args.quick and args.out is None:
-        from benchmarks.common import results_text
-
-        print(results_text(title + " (quick)", intro, parts))
-        return 0
-    write_results(args.out or RESULTS, title + (" (quick)" if args.quick else ""), intro, parts)
+    print_or_write(args.out or (None if args.quick else RESULTS),
+                   "Periodic shear against the walled test: cost per particle-step", intro, parts, quick=args.quick)
     return 0
 
 

@@ -36,7 +36,6 @@ def window_means(path, window=(0.4, np.inf), near=None) -> dict:
     over the window, "p 10-90%"); plus the window's snapshot count and eps_q range. ``near``:
     the counting convention (module docstring)."""
     from grainview.analysis.force_pdf import pooled_force_pdf, strong_force_exponent
-
     from grainview.analysis.strain import shear_strain
 
     ds = grainview.open_dataset(path, chunks=None)

@@ -112,8 +112,8 @@ def simulate(run: Run, cache=None) -> str:
     if os.path.exists(path):
         return path
     part = path + ".part"
-    start = time.perf_counter()
     if os.path.exists(part) and file_state(part) in ("partial", "finished"):
+        start = time.perf_counter()
         _log(f"{run.name}: resuming {part}")
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")

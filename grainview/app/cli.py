@@ -365,9 +365,8 @@ def _simulate(prep, path, *, test, near_contacts, overwrite, progress, scene="bi
     from solver.engine import prepare
 
     runner = engine_named(engine or DEFAULT_ENGINE)
-    if scene == "shear" and (engine or DEFAULT_ENGINE) != DEFAULT_ENGINE:
-        raise GrainviewError(f"scene shear: the periodic cell is this package's solver's ({DEFAULT_ENGINE}), "
-                             f"not engine {engine}'s")
+    if scene == "shear":
+        _refuse_other_engines(engine)
     path = Path(path)
     if path.exists() and not overwrite:
         raise GrainviewError(f"{path} exists; pass --overwrite to replace it")
@@ -914,13 +913,19 @@ def _check_shear(args, parameters):
     """Scene shear: the settings only this package's solver and its NLGS or Anderson sweeps take
     (:func:`solver.cell_coupling.check_solver`), before any work."""
     from solver.cell_coupling import check_solver
-    from solver.engine import DEFAULT_ENGINE
     from solver.parameters import Parameters
 
-    if (args.engine or DEFAULT_ENGINE) != DEFAULT_ENGINE:
-        raise GrainviewError(f"scene shear: the periodic cell is this package's solver's ({DEFAULT_ENGINE}), "
-                             f"not engine {args.engine}'s")
+    _refuse_other_engines(args.engine)
     check_solver(Parameters(**parameters))
+
+
+def _refuse_other_engines(engine):
+    """Scene shear: the periodic cell is this package's solver's; another ``engine`` is refused."""
+    from solver.engine import DEFAULT_ENGINE
+
+    if (engine or DEFAULT_ENGINE) != DEFAULT_ENGINE:
+        raise GrainviewError(f"scene shear: the periodic cell is this package's solver's ({DEFAULT_ENGINE}), "
+                             f"not engine {engine}'s")
 
 
 def _estimated_tests(tests, scene):
