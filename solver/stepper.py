@@ -597,6 +597,12 @@ class Simulation:
             options["domains"] = 1
         result = method.solve(stressed, state, limits, **options)
         self.cell_rate = float(stressed.cell[cell_coupling.RATE])
+        smallest = float(self.radius[:self.n_particles].min())
+        if not abs(self.cell_rate) * float(p.time_step) <= smallest:
+            raise ParameterError(f"the periodic cell's height would change by {self.cell_rate * p.time_step:.4g} m at "
+                                 f"step {self.step_index}, more than the smallest grain's radius {smallest:.4g} m in one "
+                                 f"step: its stress control diverged with a cell mass of {cell.mass:.4g} kg (expected "
+                                 "a larger cell mass or a smaller time step)")
         return result
 
     def _move_cell(self, problem, pn, pt):

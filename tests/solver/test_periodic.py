@@ -493,3 +493,35 @@ def test_load_sample_reads_a_periodic_shear_at_any_snapshot(tmp_path):
         warnings.simplefilter("ignore")
         sim.step()
     assert np.all(np.isfinite(sim.position))
+
+
+def square_lattice_in_a_stressed_cell(mass):
+    """36 disks (r = 1 cm) on a square lattice squeezed by 0.1% in a 12 cm cell under sigma0 =
+    10 kPa, the cell's mass ``mass`` (kg; the disks weigh 29 kg)."""
+    r, k = 0.01, 6
+    grid = (np.arange(k) + 0.5) * 2 * r
+    x, y = np.meshgrid(grid, grid)
+    pos = np.c_[x.ravel(), y.ravel()] + np.random.default_rng(0).normal(0.0, 1e-5, (k * k, 2))
+    cell = PeriodicCell([0.0, 0.0], 2 * r * k, 2 * r * k * 0.999, stress=1e4, mass=mass, shear_rate=5.0)
+    p = Parameters(time_step=1e-4, friction=0.4, seed=1)
+    return Simulation(pos, np.zeros(k * k), np.full(k * k, r), np.zeros(k * k, int), parameters=p, cell=cell)
+
+
+def test_a_diverging_stress_control_stops_with_one_line_before_the_cell_moves():
+    """A cell a thousandth of a percent of the sample's mass: the coupled sweeps give its height a
+    change of more than a grain's radius in one step; the step is refused before anything moves
+    (with the tenth of the sample's mass the default gives, the same lattice steps on)."""
+    sim = square_lattice_in_a_stressed_cell(mass=1e-3)
+    height, position = sim.cell.height, sim.position.copy()
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        with pytest.raises(ParameterError, match="stress control diverged with a cell mass of 0.001 kg"):
+            for _ in range(20):
+                sim.step()
+    assert sim.cell.height == height and np.array_equal(sim.position, position)
+    sane = square_lattice_in_a_stressed_cell(mass=3.0)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        for _ in range(20):
+            sane.step()
+    assert abs(sane.cell.height / height - 1) < 0.2
