@@ -1,4 +1,4 @@
-"""Body-space ADMM (solver.body_admm) against the NLGS on the stepper's own contact problems at
+"""Body-space ADMM (benchmarks.research.body_admm) against the NLGS on the stepper's own contact problems at
 1000, 4000 and 14,400 pentagons: iterations and seconds to a local-law residual of 1e-4 and
 1e-6 (or the best within a cap), the factorisations of M + rho H^T H and their time, and the
 rho each used.
@@ -24,7 +24,7 @@ capture asserts that W r + q equals the stepper's own local velocities
 points (the 14,400 ones come from the same snapshot), that W and q equal the stored ones.
 
 Each method starts from the stored warm start (the impulses, and the velocities they imply).
-ADMM: solver.body_admm.solve with its defaults, the local-law residual computed every 5
+ADMM: benchmarks.research.body_admm.solve with its defaults, the local-law residual computed every 5
 iterations on the clock (it is the stopping test), cap ADMM_CAP iterations; time to a target is
 the first check within it. NLGS: benchmarks.contact_solvers.nlgs_trajectory (the kernel of
 solve_contact_problem(method='nlgs'), sweeps in chunks of ~5% of those done, the residual off
@@ -131,7 +131,7 @@ INTRO = ("Written by `python -m benchmarks.body_admm --out benchmarks/results/bo
          "problems, the caps and how each cell is timed): iterations (NLGS: sweeps) and seconds to a local-law "
          "residual |F|/|r| of 1e-4 and 1e-6 from the stored warm start, one run per cell; the ADMM's "
          "factorisations of D + rho A^T A (count, seconds) and the rho it used; then three probes of why.")
-VARIANTS = {  # label -> options of solver.body_admm.solve
+VARIANTS = {  # label -> options of benchmarks.research.body_admm.solve
     "admm": {},
     "admm wnn": dict(scaling="wnn"),
     "admm wnn grow": dict(scaling="wnn", balance_every=0, stall_growth=3.0),
@@ -150,8 +150,8 @@ def nlgs_run(W, q, mu, initial, stop=TARGETS[-1]):
 
 
 def admm_run(entry, cap=ADMM_CAP, **options):
-    """(record, solution) of solver.body_admm.solve on ``entry`` from its warm start."""
-    from solver import body_admm
+    """(record, solution) of benchmarks.research.body_admm.solve on ``entry`` from its warm start."""
+    from benchmarks.research import body_admm
 
     record = {}
     solution = body_admm.solve(entry["H"], entry["minv"], entry["v_free"], entry["bias"], entry["mu"], TARGETS[-1], cap,
@@ -167,8 +167,8 @@ def reached(trajectory, target):
 
 def factor_fill(entry, rho=None):
     """(seconds, nnz of L + U, unknowns) of one factorisation of D + rho A^T A for ``entry``
-    (rho: solver.body_admm's default)."""
-    from solver import body_admm
+    (rho: benchmarks.research.body_admm's default)."""
+    from benchmarks.research import body_admm
 
     problem = body_admm.body_problem(entry["H"], entry["minv"], entry["v_free"], entry["bias"], entry["mu"])
     rho = float(np.median(1.0 / problem.wnn)) if rho is None else rho

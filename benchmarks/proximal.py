@@ -1,4 +1,4 @@
-"""Proximal-point steps around the semi-smooth Newton (solver.proximal_newton, Siconos' PROX) on
+"""Proximal-point steps around the semi-smooth Newton (benchmarks.research.proximal_newton, Siconos' PROX) on
 the problems of benchmarks/contact_solvers.py, and two zero-code probes of other families on
 the pentagon problems: ADMM (OSQP) and an interior point method (Clarabel) on the convex
 problem of De Saxcé's fixed point. Written to results/proximal.md; the notes below its marker
@@ -13,7 +13,7 @@ contact_solvers/, ignored by git): Siconos' three 2D granular-flow problems from
 stepper's captured pentagon problems at 1000, 4000 and 14,400 (three each) from the stepper's
 warm start.
 
-**PROX** (:func:`solver.proximal_newton.solve_recorded`, its defaults: alpha from 1, x5 on an
+**PROX** (:func:`benchmarks.research.proximal_newton.solve_recorded`, its defaults: alpha from 1, x5 on an
 inner failure, /10 on a success, inner tolerance e_k / 10), run once per problem to the
 tighter target (1e-8, or the NLGS's best of contact-solvers.md's last run where the NLGS
 stopped short of 1e-8: DATA/rows.pkl) with at most ``OUTER_CAP`` outer steps and no outer step
@@ -85,7 +85,7 @@ def nlgs_best(label):
 
 def first_within(history, target):
     """(factorisations, seconds, outer steps) to the first centre of ``history``
-    (solver.proximal_newton.ProximalHistory) within ``target``; None if none is."""
+    (benchmarks.research.proximal_newton.ProximalHistory) within ``target``; None if none is."""
     lus = np.concatenate([[0], np.cumsum(history.factorisations)])
     for k, e in enumerate(history.residuals):
         if e <= target:
@@ -101,7 +101,7 @@ def best_within_lus(history, lus):
 
 def prox_row(label, W, q, mu, initial):
     """One PROX run on a problem (module docstring): a row dict."""
-    from solver.proximal_newton import solve_recorded
+    from benchmarks.research.proximal_newton import solve_recorded
 
     tight = nlgs_best(label)
     cap = SICONOS_LU_CAP if label.startswith("Siconos") else LU_CAP
@@ -328,7 +328,7 @@ def write(rows, path):
 
 def warm_up():
     """Compile or load the kernels the runs use, off the record."""
-    from solver.proximal_newton import solve_recorded
+    from benchmarks.research.proximal_newton import solve_recorded
 
     W = sparse.csr_matrix(np.array([[2.0, 0, 1, 0], [0, 2, 0, 0], [1, 0, 2, 0], [0, 0, 0, 2]]))
     q, mu = np.array([-3.0, 0.5, -3.0, -0.5]), np.full(2, 0.3)

@@ -1,4 +1,4 @@
-"""The two-level method of solver.two_level (NLGS sweeps + one smoothed-aggregation V-cycle on
+"""The two-level method of benchmarks.research.two_level (NLGS sweeps + one smoothed-aggregation V-cycle on
 the truncated face, projection, line search, inside De Saxcé's fixed point on s = mu |u_t|) on
 the problems of benchmarks/contact_solvers.py: cycles and seconds to a local-law residual of
 1e-4 and 1e-6, against the same cycle without the V-cycle and plain NLGS.
@@ -17,7 +17,7 @@ granular-flow problems from r = 0, and the stepper's pentagon problems at 1000, 
 
 Methods, each from the same start, one run per cell:
 
-* ``two-level``: :func:`solver.two_level.solve_recorded` as specified (1 NLGS sweep, the
+* ``two-level``: :func:`benchmarks.research.two_level.solve_recorded` as specified (1 NLGS sweep, the
   V-cycle on (T^T W T + 1e-8 diag) d = -g, projection, exact line search, 1 NLGS sweep);
 * ``two-level convex``: the same with the smoother that minimises J point by point at the
   cycle's shift (the W_kk-metric projection on the cone: what TNNMG's convergence proof asks of
@@ -68,7 +68,7 @@ VARIANTS = {"two-level": {}, "two-level convex": {"smoother": "convex"},
 
 def run_variant(W, q, mu, initial, options):
     """A row for one two-level variant (module docstring)."""
-    from solver.two_level import solve_recorded
+    from benchmarks.research.two_level import solve_recorded
 
     cap = CONTROL_CYCLES if options.get("coarse", True) is False else CYCLES
     start = time.perf_counter()
@@ -132,7 +132,7 @@ def diagnose(W, q, mu, initial):
     from scipy.sparse.linalg import splu
 
     from benchmarks.contact_solvers import as_matrix_problem, law, nlgs_sweeps
-    from solver import two_level
+    from benchmarks.research import two_level
 
     n = mu.size
     r = initial.copy()

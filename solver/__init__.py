@@ -1,4 +1,5 @@
-"""A compact contact-dynamics solver for rigid disks and regular polygons between walls.
+"""A compact contact-dynamics solver for rigid disks and convex polygons (regular or any other,
+:mod:`solver.shapes`), between walls or in a biperiodic cell.
 
 Moreau–Jean time stepping with a nonlinear Gauss–Seidel solution of Signorini's condition and
 Coulomb's law (Jean 1999; Moreau 2004), polygon contacts by the shadow-overlap idea (simple

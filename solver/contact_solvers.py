@@ -1,7 +1,16 @@
 """The one registry of the methods that solve a frictional contact problem, by name.
 
-A method registers once (:func:`register`) as a :class:`Method`, with one or both of two
-entry points:
+It lists only methods a user can choose: by ``Parameters.solver`` (the command line's
+``--solver``) for the stepper's problem, by ``solve_contact_problem(method=)`` for a problem given
+by its matrix. Experiments that no user path reaches are not registered; they live outside the
+solver, in benchmarks/research/.
+
+A method registers once (:func:`register`) as a :class:`Method`, with a status (one of
+:data:`STATUSES`: ``default``, the stepper's method unless another is chosen, exactly one;
+``alternative``, a method to choose for a reason the docs give; ``experimental``, kept to be
+studied, with a known limit) and one or both of two entry points, declared by their signatures
+(:class:`StepperSolve`, :class:`MatrixSolve`; :func:`register` refuses an entry point whose
+parameters differ):
 
 ``solve(problem, state, limits, **options) -> NLGSResult`` (the stepper's problem)
     ``problem`` the time step's :class:`solver.nlgs.ContactProblem`; ``state`` a
@@ -21,21 +30,21 @@ entry points:
 
 The methods registered here:
 
-``nlgs``
+``nlgs`` (alternative)
     Point-by-point nonlinear Gauss–Seidel (:mod:`solver.nlgs`). In the stepper: the serial
     sweep, in a random order when ``Parameters.shuffle``, or the domain-decomposed sweeps of
     :mod:`solver.parallel_nlgs` when ``Parameters.domains`` > 1. On a matrix
     (:func:`solver.nlgs.solve_matrix`): ``tolerance`` its quadratic norm, ``max_tolerance`` (an
     option, default 60 x ``tolerance``) its max norm, ``max_iterations`` the sweep cap.
-``anderson``
+``anderson`` (default)
     NLGS sweeps combined by Anderson extrapolation (:mod:`solver.acceleration`; the stepper's
     default), ``Parameters.anderson_memory`` past sweeps every ``anderson_period`` sweeps, on
     ``domains`` domains; no shuffled order. Stepper only.
-``newton``
+``newton`` (experimental)
     Semi-smooth Newton on Alart–Curnier's function with a line search
     (:mod:`solver.nonsmooth_newton`); ``tolerance`` is the local-law residual
     (:mod:`solver.contact_solution`). Matrix only.
-``pcg``
+``pcg`` (experimental)
     Projected conjugate gradient after Renouf & Alart (:mod:`solver.projected_cg`);
     ``tolerance`` is the local-law residual. In the stepper it solves the step's problem in
     matrix form (:mod:`solver.matrix_form`: W and q assembled every step, the velocities
@@ -53,12 +62,13 @@ The methods registered here:
 ``anderson``; files and scripts written before ``Parameters.solver``) to the methods they name.
 
 Adding a method: write its entry point(s) with the signatures above in a module of its own,
-and add one ``register(Method(...))`` below, saying which ``Parameters`` fields it reads as
-options (``parameters``), whether it runs on several domains (``domains``), whether it visits
-points in a random order (``shuffle``) and whether it applies the NLGS's stall test
-(``stall``). The stepper, ``Parameters.validate``, the command line's choices and restart read
-the registry and need no edit; tests/solver/test_physics.py runs every stepper method on its
-analytic scenes.
+and add one ``register(Method(...))`` below, saying its status, which ``Parameters`` fields it
+reads as options (``parameters``), whether it runs on several domains (``domains``), whether it
+visits points in a random order (``shuffle``) and whether it applies the NLGS's stall test
+(``stall``). The stepper, ``Parameters.validate``, the command line's choices and their
+help (:func:`choices_help`) and restart read the registry and need no edit; add its row to the
+table of docs/solver.md (tests/solver/test_solver_docs.py compares the two);
+tests/solver/test_physics.py runs every stepper method on its analytic scenes.
 
 This module imports numpy and the contract's errors only (each entry point imports its
 solver's module when called), so the command line and :mod:`solver.parameters` read the
@@ -68,8 +78,9 @@ registry's names without loading a compiled kernel.
 from __future__ import annotations
 
 import importlib
+import inspect
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Callable, NamedTuple
+from typing import TYPE_CHECKING, Callable, NamedTuple, Protocol
 
 import numpy as np
 
@@ -81,8 +92,12 @@ if TYPE_CHECKING:  # the results' types, named in the signatures only
     from .contact_solution import ContactSolution
     from .nlgs import NLGSResult
 
-__all__ = ["ACCELERATIONS", "ContactState", "Limits", "Method", "matrix_methods", "method", "register",
-           "solver", "solve_nlgs", "stepper_methods"]
+__all__ = ["ACCELERATIONS", "STATUSES", "ContactState", "Limits", "MatrixSolve", "Method", "StepperSolve",
+           "choices", "choices_help", "default_method", "matrix_methods", "method", "register", "solver",
+           "solve_nlgs", "stepper_methods"]
+
+STATUSES = ("default", "alternative", "experimental")
+"""What a registered method is to a user, in the order the choices are listed (module docstring)."""
 
 
 class ContactState(NamedTuple):
@@ -97,14 +112,53 @@ class ContactState(NamedTuple):
     w: np.ndarray
 
 
+class StepperSolve(Protocol):
+    """The stepper's entry point (module docstring): the step's problem, its state updated in
+    place, its limits, and the method's own options as keywords."""
+
+    def __call__(self, problem, state: ContactState, limits: Limits, **options) -> NLGSResult: ...
+
+
+class MatrixSolve(Protocol):
+    """The matrix entry point (module docstring): u = W r + q, the friction, the tolerance, the
+    iteration cap and the starting impulses, and the method's own options as keywords."""
+
+    def __call__(self, W, q, mu, tolerance, max_iterations, initial, **options) -> ContactSolution: ...
+
+
+def _positional(protocol) -> tuple:
+    """The names of the positional parameters of ``protocol``'s ``__call__`` (``self`` aside)."""
+    return tuple(name for name, p in inspect.signature(protocol.__call__).parameters.items()
+                 if p.kind is p.POSITIONAL_OR_KEYWORD and name != "self")
+
+
+def signature_problems(entry, protocol) -> list:
+    """How the callable ``entry`` differs from the declared signature ``protocol``
+    (:class:`StepperSolve` or :class:`MatrixSolve`): its positional parameters must be the
+    protocol's, in order, and every other parameter a keyword with a default (an option)."""
+    expected, bad = _positional(protocol), []
+    parameters = list(inspect.signature(entry).parameters.values())
+    positional = tuple(p.name for p in parameters if p.kind in (p.POSITIONAL_ONLY, p.POSITIONAL_OR_KEYWORD)
+                       and p.default is p.empty)
+    if positional != expected:
+        bad.append(f"takes ({', '.join(positional)}) where {protocol.__name__} takes ({', '.join(expected)})")
+    loose = [p.name for p in parameters if p.name not in expected and p.kind is not p.VAR_KEYWORD
+             and p.default is p.empty]
+    if loose:
+        bad.append(f"options without a default: {', '.join(loose)}")
+    return bad
+
+
 @dataclass(frozen=True)
 class Method:
     """One registered way of solving (module docstring).
 
     name : the name ``Parameters.solver``, ``--solver`` and ``solve_contact_problem(method=)``
-        take; summary : one line saying what it is.
-    solve : the stepper entry point, or None (matrix problems only).
-    solve_matrix : the matrix entry point, or None (the stepper's problem only).
+        take; summary : one line saying what it is (the command line's help).
+    status : one of :data:`STATUSES`.
+    solve : the stepper entry point (:class:`StepperSolve`), or None (matrix problems only).
+    solve_matrix : the matrix entry point (:class:`MatrixSolve`), or None (the stepper's
+        problem only).
     parameters : ((Parameters field, option keyword), ...) that :meth:`options` passes to ``solve``.
     domains : whether ``solve`` runs on several domains (options ``domains``, ``x``: the
         particles' abscissae in m, ``decomposition``: :func:`solver.parallel_nlgs.decompose`).
@@ -122,6 +176,7 @@ class Method:
 
     name: str
     summary: str
+    status: str
     solve: Callable | None = None
     solve_matrix: Callable | None = None
     parameters: tuple = ()
@@ -177,13 +232,43 @@ ACCELERATIONS = {"off": "nlgs", "anderson": "anderson"}
 
 def register(entry: Method) -> Method:
     """Add ``entry`` to the registry under its name (once: a second method of the same name is
-    refused). Returns it."""
+    refused), after checking its status, its entry points' signatures and, for a stepper
+    method with status ``default``, that it is the only one. Returns it."""
     if entry.name in _METHODS:
         raise ValueError(f"a contact solver named {entry.name!r} is already registered")
     if entry.solve is None and entry.solve_matrix is None:
         raise ValueError(f"{entry.name!r}: a method needs a stepper entry (solve) or a matrix one (solve_matrix)")
+    if entry.status not in STATUSES:
+        raise ValueError(f"{entry.name!r}: status={entry.status!r}, expected one of {', '.join(STATUSES)}")
+    if entry.status == "default":
+        other = next((name for name, m in _METHODS.items() if m.status == "default"), None)
+        if entry.solve is None or other is not None:
+            raise ValueError(f"{entry.name!r}: the default is one stepper method" + (f" ({other!r} is)" if other else ""))
+    bad = [f"{kind} {problem}" for kind, function, protocol in (("solve", entry.solve, StepperSolve),
+                                                                ("solve_matrix", entry.solve_matrix, MatrixSolve))
+           if function is not None for problem in signature_problems(function, protocol)]
+    if bad:
+        raise ValueError(f"{entry.name!r}: " + "; ".join(bad))
     _METHODS[entry.name] = entry
     return entry
+
+
+def default_method() -> str:
+    """The name of the stepper's default method (status ``default``)."""
+    return next(name for name, m in _METHODS.items() if m.status == "default")
+
+
+def choices() -> tuple:
+    """((name, status, summary), ...) of the methods the time stepper can use, the default first,
+    then by status (:data:`STATUSES`) and name: the command line's ``--solver`` choices."""
+    return tuple(sorted(((name, m.status, m.summary) for name, m in _METHODS.items() if m.in_stepper),
+                        key=lambda c: (STATUSES.index(c[1]), c[0])))
+
+
+def choices_help() -> str:
+    """The stepper's methods with their status and summary, in words, for the help of
+    ``--solver``: "'anderson' (default): Anderson-accelerated ...; 'nlgs' (alternative): ..."."""
+    return "; ".join(f"{name!r} ({status}): {summary}" for name, status, summary in choices())
 
 
 def stepper_methods() -> tuple:
@@ -352,13 +437,14 @@ def _own_stall_words(module: str, count: str, unit: str) -> Callable[[], str]:
     return words
 
 
-register(Method("nlgs", "nonlinear Gauss-Seidel sweeps (serial, shuffled or on domains)", solve=solve_stepper_nlgs,
-                solve_matrix=solve_nlgs, parameters=(), domains=True, shuffle=True))
-register(Method("anderson", "Anderson-accelerated NLGS sweeps (the default)", solve=solve_stepper_anderson,
+register(Method("nlgs", "nonlinear Gauss-Seidel sweeps (serial, shuffled or on domains)", "alternative",
+                solve=solve_stepper_nlgs, solve_matrix=solve_nlgs, parameters=(), domains=True, shuffle=True))
+register(Method("anderson", "Anderson-accelerated NLGS sweeps, the same local-law residual in less time per step "
+                "than 'nlgs'", "default", solve=solve_stepper_anderson,
                 parameters=(("anderson_memory", "memory"), ("anderson_period", "period")), domains=True))
-register(Method("newton", "semi-smooth Newton on Alart-Curnier's function", solve_matrix=solve_newton,
+register(Method("newton", "semi-smooth Newton on Alart-Curnier's function", "experimental", solve_matrix=solve_newton,
                 stall=False, label="Newton", iteration="Newton step", norms=LOCAL_LAW_NORMS,
                 own_stall=_own_stall_words("nonsmooth_newton", "STALL_STEPS", "Newton steps")))
-register(Method("pcg", "projected conjugate gradient (Renouf & Alart) on the step's matrix", solve=solve_stepper_pcg,
-                solve_matrix=solve_pcg, stall=False, label="Projected-CG", iteration="iteration", norms=LOCAL_LAW_NORMS,
+register(Method("pcg", "projected conjugate gradient (Renouf & Alart) on the step's matrix", "experimental",
+                solve=solve_stepper_pcg, solve_matrix=solve_pcg, stall=False, label="Projected-CG", iteration="iteration", norms=LOCAL_LAW_NORMS,
                 own_stall=_own_stall_words("projected_cg", "STALL_ITERATIONS", "iterations")))

@@ -185,9 +185,8 @@ class Parameters:
                             check=lambda v: isinstance(v, (bool, np.bool_)), expected="True or False")
     seed: int = setting(0, "seed of the random NLGS ordering", check=lambda v: whole(v) and 0 <= v <= MAX_SEED,
                         expected="a whole number in 0..2147483647")
-    solver: str = setting("anderson", "the contact solver of each step, a method of the registry "
-                          "solver.contact_solvers: 'anderson' (the default), Anderson-accelerated NLGS sweeps, the "
-                          "same local-law residual in less time per step than 'nlgs', plain sweeps (docs/solver.md)",
+    solver: str = setting(contact_solvers.default_method(), "the contact solver of each step, a method of the "
+                          f"registry solver.contact_solvers (docs/solver.md): {contact_solvers.choices_help()}",
                           choices=contact_solvers.stepper_methods)
     anderson_memory: int = setting(3, "past iterates combined by the Anderson extrapolation",
                                    check=lambda v: whole(v) and 1 <= v <= 50, expected="an integer in 1..50")

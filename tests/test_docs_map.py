@@ -2,7 +2,8 @@
 
 Each module (every ``.py`` file under the two packages and their subpackages, ``__init__.py``
 aside) is one entry of the map: a table row or list item whose first backticked text is the
-module's path from the repository root (```solver/nlgs.py```). Each subpackage is an entry
+module's path from the repository root (```solver/nlgs.py```), followed by what it holds (an
+empty cell or a bare path is no entry's description). Each subpackage is an entry
 too (```grainview/formats/```, its ``__init__.py``). Every ``solver/...`` or ``grainview/...``
 path the map names anywhere must exist, so a module that is moved or removed fails here as
 much as one that is added and not described.
@@ -42,6 +43,20 @@ def entries(text: str) -> list[str]:
     return [m.group(1) for line in text.splitlines() if (m := ENTRY.match(line))]
 
 
+def undescribed(text: str) -> list[str]:
+    """The entries of the map with nothing said of them: a table row whose other cells are empty,
+    a list item with no words after its path (punctuation and backticks aside)."""
+    empty = []
+    for line in text.splitlines():
+        if not (m := ENTRY.match(line)):
+            continue
+        rest = line[m.end():]
+        words = re.sub(r"[|:;,.\-–—()`\s]", "", rest.split("`", 1)[-1] if rest.startswith("`") else rest)
+        if not words:
+            empty.append(m.group(1))
+    return empty
+
+
 def named(text: str) -> set[str]:
     """Every backticked ``solver/...`` or ``grainview/...`` path anywhere in the map."""
     return set(PATH.findall(text))
@@ -53,6 +68,18 @@ def test_every_module_has_one_entry():
     assert not missing, f"docs/map.md has no entry for {missing}"
     twice = sorted({p for p in listed if listed.count(p) > 1})
     assert not twice, f"docs/map.md lists {twice} more than once"
+
+
+def test_every_entry_says_what_its_module_holds():
+    empty = undescribed(MAP.read_text())
+    assert not empty, f"docs/map.md says nothing of {empty}"
+
+
+def test_the_check_sees_an_entry_without_a_description():
+    text = ("| module | holds |\n|---|---|\n| `solver/nlgs.py` | the sweeps |\n| `solver/empty.py` |  |\n"
+            "| `solver/dash.py` | - |\n- `grainview/formats/`: readers\n- `grainview/bare.py`:\n"
+            "- `grainview/tick.py` ``\n")
+    assert undescribed(text) == ["solver/empty.py", "solver/dash.py", "grainview/bare.py", "grainview/tick.py"]
 
 
 def test_every_path_the_map_names_exists():

@@ -27,9 +27,6 @@ import pytest
 ROOT = Path(__file__).resolve().parents[1]
 NOT_CHECKED = {
     "grainview/plot": "draws figures; writes no number",
-    "solver/body_admm.py": "matrix-form solver of captured problems (benchmarks), not a stepper method",
-    "solver/two_level.py": "matrix-form solver of captured problems (benchmarks), not a stepper method",
-    "solver/proximal_newton.py": "matrix-form solver of captured problems (benchmarks), not a stepper method",
     "solver/nonsmooth_newton.py": "matrix-form solver of captured problems, not a stepper method",
     "solver/matrix_form.py": "the matrix form (W, q) of a captured problem, for the matrix-form solvers",
     "solver/contact_solution.py": "residuals of a matrix-form solution, for the matrix-form solvers",

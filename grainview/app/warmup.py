@@ -37,11 +37,10 @@ SOLVER_PACKAGES = ("solver",)
 GROUPS = {"solver": SOLVER_PACKAGES, "analysis": ("grainview.analysis._kernels",)}
 """The kernels by what needs them: a simulation the solver's, a report the analysis's too (the
 keys of :data:`solver.paper_size.COMPILE_SECONDS`)."""
-NOT_IN_RUNS = ("solver.two_level", "solver.body_admm", "solver.residuals.local_law_residuals")
-"""Kernels that no run, study or report calls, by module or by name: the research methods
-outside the stepper's registry (matrix-form solvers of captured problems, measured by
-benchmarks/two_level.py and benchmarks/body_admm.py) and a public helper of the residuals that
-only a user's own code calls. The warm-up's workload does not compile them and
+NOT_IN_RUNS = ("solver.residuals.local_law_residuals",)
+"""Kernels that no run, study or report calls, by module or by name: a public helper of the
+residuals that only a user's own code calls (the solver research, which no run reaches either,
+lives outside the solver, in benchmarks/research/). The warm-up's workload does not compile them and
 :func:`cache_state` leaves them out (tests/grainview/test_study_time.py checks that after a
 warm-up no other kernel is missing from the cache)."""
 

@@ -46,6 +46,7 @@ import functools
 
 import xarray as xr
 
+from ._docs import fill_doc as _fill_doc
 from ._style import save_figure
 from .forces import (plot_angular_forces, plot_contact_proportions, plot_force_anisotropies,
                      plot_force_anisotropy, plot_force_pdf, plot_force_pdf_by_kind, plot_force_pdfs,
@@ -87,6 +88,7 @@ def _delegate(func):
     return method
 
 
+@_fill_doc
 class PlotAccessor:
     """The figures of one dataset: ``ds.grain.plot.q_over_p(ax=ax, label="pentagons")``
     (:attr:`grainview.accessor.GrainAccessor.plot`), or ``PlotAccessor(ds).q_over_p(...)``.
@@ -96,8 +98,7 @@ class PlotAccessor:
 
     Parameters
     ----------
-    ds : xarray.Dataset
-        A dataset of the contract.
+    {ds_short}
 
     References
     ----------

@@ -48,6 +48,12 @@ min_size : int, default 3
     "particles": """\
 particles : bool, default True
     Draw the particles under the network.""",
+    "map_options": """\
+**options
+    Keyword arguments of :func:`plot_particle_map` (``reference``, ``walls``, ``cmap``).""",
+    "fn_forces": """\
+fn : array_like of float
+    Normal forces, N.""",
     "line_kw": """\
 **line_kw
     Keyword arguments of ``matplotlib.axes.Axes.plot``.""",

@@ -38,7 +38,6 @@ the pentagon sample wherever samples are compared."""
 
 
 @fill_doc
-@fill_doc
 def plot_particles(data, ax=None, time: int = -1, facecolor=PARTICLE_FACE, edgecolor=PARTICLE_EDGE,
                    linewidth: float = 0.5, values=None, cmap=None, norm=None):
     """Draw the particles of snapshot ``time``: disks and regular polygons.
@@ -188,7 +187,6 @@ PARTICLE_FIELDS = {"c": "contacts c", "m_s": "simple contacts m_s", "m_d": "doub
 
 
 @fill_doc
-@fill_doc
 def plot_particle_map(data, field: str = "c", ax=None, time: int = -1, reference: int = 0, walls: bool = True,
                       cmap: str = "cividis"):
     """Particles of snapshot ``time`` coloured by a per-particle ``field``, with a colour bar.
@@ -252,7 +250,6 @@ def plot_particle_map(data, field: str = "c", ax=None, time: int = -1, reference
 
 
 @fill_doc
-@fill_doc
 def plot_connectivity_map(data, ax=None, time: int = -1, **options):
     """:func:`plot_particle_map` of the contacts c of each particle.
 
@@ -261,8 +258,7 @@ def plot_connectivity_map(data, ax=None, time: int = -1, **options):
     {data_one}
     {ax}
     {time_drawn}
-    **options
-        Keyword arguments of :func:`plot_particle_map` (``reference``, ``walls``, ``cmap``).
+    {map_options}
 
     Returns
     -------
@@ -277,7 +273,6 @@ def plot_connectivity_map(data, ax=None, time: int = -1, **options):
 
 
 @fill_doc
-@fill_doc
 def plot_rattler_map(data, ax=None, time: int = -1, **options):
     """:func:`plot_particle_map` of the rattlers (particles without force-bearing contacts).
 
@@ -286,8 +281,7 @@ def plot_rattler_map(data, ax=None, time: int = -1, **options):
     {data_one}
     {ax}
     {time_drawn}
-    **options
-        Keyword arguments of :func:`plot_particle_map` (``reference``, ``walls``, ``cmap``).
+    {map_options}
 
     Returns
     -------
@@ -302,7 +296,6 @@ def plot_rattler_map(data, ax=None, time: int = -1, **options):
 
 
 @fill_doc
-@fill_doc
 def plot_rotation_map(data, ax=None, time: int = -1, **options):
     """:func:`plot_particle_map` of each particle's rotation (rad) since the ``reference`` snapshot.
 
@@ -311,8 +304,7 @@ def plot_rotation_map(data, ax=None, time: int = -1, **options):
     {data_one}
     {ax}
     {time_drawn}
-    **options
-        Keyword arguments of :func:`plot_particle_map` (``reference``, ``walls``, ``cmap``).
+    {map_options}
 
     Returns
     -------
@@ -433,6 +425,7 @@ def contact_segments(ds: xr.Dataset, k: int, mask) -> tuple[np.ndarray, np.ndarr
     return segments, np.concatenate([slots, slots[across]])
 
 
+@fill_doc
 def force_linewidths(fn, max_linewidth: float, force_scale=None) -> np.ndarray:
     """Line widths proportional to the normal force, in points.
 
@@ -443,8 +436,7 @@ def force_linewidths(fn, max_linewidth: float, force_scale=None) -> np.ndarray:
 
     Parameters
     ----------
-    fn : array_like of float
-        Normal forces, N.
+    {fn_forces}
     max_linewidth : float
         Width of the force F, points.
     force_scale : float, optional
@@ -465,6 +457,7 @@ def force_linewidths(fn, max_linewidth: float, force_scale=None) -> np.ndarray:
     return max_linewidth * fn / top if top > 0 else np.zeros_like(fn)
 
 
+@fill_doc
 def width_force(fn, force_scale=None) -> float:
     """The force F (N) drawn at the largest line width.
 
@@ -472,8 +465,7 @@ def width_force(fn, force_scale=None) -> float:
 
     Parameters
     ----------
-    fn : array_like of float
-        Normal forces, N.
+    {fn_forces}
     force_scale : float, optional
         F in N.
 
@@ -615,7 +607,6 @@ def contact_collection(ax) -> LineCollection:
 
 
 @fill_doc
-@fill_doc
 def plot_force_chains(data, ax=None, time: int = -1, walls: bool = False, max_linewidth: float = 3.0,
                       colour="k", particles: bool = True, force_scale=None):
     """Map of the normal forces of snapshot ``time`` (paper Fig. 13).
@@ -660,7 +651,6 @@ def plot_force_chains(data, ax=None, time: int = -1, walls: bool = False, max_li
     return ax
 
 
-@fill_doc
 @fill_doc
 def plot_force_classes(data, ax=None, time: int = -1, walls: bool = False, very_weak: float = 0.1,
                        strong: float = 1.0, width_by_force: bool = False, linewidth: float = 1.0,
@@ -716,7 +706,6 @@ def plot_force_classes(data, ax=None, time: int = -1, walls: bool = False, very_
     return ax
 
 
-@fill_doc
 @fill_doc
 def plot_contact_kinds(data, ax=None, time: int = -1, walls: bool = False, max_linewidth: float = 3.0,
                        particles: bool = True):

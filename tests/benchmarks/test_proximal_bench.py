@@ -41,7 +41,7 @@ def test_a_probe_started_at_the_answer_returns_it(name):
 
 def test_the_outer_steps_factorisations_and_times_to_a_target():
     bench = load("proximal")
-    from solver.proximal_newton import ProximalHistory
+    from benchmarks.research.proximal_newton import ProximalHistory
 
     history = ProximalHistory(residuals=(1e-2, 1e-3, 1e-5, 1e-9), seconds=(0.0, 1.0, 2.0, 3.5),
                               alphas=(1.0, 0.1, 0.01), newton_steps=(3, 4, 5), factorisations=(3, 6, 5),

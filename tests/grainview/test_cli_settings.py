@@ -50,20 +50,45 @@ def test_every_derived_option_has_its_fields_default_type_and_help():
     assert seen == expected
 
 
+def _set_defaults(parser) -> dict:
+    """The values ``parser`` and its subparsers set by ``set_defaults`` (no option of theirs)."""
+    found = dict(parser._defaults)
+    for action in parser._actions:
+        if isinstance(action.choices, dict):  # a subcommand's parsers
+            for sub in action.choices.values():
+                found.update(_set_defaults(sub))
+    return found
+
+
 def test_no_option_of_a_simulating_command_bypasses_the_records():
-    """An option whose destination is a field of the records is the field's own option."""
+    """An option whose destination is a field of the records is the field's own option, and no
+    ``set_defaults`` gives a field of the records a value of the command line's own."""
     names = {f.name for record in RECORDS for f in fields(record)}
     for command in SIMULATING:
         for action in _subparser(command)._actions:
             if action.dest in names:
                 assert isinstance(action, cli._Given), (command, action.option_strings)
+        assert not names & set(_set_defaults(_subparser(command))), command
+
+
+def test_the_check_sees_a_record_field_set_by_set_defaults():
+    import argparse
+
+    parser = argparse.ArgumentParser()
+    sub = parser.add_subparsers().add_parser("run")
+    sub.set_defaults(func=print, tolerance=1e-3)
+    assert _set_defaults(parser) == {"func": print, "tolerance": 1e-3}
 
 
 def _numeric_defaults(source):
-    """The ``default=`` keywords of ``source`` whose value is a number written out."""
+    """The ``default=`` keywords of ``source``, and every keyword of a ``set_defaults(...)`` call,
+    whose value is a number written out."""
     found = []
-    for node in ast.walk(ast.parse(source)):
-        if isinstance(node, ast.keyword) and node.arg == "default":
+    tree = ast.parse(source)
+    set_defaults = {id(k) for node in ast.walk(tree) if isinstance(node, ast.Call)
+                    and isinstance(node.func, ast.Attribute) and node.func.attr == "set_defaults" for k in node.keywords}
+    for node in ast.walk(tree):
+        if isinstance(node, ast.keyword) and (node.arg == "default" or id(node) in set_defaults):
             sign = -1 if isinstance(node.value, ast.UnaryOp) and isinstance(node.value.op, ast.USub) else 1
             value = node.value.operand if isinstance(node.value, ast.UnaryOp) else node.value
             if isinstance(value, ast.Constant) and isinstance(value.value, (int, float)) \
@@ -95,8 +120,8 @@ def test_the_command_line_holds_no_numeric_default_of_its_own():
     """Neither an option's ``default=`` nor a module-level constant of cli.py holds a number:
     defaults come from the settings records (solver.parameters) or the library function the
     option feeds (library_default, library_constant, solver.ensemble.SEEDS_PER_SETTING)."""
-    assert _numeric_defaults("p.add_argument('--x', default=-0.5)\np.add_argument('--y', default=3)") \
-        == [(1, -0.5), (2, 3)]  # the scan sees them
+    assert _numeric_defaults("p.add_argument('--x', default=-0.5)\np.add_argument('--y', default=3)\n"
+                             "p.set_defaults(func=run, every=20)") == [(1, -0.5), (2, 3), (3, 20)]  # the scan sees them
     assert _numeric_constants("SEEDS = 3\nSIZE = {'n': 11}\nNAMES = ('a',)\nX = len('..') + 7", {"X"}) \
         == [(1, ["SEEDS"], [3]), (2, ["SIZE"], [11])]
     source = Path(cli.__file__).read_text(encoding="utf-8")

@@ -1,6 +1,6 @@
 """The figures only draw: no analysis function is defined under grainview/plot/.
 
-Every public function of a module of grainview/plot/ either returns what it drew (its numpydoc
+Every function (public or private) of a module of grainview/plot/ either returns what it drew (its numpydoc
 ``Returns`` names a matplotlib type: Axes, Figure, lines) or is one of the drawing helpers listed
 here, each with what it is for. Anything that computes a result from a dataset belongs to a topic
 module of grainview/analysis/ (and to ``ds.grain``), where the figures call it."""
@@ -44,6 +44,26 @@ DRAWING_HELPERS = {
 """The public functions of grainview/plot/ that draw, label or save without returning a
 matplotlib object, and what each is for."""
 
+PRIVATE_HELPERS = {
+    "_delegate": "a figure as a method of ds.grain.plot", "_used_colours": "the colours already on the axes",
+    "_chains_of": "the snapshot of chains a map draws", "_fields_of": "the snapshot of fields a map draws",
+    "_names": "the field names a figure accepts", "_label": "a field's axis label",
+    "_frame": "the box or cell drawn around a map", "_polar": "a polar force profile drawn",
+    "_cartesian_profile": "a force profile drawn against theta", "_pdf": "the pooled pdf a figure draws",
+    "_draw_pdf": "a pdf's bins drawn", "_draw_fit": "a pdf's exponential fit drawn", "_pdf_axes": "a pdf's scales",
+    "_outside_note": "a panel's note of contacts out of range", "_xi": "a profile against xi drawn",
+    "_angles": "phi and psi as the stress-dilatancy figure draws them (the analysis's)",
+    "_partial_q_over_p": "q/p by contact kind as a figure draws it (the analysis's)",
+    "_cell_of": "a periodic map's cell", "_cell_corners": "a periodic map's cell corners",
+    "_cell_outline": "a periodic map's cell outline", "_cell_images": "the particle images a periodic map draws",
+    "_network": "the contact network drawn on a map", "_clip_to_cell": "an artist clipped to the cell",
+    "_digits": "a number in a legend", "_legend": "a map's legend", "_writer": "a movie's writer",
+    "_result": "the persistence result a figure draws", "_with_particles": "a result carrying its particles",
+}
+"""The private functions of grainview/plot/ that return no matplotlib object, and what each is
+for: a private helper is checked as a public one is, so that no analysis hides behind an
+underscore."""
+
 
 def _returns(func: ast.FunctionDef) -> str:
     """The first line of a function's numpydoc Returns section ('' without one), its shared
@@ -53,11 +73,12 @@ def _returns(func: ast.FunctionDef) -> str:
 
 
 def analysis_functions(source: str) -> list:
-    """The public top-level functions of ``source`` that return no matplotlib object and are not
-    listed drawing helpers: analysis that belongs to grainview/analysis/."""
+    """The top-level functions of ``source``, public or private, that return no matplotlib object
+    and are not listed helpers (:data:`DRAWING_HELPERS`, :data:`PRIVATE_HELPERS`): analysis
+    that belongs to grainview/analysis/."""
     return [node.name for node in ast.parse(source).body
-            if isinstance(node, ast.FunctionDef) and not node.name.startswith("_")
-            and "matplotlib" not in _returns(node) and node.name not in DRAWING_HELPERS]
+            if isinstance(node, ast.FunctionDef) and "matplotlib" not in _returns(node)
+            and node.name not in DRAWING_HELPERS and node.name not in PRIVATE_HELPERS]
 
 
 def test_the_check_sees_an_analysis_function():
@@ -82,8 +103,11 @@ def thing_profile(ds):
 
 def _private(ds):
     return ds
+
+def _delegate(func):
+    return func
 '''
-    assert analysis_functions(source) == ["thing_profile"]
+    assert analysis_functions(source) == ["thing_profile", "_private"]  # a private one too
 
 
 def test_no_analysis_function_is_defined_under_plot():
@@ -98,3 +122,4 @@ def test_every_listed_helper_is_still_there():
     defined = {node.name for path in PLOT.glob("*.py") for node in ast.parse(path.read_text()).body
                if isinstance(node, ast.FunctionDef)}
     assert set(DRAWING_HELPERS) - defined == set()
+    assert set(PRIVATE_HELPERS) - defined == set()

@@ -4,6 +4,7 @@ the stepper's dispatch through it, the problem a step poses and the step's stage
 import copy
 import dataclasses
 import pickle
+import re
 import time
 import warnings
 
@@ -42,10 +43,48 @@ def test_an_unknown_or_matrix_only_solver_is_refused_in_one_line_naming_the_regi
 
 def test_a_method_registers_once():
     with pytest.raises(ValueError, match="'nlgs' is already registered"):
-        contact_solvers.register(contact_solvers.Method("nlgs", "again", solve=lambda *a: None))
+        contact_solvers.register(contact_solvers.Method("nlgs", "again", "alternative", solve=lambda *a: None))
     with pytest.raises(ValueError, match="needs a stepper entry"):
-        contact_solvers.register(contact_solvers.Method("nothing", "no entry point"))
+        contact_solvers.register(contact_solvers.Method("nothing", "no entry point", "alternative"))
     assert "nothing" not in contact_solvers.stepper_methods() + contact_solvers.matrix_methods()
+
+
+def _stepper(problem, state, limits, *, memory=3):
+    pass
+
+
+def _matrix(W, q, mu, tolerance, max_iterations, initial, *, scale=1.0):
+    pass
+
+
+@pytest.mark.parametrize("entry, words", [
+    (dict(status="best", solve=_stepper), "status='best', expected one of default, alternative, experimental"),
+    (dict(status="default", solve=_stepper), "the default is one stepper method ('anderson' is)"),
+    (dict(status="default", solve_matrix=_matrix), "the default is one stepper method"),
+    (dict(status="alternative", solve=_matrix), "solve takes (W, q, mu, tolerance, max_iterations, initial) where "
+                                                "StepperSolve takes (problem, state, limits)"),
+    (dict(status="alternative", solve_matrix=_stepper), "solve_matrix takes (problem, state, limits) where "
+                                                        "MatrixSolve takes (W, q, mu, tolerance, max_iterations, "
+                                                        "initial)"),
+    (dict(status="alternative", solve=lambda problem, state, limits, memory: None),
+     "solve takes (problem, state, limits, memory)"),
+])
+def test_a_method_is_refused_without_a_status_or_with_an_entry_point_of_another_signature(entry, words):
+    with pytest.raises(ValueError, match=re.escape(words)):
+        contact_solvers.register(contact_solvers.Method("trial", "a trial", **entry))
+    assert "trial" not in contact_solvers.stepper_methods() + contact_solvers.matrix_methods()
+
+
+def test_every_method_has_a_status_and_the_stepper_one_default():
+    statuses = {name: contact_solvers.method(name).status
+                for name in (*contact_solvers.stepper_methods(), *contact_solvers.matrix_methods())}
+    assert set(statuses.values()) <= set(contact_solvers.STATUSES)
+    assert [name for name, status in statuses.items() if status == "default"] == [Parameters.solver] == \
+        [contact_solvers.default_method()]
+    assert [name for name, _, _ in contact_solvers.choices()] == ["anderson", "nlgs", "pcg"]  # the default first
+    assert [status for _, status, _ in contact_solvers.choices()] == ["default", "alternative", "experimental"]
+    for name, status, summary in contact_solvers.choices():
+        assert f"{name!r} ({status}): {summary}" in contact_solvers.choices_help()
 
 
 def test_what_a_method_cannot_run_with_is_named():

@@ -1,4 +1,4 @@
-"""solver/proximal_newton.py: proximal-point steps around the semi-smooth Newton, on problems
+"""benchmarks/research/proximal_newton.py: proximal-point steps around the semi-smooth Newton, on problems
 solved by hand (one point open, sticking, sliding; two bodies stacked on a floor) and on random
 systems of bodies against the NLGS; each result's residual recomputed here from its impulses."""
 
@@ -8,11 +8,12 @@ import numpy as np
 import pytest
 from scipy import sparse
 
+from benchmarks.research import proximal_newton
 from grainview.contract.errors import ParameterError
-from solver import proximal_newton, residuals
+from solver import residuals
 from solver.contact_problem import solve_contact_problem
 
-from .conftest import random_body_problem
+from ...solver.conftest import random_body_problem
 
 
 def independent_residual(W, q, mu, impulse):

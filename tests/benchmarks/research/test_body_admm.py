@@ -1,12 +1,12 @@
-"""Body-space ADMM (solver/body_admm.py) on problems whose answer is known by hand, and on a
+"""Body-space ADMM (benchmarks/research/body_admm.py) on problems whose answer is known by hand, and on a
 random problem against the NLGS."""
 
 import numpy as np
 import pytest
 from scipy import sparse
 
+from benchmarks.research import body_admm
 from grainview.contract.errors import ParameterError
-from solver import body_admm
 from solver.contact_problem import solve_contact_problem
 from solver.contact_solution import contact_solution
 

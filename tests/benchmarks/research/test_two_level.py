@@ -1,4 +1,4 @@
-"""The two-level method (solver/two_level.py) on problems whose answer is known by hand, and on a
+"""The two-level method (benchmarks/research/two_level.py) on problems whose answer is known by hand, and on a
 random problem against the NLGS."""
 
 import sys
@@ -9,8 +9,9 @@ from scipy import sparse
 
 pytest.importorskip("pyamg")
 
+from benchmarks.research import two_level  # noqa: E402
 from grainview.contract.errors import ParameterError  # noqa: E402
-from solver import residuals, two_level  # noqa: E402
+from solver import residuals  # noqa: E402
 from solver.contact_problem import solve_contact_problem  # noqa: E402
 
 W_SLIDE = np.diag([2.0, 2.0])

@@ -53,9 +53,9 @@ from numba import njit
 
 from grainview.contract.errors import ParameterError
 
-from .contact_solution import ContactSolution, contact_solution, local_law_residual, natural_map_at
-from .residuals import cone_projection
-from .solve_records import Impulses, Limits, MatrixProblem
+from solver.contact_solution import ContactSolution, contact_solution, local_law_residual, natural_map_at
+from solver.residuals import cone_projection
+from solver.solve_records import Impulses, Limits, MatrixProblem
 
 __all__ = ["OPEN", "STICKING", "SLIDING", "CycleRecord", "Face", "TwoLevelResult", "classify", "face_basis",
            "project_on_cones", "cone_minimiser", "convex_sweeps", "solve", "solve_recorded"]
@@ -273,8 +273,8 @@ def solve_recorded(W, q, mu, tolerance, max_iterations, initial, *, coarse=True,
     TwoLevelResult: the :class:`ContactSolution` (iterations = cycles), the starting residual and
     one :class:`CycleRecord` per cycle.
     """
-    from . import nlgs
-    from .contact_problem import check_problem
+    from solver import nlgs
+    from solver.contact_problem import check_problem
 
     W, q, mu, n = check_problem(W, q, mu)
     initial = np.asarray(initial, dtype=np.float64).reshape(-1)

@@ -62,8 +62,8 @@ from numba import njit
 
 from grainview.contract.errors import ParameterError
 
-from .contact_solution import ContactSolution, largest_point_residual, local_law_residual, natural_map_at
-from .residuals import cone_projection
+from solver.contact_solution import ContactSolution, largest_point_residual, local_law_residual, natural_map_at
+from solver.residuals import cone_projection
 
 STALL_WINDOW = 100
 """Iterations over which ``stall_growth`` looks for progress of the best local-law residual."""

@@ -39,8 +39,8 @@ from scipy import sparse
 
 from grainview.contract.errors import ParameterError
 
-from . import nonsmooth_newton
-from .contact_solution import ContactSolution, contact_solution, local_law_residual, natural_map
+from solver import nonsmooth_newton
+from solver.contact_solution import ContactSolution, contact_solution, local_law_residual, natural_map
 
 __all__ = ["ALPHA", "GROW", "INNER_RATIO", "INNER_STEPS", "SHRINK", "ProximalHistory", "solve", "solve_recorded"]
 

@@ -1,0 +1,1 @@
+"""Tests of the solver research (benchmarks/research/): experiments no user path reaches."""
