@@ -1,5 +1,5 @@
 """Simulation engines behind one interface: what the command line's ``run``, ``study`` and
-``ensemble`` (and :mod:`solver.ensemble`) ask of the code that simulates.
+``ensemble`` (and :mod:`grainview.app.ensemble`) ask of the code that simulates.
 
 An engine makes a sample as a :class:`solver.preparation.Preparation` says (``prepare``),
 shears it in the biaxial test a :class:`solver.parameters.BiaxialTest` describes into a file

@@ -380,7 +380,7 @@ def _simulate(prep, path, *, test, near_contacts, overwrite, progress, scene="bi
         print(f"{name}: depositing {prep.particles} particles and compacting under {prep.sigma0:g} Pa ...", flush=True)
     from time import monotonic
 
-    from solver.paper_size import hours
+    from grainview.app.paper_size import hours
 
     start = monotonic()
     with warnings.catch_warnings(record=True) as caught:
@@ -418,9 +418,9 @@ def _simulate(prep, path, *, test, near_contacts, overwrite, progress, scene="bi
 
 
 def _inertia(sample, test) -> str:
-    """The test's inertia numbers at its start, in words (:func:`solver.paper_size.inertia_numbers`),
+    """The test's inertia numbers at its start, in words (:func:`grainview.app.paper_size.inertia_numbers`),
     or "" for a sample that is not this package's simulation."""
-    from solver.paper_size import inertia_numbers
+    from grainview.app.paper_size import inertia_numbers
 
     try:
         paper, grain = inertia_numbers(sample, test.velocity)
@@ -564,7 +564,7 @@ def _run(args) -> int:
     from solver.engine import DEFAULT_ENGINE
 
     if (args.engine or DEFAULT_ENGINE) == DEFAULT_ENGINE:
-        from solver.paper_size import machine_load
+        from grainview.app.paper_size import machine_load
 
         from .warmup import cold_shares
 
@@ -639,7 +639,7 @@ def _split(text, kind, name):
 
 
 def _ensemble(args) -> int:
-    from solver.ensemble import check_cluster, grid, run_ensemble
+    from grainview.app.ensemble import check_cluster, grid, run_ensemble
 
     check_cluster(args.scheduler, args.workers)  # before any line is printed; the library's one check
     test = _test(args)
@@ -678,8 +678,8 @@ def _ensemble(args) -> int:
 def _study_particles(args) -> dict:
     """The study's sample sizes, label -> particles: ``--particles N`` for both samples,
     ``--particles N1,N2`` for the pentagons and the disks, ``--paper-size`` the paper's
-    (:data:`solver.paper_size.PAPER_PARTICLES`)."""
-    from solver.paper_size import PAPER_PARTICLES
+    (:data:`grainview.app.paper_size.PAPER_PARTICLES`)."""
+    from grainview.app.paper_size import PAPER_PARTICLES
 
     if args.paper_size:
         if "particles" in _given(args):
@@ -701,10 +701,10 @@ def _study_particles(args) -> dict:
 def _study_tests(args, particles) -> dict:
     """The study's biaxial test of each sample, label -> :class:`solver.parameters.BiaxialTest`:
     the command line's; with ``--paper-size`` and no ``--velocity``, each sample's top wall at
-    the strain rate of 400 particles at 1 cm/s (:func:`solver.paper_size.velocity_for`)."""
+    the strain rate of 400 particles at 1 cm/s (:func:`grainview.app.paper_size.velocity_for`)."""
     from dataclasses import replace
 
-    from solver.paper_size import velocity_for
+    from grainview.app.paper_size import velocity_for
 
     test = _test(args)
     if not args.paper_size or "velocity" in _given(args):
@@ -765,7 +765,7 @@ def _study_sample(label, prep, path, state, checkpoint, *, test, near_contacts, 
         import warnings
         from time import monotonic
 
-        from solver.paper_size import hours
+        from grainview.app.paper_size import hours
 
         print(f"{label}: resuming the test in {path} ...", flush=True)
         start = monotonic()
@@ -791,8 +791,8 @@ def _print_estimate(preps, tests, parameters, jobs, shares=None, report=True, lo
     where its cost comes from, the compiling (``shares``: :func:`grainview.app.warmup.cold_shares`
     of a cold cache) and the report (``report``), the machine's load (``load``: (load average,
     cores), default this machine's) and what it makes of them, and the whole
-    (:func:`solver.paper_size.study_estimate`)."""
-    from solver.paper_size import STUDY_TIME, hours, machine_load, study_estimate
+    (:func:`grainview.app.paper_size.study_estimate`)."""
+    from grainview.app.paper_size import STUDY_TIME, hours, machine_load, study_estimate
     from solver.parameters import Parameters
 
     p = Parameters(**parameters)
@@ -833,7 +833,7 @@ def _compile_line(command, shares, load) -> str:
     """The line that says, before anything else, that the kernels are compiled first and for
     about how long (``shares``: :func:`grainview.app.warmup.cold_shares`; ``load``: (load
     average, cores)); "" on a warm cache."""
-    from solver.paper_size import COMPILE_SECONDS, hours, load_factor
+    from grainview.app.paper_size import COMPILE_SECONDS, hours, load_factor
 
     seconds = sum(COMPILE_SECONDS[group] * share for group, (share, _) in shares.items())
     if not seconds:
@@ -851,7 +851,7 @@ def _compile_ahead(command, shares, progress):
     auto), else a line a minute too. Ends with a line saying how long it took."""
     from time import monotonic
 
-    from solver.paper_size import hours
+    from grainview.app.paper_size import hours
 
     from .warmup import GROUPS, warm_up
 
@@ -981,7 +981,7 @@ def _study(args) -> int:
     to_run = [label for label, state in states.items() if state != "finished"]
     if to_run:
         from solver.engine import DEFAULT_ENGINE
-        from solver.paper_size import machine_load
+        from grainview.app.paper_size import machine_load
 
         from .warmup import GROUPS, cold_shares
 
@@ -1200,7 +1200,7 @@ def _simulation_options(p, samples=1):
 
 
 def _study_parser(sub):
-    from solver.paper_size import PAPER_PARTICLES, REFERENCE_PARTICLES, REFERENCE_VELOCITY, velocity_for
+    from grainview.app.paper_size import PAPER_PARTICLES, REFERENCE_PARTICLES, REFERENCE_VELOCITY, velocity_for
     from solver.preparation import Preparation
 
     minutes = library_constant("solver.compaction_checkpoint", "CHECKPOINT_SECONDS") / 60
@@ -1308,7 +1308,7 @@ def _ensemble_parser(sub):
         default = getattr(Preparation, name)
         ens.add_argument(_flag(name), dest=f"{name}_list", default=None,
                          help=f"comma-separated values of {name}{unit} (default {default:g}, the preparation's)")
-    seeds = library_constant("solver.ensemble", "SEEDS_PER_SETTING")
+    seeds = library_constant("grainview.app.ensemble", "SEEDS_PER_SETTING")
     ens.add_argument("--seeds", type=int, default=seeds, help=f"seeds per setting (default {seeds})")
     setting_option(ens, Preparation, "seed", flag="--first-seed", help=f"first seed (default {Preparation.seed})")
     _test_options(ens)
@@ -1386,7 +1386,7 @@ def _demo_parser(sub):
 
 
 def _warmup_parser(sub):
-    from solver.paper_size import COMPILE_SECONDS, STUDY_TIME, hours
+    from grainview.app.paper_size import COMPILE_SECONDS, STUDY_TIME, hours
 
     cold = hours(sum(COMPILE_SECONDS.values()))
     warmup = sub.add_parser("warmup", help="compile every numba kernel into the cache, so that runs start at once",

@@ -36,7 +36,7 @@ SOLVER_PACKAGES = ("solver",)
 :data:`PACKAGES`' others."""
 GROUPS = {"solver": SOLVER_PACKAGES, "analysis": ("grainview.analysis._kernels",)}
 """The kernels by what needs them: a simulation the solver's, a report the analysis's too (the
-keys of :data:`solver.paper_size.COMPILE_SECONDS`)."""
+keys of :data:`grainview.app.paper_size.COMPILE_SECONDS`)."""
 NOT_IN_RUNS = ("solver.two_level", "solver.body_admm", "solver.residuals.local_law_residuals")
 """Kernels that no run, study or report calls, by module or by name: the research methods
 outside the stepper's registry (matrix-form solvers of captured problems, measured by

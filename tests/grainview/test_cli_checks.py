@@ -120,14 +120,14 @@ def test_shape_given_as_a_number_of_vertices_runs(tmp_path, capsys):
 
 
 def test_ensemble_shapes_are_names_and_numbers(tmp_path, monkeypatch):
-    import solver.ensemble
+    import grainview.app.ensemble
 
     seen = []
 
     def run_ensemble(specs, out, **kwargs):
         seen.extend(specs)
         return []
-    monkeypatch.setattr(solver.ensemble, "run_ensemble", run_ensemble)
+    monkeypatch.setattr(grainview.app.ensemble, "run_ensemble", run_ensemble)
     assert main(["ensemble", "--shapes", "disk, 6,pentagons", "--seeds", "1", "--no-report",
                  "--out", str(tmp_path / "e")]) == 0
     assert [s.shape for s in seen] == ["disk", 6, "pentagons"]

@@ -94,7 +94,7 @@ NOT_SETTINGS = set()
 def test_the_command_line_holds_no_numeric_default_of_its_own():
     """Neither an option's ``default=`` nor a module-level constant of cli.py holds a number:
     defaults come from the settings records (solver.parameters) or the library function the
-    option feeds (library_default, library_constant, solver.ensemble.SEEDS_PER_SETTING)."""
+    option feeds (library_default, library_constant, grainview.app.ensemble.SEEDS_PER_SETTING)."""
     assert _numeric_defaults("p.add_argument('--x', default=-0.5)\np.add_argument('--y', default=3)") \
         == [(1, -0.5), (2, 3)]  # the scan sees them
     assert _numeric_constants("SEEDS = 3\nSIZE = {'n': 11}\nNAMES = ('a',)\nX = len('..') + 7", {"X"}) \
@@ -114,7 +114,7 @@ def test_options_of_other_functions_take_those_functions_defaults():
     assert cli.library_default("grainview.analysis.synthetic", "harmonic_series", "seed") \
         == inspect.signature(harmonic_series).parameters["seed"].default
     from grainview.app.demo import run_demo
-    from solver.ensemble import SEEDS_PER_SETTING, grid
+    from grainview.app.ensemble import SEEDS_PER_SETTING, grid
 
     demo = build_parser().parse_args(["demo"])
     assert (demo.snapshots, demo.contacts) == tuple(inspect.signature(run_demo).parameters[k].default
@@ -238,7 +238,7 @@ def test_run_reaches_the_simulation_through_the_chosen_engine(tmp_path, fake_eng
 
 
 def test_ensemble_runs_go_through_their_engine(tmp_path, fake_engine):
-    from solver.ensemble import grid, run_one
+    from grainview.app.ensemble import grid, run_one
 
     spec, = grid(shapes=("disk",), particles=(12,), seeds=1, engine="fake", strain=0.05, every=5)
     result = run_one(spec, tmp_path)

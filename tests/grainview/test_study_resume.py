@@ -155,7 +155,7 @@ def test_bad_sizes_are_refused_in_one_line(tmp_path, capsys, argv, fragment):
 
 
 def test_estimate_from_measured_costs():
-    from solver.paper_size import COSTS, estimate, velocity_for
+    from grainview.app.paper_size import COSTS, estimate, velocity_for
     from solver.parameters import BiaxialTest
     from solver.preparation import preparation
 
