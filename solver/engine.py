@@ -25,6 +25,8 @@ from typing import Protocol, runtime_checkable
 
 from grainview.contract.errors import ParameterError
 
+from .parameters import SHEAR_STRAIN  # noqa: F401 (the periodic shear scene's default gamma, for the command line)
+
 ENTRY_POINT_GROUP = "grainview.engines"
 """Entry-point group through which installed packages register engines."""
 

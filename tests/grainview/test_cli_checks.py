@@ -75,7 +75,7 @@ def test_an_output_name_too_long_for_the_writers_temporary_files_is_refused(tmp_
 def test_the_longest_accepted_name_is_written_and_compressed(tmp_path):
     """The limit is the writer's: a file of the longest accepted name is created, appended and
     compressed (its temporary names fit)."""
-    from grainview.app.cli import longest_output_name
+    from grainview.app.simulation import longest_output_name
     from grainview.contract.writer import compress_file
 
     from . import builders

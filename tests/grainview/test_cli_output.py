@@ -49,7 +49,7 @@ def _wide_table():
 
 @pytest.mark.parametrize("width", [60, 80, 237])
 def test_terminal_table_fits_the_width_and_rounds_as_the_markdown(width):
-    from grainview.app.report import terminal_table
+    from grainview.app.table_text import terminal_table
 
     text = terminal_table(_wide_table(), width=width)
     lines = text.splitlines()

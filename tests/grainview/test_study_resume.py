@@ -11,7 +11,9 @@ import netCDF4
 import numpy as np
 import pytest
 
-from grainview.app.cli import _study_particles, _study_tests, build_parser, main
+from grainview.app.cli import build_parser, main
+from grainview.app.study import study_particles as _study_particles
+from grainview.app.study import study_tests as _study_tests
 from solver import stepper
 from solver.compaction_checkpoint import CompactionCheckpoint
 
@@ -174,7 +176,7 @@ def test_estimate_from_measured_costs():
 
 
 def test_side_by_side_progress_without_a_terminal_prints_lines(capsys):
-    from grainview.app.cli import _SampleProgress
+    from grainview.app.progress import SampleProgress as _SampleProgress
 
     progress = _SampleProgress.for_jobs(None)
     assert _SampleProgress.for_jobs(False) is False and _SampleProgress.for_jobs(True).terminal

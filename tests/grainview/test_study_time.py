@@ -16,7 +16,10 @@ import warnings
 
 import pytest
 
-from grainview.app.cli import _compile_line, _print_estimate, _study_sample, _warnings_as_notes, main
+from grainview.app.cli import _warnings_as_notes, main
+from grainview.app.estimates import compile_line as _compile_line
+from grainview.app.estimates import print_estimate as _print_estimate
+from grainview.app.study import study_sample as _study_sample
 from grainview.contract.errors import ConvergenceWarning
 from grainview.app import paper_size
 from solver.parameters import BiaxialTest
