@@ -9,7 +9,7 @@ LocalCluster with bounded memory per worker.
 committed numbers are that file's.
 
 Runner: the same set of small biaxial tests (pentagons and disks, one seed each per worker)
-run by ``solver.ensemble.run_ensemble`` on a LocalCluster of 1 worker, then of 2 workers (cold
+run by ``grainview.app.ensemble.run_ensemble`` on a LocalCluster of 1 worker, then of 2 workers (cold
 output folders, warm numba cache); efficiency = T(1 worker) / (workers x T(workers)).
 
 Out of core: ``runs`` synthetic harmonic-model series (grainview.analysis.synthetic, streamed to disk)
@@ -45,7 +45,7 @@ def runner_efficiency(folder, particles=100, seeds=2, strain=0.02, workers=(1, 2
     """Wall time of one ensemble (pentagons + disks x ``seeds``) on each worker count."""
     import shutil
 
-    from solver.ensemble import grid, run_ensemble
+    from grainview.app.ensemble import grid, run_ensemble
 
     specs = grid(shapes=("pentagon", "disk"), particles=(particles,), seeds=seeds, strain=strain, every=100)
     times, steps, inside = {}, {}, {}

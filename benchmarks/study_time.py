@@ -14,7 +14,7 @@ stderr; the study's progress lines left out of the table) is timestamped as it a
 1-minute load average then and the processor time (user + system) used so far by the command
 and its worker processes, so the table gives the time to the first line, to each stage and to
 the end, and what each stage cost in processor time: the time it takes on a core with nothing
-else on it, which solver/paper_size.py's 400-particle costs, ``COMPILE_SECONDS`` and
+else on it, which grainview/app/paper_size.py's 400-particle costs, ``COMPILE_SECONDS`` and
 ``REPORT_SECONDS`` are taken from (the ``calibration`` run: a ``--jobs 1`` study runs its stages
 one after the other in one process, so the processor time between two of its lines is that
 stage's). The study's own

@@ -5,7 +5,8 @@ the new place.
 grainview's modules live in rooms by concern (docs/map.md): the analysis in
 ``grainview/analysis/`` (its pure array functions in ``analysis/arrays/``, its numba kernels in
 ``analysis/_kernels/``), other formats and the export in ``grainview/formats/``, the report and
-the command line in ``grainview/app/``. Scripts and notebooks written against the former flat
+the command line in ``grainview/app/``, with the application code that once sat in the solver
+(``solver.ensemble``, ``solver.paper_size``). Scripts and notebooks written against the former flat
 layout keep working through the finder below, which serves each former name by importing the
 module at its new place and registering that module under the former name as well, so that
 both names give one module (its functions, classes and state are shared, nothing is copied).
@@ -28,6 +29,7 @@ MOVED = {
     **{f"grainview.{name}": f"grainview.app.{name}" for name in (
         "cli", "convergence", "ensemble_report", "file_summary", "report", "warmup")},
     **{f"grainview.{name}": f"grainview.formats.{name}" for name in ("export", "opening", "vtk_xml")},
+    **{f"solver.{name}": f"grainview.app.{name}" for name in ("ensemble", "paper_size")},
 }
 """Former module name -> its place now; a former package's submodules follow it."""
 

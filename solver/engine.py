@@ -1,5 +1,5 @@
 """Simulation engines behind one interface: what the command line's ``run``, ``study`` and
-``ensemble`` (and :mod:`solver.ensemble`) ask of the code that simulates.
+``ensemble`` (and :mod:`grainview.app.ensemble`) ask of the code that simulates.
 
 An engine makes a sample as a :class:`solver.preparation.Preparation` says (``prepare``),
 shears it in the biaxial test a :class:`solver.parameters.BiaxialTest` describes into a file
@@ -24,6 +24,8 @@ import importlib
 from typing import Protocol, runtime_checkable
 
 from grainview.contract.errors import ParameterError
+
+from .parameters import SHEAR_STRAIN  # noqa: F401 (the periodic shear scene's default gamma, for the command line)
 
 ENTRY_POINT_GROUP = "grainview.engines"
 """Entry-point group through which installed packages register engines."""

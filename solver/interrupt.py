@@ -28,6 +28,28 @@ PROGRESS_LINE_SECONDS = 60.0
 
 
 @contextlib.contextmanager
+def handling(handler, signals=STOP_SIGNALS):
+    """Within the block, ``handler(signum, frame)`` handles each of ``signals``; the previous
+    handlers are restored after it (the default action where the previous one was not set
+    from Python). Yields True, or False outside the main thread, where no handler can be set
+    and none is."""
+    previous = {}
+    try:
+        for signum in signals:
+            previous[signum] = signal.signal(signum, handler)
+    except ValueError:  # not the main thread
+        for signum, old in previous.items():
+            signal.signal(signum, old if old is not None else signal.SIG_DFL)
+        yield False
+        return
+    try:
+        yield True
+    finally:
+        for signum, old in previous.items():
+            signal.signal(signum, old if old is not None else signal.SIG_DFL)
+
+
+@contextlib.contextmanager
 def interruptible():
     """Turn Ctrl-C and SIGTERM into a flag checked between steps, so a run stops after a whole
     step: ``state["stop"]`` becomes True and ``state["signal"]`` names the signal."""
@@ -40,20 +62,8 @@ def interruptible():
         state["stop"] = True
         state["signal"] = signum
 
-    previous = {}
-    try:
-        for signum in STOP_SIGNALS:
-            previous[signum] = signal.signal(signum, handler)
-    except ValueError:  # not the main thread
-        for signum, old in previous.items():
-            signal.signal(signum, old)
+    with handling(handler):
         yield state
-        return
-    try:
-        yield state
-    finally:
-        for signum, old in previous.items():
-            signal.signal(signum, old)
 
 
 @contextlib.contextmanager
@@ -70,15 +80,8 @@ def sigterm_raises():
     def handler(_signum, _frame):
         raise Terminated()
 
-    try:
-        previous = signal.signal(signal.SIGTERM, handler)
-    except ValueError:  # not the main thread
+    with handling(handler, (signal.SIGTERM,)):
         yield
-        return
-    try:
-        yield
-    finally:
-        signal.signal(signal.SIGTERM, previous if previous is not None else signal.SIG_DFL)
 
 
 def stop_exception(state) -> BaseException:

@@ -272,6 +272,11 @@ def _half(value):
     return int(value) // 2 if whole(value) else "?"
 
 
+SHEAR_STRAIN = 0.5
+"""The final shear gamma of the periodic shear scene by default (:mod:`solver.periodic_shear`;
+the biaxial test's strain, :class:`BiaxialTest`, is an eps_1)."""
+
+
 @dataclass(frozen=True)
 class BiaxialTest:
     """The biaxial test of a prepared sample (:func:`solver.scenes.biaxial_test`): the top wall

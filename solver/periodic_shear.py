@@ -27,11 +27,10 @@ from .cell_coupling import check_solver
 from .contact_points import rank_in_pair
 from .interrupt import interruptible, progress_bar, resume_instructions, stop_exception, stop_reason
 from .output import Recorder
+from .parameters import SHEAR_STRAIN
 from .periodic_cell import PeriodicCell
 from .stepper import Simulation
 
-SHEAR_STRAIN = 0.5
-"""Default final shear gamma."""
 SHEAR_EVERY = 200
 """Default steps between snapshots."""
 CELL_MASS = 0.1

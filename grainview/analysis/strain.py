@@ -14,18 +14,13 @@ from ..contract import portable_math
 from ..contract.cell import unwrap_tilt
 from . import sample
 from ._lift import ratio, with_attrs
-from .arrays.strain import log_strain
+from .arrays.strain import RESIDUAL_STRAIN, log_strain
 from ..contract.errors import ParameterError
 from .stress import stress_invariants
 from ._docs import fill_doc
 
 __all__ = ["time_derivative", "strains", "deformation_gradient", "residual_window", "shear_strain",
            "friction_and_dilatancy", "friction_offset", "inertia_number"]
-
-RESIDUAL_STRAIN = 0.3
-"""Start of the residual state in shear strain eps_q (the paper reads its residual values at
-eps_q >= 0.3: Figs. 7, 8, 10 and the residual plateaus of Figs. 3, 6, 9, 11)."""
-
 
 def time_derivative(da: xr.DataArray) -> xr.DataArray:
     """d(da)/dt by centred differences (one-sided at both ends), lazily on any chunking.

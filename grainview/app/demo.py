@@ -13,8 +13,13 @@ from pathlib import Path
 
 from ..contract.errors import ParameterError
 
+SNAPSHOTS = 11
+"""Snapshots of the demo's series by default."""
+CONTACTS = 20000
+"""Contacts per snapshot of the demo's series by default: enough that reading it lazily matters."""
 
-def run_demo(out, *, snapshots=11, contacts=20000, seed=None, overwrite=False, compress=True, log=None):
+
+def run_demo(out, *, snapshots=SNAPSHOTS, contacts=CONTACTS, seed=None, overwrite=False, compress=True, log=None):
     """Write ``out/synthetic.nc`` (``snapshots`` snapshots of ``contacts`` contacts; large
     enough by default that reading it lazily matters) and ``out/harmonic_prediction.csv``.
 

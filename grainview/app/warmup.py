@@ -36,7 +36,7 @@ SOLVER_PACKAGES = ("solver",)
 :data:`PACKAGES`' others."""
 GROUPS = {"solver": SOLVER_PACKAGES, "analysis": ("grainview.analysis._kernels",)}
 """The kernels by what needs them: a simulation the solver's, a report the analysis's too (the
-keys of :data:`solver.paper_size.COMPILE_SECONDS`)."""
+keys of :data:`grainview.app.paper_size.COMPILE_SECONDS`)."""
 NOT_IN_RUNS = ("solver.residuals.local_law_residuals",)
 """Kernels that no run, study or report calls, by module or by name: a public helper of the
 residuals that only a user's own code calls (the solver research, which no run reaches either,

@@ -11,7 +11,7 @@ import netCDF4
 import numpy as np
 import pytest
 
-from grainview.app.cli import _simulate
+from grainview.app.simulation import simulate as _simulate
 from grainview.contract.errors import ParameterError
 from solver.parameters import BiaxialTest
 from solver.preparation import preparation

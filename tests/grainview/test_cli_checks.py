@@ -75,7 +75,7 @@ def test_an_output_name_too_long_for_the_writers_temporary_files_is_refused(tmp_
 def test_the_longest_accepted_name_is_written_and_compressed(tmp_path):
     """The limit is the writer's: a file of the longest accepted name is created, appended and
     compressed (its temporary names fit)."""
-    from grainview.app.cli import longest_output_name
+    from grainview.app.simulation import longest_output_name
     from grainview.contract.writer import compress_file
 
     from . import builders
@@ -120,14 +120,14 @@ def test_shape_given_as_a_number_of_vertices_runs(tmp_path, capsys):
 
 
 def test_ensemble_shapes_are_names_and_numbers(tmp_path, monkeypatch):
-    import solver.ensemble
+    import grainview.app.ensemble
 
     seen = []
 
     def run_ensemble(specs, out, **kwargs):
         seen.extend(specs)
         return []
-    monkeypatch.setattr(solver.ensemble, "run_ensemble", run_ensemble)
+    monkeypatch.setattr(grainview.app.ensemble, "run_ensemble", run_ensemble)
     assert main(["ensemble", "--shapes", "disk, 6,pentagons", "--seeds", "1", "--no-report",
                  "--out", str(tmp_path / "e")]) == 0
     assert [s.shape for s in seen] == ["disk", 6, "pentagons"]

@@ -49,7 +49,7 @@ def _wide_table():
 
 @pytest.mark.parametrize("width", [60, 80, 237])
 def test_terminal_table_fits_the_width_and_rounds_as_the_markdown(width):
-    from grainview.app.report import terminal_table
+    from grainview.app.table_text import terminal_table
 
     text = terminal_table(_wide_table(), width=width)
     lines = text.splitlines()
@@ -108,7 +108,7 @@ def test_ensemble_report_counts_the_seeds_short_of_the_window(tmp_path):
 
 
 def test_ensemble_refuses_to_replace_its_report_before_any_run(tmp_path, monkeypatch, capsys):
-    import solver.ensemble
+    import grainview.app.ensemble
 
     report = tmp_path / "ens" / "report"
     report.mkdir(parents=True)
@@ -116,7 +116,7 @@ def test_ensemble_refuses_to_replace_its_report_before_any_run(tmp_path, monkeyp
 
     def no_work(*args, **kwargs):
         raise AssertionError("ran before refusing")
-    monkeypatch.setattr(solver.ensemble, "run_ensemble", no_work)
+    monkeypatch.setattr(grainview.app.ensemble, "run_ensemble", no_work)
     assert main(["ensemble", "--out", str(tmp_path / "ens"), "--seeds", "1", "--progress", "off"]) == 2
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and err.startswith("grainview: error:") and "--overwrite-report" in err
@@ -124,7 +124,7 @@ def test_ensemble_refuses_to_replace_its_report_before_any_run(tmp_path, monkeyp
 
 
 def test_ensemble_replaces_its_report_when_asked_and_keeps_the_runs(tmp_path, monkeypatch, capsys):
-    import solver.ensemble
+    import grainview.app.ensemble
 
     paths = _seeds(tmp_path)
     report = tmp_path / "ens" / "report"
@@ -135,7 +135,7 @@ def test_ensemble_replaces_its_report_when_asked_and_keeps_the_runs(tmp_path, mo
     def finished(specs, folder, **kwargs):  # every run already finished: nothing redone
         calls.append(kwargs["overwrite"])
         return [{"path": str(p)} for p in paths]
-    monkeypatch.setattr(solver.ensemble, "run_ensemble", finished)
+    monkeypatch.setattr(grainview.app.ensemble, "run_ensemble", finished)
     argv = ["ensemble", "--out", str(tmp_path / "ens"), "--seeds", "2", "--progress", "off", "--residual-strain", "0"]
     assert main([*argv, "--overwrite-report"]) == 0
     assert calls == [False]  # the runs' files are kept

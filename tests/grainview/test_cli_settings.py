@@ -10,6 +10,7 @@ import numpy as np
 import pytest
 
 import grainview.app.cli as cli
+from grainview.app import settings
 from grainview.app.cli import build_parser, main
 from solver.parameters import BiaxialTest, Parameters
 from solver.preparation import Preparation
@@ -31,7 +32,7 @@ def test_every_derived_option_has_its_fields_default_type_and_help():
     seen = set()
     for command in SIMULATING:
         for action in _subparser(command)._actions:
-            if not isinstance(action, cli._Given):
+            if not isinstance(action, settings.Given):
                 continue
             f = _field(action.dest)
             seen.add(action.dest)
@@ -45,7 +46,7 @@ def test_every_derived_option_has_its_fields_default_type_and_help():
             else:
                 first = str(f.type).split("|")[0].strip()  # float | None: float
                 assert action.type is {"float": float, "int": int, "str": str}[first]
-    expected = set(cli.SOLVER_OPTIONS) | set(cli.PREPARATION_OPTIONS) | set(cli.TEST_OPTIONS) | {"particles", "seed",
+    expected = set(settings.SOLVER_OPTIONS) | set(settings.PREPARATION_OPTIONS) | set(settings.TEST_OPTIONS) | {"particles", "seed",
                                                                                                  "shape"}
     assert seen == expected
 
@@ -67,7 +68,7 @@ def test_no_option_of_a_simulating_command_bypasses_the_records():
     for command in SIMULATING:
         for action in _subparser(command)._actions:
             if action.dest in names:
-                assert isinstance(action, cli._Given), (command, action.option_strings)
+                assert isinstance(action, settings.Given), (command, action.option_strings)
         assert not names & set(_set_defaults(_subparser(command))), command
 
 
@@ -117,16 +118,20 @@ NOT_SETTINGS = set()
 
 
 def test_the_command_line_holds_no_numeric_default_of_its_own():
-    """Neither an option's ``default=`` nor a module-level constant of cli.py holds a number:
+    """Neither an option's ``default=`` nor a module-level constant of the command line's modules
+    holds a number:
     defaults come from the settings records (solver.parameters) or the library function the
-    option feeds (library_default, library_constant, solver.ensemble.SEEDS_PER_SETTING)."""
+    option feeds, imported as values (grainview.app.ensemble.SEEDS_PER_SETTING...)."""
     assert _numeric_defaults("p.add_argument('--x', default=-0.5)\np.add_argument('--y', default=3)\n"
                              "p.set_defaults(func=run, every=20)") == [(1, -0.5), (2, 3), (3, 20)]  # the scan sees them
     assert _numeric_constants("SEEDS = 3\nSIZE = {'n': 11}\nNAMES = ('a',)\nX = len('..') + 7", {"X"}) \
         == [(1, ["SEEDS"], [3]), (2, ["SIZE"], [11])]
-    source = Path(cli.__file__).read_text(encoding="utf-8")
-    assert _numeric_defaults(source) == []
-    assert _numeric_constants(source, NOT_SETTINGS) == []
+    from grainview.app import convert_command
+
+    for module in (cli, settings, convert_command):  # the command line's options
+        source = Path(module.__file__).read_text(encoding="utf-8")
+        assert _numeric_defaults(source) == []
+        assert _numeric_constants(source, NOT_SETTINGS) == []
 
 
 def test_options_of_other_functions_take_those_functions_defaults():
@@ -134,21 +139,17 @@ def test_options_of_other_functions_take_those_functions_defaults():
     from grainview.formats.pegs import convert_pegs
     import inspect
 
-    assert cli.library_default("grainview.formats.pegs", "convert_pegs", "density_kg_m3") \
-        == inspect.signature(convert_pegs).parameters["density_kg_m3"].default
-    assert cli.library_default("grainview.analysis.synthetic", "harmonic_series", "seed") \
-        == inspect.signature(harmonic_series).parameters["seed"].default
     from grainview.app.demo import run_demo
-    from solver.ensemble import SEEDS_PER_SETTING, grid
+    from grainview.app.ensemble import SEEDS_PER_SETTING, grid
 
     demo = build_parser().parse_args(["demo"])
     assert (demo.snapshots, demo.contacts) == tuple(inspect.signature(run_demo).parameters[k].default
                                                     for k in ("snapshots", "contacts"))
+    assert demo.seed == inspect.signature(harmonic_series).parameters["seed"].default
     assert build_parser().parse_args(["ensemble"]).seeds == SEEDS_PER_SETTING \
         == inspect.signature(grid).parameters["seeds"].default
     from grainview.analysis.strain import RESIDUAL_STRAIN
 
-    assert cli.library_constant("grainview.analysis.strain", "RESIDUAL_STRAIN") == RESIDUAL_STRAIN
     assert build_parser().parse_args(["report", "x.nc"]).residual_strain == RESIDUAL_STRAIN
     pegs = build_parser().parse_args(["convert", "pegs", "a.txt", "--positions", "p.txt", "--metres-per-pixel", "1",
                                       "--force-unit-n", "1", "--out", "x.nc"])
@@ -167,17 +168,17 @@ def test_options_of_other_functions_take_those_functions_defaults():
 ])
 def test_a_named_preparation_holds_where_no_option_is_given(argv, expected):
     args = build_parser().parse_args(["run", *argv])
-    prep = cli._preparation(args, "pentagon")
+    prep = settings.preparation_of(args, "pentagon")
     for name, value in expected.items():
         assert getattr(prep, name) == value, name
 
 
 def test_only_the_solver_settings_given_are_passed_on():
     args = build_parser().parse_args(["run", "--time-step", "4e-4", "--solver", "nlgs"])
-    assert cli._solver_parameters(args) == {"time_step": 4e-4, "solver": "nlgs"}
-    assert cli._solver_parameters(build_parser().parse_args(["run"])) == {}
+    assert settings.solver_parameters(args) == {"time_step": 4e-4, "solver": "nlgs"}
+    assert settings.solver_parameters(build_parser().parse_args(["run"])) == {}
     old = build_parser().parse_args(["run", "--acceleration", "off"])
-    assert cli._solver_parameters(old) == {"solver": "nlgs"}
+    assert settings.solver_parameters(old) == {"solver": "nlgs"}
 
 
 @pytest.mark.parametrize("argv, line", [
@@ -263,7 +264,7 @@ def test_run_reaches_the_simulation_through_the_chosen_engine(tmp_path, fake_eng
 
 
 def test_ensemble_runs_go_through_their_engine(tmp_path, fake_engine):
-    from solver.ensemble import grid, run_one
+    from grainview.app.ensemble import grid, run_one
 
     spec, = grid(shapes=("disk",), particles=(12,), seeds=1, engine="fake", strain=0.05, every=5)
     result = run_one(spec, tmp_path)

@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 import grainview
-from grainview.app.cli import _simulate
+from grainview.app.simulation import simulate as _simulate
 from grainview.app.convergence import compaction_in_file, compaction_text, unconverged_in_file, unconverged_text
 from grainview.app.report import convergence_notes, convergence_text
 from solver.parameters import BiaxialTest

@@ -11,7 +11,9 @@ import netCDF4
 import numpy as np
 import pytest
 
-from grainview.app.cli import _study_particles, _study_tests, build_parser, main
+from grainview.app.cli import build_parser, main
+from grainview.app.study import study_particles as _study_particles
+from grainview.app.study import study_tests as _study_tests
 from solver import stepper
 from solver.compaction_checkpoint import CompactionCheckpoint
 
@@ -155,7 +157,7 @@ def test_bad_sizes_are_refused_in_one_line(tmp_path, capsys, argv, fragment):
 
 
 def test_estimate_from_measured_costs():
-    from solver.paper_size import COSTS, estimate, velocity_for
+    from grainview.app.paper_size import COSTS, estimate, velocity_for
     from solver.parameters import BiaxialTest
     from solver.preparation import preparation
 
@@ -174,7 +176,7 @@ def test_estimate_from_measured_costs():
 
 
 def test_side_by_side_progress_without_a_terminal_prints_lines(capsys):
-    from grainview.app.cli import _SampleProgress
+    from grainview.app.progress import SampleProgress as _SampleProgress
 
     progress = _SampleProgress.for_jobs(None)
     assert _SampleProgress.for_jobs(False) is False and _SampleProgress.for_jobs(True).terminal

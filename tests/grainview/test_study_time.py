@@ -1,7 +1,7 @@
 """What ``grainview study`` and ``grainview run`` say of their time: whether numba's cache holds
 the kernels for this processor (grainview.app.warmup.cache_holds), the first line on a cold
 cache, the estimate's parts and its arithmetic under a given load
-(solver.paper_size.study_estimate), and a resumed test's unconverged steps in one line. No
+(grainview.app.paper_size.study_estimate), and a resumed test's unconverged steps in one line. No
 time is measured here (benchmarks/study_time.py measures them)."""
 
 from __future__ import annotations
@@ -16,9 +16,12 @@ import warnings
 
 import pytest
 
-from grainview.app.cli import _compile_line, _print_estimate, _study_sample, _warnings_as_notes, main
+from grainview.app.cli import _warnings_as_notes, main
+from grainview.app.estimates import compile_line as _compile_line
+from grainview.app.estimates import print_estimate as _print_estimate
+from grainview.app.study import study_sample as _study_sample
 from grainview.contract.errors import ConvergenceWarning
-from solver import paper_size
+from grainview.app import paper_size
 from solver.parameters import BiaxialTest
 from solver.preparation import preparation
 

@@ -123,7 +123,7 @@ def test_a_kill_while_a_checkpoint_is_written_keeps_the_previous_one(tmp_path, m
 def test_an_ensemble_run_killed_in_its_compaction_resumes_from_its_checkpoint(tmp_path, monkeypatch):
     import netCDF4
 
-    from solver.ensemble import RunSpec, run_one
+    from grainview.app.ensemble import RunSpec, run_one
 
     spec = RunSpec(shape="pentagon", particles=30, seed=1, strain=0.004, every=10)
     (tmp_path / "reference").mkdir()

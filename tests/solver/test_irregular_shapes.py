@@ -232,7 +232,7 @@ def test_shape_names_files_and_labels(tmp_path):
     with pytest.raises(ParameterError, match="no such file"):
         check_shape(str(tmp_path / "missing.json"))
     assert shape_label(str(tmp_path / "grains.json")) == "grains" and shape_label("irregular") == "irregular"
-    from solver.ensemble import RunSpec
+    from grainview.app.ensemble import RunSpec
 
     path = _write(tmp_path, [[[0, 0], [1, 0], [0, 1]]], "triangles.json")
     assert RunSpec(shape=path, particles=40, strain=0.01).validate().name == "triangles_n40_s0"

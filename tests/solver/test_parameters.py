@@ -149,7 +149,7 @@ def test_a_sample_no_preparation_made_has_an_empty_history():
 def test_the_scenes_take_their_defaults_from_the_records():
     import inspect
 
-    from solver.ensemble import RunSpec
+    from grainview.app.ensemble import RunSpec
     from solver.scenes import biaxial_test, compaction_sample, isotropic_compaction
 
     def defaults(func):

@@ -6,6 +6,10 @@ import numpy as np
 
 from ...contract import portable_math
 
+RESIDUAL_STRAIN = 0.3
+"""Start of the residual state in shear strain eps_q (the paper reads its residual values at
+eps_q >= 0.3: Figs. 7, 8, 10 and the residual plateaus of Figs. 3, 6, 9, 11)."""
+
 
 def log_strain(size, reference):
     """Logarithmic strain of a box extent, compression positive: ln(1 + (L0 - L)/L0).

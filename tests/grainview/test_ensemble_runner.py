@@ -17,8 +17,8 @@ import grainview
 from grainview.analysis.ensemble import run_dataset
 from grainview.contract.errors import ParameterError
 from grainview.contract.writer import is_compressed
-from solver import ensemble
-from solver.ensemble import RunSpec, grid, run_ensemble, run_one
+from grainview.app import ensemble
+from grainview.app.ensemble import RunSpec, grid, run_ensemble, run_one
 
 distributed = pytest.importorskip("distributed")
 
