@@ -51,7 +51,8 @@ import sys
 import pandas as pd
 from grainview.contract.io import open_dataset
 from grainview.analysis.tables import contacts_table
-from grainview.formats.export import KIND_NAMES, _CSV_NAMES, snapshot_indices
+from grainview.analysis.snapshots import snapshot_indices
+from grainview.export.contacts_csv import KIND_NAMES, _CSV_NAMES
 ds = open_dataset(sys.argv[1])
 frames = []
 for k in snapshot_indices(ds, 1):

@@ -4,11 +4,13 @@ the new place.
 
 grainview's modules live in rooms by concern (docs/map.md): the analysis in
 ``grainview/analysis/`` (its pure array functions in ``analysis/arrays/``, its numba kernels in
-``analysis/_kernels/``), other formats and the export in ``grainview/formats/``, the report and
-the command line in ``grainview/app/``. Scripts and notebooks written against the former flat
-layout keep working through the finder below, which serves each former name by importing the
-module at its new place and registering that module under the former name as well, so that
-both names give one module (its functions, classes and state are shared, nothing is copied).
+``analysis/_kernels/``), other formats in ``grainview/formats/``, the writers in
+``grainview/export/``, the report and the command line in ``grainview/app/``. Scripts and
+notebooks written against a former layout keep working through the finder below, which serves
+each former name by importing the module at its new place and registering that module under
+the former name as well, so that both names give one module (its functions, classes and state
+are shared, nothing is copied). The flat name ``grainview.export`` is now the writers' room
+itself, which holds the former module's functions.
 """
 
 from __future__ import annotations
@@ -27,7 +29,10 @@ MOVED = {
         "tables", "xi_network")},
     **{f"grainview.{name}": f"grainview.app.{name}" for name in (
         "cli", "convergence", "ensemble_report", "file_summary", "report", "warmup")},
-    **{f"grainview.{name}": f"grainview.formats.{name}" for name in ("export", "opening", "vtk_xml")},
+    "grainview.opening": "grainview.formats.opening",
+    "grainview.vtk_xml": "grainview.export.vtk_xml",
+    "grainview.formats.export": "grainview.export",
+    "grainview.formats.vtk_xml": "grainview.export.vtk_xml",
 }
 """Former module name -> its place now; a former package's submodules follow it."""
 

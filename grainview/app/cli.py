@@ -77,7 +77,7 @@ def _info(args) -> int:
 
 
 def _export(args) -> int:
-    from ..formats.export import write_csv, write_vtk
+    from ..export import write_csv, write_vtk
     from ..contract.io import open_dataset
     from ..contract.validation import validate
 
@@ -1359,7 +1359,7 @@ def _export_parser(sub):
     export.add_argument("file", help="netCDF file of the grainview contract")
     export.add_argument("--to", choices=("vtk", "csv"), required=True, help="output format")
     export.add_argument("--out", required=True, help="output folder (created if needed)")
-    every = library_default("grainview.formats.export", "write_vtk", "every")
+    every = library_default("grainview.export.vtk", "write_vtk", "every")
     export.add_argument("--every", type=int, default=every,
                         help=f"export every k-th snapshot (and the last; default {every})")
     export.add_argument("--overwrite", action="store_true", help="replace existing files in --out")

@@ -24,7 +24,7 @@ from grainview.contract.shapes import (body_vertices, body_vertices_of, inertia_
                                        shape_problems, vertex_phases, world_vertices)
 from grainview.contract.validation import validate
 from grainview.contract.writer import SnapshotWriter
-from grainview.formats.export import write_vtk
+from grainview.export import write_vtk
 from grainview.app.file_summary import describe_file, read_facts
 
 from .test_export import read_vtp
