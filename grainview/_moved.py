@@ -25,10 +25,10 @@ MOVED = {
     **{f"grainview.{name}": f"grainview.analysis.{name}" for name in (
         "_kernels", "_lift", "arrays", "coarse_graining", "connectivity", "contacts", "ensemble", "fabric",
         "force_chains", "force_networks", "force_pdf", "forces", "lifetimes", "network_topology",
-        "particle_fields", "persistence", "sample", "shear_bands", "strain", "stress", "summary", "synthetic",
-        "tables", "xi_network")},
+        "particle_fields", "persistence", "sample", "shear_bands", "strain", "stress", "tables", "xi_network")},
     **{f"grainview.{name}": f"grainview.app.{name}" for name in (
-        "cli", "convergence", "ensemble_report", "file_summary", "report", "warmup")},
+        "cli", "convergence", "ensemble_report", "file_summary", "report", "summary", "warmup")},
+    "grainview.analysis.summary": "grainview.app.summary",
     "grainview.opening": "grainview.formats.opening",
     "grainview.vtk_xml": "grainview.export.vtk_xml",
     "grainview.formats.export": "grainview.export",
