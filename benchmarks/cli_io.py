@@ -5,7 +5,7 @@
                                 [--sources DIR --commit C] [--out results/cli-io.md]
 
 The file is ``--file`` (e.g. a study's ``pentagons.nc``) or, without it, a synthetic series
-(:func:`grainview.analysis.synthetic.harmonic_series`) of ``--snapshots`` snapshots of
+(:func:`grainview.datasets.harmonic_series`) of ``--snapshots`` snapshots of
 ``--contacts`` contacts, the size of a 400-particle study's run, written compressed to a
 temporary folder. Every measurement is a fresh process, timed from outside, so each includes
 Python's start and the imports, as a user sees them.
@@ -114,7 +114,7 @@ def drop_from_cache(path: Path) -> None:
 
 def synthetic_file(folder: Path, snapshots: int, contacts: int) -> Path:
     """A compressed synthetic series of the given size in ``folder``."""
-    from grainview.analysis.synthetic import harmonic_series
+    from grainview.datasets import harmonic_series
     from grainview.contract.dataset import netcdf_options
 
     ds = harmonic_series(n_snapshots=snapshots, n_contacts=contacts)

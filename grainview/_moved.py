@@ -29,6 +29,8 @@ MOVED = {
     **{f"grainview.{name}": f"grainview.app.{name}" for name in (
         "cli", "convergence", "ensemble_report", "file_summary", "report", "summary", "warmup")},
     "grainview.analysis.summary": "grainview.app.summary",
+    "grainview.synthetic": "grainview.datasets",
+    "grainview.analysis.synthetic": "grainview.datasets",
     "grainview.opening": "grainview.formats.opening",
     "grainview.vtk_xml": "grainview.export.vtk_xml",
     "grainview.formats.export": "grainview.export",

@@ -81,7 +81,7 @@ def test_the_array_layer_imports_nothing_of_the_labelled_layer():
 
 ROOMS = {
     "grainview.contract": 0,
-    "solver": 1,
+    "solver": 1, "grainview.datasets": 1,
     "grainview.formats": 2,
     "grainview.analysis": 3,
     "grainview.export": 4, "grainview.plot": 4,
@@ -92,11 +92,13 @@ ROOMS = {
 lower floors, never a higher floor or another room of its floor. The drawing reads contract <-
 formats (other codes' files read into the contract) <- analysis <- export (the writers), plot
 (the figures) <- application, with the solver on the contract alone (the readers' conversions
-stop on SIGTERM as its runs do); the package's front door (``grainview/__init__.py``, the
+stop on SIGTERM as its runs do) and the example datasets (``grainview.datasets``) on it beside the
+solver; the package's front door (``grainview/__init__.py``, the
 ``ds.grain`` accessor and its registration, the command line) sits on top of them all."""
 
 FRONT_DOOR = {"grainview", "grainview.__main__", "grainview._moved", "grainview._register", "grainview.accessor"}
-"""The only modules of grainview outside a room's folder."""
+"""The only modules of grainview outside a room's folder (``grainview.datasets`` aside, a room of its
+own)."""
 
 
 def room_of(module: str) -> str:

@@ -1378,7 +1378,7 @@ def _demo_parser(sub):
     snapshots, contacts = (library_default("grainview.app.demo", "run_demo", k) for k in ("snapshots", "contacts"))
     demo.add_argument("--snapshots", type=int, default=snapshots, help=f"number of snapshots (default {snapshots})")
     demo.add_argument("--contacts", type=int, default=contacts, help=f"contacts per snapshot (default {contacts})")
-    seed = library_default("grainview.analysis.synthetic", "harmonic_series", "seed")
+    seed = library_default("grainview.datasets", "harmonic_series", "seed")
     demo.add_argument("--seed", type=int, default=seed, help=f"random seed (default {seed})")
     demo.add_argument("--overwrite", action="store_true", help="replace existing output files")
     _no_compress_option(demo)

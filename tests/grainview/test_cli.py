@@ -7,7 +7,7 @@ import xarray as xr
 
 import grainview
 from grainview.app.cli import main
-from grainview.analysis.synthetic import harmonic_series
+from grainview.datasets import harmonic_series
 from grainview.contract.writer import is_compressed
 
 

@@ -16,7 +16,7 @@ import pytest
 import grainview
 from grainview.app.cli import build_parser, main
 from grainview.contract.dataset import netcdf_encoding
-from grainview.analysis.synthetic import harmonic_series
+from grainview.datasets import harmonic_series
 
 from .test_near_contacts import chain
 

@@ -105,13 +105,13 @@ def test_the_command_line_holds_no_numeric_default_of_its_own():
 
 
 def test_options_of_other_functions_take_those_functions_defaults():
-    from grainview.analysis.synthetic import harmonic_series
+    from grainview.datasets import harmonic_series
     from grainview.formats.pegs import convert_pegs
     import inspect
 
     assert cli.library_default("grainview.formats.pegs", "convert_pegs", "density_kg_m3") \
         == inspect.signature(convert_pegs).parameters["density_kg_m3"].default
-    assert cli.library_default("grainview.analysis.synthetic", "harmonic_series", "seed") \
+    assert cli.library_default("grainview.datasets", "harmonic_series", "seed") \
         == inspect.signature(harmonic_series).parameters["seed"].default
     from grainview.app.demo import run_demo
     from solver.ensemble import SEEDS_PER_SETTING, grid
