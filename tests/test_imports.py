@@ -153,6 +153,44 @@ def test_every_import_goes_down_the_rooms():
     assert wrong_way_imports(graph) == set()
 
 
+ACCESSOR_CALLERS = ("grainview.app", "grainview")
+"""The rooms that may call the ``ds.grain`` accessor: it sits on the front door, so that a call
+through it from a lower room is an import going up that the import graph cannot see."""
+
+
+def accessor_uses(source: str) -> list:
+    """The lines of ``source`` that read an attribute named ``grain`` (``ds.grain.strains()``,
+    ``getattr(ds, "grain")``)."""
+    lines = []
+    for node in ast.walk(ast.parse(source)):
+        if isinstance(node, ast.Attribute) and node.attr == "grain":
+            lines.append(node.lineno)
+        elif (isinstance(node, ast.Call) and isinstance(node.func, ast.Name) and node.func.id in ("getattr", "hasattr")
+              and len(node.args) > 1 and isinstance(node.args[1], ast.Constant) and node.args[1].value == "grain"):
+            lines.append(node.lineno)
+    return sorted(lines)
+
+
+def test_the_accessor_check_sees_a_call_and_not_a_docstring():
+    source = ('"""Uses ``ds.grain.strains()``."""\n'
+              "def f(ds):\n    return ds.grain.strains()\n"
+              "def g(ds):\n    return getattr(ds, 'grain').fabric()\n"
+              "def h(grain):\n    return grain.strains\n")
+    assert accessor_uses(source) == [3, 5]
+
+
+def test_no_room_below_the_application_calls_the_accessor():
+    callers = {}
+    for package in PACKAGES:
+        for path in (ROOT / package).rglob("*.py"):
+            module = _module_name(path)
+            if room_of(module) in ACCESSOR_CALLERS:
+                continue
+            if lines := accessor_uses(path.read_text()):
+                callers[module] = lines
+    assert callers == {}, f"calls through ds.grain below the application (call the topic functions): {callers}"
+
+
 def _modules_after(code: str) -> set:
     """The heavy third-party modules loaded by ``code`` in a fresh interpreter."""
     import json

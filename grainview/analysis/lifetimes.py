@@ -35,6 +35,7 @@ from ._lift import with_attrs
 from .contacts import check_near, n_particles, near_attr
 from ..contract.errors import ParameterError
 from .persistence import _blocks, _check_flag, body_count
+from .strain import strains
 
 __all__ = ["contact_events", "kaplan_meier", "lifetime_survival", "median_lifetime_by_force", "strong_persistence"]
 
@@ -157,11 +158,11 @@ def contact_events(ds: xr.Dataset, walls: bool = True, near=None) -> xr.Dataset:
         "birth_fn": (dim, e["birth_fn"]),
     })
     if "box_min" in ds and "box_max" in ds:
-        eps_q = np.asarray(ds.grain.strains()["eps_q"].values, dtype=float)
+        eps_q = np.asarray(strains(ds)["eps_q"].values, dtype=float)
         out["lifetime_eps_q"] = with_attrs(xr.DataArray(eps_q[end_index] - eps_q[e["birth"]], dims=dim),
                                            "lifetime_eps_q", "1", "shear strain eps_q over the life")
     if "cell" in ds.variables:
-        gamma = np.asarray(ds.grain.strains()["gamma"].values, dtype=float)
+        gamma = np.asarray(strains(ds)["gamma"].values, dtype=float)
         out["lifetime_gamma"] = with_attrs(xr.DataArray(gamma[end_index] - gamma[e["birth"]], dims=dim),
                                            "lifetime_gamma", "1", "simple-shear strain gamma of the cell over the life")
     for name, units, long_name in (("birth", "s", "time of the first snapshot of the life"),
