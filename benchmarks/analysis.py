@@ -2,7 +2,7 @@
 (K = 100), persistence and contact lifetimes on a synthetic series opened lazily from
 netCDF, with the peak memory of each measurement; eager (loaded) against dask (lazy).
 
-The series is drawn from the harmonic model (grainview.analysis.synthetic) and streamed to disk one
+The series is drawn from the harmonic model (grainview.datasets) and streamed to disk one
 snapshot at a time with the solver's writer, so it never has to fit in memory.
 """
 
@@ -44,7 +44,7 @@ def write_series(path, n_snapshots, n_contacts, seed=0, attrs=None):
     """Stream a harmonic-model series of ``n_snapshots`` x ``n_contacts`` to ``path`` (global
     attributes ``attrs`` added)."""
     from grainview.contract.writer import SnapshotWriter
-    from grainview.analysis.synthetic import PAIR_LENGTH_M, harmonic_contacts
+    from grainview.datasets import PAIR_LENGTH_M, harmonic_contacts
 
     rng = np.random.default_rng(seed)
     n_part = 2 * n_contacts

@@ -5,7 +5,7 @@
                                 [--sources DIR --commit C] [--out results/cli-io.md]
 
 The file is ``--file`` (e.g. a study's ``pentagons.nc``) or, without it, a synthetic series
-(:func:`grainview.analysis.synthetic.harmonic_series`) of ``--snapshots`` snapshots of
+(:func:`grainview.datasets.harmonic_series`) of ``--snapshots`` snapshots of
 ``--contacts`` contacts, the size of a 400-particle study's run, written compressed to a
 temporary folder. Every measurement is a fresh process, timed from outside, so each includes
 Python's start and the imports, as a user sees them.
@@ -51,7 +51,8 @@ import sys
 import pandas as pd
 from grainview.contract.io import open_dataset
 from grainview.analysis.tables import contacts_table
-from grainview.formats.export import KIND_NAMES, _CSV_NAMES, snapshot_indices
+from grainview.analysis.snapshots import snapshot_indices
+from grainview.export.contacts_csv import KIND_NAMES, _CSV_NAMES
 ds = open_dataset(sys.argv[1])
 frames = []
 for k in snapshot_indices(ds, 1):
@@ -113,7 +114,7 @@ def drop_from_cache(path: Path) -> None:
 
 def synthetic_file(folder: Path, snapshots: int, contacts: int) -> Path:
     """A compressed synthetic series of the given size in ``folder``."""
-    from grainview.analysis.synthetic import harmonic_series
+    from grainview.datasets import harmonic_series
     from grainview.contract.dataset import netcdf_options
 
     ds = harmonic_series(n_snapshots=snapshots, n_contacts=contacts)

@@ -12,7 +12,7 @@ Runner: the same set of small biaxial tests (pentagons and disks, one seed each 
 run by ``grainview.app.ensemble.run_ensemble`` on a LocalCluster of 1 worker, then of 2 workers (cold
 output folders, warm numba cache); efficiency = T(1 worker) / (workers x T(workers)).
 
-Out of core: ``runs`` synthetic harmonic-model series (grainview.analysis.synthetic, streamed to disk)
+Out of core: ``runs`` synthetic harmonic-model series (grainview.datasets, streamed to disk)
 of ``snapshots`` x ``contacts`` each, two settings of half the runs each, opened with
 ``grainview.open_ensemble``; the stress invariants and the fabric anisotropy of every run and
 snapshot, reduced to mean +- spread over seeds on eps_q bins (``seed_statistics``), computed on

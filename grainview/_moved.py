@@ -4,12 +4,14 @@ the new place.
 
 grainview's modules live in rooms by concern (docs/map.md): the analysis in
 ``grainview/analysis/`` (its pure array functions in ``analysis/arrays/``, its numba kernels in
-``analysis/_kernels/``), other formats and the export in ``grainview/formats/``, the report and
-the command line in ``grainview/app/``, with the application code that once sat in the solver
-(``solver.ensemble``, ``solver.paper_size``). Scripts and notebooks written against the former flat
-layout keep working through the finder below, which serves each former name by importing the
-module at its new place and registering that module under the former name as well, so that
-both names give one module (its functions, classes and state are shared, nothing is copied).
+``analysis/_kernels/``), other formats in ``grainview/formats/``, the writers in
+``grainview/export/``, the report and the command line in ``grainview/app/``, with the
+application code that once sat in the solver (``solver.ensemble``, ``solver.paper_size``).
+Scripts and notebooks written against a former layout keep working through the finder below,
+which serves each former name by importing the module at its new place and registering that
+module under the former name as well, so that both names give one module (its functions,
+classes and state are shared, nothing is copied). The flat name ``grainview.export`` is now
+the writers' room itself, which holds the former module's functions.
 """
 
 from __future__ import annotations
@@ -24,11 +26,16 @@ MOVED = {
     **{f"grainview.{name}": f"grainview.analysis.{name}" for name in (
         "_kernels", "_lift", "arrays", "coarse_graining", "connectivity", "contacts", "ensemble", "fabric",
         "force_chains", "force_networks", "force_pdf", "forces", "lifetimes", "network_topology",
-        "particle_fields", "persistence", "sample", "shear_bands", "strain", "stress", "summary", "synthetic",
-        "tables", "xi_network")},
+        "particle_fields", "persistence", "sample", "shear_bands", "strain", "stress", "tables", "xi_network")},
     **{f"grainview.{name}": f"grainview.app.{name}" for name in (
-        "cli", "convergence", "ensemble_report", "file_summary", "report", "warmup")},
-    **{f"grainview.{name}": f"grainview.formats.{name}" for name in ("export", "opening", "vtk_xml")},
+        "cli", "convergence", "ensemble_report", "file_summary", "report", "summary", "warmup")},
+    "grainview.analysis.summary": "grainview.app.summary",
+    "grainview.synthetic": "grainview.datasets",
+    "grainview.analysis.synthetic": "grainview.datasets",
+    "grainview.opening": "grainview.formats.opening",
+    "grainview.vtk_xml": "grainview.export.vtk_xml",
+    "grainview.formats.export": "grainview.export",
+    "grainview.formats.vtk_xml": "grainview.export.vtk_xml",
     **{f"solver.{name}": f"grainview.app.{name}" for name in ("ensemble", "paper_size")},
 }
 """Former module name -> its place now; a former package's submodules follow it."""

@@ -81,20 +81,24 @@ def test_the_array_layer_imports_nothing_of_the_labelled_layer():
 
 ROOMS = {
     "grainview.contract": 0,
-    "grainview.analysis": 1, "solver": 1,
+    "solver": 1, "grainview.datasets": 1,
     "grainview.formats": 2,
-    "grainview.plot": 3,
-    "grainview.app": 4,
-    "grainview": 5,
+    "grainview.analysis": 3,
+    "grainview.export": 4, "grainview.plot": 4,
+    "grainview.app": 5,
+    "grainview": 6,
 }
 """The rooms of the packages and their floor: a module may import its own room and the rooms on
 lower floors, never a higher floor or another room of its floor. The drawing reads contract <-
-analysis <- formats (other codes' files, the export) <- plot <- application, with the solver beside
-the analysis on the contract; the package's front door (``grainview/__init__.py``, the ``ds.grain``
-accessor and its registration, the command line) sits on top of them all."""
+formats (other codes' files read into the contract) <- analysis <- export (the writers), plot
+(the figures) <- application, with the solver on the contract alone (the readers' conversions
+stop on SIGTERM as its runs do) and the example datasets (``grainview.datasets``) on it beside the
+solver; the package's front door (``grainview/__init__.py``, the
+``ds.grain`` accessor and its registration, the command line) sits on top of them all."""
 
 FRONT_DOOR = {"grainview", "grainview.__main__", "grainview._moved", "grainview._register", "grainview.accessor"}
-"""The only modules of grainview outside a room's folder."""
+"""The only modules of grainview outside a room's folder (``grainview.datasets`` aside, a room of its
+own)."""
 
 
 def room_of(module: str) -> str:
@@ -122,15 +126,18 @@ def wrong_way_imports(graph) -> set:
 
 def test_the_room_check_sees_an_import_going_up_or_sideways():
     graph = {"grainview.analysis.stress": {"grainview.contract.schema", "grainview.analysis._lift"},
-             "grainview.plot.maps": {"grainview.analysis.stress", "grainview.formats.export"},
-             "grainview.contract.schema": set(), "grainview.analysis._lift": set(), "grainview.formats.export": set(),
+             "grainview.plot.maps": {"grainview.analysis.stress", "grainview.formats.opening"},
+             "grainview.contract.schema": set(), "grainview.analysis._lift": set(), "grainview.formats.opening": set(),
+             "grainview.export.vtk": {"grainview.analysis.stress"},
              "grainview.app.report": {"grainview.plot.maps", "grainview.accessor"}, "grainview.accessor": set()}
     assert wrong_way_imports(graph) == {("grainview.app.report", "grainview.accessor")}
     graph["grainview.analysis.stress"].add("grainview.plot.maps")  # up
-    graph["solver.output"] = {"grainview.analysis._lift"}  # sideways
+    graph["grainview.formats.opening"].add("grainview.analysis._lift")  # up
+    graph["grainview.plot.maps"].add("grainview.export.vtk")  # sideways
     assert wrong_way_imports(graph) == {("grainview.app.report", "grainview.accessor"),
                                         ("grainview.analysis.stress", "grainview.plot.maps"),
-                                        ("solver.output", "grainview.analysis._lift")}
+                                        ("grainview.formats.opening", "grainview.analysis._lift"),
+                                        ("grainview.plot.maps", "grainview.export.vtk")}
     try:
         room_of("grainview.stress")  # a module left on the flat floor
     except KeyError as error:
@@ -144,6 +151,44 @@ def test_every_import_goes_down_the_rooms():
     assert {room_of(module) for module in graph} == set(ROOMS)  # every module in a room, every room used
     assert "grainview.plot.maps" in graph and "grainview.analysis.contacts" in graph["grainview.plot.maps"]
     assert wrong_way_imports(graph) == set()
+
+
+ACCESSOR_CALLERS = ("grainview.app", "grainview")
+"""The rooms that may call the ``ds.grain`` accessor: it sits on the front door, so that a call
+through it from a lower room is an import going up that the import graph cannot see."""
+
+
+def accessor_uses(source: str) -> list:
+    """The lines of ``source`` that read an attribute named ``grain`` (``ds.grain.strains()``,
+    ``getattr(ds, "grain")``)."""
+    lines = []
+    for node in ast.walk(ast.parse(source)):
+        if isinstance(node, ast.Attribute) and node.attr == "grain":
+            lines.append(node.lineno)
+        elif (isinstance(node, ast.Call) and isinstance(node.func, ast.Name) and node.func.id in ("getattr", "hasattr")
+              and len(node.args) > 1 and isinstance(node.args[1], ast.Constant) and node.args[1].value == "grain"):
+            lines.append(node.lineno)
+    return sorted(lines)
+
+
+def test_the_accessor_check_sees_a_call_and_not_a_docstring():
+    source = ('"""Uses ``ds.grain.strains()``."""\n'
+              "def f(ds):\n    return ds.grain.strains()\n"
+              "def g(ds):\n    return getattr(ds, 'grain').fabric()\n"
+              "def h(grain):\n    return grain.strains\n")
+    assert accessor_uses(source) == [3, 5]
+
+
+def test_no_room_below_the_application_calls_the_accessor():
+    callers = {}
+    for package in PACKAGES:
+        for path in (ROOT / package).rglob("*.py"):
+            module = _module_name(path)
+            if room_of(module) in ACCESSOR_CALLERS:
+                continue
+            if lines := accessor_uses(path.read_text()):
+                callers[module] = lines
+    assert callers == {}, f"calls through ds.grain below the application (call the topic functions): {callers}"
 
 
 def _modules_after(code: str) -> set:
@@ -182,6 +227,17 @@ def test_the_contract_imports_nothing_of_grainview_outside_itself():
     for module in contract:
         assert all(dep.startswith("grainview.contract") for dep in graph[module] if dep.startswith("grainview")), \
             (module, sorted(graph[module]))
+
+
+def test_the_formats_import_nothing_of_grainview_but_the_contract():
+    """The readers of other codes' files build datasets of the contract; what is computed from
+    them, and written from that, lives above them (the analysis, the exports)."""
+    graph = import_graph()
+    formats = [module for module in graph if module.startswith("grainview.formats")]
+    assert len(formats) >= 10
+    for module in formats:
+        assert all(dep.startswith(("grainview.formats", "grainview.contract")) for dep in graph[module]
+                   if dep.startswith("grainview")), (module, sorted(graph[module]))
 
 
 def test_importing_the_contract_loads_no_xarray_dask_pandas_or_matplotlib():

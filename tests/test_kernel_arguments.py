@@ -16,12 +16,6 @@ FOLDERS = ("solver", "grainview", "benchmarks/research")
 MAX_ARGUMENTS = 8
 MODULES = sorted(path.relative_to(ROOT).as_posix() for folder in FOLDERS for path in (ROOT / folder).rglob("*.py")
                  if "__pycache__" not in path.parts)
-STILL_WIDE = {
-    "grainview/analysis/_kernels/coarse_graining.py": {"spread_points", "spread_segments"},
-    "grainview/analysis/_kernels/force_chains.py": {"accumulate_moments", "aligned_links"},
-}
-"""Kernels over the cap when the check came to cover grainview, to be given records; none may
-be added (a kernel that leaves the list may stay off it)."""
 
 
 def _is_njit(node) -> bool:
@@ -100,6 +94,6 @@ def test_every_folder_and_subfolder_is_read():
 @pytest.mark.parametrize("module", MODULES)
 def test_no_kernel_takes_more_than_eight_arguments(module):
     wide = {name: count for name, count in kernel_arguments((ROOT / module).read_text()).items()
-            if count > MAX_ARGUMENTS and name not in STILL_WIDE.get(module, ())}
+            if count > MAX_ARGUMENTS}
     assert not wide, (f"{module}: kernels with more than {MAX_ARGUMENTS} arguments {wide}; pass the problem, state "
-                      "and scratch as records (solver/solve_records.py)")
+                      "and scratch as records (solver/solve_records.py, grainview/analysis/_kernels/records.py)")

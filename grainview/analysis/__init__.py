@@ -9,6 +9,7 @@ Three layers, one above the other:
    :mod:`grainview.analysis._lift`;
 3. the ``ds.grain`` accessor (:mod:`grainview.accessor`), which delegates to the topic modules.
 
-This room imports only the data contract (:mod:`grainview.contract`); the figures, the other
-formats and the application build on it (``tests/test_imports.py`` checks the drawing).
+This room imports only the data contract (:mod:`grainview.contract`); the exports, the figures
+and the application build on it (``tests/test_imports.py`` checks the drawing), and it never
+calls the accessor, which sits above it.
 """

@@ -219,7 +219,7 @@ def _with_parameters(ens: xr.Dataset, runs, varying) -> xr.Dataset:
         if short == "particles":
             values = [ds.sizes["particle"] for ds in runs]
         if short == "shape" and all(isinstance(v, float) and np.isnan(v) for v in values):
-            from .summary import shape_name
+            from .sample import shape_name
 
             values = [shape_name(ds) for ds in runs]
         params[short] = ("run", np.asarray(values))

@@ -23,7 +23,8 @@ lifetimes are not measured from birth):
 u the distinct observed lifetimes, d_u the lives ending with lifetime u and n_u the lives
 whose observed duration is at least u (deaths and censored alike: "at risk").
 
-Coupling snapshots, these are computed (not lazy), one time-chunk at a time.
+Coupling snapshots, these are computed (not lazy), one time-chunk at a time; the lives are
+followed, and their survival estimated, on plain arrays by :mod:`grainview.analysis.arrays.lifetimes`.
 """
 
 from __future__ import annotations
@@ -35,59 +36,24 @@ from ._lift import with_attrs
 from .contacts import check_near, n_particles, near_attr
 from ..contract.errors import ParameterError
 from .persistence import _blocks, _check_flag, body_count
+from .strain import strains
+from .arrays.lifetimes import (advance_lives, all_lives, count_still_strong, kaplan_meier, median_lifetime, no_lives,
+                               strong_pairs, survival_on)
 
 __all__ = ["contact_events", "kaplan_meier", "lifetime_survival", "median_lifetime_by_force", "strong_persistence"]
-
-_FIELDS = ("key", "birth", "kind_at_birth", "last_kind", "switches", "sum_fn", "max_fn", "count", "birth_fn")
-
-
-def _empty_open():
-    return {"key": np.empty(0, np.int64), "birth": np.empty(0, np.int64), "kind_at_birth": np.empty(0, np.int8),
-            "last_kind": np.empty(0, np.int8), "switches": np.empty(0, np.int64), "sum_fn": np.empty(0),
-            "max_fn": np.empty(0), "count": np.empty(0, np.int64), "birth_fn": np.empty(0)}
-
-
-def _take(state, mask):
-    return {name: values[mask] for name, values in state.items()}
 
 
 def _events(ds, walls, near):
     """The lives of every pair as a dict of arrays (one entry per life), scanning snapshots in
     order: per snapshot one sort and one ``np.searchsorted`` against the open lives."""
-    open_ = _empty_open()
-    ended = []
+    lives, ended = no_lives(), []
     for block, keys, present, kind, fn in _blocks(ds, walls, near, force=True):
         for r in range(keys.shape[0]):
-            t = block.start + r
-            k, kd, f = keys[r][present[r]], kind[r][present[r]].astype(np.int8), fn[r][present[r]]
-            k, first = np.unique(k, return_index=True)  # the contract stores a pair once per snapshot
-            kd, f = kd[first], f[first]
-            if open_["key"].size:
-                position = np.minimum(np.searchsorted(open_["key"], k), open_["key"].size - 1)
-                found = open_["key"][position] == k
-            else:
-                position, found = np.zeros(k.size, np.int64), np.zeros(k.size, bool)
-            alive = np.zeros(open_["key"].size, bool)
-            alive[position[found]] = True
-            if (~alive).any():
-                ended.append({**_take(open_, ~alive), "death": np.full((~alive).sum(), t, np.int64)})
-            index = position[found]
-            open_["switches"][index] += open_["last_kind"][index] != kd[found]
-            open_["last_kind"][index] = kd[found]
-            open_["sum_fn"][index] += f[found]
-            open_["max_fn"][index] = np.maximum(open_["max_fn"][index], f[found])
-            open_["count"][index] += 1
-            born = ~found
-            new = {"key": k[born], "birth": np.full(born.sum(), t, np.int64), "kind_at_birth": kd[born],
-                   "last_kind": kd[born], "switches": np.zeros(born.sum(), np.int64), "sum_fn": f[born].astype(float),
-                   "max_fn": f[born].astype(float), "count": np.ones(born.sum(), np.int64),
-                   "birth_fn": f[born].astype(float)}
-            kept = _take(open_, alive)
-            merged = {name: np.concatenate([kept[name], new[name]]) for name in _FIELDS}
-            order = np.argsort(merged["key"], kind="stable")
-            open_ = _take(merged, order)
-    ended.append({**open_, "death": np.full(open_["key"].size, -1, np.int64)})  # right-censored
-    return {name: np.concatenate([e[name] for e in ended]) for name in (*_FIELDS, "death")}
+            lives, gone = advance_lives(lives, block.start + r, keys[r][present[r]], kind[r][present[r]],
+                                        fn[r][present[r]])
+            if gone is not None:
+                ended.append(gone)
+    return all_lives(lives, ended)
 
 
 def contact_events(ds: xr.Dataset, walls: bool = True, near=None) -> xr.Dataset:
@@ -157,11 +123,11 @@ def contact_events(ds: xr.Dataset, walls: bool = True, near=None) -> xr.Dataset:
         "birth_fn": (dim, e["birth_fn"]),
     })
     if "box_min" in ds and "box_max" in ds:
-        eps_q = np.asarray(ds.grain.strains()["eps_q"].values, dtype=float)
+        eps_q = np.asarray(strains(ds)["eps_q"].values, dtype=float)
         out["lifetime_eps_q"] = with_attrs(xr.DataArray(eps_q[end_index] - eps_q[e["birth"]], dims=dim),
                                            "lifetime_eps_q", "1", "shear strain eps_q over the life")
     if "cell" in ds.variables:
-        gamma = np.asarray(ds.grain.strains()["gamma"].values, dtype=float)
+        gamma = np.asarray(strains(ds)["gamma"].values, dtype=float)
         out["lifetime_gamma"] = with_attrs(xr.DataArray(gamma[end_index] - gamma[e["birth"]], dims=dim),
                                            "lifetime_gamma", "1", "simple-shear strain gamma of the cell over the life")
     for name, units, long_name in (("birth", "s", "time of the first snapshot of the life"),
@@ -174,46 +140,6 @@ def contact_events(ds: xr.Dataset, walls: bool = True, near=None) -> xr.Dataset:
     out.attrs.update(walls=int(walls), near=near_attr(near), n_particles=n_particles(ds),
                      comment="lifetimes resolved to the snapshot interval (grainview.analysis.lifetimes)")
     return out
-
-
-def kaplan_meier(durations, observed):
-    """Kaplan–Meier survival S(u) at the distinct observed durations u.
-
-        S(u) = prod_{v <= u} (1 - d_v/n_v)
-
-    (u, S(u)) at the distinct durations u of ``durations`` whose ``observed`` flag is True
-    (False = right-censored); d_v the deaths at v and n_v the durations of at least v (at risk).
-
-    Parameters
-    ----------
-    durations : array_like of float
-        Observed durations (a death's lifetime, or a censored life's duration so far).
-    observed : array_like of bool
-        True where the duration ends in a death, False where it is right-censored.
-
-    Returns
-    -------
-    u : numpy.ndarray
-        The distinct durations that end in a death, increasing.
-    survival : numpy.ndarray
-        S(u) at each of them; every life still counts as at risk up to its own duration,
-        censored or not.
-
-    Raises
-    ------
-    grainview.contract.errors.ParameterError
-        When ``durations`` and ``observed`` differ in shape.
-    """
-    durations = np.asarray(durations, dtype=float)
-    observed = np.asarray(observed, dtype=bool)
-    if durations.shape != observed.shape:
-        raise ParameterError("durations and observed must have the same length")
-    u = np.unique(durations[observed])
-    ordered = np.sort(durations)
-    at_risk = ordered.size - np.searchsorted(ordered, u, side="left")
-    deaths = np.searchsorted(np.sort(durations[observed]), u, side="right") - np.searchsorted(
-        np.sort(durations[observed]), u, side="left")
-    return u, np.cumprod(1.0 - deaths / at_risk)
 
 
 def lifetime_survival(ds: xr.Dataset, walls: bool = True, near=None, by=None, unit: str = "time",
@@ -285,9 +211,7 @@ def lifetime_survival(ds: xr.Dataset, walls: bool = True, near=None, by=None, un
     grid = np.unique(tau[observed])
     survival = np.ones((len(groups), grid.size))
     for row, mask in enumerate(groups.values()):
-        u, s = kaplan_meier(tau[mask], observed[mask])
-        step = np.searchsorted(u, grid, side="right") - 1  # last event time <= tau
-        survival[row] = np.where(step >= 0, s[np.maximum(step, 0)] if s.size else 1.0, 1.0)
+        survival[row] = survival_on(grid, tau[mask], observed[mask])
     da = xr.DataArray(survival, dims=("group", "lifetime"),
                       coords={"group": list(groups), "lifetime": grid,
                               "lives": ("group", [int(m.sum()) for m in groups.values()])})
@@ -337,9 +261,7 @@ def median_lifetime_by_force(ds: xr.Dataset, bins=(0.0, 0.5, 1.0, 1.5, 2.0, np.i
     medians, counts = [], []
     for b in range(bins.size - 1):
         members = which == b
-        u, s = kaplan_meier(events["lifetime"].values[members], ~events["censored"].values[members])
-        below = np.flatnonzero(s <= 0.5)
-        medians.append(u[below[0]] if below.size else np.nan)
+        medians.append(median_lifetime(events["lifetime"].values[members], ~events["censored"].values[members]))
         counts.append(int(members.sum()))
     labels = [f"{lo:g}-{hi:g}" for lo, hi in zip(bins[:-1], bins[1:])]
     da = xr.DataArray(np.array(medians, float), dims="force_bin",
@@ -394,13 +316,8 @@ def strong_persistence(ds: xr.Dataset, max_lag: int = 20, strong: float = 1.0, w
     window = deque(maxlen=max_lag)
     for block, keys, present, _, fn in _blocks(ds, walls, near, force=True):
         for r in range(keys.shape[0]):
-            f = fn[r][present[r]]
-            sets = np.unique(keys[r][present[r]][f > strong * f.mean()]) if f.size else np.empty(0, np.int64)
-            total[0] += sets.size
-            kept[0] += sets.size
-            for lag, earlier in enumerate(reversed(window), start=1):
-                total[lag] += earlier.size
-                kept[lag] += np.isin(earlier, sets, assume_unique=True).sum()
+            sets = strong_pairs(keys[r][present[r]], fn[r][present[r]], strong)
+            count_still_strong(sets, window, kept, total)
             window.append(sets)
     times = np.asarray(ds["time"].values, float)
     lag_time = [float(np.mean(times[lag:] - times[:times.size - lag])) if times.size > lag else np.nan

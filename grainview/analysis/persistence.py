@@ -9,7 +9,8 @@ the order of the slots or of i and j. Pairs are matched with sorted keys and
 These quantities couple snapshots, so they are computed rather than left lazy: on a dask-backed
 dataset the snapshots are read one time-chunk at a time, carrying the state needed from one
 chunk to the next (the reference contacts, the previous snapshot), so a file larger than
-memory streams through.
+memory streams through. The matching of the pairs on plain arrays is
+:mod:`grainview.analysis.arrays.persistence`'.
 """
 
 from __future__ import annotations
@@ -20,13 +21,10 @@ import xarray as xr
 from ._lift import with_attrs
 from .contacts import check_near, n_particles, near_attr, selection, snapshot_index
 from ..contract.errors import ParameterError
-from ..contract.schema import KIND_DOUBLE, KIND_SIMPLE
 from ._docs import fill_doc
+from .arrays.persistence import pair_keys, pair_transitions, pooled_counts, reference_found
 
 __all__ = ["body_count", "pair_keys", "pooled_contacts", "time_blocks", "persistence", "type_transitions"]
-
-_MAX_KEY = np.iinfo(np.int64).max // 2
-
 
 @fill_doc
 def body_count(ds: xr.Dataset) -> int:
@@ -45,33 +43,6 @@ def body_count(ds: xr.Dataset) -> int:
     """
     n_walls = max(ds.sizes.get("wall", 0), int(ds.attrs.get("n_walls", 0) or 0))
     return n_particles(ds) + n_walls
-
-
-def pair_keys(i, j, n_bodies):
-    """int64 key ``min(i, j) n_bodies + max(i, j)`` of each pair (unique for bodies < n_bodies).
-
-        key = min(i, j) n_bodies + max(i, j)
-
-    Parameters
-    ----------
-    i, j : array_like of int
-        The bodies of each contact (same shape).
-    n_bodies : int
-        The stride, N + W (:func:`body_count`).
-
-    Returns
-    -------
-    numpy.ndarray
-        int64 keys, the shape of ``i`` and ``j``.
-
-    References
-    ----------
-    Azéma, Radjai, Peyroux & Saussine, Phys. Rev. E 76, 011301 (2007),
-    Sec. IV.A (a contact as a pair of bodies); docs/conventions.md §8.
-    """
-    i = np.asarray(i, np.int64)
-    j = np.asarray(j, np.int64)
-    return np.minimum(i, j) * n_bodies + np.maximum(i, j)
 
 
 @fill_doc
@@ -176,12 +147,7 @@ def persistence(ds: xr.Dataset, reference: int = 0, uninterrupted: bool = False,
             alive = np.ones(ref_keys.size, bool)
         if ref_keys.size == 0:
             break
-        keys, present = keys[first:], present[first:]
-        position = np.minimum(np.searchsorted(ref_keys, keys), ref_keys.size - 1)
-        hit = present & (ref_keys[position] == keys)
-        found = np.zeros((keys.shape[0], ref_keys.size), bool)  # found[t, r]: reference contact r at t
-        rows, cols = np.nonzero(hit)
-        found[rows, position[rows, cols]] = True
+        found = reference_found(ref_keys, keys[first:], present[first:])
         if uninterrupted:
             found = np.logical_and.accumulate(found & alive, axis=0)
             alive = found[-1].copy()
@@ -190,39 +156,6 @@ def persistence(ds: xr.Dataset, reference: int = 0, uninterrupted: bool = False,
     return with_attrs(da, "gamma", "1", "fraction of persistent contacts gamma",
                       reference=reference, uninterrupted=int(uninterrupted), walls=int(walls),
                       near=near_attr(near))
-
-
-def _pair_transitions(prev_keys, prev_kind, prev_present, keys, kind, present, stride):
-    """Numbers of contacts present at t-1 and t that went simple -> double and double -> simple,
-    and the number of contacts at t-1, for consecutive rows (prev row r matches row r).
-
-    Rows are separated by adding ``r * stride**2`` to the keys (exact integer offsets), so a
-    single sort and ``np.searchsorted`` match all pairs of a block.
-    """
-    n_rows = keys.shape[0]
-    span = stride * stride
-    rows_per_pass = max(1, _MAX_KEY // span - 1)
-    s_to_d = np.zeros(n_rows, np.int64)
-    d_to_s = np.zeros(n_rows, np.int64)
-    for lo in range(0, n_rows, rows_per_pass):  # one pass unless keys would overflow int64
-        hi = min(lo + rows_per_pass, n_rows)
-        offset = np.arange(hi - lo, dtype=np.int64)[:, None] * span
-        before = (prev_keys[lo:hi] + offset)[prev_present[lo:hi]]
-        before_kind = prev_kind[lo:hi][prev_present[lo:hi]]
-        order = np.argsort(before, kind="stable")
-        before, before_kind = before[order], before_kind[order]
-        row, col = np.nonzero(present[lo:hi])
-        now = keys[lo:hi][row, col] + offset[row, 0]
-        if before.size == 0 or now.size == 0:
-            continue
-        position = np.minimum(np.searchsorted(before, now), before.size - 1)
-        matched = before[position] == now
-        was, becomes = before_kind[position], kind[lo:hi][row, col]
-        s_to_d[lo:hi] = np.bincount(row[matched & (was == KIND_SIMPLE) & (becomes == KIND_DOUBLE)],
-                                    minlength=hi - lo)
-        d_to_s[lo:hi] = np.bincount(row[matched & (was == KIND_DOUBLE) & (becomes == KIND_SIMPLE)],
-                                    minlength=hi - lo)
-    return s_to_d, d_to_s, prev_present.sum(axis=1)
 
 
 @fill_doc
@@ -283,7 +216,7 @@ def type_transitions(ds: xr.Dataset, walls: bool = False, near=None) -> xr.Datas
         prev_kind = np.concatenate([carry[1], kind[:-1]])
         prev_present = np.concatenate([carry[2], present[:-1]])
         if keys.shape[0]:
-            n_sd, n_ds, n_prev = _pair_transitions(prev_keys, prev_kind, prev_present, keys, kind, present, stride)
+            n_sd, n_ds, n_prev = pair_transitions(prev_keys, prev_kind, prev_present, keys, kind, present, stride)
             with np.errstate(invalid="ignore", divide="ignore"):
                 s_to_d[start:block.stop] = np.where(n_prev > 0, n_sd / np.maximum(n_prev, 1), 0.0)
                 d_to_s[start:block.stop] = np.where(n_prev > 0, n_ds / np.maximum(n_prev, 1), 0.0)
@@ -327,4 +260,4 @@ def pooled_contacts(ds: xr.Dataset, walls: bool = False) -> tuple[int, float]:
     order = ("time", "contact")
     present = np.asarray(selection(ds, walls=walls).transpose(*order).values, bool)
     keys = pair_keys(ds["i"].transpose(*order).values, ds["j"].transpose(*order).values, body_count(ds))
-    return int(np.unique(keys[present]).size), float(present.sum(axis=1).mean())
+    return pooled_counts(keys, present)

@@ -1,14 +1,16 @@
-"""The sample box: width l, height h and volume V of each snapshot."""
+"""The sample: its box (width l, height h and volume V of each snapshot) and its particles'
+shapes (which are regular polygons, one name for them all)."""
 
 from __future__ import annotations
 
+import numpy as np
 import xarray as xr
 
 from ._lift import with_attrs
-from ..contract.shapes import particle_area_of
+from ..contract.shapes import particle_area_of, regular_polygons
 from ._docs import fill_doc
 
-__all__ = ["thickness", "width", "height", "volume", "solid_fraction", "area"]
+__all__ = ["thickness", "width", "height", "volume", "solid_fraction", "area", "regular_of", "shape_name"]
 
 
 @fill_doc
@@ -149,3 +151,27 @@ def area(ds: xr.Dataset) -> xr.DataArray:
     Sec. III (the V of the volumetric strain eps_p); docs/conventions.md §6.
     """
     return with_attrs(width(ds) * height(ds), "area", "m2", "sample area l h")
+
+
+def regular_of(ds) -> np.ndarray:
+    """(P,) bool: which particles of a dataset of the contract are regular polygons
+    (:func:`grainview.contract.shapes.regular_polygons` of its ``vertices``, when it has them)."""
+    n_vertices = np.asarray(ds["n_vertices"].values)
+    if "vertices" not in ds.variables:  # the contract: without vertices, every polygon is regular
+        return n_vertices >= 3
+    return regular_polygons(ds["radius"].values, n_vertices, ds["vertices"].values)
+
+
+def shape_name(ds) -> str:
+    """One name for a sample's particles: "disk" (every particle a disk), "<n>-gon" (every one
+    a regular n-gon), "irregular polygon" (every one a polygon, some irregular) or "mixed"
+    (disks and polygons, or regular polygons of several vertex counts)."""
+    n_vertices = np.asarray(ds["n_vertices"].values)
+    if not n_vertices.any():
+        return "disk"
+    if not (n_vertices >= 3).all():
+        return "mixed"
+    regular = regular_of(ds)
+    if not regular.all():
+        return "irregular polygon"
+    return f"{int(n_vertices[0])}-gon" if (n_vertices == n_vertices[0]).all() else "mixed"

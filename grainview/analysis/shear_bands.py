@@ -6,7 +6,8 @@ half maximum of its profile); docs/analysis.md, "Coarse-grained fields".
 Orientation: a line at angle theta (degrees, counterclockwise from the x axis, in [0, 180)) has
 the unit normal n = (-sin theta, cos theta); a node r = (x, y) lies on the line at signed
 distance s = r . n = -x sin theta + y cos theta (m) from the origin. theta = 0 gives the
-profile across y (averages over x), theta = 90 the profile across x, reversed.
+profile across y (averages over x), theta = 90 the profile across x, reversed. The arithmetic
+on the grid's arrays is :mod:`grainview.analysis.arrays.shear_bands`'.
 """
 
 from __future__ import annotations
@@ -15,6 +16,7 @@ import numpy as np
 import xarray as xr
 
 from ..contract.errors import ParameterError
+from .arrays.shear_bands import binned_mean, half_maximum, node_bins, normal_distance, strongest_strip
 
 __all__ = ["profile_along", "find_shear_band", "normal_distance", "DEFAULT_ANGLES", "DEFAULT_CONTRAST",
            "DEFAULT_STRIP_CELLS"]
@@ -50,49 +52,6 @@ def _spacing_of(x, y):
     if steps.size == 0:
         raise ParameterError("the field has a single grid node: expected a grid of several nodes")
     return float(steps.max())
-
-
-def normal_distance(x, y, angle: float):
-    """Signed distance s = -x sin(theta) + y cos(theta) (m) of the nodes (x, y) from the line
-    through the origin at ``angle`` theta (degrees from the x axis).
-
-    Parameters
-    ----------
-    x, y : array_like
-        Coordinates, m (broadcast together).
-    angle : float
-        The lines' orientation theta, degrees counterclockwise from the x axis.
-
-    Returns
-    -------
-    numpy.ndarray
-        s, m.
-    """
-    t = np.radians(angle)
-    return -np.asarray(x, float) * np.sin(t) + np.asarray(y, float) * np.cos(t)
-
-
-def _bins(x, y, angle, bin_width):
-    """Each node's bin k = round(s / h) over (y, x), and the bins' range."""
-    s = normal_distance(x[None, :], y[:, None], angle)
-    k = np.rint(s / bin_width).astype(np.int64)
-    return k, int(k.min()), int(k.max())
-
-
-def _binned_mean(values, k, k0, n_bins):
-    """Mean of ``values`` (..., y, x) over the nodes of each bin (NaN skipped): (..., n_bins)."""
-    flat = values.reshape((-1, k.size))
-    ok = np.isfinite(flat)
-    # one bincount over (row, bin) pairs: each bin's sum in node order, the same bits on every
-    # processor (a product with a one-hot matrix would sum in the order of the BLAS kernel)
-    where = (np.arange(flat.shape[0])[:, None] * n_bins + (k.ravel() - k0)[None, :]).ravel()
-    size = flat.shape[0] * n_bins
-    sums = np.bincount(where, np.where(ok, flat, 0.0).ravel(), minlength=size).reshape(flat.shape[0], n_bins)
-    counts = np.bincount(where, ok.ravel().astype(float), minlength=size).reshape(flat.shape[0], n_bins)
-    sums = sums.reshape(values.shape[:-2] + (n_bins,))
-    counts = counts.reshape(values.shape[:-2] + (n_bins,))
-    with np.errstate(invalid="ignore", divide="ignore"):
-        return np.where(counts > 0, sums / np.where(counts > 0, counts, 1.0), np.nan)
 
 
 def profile_along(field: xr.DataArray, angle: float, inside=None, bin_width=None) -> xr.DataArray:
@@ -137,10 +96,10 @@ def profile_along(field: xr.DataArray, angle: float, inside=None, bin_width=None
     x, y = _grid_of(field)
     angle = _number(angle, "angle", "an orientation in degrees", low=-np.inf)
     h = _spacing_of(x, y) if bin_width is None else _number(bin_width, "bin_width", "a bin width > 0 in m")
-    k, k0, k1 = _bins(x, y, angle, h)
+    k, k0, k1 = node_bins(x, y, angle, h)
     n_bins = k1 - k0 + 1
     values = field if inside is None else field.where(inside)
-    out = xr.apply_ufunc(_binned_mean, values.transpose(..., "y", "x"), input_core_dims=[["y", "x"]],
+    out = xr.apply_ufunc(binned_mean, values.transpose(..., "y", "x"), input_core_dims=[["y", "x"]],
                          output_core_dims=[["s"]], kwargs={"k": k, "k0": k0, "n_bins": n_bins},
                          dask="parallelized", output_dtypes=[float],
                          dask_gufunc_kwargs={"output_sizes": {"s": n_bins}})
@@ -151,24 +110,6 @@ def profile_along(field: xr.DataArray, angle: float, inside=None, bin_width=None
     if "long_name" in out.attrs:
         out.attrs["long_name"] = f"{out.attrs['long_name']}, averaged along lines at {angle:g} deg"
     return out.rename(field.name)
-
-
-def _half_maximum(s, p, peak):
-    """Distances of the half-maximum crossings either side of bin ``peak`` of the profile p(s)
-    (linear interpolation), half-way between the peak and the profile's median; NaN where the
-    profile stays above it to its end."""
-    level = 0.5 * (p[peak] + np.nanmedian(p))
-    ends = []
-    for step in (-1, 1):
-        k, found = peak, np.nan
-        while 0 <= k + step < p.size and np.isfinite(p[k + step]):
-            if p[k + step] < level:
-                u = (p[k] - level) / (p[k] - p[k + step])
-                found = s[k] + u * (s[k + step] - s[k])
-                break
-            k += step
-        ends.append(found)
-    return ends[0], ends[1], level
 
 
 def find_shear_band(rate: xr.DataArray, inside=None, width=None, angles=None, contrast: float = DEFAULT_CONTRAST,
@@ -252,19 +193,7 @@ def find_shear_band(rate: xr.DataArray, inside=None, width=None, angles=None, co
     if np.any(g[ok] < 0):
         raise ParameterError("rate: negative values; expected a shear rate (>= 0)")
     total, n = g[ok].sum(), ok.sum()
-    best = None
-    for angle in angles:
-        k, k0, k1 = _bins(x, y, angle, h)
-        sums = np.bincount(k[ok] - k0, g[ok], minlength=k1 - k0 + 1)
-        counts = np.bincount(k[ok] - k0, minlength=k1 - k0 + 1).astype(float)
-        if sums.size < m:
-            continue
-        window = np.ones(m)
-        strip_sum, strip_n = np.convolve(sums, window, "valid"), np.convolve(counts, window, "valid")
-        excess = strip_sum / total - strip_n / n
-        j = int(np.argmax(excess))
-        if best is None or excess[j] > best[0]:
-            best = (float(excess[j]), float(angle), j, k0, float(strip_sum[j]), float(strip_n[j]))
+    best = strongest_strip(g, x, y, angles, h, m)
     if best is None:
         raise ParameterError(f"width={width!r}: expected a strip narrower than the grid")
     excess, angle, j, k0, strip_sum, strip_n = best
@@ -279,7 +208,7 @@ def find_shear_band(rate: xr.DataArray, inside=None, width=None, angles=None, co
     first = int(np.argmin(np.abs(s - (k0 + j) * h)))
     strip = p[first:first + m]
     peak = first + int(np.nanargmax(strip)) if np.isfinite(strip).any() else first
-    lo, hi, level = _half_maximum(s, p, peak)
+    lo, hi, level = half_maximum(s, p, peak)
     fwhm = hi - lo
     found = bool(c >= contrast and np.isfinite(fwhm))
     scalar = lambda v, units, long_name: xr.DataArray(v, attrs={"units": units, "long_name": long_name})  # noqa: E731

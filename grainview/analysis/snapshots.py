@@ -4,7 +4,8 @@ The figures and the report average a distribution (a pdf, an angular profile, th
 xi-network's q(xi)/p) over a set of snapshots chosen by one argument ``time``
 (:func:`select_snapshots`): by default the residual state, eps_q >= 0.3
 (:func:`grainview.analysis.strain.residual_window`), or for a run that stops short of it the
-last 30% of its shear strain.
+last 30% of its shear strain. An export or a movie takes every n-th snapshot and the last
+(:func:`snapshot_indices`).
 """
 
 from __future__ import annotations
@@ -105,3 +106,30 @@ def time_mean(da):
     """Average over the snapshots, NaN-aware, attributes kept; lazy as ``da`` (a result without
     ``time`` comes back unchanged)."""
     return da.mean("time", skipna=True, keep_attrs=True) if "time" in da.dims else da
+
+
+def snapshot_indices(ds: xr.Dataset, every: int = 1) -> np.ndarray:
+    """Indices 0, every, 2 every, ... of the snapshots an export writes or a movie draws (and
+    always the last).
+
+    Parameters
+    ----------
+    ds : xarray.Dataset
+        A grainview dataset.
+    every : int, default 1
+        The step between the snapshots taken (>= 1).
+
+    Returns
+    -------
+    numpy.ndarray
+        Increasing snapshot indices, the last snapshot included (empty for no snapshot).
+
+    Raises
+    ------
+    grainview.contract.errors.ParameterError
+        When ``every`` is not an integer >= 1.
+    """
+    if isinstance(every, bool) or not isinstance(every, (int, np.integer)) or every < 1:
+        raise ParameterError(f"every={every!r}: expected an integer >= 1")
+    n = ds.sizes["time"]
+    return np.unique(np.append(np.arange(0, n, every), n - 1)) if n else np.arange(0)

@@ -85,7 +85,7 @@ def _info(args) -> int:
 
 
 def _export(args) -> int:
-    from ..formats.export import write_csv, write_vtk
+    from ..export import write_csv, write_vtk
     from ..contract.io import open_dataset
     from ..contract.validation import validate
 
@@ -419,7 +419,7 @@ def _export_parser(sub):
     export.add_argument("--out", required=True, help="output folder (created if needed)")
     import inspect
 
-    from ..formats.export import write_vtk
+    from ..export.vtk import write_vtk
 
     every = inspect.signature(write_vtk).parameters["every"].default
     export.add_argument("--every", type=int, default=every,
@@ -439,7 +439,7 @@ def _demo_parser(sub):
                       "--overwrite")
     import inspect
 
-    from ..analysis.synthetic import harmonic_series
+    from ..datasets import harmonic_series
     from .demo import CONTACTS as contacts
     from .demo import SNAPSHOTS as snapshots
 

@@ -1,7 +1,7 @@
 """``grainview demo``: a synthetic series drawn from the harmonic model, written to a file and
 analysed lazily from it, with no simulation (seconds).
 
-The series (:func:`grainview.analysis.synthetic.harmonic_series`) has contacts whose normal
+The series (:func:`grainview.datasets.harmonic_series`) has contacts whose normal
 density and mean forces follow Eqs. (6)-(8) of Azéma et al. (2007); q/p computed from the file
 is compared with the harmonic prediction q/p = (a' + a_n + a_t)/2, Eq. (9), each column
 computed with dask from a file opened in chunks of 5 snapshots.
@@ -52,7 +52,7 @@ def run_demo(out, *, snapshots=SNAPSHOTS, contacts=CONTACTS, seed=None, overwrit
     FileExistsError
         When an output file exists and ``overwrite`` is False.
     """
-    from ..analysis.synthetic import harmonic_series
+    from ..datasets import harmonic_series
     from ..contract.dataset import netcdf_options
     from ..formats.opening import open_dataset
 

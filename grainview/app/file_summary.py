@@ -3,7 +3,7 @@
 Importing xarray, pandas and dask takes about a second on its own, longer than the whole
 summary of a study's file. So the summary that ``grainview info`` prints is read here with
 netCDF4, computed with the pure array functions of :mod:`grainview.analysis.arrays` (the same physics
-as the accessors) and formatted by :func:`grainview.analysis.summary.summary_lines` (the same lines as
+as the accessors) and formatted by :func:`grainview.app.summary.summary_lines` (the same lines as
 the report's index). The checks made on the way: the file opens as netCDF, it is a grainview
 file, its structure and units follow the contract (:func:`grainview.contract.schema.structure_problems`,
 :func:`grainview.contract.schema.unit_problems`), a netCDF-3 file is neither shorter than its fixed data
@@ -83,7 +83,7 @@ def read_facts(path, check=False) -> tuple[dict, dict]:
     Returns
     -------
     facts : dict
-        What :func:`grainview.analysis.summary.summary_lines` reads: ``n_vertices``, ``regular``
+        What :func:`grainview.app.summary.summary_lines` reads: ``n_vertices``, ``regular``
         (which polygons are regular, :func:`grainview.contract.shapes.regular_polygons`), ``n_walls``,
         ``n_slots``, ``snapshots`` (complete ones), ``time`` (s), ``contact_count``,
         ``solid_fraction``, ``eps_1`` and ``eps_q`` of the last snapshot (log strains against
@@ -208,10 +208,10 @@ def cell_line(cell: dict) -> str:
 
 def describe_file(path, check=False) -> tuple[list, dict]:
     """The lines ``grainview info`` prints for ``path`` (:func:`read_facts`, formatted by
-    :func:`grainview.analysis.summary.summary_lines`, then the file's size and format, and notes on
+    :func:`grainview.app.summary.summary_lines`, then the file's size and format, and notes on
     variables without units and on a missing schema version) and the file's global attributes;
     ``check``: as for :func:`read_facts` (``grainview info --check``)."""
-    from ..analysis.summary import summary_lines
+    from .summary import summary_lines
 
     facts, attrs = read_facts(path, check=check)
     lines = summary_lines(facts, attrs)

@@ -78,7 +78,8 @@ def _ratio(a, b):
 
 def describe_run(ds: xr.Dataset, window: xr.DataArray, residual_strain: float) -> dict:
     """The rows that say what a run is: particles, seed, preparation, window, criterion."""
-    from ..analysis.summary import regular_of, shape_counts
+    from ..analysis.sample import regular_of
+    from .summary import shape_counts
 
     attrs = ds.attrs
     n_vertices = ds["n_vertices"].values
@@ -244,7 +245,7 @@ def description_numbers(ds: xr.Dataset, residual_strain: float = RESIDUAL_STRAIN
 def paper_sample(ds: xr.Dataset) -> str | None:
     """The paper's sample whose particles a run has: "disks" (every particle a disk),
     "pentagons" (every particle a regular pentagon) or None."""
-    from ..analysis.summary import shape_name
+    from ..analysis.sample import shape_name
 
     return {"disk": "disks", "5-gon": "pentagons"}.get(shape_name(ds))
 
@@ -336,9 +337,10 @@ def caption(label: str, ds: xr.Dataset, what: str, residual_strain: float = RESI
     """One line saying what a figure shows of run ``label``: N and shape, seed, preparation,
     and, by ``what``: "map" the snapshot drawn, "distribution" the residual window averaged
     over, anything else the range of the evolution."""
+    from ..analysis.sample import regular_of
     from ..analysis.snapshots import residual_snapshots
     from ..analysis.strain import strains
-    from ..analysis.summary import regular_of, shape_counts
+    from .summary import shape_counts
 
     shape = shape_counts(ds["n_vertices"].values, regular_of(ds))
     seed = ds.attrs.get("preparation_seed", ds.attrs.get("solver_seed", "?"))
@@ -536,9 +538,9 @@ def file_link(source, folder) -> str:
 
 
 def write_index(runs: dict, out: Path, captions: dict, residual_strain: float = RESIDUAL_STRAIN) -> Path:
-    """``out/index.md``: the runs (their settings, :func:`grainview.analysis.summary.describe`), the
+    """``out/index.md``: the runs (their settings, :func:`grainview.app.summary.describe`), the
     headline table, and every figure file with its caption, in the paper's order."""
-    from ..analysis.summary import describe
+    from .summary import describe
 
     out = Path(out)
     lines = ["# Report", "", "Force transmission in the runs below, next to Azema, Radjai, Peyroux & Saussine, "

@@ -1,7 +1,9 @@
 """Writing a netCDF file of the data contract snapshot by snapshot, safe against a killed run.
 
 :class:`SnapshotWriter` is what the solver writes through (:mod:`solver.output`); it needs
-netCDF4 and numpy only. The contract it writes is :mod:`grainview.contract.schema`.
+netCDF4 and numpy only. The contract it writes is :mod:`grainview.contract.schema`. Any other
+file (an export, a movie) is written under a temporary name and moved into place by
+:func:`write_atomically`.
 """
 
 from __future__ import annotations
@@ -844,3 +846,35 @@ class SnapshotWriter:
 
     def __exit__(self, *exc):
         self.close()
+
+
+def write_atomically(path, overwrite, write):
+    """Write ``path`` through ``write(temporary path)`` and move it into place.
+
+    An interrupted write never leaves a half-written file under the final name; an existing
+    ``path`` is refused unless ``overwrite``.
+
+    Parameters
+    ----------
+    path : str
+        The final file name.
+    overwrite : bool
+        Replace an existing ``path``.
+    write : callable
+        Called with the temporary path (``<root>.part<ext>`` beside ``path``); writes the file.
+
+    Returns
+    -------
+    None
+
+    Raises
+    ------
+    grainview.contract.errors.ParameterError
+        When ``path`` exists and ``overwrite`` is False.
+    """
+    if os.path.exists(path) and not overwrite:
+        raise ParameterError(f"{path} exists; pass overwrite=True to replace it")
+    root, ext = os.path.splitext(path)
+    temporary = f"{root}.part{ext}"
+    write(temporary)
+    os.replace(temporary, path)

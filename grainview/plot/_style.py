@@ -298,7 +298,7 @@ def shape_key(label=None, ds: xr.Dataset | None = None) -> str | None:
         A sample key of :data:`PALETTE`, or None.
     """
     if ds is not None and "n_vertices" in ds:
-        from ..analysis.summary import shape_name
+        from ..analysis.sample import shape_name
 
         return {"disk": "disks", "5-gon": "pentagons"}.get(shape_name(ds))
     low = str(label or "").lower()

@@ -278,8 +278,8 @@ def animate_chains(data, path, every: int = 1, fps: int = 8, angle: float = 45.0
     """
     import matplotlib.pyplot as plt
 
-    from ..formats.export import snapshot_indices
     from ..analysis.force_chains import force_chains
+    from ..analysis.snapshots import snapshot_indices
     from .movies import _writer, frame_title, save_frames
 
     if os.path.exists(path) and not overwrite:  # before any drawing

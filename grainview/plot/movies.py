@@ -54,11 +54,11 @@ def frame_title(ds):
 def save_frames(fig, path, writer, frames, draw, *, dpi, progress, overwrite, desc) -> str:
     """Draw ``draw(row, k)`` for each snapshot index k of ``frames`` (row its position) on
     ``fig``, grab each as a frame of ``writer``, and write the movie to ``path`` atomically
-    (:func:`grainview.formats.export.write_atomically`); ``fig`` is closed in any case. Returns
+    (:func:`grainview.contract.writer.write_atomically`); ``fig`` is closed in any case. Returns
     ``str(path)``."""
     import matplotlib.pyplot as plt
 
-    from ..formats.export import write_atomically
+    from ..contract.writer import write_atomically
 
     rows = list(enumerate(frames))
     if progress:
@@ -88,7 +88,7 @@ def animate(data, path, kind: str = "force_chains", every: int = 1, fps: int = 8
     movie at ``max_linewidth`` points), ``"force_classes"`` (very weak / weak / strong, paper
     Fig. 17) or ``"connectivity"`` (particles coloured by their contacts, one colour bar for the
     movie). Each frame is titled with its shear strain eps_q and time. Written atomically
-    (:func:`grainview.formats.export.write_atomically`).
+    (:func:`grainview.contract.writer.write_atomically`).
 
     Parameters
     ----------
@@ -129,7 +129,7 @@ def animate(data, path, kind: str = "force_chains", every: int = 1, fps: int = 8
     """
     import matplotlib.pyplot as plt
 
-    from ..formats.export import snapshot_indices
+    from ..analysis.snapshots import snapshot_indices
     from .maps import plot_force_chains, plot_force_classes, plot_particles
 
     if kind not in KINDS:

@@ -11,7 +11,7 @@ import pytest
 
 import grainview
 import grainview.contract.writer as writer
-from grainview.analysis.synthetic import harmonic_series
+from grainview.datasets import harmonic_series
 from grainview.app.cli import main
 from grainview.contract.dataset import netcdf_options
 from grainview.contract.errors import FileFormatError

@@ -7,7 +7,7 @@ import xarray as xr
 
 import grainview
 from grainview.app.cli import main
-from grainview.analysis.synthetic import harmonic_series
+from grainview.datasets import harmonic_series
 from grainview.contract.writer import is_compressed
 
 
@@ -246,7 +246,7 @@ def test_info_reads_the_file_without_xarray_and_says_what_the_accessors_say(tmp_
     import sys
 
     from grainview.app.file_summary import describe_file
-    from grainview.analysis.summary import describe
+    from grainview.app.summary import describe
 
     path = tmp_path / "run.nc"
     ds = harmonic_series(n_snapshots=4, n_contacts=300, anisotropy=(0.2, 0.3, 0.1), seed=3)

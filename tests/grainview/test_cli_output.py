@@ -16,7 +16,7 @@ import pytest
 import grainview
 from grainview.app.cli import build_parser, main
 from grainview.contract.dataset import netcdf_encoding
-from grainview.analysis.synthetic import harmonic_series
+from grainview.datasets import harmonic_series
 
 from .test_near_contacts import chain
 
@@ -147,7 +147,7 @@ def test_ensemble_replaces_its_report_when_asked_and_keeps_the_runs(tmp_path, mo
 # 16. CSV export and headline.csv -------------------------------------------------------
 
 def test_csv_export_flags_the_pairs_without_force_and_names_kinds_and_units(tmp_path):
-    from grainview.formats.export import write_csv
+    from grainview.export import write_csv
 
     ds = chain()
     kind = ds["kind"].values.copy()

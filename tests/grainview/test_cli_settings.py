@@ -135,7 +135,7 @@ def test_the_command_line_holds_no_numeric_default_of_its_own():
 
 
 def test_options_of_other_functions_take_those_functions_defaults():
-    from grainview.analysis.synthetic import harmonic_series
+    from grainview.datasets import harmonic_series
     from grainview.formats.pegs import convert_pegs
     import inspect
 

@@ -8,6 +8,7 @@ import xarray as xr
 
 from grainview.analysis import sample
 from grainview.analysis._kernels.coarse_graining import spread_points, spread_segments
+from grainview.analysis._kernels.records import Grid, Points, Segments
 from grainview.analysis.arrays.stress import stress_tensor as love_weber
 from grainview.analysis.coarse_graining import coarse_grained, field_invariants, interior, profile, scalar_field
 from grainview.contract.dataset import make_dataset
@@ -46,7 +47,7 @@ def test_spread_points_is_the_direct_sum():
     x, y = np.linspace(-0.3, 1.3, 41), np.linspace(-0.2, 1.2, 37)
     w, c = 0.15, 0.4
     out = np.zeros((2, y.size, x.size, 3))
-    spread_points(px, py, active, weights, x, y, w, c, out)
+    spread_points(Points(px, py, active, weights), Grid(x, y, w, c), out)
     X, Y = np.meshgrid(x, y)
     for b in range(2):
         expected = sum(phi(X - px[b, p], Y - py[b, p], w, c)[..., None] * weights[b, p]
@@ -67,7 +68,7 @@ def test_spread_segments_is_the_line_integral(cutoff):
     lx[0, 0], ly[0, 0] = 0.0, 0.0  # a point
     x, y = np.linspace(-0.6, 1.6, 23), np.linspace(-0.5, 1.5, 19)
     out = np.zeros((1, y.size, x.size, 1))
-    spread_segments(sx, sy, lx, ly, np.ones((1, 6), bool), np.ones((1, 6, 1)), x, y, w, c, out)
+    spread_segments(Segments(sx, sy, lx, ly, np.ones((1, 6), bool), np.ones((1, 6, 1))), Grid(x, y, w, c), out)
     X, Y = np.meshgrid(x, y)
     if cutoff == 3.0:
         u = (np.arange(40_000) + 0.5) / 40_000

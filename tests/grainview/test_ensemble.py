@@ -14,7 +14,7 @@ import grainview
 from grainview.contract.dataset import netcdf_encoding
 from grainview.analysis.ensemble import run_dataset, seed_statistics
 from grainview.contract.errors import ParameterError
-from grainview.analysis.synthetic import harmonic_series
+from grainview.datasets import harmonic_series
 
 from .conftest import raise_if_dask_computes
 

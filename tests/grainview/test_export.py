@@ -12,7 +12,7 @@ import pandas as pd
 import pytest
 
 from grainview.contract.errors import ParameterError
-from grainview.formats.export import write_csv, write_vtk
+from grainview.export import write_csv, write_vtk
 
 from .test_lifetimes import SERIES
 from .test_persistence import N, S, sequence_dataset
@@ -171,11 +171,12 @@ def test_csv_in_blocks_is_the_snapshots_tables_one_after_the_other(tmp_path, mon
     """The table read a block of snapshots at a time, whatever the block, is the tables of the
     snapshots one by one, concatenated (the per-snapshot way, rebuilt here), with a progress
     bar over the snapshots when asked for."""
-    import grainview.formats.export as export
+    import grainview.export.contacts_csv as export
+    from grainview.analysis.snapshots import snapshot_indices
     from grainview.analysis.tables import contacts_table
 
     ds = polygons_and_disks()
-    chosen = export.snapshot_indices(ds, every)
+    chosen = snapshot_indices(ds, every)
     frames = []
     for k in chosen:
         table = contacts_table(ds, time=int(k))

@@ -11,7 +11,7 @@ import xml.etree.ElementTree as ElementTree
 import numpy as np
 import pytest
 
-from grainview.formats.export import write_vtk
+from grainview.export import write_vtk
 
 from .test_export import polygons_and_disks
 from .test_lifetimes import SERIES

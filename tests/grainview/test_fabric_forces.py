@@ -6,7 +6,7 @@ import xarray as xr
 from hypothesis import given, settings, strategies as st
 
 from grainview import make_dataset
-from grainview.analysis.synthetic import harmonic_contacts
+from grainview.datasets import harmonic_contacts
 from grainview.contract.errors import ParameterError
 
 from . import builders
@@ -67,7 +67,7 @@ def test_angular_averages_and_orientation_pdf():
 
 
 def harmonic_sample(n=100_000, a=0.3, a_n=0.4, a_t=0.25, theta_0=0.3, seed=0):
-    """Contacts drawn from the harmonic model of ERRATA item 3 (grainview.analysis.synthetic), all
+    """Contacts drawn from the harmonic model of ERRATA item 3 (grainview.datasets), all
     directions theta_0, tangential forces resisting the shear; each contact its own pair."""
     normal, fn, ft, kind = harmonic_contacts(n, a, a_n, a_t, theta_0, mean_force=2.0, rng=seed)
     i = np.arange(0, 2 * n, 2)
@@ -162,7 +162,7 @@ def _angular_profile_by_loop(ds, snapshots, bins, component="fn"):
 
 @pytest.mark.parametrize("component", ["fn", "ft"])
 def test_angular_profile_against_a_loop_through_the_accessor(prepare, component):
-    from grainview.analysis.synthetic import harmonic_series
+    from grainview.datasets import harmonic_series
 
     ds = harmonic_series(n_snapshots=4, n_contacts=150, seed=5)
     lazy = prepare(ds)

@@ -244,7 +244,7 @@ def test_an_exact_exponential_gives_back_its_prefactor_and_exponent():
 def test_pooled_pdf_over_chosen_snapshots_through_the_accessor(prepare):
     """``time=`` pools the snapshots it chooses, lazily, the same as pooling them picked by hand."""
     from grainview.analysis.force_pdf import counting_error, strong_force_prefactor
-    from grainview.analysis.synthetic import harmonic_series
+    from grainview.datasets import harmonic_series
 
     ds = harmonic_series(n_snapshots=5, n_contacts=400, seed=2)
     lazy = prepare(ds)

@@ -11,7 +11,7 @@ import grainview
 from grainview.app.cli import main
 from grainview.contract.dataset import netcdf_options
 from grainview.contract.errors import FileFormatError, SchemaError
-from grainview.analysis.synthetic import harmonic_series
+from grainview.datasets import harmonic_series
 
 
 def _netcdf3(path, n_snapshots=55, n_contacts=20, complete=True):

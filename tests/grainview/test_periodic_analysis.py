@@ -10,7 +10,7 @@ import pytest
 import grainview
 import grainview.analysis.coarse_graining
 import grainview.analysis.strain
-import grainview.formats.export
+import grainview.export
 from grainview.contract import cell as cells
 
 
@@ -378,7 +378,7 @@ def test_vtk_export_wraps_the_particles_and_writes_the_cell(tmp_path):
                                                branch=base["branch"].values[0, :10])],
                                 box_min=[0, 0], box_max=[10, 10], periodic=[1, 1], cell=base["cell"].values)
     assert ds.attrs["cell_positions"] == "unwrapped"
-    written = grainview.formats.export.write_vtk(ds, tmp_path)
+    written = grainview.export.write_vtk(ds, tmp_path)
     assert any(p.endswith("cell_00000.vtp") for p in written)
 
     def points(name):

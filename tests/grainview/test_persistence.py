@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 
 from grainview import make_dataset
-from grainview.analysis import persistence as persistence_module
+from grainview.analysis.arrays import persistence as persistence_arrays
 from grainview.contract.errors import ParameterError
 from grainview.analysis.persistence import pair_keys, persistence, type_transitions
 
@@ -171,7 +171,7 @@ def test_streams_one_chunk_at_a_time(chunk, reference, expected_computes):
 def test_key_overflow_guard_gives_same_answer(monkeypatch):
     ds = evolving_dataset(seed=4)
     expected = type_transitions(ds)
-    monkeypatch.setattr(persistence_module, "_MAX_KEY", 3 * 11**2)  # forces passes of 2 rows
+    monkeypatch.setattr(persistence_arrays, "_MAX_KEY", 3 * 11**2)  # forces passes of 2 rows
     for name, da in type_transitions(ds).items():
         np.testing.assert_array_equal(da.values, expected[name].values)
 

@@ -25,7 +25,7 @@ from grainview.analysis.snapshots import select_snapshots  # noqa: E402
 from grainview.plot.maps import CLASS_COLOURS, KIND_COLOURS, contact_collection, newtons, per_metre  # noqa: E402
 from grainview.analysis.strain import friction_and_dilatancy, strains  # noqa: E402
 from grainview.analysis.stress import stress_invariants  # noqa: E402
-from grainview.analysis.synthetic import harmonic_series  # noqa: E402
+from grainview.datasets import harmonic_series  # noqa: E402
 
 from . import builders  # noqa: E402
 

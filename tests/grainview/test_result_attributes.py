@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 import xarray as xr
 
-from grainview.analysis.synthetic import harmonic_series
+from grainview.datasets import harmonic_series
 
 CALLS = [
     ("stress_tensor", {}), ("stress_invariants", {}), ("strains", {}), ("friction_and_dilatancy", {}),
@@ -52,7 +52,7 @@ def test_a_result_does_not_inherit_the_attributes_of_its_input(series):
 
 
 def test_time_series_carry_the_strains_as_coordinates():
-    from grainview.analysis.synthetic import harmonic_series
+    from grainview.datasets import harmonic_series
 
     ds = harmonic_series(n_snapshots=30, n_contacts=200)
     eps = ds.grain.strains()
@@ -72,7 +72,7 @@ def test_long_series_open_in_several_chunks(tmp_path):
     import grainview
     from grainview.contract.dataset import netcdf_encoding
     from grainview.contract.io import MIN_CHUNK_SNAPSHOTS
-    from grainview.analysis.synthetic import harmonic_series
+    from grainview.datasets import harmonic_series
 
     ds = harmonic_series(n_snapshots=200, n_contacts=50)
     path = tmp_path / "long.nc"

@@ -149,7 +149,7 @@ def test_to_netcdf_with_contract_encoding_round_trips(tmp_path):
 
 
 def test_a_zlib_copy_is_smaller_and_opens_and_validates_unchanged(tmp_path):
-    from grainview.analysis.synthetic import harmonic_series
+    from grainview.datasets import harmonic_series
     ds = harmonic_series(n_snapshots=4, n_contacts=2000)
     plain, packed = tmp_path / "plain.nc", tmp_path / "zlib.nc"
     ds.to_netcdf(plain, format="NETCDF4_CLASSIC", encoding=grainview.contract.dataset.netcdf_encoding(ds))

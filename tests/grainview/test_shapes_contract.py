@@ -24,7 +24,7 @@ from grainview.contract.shapes import (body_vertices, body_vertices_of, inertia_
                                        shape_problems, vertex_phases, world_vertices)
 from grainview.contract.validation import validate
 from grainview.contract.writer import SnapshotWriter
-from grainview.formats.export import write_vtk
+from grainview.export import write_vtk
 from grainview.app.file_summary import describe_file, read_facts
 
 from .test_export import read_vtp
@@ -361,7 +361,7 @@ def test_only_regular_pentagons_are_the_papers_pentagons():
     in the palette, and its report row and captions say what it is."""
     from grainview.plot._style import shape_key
     from grainview.app.report import caption, describe_run, paper_sample
-    from grainview.analysis.summary import shape_name
+    from grainview.analysis.sample import shape_name
 
     kite = regular_vertices(1.0, 5)
     kite[0, 0] = 2.0

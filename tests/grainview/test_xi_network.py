@@ -134,7 +134,7 @@ def test_default_xi_and_scalar():
 
 
 def test_xi_profile_is_the_mean_of_each_snapshots_network_through_the_accessor(prepare):
-    from grainview.analysis.synthetic import harmonic_series
+    from grainview.datasets import harmonic_series
 
     from .conftest import raise_if_dask_computes
 

@@ -165,7 +165,7 @@ def test_compressed_files_can_be_opened_again_and_again_with_dask_threads(tmp_pa
     process; the classic data model stores strings as characters. Run in a subprocess, so
     that a crash fails this test instead of ending the test session."""
     from grainview.contract.dataset import netcdf_options
-    from grainview.analysis.synthetic import harmonic_series
+    from grainview.datasets import harmonic_series
 
     paths = []
     for seed in range(3):
@@ -259,7 +259,7 @@ def test_compressed_files_have_one_snapshot_per_chunk_and_deflate_only_what_shri
     point (stored as they are) and most of i, j, kind (deflated). compress_file and the xarray
     path (netcdf_options) make the same layout, and the values read back unchanged."""
     from grainview.contract.dataset import netcdf_options
-    from grainview.analysis.synthetic import harmonic_series
+    from grainview.datasets import harmonic_series
 
     ds = harmonic_series(n_snapshots=6, n_contacts=20_000, seed=1)
     plain, packed, direct = tmp_path / "plain.nc", tmp_path / "packed.nc", tmp_path / "direct.nc"
@@ -289,7 +289,7 @@ def test_files_compressed_the_previous_way_still_open_unchanged(tmp_path):
     """Files compressed before: zlib 4 on every variable, the netCDF library's own chunks
     (several snapshots per chunk along a fixed-size time)."""
     from grainview.contract.dataset import netcdf_encoding
-    from grainview.analysis.synthetic import harmonic_series
+    from grainview.datasets import harmonic_series
 
     ds = harmonic_series(n_snapshots=30, n_contacts=3000, seed=2)
     old, plain = tmp_path / "old.nc", tmp_path / "plain.nc"
@@ -312,7 +312,7 @@ def test_chunks_of_empty_slots_are_not_stored_and_read_back_as_fill(tmp_path):
     that hold only empty slots are left unwritten, so the file is smaller by their bytes, and
     read back the same values bit for bit."""
     from grainview.contract.dataset import netcdf_options
-    from grainview.analysis.synthetic import harmonic_series
+    from grainview.datasets import harmonic_series
 
     ds = harmonic_series(n_snapshots=6, n_contacts=20_000, seed=1)
     half = ds.copy(deep=True)

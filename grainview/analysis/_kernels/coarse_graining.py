@@ -2,8 +2,9 @@
 particles' centres) and along segments (the contacts' branch vectors) onto a grid.
 
 Structure of arrays: coordinates and weights come as separate contiguous float64 arrays, one
-row per snapshot; the caller (:mod:`grainview.analysis.arrays.coarse_graining`) validates them. Every
-kernel adds into ``out`` (B, ny, nx, K), ``K`` the number of quantities carried by each source.
+row per snapshot, in the records of :mod:`grainview.analysis._kernels.records` (the sources, the
+grid); the caller (:mod:`grainview.analysis.arrays.coarse_graining`) validates them. Every kernel
+adds into ``out`` (B, ny, nx, K), ``K`` the number of quantities carried by each source.
 
 The kernel is the Gaussian of standard deviation w cut at radius c and renormalised,
 
@@ -34,13 +35,17 @@ def _norm(width, cutoff):
 
 
 @njit(cache=True, nogil=True)
-def spread_points(px, py, active, weights, x, y, width, cutoff, out):
+def spread_points(points, grid, out):
     """out[b, iy, ix, k] += weights[b, p, k] phi((x[ix], y[iy]) - (px[b, p], py[b, p])) over the
     points with ``active[b, p]``.
 
-    px, py (B, P) m; active (B, P) bool; weights (B, P, K); x (nx,), y (ny,) ascending, m;
-    width w and cutoff radius c in m; out (B, ny, nx, K), weights' units per m^2.
+    ``points`` (:class:`~grainview.analysis._kernels.records.Points`): px, py (B, P) m, active
+    (B, P) bool, weights (B, P, K); ``grid`` (:class:`~grainview.analysis._kernels.records.Grid`):
+    x (nx,), y (ny,) ascending, m, width w and cutoff radius c in m; out (B, ny, nx, K), weights'
+    units per m^2.
     """
+    px, py, active, weights = points.x, points.y, points.active, points.weights
+    x, y, width, cutoff = grid.x, grid.y, grid.width, grid.cutoff
     n_batch, n_points = px.shape
     n_k = weights.shape[2]
     norm = _norm(width, cutoff)
@@ -70,14 +75,19 @@ def spread_points(px, py, active, weights, x, y, width, cutoff, out):
 
 
 @njit(cache=True, nogil=True)
-def spread_segments(sx, sy, lx, ly, active, weights, x, y, width, cutoff, out):
+def spread_segments(segments, grid, out):
     """out[b, iy, ix, k] += weights[b, c, k] psi_c(x[ix], y[iy]) over the segments with
     ``active[b, c]``, psi_c the kernel integrated along segment c from (sx, sy) to
     (sx + lx, sy + ly) (the module's formula; a segment shorter than 1e-12 w is a point).
 
-    sx, sy, lx, ly (B, C) m; active (B, C) bool; weights (B, C, K); x (nx,), y (ny,) ascending,
-    m; width w and cutoff radius c in m; out (B, ny, nx, K).
+    ``segments`` (:class:`~grainview.analysis._kernels.records.Segments`): sx, sy, lx, ly (B, C)
+    m, active (B, C) bool, weights (B, C, K); ``grid``
+    (:class:`~grainview.analysis._kernels.records.Grid`): x (nx,), y (ny,) ascending, m, width w
+    and cutoff radius c in m; out (B, ny, nx, K).
     """
+    sx, sy, lx, ly = segments.start_x, segments.start_y, segments.length_x, segments.length_y
+    active, weights = segments.active, segments.weights
+    x, y, width, cutoff = grid.x, grid.y, grid.width, grid.cutoff
     n_batch, n_seg = sx.shape
     n_k = weights.shape[2]
     norm = _norm(width, cutoff)

@@ -59,14 +59,17 @@ def label_components(i, j, link, n_particles, min_size):
 
 
 @njit(cache=True, nogil=True)
-def accumulate_moments(i, j, fx, fy, px, py, x, y, mask):
+def accumulate_moments(slots, force, point, centre):
     """Sum over each particle's contacts of s f (x) (x^c - x_p), one row per snapshot.
 
-    Structure of arrays, all (R, C) but the centres ``x``, ``y`` (R, P): bodies ``i``, ``j``
-    (int64), force components ``fx``, ``fy`` (N), application point ``px``, ``py`` (m),
-    ``mask`` (bool). s = +1 for body i and -1 for body j; a body outside [0, P) (a wall, an
-    empty slot) gets nothing. Result (R, P, 2, 2), N m, [a, b] = f_a (x^c - x_p)_b.
+    Records of :mod:`grainview.analysis._kernels.records`, all (R, C) but the centres (R, P):
+    ``slots`` the bodies ``i``, ``j`` (int64) and ``mask`` (bool), ``force`` the force
+    components (N), ``point`` the application point (m), ``centre`` the particles' centres (m).
+    s = +1 for body i and -1 for body j; a body outside [0, P) (a wall, an empty slot) gets
+    nothing. Result (R, P, 2, 2), N m, [a, b] = f_a (x^c - x_p)_b.
     """
+    i, j, mask = slots.i, slots.j, slots.mask
+    fx, fy, px, py, x, y = force.x, force.y, point.x, point.y, centre.x, centre.y
     n_rows, n_slots = i.shape
     n_part = x.shape[1]
     out = np.zeros((n_rows, n_part, 2, 2))
@@ -91,10 +94,13 @@ def accumulate_moments(i, j, fx, fy, px, py, x, y, mask):
 
 
 @njit(cache=True, nogil=True)
-def aligned_links(i, j, bx, by, mask, candidate, dx, dy, cos_limit):
-    """Boolean (R, C): the slots of ``mask`` between two particles of ``candidate`` (R, P)
-    whose branch vector (``bx``, ``by``) makes |cos| >= ``cos_limit`` with both particles'
-    unit major directions (``dx``, ``dy``, (R, P))."""
+def aligned_links(slots, branch, candidate, direction, cos_limit):
+    """Boolean (R, C): the slots of ``slots.mask`` between two particles of ``candidate`` (R, P)
+    whose ``branch`` vector (R, C) makes |cos| >= ``cos_limit`` with both particles' unit major
+    ``direction`` (R, P); ``slots``, ``branch`` and ``direction`` records of
+    :mod:`grainview.analysis._kernels.records`."""
+    i, j, mask = slots.i, slots.j, slots.mask
+    bx, by, dx, dy = branch.x, branch.y, direction.x, direction.y
     n_rows, n_slots = i.shape
     n_part = candidate.shape[1]
     out = np.zeros((n_rows, n_slots), dtype=np.bool_)

@@ -30,6 +30,7 @@ from __future__ import annotations
 import numpy as np
 
 from .._kernels.coarse_graining import spread_points, spread_segments
+from .._kernels.records import Grid, Points, Segments
 from ...contract.cell import fractional, from_fractional, wrap
 from ...contract.errors import ParameterError
 from .signature import CONTACT, CONTACT_XY, PARTICLE, SCALAR, TENSOR, core_dims
@@ -248,6 +249,7 @@ def coarse_grained_fields(position, velocity, mass, area, i, fn, ft, normal, bra
                         m * v[..., 1] ** 2], axis=-1)
     active = np.isfinite(pos).all(-1) & np.isfinite(m) & np.isfinite(a)
     points = np.zeros((b, y.size, x.size, weights.shape[-1]))
+    grid = Grid(x, y, float(width), radius)
     if cell is not None:
         cells_ = _rows(cell, lead, (2, 2))
         rates = _rows(0.0 if cell_rate is None else cell_rate, lead, (2, 2))
@@ -270,13 +272,11 @@ def coarse_grained_fields(position, velocity, mass, area, i, fn, ft, normal, bra
         weights = np.stack([masses, areas, masses * speeds[..., 0], masses * speeds[..., 1],
                             masses * speeds[..., 0] ** 2, masses * speeds[..., 0] * speeds[..., 1],
                             masses * speeds[..., 1] ** 2], axis=-1)
-        spread_points(np.ascontiguousarray(centres[..., 0]), np.ascontiguousarray(centres[..., 1]), alive,
-                      np.ascontiguousarray(np.where(alive[..., None], weights, 0.0)), x, y, float(width), radius,
-                      points)
+        spread_points(Points(np.ascontiguousarray(centres[..., 0]), np.ascontiguousarray(centres[..., 1]), alive,
+                             np.ascontiguousarray(np.where(alive[..., None], weights, 0.0))), grid, points)
     else:
-        spread_points(np.ascontiguousarray(pos[..., 0]), np.ascontiguousarray(pos[..., 1]), active,
-                      np.ascontiguousarray(np.where(active[..., None], weights, 0.0)), x, y, float(width), radius,
-                      points)
+        spread_points(Points(np.ascontiguousarray(pos[..., 0]), np.ascontiguousarray(pos[..., 1]), active,
+                             np.ascontiguousarray(np.where(active[..., None], weights, 0.0))), grid, points)
 
     # contacts: f (x) l (xx, xy, yx, yy) where stressed, n (x) n (xx, xy, yy) and 1 where in the fabric
     stress_mask = np.broadcast_to(np.asarray(stress_mask, bool), lead + (n_c,)).reshape(b, n_c)
@@ -307,15 +307,15 @@ def coarse_grained_fields(position, velocity, mass, area, i, fn, ft, normal, bra
         starts = _gather(home, source) + _gather(offsets, image)
         arms = _gather(arm, source)
         weight_images = np.where(used_images[..., None], _gather(weights, source), 0.0)
-        spread_segments(np.ascontiguousarray(starts[..., 0]), np.ascontiguousarray(starts[..., 1]),
-                        np.ascontiguousarray(arms[..., 0]), np.ascontiguousarray(arms[..., 1]),
-                        used_images, np.ascontiguousarray(weight_images), x, y, float(width), radius, segments)
+        spread_segments(Segments(np.ascontiguousarray(starts[..., 0]), np.ascontiguousarray(starts[..., 1]),
+                                 np.ascontiguousarray(arms[..., 0]), np.ascontiguousarray(arms[..., 1]),
+                                 used_images, np.ascontiguousarray(weight_images)), grid, segments)
     else:
-        spread_segments(np.ascontiguousarray(np.where(active, start[..., 0], 0.0)),
-                        np.ascontiguousarray(np.where(active, start[..., 1], 0.0)),
-                        np.ascontiguousarray(np.where(active, arm[..., 0], 0.0)),
-                        np.ascontiguousarray(np.where(active, arm[..., 1], 0.0)),
-                        active, np.ascontiguousarray(weights), x, y, float(width), radius, segments)
+        spread_segments(Segments(np.ascontiguousarray(np.where(active, start[..., 0], 0.0)),
+                                 np.ascontiguousarray(np.where(active, start[..., 1], 0.0)),
+                                 np.ascontiguousarray(np.where(active, arm[..., 0], 0.0)),
+                                 np.ascontiguousarray(np.where(active, arm[..., 1], 0.0)),
+                                 active, np.ascontiguousarray(weights)), grid, segments)
 
     per_t = (1.0 / t)[:, None, None, None]
     points_t = points * per_t  # per unit volume

@@ -32,6 +32,7 @@ import numpy as np
 
 from ...contract import portable_math
 from .._kernels.force_chains import accumulate_moments, aligned_links, follow_tracks, label_components
+from .._kernels.records import XY, Slots
 from .signature import CONTACT, CONTACT_XY, PARTICLE, SCALAR, TENSOR, core_dims
 from .tensors import principal
 from .vectors import force_vectors
@@ -78,19 +79,20 @@ def particle_moments(i, j, fn, ft, normal, point, mask, position, branch=None):
     position = np.broadcast_to(position, lead[:-1] + (n_part, 2))
     i_rows = _rows(np.broadcast_to(i, lead), 1).astype(np.int64)
     j_rows = _rows(np.broadcast_to(j, lead), 1).astype(np.int64)
-    common = (_rows(force[..., 0], 1), _rows(force[..., 1], 1))
-    centres = (_rows(position[..., 0], 1).astype(np.float64), _rows(position[..., 1], 1).astype(np.float64))
+    forces = XY(_rows(force[..., 0], 1), _rows(force[..., 1], 1))
+    centres = XY(_rows(position[..., 0], 1).astype(np.float64), _rows(position[..., 1], 1).astype(np.float64))
     mask_rows = _rows(np.broadcast_to(mask, lead), 1).astype(bool)
     if branch is None:
-        moments = accumulate_moments(i_rows, j_rows, *common, _rows(point[..., 0], 1).astype(np.float64),
-                                     _rows(point[..., 1], 1).astype(np.float64), *centres, mask_rows)
+        moments = accumulate_moments(Slots(i_rows, j_rows, mask_rows), forces,
+                                     XY(_rows(point[..., 0], 1).astype(np.float64),
+                                        _rows(point[..., 1], 1).astype(np.float64)), centres)
         return moments.reshape(lead[:-1] + (n_part, 2, 2))
     point_i, point_j = periodic_points(i, j, point, np.broadcast_to(branch, lead + (2,)), position)
     nobody = np.full_like(i_rows, -1)
-    moments = accumulate_moments(i_rows, nobody, *common, _rows(point_i[..., 0], 1), _rows(point_i[..., 1], 1),
-                                 *centres, mask_rows)
-    moments += accumulate_moments(nobody, j_rows, *common, _rows(point_j[..., 0], 1), _rows(point_j[..., 1], 1),
-                                  *centres, mask_rows)
+    moments = accumulate_moments(Slots(i_rows, nobody, mask_rows), forces,
+                                 XY(_rows(point_i[..., 0], 1), _rows(point_i[..., 1], 1)), centres)
+    moments += accumulate_moments(Slots(nobody, j_rows, mask_rows), forces,
+                                  XY(_rows(point_j[..., 0], 1), _rows(point_j[..., 1], 1)), centres)
     return moments.reshape(lead[:-1] + (n_part, 2, 2))
 
 
@@ -151,11 +153,12 @@ def chain_links(i, j, branch, mask, candidate, theta_1, angle):
     lead = np.broadcast_shapes(np.shape(mask), np.shape(i), np.shape(j))
     theta_1 = np.broadcast_to(theta_1, candidate.shape)
     branch = np.broadcast_to(branch, lead + (2,))
-    links = aligned_links(_rows(np.broadcast_to(i, lead), 1).astype(np.int64),
-                          _rows(np.broadcast_to(j, lead), 1).astype(np.int64),
-                          _rows(branch[..., 0], 1).astype(np.float64), _rows(branch[..., 1], 1).astype(np.float64),
-                          _rows(np.broadcast_to(mask, lead), 1).astype(bool), _rows(candidate, 1),
-                          _rows(np.cos(theta_1), 1), _rows(np.sin(theta_1), 1), float(np.cos(np.deg2rad(angle))))
+    slots = Slots(_rows(np.broadcast_to(i, lead), 1).astype(np.int64),
+                  _rows(np.broadcast_to(j, lead), 1).astype(np.int64),
+                  _rows(np.broadcast_to(mask, lead), 1).astype(bool))
+    branches = XY(_rows(branch[..., 0], 1).astype(np.float64), _rows(branch[..., 1], 1).astype(np.float64))
+    directions = XY(_rows(np.cos(theta_1), 1), _rows(np.sin(theta_1), 1))
+    links = aligned_links(slots, branches, _rows(candidate, 1), directions, float(np.cos(np.deg2rad(angle))))
     return links.reshape(lead)
 
 

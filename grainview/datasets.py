@@ -1,4 +1,4 @@
-"""Synthetic datasets of the contract drawn from the harmonic model (docs/conventions.md §3).
+"""Example datasets of the contract drawn from the harmonic model (docs/conventions.md §3).
 
 Used by the demo, the tests and the analysis benchmarks: contacts whose orientation density
 is P(theta) = (1/pi)[1 + a cos 2(theta - theta_0)], normal forces
@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..contract.dataset import make_dataset
+from .contract.dataset import make_dataset
 
 PAIR_LENGTH_M = 0.02
 SOLID_FRACTION = 0.1
@@ -74,4 +74,5 @@ def harmonic_series(n_snapshots=10, n_contacts=1000, anisotropy=(0.3, 0.4, 0.25)
     return make_dataset(radius=np.full(n_part, radius), position=pos, contacts=contacts,
                         box_min=np.zeros((n_snapshots, 2)), box_max=box_max,
                         time=np.arange(n_snapshots, dtype=float), n_contact_slots=n_contacts,
+                        # the function's former name, which files have always carried (and which still imports)
                         attrs={"source": "grainview.analysis.synthetic.harmonic_series", "seed": seed})

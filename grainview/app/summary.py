@@ -1,6 +1,8 @@
 """A reader's summary of a dataset of the contract, in a few lines: what the report's index
 says of each run and, read from the file without xarray (:mod:`grainview.app.file_summary`), what
-``grainview info`` prints."""
+``grainview info`` prints (numpy alone when imported, so that ``info`` loads no xarray). Which
+particles are regular polygons, and one name for a sample's shapes, are the analysis's
+(:func:`grainview.analysis.sample.regular_of`, :func:`grainview.analysis.sample.shape_name`)."""
 
 from __future__ import annotations
 
@@ -12,6 +14,8 @@ def describe(ds) -> list:
     q/p reached, and the settings a physicist asks for first, in readable units (what the
     report's index says of each run; ``grainview info`` prints the same lines from the file,
     :func:`grainview.app.file_summary.describe_file`)."""
+    from ..analysis.sample import regular_of
+
     snapshots = ds.sizes.get("time", 0)
     facts = {"n_vertices": ds["n_vertices"].values, "n_walls": ds.sizes.get("wall", 0), "regular": regular_of(ds),
              "n_slots": ds.sizes["contact"], "snapshots": snapshots}
@@ -42,32 +46,6 @@ def shape_counts(n_vertices, regular=None) -> str:
         words.append(f"{int(irregular.sum())} irregular convex polygons with "
                      f"{low if low == high else f'{low}-{high}'} vertices")
     return ", ".join(words)
-
-
-def regular_of(ds) -> np.ndarray:
-    """(P,) bool: which particles of a dataset of the contract are regular polygons
-    (:func:`grainview.contract.shapes.regular_polygons` of its ``vertices``, when it has them)."""
-    from ..contract.shapes import regular_polygons
-
-    n_vertices = np.asarray(ds["n_vertices"].values)
-    if "vertices" not in ds.variables:  # the contract: without vertices, every polygon is regular
-        return n_vertices >= 3
-    return regular_polygons(ds["radius"].values, n_vertices, ds["vertices"].values)
-
-
-def shape_name(ds) -> str:
-    """One name for a sample's particles: "disk" (every particle a disk), "<n>-gon" (every one
-    a regular n-gon), "irregular polygon" (every one a polygon, some irregular) or "mixed"
-    (disks and polygons, or regular polygons of several vertex counts)."""
-    n_vertices = np.asarray(ds["n_vertices"].values)
-    if not n_vertices.any():
-        return "disk"
-    if not (n_vertices >= 3).all():
-        return "mixed"
-    regular = regular_of(ds)
-    if not regular.all():
-        return "irregular polygon"
-    return f"{int(n_vertices[0])}-gon" if (n_vertices == n_vertices[0]).all() else "mixed"
 
 
 def summary_lines(facts: dict, attrs: dict) -> list:
