@@ -81,9 +81,9 @@ def test_the_array_layer_imports_nothing_of_the_labelled_layer():
 
 ROOMS = {
     "grainview.contract": 0,
-    "solver": 1, "grainview.datasets": 1,
+    "grainview.datasets": 1,
     "grainview.formats": 2,
-    "grainview.analysis": 3,
+    "grainview.analysis": 3, "solver": 3,
     "grainview.export": 4, "grainview.plot": 4,
     "grainview.app": 5,
     "grainview": 6,
@@ -91,9 +91,9 @@ ROOMS = {
 """The rooms of the packages and their floor: a module may import its own room and the rooms on
 lower floors, never a higher floor or another room of its floor. The drawing reads contract <-
 formats (other codes' files read into the contract) <- analysis <- export (the writers), plot
-(the figures) <- application, with the solver on the contract alone (the readers' conversions
-stop on SIGTERM as its runs do) and the example datasets (``grainview.datasets``) on it beside the
-solver; the package's front door (``grainview/__init__.py``, the
+(the figures) <- application, with the solver beside the analysis, on the contract alone (the
+signals that stop a run or a conversion cleanly are the contract's) and the example datasets
+(``grainview.datasets``) on the contract; the package's front door (``grainview/__init__.py``, the
 ``ds.grain`` accessor and its registration, the command line) sits on top of them all."""
 
 FRONT_DOOR = {"grainview", "grainview.__main__", "grainview._moved", "grainview._register", "grainview.accessor"}

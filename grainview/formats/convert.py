@@ -162,7 +162,7 @@ def write_snapshots(out, static, snapshots, optional, *, overwrite=False, compre
     Ctrl-C does; the temporary files of conversions to ``out`` whose process is gone are removed
     first.
     """
-    from solver.interrupt import sigterm_raises
+    from ..contract.signals import sigterm_raises
 
     from ..contract.writer import lock_file
 
