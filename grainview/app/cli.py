@@ -251,9 +251,9 @@ def _ensemble(args) -> int:
 
 def _study_parser(sub):
     from grainview.app.paper_size import PAPER_PARTICLES, REFERENCE_PARTICLES, REFERENCE_VELOCITY, velocity_for
-    from solver.preparation import Preparation
+    from solver.engine import Preparation
 
-    from solver.compaction_checkpoint import CHECKPOINT_SECONDS
+    from solver.engine import CHECKPOINT_SECONDS
     from solver.engine import SHEAR_STRAIN
 
     minutes = CHECKPOINT_SECONDS / 60
@@ -291,9 +291,9 @@ def _study_parser(sub):
 
 def _run_parser(sub):
     from solver.engine import SHEAR_STRAIN
-    from solver.parameters import BiaxialTest
-    from solver.preparation import Preparation
-    from solver.shape_families import MAX_VERTICES
+    from solver.engine import BiaxialTest
+    from solver.engine import Preparation
+    from solver.engine import MAX_VERTICES
 
     run = sub.add_parser("run", help=COMMAND_HELP["run"],
                          description=f"Geometric deposit, isotropic compaction under sigma0 ({Preparation.sigma0 / 1e3:g} "
@@ -349,9 +349,9 @@ def _report_parser(sub):
 
 
 def _ensemble_parser(sub):
-    from solver.parameters import Parameters
-    from solver.shape_families import MAX_VERTICES
-    from solver.preparation import DEFAULT_PRESET, Preparation
+    from solver.engine import Parameters
+    from solver.engine import MAX_VERTICES
+    from solver.engine import DEFAULT_PRESET, Preparation
 
     ens = sub.add_parser("ensemble", help=COMMAND_HELP["ensemble"],
                          description="One biaxial test per (shape, particles, friction, sigma0, seed) on a "
@@ -577,7 +577,7 @@ def main(argv=None) -> int:
         print("grainview: interrupted", file=sys.stderr)
         return 130
     except SystemExit as exc:
-        from solver.interrupt import Terminated  # the command line runs the solver; this is stdlib only
+        from solver.engine import Terminated  # loaded with the progress lines' signal handling
 
         if not isinstance(exc, Terminated):
             raise
