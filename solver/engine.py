@@ -37,9 +37,10 @@ from grainview.contract.errors import ParameterError
 
 from .interrupt import PROGRESS_LINE_SECONDS, Terminated, handling, sigterm_raises  # noqa: F401 (stdlib only)
 
-if TYPE_CHECKING:  # the records' homes, loaded when first asked for (:func:`__getattr__`)
+if TYPE_CHECKING:  # for readers and type checkers: RECORDS, loaded when first asked for (:func:`__getattr__`)
     from .compaction_checkpoint import CHECKPOINT_SECONDS  # noqa: F401
     from .contact_solvers import ACCELERATIONS, from_acceleration, stop_rule  # noqa: F401
+    from .contact_solvers import method as solver_method  # noqa: F401
     from .parameters import SHEAR_STRAIN, BiaxialTest, Parameters, default_of, problems  # noqa: F401
     from .preparation import (DEFAULT_PRESET, MIN_TEST_STEPS, Preparation, preparation, preset_name,  # noqa: F401
                               preset_names)

@@ -43,9 +43,7 @@ import numpy as np
 
 from grainview.contract.errors import ConvergenceWarning, FileFormatError, ParameterError
 
-from solver.engine import DEFAULT_ENGINE, engine, prepare
-from solver.engine import BiaxialTest
-from solver.engine import DEFAULT_PRESET, Preparation
+from solver.engine import DEFAULT_ENGINE, DEFAULT_PRESET, BiaxialTest, Preparation, engine, prepare
 
 EVENT_TOPIC = "grainview-ensemble"
 """Topic of the progress events the workers send to the client (``Worker.log_event``)."""

@@ -199,8 +199,7 @@ def engine_option(p):
 
 def test_options(p):
     """The biaxial test's options, from :class:`solver.parameters.BiaxialTest`."""
-    from solver.engine import BiaxialTest
-    from solver.engine import MIN_TEST_STEPS
+    from solver.engine import MIN_TEST_STEPS, BiaxialTest
 
     setting_option(p, BiaxialTest, "strain")
     setting_option(p, BiaxialTest, "velocity", more=f": finite, > 0, and such that the test takes at least "
@@ -213,8 +212,7 @@ def simulation_options(p, samples=()):
     the preparation, each from its record's field (:func:`setting_option`). ``samples``: the
     labels of the samples a command makes, when more than one (the study's ``--particles``
     takes one size or one per sample)."""
-    from solver.engine import Parameters
-    from solver.engine import DEFAULT_PRESET, Preparation, preset_names
+    from solver.engine import DEFAULT_PRESET, Parameters, Preparation, preset_names
 
     if len(samples) > 1:
         setting_option(p, Preparation, "particles", type=str, more=f"; or {len(samples)}, comma-separated, one "

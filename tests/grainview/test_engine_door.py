@@ -47,6 +47,19 @@ def test_the_application_imports_only_the_engine_interface_of_the_solver():
         "grainview/app reaches the solver through solver.engine only (re-export or wrap what it needs there)"
 
 
+def test_every_record_of_the_door_is_its_homes_and_the_door_invents_none():
+    import importlib
+
+    for home, names in engines.RECORDS.items():
+        for name in names:
+            door_name = {v: k for k, v in engines._RENAMED.items()}.get(name, name)
+            assert getattr(engines, door_name) is getattr(importlib.import_module(f"solver.{home}"), name)
+    with pytest.raises(AttributeError):
+        engines.method  # only as solver_method
+    with pytest.raises(ImportError):
+        exec("from solver.engine import Simulation")
+
+
 def test_loading_the_door_loads_no_numba():
     code = "import sys, solver.engine; print('numba' in sys.modules)"
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True, cwd=ROOT)
