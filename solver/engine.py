@@ -15,17 +15,59 @@ engine; numerical settings of an engine's own go in ``parameters``, a dict of
 (``name = "package.module:Class"``), so that a new engine needs no edit of the command line.
 The one engine here is :class:`ContactDynamics`, this package's Moreau–Jean solver.
 
+Each engine declares the scenes it runs (``scenes``: :data:`BASE_SCENES`, and ``"shear"``,
+the periodic cell's simple shear, for one that has :meth:`ContactDynamics.simple_shear`); the
+command line refuses a scene its engine does not declare (:func:`check_scene`).
+
+This module is the application's one door to the solver: :mod:`grainview.app` imports
+nothing else of ``solver`` (tests/grainview/test_engine_door.py). The settings' records and
+constants it needs are re-exported here from their homes (:data:`RECORDS`, each loaded when
+first asked for); what would load numba kernels is reached through functions that import it
+when called.
+
 Loading this module, or listing the engines, imports no numba kernel.
 """
 
 from __future__ import annotations
 
 import importlib
-from typing import Protocol, runtime_checkable
+from typing import TYPE_CHECKING, Protocol, runtime_checkable
 
 from grainview.contract.errors import ParameterError
 
-from .parameters import SHEAR_STRAIN  # noqa: F401 (the periodic shear scene's default gamma, for the command line)
+from .interrupt import PROGRESS_LINE_SECONDS, Terminated, handling, sigterm_raises  # noqa: F401 (stdlib only)
+
+if TYPE_CHECKING:  # for readers and type checkers: RECORDS, loaded when first asked for (:func:`__getattr__`)
+    from .compaction_checkpoint import CHECKPOINT_SECONDS  # noqa: F401
+    from .contact_solvers import ACCELERATIONS, from_acceleration, stop_rule  # noqa: F401
+    from .contact_solvers import method as solver_method  # noqa: F401
+    from .parameters import SHEAR_STRAIN, BiaxialTest, Parameters, default_of, problems  # noqa: F401
+    from .preparation import (DEFAULT_PRESET, MIN_TEST_STEPS, Preparation, preparation, preset_name,  # noqa: F401
+                              preset_names)
+    from .shape_families import MAX_VERTICES, SHAPE_FILE_SUFFIX, check_shape, shape_label  # noqa: F401
+
+RECORDS = {"compaction_checkpoint": ("CHECKPOINT_SECONDS",),
+           "contact_solvers": ("ACCELERATIONS", "from_acceleration", "stop_rule", "method"),
+           "parameters": ("SHEAR_STRAIN", "BiaxialTest", "Parameters", "default_of", "problems"),
+           "preparation": ("DEFAULT_PRESET", "MIN_TEST_STEPS", "Preparation", "preparation", "preset_name",
+                           "preset_names"),
+           "shape_families": ("MAX_VERTICES", "SHAPE_FILE_SUFFIX", "check_shape", "shape_label")}
+"""The settings' records and constants the application reads, re-exported from their homes
+(module of ``solver`` -> names; ``contact_solvers.method`` as ``solver_method``)."""
+_RENAMED = {"solver_method": "method"}
+
+
+def __getattr__(name):
+    """A name of :data:`RECORDS`, imported from its home when first asked for, so that loading
+    this module costs no more than the interrupt handling's standard library."""
+    home_name = _RENAMED.get(name, name)
+    home = next((module for module, names in RECORDS.items() if home_name in names), None)
+    if home is None or name in _RENAMED.values():
+        raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+    value = getattr(importlib.import_module(f"{__package__}.{home}"), home_name)
+    globals()[name] = value
+    return value
+
 
 ENTRY_POINT_GROUP = "grainview.engines"
 """Entry-point group through which installed packages register engines."""
@@ -35,6 +77,10 @@ ENGINES = {"solver": "solver.engine:ContactDynamics"}
 
 DEFAULT_ENGINE = "solver"
 """The engine used when none is named."""
+
+BASE_SCENES = ("isotropic", "biaxial")
+"""The scenes every engine runs (``prepare`` then ``write_state``, or ``shear``): those of an
+engine that declares no ``scenes``."""
 
 
 @runtime_checkable
@@ -47,7 +93,11 @@ class Engine(Protocol):
     An engine that keeps compaction checkpoints (``prepare(..., checkpoint=)``) also has
     ``check_checkpoint(checkpoint, preparation, parameters)``, which refuses in one line a
     checkpoint file made with other settings (:func:`check_checkpoint`); one without them
-    leaves both out."""
+    leaves both out.
+
+    ``scenes`` names what the engine runs (default :data:`BASE_SCENES`); one that declares
+    ``"shear"`` also has ``check_simple_shear(parameters)``, ``shear_rate(sample, velocity)``
+    and ``simple_shear(sample, path, test, shear_rate, ...)``, as :class:`ContactDynamics`."""
 
     name: str
 
@@ -82,6 +132,9 @@ class ContactDynamics:
     and biaxial test (:func:`solver.scenes.biaxial_test`), resumed by :mod:`solver.restart`."""
 
     name = "solver"
+    summary = "this package's contact dynamics"
+    """The engine in a few words (the ``--engine`` help and the docs' table of engines)."""
+    scenes = (*BASE_SCENES, "shear")
 
     def check(self, preparation, parameters: dict, test=None):
         from .parameters import Parameters
@@ -130,6 +183,38 @@ class ContactDynamics:
 
         return file_state(path)
 
+    def check_simple_shear(self, parameters: dict):
+        """Refuse, in one line, the settings the periodic cell's shear does not take
+        (:func:`solver.cell_coupling.check_solver`)."""
+        from .cell_coupling import check_solver
+        from .parameters import Parameters
+
+        check_solver(Parameters(**parameters))
+
+    def shear_rate(self, sample, velocity: float) -> float:
+        """The shear rate (s-1) of the biaxial test at wall speed ``velocity``
+        (:func:`solver.periodic_shear.matching_shear_rate`)."""
+        from .periodic_shear import matching_shear_rate
+
+        return matching_shear_rate(sample, velocity)
+
+    def simple_shear(self, sample, path, test, shear_rate, *, attrs=None, near_contacts=False, overwrite=False,
+                     progress=None, compress=True) -> int:
+        """Shear ``sample`` in the biperiodic cell of its box at ``shear_rate`` (s-1) to gamma =
+        ``test.strain`` (:func:`solver.periodic_shear.shear_test`), written to ``path``."""
+        from .periodic_shear import periodic_sample, shear_test
+
+        return shear_test(periodic_sample(sample), path, strain=test.strain, shear_rate=shear_rate,
+                          every=int(test.every), overwrite=overwrite, attrs=attrs, progress=progress,
+                          near_contacts=near_contacts, compress=compress)
+
+    def warm_up_stages(self, folder) -> list:
+        """The solver's part of ``grainview warmup``'s workload, as (what it compiles, callable)
+        pairs (:func:`solver.warm_up.stages`)."""
+        from .warm_up import stages
+
+        return stages(folder)
+
 
 def check_checkpoint(runner, checkpoint, preparation, parameters: dict):
     """``runner.check_checkpoint`` where the engine keeps checkpoints (an engine of the
@@ -149,6 +234,34 @@ def prepare(runner, preparation, parameters: dict, progress=None, checkpoint=Non
     return runner.prepare(preparation, parameters, progress=progress)
 
 
+def scenes_of(runner) -> tuple:
+    """The scenes ``runner`` declares (:data:`BASE_SCENES` for one that declares none)."""
+    return tuple(getattr(runner, "scenes", BASE_SCENES))
+
+
+def check_scene(name, scene: str):
+    """Refuse, in one :class:`ParameterError` line, ``scene`` for the engine registered as
+    ``name`` (None: the default) when the engine does not declare it."""
+    if scene not in scenes_of(engine(name or DEFAULT_ENGINE)):
+        raise ParameterError(f"scene {scene}: the periodic cell is this package's solver's ({DEFAULT_ENGINE}), "
+                             f"not engine {name}'s")
+
+
+def file_state(path) -> str:
+    """How far the test in ``path`` got (:func:`solver.restart.file_state`)."""
+    from .restart import file_state
+
+    return file_state(path)
+
+
+def check_settings(path, expected: dict, *advice):
+    """Refuse to go on with the file ``path`` written with other settings than ``expected``
+    (:func:`solver.restart.check_settings`, with its ``advice``)."""
+    from .restart import check_settings
+
+    check_settings(path, expected, *advice)
+
+
 def _registered() -> dict:
     """:data:`ENGINES` and the engines of the entry-point group, by name."""
     from importlib.metadata import entry_points
@@ -165,11 +278,23 @@ def engine_names() -> list[str]:
     return [DEFAULT_ENGINE] + [name for name in names if name != DEFAULT_ENGINE]
 
 
-def engine(name: str = DEFAULT_ENGINE) -> Engine:
-    """An instance of the engine registered as ``name``; a :class:`ParameterError` naming the
+def engine_class(name: str = DEFAULT_ENGINE):
+    """The class of the engine registered as ``name``; a :class:`ParameterError` naming the
     known ones otherwise."""
     target = _registered().get(name)
     if target is None:
         raise ParameterError(f"engine={name!r}: expected one of {', '.join(engine_names())}")
     module, _, attribute = target.partition(":")
-    return getattr(importlib.import_module(module), attribute)()
+    return getattr(importlib.import_module(module), attribute)
+
+
+def engine_help() -> str:
+    """``--engine``'s help text: the registry's default and its summary."""
+    return (f"the simulation engine (solver.engine; default {DEFAULT_ENGINE}: "
+            f"{engine_class(DEFAULT_ENGINE).summary})")
+
+
+def engine(name: str = DEFAULT_ENGINE) -> Engine:
+    """An instance of the engine registered as ``name``; a :class:`ParameterError` naming the
+    known ones otherwise."""
+    return engine_class(name)()

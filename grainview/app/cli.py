@@ -251,10 +251,9 @@ def _ensemble(args) -> int:
 
 def _study_parser(sub):
     from grainview.app.paper_size import PAPER_PARTICLES, REFERENCE_PARTICLES, REFERENCE_VELOCITY, velocity_for
-    from solver.preparation import Preparation
+    from solver.engine import Preparation
 
-    from solver.compaction_checkpoint import CHECKPOINT_SECONDS
-    from solver.engine import SHEAR_STRAIN
+    from solver.engine import CHECKPOINT_SECONDS, SHEAR_STRAIN
 
     minutes = CHECKPOINT_SECONDS / 60
     study = sub.add_parser("study", help=COMMAND_HELP["study"],
@@ -290,10 +289,7 @@ def _study_parser(sub):
 
 
 def _run_parser(sub):
-    from solver.engine import SHEAR_STRAIN
-    from solver.parameters import BiaxialTest
-    from solver.preparation import Preparation
-    from solver.shape_families import MAX_VERTICES
+    from solver.engine import MAX_VERTICES, SHEAR_STRAIN, BiaxialTest, Preparation
 
     run = sub.add_parser("run", help=COMMAND_HELP["run"],
                          description=f"Geometric deposit, isotropic compaction under sigma0 ({Preparation.sigma0 / 1e3:g} "
@@ -349,9 +345,7 @@ def _report_parser(sub):
 
 
 def _ensemble_parser(sub):
-    from solver.parameters import Parameters
-    from solver.shape_families import MAX_VERTICES
-    from solver.preparation import DEFAULT_PRESET, Preparation
+    from solver.engine import DEFAULT_PRESET, MAX_VERTICES, Parameters, Preparation
 
     ens = sub.add_parser("ensemble", help=COMMAND_HELP["ensemble"],
                          description="One biaxial test per (shape, particles, friction, sigma0, seed) on a "
@@ -577,7 +571,7 @@ def main(argv=None) -> int:
         print("grainview: interrupted", file=sys.stderr)
         return 130
     except SystemExit as exc:
-        from solver.interrupt import Terminated  # the command line runs the solver; this is stdlib only
+        from solver.engine import Terminated  # loaded with the progress lines' signal handling
 
         if not isinstance(exc, Terminated):
             raise

@@ -130,7 +130,7 @@ def compaction_text(compaction: dict | None) -> str:
 def solver_name(attrs) -> str:
     """The contact solver a file's steps were solved with: its ``solver_solver``, or for a file
     written before that attribute its ``solver_acceleration`` ("anderson" or the plain NLGS)."""
-    from solver.contact_solvers import from_acceleration
+    from solver.engine import from_acceleration
 
     if "solver_solver" in attrs:
         return str(attrs["solver_solver"])
@@ -143,10 +143,10 @@ def solver_name(attrs) -> str:
 def _method(counts: dict):
     """The registered method of ``counts['solver']`` (default the NLGS), or None for a name this
     package does not know."""
-    from solver import contact_solvers
+    from solver.engine import solver_method
 
     try:
-        return contact_solvers.method(counts.get("solver") or "nlgs")
+        return solver_method(counts.get("solver") or "nlgs")
     except ValueError:
         return None
 
@@ -155,12 +155,12 @@ def stop_rule(counts: dict) -> str:
     """What stopped the unconverged steps, in the words of their contact solver
     (:func:`solver.contact_solvers.stop_rule`): its iteration cap and, when it was on, its stall
     test."""
-    from solver import contact_solvers
+    from solver.engine import stop_rule as solver_stop_rule
 
     m = _method(counts)
     if m is None:
         return "the iteration cap or a stall test"
-    return contact_solvers.stop_rule(m.name, counts.get("max_iterations"), counts.get("stall_sweeps"))
+    return solver_stop_rule(m.name, counts.get("max_iterations"), counts.get("stall_sweeps"))
 
 
 def norms_phrase(counts: dict) -> str:

@@ -43,9 +43,7 @@ import numpy as np
 
 from grainview.contract.errors import ConvergenceWarning, FileFormatError, ParameterError
 
-from solver.engine import DEFAULT_ENGINE, engine, prepare
-from solver.parameters import BiaxialTest
-from solver.preparation import DEFAULT_PRESET, Preparation
+from solver.engine import DEFAULT_ENGINE, DEFAULT_PRESET, BiaxialTest, Preparation, engine, prepare
 
 EVENT_TOPIC = "grainview-ensemble"
 """Topic of the progress events the workers send to the client (``Worker.log_event``)."""
@@ -79,7 +77,7 @@ class RunSpec:
     @property
     def name(self) -> str:
         """File stem naming the run by its parameters, e.g. ``pentagon_n400_mu0.4_s2``."""
-        from solver.shape_families import shape_label
+        from solver.engine import shape_label
 
         parts = [shape_label(self.shape), f"n{self.particles}"]
         if self.preparation != "paper":
@@ -107,7 +105,7 @@ class RunSpec:
 
     def sample(self):
         """The :class:`solver.preparation.Preparation` of the run's sample."""
-        from solver.preparation import preparation
+        from solver.engine import preparation
 
         return preparation(self.preparation, particles=self.particles, shape=self.shape, seed=self.seed,
                            friction=self.friction, sigma0=self.sigma0)
@@ -115,7 +113,7 @@ class RunSpec:
     def expected_attrs(self) -> dict:
         """File attributes a file of this run holds (to recognise it when resuming): the test,
         the whole preparation, and the solver parameters the spec sets."""
-        from solver.preparation import preset_name
+        from solver.engine import preset_name
 
         prep = self.sample()
         expected = {"strain_target": self.strain, "wall_velocity_m_s": self.velocity, "snapshot_every": self.every,
@@ -154,7 +152,7 @@ def grid(*, shapes=(RunSpec.shape,), frictions=(None,), seeds=SEEDS_PER_SETTING,
 
 def file_state(path) -> str:
     """What the file of a run holds (:func:`solver.restart.file_state`)."""
-    from solver.restart import file_state
+    from solver.engine import file_state
 
     return file_state(path)
 
@@ -162,7 +160,7 @@ def file_state(path) -> str:
 def _check_settings(path, spec: RunSpec):
     """Refuse to resume a file written with other settings than ``spec``
     (:func:`solver.restart.check_settings`)."""
-    from solver.restart import check_settings
+    from solver.engine import check_settings
 
     check_settings(path, spec.expected_attrs())
 

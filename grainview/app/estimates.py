@@ -16,7 +16,7 @@ def print_estimate(preps, tests, parameters, jobs, shares=None, report=True, loa
     cores), default this machine's) and what it makes of them, and the whole
     (:func:`grainview.app.paper_size.study_estimate`)."""
     from grainview.app.paper_size import STUDY_TIME, hours, machine_load, study_estimate
-    from solver.parameters import Parameters
+    from solver.engine import Parameters
 
     p = Parameters(**parameters)
     load, cores = machine_load() if load is None else load
@@ -111,7 +111,7 @@ def compile_ahead(command, shares, progress):
         else:
             print(text, flush=True)
 
-    from solver.interrupt import sigterm_raises
+    from solver.engine import sigterm_raises
 
     try:
         with sigterm_raises():  # nothing is written yet: SIGTERM stops the command at once, as Ctrl-C does

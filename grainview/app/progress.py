@@ -9,7 +9,7 @@ import contextlib
 import signal
 import sys
 
-from solver.interrupt import PROGRESS_LINE_SECONDS, handling
+from solver.engine import PROGRESS_LINE_SECONDS, handling
 
 
 @contextlib.contextmanager

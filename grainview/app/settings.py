@@ -35,7 +35,7 @@ def preparation_of(args, shape, particles=None):
     """The :class:`solver.preparation.Preparation` the command line asks for: the named preset
     with the preparation's settings given on the command line (:data:`PREPARATION_OPTIONS`);
     ``particles``: the sample's size (default ``--particles``)."""
-    from solver.preparation import preparation
+    from solver.engine import preparation
 
     changes = {name: getattr(args, name) for name in PREPARATION_OPTIONS if name in given(args)}
     particles = args.particles if particles is None else particles
@@ -45,11 +45,11 @@ def preparation_of(args, shape, particles=None):
 def solver_parameters(args) -> dict:
     """The :class:`solver.Parameters` fields given on the command line (:data:`SOLVER_OPTIONS`;
     the others keep their defaults), validated."""
-    from solver.parameters import Parameters
+    from solver.engine import Parameters
 
     parameters = {name: getattr(args, name) for name in SOLVER_OPTIONS if name in given(args)}
     if getattr(args, "acceleration", None) is not None:  # the former name of --solver
-        from solver.contact_solvers import from_acceleration
+        from solver.engine import from_acceleration
 
         if "solver" in parameters:
             raise GrainviewError("--acceleration and --solver name the same setting: expected one of them")
@@ -61,7 +61,7 @@ def solver_parameters(args) -> dict:
 def biaxial_test(args):
     """The :class:`solver.parameters.BiaxialTest` of the command line, checked by its own
     validator before anything is simulated; a bad value is named by its flag."""
-    from solver.parameters import BiaxialTest, problems
+    from solver.engine import BiaxialTest, problems
 
     test = BiaxialTest(**{name: getattr(args, name) for name in TEST_OPTIONS})
     for name, value, expected in problems(test)[:1]:
@@ -122,7 +122,7 @@ def shape_of(text, option=None):
     lists (read and checked here, given on as an absolute path)."""
     import os
 
-    from solver.shape_families import SHAPE_FILE_SUFFIX, check_shape
+    from solver.engine import SHAPE_FILE_SUFFIX, check_shape
 
     text = str(text).strip()
     shape = int(text) if text.isdigit() else text
@@ -183,7 +183,7 @@ def residual_option(p):
 
 def acceleration_option(p):
     """``--acceleration``, the former name of ``--solver`` (command lines written before it)."""
-    from solver.contact_solvers import ACCELERATIONS
+    from solver.engine import ACCELERATIONS
 
     p.add_argument("--acceleration", choices=tuple(ACCELERATIONS), default=None,
                    help="the former name of --solver: " + ", ".join(f"{old} is {new}" for old, new in
@@ -191,17 +191,15 @@ def acceleration_option(p):
 
 
 def engine_option(p):
-    from solver.engine import DEFAULT_ENGINE, engine_names
+    """``--engine``: the registry's engines (:mod:`solver.engine`), its default and its words."""
+    from solver.engine import DEFAULT_ENGINE, engine_help, engine_names
 
-    p.add_argument("--engine", choices=engine_names(), default=DEFAULT_ENGINE,
-                   help=f"the simulation engine (solver.engine; default {DEFAULT_ENGINE}: this package's contact "
-                   "dynamics)")
+    p.add_argument("--engine", choices=engine_names(), default=DEFAULT_ENGINE, help=engine_help())
 
 
 def test_options(p):
     """The biaxial test's options, from :class:`solver.parameters.BiaxialTest`."""
-    from solver.parameters import BiaxialTest
-    from solver.preparation import MIN_TEST_STEPS
+    from solver.engine import MIN_TEST_STEPS, BiaxialTest
 
     setting_option(p, BiaxialTest, "strain")
     setting_option(p, BiaxialTest, "velocity", more=f": finite, > 0, and such that the test takes at least "
@@ -214,8 +212,7 @@ def simulation_options(p, samples=()):
     the preparation, each from its record's field (:func:`setting_option`). ``samples``: the
     labels of the samples a command makes, when more than one (the study's ``--particles``
     takes one size or one per sample)."""
-    from solver.parameters import Parameters
-    from solver.preparation import DEFAULT_PRESET, Preparation, preset_names
+    from solver.engine import DEFAULT_PRESET, Parameters, Preparation, preset_names
 
     if len(samples) > 1:
         setting_option(p, Preparation, "particles", type=str, more=f"; or {len(samples)}, comma-separated, one "

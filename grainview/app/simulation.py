@@ -25,17 +25,16 @@ def simulate(prep, path, *, test, near_contacts, overwrite, progress, scene="bia
     gamma = ``test.strain`` under sigma_yy = sigma0 (:mod:`solver.periodic_shear`)."""
     import warnings
 
-    from solver.engine import DEFAULT_ENGINE
+    from solver.engine import DEFAULT_ENGINE, check_scene, prepare
     from solver.engine import engine as engine_named
-    from solver.engine import prepare
 
     runner = engine_named(engine or DEFAULT_ENGINE)
     if scene == "shear":
-        refuse_other_engines(engine)
+        check_scene(engine, scene)
     path = Path(path)
     if path.exists() and not overwrite:
         raise GrainviewError(f"{path} exists; pass --overwrite to replace it")
-    from solver.shape_families import shape_label
+    from solver.engine import shape_label
 
     name = label or shape_label(prep.shape)
     resumed = checkpoint is not None and Path(checkpoint).exists()
@@ -61,14 +60,11 @@ def simulate(prep, path, *, test, near_contacts, overwrite, progress, scene="bia
             runner.write_state(sample, path, attrs={"scene": "isotropic"}, overwrite=overwrite,
                                near_contacts=near_contacts, compress=compress)
         elif scene == "shear":
-            from solver.periodic_shear import matching_shear_rate, periodic_sample, shear_test
-
-            rate = matching_shear_rate(sample, test.velocity) if shear_rate is None else shear_rate
+            rate = runner.shear_rate(sample, test.velocity) if shear_rate is None else shear_rate
             print(f"{name}: periodic simple shear to gamma = {test.strain} at {rate:.3g} s-1 under "
                   f"sigma_yy = {prep.sigma0:g} Pa ...", flush=True)
-            shear_test(periodic_sample(sample), path, strain=test.strain, shear_rate=rate, every=int(test.every),
-                       overwrite=overwrite, attrs=history.attrs(), progress=progress, near_contacts=near_contacts,
-                       compress=compress)
+            runner.simple_shear(sample, path, test, rate, overwrite=overwrite, attrs=history.attrs(),
+                                progress=progress, near_contacts=near_contacts, compress=compress)
         else:
             print(f"{name}: biaxial compression to eps_1 = {test.strain} at {test.velocity:g} m/s{inertia_words(sample, test)}"
                   " ...", flush=True)
@@ -211,19 +207,9 @@ def check_run_settings(args, prep):
 
 
 def check_shear(args, parameters):
-    """Scene shear: the settings only this package's solver and its NLGS or Anderson sweeps take
-    (:func:`solver.cell_coupling.check_solver`), before any work."""
-    from solver.cell_coupling import check_solver
-    from solver.parameters import Parameters
+    """Scene shear: an engine that declares it (:func:`solver.engine.check_scene`), and the
+    settings its periodic cell takes (``check_simple_shear``), before any work."""
+    from solver.engine import check_scene, engine
 
-    refuse_other_engines(args.engine)
-    check_solver(Parameters(**parameters))
-
-
-def refuse_other_engines(engine):
-    """Scene shear: the periodic cell is this package's solver's; another ``engine`` is refused."""
-    from solver.engine import DEFAULT_ENGINE
-
-    if (engine or DEFAULT_ENGINE) != DEFAULT_ENGINE:
-        raise GrainviewError(f"scene shear: the periodic cell is this package's solver's ({DEFAULT_ENGINE}), "
-                             f"not engine {engine}'s")
+    check_scene(args.engine, "shear")
+    engine(args.engine).check_simple_shear(parameters)

@@ -64,7 +64,7 @@ def study_state(runner, prep, parameters, path, checkpoint, expected, overwrite)
     file's attributes; ``prep`` and ``parameters``: what the checkpoint is of) is refused in one
     line before any work, unless ``overwrite`` (then the checkpoint is removed and the sample
     starts afresh)."""
-    from solver.restart import check_settings
+    from solver.engine import check_settings
 
     if overwrite:
         checkpoint.unlink(missing_ok=True)
@@ -177,7 +177,7 @@ def run_study(args) -> int | None:
     checkpoints = {label: out / f"{label}.compaction.nc" for label in samples}
     if out.is_file():
         raise GrainviewError(f"--out {out} is a file; expected a folder")
-    from solver.parameters import Parameters, default_of
+    from solver.engine import Parameters, default_of
 
     recorded = {name: parameters.get(name, default_of(Parameters, name)) for name in SOLVER_OPTIONS}
     states = {label: study_state(runner, preps[label], parameters, paths[label], checkpoints[label],
@@ -223,7 +223,7 @@ def run_study(args) -> int | None:
                 except (KeyboardInterrupt, SystemExit) as exc:  # a worker stopped by Ctrl-C or SIGTERM
                     stopped.append(exc)
             if stop["signal"] is not None or stopped:
-                from solver.interrupt import Terminated
+                from solver.engine import Terminated
 
                 raise (Terminated() if stop["signal"] == signal.SIGTERM or any(
                     isinstance(exc, SystemExit) for exc in stopped) else KeyboardInterrupt())

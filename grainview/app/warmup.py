@@ -58,9 +58,9 @@ def cache_location() -> str:
 
     if CACHE_DIR:
         return f"{os.path.abspath(CACHE_DIR)} (NUMBA_CACHE_DIR)"
-    import solver
+    from solver import engine
 
-    return (f"__pycache__ folders beside the modules, e.g. {Path(solver.__file__).parent / '__pycache__'} "
+    return (f"__pycache__ folders beside the modules, e.g. {Path(engine.__file__).parent / '__pycache__'} "
             "(NUMBA_CACHE_DIR unset; set it to choose a folder)")
 
 
@@ -158,51 +158,11 @@ def cold_shares(groups=tuple(GROUPS)) -> dict:
     return out
 
 
-def _steps(shape, steps=3, **parameters):
-    """A tiny compaction sample of ``shape`` stepped ``steps`` times with ``parameters``."""
-    from solver import compaction_sample
-
-    sim = compaction_sample(24, shape, seed=0, **parameters)
-    for _ in range(steps):
-        sim.step()
-    return sim
-
-
 def _stages(folder):
-    """The workload, as (what it compiles, callable) pairs in the order they run."""
-    from solver import biaxial_test
-
-    def solver_shape(shape):
-        from solver import contact_solvers
-
-        def run():  # every solver of the registry the stepper can use, on its domains and in its orders
-            for name in contact_solvers.stepper_methods():
-                method = contact_solvers.method(name)
-                _steps(shape, solver=name)
-                if method.domains:
-                    _steps(shape, solver=name, domains=2)
-                if method.shuffle:
-                    _steps(shape, solver=name, shuffle=True)
-            _steps(shape, stall_sweeps=2, max_iterations=20)
-        return run
-
-    def written():
-        from solver.periodic_shear import periodic_sample, shear_test
-
-        for shape in ("pentagon", "disk"):
-            biaxial_test(_steps(shape, steps=1), Path(folder) / f"{shape}.nc", strain=5e-4, every=2,
-                         near_contacts=True, progress=False, compress=False)
-            for name in ("anderson", "nlgs"):  # grainview run shear: the periodic cell's kernels
-                shear_test(periodic_sample(_steps(shape, steps=1, solver=name)), Path(folder) / f"{shape}_shear.nc",
-                           strain=2e-3, shear_rate=1.0, every=2, overwrite=True, progress=False, compress=False)
-
-    def matrix():
-        import numpy as np
-
-        from solver.contact_problem import solve_contact_problem
-
-        W = np.array([[2.0, 0.5, 0.0, 0.0], [0.5, 2.0, 0.0, 0.0], [0.0, 0.0, 2.0, 0.0], [0.0, 0.0, 0.0, 2.0]])
-        solve_contact_problem(W, np.array([-1.0, 0.2, 0.5, 0.1]), np.array([0.4, 0.4]))
+    """The workload, as (what it compiles, callable) pairs in the order they run: the engine's
+    (:meth:`solver.engine.ContactDynamics.warm_up_stages`, which writes the ``pentagon.nc``
+    the analysis's stage reads), then the analysis's."""
+    from solver.engine import engine
 
     def analysis():
         from ..contract.io import open_dataset
@@ -213,10 +173,7 @@ def _stages(folder):
             ds.grain.network_persistence().compute()
             ds.grain.force_chains(follow=True)
 
-    return [("solver: pentagon steps (plain, Anderson, shuffled, stall test, 2 domains)", solver_shape("pentagon")),
-            ("solver: disk steps (plain, Anderson, shuffled, stall test, 2 domains)", solver_shape("disk")),
-            ("solver: a written biaxial test, a periodic shear and their residuals", written),
-            ("solver: a contact problem given as a matrix", matrix),
+    return [*engine().warm_up_stages(folder),
             ("analysis: the xi-network, the coarse-grained fields, the network's topology, the force chains",
              analysis)]
 

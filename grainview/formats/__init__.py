@@ -2,27 +2,23 @@
 
 Each reader is usable three ways: as a function (``open_lammps``, ``open_box2d``...), through
 ``grainview.open_dataset(path, format="lammps", ...)`` and ``xr.open_dataset(path,
-engine="lammps", ...)``, and on the command line (``grainview convert lammps ...``).
+engine="lammps", ...)``, and on the command line (``grainview convert lammps ...``), all from
+its record in the readers' registry (:mod:`grainview.formats.readers`).
 """
 
 from __future__ import annotations
 
-import importlib
-
 from ..contract.errors import ParameterError
+from .readers import READERS, load, reader, readers
 
 __all__ = ["READERS", "open_format"]
 
-READERS = {"lammps": "grainview.formats.lammps:open_lammps", "box2d": "grainview.formats.peers:open_box2d",
-           "pymunk": "grainview.formats.peers:open_pymunk", "lmgc90": "grainview.formats.lmgc90:open_lmgc90",
-           "mercurydpm": "grainview.formats.mercurydpm:open_mercurydpm", "pegs": "grainview.formats.pegs:open_pegs"}
-"""Format name -> the reader that opens it as an in-memory dataset of the contract."""
-
 
 def open_format(format: str, path, **options):
-    """Open ``path`` with the reader of ``format`` (:data:`READERS`); one line for an unknown
-    format."""
-    if format not in READERS:
-        raise ParameterError(f"format={format!r}: expected 'grainview' or one of {', '.join(sorted(READERS))}")
-    module, name = READERS[format].split(":")
-    return getattr(importlib.import_module(module), name)(path, **options)
+    """Open ``path`` with the reader of ``format`` (:data:`READERS`, or another package's
+    through its entry point, :func:`grainview.formats.readers.readers`); one line for an
+    unknown format."""
+    found = reader(format)
+    if found is None:
+        raise ParameterError(f"format={format!r}: expected 'grainview' or one of {', '.join(sorted(readers()))}")
+    return load(found.opener)(path, **options)

@@ -877,6 +877,18 @@ def _warn_no_log(log):
                       "confirm (log=..., --log)", UserWarning, stacklevel=3)
 
 
+def parse_columns(text):
+    """``--columns QUANTITY=COLUMN,...`` of ``grainview convert lammps`` as ``columns``
+    (None for none given)."""
+    if not text:
+        return None
+    try:
+        return dict(item.split("=", 1) for item in text.split(","))
+    except ValueError:
+        raise ParameterError(f"--columns {text}: expected QUANTITY=COLUMN,... (e.g. "
+                             "patom1=c_pairs[1],patom2=c_pairs[2])") from None
+
+
 def convert_lammps(out, particles, contacts, walls=None, *, log=None, time_step=None, columns=None, inertia="auto",
                    overwrite=False, compress=True, progress=False):
     """Convert a LAMMPS 2D granular run into a file of the contract, snapshot by snapshot.

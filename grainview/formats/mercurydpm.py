@@ -669,6 +669,18 @@ def open_mercurydpm(data, fstat=None, restart=None, *, units=None, progress=Fals
                              wall_normal=static["wall_normal"])
 
 
+def parse_units(text):
+    """``--units si`` or ``--units length=L,mass=M,time=T`` of ``grainview convert
+    mercurydpm`` as the reader's ``units``."""
+    if text.strip().lower() == "si":
+        return "si"
+    try:
+        return {key.strip(): float(value) for key, value in (item.split("=", 1) for item in text.split(","))}
+    except ValueError:
+        raise ParameterError(f"--units {text}: expected si or length=L,mass=M,time=T (the SI value of one unit of "
+                             "the run: m, kg, s)") from None
+
+
 def convert_mercurydpm(out, data, fstat=None, restart=None, *, units=None, overwrite=False, compress=True,
                        progress=False):
     """Convert a MercuryDPM 2D run into a file of the contract, snapshot by snapshot.
