@@ -22,6 +22,7 @@ import xarray as xr
 from ..analysis.snapshots import snapshot_indices
 from ..contract.errors import ParameterError
 from ..contract.writer import write_atomically
+from ._docs import fill_doc
 
 __all__ = ["write_csv", "CSV_COLUMNS", "KIND_NAMES"]
 
@@ -59,6 +60,7 @@ _CSV_VARIABLES = ("contact_count", "i", "j", "kind", "fn", "ft", "normal", "poin
 """The variables :func:`grainview.analysis.tables.contacts_table` reads."""
 
 
+@fill_doc
 def write_csv(ds: xr.Dataset, out_dir, every: int = 1, overwrite: bool = False, progress=None) -> str:
     """Write ``contacts.csv``: the tidy contact table of every ``every``-th snapshot.
 
@@ -71,12 +73,7 @@ def write_csv(ds: xr.Dataset, out_dir, every: int = 1, overwrite: bool = False, 
 
     Parameters
     ----------
-    ds : xarray.Dataset
-        A grainview dataset.
-    out_dir : str or path-like
-        Output folder, created if needed.
-    every : int, default 1
-        Write every ``every``-th snapshot (the last always included).
+    {written}
     overwrite : bool, default False
         Replace an existing ``contacts.csv``.
     progress : bool, optional

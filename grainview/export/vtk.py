@@ -56,6 +56,7 @@ from ..contract.cell import wrap
 from ..contract.errors import ParameterError
 from ..contract.shapes import body_vertices_of, world_vertices
 from ..contract.writer import write_atomically
+from ._docs import fill_doc
 from .vtk_xml import collection, multiblock, polydata, write_xml
 
 __all__ = ["write_vtk", "VTK_BLOCKS"]
@@ -146,6 +147,7 @@ def _snapshot_files(snap: xr.Dataset, fields: xr.Dataset, classes: np.ndarray, p
     return trees
 
 
+@fill_doc
 def write_vtk(ds: xr.Dataset, out_dir, every: int = 1, overwrite: bool = False, progress=None) -> list:
     """Write the VTK files of the module docstring for every ``every``-th snapshot into ``out_dir``.
 
@@ -158,12 +160,7 @@ def write_vtk(ds: xr.Dataset, out_dir, every: int = 1, overwrite: bool = False, 
 
     Parameters
     ----------
-    ds : xarray.Dataset
-        A grainview dataset.
-    out_dir : str or path-like
-        Output folder, created if needed.
-    every : int, default 1
-        Write every ``every``-th snapshot (the last always included).
+    {written}
     overwrite : bool, default False
         Replace files that exist; otherwise an existing file is refused before anything is
         written.
