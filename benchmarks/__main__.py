@@ -150,9 +150,12 @@ SECTIONS = (
             "not: wall time, first line, stages' processor time, the study's own estimate",
             (), ("--runs", "warmup-warm,study-warm", "--study-args", "--particles 20 --strain 0.002", "--pause", "0")),
     Section("periodic-shear", "periodic_shear", "the periodic simple shear against the walled biaxial test at equal N: "
-            "processor time per particle-step and per sweep", (), ("--quick",)),
+            "processor time per particle-step and per sweep over whole tests",
+            ("--whole", "0.2", "--ways", "walled,periodic,periodic:1"), ("--quick",)),
     Section("periodic-control", "periodic_control", "a periodic cell's height under a normal stress: how steadily "
             "sigma_yy holds sigma0, and the sweeps and time it costs, per cell mass and solver", (), ("--quick",)),
+    Section("wall-control", "wall_control", "the walled test's stress-controlled wall: how steadily sigma_xx holds "
+            "sigma0 and p over the residual window, per mass of the wall", (), ("--quick",)),
 )
 """The current benchmarks, in the order of RESULTS.md. benchmarks/README.md says what each measures."""
 

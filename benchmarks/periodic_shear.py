@@ -90,11 +90,13 @@ def timed_steps(sim, run, warm, steps):
     return np.array(wall), np.array(cpu), np.array(sweeps)
 
 
-def walled(sim, path):
-    import solver
+def walled(strain=0.5):
+    def run(sim, path):
+        import solver
 
-    solver.biaxial_test(sim, path, strain=0.5, velocity=0.01, every=10**9, overwrite=True, progress=False,
-                        compress=False)
+        solver.biaxial_test(sim, path, strain=strain, velocity=0.01, every=10**9, overwrite=True, progress=False,
+                            compress=False)
+    return run
 
 
 def periodic(rate):
@@ -106,37 +108,58 @@ def periodic(rate):
     return run
 
 
-def measure(shape, particles, warm, steps):
-    """Rows (shape, way, N, medians...) of one shape."""
-    from solver.periodic_shear import periodic_sample
+WAYS = ("walled", "periodic")
+"""The runs of each shape by default (``--ways``): between walls, and in the cell under sigma0
+with the default cell mass. Also known: ``periodic:M`` (the cell's mass M times the sample's) and
+``fixed`` (the cell's height held at the box's: no unknown of the cell in the sweeps)."""
 
-    from solver.periodic_shear import matching_shear_rate
+
+def measure(shape, particles, warm, steps, ways=WAYS, whole=None):
+    """Rows (shape, way, N, medians...) of one shape, one per way (:data:`WAYS`). ``whole``: the
+    walled test runs to eps_1 = ``whole`` with every step timed (``warm`` and ``steps`` unused),
+    the other ways as many steps as it took."""
+    from solver.periodic_shear import matching_shear_rate, periodic_sample
 
     sample = compacted(shape, particles)
     rate = matching_shear_rate(sample, 0.01)
     rows = {}
-    a = copy.deepcopy(sample)
-    _settings(a)
-    rows["walled"] = timed_steps(a, walled, warm, steps)
-    b = periodic_sample(copy.deepcopy(sample))
-    _settings(b)
-    rows["periodic"] = timed_steps(b, periodic(rate), warm, steps)
+    if whole is not None:
+        ways = ["walled"] + [way for way in ways if way != "walled"]
+        warm, steps = 0, 10**9
+    for way in ways:
+        if way == "walled":
+            sim, run = copy.deepcopy(sample), walled(0.5 if whole is None else whole)
+        elif way == "fixed":
+            sim, run = periodic_sample(copy.deepcopy(sample), stress=float("nan")), periodic(rate)
+        elif way.startswith("periodic"):
+            mass = None if way == "periodic" else float(way.split(":")[1]) * float(sample.mass.sum())
+            sim, run = periodic_sample(copy.deepcopy(sample), mass=mass), periodic(rate)
+        else:
+            raise SystemExit(f"--ways: unknown run {way!r}; expected walled, periodic, periodic:M or fixed")
+        _settings(sim)
+        rows[way] = timed_steps(sim, run, warm, steps)
+        if whole is not None and way == "walled":
+            steps = len(rows[way][1])
     return rows, rate
 
 
 def table(shape, particles, rows, rate):
     from benchmarks.common import markdown_table
 
-    out, base = [], None
+    out, base, base_mean = [], None, None
     for way, (wall, cpu, sweeps) in rows.items():
         per = np.median(cpu) / particles * 1e6
         per_sweep = np.median(cpu / np.maximum(sweeps, 1)) / particles * 1e6
         base = per if base is None else base
+        mean = np.mean(cpu) / particles * 1e6
+        base_mean = mean if base_mean is None else base_mean
         out.append([shape, way, particles, len(cpu), f"{per:.2f}", f"{per_sweep:.3f}", f"{np.median(sweeps):.0f}",
-                    f"{np.median(wall) / particles * 1e6:.2f}", f"{per / base:.3f}"])
+                    f"{np.median(wall) / particles * 1e6:.2f}", f"{per / base:.3f}", f"{mean:.2f}",
+                    f"{np.mean(sweeps):.0f}", f"{mean / base_mean:.3f}"])
     return markdown_table(["shape", "run", "N", "steps timed", "CPU us / particle-step (median)",
                            "CPU us / particle-sweep (median)", "sweeps / step (median)",
-                           "wall us / particle-step (median)", "CPU per step / walled"], out), rate
+                           "wall us / particle-step (median)", "CPU per step / walled", "CPU us / particle-step (mean)",
+                           "sweeps / step (mean)", "CPU (mean) / walled"], out), rate
 
 
 def main(argv=None):
@@ -147,6 +170,10 @@ def main(argv=None):
     parser.add_argument("--shapes", default="pentagon,disk")
     parser.add_argument("--warm", type=int, default=1000, help="steps before the timed ones (default 1000)")
     parser.add_argument("--steps", type=int, default=300, help="steps timed (default 300)")
+    parser.add_argument("--ways", default=",".join(WAYS), help="the runs, comma-separated: walled, periodic, "
+                        "periodic:M (the cell's mass M times the sample's), fixed (the cell's height held)")
+    parser.add_argument("--whole", type=float, default=None, metavar="EPS_1",
+                        help="time whole tests instead: the walled one to eps_1 = EPS_1, the others as many steps")
     parser.add_argument("--quick", action="store_true", help="60 particles, 5 + 20 steps, printed only")
     parser.add_argument("--out", default=None, help="the results file (default benchmarks/results/periodic-shear.md; "
                         "a --quick run prints only, unless given one)")
@@ -157,7 +184,7 @@ def main(argv=None):
     def run():
         parts = []
         for shape in args.shapes.split(","):
-            rows, rate = measure(shape, args.particles, args.warm, args.steps)
+            rows, rate = measure(shape, args.particles, args.warm, args.steps, args.ways.split(","), args.whole)
             text, rate = table(shape, args.particles, rows, rate)
             parts.append(f"## {shape}s, N = {args.particles} (periodic at gamma_dot = {rate:.4g} s-1, the walled "
                          "test's 2 v / h0)\n\n" + text)
@@ -167,9 +194,13 @@ def main(argv=None):
     intro = (f"One compacted sample per shape (the `fast` preparation), stepped from the same state between walls "
              f"(`biaxial_test`, top wall at 1 cm/s) and in the biperiodic cell of its box (`periodic_shear`, "
              f"gamma_dot = 2 v / h0, sigma_yy held at sigma0 by the cell's height solved with the contacts), Anderson sweeps every 2 sweeps and the "
-             f"stall test over 200 sweeps on one domain. Steps 1-{args.warm} of each run are not timed (compiling, the "
-             f"start's transient: the periodic sample's boundary contacts form and its height settles); the next "
-             f"{args.steps} are, each on its own (processor time: the 2 cores are shared). {how}")
+             f"stall test over 200 sweeps on one domain. " + (
+                 f"Whole tests: every step of the walled test to eps_1 = {args.whole:g} is timed, and as many "
+                 f"steps of each other run (the same strain at the same pace), the compilation included in the "
+                 f"first run's first steps" if args.whole is not None else
+                 f"Steps 1-{args.warm} of each run are not timed (compiling, the start's transient: the periodic "
+                 f"sample's boundary contacts form and its height settles); the next {args.steps} are") +
+             f", each on its own (processor time: the 2 cores are shared). {how}")
     print_or_write(args.out or (None if args.quick else RESULTS),
                    "Periodic shear against the walled test: cost per particle-step", intro, parts, quick=args.quick)
     return 0
