@@ -1,7 +1,7 @@
 """Whether the stress-controlled wall's mass makes the walled biaxial test's stress swing.
 
-The fidelity study's compacted sample (preparation 'paper', seed 0, cached in
-``benchmarks/_data/fidelity/samples``) is sheared between walls (``solver.biaxial_test``: the top
+The fidelity study's compacted samples (preparation 'paper', each shape and seed asked for,
+cached in ``benchmarks/_data/fidelity/samples``) are sheared between walls (``solver.biaxial_test``: the top
 wall at the fidelity study's speed for its size, the right wall pushed by sigma0) to eps_1 =
 ``--strain``, once per mass of the right wall (a multiple of the sample's mass; the compaction
 gives it the whole mass, :func:`solver.scenes.isotropic_compaction`). Snapshots every
@@ -10,8 +10,8 @@ window of docs/fidelity.md), the lateral stress sigma_xx against its target sigm
 90th percentiles, the share below one half), p (10th, 50th and 90th percentiles, in kPa), q/p
 (mean), and the sweeps per step and processor time per particle-step over the whole test.
 
-    python -m benchmarks.wall_control                        # 1000 pentagons, masses 1 and 0.1
-    python -m benchmarks.wall_control --quick                # 60 pentagons to eps_1 0.02, printed only
+    python -m benchmarks.wall_control          # 1000 pentagons and disks, seeds 0 and 1, masses 1 and 0.1
+    python -m benchmarks.wall_control --quick  # 60 pentagons, seed 0, to eps_1 0.02, printed only
 """
 
 from __future__ import annotations
@@ -65,7 +65,8 @@ def main(argv=None):
 
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     parser.add_argument("--particles", type=int, default=1000)
-    parser.add_argument("--shape", default="pentagon")
+    parser.add_argument("--shapes", default="pentagon,disk", help="comma-separated (default pentagon,disk)")
+    parser.add_argument("--seeds", default="0,1", help="the samples' seeds, comma-separated (default 0,1)")
     parser.add_argument("--strain", type=float, default=0.2, help="eps_1 at the end (default 0.2)")
     parser.add_argument("--every", type=int, default=100, help="steps between snapshots (default 100)")
     parser.add_argument("--window", type=float, default=0.4, help="eps_q from which snapshots count (default 0.4)")
@@ -77,10 +78,14 @@ def main(argv=None):
     args = parser.parse_args(argv)
     if args.quick:
         args.particles, args.strain, args.every, args.window = 60, 0.02, 20, 0.0
+        args.shapes, args.seeds = "pentagon", "0"
     velocity = Config().velocity(args.particles)
-    sample = make_sample(Run(shape=args.shape, particles=args.particles))
 
     def run():
+        return [shape_part(shape, int(seed)) for shape in args.shapes.split(",") for seed in args.seeds.split(",")]
+
+    def shape_part(shape, seed):
+        sample = make_sample(Run(shape=shape, particles=args.particles, seed=seed))
         rows = []
         with tempfile.TemporaryDirectory(prefix="wall_control_") as folder:
             for factor in (float(m) for m in args.masses.split(",")):
@@ -93,11 +98,11 @@ def main(argv=None):
         table = markdown_table(["right wall's mass / sample mass", "snapshots", "sigma_xx / sigma0 (mean)", "10-90%",
                                 "share < 1/2", "p (kPa): 10% / 50% / 90%", "q/p (mean)", "sweeps / step",
                                 "CPU us / particle-step"], rows)
-        return [f"## {args.shape}s, N = {args.particles}, eps_1 0 to {args.strain:g}, window eps_q >= "
-                f"{args.window:g}\n\n{table}"]
+        return (f"## {shape}s, N = {args.particles}, seed {seed}, eps_1 0 to {args.strain:g}, window eps_q >= "
+                f"{args.window:g}\n\n{table}")
 
     parts, how = measured(run, "one process, one domain")
-    intro = (f"The fidelity study's compacted sample ({args.shape}s, N = {args.particles}, preparation 'paper', seed 0) "
+    intro = (f"The fidelity study's compacted samples (N = {args.particles}, preparation 'paper') "
              f"sheared between walls at v = {velocity * 100:g} cm/s (the fidelity study's wall speed for this size), "
              f"the right wall pushed by sigma0 = 10 kPa with the mass given, the solver settings the sample was "
              f"compacted with; snapshots every {args.every} steps. {how}")
