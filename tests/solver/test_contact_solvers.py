@@ -10,25 +10,12 @@ import pytest
 from scipy import sparse
 
 from grainview.contract.errors import ParameterError
-from solver import contact_solvers, residuals
+from solver import contact_solvers
 from solver.contact_problem import solve_contact_problem
 
-from .conftest import random_body_problem
+from .conftest import independent_residual, random_body_problem
 
 NEW_METHODS = ["newton", "pcg"]
-
-
-def independent_residual(W, q, mu, impulse):
-    """|F| / |r| of the natural map recomputed from the impulses alone: u = W r + q, rho = 1 / W_nn."""
-    W = np.asarray(sparse.csr_matrix(W).toarray())
-    n = len(impulse)
-    u = (W @ impulse.reshape(-1) + np.asarray(q, float)).reshape(n, 2)
-    mu = np.broadcast_to(np.asarray(mu, float), (n,)).copy()
-    fn, ft = residuals.natural_maps(impulse[:, 0].copy(), impulse[:, 1].copy(), u[:, 0].copy(), u[:, 1].copy(), mu,
-                                    1.0 / np.diag(W)[0::2])
-    size = np.linalg.norm(impulse)
-    violation = np.hypot(np.linalg.norm(fn), np.linalg.norm(ft))
-    return violation / size if size > 0 else violation
 
 
 def coupled():
