@@ -1,12 +1,15 @@
 """Shear a study's compacted samples again at another top-wall speed, without compacting them again.
 
 The paper-size study (``grainview study --paper-size``) spends a large part of its pentagons'
-time in the compaction (docs/fidelity.md, section 4: 1.5 h of their 3.4 h). To ask whether the residual state
-depends on the strain rate at that size, this script takes the compacted sample of each
-finished study file -- its first snapshot, the state the test started from, with its warm
-start (:func:`solver.load_sample`) -- and shears it again to the same strain at ``--velocity``::
+time in the compaction (docs/fidelity.md, section 4: 1.5 h of their 3.4 h). To shear its
+samples at another speed, or again on another machine, this script takes the compacted sample
+of each file of ``source`` -- the first snapshot of a finished study's test, the state the test
+started from, or the one snapshot of a compacted sample (``grainview study --scene isotropic``),
+with its warm start (:func:`solver.load_sample`) -- and shears it to ``--strain`` (default:
+the original test's, or the biaxial test's default for a compacted sample) at ``--velocity``.
+The repository keeps the paper-size samples (:data:`PAPER_SAMPLES`), so on a fresh clone::
 
-    python -m benchmarks.fidelity.reshear /work/runs/paper_size /work/runs/paper_size_1cm \\
+    python -m benchmarks.fidelity.reshear benchmarks/fidelity/samples paper_size_1cm \
         --velocity 0.01 --every 1200 --domains 1 --samples pentagons
 
 ``--every`` keeps the snapshots at the same strain spacing as the original file when it is
@@ -30,6 +33,10 @@ from pathlib import Path
 from grainview.contract.errors import ParameterError
 
 SAMPLES = ("pentagons", "disks")
+
+PAPER_SAMPLES = Path("benchmarks/fidelity/samples")
+"""Where the repository keeps the paper-size study's compacted samples (14,400 pentagons, 10,000
+disks), from the repository's root; ``samples/README.md`` there says how they were made."""
 
 
 def reshear(source: Path, out: Path, label: str, *, velocity: float, every: int, domains: int | None,
@@ -61,26 +68,43 @@ def reshear(source: Path, out: Path, label: str, *, velocity: float, every: int,
         resume(path, progress=progress)
         return "resumed"
     original = source / f"{label}.nc"
-    if file_state(original) != "finished":
-        raise ParameterError(f"{original} is not a finished test; expected a study's complete file")
+    import netCDF4
+
+    from grainview.app.study import compacted_state
+    from solver.engine import BiaxialTest
+
+    compacted = original.exists() and scene_of(original) == "isotropic"
+    if (compacted_state(original) if compacted else file_state(original)) != "finished":
+        raise ParameterError(f"{original} is neither a finished test nor a compacted sample; expected a study's "
+                             "complete file (grainview study, scene biaxial or isotropic)")
     sim = load_sample(original, 0)
     if domains is not None:
         sim.set_parameters(domains=domains)
-    import netCDF4
-
     with netCDF4.Dataset(original) as ds:
-        target = float(ds.getncattr("strain_target")) if strain is None else strain
-        attrs = {"resheared_from": str(original), "resheared_from_velocity_m_s": float(ds.getncattr(
-            "wall_velocity_m_s"))}
+        attrs = {"resheared_from": str(original)}
+        if compacted:
+            target = BiaxialTest.strain if strain is None else strain
+        else:
+            target = float(ds.getncattr("strain_target")) if strain is None else strain
+            attrs["resheared_from_velocity_m_s"] = float(ds.getncattr("wall_velocity_m_s"))
     out.mkdir(parents=True, exist_ok=True)
     biaxial_test(sim, path, strain=target, velocity=velocity, every=every, near_contacts=True, attrs=attrs,
                  progress=progress)
     return "started"
 
 
+def scene_of(path) -> str:
+    """The ``scene`` attribute of the solver's file ``path`` ("" when it has none)."""
+    import netCDF4
+
+    with netCDF4.Dataset(path) as ds:
+        return str(getattr(ds, "scene", ""))
+
+
 def main(argv=None) -> int:
     parser = argparse.ArgumentParser(prog="python -m benchmarks.fidelity.reshear", description=__doc__.split("\n")[0])
-    parser.add_argument("source", type=Path, help="folder of a finished study (pentagons.nc, disks.nc)")
+    parser.add_argument("source", type=Path, help="folder of a finished study or of its compacted samples "
+                        "(pentagons.nc, disks.nc; grainview study --scene isotropic), e.g. " + str(PAPER_SAMPLES))
     parser.add_argument("out", type=Path, help="folder for the new tests (created)")
     parser.add_argument("--velocity", type=float, required=True, help="top-wall speed of the new tests (m/s)")
     parser.add_argument("--every", type=int, required=True, help="steps between snapshots")

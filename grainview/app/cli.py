@@ -278,9 +278,10 @@ def _study_parser(sub):
                        "goes on where a stopped or killed run was (docs/fidelity.md, section 4)")
     study.add_argument("--no-report", action="store_true",
                        help="simulate only (grainview report OUT/pentagons.nc OUT/disks.nc --out DIR reports later)")
-    study.add_argument("--scene", choices=["biaxial", "shear"], default="biaxial",
-                       help="biaxial (default: the top wall compresses each sample) or shear (each compacted sample in "
-                       "the biperiodic cell of its box, sheared to gamma = --strain, default "
+    study.add_argument("--scene", choices=["biaxial", "isotropic", "shear"], default="biaxial",
+                       help="biaxial (default: the top wall compresses each sample), isotropic (each sample compacted "
+                       "and written, OUT/<sample>.nc, for a test to start from later; no report) or shear (each "
+                       "compacted sample in the biperiodic cell of its box, sheared to gamma = --strain, default "
                        f"{SHEAR_STRAIN:g}, at 2 v/h under sigma_yy = "
                        "sigma0; as grainview run shear)")
     residual_option(study)

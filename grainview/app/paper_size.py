@@ -158,8 +158,8 @@ def estimate(preparation, test, time_step, domains=1) -> dict:
     ----------
     preparation : solver.parameters.Preparation
         The sample and how it is compacted.
-    test : solver.parameters.BiaxialTest
-        The biaxial test it is sheared in.
+    test : solver.parameters.BiaxialTest or None
+        The biaxial test it is sheared in; None for a sample compacted only.
     time_step : float
         The time step, s.
     domains : int, default 1
@@ -169,7 +169,7 @@ def estimate(preparation, test, time_step, domains=1) -> dict:
     -------
     dict
         ``{"compaction": (steps, microseconds per particle and step, seconds, source), "test":
-        (...)}``, from :data:`COSTS` (module docstring).
+        (...)}`` (no ``"test"`` when ``test`` is None), from :data:`COSTS` (module docstring).
     """
     n = int(preparation.particles)
     kind = shape_kind(preparation.shape)
@@ -179,6 +179,8 @@ def estimate(preparation, test, time_step, domains=1) -> dict:
     steps = min(_between(costs, n, lambda c: c.steps, outside=math.sqrt), preparation.max_steps)
     cost = _between(costs, n, field)
     out["compaction"] = (int(round(steps)), cost, float(steps * n * cost * 1e-6), _sources(costs, n))
+    if test is None:
+        return out
     costs = COSTS[(kind, "test")]
     steps = preparation.test_steps(time_step, test.velocity, test.strain)
     cost = _between(costs, n, field)

@@ -69,7 +69,7 @@ def study_state(runner, prep, parameters, path, checkpoint, expected, overwrite)
     if overwrite:
         checkpoint.unlink(missing_ok=True)
         return "start"
-    state = runner.file_state(path)
+    state = compacted_state(path) if expected.get("scene") == "isotropic" else runner.file_state(path)
     if state in ("finished", "partial"):
         check_settings(path, expected, "pass --overwrite to replace it, or give the settings it was made with")
         checkpoint.unlink(missing_ok=True)  # the compaction is in the test's file now
@@ -81,14 +81,25 @@ def study_state(runner, prep, parameters, path, checkpoint, expected, overwrite)
     return "start"
 
 
+def compacted_state(path) -> str:
+    """How far the file of a compacted sample (scene isotropic: one snapshot) got: "missing",
+    "empty" (created, its snapshot not written: the run died between the two) or "finished"."""
+    if not path.exists():
+        return "missing"
+    from ..contract.writer import last_complete_value
+
+    return "empty" if last_complete_value(path, "time") is None else "finished"
+
+
 def expected_attrs(prep, test, parameters, scene="biaxial") -> dict:
     """File attributes a study file of ``prep`` sheared in ``test`` (the biaxial test, or the
     periodic cell's shear for ``scene="shear"``: its rate comes from the compacted sample, so
-    only its strain is known) with the solver settings ``parameters`` (the command line's
-    :data:`SOLVER_OPTIONS`, given or default) holds."""
+    only its strain is known; ``scene="isotropic"``: the compacted sample alone, no test) with
+    the solver settings ``parameters`` (the command line's :data:`SOLVER_OPTIONS`, given or
+    default) holds."""
     velocity = {"wall_velocity_m_s": test.velocity} if scene == "biaxial" else {}
-    return {"scene": scene, "strain_target": test.strain, **velocity, "snapshot_every": test.every,
-            "solver_friction": prep.friction, "sigma0_Pa": prep.sigma0, **prep.attrs(),
+    tested = {} if scene == "isotropic" else {"strain_target": test.strain, **velocity, "snapshot_every": test.every}
+    return {"scene": scene, **tested, "solver_friction": prep.friction, "sigma0_Pa": prep.sigma0, **prep.attrs(),
             **{f"solver_{k}": v for k, v in parameters.items()}}
 
 
@@ -102,6 +113,9 @@ def study_sample(label, prep, path, state, checkpoint, *, test, near_contacts, o
     from solver.engine import engine as engine_named
 
     runner = engine_named(engine or DEFAULT_ENGINE)
+    if state == "finished" and scene == "isotropic":
+        print(f"{label}: {path} is complete (skipped)", flush=True)
+        return path
     if state == "finished":
         runner.resume(path, progress=progress, compress=compress)
         print(f"{label}: {path} is complete (skipped)", flush=True)
@@ -132,9 +146,12 @@ def study_sample(label, prep, path, state, checkpoint, *, test, near_contacts, o
 
 
 def estimated_tests(tests, scene):
-    """The biaxial tests whose estimate stands for the study's tests: for scene shear, the one
+    """The biaxial tests whose estimate stands for the study's tests (None for scene isotropic,
+    whose samples are compacted only): for scene shear, the one
     that reaches the same eps_q in as many steps (h (e^eps_1 - 1) = gamma h / 2 at the same top
     wall speed); a periodic step's cost is the walled one's in the estimate."""
+    if scene == "isotropic":
+        return dict.fromkeys(tests)
     if scene != "shear":
         return tests
     import math
@@ -172,7 +189,7 @@ def run_study(args) -> int | None:
     if shear:
         check_shear(args, parameters)
     for label, prep in preps.items():
-        runner.check(prep, parameters, None if shear else tests[label])
+        runner.check(prep, parameters, tests[label] if args.scene == "biaxial" else None)
     paths = {label: out / f"{label}.nc" for label in samples}
     checkpoints = {label: out / f"{label}.compaction.nc" for label in samples}
     if out.is_file():
@@ -229,6 +246,10 @@ def run_study(args) -> int | None:
                     isinstance(exc, SystemExit) for exc in stopped) else KeyboardInterrupt())
     report = out / "report"
     if args.no_report:
+        return 0
+    if args.scene == "isotropic":
+        print(f"study: the compacted samples are {', '.join(str(p) for p in paths.values())}; a report needs "
+              "tests (scene biaxial or shear)", flush=True)
         return 0
     if all(state == "finished" for state in states.values()) and (report / "headline.csv").exists():
         print(f"study: every sample was complete already and {report} holds their report; nothing to do "

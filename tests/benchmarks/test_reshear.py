@@ -3,7 +3,9 @@
 The independent check: resheared at the study's own speed and snapshot interval, the new
 file is the study's file again, bit for bit (the sample, its warm start and the test are all
 restored from snapshot 0); resheared at another speed, it starts from the same state and
-records the new speed and where it came from."""
+records the new speed and where it came from. A sample compacted alone (``grainview study
+--scene isotropic``, what the repository keeps of the paper-size study) is the study's
+snapshot 0, and sheared from it gives the study's file again."""
 
 from __future__ import annotations
 
@@ -11,6 +13,7 @@ import netCDF4
 import numpy as np
 import pytest
 
+from grainview.app.cli import main
 from grainview.app.simulation import simulate as _simulate
 from grainview.contract.errors import ParameterError
 from solver.parameters import BiaxialTest
@@ -68,5 +71,31 @@ def test_resheared_at_another_speed_starts_from_the_same_state(study, tmp_path):
 
 def test_an_unfinished_source_is_refused(tmp_path):
     reshear = load_benchmark("fidelity.reshear")
-    with pytest.raises(ParameterError, match="is not a finished test"):
+    with pytest.raises(ParameterError, match="is neither a finished test nor a compacted sample"):
         reshear.reshear(tmp_path, tmp_path / "out", "pentagons", velocity=0.01, every=10, domains=None)
+
+
+def test_a_compacted_sample_sheared_is_the_study_file_again(study, tmp_path, capsys):
+    samples = tmp_path / "samples"
+    command = ["study", "--scene", "isotropic", "--particles", "30,24", "--jobs", "1", "--progress", "off",
+               "--out", str(samples)]
+    assert main(command) == 0
+    with netCDF4.Dataset(samples / "pentagons.nc") as nc:
+        assert nc.getncattr("scene") == "isotropic" and nc.dimensions["time"].size == 1
+        assert nc.getncattr("compaction_settled") == 1
+    for name in ("position", "angle", "velocity", "normal_impulse", "wall_position", "step"):
+        assert np.array_equal(_values(samples / "pentagons.nc", name)[0], _values(study / "pentagons.nc", name)[0],
+                              equal_nan=True), name
+    assert main(command) == 0  # the same command again: nothing to do
+    assert "pentagons.nc is complete (skipped)" in capsys.readouterr().out
+    assert main([*command, "--seed", "2"]) == 2  # a sample of other settings: refused in one line, kept
+    assert "holds another run (preparation_seed = 0, this run's is 2)" in capsys.readouterr().err
+    reshear = load_benchmark("fidelity.reshear")
+    out = tmp_path / "resheared"
+    assert reshear.reshear(samples, out, "pentagons", velocity=0.01, every=10, domains=None, strain=0.004) == "started"
+    for name in VARIABLES:
+        assert np.array_equal(_values(study / "pentagons.nc", name), _values(out / "pentagons.nc", name),
+                              equal_nan=True), name
+    with netCDF4.Dataset(out / "pentagons.nc") as nc:
+        assert nc.getncattr("resheared_from") == str(samples / "pentagons.nc")
+        assert "resheared_from_velocity_m_s" not in nc.ncattrs()

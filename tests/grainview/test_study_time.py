@@ -95,6 +95,8 @@ def test_the_costs_are_the_measured_ones_at_the_measured_sizes_and_a_power_law_b
         at_large = paper_size.estimate(preparation("paper", particles=14400, shape=shape), test, 5e-4, domains=2)
         assert at_large["compaction"][:2] == (large.steps, large.two_domains)
         assert at_large["test"][1] == shear_large.two_domains
+        compacted_only = paper_size.estimate(preparation("paper", particles=14400, shape=shape), None, 5e-4, domains=2)
+        assert compacted_only == {"compaction": at_large["compaction"]}  # a sample compacted only: no test
         n = 2400  # between: the power law through the two sizes
         between = paper_size.estimate(preparation("paper", particles=n, shape=shape), test, 5e-4)
         exponent = math.log(shear_large.serial / shear_small.serial) / math.log(14400 / 400)
