@@ -38,14 +38,13 @@ def run_mass(sample_path, factor, strain, velocity, every, window, folder):
     from grainview.analysis.strain import shear_strain
 
     sim = solver.load_sample(sample_path)
-    sim.walls.mass[sim.walls.index("right")] = factor * float(sim.mass.sum())
     sigma0 = float(sim.history.sigma0)
     path = os.path.join(folder, f"mass_{factor:g}.nc")
     start = time.process_time()
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
-        steps = solver.biaxial_test(sim, path, strain=strain, velocity=velocity, every=every, overwrite=True,
-                                    progress=False, compress=False)
+        steps = solver.biaxial_test(sim, path, strain=strain, velocity=velocity, every=every, wall_mass=factor,
+                                    overwrite=True, progress=False, compress=False)
     cpu = time.process_time() - start
     with grainview.open_dataset(path, chunks=None) as ds:
         keep = np.flatnonzero(shear_strain(ds).values >= window)

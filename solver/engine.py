@@ -135,6 +135,8 @@ class ContactDynamics:
     summary = "this package's contact dynamics"
     """The engine in a few words (the ``--engine`` help and the docs' table of engines)."""
     scenes = (*BASE_SCENES, "shear")
+    test_settings = ("wall_mass",)
+    """The :class:`BiaxialTest` settings beyond the strain, speed and snapshots that it takes."""
 
     def check(self, preparation, parameters: dict, test=None):
         from .parameters import Parameters
@@ -163,7 +165,7 @@ class ContactDynamics:
         from .scenes import biaxial_test
 
         return biaxial_test(sample, path, strain=test.strain, velocity=test.velocity, every=int(test.every),
-                            overwrite=overwrite, attrs=attrs, progress=progress, near_contacts=near_contacts,
+                            wall_mass=test.wall_mass, overwrite=overwrite, attrs=attrs, progress=progress, near_contacts=near_contacts,
                             compress=compress)
 
     def write_state(self, sample, path, *, attrs=None, near_contacts=False, overwrite=False, compress=True):
@@ -237,6 +239,21 @@ def prepare(runner, preparation, parameters: dict, progress=None, checkpoint=Non
 def scenes_of(runner) -> tuple:
     """The scenes ``runner`` declares (:data:`BASE_SCENES` for one that declares none)."""
     return tuple(getattr(runner, "scenes", BASE_SCENES))
+
+
+def check_test(name, test, scene: str = "biaxial"):
+    """Refuse, in one :class:`ParameterError` line, a biaxial ``test`` whose right wall's mass
+    (``test.wall_mass``) is set for another scene than ``scene="biaxial"``, or for the engine
+    registered as ``name`` (None: the default) when it does not declare ``wall_mass`` among its
+    ``test_settings``."""
+    if test is None or test.wall_mass is None:
+        return
+    if scene != "biaxial":
+        raise ParameterError(f"wall_mass={test.wall_mass:g}: the right wall's mass is the biaxial test's; scene "
+                             f"{scene} has no such wall")
+    if "wall_mass" not in getattr(engine(name or DEFAULT_ENGINE), "test_settings", ()):
+        raise ParameterError(f"wall_mass={test.wall_mass:g}: the right wall's mass is set by this package's solver "
+                             f"({DEFAULT_ENGINE}), not by engine {name}")
 
 
 def check_scene(name, scene: str):

@@ -281,7 +281,8 @@ the biaxial test's strain, :class:`BiaxialTest`, is an eps_1)."""
 class BiaxialTest:
     """The biaxial test of a prepared sample (:func:`solver.scenes.biaxial_test`): the top wall
     moves down at ``velocity`` until the vertical strain eps_1 = ln(1 + dh/h0) reaches
-    ``strain``, with a snapshot every ``every`` steps."""
+    ``strain``, with a snapshot every ``every`` steps; the right wall, pushed by sigma0, has
+    ``wall_mass`` times the sample's mass (None: the mass the compaction gave it)."""
 
     strain: float = setting(0.2, "vertical strain eps_1 of the biaxial test (eps_q ~0.6, into the residual state)",
                             check=lambda v: 0 < v < 1, expected="a vertical strain eps_1 in (0, 1)")
@@ -289,6 +290,9 @@ class BiaxialTest:
                               expected="a finite wall speed > 0 in m/s")
     every: int = setting(200, "steps between snapshots", check=lambda v: whole(v) and v >= 1,
                          expected="a positive whole number of steps between snapshots")
+    wall_mass: float | None = setting(None, "mass of the stress-controlled right wall, in units of the sample's mass "
+                                      "(none: the compaction's wall, of the whole sample's mass)", check=positive,
+                                      expected="a finite multiple > 0 of the sample's mass, or none", optional=True)
 
     def validate(self):
         """The test itself, checked: one :class:`ParameterError` naming every bad value."""

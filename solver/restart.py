@@ -272,8 +272,9 @@ def file_state(path) -> str:
 def check_settings(path, expected, advice="pass overwrite=True to replace it"):
     """Refuse, in one :class:`FileExistsError` line naming the first difference and ``advice``,
     to resume or keep the run in ``path`` when its global attributes differ from ``expected``
-    (name -> value: numbers equal to 1e-12 relative, other values as text; a bool as 0/1): a
-    run of other settings than the ones asked for is neither resumed nor taken as finished."""
+    (name -> value: numbers equal to 1e-12 relative, other values as text; a bool as 0/1; None
+    or "none" also matches a file without the attribute, written before the setting existed):
+    a run of other settings than the ones asked for is neither resumed nor taken as finished."""
     import math
 
     with ContractFile(os.fspath(path)) as ds:
@@ -284,6 +285,8 @@ def check_settings(path, expected, advice="pass overwrite=True to replace it"):
             want = int(want)
         if want is None:
             want = "none"
+        if have is None and want == "none":  # a file older than the setting: it ran with the setting's none
+            continue
         numeric = isinstance(want, (int, float, np.integer, np.floating)) and not isinstance(have, str)
         same = have is not None and (math.isclose(float(have), float(want), rel_tol=1e-12) if numeric
                                      else str(have) == str(want))

@@ -189,13 +189,17 @@ def _box_size_across(sim):
 
 
 def biaxial_test(sim: Simulation, path, *, strain=BiaxialTest.strain, velocity=BiaxialTest.velocity,
-                 every=BiaxialTest.every, overwrite=False, attrs=None, progress=None, near_contacts=False,
-                 compress=True):
+                 every=BiaxialTest.every, wall_mass=BiaxialTest.wall_mass, overwrite=False, attrs=None, progress=None,
+                 near_contacts=False, compress=True):
     """Biaxial compression of a compacted sample, written to ``path`` every ``every`` steps.
 
     The top wall moves down at ``velocity`` (m s-1) until eps_1 = ln(1 + dh/h0) reaches
     ``strain`` (defaults and checks: :class:`solver.parameters.BiaxialTest`); the right wall
-    keeps the confining stress sigma0; bottom and left are fixed.
+    keeps the confining stress sigma0; bottom and left are fixed. ``wall_mass``: the right
+    wall's mass in units of the sample's (attribute ``right_wall_mass_ratio``); None keeps the
+    mass the compaction gave it. The wall's mass sets how far it overshoots when the sample
+    fails and pushes it out, and so how far the lateral stress falls below sigma0
+    (docs/fidelity.md, "Without walls").
     The snapshot at the start of the test is written first. Ctrl-C stops after the current
     step, with every written snapshot kept. ``near_contacts``: also write the pairs within the
     alert distance that carry no force (:class:`solver.output.Recorder`). The file records the
@@ -204,7 +208,7 @@ def biaxial_test(sim: Simulation, path, *, strain=BiaxialTest.strain, velocity=B
     to them. The file is netCDF-3 while the test runs and is compressed once it has finished
     (``compress``: True, a zlib level 1-9, or False; :class:`solver.output.Recorder`).
     """
-    BiaxialTest(strain, velocity, every).validate()
+    BiaxialTest(strain, velocity, every, wall_mass).validate()
     check_time_step(sim.parameters.time_step, velocity, float(sim.radius.min()), "the top wall")
     lo, hi = sim.walls.box_bounds()
     h0 = float(hi[1] - lo[1])
@@ -218,7 +222,10 @@ def biaxial_test(sim: Simulation, path, *, strain=BiaxialTest.strain, velocity=B
             "height (did the compaction settle?) or a faster wall; nothing was written")
     n_steps = int(np.ceil(steps))
     sim.walls.drive_velocity("top", (0.0, -velocity))
+    if wall_mass is not None:
+        sim.walls.mass[sim.walls.index("right")] = float(wall_mass) * float(sim.mass.sum())
     run_attrs = {"scene": "biaxial", "strain_target": strain, "wall_velocity_m_s": velocity,
+                 "right_wall_mass_ratio": "none" if wall_mass is None else float(wall_mass),
                  "sigma0_Pa": sim.history.sigma0, "snapshot_every": int(every), "biaxial_steps": n_steps,
                  **sim.history.attrs()}
     run_attrs.update(attrs or {})

@@ -40,12 +40,14 @@ disks), from the repository's root; ``samples/README.md`` there says how they we
 
 
 def reshear(source: Path, out: Path, label: str, *, velocity: float, every: int, domains: int | None,
-            strain: float | None = None, progress: bool = False) -> str:
+            strain: float | None = None, wall_mass: float | None = None, progress: bool = False) -> str:
     """Shear the compacted sample of ``source/label.nc`` into ``out/label.nc`` (or resume it).
 
     Returns what was done: "finished" (skipped), "resumed" or "started". An existing
-    ``out/label.nc`` of another ``velocity``, ``every`` or ``strain`` is refused (ParameterError, one
-    line) rather than resumed or kept as if it were the test asked for.
+    ``out/label.nc`` of another ``velocity``, ``every``, ``strain`` or ``wall_mass`` (the right
+    wall's mass in units of the sample's, :class:`solver.parameters.BiaxialTest`; None: the
+    compaction's) is refused (ParameterError, one line) rather than resumed or kept as if it
+    were the test asked for.
     """
     from solver import load_sample
     from solver.restart import check_settings, file_state, resume
@@ -54,7 +56,7 @@ def reshear(source: Path, out: Path, label: str, *, velocity: float, every: int,
     path = out / f"{label}.nc"
     state = file_state(path)
     if state in ("finished", "partial"):  # only a test of the speed and snapshots asked for is kept or resumed
-        expected = {"wall_velocity_m_s": velocity, "snapshot_every": every}
+        expected = {"wall_velocity_m_s": velocity, "snapshot_every": every, "right_wall_mass_ratio": wall_mass}
         if strain is not None:
             expected["strain_target"] = strain
         try:
@@ -88,8 +90,8 @@ def reshear(source: Path, out: Path, label: str, *, velocity: float, every: int,
             target = float(ds.getncattr("strain_target")) if strain is None else strain
             attrs["resheared_from_velocity_m_s"] = float(ds.getncattr("wall_velocity_m_s"))
     out.mkdir(parents=True, exist_ok=True)
-    biaxial_test(sim, path, strain=target, velocity=velocity, every=every, near_contacts=True, attrs=attrs,
-                 progress=progress)
+    biaxial_test(sim, path, strain=target, velocity=velocity, every=every, wall_mass=wall_mass, near_contacts=True,
+                 attrs=attrs, progress=progress)
     return "started"
 
 
@@ -110,6 +112,8 @@ def main(argv=None) -> int:
     parser.add_argument("--every", type=int, required=True, help="steps between snapshots")
     parser.add_argument("--domains", type=int, default=None, help="domains of the new tests' sweeps")
     parser.add_argument("--strain", type=float, default=None, help="eps_1 to reach (default: the original's)")
+    parser.add_argument("--wall-mass", type=float, default=None,
+                        help="the right wall's mass in units of the sample's (default: the compaction's, the sample's)")
     parser.add_argument("--samples", default=",".join(SAMPLES), help="which samples, comma-separated")
     parser.add_argument("--progress", action="store_true", help="show a progress bar")
     args = parser.parse_args(argv)
@@ -124,7 +128,8 @@ def main(argv=None) -> int:
         print(f"{label}: ...", flush=True)
         try:
             done = reshear(args.source, args.out, label, velocity=args.velocity, every=args.every,
-                           domains=args.domains, strain=args.strain, progress=args.progress)
+                           domains=args.domains, strain=args.strain, wall_mass=args.wall_mass,
+                           progress=args.progress)
         except ParameterError as exc:
             print(f"reshear: error: {exc}", file=sys.stderr)
             return 2

@@ -27,7 +27,7 @@ PREPARATION_OPTIONS = ("friction", "sigma0", "compaction_friction", "max_inertia
 command line (besides the sample: particles, shape, seed)."""
 
 
-TEST_OPTIONS = ("strain", "velocity", "every")
+TEST_OPTIONS = ("strain", "velocity", "every", "wall_mass")
 """The :class:`solver.parameters.BiaxialTest` fields: the options of the biaxial test."""
 
 
@@ -205,6 +205,7 @@ def test_options(p):
     setting_option(p, BiaxialTest, "velocity", more=f": finite, > 0, and such that the test takes at least "
                    f"{MIN_TEST_STEPS} time steps and no more than a file's 32-bit step counter holds")
     setting_option(p, BiaxialTest, "every")
+    setting_option(p, BiaxialTest, "wall_mass")
 
 
 def simulation_options(p, samples=()):

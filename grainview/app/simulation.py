@@ -197,12 +197,13 @@ def check_run_settings(args, prep):
     """Every setting of a run against the others before any work: the solver parameters (a
     time step of the wrong sign or form is named as such first), then the time step against
     the walls' speeds and the test's length in steps, by the engine (:mod:`solver.engine`)."""
-    from solver.engine import engine
+    from solver.engine import check_test, engine
 
     parameters = solver_parameters(args)
     scene = getattr(args, "scene", "biaxial")
     if scene == "shear":
         check_shear(args, parameters)
+    check_test(args.engine, biaxial_test(args), scene)
     engine(args.engine).check(prep, parameters, biaxial_test(args) if scene == "biaxial" else None)
 
 

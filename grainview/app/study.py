@@ -97,7 +97,8 @@ def expected_attrs(prep, test, parameters, scene="biaxial") -> dict:
     only its strain is known; ``scene="isotropic"``: the compacted sample alone, no test) with
     the solver settings ``parameters`` (the command line's :data:`SOLVER_OPTIONS`, given or
     default) holds."""
-    velocity = {"wall_velocity_m_s": test.velocity} if scene == "biaxial" else {}
+    velocity = {"wall_velocity_m_s": test.velocity, "right_wall_mass_ratio": test.wall_mass} if scene == "biaxial" \
+        else {}
     tested = {} if scene == "isotropic" else {"strain_target": test.strain, **velocity, "snapshot_every": test.every}
     return {"scene": scene, **tested, "solver_friction": prep.friction, "sigma0_Pa": prep.sigma0, **prep.attrs(),
             **{f"solver_{k}": v for k, v in parameters.items()}}
@@ -188,7 +189,10 @@ def run_study(args) -> int | None:
     shear = args.scene == "shear"
     if shear:
         check_shear(args, parameters)
+    from solver.engine import check_test
+
     for label, prep in preps.items():
+        check_test(args.engine, tests[label], args.scene)
         runner.check(prep, parameters, tests[label] if args.scene == "biaxial" else None)
     paths = {label: out / f"{label}.nc" for label in samples}
     checkpoints = {label: out / f"{label}.compaction.nc" for label in samples}

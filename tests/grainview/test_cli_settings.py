@@ -185,6 +185,8 @@ def test_only_the_solver_settings_given_are_passed_on():
     (["--every", "0"], "--every 0: expected a positive whole number of steps between snapshots"),
     (["--strain", "1.5"], "--strain 1.5: expected a vertical strain eps_1 in (0, 1)"),
     (["--acceleration", "off", "--solver", "nlgs"], "--acceleration and --solver name the same setting"),
+    (["--wall-mass", "0"], "--wall-mass 0: expected a finite multiple > 0 of the sample's mass, or none"),
+    (["shear", "--wall-mass", "0.1"], "the right wall's mass is the biaxial test's; scene shear has no such wall"),
 ])
 def test_bad_test_settings_are_named_by_their_flag(tmp_path, capsys, argv, line):
     assert main(["run", *argv, "--out", str(tmp_path / "x.nc")]) == 2
@@ -261,6 +263,14 @@ def test_run_reaches_the_simulation_through_the_chosen_engine(tmp_path, fake_eng
     main(["run", "isotropic", "--engine", "fake", "--out", str(tmp_path / "i.nc"), "--progress", "off"])
     assert fake_engine[-1] == ("write_state", "i.nc", {"scene": "isotropic"})
     assert fake_engine[-3][3] is None  # an isotropic run checks the preparation without a test
+
+
+def test_an_engine_that_does_not_take_the_wall_mass_is_not_given_one(tmp_path, fake_engine, capsys):
+    argv = ["run", "--engine", "fake", "--particles", "12", "--out", str(tmp_path / "r.nc"), "--progress", "off"]
+    assert main([*argv, "--wall-mass", "0.1"]) == 2
+    assert "wall_mass=0.1: the right wall's mass is set by this package's solver (solver), not by engine fake" \
+        in capsys.readouterr().err
+    assert fake_engine == [] and list(tmp_path.iterdir()) == []
 
 
 def test_ensemble_runs_go_through_their_engine(tmp_path, fake_engine):
