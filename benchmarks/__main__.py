@@ -156,6 +156,8 @@ SECTIONS = (
             "sigma_yy holds sigma0, and the sweeps and time it costs, per cell mass and solver", (), ("--quick",)),
     Section("wall-control", "wall_control", "the walled test's stress-controlled wall: how steadily sigma_xx holds "
             "sigma0 and p over the residual window, per mass of the wall", (), ("--quick",)),
+    Section("wall-motion", "wall_motion", "the walled tests' right wall: its stress, motion and free-flight time, "
+            "and p across the sample, over the residual window (reads the fidelity study's files)", (), ("--quick",)),
 )
 """The current benchmarks, in the order of RESULTS.md. benchmarks/README.md says what each measures."""
 
