@@ -30,22 +30,10 @@ from __future__ import annotations
 from numba import njit
 from numba.extending import overload
 
-from grainview.contract.errors import ParameterError
-
-STRESSED_CELL_SOLVERS = ("anderson", "nlgs")
-"""The stepper methods that sweep the cell's rate with the contacts (:func:`couple_cell`)."""
 RATE_AT_ASSEMBLY, RATE, MASS, LOAD = 0, 1, 2, 3
 """The entries of a :class:`solver.solve_records.StressedCellProblem`'s ``cell`` (4,): dh/dt
 that the bias and slip hold at assembly (m s-1), the one they hold now (updated in place), M
 (kg) and h sigma0 l t (N s)."""
-
-
-def check_solver(parameters):
-    """Refuse, in one line, a stepper solver (``parameters.solver``) that cannot sweep a
-    stress-controlled cell's rate with the contacts (:data:`STRESSED_CELL_SOLVERS`)."""
-    if parameters.solver not in STRESSED_CELL_SOLVERS:
-        raise ParameterError(f"solver={parameters.solver!r}: a periodic cell under a normal stress is solved by "
-                             f"{' or '.join(STRESSED_CELL_SOLVERS)} (its height's rate is swept with the contacts)")
 
 
 def couple_cell(problem, impulses):

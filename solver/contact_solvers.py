@@ -172,6 +172,9 @@ class Method:
     own_stall : a function of no argument returning the words for its own stall test, for a
         method without the NLGS's (None for none); called when the words are needed, so that
         the registry imports no method's module.
+    couples_cell : whether ``solve`` sweeps a stress-controlled periodic cell's rate with the
+        contacts (:func:`solver.cell_coupling.couple_cell`): only such a method solves the
+        periodic shear under a normal stress.
     """
 
     name: str
@@ -187,6 +190,7 @@ class Method:
     iteration: str = "sweep"
     norms: str = "both stopping norms (the impulses' change over a sweep) met their tolerances"
     own_stall: Callable | None = None
+    couples_cell: bool = False
 
     @property
     def in_stepper(self) -> bool:
@@ -274,6 +278,21 @@ def choices_help() -> str:
 def stepper_methods() -> tuple:
     """The names of the methods the time stepper can use, sorted."""
     return tuple(sorted(name for name, m in _METHODS.items() if m.in_stepper))
+
+
+def cell_coupling_methods() -> tuple:
+    """The names of the stepper methods that sweep a stress-controlled periodic cell's rate with
+    the contacts (``couples_cell``), sorted."""
+    return tuple(sorted(name for name, m in _METHODS.items() if m.in_stepper and m.couples_cell))
+
+
+def check_cell_coupling(parameters):
+    """Refuse, in one line, a stepper solver (``parameters.solver``) that cannot sweep a
+    stress-controlled periodic cell's rate with the contacts (:func:`cell_coupling_methods`)."""
+    solvers = cell_coupling_methods()
+    if parameters.solver not in solvers:
+        raise ParameterError(f"solver={parameters.solver!r}: a periodic cell under a normal stress is solved by "
+                             f"{' or '.join(solvers)} (its height's rate is swept with the contacts)")
 
 
 def matrix_methods() -> tuple:
@@ -438,10 +457,12 @@ def _own_stall_words(module: str, count: str, unit: str) -> Callable[[], str]:
 
 
 register(Method("nlgs", "nonlinear Gauss-Seidel sweeps (serial, shuffled or on domains)", "alternative",
-                solve=solve_stepper_nlgs, solve_matrix=solve_nlgs, parameters=(), domains=True, shuffle=True))
+                solve=solve_stepper_nlgs, solve_matrix=solve_nlgs, parameters=(), domains=True, shuffle=True,
+                couples_cell=True))
 register(Method("anderson", "Anderson-accelerated NLGS sweeps, the same local-law residual in less time per step "
                 "than 'nlgs'", "default", solve=solve_stepper_anderson,
-                parameters=(("anderson_memory", "memory"), ("anderson_period", "period")), domains=True))
+                parameters=(("anderson_memory", "memory"), ("anderson_period", "period")), domains=True,
+                couples_cell=True))
 register(Method("newton", "semi-smooth Newton on Alart-Curnier's function", "experimental", solve_matrix=solve_newton,
                 stall=False, label="Newton", iteration="Newton step", norms=LOCAL_LAW_NORMS,
                 own_stall=_own_stall_words("nonsmooth_newton", "STALL_STEPS", "Newton steps")))

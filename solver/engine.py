@@ -187,11 +187,11 @@ class ContactDynamics:
 
     def check_simple_shear(self, parameters: dict):
         """Refuse, in one line, the settings the periodic cell's shear does not take
-        (:func:`solver.cell_coupling.check_solver`)."""
-        from .cell_coupling import check_solver
+        (:func:`solver.contact_solvers.check_cell_coupling`)."""
+        from .contact_solvers import check_cell_coupling
         from .parameters import Parameters
 
-        check_solver(Parameters(**parameters))
+        check_cell_coupling(Parameters(**parameters))
 
     def shear_rate(self, sample, velocity: float) -> float:
         """The shear rate (s-1) of the biaxial test at wall speed ``velocity``

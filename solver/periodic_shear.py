@@ -23,7 +23,7 @@ import numpy as np
 from grainview.contract.errors import ParameterError
 from grainview.contract.schema import MAX_STEP_INDEX
 
-from .cell_coupling import check_solver
+from .contact_solvers import check_cell_coupling
 from .contact_points import rank_in_pair
 from .interrupt import interruptible, progress_bar, resume_instructions, stop_exception, stop_reason
 from .output import Recorder
@@ -116,7 +116,7 @@ def shear_test(sim: Simulation, path, *, strain=SHEAR_STRAIN, shear_rate, every=
     n_steps = int(np.ceil(steps))
     cell = sim.cell
     if cell.stress is not None:
-        check_solver(sim.parameters)
+        check_cell_coupling(sim.parameters)
     cell.shear_rate = float(shear_rate)
     if affine_start:
         n = sim.n_particles

@@ -586,7 +586,7 @@ class Simulation:
         :class:`solver.nlgs.NLGSResult`."""
         p = self.parameters
         cell = self.cell
-        cell_coupling.check_solver(p)
+        contact_solvers.check_cell_coupling(p)
         load = float(p.time_step) * cell.stress * cell.length * float(p.thickness)
         stressed = StressedCellProblem(*problem, self.point_image[:, 1].astype(np.float64),
                                        np.array([cell.height_rate, cell.height_rate, cell.mass, load]))

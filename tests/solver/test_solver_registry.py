@@ -24,6 +24,12 @@ def test_the_registered_methods_and_what_each_solves():
     pcg = contact_solvers.method("pcg")
     assert pcg.in_stepper and not (pcg.domains or pcg.shuffle or pcg.stall)
     assert not contact_solvers.method("newton").in_stepper
+    # the periodic cell under a normal stress: the methods whose sweeps couple its rate, and no other
+    assert contact_solvers.cell_coupling_methods() == ("anderson", "nlgs")
+    contact_solvers.check_cell_coupling(Parameters(solver="nlgs"))
+    with pytest.raises(ParameterError, match="solver='pcg': a periodic cell under a normal stress is solved by "
+                                             r"anderson or nlgs \(its height's rate is swept with the contacts\)"):
+        contact_solvers.check_cell_coupling(Parameters(solver="pcg"))
 
 
 @pytest.mark.parametrize("name", ["fast", "newton", None])
