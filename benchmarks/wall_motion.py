@@ -70,7 +70,10 @@ def wall_motion(path, window=0.4) -> dict:
     from grainview.analysis.strain import shear_strain
 
     with grainview.open_dataset(path, chunks=None) as ds:
-        walls = [str(w) for w in ds["wall"].values]
+        walls = [str(w) for w in ds["wall"].values] if "wall" in ds else []
+        if ds.attrs.get("scene", "biaxial") != "biaxial" or "right" not in walls:
+            raise ValueError(f"{path}: scene {ds.attrs.get('scene', 'unknown')}, walls {walls or 'none'}; expected a "
+                             "walled biaxial test (solver.biaxial_test)")
         right = walls.index("right")
         sigma0 = float(ds.attrs["sigma0_Pa"])
         speed = float(ds.attrs["wall_velocity_m_s"])
@@ -80,7 +83,11 @@ def wall_motion(path, window=0.4) -> dict:
         height0 = float(hi[0, 1] - lo[0, 1])
         d = mean_diameter(ds)
         thickness = float(ds.attrs["thickness_m"])
-        keep = np.flatnonzero(shear_strain(ds).values >= window)
+        eps_q = shear_strain(ds).values
+        keep = np.flatnonzero(eps_q >= window)
+        if not keep.size:
+            raise ValueError(f"{path}: no snapshot with eps_q >= {window:g} (its largest is {eps_q.max():.3g}); "
+                             "expected a lower --window")
         res = ds.isel(time=keep)
         sxx = res.grain.stress_tensor().values[:, 0, 0] / sigma0
         height = (res["box_max"] - res["box_min"]).values[:, 1]
@@ -157,6 +164,7 @@ def main(argv=None) -> int:
     import tempfile
 
     from benchmarks.common import print_or_write
+    from grainview.contract.errors import GrainviewError
     from benchmarks.fidelity.runs import CACHE
 
     parser = argparse.ArgumentParser(prog="python -m benchmarks.wall_motion", description=__doc__.split("\n")[0])
@@ -169,6 +177,8 @@ def main(argv=None) -> int:
     parser.add_argument("--quick", action="store_true", help="two short tests of 60 pentagons, printed only")
     parser.add_argument("--out", default=None, help=f"the results file (default {RESULTS}; a --quick run prints only)")
     args = parser.parse_args(argv)
+    if not (np.isfinite(args.window) and args.window >= 0):
+        parser.error(f"--window {args.window:g}: expected a finite eps_q >= 0")
     with tempfile.TemporaryDirectory(prefix="wall_motion_") as scratch:
         if args.quick:
             args.files, args.window = quick_files(scratch), 0.0
@@ -179,7 +189,10 @@ def main(argv=None) -> int:
         labels = args.labels.split(",") if args.labels else [label_of(f) for f in files]
         if len(labels) != len(files):
             parser.error(f"--labels: {len(labels)} labels for {len(files)} files")
-        rows = [row(label, wall_motion(path, args.window)) for label, path in zip(labels, files)]
+        try:
+            rows = [row(label, wall_motion(path, args.window)) for label, path in zip(labels, files)]
+        except (ValueError, GrainviewError) as exc:  # not a walled test, an empty window, an unreadable file
+            parser.error(str(exc))
     table = "\n".join([HEADER, "|" + "---|" * (HEADER.count(" | ") + 1), *rows])
     intro = (f"Walled biaxial tests of the fidelity study (their own speeds and wall masses), snapshots with eps_q >= "
              f"{args.window:g}; what each column is: the module's docstring.")

@@ -277,6 +277,11 @@ SHEAR_STRAIN = 0.5
 the biaxial test's strain, :class:`BiaxialTest`, is an eps_1)."""
 
 
+MIN_WALL_MASS = 1e-6
+"""The lightest right wall of a biaxial test, in units of the sample's mass: lighter than any
+grain of a sample of fewer than a million, and far from where its inverse mass overflows."""
+
+
 @dataclass(frozen=True)
 class BiaxialTest:
     """The biaxial test of a prepared sample (:func:`solver.scenes.biaxial_test`): the top wall
@@ -291,8 +296,10 @@ class BiaxialTest:
     every: int = setting(200, "steps between snapshots", check=lambda v: whole(v) and v >= 1,
                          expected="a positive whole number of steps between snapshots")
     wall_mass: float | None = setting(None, "mass of the stress-controlled right wall, in units of the sample's mass "
-                                      "(none: the compaction's wall, of the whole sample's mass)", check=positive,
-                                      expected="a finite multiple > 0 of the sample's mass, or none", optional=True)
+                                      "(none: the compaction's wall, of the whole sample's mass)",
+                                      check=lambda v: positive(v) and v >= MIN_WALL_MASS,
+                                      expected=f"a finite multiple >= {MIN_WALL_MASS:g} of the sample's mass, or none",
+                                      optional=True)
 
     def validate(self):
         """The test itself, checked: one :class:`ParameterError` naming every bad value."""

@@ -291,7 +291,8 @@ def check_settings(path, expected, advice="pass overwrite=True to replace it"):
         same = have is not None and (math.isclose(float(have), float(want), rel_tol=1e-12) if numeric
                                      else str(have) == str(want))
         if not same:
-            raise FileExistsError(f"{path} holds another run ({key} = {have}, this run's is {want}); {advice}")
+            shown = "none recorded" if have is None else have
+            raise FileExistsError(f"{path} holds another run ({key} = {shown}, this run's is {want}); {advice}")
 
 
 def resume(path, progress=None, compress=True) -> int:

@@ -90,9 +90,20 @@ class Given(argparse.Action):
 
 
 def setting_type(f):
-    """The command-line type of a settings field: its annotation's first type (``float | None``:
-    float; ``str | int``: str, parsed further by the command)."""
-    return {"float": float, "int": int}.get(str(f.type).split("|")[0].strip(), str)
+    """The command-line type of a settings field: its annotation's first type (``str | int``:
+    str, parsed further by the command); for ``float | None`` a float or the word ``none``
+    (:func:`optional_float`)."""
+    kinds = [kind.strip() for kind in str(f.type).split("|")]
+    base = {"float": float, "int": int}.get(kinds[0], str)
+    return optional_float if base is float and "None" in kinds else base
+
+
+def optional_float(text: str) -> float | None:
+    """A float of the command line, or None for ``none`` (the help's word for an unset setting)."""
+    return None if str(text).strip().lower() == "none" else float(text)
+
+
+optional_float.__name__ = "float"  # argparse says "invalid float value: 'x'"
 
 
 def setting_option(parser, record, name, *, more="", flag=None, **overrides):

@@ -69,6 +69,9 @@ def study_state(runner, prep, parameters, path, checkpoint, expected, overwrite)
     if overwrite:
         checkpoint.unlink(missing_ok=True)
         return "start"
+    if path.exists() and expected.get("scene") != "isotropic":  # a compacted sample, or another scene's test
+        check_settings(path, {"scene": expected["scene"]}, "give another --out (a compacted sample is sheared by "
+                       "reading it: solver.load_sample), or pass --overwrite to replace it")
     state = compacted_state(path) if expected.get("scene") == "isotropic" else runner.file_state(path)
     if state in ("finished", "partial"):
         check_settings(path, expected, "pass --overwrite to replace it, or give the settings it was made with")
@@ -83,12 +86,21 @@ def study_state(runner, prep, parameters, path, checkpoint, expected, overwrite)
 
 def compacted_state(path) -> str:
     """How far the file of a compacted sample (scene isotropic: one snapshot) got: "missing",
-    "empty" (created, its snapshot not written: the run died between the two) or "finished"."""
+    "empty" (created, its snapshot not written: the run died between the two) or "finished"; a
+    file that is not a run's (no snapshot and no ``scene`` attribute) is refused in one line,
+    not taken as empty and replaced."""
     if not path.exists():
         return "missing"
-    from ..contract.writer import last_complete_value
+    from ..contract.reader import ContractFile
 
-    return "empty" if last_complete_value(path, "time") is None else "finished"
+    with ContractFile(path) as ds:  # FileFormatError, in one line, for a file that is not netCDF
+        attrs, snapshots = ds.attrs, ds.n_snapshots
+    if snapshots:
+        return "finished"
+    if "scene" not in attrs:  # not a run's file: another netCDF file, not the study's to replace
+        raise GrainviewError(f"{path} is not a file of grainview's runs (no snapshot, no scene attribute); pass "
+                             "--overwrite to replace it, or give another --out")
+    return "empty"
 
 
 def expected_attrs(prep, test, parameters, scene="biaxial") -> dict:
@@ -214,12 +226,13 @@ def run_study(args) -> int | None:
 
         load = machine_load()
         groups = [group for group in GROUPS if group != "solver" or (args.engine or DEFAULT_ENGINE) == DEFAULT_ENGINE]
-        shares = cold_shares(groups if not args.no_report else [g for g in groups if g == "solver"])
+        reported = not args.no_report and args.scene != "isotropic"  # compacted samples are not reported
+        shares = cold_shares(groups if reported else [g for g in groups if g == "solver"])
         line = compile_line("study", shares, load)
         if line:
             print(line, flush=True)
         print_estimate({label: preps[label] for label in to_run}, estimated_tests(tests, args.scene), parameters,
-                        args.jobs, shares, report=not args.no_report, load=load)
+                        args.jobs, shares, report=reported, load=load)
         compile_ahead("study", shares, progress_flag(args))
     args.near_contacts = True  # the report counts near pairs as well (docs/fidelity.md)
     kwargs = simulation_kwargs(args)

@@ -90,6 +90,9 @@ def test_a_compacted_sample_sheared_is_the_study_file_again(study, tmp_path, cap
     assert "pentagons.nc is complete (skipped)" in capsys.readouterr().out
     assert main([*command, "--seed", "2"]) == 2  # a sample of other settings: refused in one line, kept
     assert "holds another run (preparation_seed = 0, this run's is 2)" in capsys.readouterr().err
+    biaxial = [c for c in command if c not in ("--scene", "isotropic")]  # a test asked for in the samples' folder
+    assert main(biaxial) == 2
+    assert "holds another run (scene = isotropic, this run's is biaxial); give another --out" in capsys.readouterr().err
     reshear = load_benchmark("fidelity.reshear")
     out = tmp_path / "resheared"
     assert reshear.reshear(samples, out, "pentagons", velocity=0.01, every=10, domains=None, strain=0.004) == "started"

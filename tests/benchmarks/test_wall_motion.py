@@ -64,3 +64,18 @@ def test_the_table_has_a_row_per_file(walled, tmp_path):
     assert motion.main([str(path), str(path), "--labels", "a,b", "--window", "0", "--out", str(out)]) == 0
     lines = [line for line in out.read_text().splitlines() if line.startswith("| ")]
     assert len(lines) == 3 and lines[1].startswith("| a | 60 | 1 | 0.2 |") and lines[2].startswith("| b |")
+
+
+def test_a_file_or_window_without_a_walled_snapshot_is_refused_in_one_line(walled, tmp_path, capsys):
+    path, sim = walled
+    motion = load_benchmark("wall_motion")
+    with pytest.raises(SystemExit):
+        motion.main([str(path), "--window", "5", "--out", str(tmp_path / "w.md")])
+    assert "no snapshot with eps_q >= 5 (its largest is" in capsys.readouterr().err.splitlines()[-1]
+    from solver.output import Recorder
+
+    compacted = tmp_path / "compacted.nc"  # a sample as written alone: no biaxial test
+    with Recorder(compacted, sim, attrs={"scene": "isotropic"}) as rec:
+        rec.write()
+    with pytest.raises(ValueError, match="scene isotropic, walls .*; expected a walled biaxial test"):
+        motion.wall_motion(compacted)

@@ -44,8 +44,11 @@ def test_every_derived_option_has_its_fields_default_type_and_help():
             elif command == "study" and action.dest == "particles":  # one size, or one per sample: parsed by the study
                 assert action.type is str and "comma-separated, one per sample" in action.help
             else:
-                first = str(f.type).split("|")[0].strip()  # float | None: float
-                assert action.type is {"float": float, "int": int, "str": str}[first]
+                kinds = [kind.strip() for kind in str(f.type).split("|")]
+                expected = {"float": float, "int": int, "str": str}[kinds[0]]
+                if expected is float and "None" in kinds:  # float | None: a float, or the word none
+                    expected = settings.optional_float
+                assert action.type is expected
     expected = set(settings.SOLVER_OPTIONS) | set(settings.PREPARATION_OPTIONS) | set(settings.TEST_OPTIONS) | {"particles", "seed",
                                                                                                  "shape"}
     assert seen == expected
@@ -185,7 +188,8 @@ def test_only_the_solver_settings_given_are_passed_on():
     (["--every", "0"], "--every 0: expected a positive whole number of steps between snapshots"),
     (["--strain", "1.5"], "--strain 1.5: expected a vertical strain eps_1 in (0, 1)"),
     (["--acceleration", "off", "--solver", "nlgs"], "--acceleration and --solver name the same setting"),
-    (["--wall-mass", "0"], "--wall-mass 0: expected a finite multiple > 0 of the sample's mass, or none"),
+    (["--wall-mass", "0"], "--wall-mass 0: expected a finite multiple >= 1e-06 of the sample's mass, or none"),
+    (["--wall-mass", "1e-300"], "--wall-mass 1e-300: expected a finite multiple >= 1e-06 of the sample's mass, or none"),
     (["shear", "--wall-mass", "0.1"], "the right wall's mass is the biaxial test's; scene shear has no such wall"),
 ])
 def test_bad_test_settings_are_named_by_their_flag(tmp_path, capsys, argv, line):
@@ -265,6 +269,15 @@ def test_run_reaches_the_simulation_through_the_chosen_engine(tmp_path, fake_eng
     assert fake_engine[-3][3] is None  # an isotropic run checks the preparation without a test
 
 
+def test_an_optional_setting_takes_the_word_none(capsys):
+    assert build_parser().parse_args(["run", "--wall-mass", "none"]).wall_mass is None
+    assert build_parser().parse_args(["run", "--wall-mass", "0.1"]).wall_mass == 0.1
+    assert build_parser().parse_args(["run", "--compaction-friction", "None"]).compaction_friction is None
+    with pytest.raises(SystemExit):
+        build_parser().parse_args(["run", "--wall-mass", "heavy"])
+    assert "argument --wall-mass: invalid float value: 'heavy'" in capsys.readouterr().err
+
+
 def test_an_engine_that_does_not_take_the_wall_mass_is_not_given_one(tmp_path, fake_engine, capsys):
     argv = ["run", "--engine", "fake", "--particles", "12", "--out", str(tmp_path / "r.nc"), "--progress", "off"]
     assert main([*argv, "--wall-mass", "0.1"]) == 2
@@ -309,3 +322,19 @@ def test_the_study_asks_the_engine_to_check_a_checkpoint_it_finds(tmp_path, fake
     fake_engine.clear()
     assert main([*argv, "--engine", "fake"]) == 0
     assert not any(c[0] == "check_checkpoint" for c in fake_engine) and any(c[0] == "prepare" for c in fake_engine)
+
+
+def test_a_compacted_study_does_not_take_a_foreign_file_for_an_empty_one(tmp_path, capsys):
+    import netCDF4
+
+    out = tmp_path / "samples"
+    out.mkdir()
+    with netCDF4.Dataset(out / "pentagons.nc", "w") as nc:  # someone's own netCDF file, no snapshot of a run
+        nc.createDimension("x", 3)
+        nc.createVariable("temperature", "f8", ("x",))[:] = [1.0, 2.0, 3.0]
+    before = (out / "pentagons.nc").read_bytes()
+    assert main(["study", "--scene", "isotropic", "--particles", "20", "--jobs", "1", "--progress", "off",
+                 "--out", str(out)]) == 2
+    assert "pentagons.nc is not a file of grainview's runs (no snapshot, no scene attribute); pass --overwrite" \
+        in capsys.readouterr().err
+    assert (out / "pentagons.nc").read_bytes() == before and sorted(p.name for p in out.iterdir()) == ["pentagons.nc"]
