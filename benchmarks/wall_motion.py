@@ -194,7 +194,9 @@ def main(argv=None) -> int:
         except (ValueError, GrainviewError) as exc:  # not a walled test, an empty window, an unreadable file
             parser.error(str(exc))
     table = "\n".join([HEADER, "|" + "---|" * (HEADER.count(" | ") + 1), *rows])
-    intro = (f"Walled biaxial tests of the fidelity study (their own speeds and wall masses), snapshots with eps_q >= "
+    source = (f"the files {', '.join(os.path.basename(f) for f in files)}" if args.files else
+              f"the fidelity study's ({args.runs})")
+    intro = (f"Walled biaxial tests, {source}, at their own speeds and wall masses; snapshots with eps_q >= "
              f"{args.window:g}; what each column is: the module's docstring.")
     print_or_write(args.out or (None if args.quick else RESULTS), "The right wall's motion in the walled tests",
                    intro, [table], quick=args.quick)
