@@ -28,6 +28,8 @@ from __future__ import annotations
 import argparse
 import sys
 import time
+import warnings
+from contextlib import contextmanager
 from pathlib import Path
 
 from grainview.contract.errors import ParameterError
@@ -67,7 +69,8 @@ def reshear(source: Path, out: Path, label: str, *, velocity: float, every: int,
         resume(path, compress=True)  # compresses a file whose compression was stopped; else nothing
         return "finished"
     if state == "partial":
-        resume(path, progress=progress)
+        with one_line_on_unconverged(path):
+            resume(path, progress=progress)
         return "resumed"
     original = source / f"{label}.nc"
     import netCDF4
@@ -90,9 +93,29 @@ def reshear(source: Path, out: Path, label: str, *, velocity: float, every: int,
             target = float(ds.getncattr("strain_target")) if strain is None else strain
             attrs["resheared_from_velocity_m_s"] = float(ds.getncattr("wall_velocity_m_s"))
     out.mkdir(parents=True, exist_ok=True)
-    biaxial_test(sim, path, strain=target, velocity=velocity, every=every, wall_mass=wall_mass, near_contacts=True,
-                 attrs=attrs, progress=progress)
+    with one_line_on_unconverged(path):
+        biaxial_test(sim, path, strain=target, velocity=velocity, every=every, wall_mass=wall_mass,
+                     near_contacts=True, attrs=attrs, progress=progress)
     return "started"
+
+
+@contextmanager
+def one_line_on_unconverged(path, taken="the steps taken now"):
+    """The steps whose contact solver stopped at its cap, said in one line at the end (or when
+    stopped) from the file's records, as ``grainview study`` does, instead of a warning each;
+    other warnings shown as they come."""
+    from grainview.app.simulation import reissue, resumed_unconverged_warning
+    from grainview.contract.errors import ConvergenceWarning
+
+    try:
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            yield
+    finally:  # outside the recording: the warnings shown again are not recorded again
+        reissue(caught)
+        unconverged = sum(issubclass(w.category, ConvergenceWarning) for w in caught)
+        if unconverged and path.exists():
+            print(f"{path.stem}: warning: {resumed_unconverged_warning(path, unconverged, taken)}", file=sys.stderr)
 
 
 def scene_of(path) -> str:

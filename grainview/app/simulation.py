@@ -131,11 +131,12 @@ def reissue(caught):
             warnings.warn_explicit(w.message, w.category, w.filename, w.lineno)
 
 
-def resumed_unconverged_warning(path, unconverged) -> str:
+def resumed_unconverged_warning(path, unconverged, taken="the resumed test's steps") -> str:
     """What the warning on a resumed test's unconverged steps says: how many of the steps taken
     now stopped at their contact solver's iteration cap or stall test, and, from the written
     file, how many of the whole test's did and how far their impulses were from a solution
-    (grainview.app.convergence), in the words of :func:`unconverged_warning`."""
+    (grainview.app.convergence), in the words of :func:`unconverged_warning`; ``taken`` names the
+    steps taken now."""
     import netCDF4
 
     from .convergence import norms_phrase, residual_comparison, stop_rule, tolerances, unconverged_in_file
@@ -143,9 +144,9 @@ def resumed_unconverged_warning(path, unconverged) -> str:
     with netCDF4.Dataset(path) as nc:
         counts = unconverged_in_file(nc.variables, {k: nc.getncattr(k) for k in nc.ncattrs()})
     if counts is None:  # another engine's file
-        return f"the contact solver did not converge in {unconverged} step(s) of the resumed test"
+        return f"the contact solver did not converge in {unconverged} of {taken}"
     whole = f"; in the whole test {counts['steps']} of its {counts['of']} ({residual_comparison(counts)})"
-    return (f"the contact solver ({counts['solver']}) did not converge in {unconverged} of the resumed test's steps"
+    return (f"the contact solver ({counts['solver']}) did not converge in {unconverged} of {taken}"
             f"{whole}. They stopped at {stop_rule(counts)} before {norms_phrase(counts)} ({tolerances(counts)}). "
             f"{path} records the test's per snapshot (nlgs_unconverged_steps), and its report states them")
 

@@ -102,3 +102,19 @@ def test_a_compacted_sample_sheared_is_the_study_file_again(study, tmp_path, cap
     with netCDF4.Dataset(out / "pentagons.nc") as nc:
         assert nc.getncattr("resheared_from") == str(samples / "pentagons.nc")
         assert "resheared_from_velocity_m_s" not in nc.ncattrs()
+
+
+def test_unconverged_steps_are_said_in_one_line_and_other_warnings_shown(study, capsys):
+    import warnings
+
+    from grainview.contract.errors import ConvergenceWarning
+
+    reshear = load_benchmark("fidelity.reshear")
+    with pytest.warns(UserWarning, match="something else"):
+        with reshear.one_line_on_unconverged(study / "pentagons.nc"):
+            for _ in range(3):
+                warnings.warn("did not converge", ConvergenceWarning)
+            warnings.warn("something else", UserWarning)
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and err[0].startswith("pentagons: warning: the contact solver")
+    assert "did not converge in 3 of the steps taken now" in err[0]
