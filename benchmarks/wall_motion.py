@@ -31,6 +31,7 @@ from __future__ import annotations
 
 import argparse
 import os
+import re
 import sys
 
 import numpy as np
@@ -107,28 +108,33 @@ def wall_motion(path, window=0.4) -> dict:
             "wall": wall, "sxx": sxx}
 
 
-HEADER = ("| sample | N | v (cm/s) | M / sample | t_w (ms, steps) | snapshots | sigma_xx < sigma0/2 | wall < sigma0/2 "
-          "| u 10-90% (of v) | u above its median when wall < 1/2 | p thirds max/min: median, 90%, median when sigma_xx < 1/2 |")
+HEADER = ["sample", "N", "v (cm/s)", "M / sample", "t_w (ms, steps)", "snapshots", "sigma_xx < sigma0/2",
+          "wall < sigma0/2", "u 10-90% (of v)", "u above its median when wall < 1/2",
+          "p thirds max/min: median, 90%, median when sigma_xx < 1/2"]
 
 
-def row(label, r) -> str:
+def row(label, r) -> list:
+    """The table's cells (:data:`HEADER`) for the numbers ``r`` of :func:`wall_motion`."""
     out = "-" if np.isnan(r["out|low"]) else f"{100 * r['out|low']:.0f}%"
-    return (f"| {label} | {r['particles']} | {100 * r['velocity']:.2g} | {r['mass ratio']:.3g} | "
-            f"{1e3 * r['t_w']:.0f}, {r['t_w'] / r['time step']:.0f} | {r['snapshots']} | {100 * r['sxx<1/2']:.0f}% | {100 * r['wall<1/2']:.0f}% | "
-            f"{r['u10']:+.2f} .. {r['u90']:+.2f} | "
-            f"{out} | "
-            f"{r['thirds50']:.2f}, {r['thirds90']:.2f}, {r['thirds|low']:.2f} |")
+    return [label, r["particles"], f"{100 * r['velocity']:.2g}", f"{r['mass ratio']:.3g}",
+            f"{1e3 * r['t_w']:.0f}, {r['t_w'] / r['time step']:.0f}", r["snapshots"], f"{100 * r['sxx<1/2']:.0f}%",
+            f"{100 * r['wall<1/2']:.0f}%", f"{r['u10']:+.2f} .. {r['u90']:+.2f}", out,
+            f"{r['thirds50']:.2f}, {r['thirds90']:.2f}, {r['thirds|low']:.2f}"]
+
+
+RUN_NAME = re.compile(r"(pentagon|disk)_(\d+)_\w+?_s(\d+)_v")
+"""A walled test's file name in the fidelity study's runs folder: shape, N, seed
+(``pentagon_1000_paper_s0_v1.6cm_e0.2.nc``; a periodic shear's ``..._s0_shear_v...`` does not match)."""
 
 
 def walled_files(folder) -> list[str]:
-    """The walled biaxial tests of the fidelity study's runs folder (``<shape>_<N>_<preparation>_s<seed>_v..._e...nc``),
-    pentagons before disks, then by size and seed."""
+    """The walled biaxial tests of the fidelity study's runs folder (:data:`RUN_NAME`), pentagons
+    before disks, then by size and seed."""
     import glob
-    import re
 
     found = []
     for path in glob.glob(os.path.join(folder, "*_e*.nc")):
-        match = re.match(r"(pentagon|disk)_(\d+)_\w+?_s(\d+)_v", os.path.basename(path))
+        match = RUN_NAME.match(os.path.basename(path))
         if match:
             found.append(((match[1] != "pentagon", int(match[2]), int(match[3])), path))
     return [path for _, path in sorted(found)]
@@ -136,10 +142,8 @@ def walled_files(folder) -> list[str]:
 
 def label_of(path) -> str:
     """``pentagons s0`` for ``pentagon_1000_paper_s0_v1.6cm_e0.2.nc``; the file's name otherwise."""
-    import re
-
-    match = re.match(r"(pentagon|disk)_\d+_\w+?_s(\d+)_v", os.path.basename(path))
-    return f"{match[1]}s s{match[2]}" if match else os.path.basename(path)
+    match = RUN_NAME.match(os.path.basename(path))
+    return f"{match[1]}s s{match[3]}" if match else os.path.basename(path)
 
 
 def quick_files(folder) -> list[str]:
@@ -163,7 +167,7 @@ def quick_files(folder) -> list[str]:
 def main(argv=None) -> int:
     import tempfile
 
-    from benchmarks.common import print_or_write
+    from benchmarks.common import markdown_table, print_or_write
     from grainview.contract.errors import GrainviewError
     from benchmarks.fidelity.runs import CACHE
 
@@ -193,7 +197,7 @@ def main(argv=None) -> int:
             rows = [row(label, wall_motion(path, args.window)) for label, path in zip(labels, files)]
         except (ValueError, GrainviewError) as exc:  # not a walled test, an empty window, an unreadable file
             parser.error(str(exc))
-    table = "\n".join([HEADER, "|" + "---|" * (HEADER.count(" | ") + 1), *rows])
+    table = markdown_table(HEADER, rows)
     source = (f"the files {', '.join(os.path.basename(f) for f in files)}" if args.files else
               f"the fidelity study's ({args.runs})")
     intro = (f"Walled biaxial tests, {source}, at their own speeds and wall masses; snapshots with eps_q >= "

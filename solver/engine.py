@@ -165,8 +165,8 @@ class ContactDynamics:
         from .scenes import biaxial_test
 
         return biaxial_test(sample, path, strain=test.strain, velocity=test.velocity, every=int(test.every),
-                            wall_mass=test.wall_mass, overwrite=overwrite, attrs=attrs, progress=progress, near_contacts=near_contacts,
-                            compress=compress)
+                            wall_mass=test.wall_mass, overwrite=overwrite, attrs=attrs, progress=progress,
+                            near_contacts=near_contacts, compress=compress)
 
     def write_state(self, sample, path, *, attrs=None, near_contacts=False, overwrite=False, compress=True):
         from .output import Recorder

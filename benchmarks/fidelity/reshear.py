@@ -73,25 +73,27 @@ def reshear(source: Path, out: Path, label: str, *, velocity: float, every: int,
             resume(path, progress=progress)
         return "resumed"
     original = source / f"{label}.nc"
-    import netCDF4
-
     from grainview.app.study import compacted_state
+    from grainview.contract.reader import ContractFile
     from solver.engine import BiaxialTest
 
-    compacted = original.exists() and scene_of(original) == "isotropic"
+    settings = {}
+    if original.exists():
+        with ContractFile(original) as ds:
+            settings = dict(ds.attrs)
+    compacted = settings.get("scene") == "isotropic"
     if (compacted_state(original) if compacted else file_state(original)) != "finished":
         raise ParameterError(f"{original} is neither a finished test nor a compacted sample; expected a study's "
                              "complete file (grainview study, scene biaxial or isotropic)")
     sim = load_sample(original, 0)
     if domains is not None:
         sim.set_parameters(domains=domains)
-    with netCDF4.Dataset(original) as ds:
-        attrs = {"resheared_from": str(original)}
-        if compacted:
-            target = BiaxialTest.strain if strain is None else strain
-        else:
-            target = float(ds.getncattr("strain_target")) if strain is None else strain
-            attrs["resheared_from_velocity_m_s"] = float(ds.getncattr("wall_velocity_m_s"))
+    attrs = {"resheared_from": str(original)}
+    if compacted:
+        target = BiaxialTest.strain if strain is None else strain
+    else:
+        target = float(settings["strain_target"]) if strain is None else strain
+        attrs["resheared_from_velocity_m_s"] = float(settings["wall_velocity_m_s"])
     out.mkdir(parents=True, exist_ok=True)
     with one_line_on_unconverged(path):
         biaxial_test(sim, path, strain=target, velocity=velocity, every=every, wall_mass=wall_mass,
@@ -116,14 +118,6 @@ def one_line_on_unconverged(path, taken="the steps taken now"):
         unconverged = sum(issubclass(w.category, ConvergenceWarning) for w in caught)
         if unconverged and path.exists():
             print(f"{path.stem}: warning: {resumed_unconverged_warning(path, unconverged, taken)}", file=sys.stderr)
-
-
-def scene_of(path) -> str:
-    """The ``scene`` attribute of the solver's file ``path`` ("" when it has none)."""
-    import netCDF4
-
-    with netCDF4.Dataset(path) as ds:
-        return str(getattr(ds, "scene", ""))
 
 
 def main(argv=None) -> int:

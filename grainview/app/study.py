@@ -126,11 +126,9 @@ def study_sample(label, prep, path, state, checkpoint, *, test, near_contacts, o
     from solver.engine import engine as engine_named
 
     runner = engine_named(engine or DEFAULT_ENGINE)
-    if state == "finished" and scene == "isotropic":
-        print(f"{label}: {path} is complete (skipped)", flush=True)
-        return path
     if state == "finished":
-        runner.resume(path, progress=progress, compress=compress)
+        if scene != "isotropic":  # a compacted sample has no test to compress
+            runner.resume(path, progress=progress, compress=compress)
         print(f"{label}: {path} is complete (skipped)", flush=True)
         return path
     if state == "partial":
