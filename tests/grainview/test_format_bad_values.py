@@ -508,35 +508,44 @@ def test_the_limits_follow_the_sample():
 
 # --- interrupted conversions --------------------------------------------------------------------
 
-def _long_lammps(tmp_path):
-    """The LAMMPS fixtures repeated 60 times (240 snapshots, later steps), for a conversion that
-    lasts a few seconds even on a fast machine."""
-    def repeat(text):
-        snapshots = text.split("ITEM: TIMESTEP\n")[1:]
-        out = []
-        for copy in range(60):
-            for snap in snapshots:
-                step, rest = snap.split("\n", 1)
-                out.append(f"ITEM: TIMESTEP\n{int(step) + copy * 80000}\n{rest}")
-        return "".join(out)
+# The conversion, run through the command line in another process, holds still in the middle of
+# its snapshots (after writing two, before checking the third): it touches ``paused`` and sleeps,
+# so that the signal reaches it there whatever the machine's speed or load.
+_PAUSED_CONVERSION = """
+import sys, time
+from pathlib import Path
+import grainview.formats.convert as convert
+from grainview.app.cli import main
 
-    return _lammps(tmp_path, "long", particles=repeat, contacts=repeat, walls=repeat)
+paused, checked, count = Path(sys.argv[1]), convert.check_snapshot, [0]
+
+def check_snapshot(*args, **kwargs):
+    if count[0] == 2:
+        paused.touch()
+        time.sleep(120)
+    count[0] += 1
+    return checked(*args, **kwargs)
+
+convert.check_snapshot = check_snapshot
+sys.exit(main(sys.argv[2:]))
+"""
 
 
 def _hidden(folder):
     return sorted(p.name for p in Path(folder).iterdir() if p.name.startswith("."))
 
 
-def _start_and_stop(command, folder, signum):
-    """Start ``command``, send ``signum`` once its temporary file exists; return the process,
-    ended."""
+def _start_and_stop(argv, paused, signum):
+    """Start ``grainview ARGV`` (a conversion) held in the middle of its snapshots, send
+    ``signum`` once it is held there; return the process, ended."""
+    command = [sys.executable, "-c", _PAUSED_CONVERSION, str(paused), *map(str, argv)]
     process = subprocess.Popen(command, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
     deadline = time.monotonic() + 120
-    while not any(name.endswith(".lammps") for name in _hidden(folder)):
+    while not paused.exists():
         assert process.poll() is None, process.communicate()
         assert time.monotonic() < deadline
-        time.sleep(0.005)
-    process.send_signal(signum)  # at once: on a loaded machine a pause could outlast the conversion
+        time.sleep(0.01)
+    process.send_signal(signum)
     process.stdout_text, process.stderr_text = process.communicate(timeout=120)
     return process
 
@@ -546,22 +555,23 @@ def test_an_interrupted_conversion_leaves_nothing(tmp_path, signum):
     """SIGTERM is handled as Ctrl-C: the temporary files are removed before the process ends
     (exit 143). SIGKILL cannot be handled: the next conversion to the same file removes what
     the killed one left, and writes the file."""
-    files = _long_lammps(tmp_path)
+    files = _lammps(tmp_path, "run")
     out_folder = tmp_path / "out"
     out_folder.mkdir()
     out = out_folder / "run.nc"
-    command = [sys.executable, "-m", "grainview", *map(str, _lammps_argv(files, out))]
-    process = _start_and_stop(command, out_folder, signum)
+    argv = _lammps_argv(files, out)
+    process = _start_and_stop(argv, tmp_path / "paused", signum)
     if signum == signal.SIGTERM:
         assert process.returncode == 143, process.stderr_text
         assert process.stderr_text.strip() == "grainview: terminated (SIGTERM)"
         assert _hidden(out_folder) == [] and not out.exists()
     else:
         assert process.returncode == -signal.SIGKILL
-        assert any(name.startswith(".run.nc.") for name in _hidden(out_folder))  # what a kill leaves
-    done = subprocess.run(command, capture_output=True, text=True)
+        assert [name for name in _hidden(out_folder) if name.startswith(".run.nc.")]  # what a kill leaves
+    done = subprocess.run([sys.executable, "-m", "grainview", *map(str, argv)], capture_output=True, text=True)
     assert done.returncode == 0, done.stderr
     assert _hidden(out_folder) == [] and out.exists()
+    assert xr.open_dataset(out).sizes["time"] == 4  # the fixture's snapshots, all of them
 
 
 def test_only_dead_processes_temporary_files_are_removed(tmp_path):
