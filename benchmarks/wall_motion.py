@@ -164,6 +164,13 @@ def quick_files(folder) -> list[str]:
     return paths
 
 
+def _short_names(files) -> list:
+    """Each file's name, with its folder's where two files share a name."""
+    names = [os.path.basename(f) for f in files]
+    return [os.path.join(os.path.basename(os.path.dirname(os.path.abspath(f))), name) if names.count(name) > 1
+            else name for f, name in zip(files, names)]
+
+
 def main(argv=None) -> int:
     import tempfile
 
@@ -198,7 +205,7 @@ def main(argv=None) -> int:
         except (ValueError, GrainviewError) as exc:  # not a walled test, an empty window, an unreadable file
             parser.error(str(exc))
     table = markdown_table(HEADER, rows)
-    source = (f"the files {', '.join(os.path.basename(f) for f in files)}" if args.files else
+    source = (f"the files {', '.join(_short_names(files))}" if args.files else
               f"the fidelity study's ({args.runs})")
     intro = (f"Walled biaxial tests, {source}, at their own speeds and wall masses; snapshots with eps_q >= "
              f"{args.window:g}; what each column is: the module's docstring.")
