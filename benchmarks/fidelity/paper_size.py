@@ -5,8 +5,10 @@ docs/fidelity.md sections 4, 7 and 8 at 14,400 pentagons and 10,000 disks.
     grainview study --out study                                              # the 400-particle study (minutes)
     python -m benchmarks.fidelity.paper_size paper_size --reference study    # this page
 
-Reads ``FOLDER/pentagons.nc`` and ``FOLDER/disks.nc`` of each study and writes
-``benchmarks/fidelity/paper-size.md`` and the figure ``fidelity_paper_size.png`` beside it:
+Reads ``FOLDER/pentagons.nc`` and ``FOLDER/disks.nc`` of each study (or, for a test carried over
+sittings, ``python -m benchmarks.fidelity.carry``, the per-snapshot measures kept beside them:
+``FOLDER/<label>.measures.nc``) and writes ``benchmarks/fidelity/paper-size.md`` and the figure
+``fidelity_paper_size.png`` beside it:
 
 * the size-series rows (the ``sizes`` section of ``python -m benchmarks.fidelity``): window
   means over eps_q 0.3-0.4 and eps_q >= 0.4 of q/p, its two boundary-free checks (the core's
@@ -40,33 +42,46 @@ WINDOWS = ((0.3, 0.4), RESIDUAL)
 """The shear-strain windows of the size-series rows."""
 
 
-def run_facts(path) -> dict:
+def study_measures(folder, file) -> dict | None:
+    """The per-snapshot measures (:func:`benchmarks.fidelity.measure.snapshot_measures`) of one
+    run of a study folder in both counting conventions, {"force-bearing": ..., "near": ...}:
+    the carried ones where the folder holds ``<label>.measures.nc`` (a run carried over
+    sittings, :mod:`benchmarks.fidelity.carry`), else measured from the run's file; None when
+    the folder has neither."""
+    from benchmarks.fidelity import carry
+
+    label = os.path.splitext(file)[0]
+    if os.path.isfile(carry.measures_path(folder, label)):
+        return {how: carry.load_measures(folder, label, how) for how in carry.COUNTINGS}
+    path = os.path.join(folder, file)
+    if not os.path.isfile(path):
+        return None
+    return {"force-bearing": measure.snapshot_measures(path), "near": measure.snapshot_measures(path, RELATION_NEAR * D_MIN)}
+
+
+def run_facts(m) -> dict:
     """Particles, steps, the last eps_q, the median inertia number and the mean stress p (Pa)
     over eps_q >= 0.3 (median, 10th percentile, least and largest: how steady the test's stress
-    level is) of a test's file."""
-    import grainview
-
-    with grainview.open_dataset(path, chunks=None) as ds:
-        eps_q = ds.grain.strains()["eps_q"].values
-        inertia = float(ds.grain.inertia_number().median())
-        p = ds.grain.stress_invariants()["p"].values[eps_q >= 0.3]
-        levels = np.percentile(p, [50, 10, 0, 100]) if p.size else np.full(4, np.nan)
-        steps = int(ds["step"].values[-1] - ds["step"].values[0]) if "step" in ds else -1
-        return {"particles": int(ds.sizes["particle"]), "snapshots": int(ds.sizes["time"]), "steps": steps,
-                "eps_q max": float(eps_q.max()), "inertia": inertia,
-                "velocity": float(ds.attrs.get("wall_velocity_m_s", np.nan)),
-                "compaction steps": int(ds.attrs.get("compaction_steps", -1)), "p levels": levels}
+    level is) of a test's measures."""
+    eps_q = m["eps_q"].values
+    p = m["p"].values[eps_q >= 0.3]
+    levels = np.percentile(p, [50, 10, 0, 100]) if p.size else np.full(4, np.nan)
+    step = m["step"].values
+    return {"particles": int(m.attrs["particles"]), "snapshots": int(m.sizes["time"]),
+            "steps": int(step[-1] - step[0]) if step[0] >= 0 else -1, "eps_q max": float(m.attrs["eps_q_max"]),
+            "inertia": float(np.median(m["inertia_number"].values)), "velocity": float(m.attrs["velocity"]),
+            "compaction steps": int(m.attrs["compaction_steps"]), "p levels": levels}
 
 
-def size_rows(label, path) -> list:
-    """The size-series rows of one file (module docstring), one per window."""
+def size_rows(label, m) -> list:
+    """The size-series rows of one test's measures (module docstring), one per window."""
     rows = []
     for window in WINDOWS:
-        s = measure.window_means(path, window)
+        s = measure.window_means(m, window)
         if not s["snapshots"]:
             rows.append([label, _window(window), 0] + ["-"] * 12)
             continue
-        checks = measure.boundary_checks(path, window)
+        checks = measure.boundary_checks(m, window)
         rows.append([label, _window(window), s["snapshots"], _f(s["q/p"]), _f(checks["q/p central"]),
                      checks["central particles"], _f(checks["q/p walls"]), _f(s["prediction"]),
                      _f(s["prediction cross"]), _f(s["a"], 2), _f(s["a_n"], 2), _f(s["a_t"], 2), _f(s["z"], 2),
@@ -74,12 +89,12 @@ def size_rows(label, path) -> list:
     return rows
 
 
-def residual_states(path) -> dict:
+def residual_states(measures) -> dict:
     """The residual-window summaries (:func:`benchmarks.fidelity.measure.window_means`) of one
-    file, force-bearing and with near pairs counted: {"force-bearing": ..., "near": ...}."""
-    counted = {"force-bearing": measure.window_means(path, RESIDUAL),
-               "near": measure.window_means(path, RESIDUAL, RELATION_NEAR * D_MIN)}
-    initial = measure.initial_state(path)["solid fraction"]  # the test's first snapshot: the compacted sample
+    test's measures (:func:`study_measures`), force-bearing and with near pairs counted:
+    {"force-bearing": ..., "near": ...}."""
+    counted = {how: measure.window_means(m, RESIDUAL) for how, m in measures.items()}
+    initial = float(measures["force-bearing"]["solid_fraction"].values[0])  # the test's start: the compacted sample
     for summary in counted.values():
         summary["solid fraction initial"] = initial
     return counted
@@ -101,24 +116,30 @@ def main(argv=None):
     studies = {"paper size": args.folder}
     if args.reference:
         studies = {"400": args.reference, **studies}
-    present = {(name, shape): os.path.join(folder, file) for name, folder in studies.items()
-               for shape, file in SAMPLES.items() if os.path.isfile(os.path.join(folder, file))}
-    if not present:
-        raise SystemExit(f"{args.folder}: no {' or '.join(SAMPLES.values())} (expected a study's output folder)")
-    missing = [f"{name} {shape}s" for name in studies for shape in SAMPLES if (name, shape) not in present]
     start = time.perf_counter()
+    present = {}
+    for name, folder in studies.items():
+        for shape, file in SAMPLES.items():
+            measured = study_measures(folder, file)
+            if measured is not None:
+                present[(name, shape)] = measured
+    if not present:
+        raise SystemExit(f"{args.folder}: no {' or '.join(SAMPLES.values())} and no carried measures of them "
+                         "(expected a study's output folder, or a carry folder)")
+    missing = [f"{name} {shape}s" for name in studies for shape in SAMPLES if (name, shape) not in present]
     facts, sizes, states, curves = [], [], {}, []
-    for (name, shape), path in present.items():
-        f = run_facts(path)
+    for (name, shape), measured in present.items():
+        m = measured["force-bearing"]
+        f = run_facts(m)
         label = f"{shape}s {f['particles']}"
         print(f"{label}: {f['snapshots']} snapshots, eps_q up to {f['eps_q max']:.3f} ...", flush=True)
         median, tenth, least, largest = f["p levels"] / 1e3
         facts.append([label, f["compaction steps"], f["steps"], f["snapshots"], f"{f['velocity'] * 100:g}",
                       f"{f['inertia']:.1e}", _f(f["eps_q max"]),
                       f"{median:.1f}, {tenth:.1f}, {least:.1f}-{largest:.1f}"])
-        sizes += size_rows(label, path)
-        states[(name, shape)] = residual_states(path)
-        curves.append((f"{shape}s, N = {f['particles']}", shape, measure.strain_series(path)))
+        sizes += size_rows(label, m)
+        states[(name, shape)] = residual_states(measured)
+        curves.append((f"{shape}s, N = {f['particles']}", shape, measure.strain_series(m)))
     state_rows = []
     for (name, shape), counted in states.items():
         for how, s in counted.items():

@@ -20,7 +20,7 @@ from .snapshots import select_snapshots
 from ..contract.errors import ParameterError
 from ._docs import fill_doc
 
-__all__ = ["force_pdf", "pooled_force_pdf", "strong_force_exponent", "strong_force_prefactor", "counting_error"]
+__all__ = ["force_pdf", "pooled_force_pdf", "pool_force_pdf", "strong_force_exponent", "strong_force_prefactor", "counting_error"]
 
 SCALES = ("log", "linear")
 DEFAULT_RANGE = {"linear": (0.0, 10.0), "log": (1e-4, 10.0)}
@@ -179,6 +179,34 @@ def pooled_force_pdf(ds: xr.Dataset, bins: int = 50, scale: str = "log", range=N
     counts, n_selected, n_zero, edges, scale = _histogram(ds, bins, scale, range, kind, walls, near)
     return _pdf_dataset(counts.sum("time"), n_selected.sum("time"), n_zero.sum("time"), edges, scale,
                         {"kind": str(kind), "walls": int(walls), "pooled_snapshots": int(ds.sizes["time"])})
+
+
+def pool_force_pdf(pdf: xr.Dataset) -> xr.Dataset:
+    """The pooled pdf of a per-snapshot :func:`force_pdf` result (dims time, bin): the counts
+    of every snapshot summed and the density taken from the sums, as :func:`pooled_force_pdf`
+    does from the contacts. It lets a pdf be pooled from per-snapshot counts kept on their own
+    (a run's measures, one session at a time), without the contacts.
+
+    Parameters
+    ----------
+    pdf : xarray.Dataset
+        ``count`` (time, bin), ``n_contacts`` and ``zero_fraction`` (time), the coordinate
+        ``bin_edges`` and the attribute ``scale`` of :func:`force_pdf`; other variables are
+        ignored.
+
+    Returns
+    -------
+    xarray.Dataset
+        As :func:`pooled_force_pdf`.
+    """
+    missing = [name for name in ("count", "n_contacts", "zero_fraction", "bin_edges") if name not in pdf]
+    if missing or "time" not in pdf["count"].dims or "scale" not in pdf.attrs:
+        raise ParameterError(f"pdf lacks {missing or 'time or its scale'}: expected a per-snapshot result of force_pdf")
+    n = pdf["n_contacts"]
+    n_zero = (pdf["zero_fraction"].fillna(0.0) * n).round().astype(np.int64)
+    attrs = {k: v for k, v in pdf.attrs.items() if k in ("kind", "walls")}
+    return _pdf_dataset(pdf["count"].sum("time"), n.sum("time"), n_zero.sum("time"), pdf["bin_edges"].values,
+                        pdf.attrs["scale"], {**attrs, "pooled_snapshots": int(pdf.sizes["time"])})
 
 
 def strong_force_exponent(pdf: xr.Dataset, low: float = 1.0, high: float = np.inf) -> xr.DataArray:

@@ -198,19 +198,21 @@ def is_compressed(path) -> bool:
         return fh.read(8) == b"\x89HDF\r\n\x1a\n"
 
 
-def _convert(path, fmt, complevel=None, lock=None) -> None:
+def _convert(path, fmt, complevel=None, lock=None, target=None, snapshots=None) -> None:
     """Rewrite ``path`` in format ``fmt`` (deflated at ``complevel`` when given), holding the
     writer's lock (``lock``, or one taken here): written under a temporary name, synced, and
-    renamed over ``path`` once complete, the folder synced after, so a failure or a kill at any
-    moment leaves the original file as it was (a kill leaves the temporary file, which the next
-    process that takes the lock removes). Variables, dimensions (the unlimited ``time`` too),
-    values, fill values and attributes are copied as they are, in the file's order; no value
-    passes through a float conversion. An I/O failure (a full disk, a file-size limit) raises
+    renamed over ``path`` (or onto ``target``) once complete, the folder synced after, so a
+    failure or a kill at any moment leaves the original file as it was (a kill leaves the
+    temporary file, which the next process that takes the lock removes). Variables, dimensions
+    (the unlimited ``time`` too), values, fill values and attributes are copied as they are, in
+    the file's order; no value passes through a float conversion. ``snapshots``: the indices
+    along ``time`` kept (default all). An I/O failure (a full disk, a file-size limit) raises
     :class:`OutputError` in one line."""
     import netCDF4
 
     path = os.fspath(path)
-    directory, base = os.path.split(os.path.abspath(path))
+    destination = path if target is None else os.fspath(target)
+    directory, base = os.path.split(os.path.abspath(destination))
     temporary = os.path.join(directory, f".{base}.{os.getpid()}.convert")
     own = lock is None
     if own:
@@ -256,6 +258,12 @@ def _convert(path, fmt, complevel=None, lock=None) -> None:
             for side in (var, out):
                 if side.chunking() not in (None, "contiguous"):
                     side.set_var_chunk_cache(size=0)
+            if per_snapshot and snapshots is not None:  # a few snapshots: one block
+                if columns is None:
+                    out[: len(snapshots)] = var[snapshots]
+                else:
+                    _write_occupied(out, 0, var[snapshots], columns, fill)
+                continue
             source_rows = var.chunking()[0] if var.chunking() not in (None, "contiguous") else 1
             for block in copy_blocks(var.shape[0], row_bytes, max(rows_per_chunk, source_rows)):
                 if columns is None:
@@ -265,7 +273,7 @@ def _convert(path, fmt, complevel=None, lock=None) -> None:
         dst.setncatts({k: src.getncattr(k) for k in src.ncattrs()})
         dst.close()
         src.close()
-        _move_into_place(temporary, path, overwrite=True)
+        _move_into_place(temporary, destination, overwrite=True)
     except BaseException as exc:
         for nc in (dst, src):
             if nc is not None:
@@ -464,6 +472,45 @@ def compress_file(path, complevel: int = DEFAULT_COMPLEVEL, lock=None) -> None:
     finally:
         if own:
             lock.release()
+
+
+def copy_snapshots(path, target, snapshots, complevel: int = DEFAULT_COMPLEVEL) -> int:
+    """Write to ``target`` a compressed copy of the contract file ``path`` that holds only the
+    complete snapshots ``snapshots`` (indices among them, negative from the end; e.g. ``[0, -1]``,
+    what a run needs to go on from its last snapshot, :mod:`solver.restart`), every value as it
+    is; ``path`` is only read. Layout and compression as :func:`compress_file`; ``target`` is
+    replaced atomically when it exists. Returns the number of snapshots copied.
+
+    Raises
+    ------
+    grainview.contract.errors.ParameterError
+        An index outside the file's complete snapshots, or ``target`` naming ``path``.
+    grainview.contract.locks.FileLockedError
+        Another process is writing ``path`` (stop the run first).
+    OutputError
+        The copy failed; ``target`` is as it was.
+    """
+    import netCDF4
+
+    complevel = check_complevel(complevel)
+    if os.path.abspath(os.fspath(path)) == os.path.abspath(os.fspath(target)):
+        raise ParameterError(f"{target}: the copy would replace its source; give another target")
+    lock = lock_file(path)
+    try:
+        with netCDF4.Dataset(os.fspath(path)) as nc:
+            nc.set_auto_mask(False)
+            complete = np.flatnonzero(complete_snapshots(nc.variables))
+        chosen = []
+        for index in snapshots:
+            if not -complete.size <= int(index) < complete.size:
+                raise ParameterError(f"{path}: snapshot {index} does not exist (the file holds "
+                                     f"{complete.size} complete snapshots)")
+            chosen.append(int(complete[int(index)]))
+        chosen = sorted(set(chosen))
+        _convert(path, COMPRESSED_FORMAT, complevel, lock=lock, target=target, snapshots=chosen)
+        return len(chosen)
+    finally:
+        lock.release()
 
 
 def decompress_file(path, lock=None) -> None:

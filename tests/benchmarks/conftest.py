@@ -4,6 +4,8 @@ imports a current benchmark as ``benchmarks.<name>`` and an archived study as
 
 import importlib
 
+import netCDF4
+import numpy as np
 import pytest
 
 
@@ -42,3 +44,11 @@ def pentagon_sample(tmp_path_factory):
     path = str(tmp_path_factory.mktemp("samples") / "pentagons.pkl")
     load_benchmark("compaction").compact("pentagon", 60, 0, "fast", acceleration="anderson", save=path)
     return path
+
+
+def stored_values(path, name):
+    """Variable ``name`` of the netCDF file ``path`` as stored, masked slots filled (NaN for
+    floats, -1 otherwise), for bit-for-bit comparisons of two files."""
+    with netCDF4.Dataset(path) as nc:
+        values = nc[name][:]
+    return np.ma.filled(values, np.nan) if values.dtype.kind == "f" else np.ma.filled(values, -1)

@@ -19,7 +19,7 @@ from grainview.contract.errors import ParameterError
 from solver.parameters import BiaxialTest
 from solver.preparation import preparation
 
-from .conftest import load_benchmark
+from .conftest import load_benchmark, stored_values as _values
 
 VARIABLES = ("position", "angle", "velocity", "fn", "ft", "normal_impulse", "wall_position", "wall_force", "step")
 
@@ -32,12 +32,6 @@ def study(tmp_path_factory):
     _simulate(prep, folder / "pentagons.nc", test=BiaxialTest(strain=0.004, every=10, velocity=0.01),
               near_contacts=True, overwrite=False, progress=False, parameters={})
     return folder
-
-
-def _values(path, name):
-    with netCDF4.Dataset(path) as nc:
-        values = nc[name][:]
-    return np.ma.filled(values, np.nan) if values.dtype.kind == "f" else np.ma.filled(values, -1)
 
 
 def test_resheared_at_the_same_speed_is_the_study_file_again(study, tmp_path):

@@ -259,3 +259,28 @@ def test_pooled_pdf_over_chosen_snapshots_through_the_accessor(prepare):
         want["f_over_mean"].values, want["pdf"].values, want["count"].values,
         float(strong_force_exponent(want)), 1.0, np.inf), rel=1e-10)
     np.testing.assert_allclose(error.values, counting_error(want).values, rtol=RTOL)
+
+
+@pytest.mark.parametrize("scale", ["linear", "log"])
+def test_pooling_per_snapshot_pdfs_is_the_pooled_pdf(scale):
+    """Two computations: the per-snapshot histograms summed (pool_force_pdf) and the contacts
+    of every snapshot histogrammed at once (pooled_force_pdf)."""
+    from grainview.analysis.force_pdf import pool_force_pdf
+
+    ds = builders.mixed_contacts(seed=7, t=5)
+    kwargs = dict(bins=8, scale=scale, range=(0.0, 3.0) if scale == "linear" else (0.05, 5.0))
+    pooled = pooled_force_pdf(ds, **kwargs).compute()
+    from_snapshots = pool_force_pdf(force_pdf(ds, **kwargs).compute())
+    for name in ("pdf", "count", "n_contacts", "zero_fraction", "outside_fraction"):
+        np.testing.assert_array_equal(from_snapshots[name].values, pooled[name].values, err_msg=name)
+    assert from_snapshots.attrs["pooled_snapshots"] == 5
+    assert 0 < float(pooled["outside_fraction"]) < 1  # the range cuts some contacts off: counted the same
+    assert float(strong_force_exponent(from_snapshots)) == float(strong_force_exponent(pooled))
+
+
+def test_pooling_needs_a_per_snapshot_pdf():
+    from grainview.analysis.force_pdf import pool_force_pdf
+
+    pooled = pooled_force_pdf(builders.mixed_contacts(seed=7, t=2), bins=4, scale="linear")
+    with pytest.raises(ParameterError, match="per-snapshot result of force_pdf"):
+        pool_force_pdf(pooled)

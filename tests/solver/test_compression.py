@@ -16,7 +16,7 @@ import xarray as xr
 import grainview
 from grainview.contract.errors import ParameterError
 from grainview.contract.locks import FileLockedError
-from grainview.contract.writer import SnapshotWriter, compress_file, decompress_file, is_compressed
+from grainview.contract.writer import SnapshotWriter, compress_file, copy_snapshots, decompress_file, is_compressed
 from solver import compaction_sample, isotropic_compaction
 from solver.output import Recorder
 
@@ -117,6 +117,44 @@ def test_a_file_being_written_is_not_converted(run_file, tmp_path):
         with pytest.raises(FileLockedError, match="being written"):
             compress_file(path)
     assert path.read_bytes() == run_file.read_bytes()
+
+
+@pytest.mark.parametrize("packed", [False, True])
+def test_a_copy_of_chosen_snapshots_holds_them_bit_for_bit(run_file, tmp_path, packed):
+    """copy_snapshots against the whole file: each kept snapshot's every variable equal, the
+    snapshot-free variables and attributes as they were, the source untouched, the copy
+    compressed and, decompressed, a file the solver appends to."""
+    source = tmp_path / "run.nc"
+    source.write_bytes(run_file.read_bytes())
+    if packed:
+        compress_file(source)
+    before = source.read_bytes()
+    copy = tmp_path / "copy.nc"
+    assert copy_snapshots(source, copy, [0, 7, -1, 7]) == 3  # duplicates once, in the file's order
+    assert source.read_bytes() == before and is_compressed(copy)
+    whole, attrs, _ = _raw(run_file)
+    kept, copy_attrs, unlimited = _raw(copy)
+    assert list(kept) == list(whole) and unlimited == ["time"] and copy_attrs.keys() == attrs.keys()
+    for name, (values, dtype, dims, _) in whole.items():
+        expected = values[[0, 7, 24]] if dims[:1] == ("time",) else values
+        np.testing.assert_array_equal(kept[name][0], expected, err_msg=name)
+    decompress_file(copy)
+    with SnapshotWriter.open_append(copy) as writer:
+        assert writer.n_snapshots == 3
+
+
+def test_a_copy_refuses_missing_snapshots_its_own_source_and_a_file_being_written(run_file, tmp_path):
+    source = tmp_path / "run.nc"
+    source.write_bytes(run_file.read_bytes())
+    with pytest.raises(ParameterError, match="snapshot 25 does not exist .*25 complete snapshots"):
+        copy_snapshots(source, tmp_path / "copy.nc", [0, 25])
+    with pytest.raises(ParameterError, match="would replace its source"):
+        copy_snapshots(source, tmp_path / "." / "run.nc", [0])
+    with SnapshotWriter.open_append(source):
+        with pytest.raises(FileLockedError, match="being written"):
+            copy_snapshots(source, tmp_path / "copy.nc", [0])
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["run.nc"]  # nothing written, no temporary left
+    assert source.read_bytes() == run_file.read_bytes()
 
 
 def test_appending_to_a_compressed_file_makes_it_netcdf3_first(run_file, tmp_path):
