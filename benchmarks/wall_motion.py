@@ -22,9 +22,11 @@ wall pushed by sigma0 with the mass the file records) and the snapshots of its r
 
     python -m benchmarks.wall_motion                 # the walled tests of benchmarks/_data/fidelity/runs
     python -m benchmarks.wall_motion FILE [FILE ...] [--labels A,B] [--window 0.4]
+    python -m benchmarks.wall_motion CARRY/pentagons.measures.nc   # a test carried over sittings
     python -m benchmarks.wall_motion --quick         # two short tests of 60 pentagons, printed only
 
-It only reads the files; benchmarks/results/wall-motion.md holds a run.
+It only reads the files, or a test's measures (``benchmarks.fidelity.measure.snapshot_measures``,
+which hold :func:`wall_series`: the same numbers); benchmarks/results/wall-motion.md holds a run.
 """
 
 from __future__ import annotations
@@ -64,42 +66,78 @@ def thirds_p(ds) -> np.ndarray:
     return out
 
 
-def wall_motion(path, window=0.4) -> dict:
-    """The numbers of the module docstring for one walled test file."""
-    import grainview
-    from grainview.analysis.coarse_graining import mean_diameter
-    from grainview.analysis.strain import shear_strain
+def check_walled(ds, source) -> int:
+    """The right wall's index in a walled biaxial test's dataset; ValueError in one line otherwise."""
+    walls = [str(w) for w in ds["wall"].values] if "wall" in ds else []
+    if ds.attrs.get("scene", "biaxial") != "biaxial" or "right" not in walls:
+        raise ValueError(f"{source}: scene {ds.attrs.get('scene', 'unknown')}, walls {walls or 'none'}; expected a "
+                         "walled biaxial test (solver.biaxial_test)")
+    return walls.index("right")
 
-    with grainview.open_dataset(path, chunks=None) as ds:
-        walls = [str(w) for w in ds["wall"].values] if "wall" in ds else []
-        if ds.attrs.get("scene", "biaxial") != "biaxial" or "right" not in walls:
-            raise ValueError(f"{path}: scene {ds.attrs.get('scene', 'unknown')}, walls {walls or 'none'}; expected a "
-                             "walled biaxial test (solver.biaxial_test)")
-        right = walls.index("right")
-        sigma0 = float(ds.attrs["sigma0_Pa"])
-        speed = float(ds.attrs["wall_velocity_m_s"])
-        mass = float(np.asarray(ds.attrs["wall_mass_kg"])[right])
-        sample = float(ds["mass"].sum())
-        lo, hi = ds["box_min"].values, ds["box_max"].values
-        height0 = float(hi[0, 1] - lo[0, 1])
-        d = mean_diameter(ds)
-        thickness = float(ds.attrs["thickness_m"])
-        eps_q = shear_strain(ds).values
-        keep = np.flatnonzero(eps_q >= window)
-        if not keep.size:
-            raise ValueError(f"{path}: no snapshot with eps_q >= {window:g} (its largest is {eps_q.max():.3g}); "
-                             "expected a lower --window")
-        res = ds.isel(time=keep)
-        sxx = res.grain.stress_tensor().values[:, 0, 0] / sigma0
-        height = (res["box_max"] - res["box_min"]).values[:, 1]
-        wall = res["wall_force"].values[:, right, 0] / (height * thickness) / sigma0  # grains push it to +x
-        u = res["wall_velocity"].values[:, right, 0] / speed
-        step = float(ds.attrs["solver_time_step"])
-        thirds = thirds_p(res)
+
+def wall_series(ds, source="the dataset") -> dict:
+    """Per snapshot of a walled biaxial test's dataset, arrays over ``time``: sigma_xx / sigma0
+    from the contacts, the grains' stress on the right wall / sigma0, the right wall's velocity
+    / the top wall's speed (outward positive), and p (Pa) of the left, middle and right thirds
+    (:func:`thirds_p`)."""
+    right = check_walled(ds, source)
+    sigma0 = float(ds.attrs["sigma0_Pa"])
+    height = (ds["box_max"] - ds["box_min"]).values[:, 1]
+    thirds = thirds_p(ds)
+    return {"sigma_xx_over_sigma0": ds.grain.stress_tensor().values[:, 0, 0] / sigma0,
+            "right_wall_stress_over_sigma0":
+                ds["wall_force"].values[:, right, 0] / (height * float(ds.attrs["thickness_m"])) / sigma0,
+            "right_wall_velocity_over_v": ds["wall_velocity"].values[:, right, 0] / float(ds.attrs["wall_velocity_m_s"]),
+            "p_left": thirds[:, 0], "p_middle": thirds[:, 1], "p_right": thirds[:, 2]}
+
+
+def wall_constants(ds, source="the dataset") -> dict:
+    """A walled biaxial test's right wall: its mass / the sample's, its free-flight time t_w (s,
+    module docstring; H the box's height at the test's first snapshot, the dataset's) and the
+    time step (s)."""
+    from grainview.analysis.coarse_graining import mean_diameter
+
+    right = check_walled(ds, source)
+    mass = float(np.asarray(ds.attrs["wall_mass_kg"])[right])
+    height0 = float(ds["box_max"].values[0, 1] - ds["box_min"].values[0, 1])
+    flight = mass * mean_diameter(ds) / (float(ds.attrs["sigma0_Pa"]) * float(ds.attrs["thickness_m"]) * height0)
+    return {"right_wall_mass_ratio": mass / float(ds["mass"].sum()), "t_w": float(np.sqrt(flight)),
+            "time_step": float(ds.attrs["solver_time_step"])}
+
+
+def _named(source) -> str:
+    return os.fspath(source) if isinstance(source, (str, os.PathLike)) else "the measures"
+
+
+def wall_motion(source, window=0.4) -> dict:
+    """The numbers of the module docstring for one walled test: its file, or its measures
+    (:func:`benchmarks.fidelity.measure.snapshot_measures`, which hold :func:`wall_series`)."""
+    from benchmarks.fidelity.measure import snapshot_measures
+
+    if isinstance(source, (str, os.PathLike)):
+        import grainview
+
+        with grainview.open_dataset(source, chunks=None) as ds:
+            check_walled(ds, source)  # before measuring: one line for a file of another scene
+        m = snapshot_measures(source)
+    else:
+        m = source
+    if "sigma_xx_over_sigma0" not in m:
+        raise ValueError(f"{_named(source)}: no right wall "
+                         "measured; expected a walled biaxial test (solver.biaxial_test)")
+    keep = np.flatnonzero(m["eps_q"].values >= window)
+    if not keep.size:
+        raise ValueError(f"{_named(source)}: no snapshot with eps_q >= {window:g} (its largest is {m.attrs['eps_q_max']:.3g}); "
+                         "expected a lower --window")
+    res = m.isel(time=keep)
+    sxx, wall = res["sigma_xx_over_sigma0"].values, res["right_wall_stress_over_sigma0"].values
+    u = res["right_wall_velocity_over_v"].values
+    thirds = np.stack([res[f"p_{t}"].values for t in ("left", "middle", "right")], axis=1)
     low = wall < 0.5
     ratio = thirds.max(axis=1) / thirds.min(axis=1)
-    return {"particles": int(ds.sizes["particle"]), "velocity": speed, "mass ratio": mass / sample,
-            "t_w": float(np.sqrt(mass * d / (sigma0 * thickness * height0))), "time step": step,
+    return {"particles": int(m.attrs["particles"]), "velocity": float(m.attrs["velocity"]),
+            "mass ratio": float(m.attrs["right_wall_mass_ratio"]), "t_w": float(m.attrs["t_w"]),
+            "time step": float(m.attrs["time_step"]),
             "snapshots": len(keep), "sxx<1/2": float(np.mean(sxx < 0.5)), "wall<1/2": float(np.mean(low)),
             "u10": float(np.percentile(u, 10)), "u90": float(np.percentile(u, 90)),
             "out|low": float(np.mean(u[low] > np.median(u))) if low.any() else np.nan,
@@ -164,6 +202,18 @@ def quick_files(folder) -> list[str]:
     return paths
 
 
+def carried_or_file(path):
+    """A test's measures where ``path`` names the measures a carry folder keeps
+    (``<label>.measures.nc``, :mod:`benchmarks.fidelity.carry`), else ``path`` itself."""
+    suffix = ".measures.nc"
+    if not os.fspath(path).endswith(suffix):
+        return path
+    from benchmarks.fidelity.carry import load_measures
+
+    folder, name = os.path.split(os.fspath(path))
+    return load_measures(folder or ".", name[: -len(suffix)])
+
+
 def _short_names(files) -> list:
     """Each file's name, with its folder's where two files share a name."""
     names = [os.path.basename(f) for f in files]
@@ -201,7 +251,7 @@ def main(argv=None) -> int:
         if len(labels) != len(files):
             parser.error(f"--labels: {len(labels)} labels for {len(files)} files")
         try:
-            rows = [row(label, wall_motion(path, args.window)) for label, path in zip(labels, files)]
+            rows = [row(label, wall_motion(carried_or_file(path), args.window)) for label, path in zip(labels, files)]
         except (ValueError, GrainviewError) as exc:  # not a walled test, an empty window, an unreadable file
             parser.error(str(exc))
     table = markdown_table(HEADER, rows)

@@ -51,7 +51,8 @@ def snapshot_measures(path, near=None, window=None, margin=3.0):
     histogram (``count`` over ``bin``, ``n_contacts``, ``zero_fraction``:
     :func:`grainview.analysis.force_pdf.force_pdf` with :data:`FORCE_BINS`, pooled by
     :func:`window_means`), and, between walls, :func:`boundary_checks`' ``q_over_p_central``,
-    ``central_particles`` and ``q_over_p_walls``. Attributes: the run's particles, top-wall speed,
+    ``central_particles`` and ``q_over_p_walls`` and, in a biaxial test, the right wall's
+    stress and motion and p across the sample (:func:`benchmarks.wall_motion.wall_series`). Attributes: the run's particles, top-wall speed,
     compaction steps and ``near_m`` (``near``: the counting convention, module docstring; -1 for
     force-bearing contacts). ``window``: only the snapshots with window[0] <= eps_q < window[1]
     (default all).
@@ -100,6 +101,11 @@ def snapshot_measures(path, near=None, window=None, margin=3.0):
                     zero_fraction=("time", pdf["zero_fraction"].values))
         if {"top", "bottom", "left", "right"} <= {str(w) for w in ds["wall"].values} if "wall" in ds else False:
             data.update({name: ("time", column) for name, column in _boundary_series(res, margin).items()})
+            if ds.attrs.get("scene", "biaxial") == "biaxial":
+                from benchmarks.wall_motion import wall_constants, wall_series
+
+                data.update({name: ("time", column) for name, column in wall_series(res, path).items()})
+                attrs.update(wall_constants(ds, path))
         coords = {"bin_edges": ("edge", pdf["bin_edges"].values), "f_over_mean": ("bin", pdf["f_over_mean"].values)}
     return xr.Dataset(data, coords=coords, attrs=attrs)
 

@@ -73,6 +73,12 @@ def test_a_carried_test_resumes_bit_for_bit_and_keeps_every_snapshots_measures(r
             assert np.array_equal(carried[name].values, direct[name].values, equal_nan=True), (how, name)
         assert carried.attrs["eps_q_max"] == direct.attrs["eps_q_max"]
         assert measure.window_means(carried, (0.0, np.inf)) == measure.window_means(whole, (0.0, np.inf), near)
+    wall_motion = load_benchmark("wall_motion")
+    from_carry = wall_motion.wall_motion(wall_motion.carried_or_file(kept / "pentagons.measures.nc"), 0.0)
+    from_file = wall_motion.wall_motion(whole, 0.0)
+    assert from_carry.keys() == from_file.keys()
+    for key, value in from_file.items():
+        assert np.array_equal(from_carry[key], value, equal_nan=True), key
 
 
 def test_carrying_another_test_into_the_folder_is_refused(runs, tmp_path):
