@@ -93,16 +93,19 @@ def wall_series(ds, source="the dataset") -> dict:
 
 def wall_constants(ds, source="the dataset") -> dict:
     """A walled biaxial test's right wall: its mass / the sample's, its free-flight time t_w (s,
-    module docstring; H the box's height at the test's first snapshot, the dataset's) and the
-    time step (s)."""
+    module docstring; H the box's height at the test's first snapshot, the dataset's), the
+    time step (s), and the test's inertia number in the paper's definition at its start,
+    I = (v / H) sqrt(m / (sigma0 t)) (m the particles' mass, t the slab's thickness)."""
     from grainview.analysis.coarse_graining import mean_diameter
 
     right = check_walled(ds, source)
     mass = float(np.asarray(ds.attrs["wall_mass_kg"])[right])
     height0 = float(ds["box_max"].values[0, 1] - ds["box_min"].values[0, 1])
-    flight = mass * mean_diameter(ds) / (float(ds.attrs["sigma0_Pa"]) * float(ds.attrs["thickness_m"]) * height0)
-    return {"right_wall_mass_ratio": mass / float(ds["mass"].sum()), "t_w": float(np.sqrt(flight)),
-            "time_step": float(ds.attrs["solver_time_step"])}
+    sigma0, thickness, sample = float(ds.attrs["sigma0_Pa"]), float(ds.attrs["thickness_m"]), float(ds["mass"].sum())
+    flight = mass * mean_diameter(ds) / (sigma0 * thickness * height0)
+    inertia = float(ds.attrs["wall_velocity_m_s"]) / height0 * np.sqrt(sample / (sigma0 * thickness))
+    return {"right_wall_mass_ratio": mass / sample, "t_w": float(np.sqrt(flight)),
+            "time_step": float(ds.attrs["solver_time_step"]), "inertia_number_start": float(inertia)}
 
 
 def _named(source) -> str:

@@ -107,3 +107,26 @@ def test_the_page_from_a_carry_folder_is_the_page_from_the_file(runs, tmp_path):
         pages.append(out.read_text().splitlines())
     assert pages[0][3:] == pages[1][3:]  # all but the title and the line with the date and time
     assert "pentagons 30" in "\n".join(pages[0]) and "Not there (yet): paper size disks" in pages[0][2]
+
+
+def test_the_swing_row_of_a_carried_test_is_the_files(runs, tmp_path, capsys):
+    """benchmarks/fidelity/swings.py on the file and on its carried measures: the same row, whose
+    p range and share of sigma_xx below sigma0/2 are those of the accessors on the file."""
+    import grainview
+
+    carry = load_benchmark("fidelity.carry")
+    swings = load_benchmark("fidelity.swings")
+    _, whole = runs
+    carry.save(whole, tmp_path / "carry")
+    assert swings.main([str(whole), str(tmp_path / "carry" / "pentagons.measures.nc"), "--window", "0"]) == 0
+    table = capsys.readouterr().out.splitlines()
+    from_file, from_carry = ([c.strip() for c in line.split("|")[2:-1]] for line in table[2:4])
+    assert from_file == from_carry and len(from_file) == len(swings.HEADER)
+    with grainview.open_dataset(whole, chunks=None) as ds:
+        p = ds.grain.stress_invariants()["p"].values / 1e3
+        sxx = ds.grain.stress_tensor().values[:, 0, 0] / float(ds.attrs["sigma0_Pa"])
+        snapshots = ds.sizes["time"]
+    cells = dict(zip(swings.HEADER, from_file))
+    assert cells["v (cm/s)"] == "1" and cells["snapshots"] == str(snapshots)
+    assert cells["p (kPa), min-max"] == f"{p.min():.1f}-{p.max():.1f}"
+    assert cells["sigma_xx < sigma0/2"] == f"{100 * np.mean(sxx < 0.5):.0f}%"
