@@ -52,10 +52,12 @@ def snapshot_measures(path, near=None, window=None, margin=3.0):
     :func:`grainview.analysis.force_pdf.force_pdf` with :data:`FORCE_BINS`, pooled by
     :func:`window_means`), and, between walls, :func:`boundary_checks`' ``q_over_p_central``,
     ``central_particles`` and ``q_over_p_walls`` and, in a biaxial test, the right wall's
-    stress and motion and p across the sample (:func:`benchmarks.wall_motion.wall_series`). Attributes: the run's particles, top-wall speed,
-    compaction steps and ``near_m`` (``near``: the counting convention, module docstring; -1 for
-    force-bearing contacts). ``window``: only the snapshots with window[0] <= eps_q < window[1]
-    (default all).
+    stress and motion and p across the sample (:func:`benchmarks.wall_motion.wall_series`).
+    Attributes: the run's particles, top-wall speed, compaction steps, ``eps_q_max`` (the
+    run's largest eps_q), ``near_m`` (``near``: the counting convention, module docstring; -1
+    for force-bearing contacts) and, in a biaxial test, the right wall's constants
+    (:func:`benchmarks.wall_motion.wall_constants`). ``window``: only the snapshots with
+    window[0] <= eps_q < window[1] (default all).
 
     The means, percentiles and pooled pdfs of :func:`window_means`, :func:`boundary_checks` and
     :func:`strain_series` are taken from it, so a run's measures written to a small file (a run
@@ -99,7 +101,8 @@ def snapshot_measures(path, near=None, window=None, margin=3.0):
         data.update(eps_q=("time", eps_q[keep]), step=("time", steps[keep]), inertia_number=("time", inertia[keep]),
                     count=(("time", "bin"), pdf["count"].values), n_contacts=("time", pdf["n_contacts"].values),
                     zero_fraction=("time", pdf["zero_fraction"].values))
-        if {"top", "bottom", "left", "right"} <= {str(w) for w in ds["wall"].values} if "wall" in ds else False:
+        walls = {str(w) for w in ds["wall"].values} if "wall" in ds else set()
+        if {"top", "bottom", "left", "right"} <= walls:
             data.update({name: ("time", column) for name, column in _boundary_series(res, margin).items()})
             if ds.attrs.get("scene", "biaxial") == "biaxial":
                 from benchmarks.wall_motion import wall_constants, wall_series
