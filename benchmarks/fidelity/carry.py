@@ -149,6 +149,26 @@ def restore(carry, runs, label) -> str:
     return target
 
 
+def status(carry) -> list[str]:
+    """Where each test carried in the folder ``carry`` stands, one line each: the steps done of
+    the test's, the last eps_q and the snapshots measured (what its README quotes)."""
+    import netCDF4
+
+    lines = []
+    for name in sorted(os.listdir(carry)):
+        if not name.endswith(".measures.nc"):
+            continue
+        label = name[: -len(".measures.nc")]
+        m = load_measures(carry, label)
+        with netCDF4.Dataset(os.path.join(os.fspath(carry), f"{label}.nc")) as nc:
+            total = int(nc.getncattr("biaxial_steps"))
+        steps = m["step"].values
+        done = int(steps[-1] - steps[0])
+        lines.append(f"{label}: step {done:,} of {total:,} ({100 * done / total:.1f}%), eps_q {float(m['eps_q'][-1]):.3f}, "
+                     f"{m.sizes['time']} snapshots measured")
+    return lines
+
+
 def main(argv=None) -> int:
     parser = argparse.ArgumentParser(prog="python -m benchmarks.fidelity.carry", description=__doc__.split("\n\n")[0])
     sub = parser.add_subparsers(dest="action", required=True)
@@ -160,8 +180,13 @@ def main(argv=None) -> int:
     r.add_argument("runs")
     for p in (s, r):
         p.add_argument("--labels", nargs="+", default=["pentagons", "disks"], help="the runs (default: both)")
+    t = sub.add_parser("status", help="where each test carried in CARRY stands")
+    t.add_argument("carry")
     args = parser.parse_args(argv)
     try:
+        if args.action == "status":
+            print("\n".join(status(args.carry)))
+            return 0
         for label in args.labels:
             if args.action == "save":
                 run = os.path.join(args.runs, f"{label}.nc")

@@ -81,6 +81,29 @@ def test_a_carried_test_resumes_bit_for_bit_and_keeps_every_snapshots_measures(r
         assert np.array_equal(from_carry[key], value, equal_nan=True), key
 
 
+def test_status_says_where_a_carried_test_stands(runs, tmp_path, capsys):
+    carry = load_benchmark("fidelity.carry")
+    _, whole = runs
+    steps = _values(whole, "step")
+    carry.save(whole, tmp_path / "carry")
+    assert carry.main(["status", str(tmp_path / "carry")]) == 0
+    done = int(steps[-1] - steps[0])
+    assert capsys.readouterr().out.startswith(f"pentagons: step {done:,} of {done:,} (100.0%), eps_q ")
+
+
+def test_the_repository_carry_folders_readmes_say_where_their_tests_stand():
+    """Each carry folder kept in the repository quotes `carry status` in its README, as it is."""
+    from pathlib import Path
+
+    carry = load_benchmark("fidelity.carry")
+    root = Path(__file__).resolve().parents[2] / "benchmarks" / "fidelity" / "carry"
+    folders = [f for f in root.iterdir() if f.is_dir()] if root.is_dir() else []
+    for folder in folders:
+        readme = (folder / "README.md").read_text()
+        for line in carry.status(folder):
+            assert f"    {line}\n" in readme, f"{folder}/README.md does not quote: {line}"
+
+
 def test_carrying_another_test_into_the_folder_is_refused(runs, tmp_path):
     carry = load_benchmark("fidelity.carry")
     reshear = load_benchmark("fidelity.reshear")
