@@ -125,7 +125,7 @@ def save(run_path, carry, label=None) -> dict:
     measures = measures.isel(time=np.argsort(steps, kind="stable"))
     measures.attrs["eps_q_max"] = float(measures["eps_q"].max())
     temporary = path + ".part"
-    measures.to_netcdf(temporary)
+    measures.to_netcdf(temporary, encoding={name: {"zlib": True, "complevel": 4} for name in measures.data_vars})
     copy_snapshots(run_path, state_file, [0, -1])  # the state after the measures: a kill between them re-measures
     os.replace(temporary, path)
     return {"step": int(steps.max()), "eps_q": float(measures["eps_q"].isel(counting=0).values[-1]),
