@@ -150,6 +150,8 @@ def main(argv=None) -> int:
         except ParameterError as exc:
             print(f"reshear: error: {exc}", file=sys.stderr)
             return 2
+        except KeyboardInterrupt:  # Ctrl-C: the solver has said where the test stopped and how to go on
+            return 130
         print(f"{label}: {done} ({(time.monotonic() - start) / 3600:.2f} h of wall time)", flush=True)
     return 0
 

@@ -112,3 +112,16 @@ def test_unconverged_steps_are_said_in_one_line_and_other_warnings_shown(study, 
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and err[0].startswith("pentagons: warning: the contact solver")
     assert "did not converge in 3 of the steps taken now" in err[0]
+
+
+def test_ctrl_c_ends_the_command_without_a_traceback(study, tmp_path, monkeypatch, capsys):
+    """The solver prints where a stopped test is and how to resume it; the command then exits 130."""
+    reshear = load_benchmark("fidelity.reshear")
+
+    def stopped(*args, **kwargs):
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(reshear, "reshear", stopped)
+    assert reshear.main([str(study), str(tmp_path / "out"), "--velocity", "0.01", "--every", "10",
+                         "--samples", "pentagons"]) == 130
+    assert capsys.readouterr().out == "pentagons: ...\n"
